@@ -1,0 +1,75 @@
+// Shared command-line options of the apps.
+#include "apps/scene_options.hpp"
+
+#include "core/fixed_region.hpp"
+#include "core/mesh/mesh_io.hpp"
+#include "resources/default_mesh.hpp"
+
+#include <sstream>
+
+namespace tissue::apps {
+namespace {
+
+Eigen::Vector3d parse_vector(const std::string& text, const std::string& what) {
+  Eigen::Vector3d value;
+  std::stringstream stream(text);
+  std::string item;
+  int count = 0;
+  while (std::getline(stream, item, ',')) {
+    if (count == 3) break;
+    try {
+      size_t used = 0;
+      value[count] = std::stod(item, &used);
+      if (used != item.size()) throw std::invalid_argument(item);
+    } catch (const std::exception&) {
+      throw ParameterError(what + ": '" + item + "' is not a number");
+    }
+    ++count;
+  }
+  if (count != 3 || std::getline(stream, item)) throw ParameterError(what + ": expected three numbers X,Y,Z, got '" + text + "'");
+  return value;
+}
+
+}  // namespace
+
+void add_scene_options(CLI::App& app, SceneOptions& options) {
+  app.add_option("--mesh", options.mesh, "Mesh file (.veg, .node/.ele, .msh) or 'frog' for the embedded frog")
+      ->capture_default_str();
+  app.add_option("--fixed", options.fixed_bou, "Vega .bou file of fixed vertices (1-indexed); default: minimum x");
+  app.add_option("--fixed-fraction", options.fixed_fraction,
+                 "Without --fixed: fix vertices within this fraction of the x extent of the minimum x")
+      ->capture_default_str();
+  app.add_option("--steps", options.steps, "Number of time steps")->capture_default_str();
+  app.add_option("--dt", options.step_size_s, "Time step [s]")->capture_default_str();
+  app.add_option("--solver", options.solver, "Linear solver: pcg or cholmod")->capture_default_str();
+  app.add_option("--tolerance", options.tolerance, "PCG relative residual tolerance")->capture_default_str();
+  app.add_option("--max-iterations", options.max_iterations, "PCG iteration cap")->capture_default_str();
+  app.add_flag("--warm-start", options.warm_start, "PCG starts from the previous step's velocity change");
+  app.add_option("--young", options.material.young_modulus_pa, "Young's modulus [Pa]")->capture_default_str();
+  app.add_option("--poisson", options.material.poisson_ratio, "Poisson's ratio")->capture_default_str();
+  app.add_option("--density", options.material.density_kg_per_m3, "Density [kg/m^3]")->capture_default_str();
+  app.add_option("--mass-damping", options.damping.mass_damping_per_s, "Rayleigh alpha [1/s]")->capture_default_str();
+  app.add_option("--stiffness-damping", options.damping.stiffness_damping_s, "Rayleigh beta [s]")->capture_default_str();
+  app.add_option("--gravity", options.gravity, "Gravity GX,GY,GZ [m/s^2]")->capture_default_str();
+}
+
+Scene make_scene(const SceneOptions& options) {
+  Scene scene;
+  scene.mesh_name = options.mesh;
+  scene.mesh = load_mesh(options.mesh);
+  if (options.steps < 1) throw ParameterError("--steps must be >= 1");
+  TissueSettings& settings = scene.settings;
+  settings.step_size_s = options.step_size_s;
+  settings.solver.kind = parse_linear_solver_kind(options.solver);
+  settings.solver.pcg = PcgSolver::Settings{options.tolerance, options.max_iterations};
+  settings.solver.warm_start = options.warm_start;
+  settings.body.material = options.material;
+  settings.body.damping = options.damping;
+  settings.body.gravity_m_per_s2 = parse_vector(options.gravity, "--gravity");
+  settings.body.fixed_vertices = options.fixed_bou.empty()
+                                     ? vertices_at_minimum(scene.mesh, 0, options.fixed_fraction)
+                                     : read_bou(options.fixed_bou, scene.mesh.vertex_count());
+  return scene;
+}
+
+}  // namespace tissue::apps

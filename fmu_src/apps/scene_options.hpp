@@ -1,0 +1,41 @@
+// Command-line options shared by tissue-demo and tissue-bench: mesh, material, damping, gravity,
+// fixed vertices, step size and linear solver, turned into a mesh plus TissueSettings.
+#pragma once
+
+#include "core/tissue.hpp"
+
+#include <CLI/CLI.hpp>
+
+#include <string>
+
+namespace tissue::apps {
+
+struct SceneOptions {
+  std::string mesh = "frog";  ///< "frog" = the embedded default, else a .veg/.node/.ele/.msh path
+  std::string fixed_bou;      ///< Vega .bou (1-indexed); empty = vertices at the minimum x
+  double fixed_fraction = 0.01;  ///< of the x extent, when no .bou is given
+  int steps = 100;
+  double step_size_s = 0.01;
+  std::string solver = "pcg";
+  double tolerance = 1e-6;
+  int max_iterations = 10000;
+  bool warm_start = false;
+  Material material{1.0e5, 0.4, 1000.0};
+  RayleighDamping damping{0.0, 0.0};
+  std::string gravity = "0,-9.81,0";
+};
+
+/// Registers the options on `app` (values are written into `options` when parsed).
+void add_scene_options(CLI::App& app, SceneOptions& options);
+
+struct Scene {
+  TetMesh mesh;
+  TissueSettings settings;
+  std::string mesh_name;
+};
+
+/// Loads the mesh, picks the fixed vertices and checks every setting. Throws MeshError or
+/// ParameterError with a message for the user.
+Scene make_scene(const SceneOptions& options);
+
+}  // namespace tissue::apps

@@ -1,0 +1,56 @@
+// Co-rotational linear elasticity of a whole tet mesh (Mueller et al.; dissertation eq. 3.13):
+// per-tet rotations, internal forces f_e = R K_e (R^T x - X) and the tangent R K_e R^T,
+// assembled into a BlockSparseMatrix through precomputed slots.
+#pragma once
+
+#include "core/fem/material.hpp"
+#include "core/fem/rotation.hpp"
+#include "core/fem/tet_element.hpp"
+#include "core/mesh/tet_mesh.hpp"
+#include "core/system/assembly.hpp"
+#include "core/system/block_sparse_matrix.hpp"
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+
+#include <vector>
+
+namespace tissue {
+
+class CorotationalElasticity {
+ public:
+  /// Precomputes shape gradients and volumes. Throws ParameterError for an invalid material.
+  CorotationalElasticity(const TetMesh& mesh, const Material& material);
+
+  [[nodiscard]] int tet_count() const { return static_cast<int>(m_tets.size()); }
+  [[nodiscard]] const LameParameters& lame() const { return m_lame; }
+  [[nodiscard]] const TetRest& rest(int tet) const { return m_rest[static_cast<size_t>(tet)]; }
+  [[nodiscard]] const Eigen::Matrix3d& rotation(int tet) const { return m_rotations[static_cast<size_t>(tet)]; }
+
+  /// One pass over the tets at the current positions (3 per vertex, [m]):
+  /// updates each R_e (warm-started from the last step), adds the internal force f_int
+  /// (the restoring force in M a + D v + f_int = f_ext, [N], 3 per vertex) into `internal_forces_n`,
+  /// and, when `tangent` is given, adds R_e K_e R_e^T into it through `slots` (blocks whose slot is -1,
+  /// i.e. that touch a fixed vertex, are skipped). The caller zeroes both outputs.
+  void evaluate(const Eigen::VectorXd& positions_m, Eigen::VectorXd& internal_forces_n, BlockSparseMatrix* tangent,
+                const std::vector<TetSlots>* slots);
+
+  /// Elastic energy sum_e V_e (mu eps:eps + lambda/2 tr(eps)^2), eps = sym(R_e^T F_e) - I, with the
+  /// rotations of these positions (the stored warm starts are not changed). [J]
+  [[nodiscard]] double elastic_energy_j(const Eigen::VectorXd& positions_m) const;
+
+  /// Forgets the warm starts (rotations back to identity), e.g. after a state was restored.
+  void reset_rotations();
+
+ private:
+  std::vector<Tet> m_tets;
+  std::vector<TetRest> m_rest;
+  std::vector<Eigen::Matrix3d> m_rotations;
+  std::vector<Eigen::Quaterniond> m_warm_starts;
+  LameParameters m_lame;
+};
+
+/// Lumped mass (eq. 4.15): each tet gives rho V / 4 to each of its vertices. [kg], one per vertex.
+std::vector<double> lumped_vertex_masses(const TetMesh& mesh, double density_kg_per_m3);
+
+}  // namespace tissue

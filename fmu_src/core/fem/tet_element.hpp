@@ -1,0 +1,37 @@
+// One linear tetrahedron: rest-state precompute (shape gradients, volume), the linear stiffness
+// K_e = V B^T E B (eq. 3.12) and the deformation gradient. Shared by the co-rotational model and tests.
+#pragma once
+
+#include "core/fem/material.hpp"
+
+#include <Eigen/Core>
+
+#include <array>
+
+namespace tissue {
+
+using Matrix12d = Eigen::Matrix<double, 12, 12>;
+using Vector12d = Eigen::Matrix<double, 12, 1>;
+using TetPositions = std::array<Eigen::Vector3d, 4>;
+
+/// Rest-state quantities of one tet.
+struct TetRest {
+  /// Column i is grad(phi_i) [1/m], the gradient of the barycentric shape function of vertex i.
+  /// The columns sum to zero, and sum_i X_i grad(phi_i)^T = I for the rest positions X_i.
+  Eigen::Matrix<double, 3, 4> shape_gradients_per_m;
+  double volume_m3 = 0.0;
+};
+
+/// Requires a positively oriented tet (volume > 0); the mesh readers guarantee it.
+TetRest precompute_tet(const TetPositions& rest_positions_m);
+
+/// F = sum_i x_i grad(phi_i)^T (3x3), the deformation gradient for current positions x.
+Eigen::Matrix3d deformation_gradient(const TetRest& rest, const TetPositions& positions_m);
+
+/// 3x3 block (i, j) of the linear stiffness: V [lambda g_i g_j^T + mu g_j g_i^T + mu (g_i . g_j) I].
+Eigen::Matrix3d linear_stiffness_block(const TetRest& rest, const LameParameters& lame, int i, int j);
+
+/// The full 12x12 K_e, vertex-major (3 rows per vertex). [N/m]
+Matrix12d linear_stiffness_matrix(const TetRest& rest, const LameParameters& lame);
+
+}  // namespace tissue

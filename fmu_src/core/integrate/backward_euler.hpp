@@ -1,0 +1,36 @@
+// Semi-implicit backward Euler (Baraff and Witkin 1998; dissertation section 4.2.4, with the
+// erratum of DESIGN section 4: the left side of eq. 4.20 holds the tangent K):
+//   (M + h D + h^2 K) dv = h (f_ext - f_int(u) - D v - h K v),   v += dv,   u += h v.
+// One linear solve per step; with D = alpha M + beta K the matrix is (1 + h alpha) M + (h beta + h^2) K.
+#pragma once
+
+#include "core/integrate/integrator.hpp"
+#include "core/solve/linear_solver.hpp"
+
+#include <memory>
+
+namespace tissue {
+
+class BackwardEuler final : public Integrator {
+ public:
+  struct Settings {
+    /// Start each solve from the previous step's dv instead of zero (matters for iterative solvers).
+    bool warm_start = false;
+  };
+  explicit BackwardEuler(std::unique_ptr<LinearSolver> solver) : BackwardEuler(std::move(solver), Settings{}) {}
+  BackwardEuler(std::unique_ptr<LinearSolver> solver, Settings settings);
+  StepReport step(DynamicsModel& model, DynamicState& state, double step_size_s) override;
+  [[nodiscard]] std::string_view name() const override { return "backward-euler"; }
+  [[nodiscard]] const LinearSolver& solver() const { return *m_solver; }
+
+ private:
+  std::unique_ptr<LinearSolver> m_solver;
+  Settings m_settings;
+  Eigen::VectorXd m_internal_force_n;
+  Eigen::VectorXd m_stiffness_times_velocity;
+  Eigen::VectorXd m_rhs;
+  Eigen::VectorXd m_system_diagonal;
+  Eigen::VectorXd m_velocity_change;  // kept: the warm start of the next solve
+};
+
+}  // namespace tissue

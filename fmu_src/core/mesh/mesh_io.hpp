@@ -1,0 +1,53 @@
+// Mesh readers: Vega .veg, TetGen .node/.ele and Gmsh .msh 4.1 (ASCII), plus Vega .bou
+// fixed-vertex lists. Every reader checks what it reads (see validate_tets) and throws
+// MeshError naming file, line and element; inverted tets are re-oriented with a warning.
+#pragma once
+
+#include "core/mesh/tet_mesh.hpp"
+
+#include <filesystem>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace tissue {
+
+/// Non-fatal findings while loading (e.g. "file:line: tet 12 inverted, re-oriented").
+struct MeshWarnings {
+  std::vector<std::string> messages;
+};
+
+/// Vega .veg: *VERTICES / *ELEMENTS TET, 1-indexed, '#' comments; other sections (*MATERIAL, *REGION,
+/// *SET, *INCLUDE, ...) are skipped, so an *INCLUDE'd file is not read.
+TetMesh read_veg(const std::filesystem::path& path, MeshWarnings* warnings = nullptr);
+/// Same, from text already in memory; `source_name` is used in messages in place of a file name.
+TetMesh parse_veg(std::string_view text, const std::string& source_name, MeshWarnings* warnings = nullptr);
+
+/// TetGen: `path` is the .node file (or the .ele file, or the common stem); the other is found beside it.
+/// Index base (0 or 1) is taken from the first vertex index in the .node file, as TetGen does.
+TetMesh read_tetgen(const std::filesystem::path& path, MeshWarnings* warnings = nullptr);
+
+/// Gmsh .msh 4.1 ASCII: $Nodes and $Elements (type 4 = 4-node tet); other element types are ignored.
+TetMesh read_gmsh(const std::filesystem::path& path, MeshWarnings* warnings = nullptr);
+TetMesh parse_gmsh(std::string_view text, const std::string& source_name, MeshWarnings* warnings = nullptr);
+
+/// Dispatches on the extension: .veg, .node/.ele, .msh.
+TetMesh read_mesh(const std::filesystem::path& path, MeshWarnings* warnings = nullptr);
+
+/// Vega .bou: 1-indexed vertex ids separated by commas/whitespace; returns sorted unique 0-based ids.
+/// Throws MeshError for ids outside [1, vertex_count].
+std::vector<int> read_bou(const std::filesystem::path& path, int vertex_count);
+
+/// Checks applied by every reader (exposed for tests and for meshes built in code):
+/// - NaN/Inf coordinates -> MeshError (line of the vertex);
+/// - vertex index outside [0, vertex_count) -> MeshError;
+/// - a tet with a repeated vertex, or |volume| <= 1e-12 * (bounding-box diagonal)^3 -> MeshError ("zero-volume");
+/// - two tets with the same vertex set -> MeshError ("duplicate of element k");
+/// - negative volume -> vertices 2 and 3 swapped, warning (after 100 such warnings, one summary line);
+/// - vertices used by no tet -> one warning (they would get no mass).
+/// `vertex_lines` / `element_lines` give the source line of each vertex / tet (may be empty);
+/// `index_base` is the file's own numbering base, used only to print element numbers as in the file.
+void validate_tets(TetMesh& mesh, const std::string& source_name, const std::vector<int>& vertex_lines,
+                   const std::vector<int>& element_lines, int index_base, MeshWarnings* warnings);
+
+}  // namespace tissue

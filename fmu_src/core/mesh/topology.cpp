@@ -1,0 +1,163 @@
+// Surface extraction and adjacency by sorting: every tet face (edge) gets a key made of its
+// sorted vertex ids; after one O(n log n) sort, the copies of a face (edge) are neighbours.
+// Sorting rather than hashing also makes the output order independent of the hash function.
+#include "core/mesh/topology.hpp"
+
+#include <algorithm>
+#include <string>
+#include <tuple>
+
+namespace tissue {
+namespace {
+
+struct FaceKey {
+  std::array<int, 3> vertices;  ///< sorted
+  int tet_face;                 ///< 4 * tet + local face
+};
+
+struct EdgeKey {
+  std::array<int, 2> vertices;  ///< sorted
+  int tet_edge;                 ///< 6 * tet + local edge
+};
+
+/// All tet faces, sorted so that the copies of a face are adjacent and in tet order.
+/// Throws MeshError for a face shared by more than two tets (overlapping elements).
+std::vector<FaceKey> sorted_faces(const TetMesh& mesh) {
+  std::vector<FaceKey> faces;
+  faces.reserve(static_cast<std::size_t>(mesh.tet_count()) * 4);
+  for (int t = 0; t < mesh.tet_count(); ++t) {
+    const Tet& tet = mesh.tets[static_cast<std::size_t>(t)];
+    for (int k = 0; k < 4; ++k) {
+      const auto& local = k_tet_faces[static_cast<std::size_t>(k)];
+      std::array<int, 3> key = {tet[static_cast<std::size_t>(local[0])], tet[static_cast<std::size_t>(local[1])],
+                                tet[static_cast<std::size_t>(local[2])]};
+      std::sort(key.begin(), key.end());
+      faces.push_back({key, 4 * t + k});
+    }
+  }
+  std::sort(faces.begin(), faces.end(), [](const FaceKey& a, const FaceKey& b) {
+    return std::tie(a.vertices[0], a.vertices[1], a.vertices[2], a.tet_face) <
+           std::tie(b.vertices[0], b.vertices[1], b.vertices[2], b.tet_face);
+  });
+  for (std::size_t k = 2; k < faces.size(); ++k) {
+    if (faces[k].vertices == faces[k - 2].vertices) {
+      const auto& v = faces[k].vertices;
+      const int tet = faces[k].tet_face / 4;
+      throw MeshError("face (" + std::to_string(v[0]) + ", " + std::to_string(v[1]) + ", " + std::to_string(v[2]) +
+                          ") is shared by more than two tets (0-based tets " +
+                          std::to_string(faces[k - 2].tet_face / 4) + ", " + std::to_string(faces[k - 1].tet_face / 4) +
+                          ", " + std::to_string(tet) + "): overlapping elements",
+                      "", 0, tet);
+    }
+  }
+  return faces;
+}
+
+}  // namespace
+
+SurfaceMesh extract_surface(const TetMesh& mesh) {
+  const std::vector<FaceKey> faces = sorted_faces(mesh);
+  std::vector<int> boundary;
+  for (std::size_t k = 0; k < faces.size();) {
+    std::size_t end = k + 1;
+    while (end < faces.size() && faces[end].vertices == faces[k].vertices) {
+      ++end;
+    }
+    if (end - k == 1) {
+      boundary.push_back(faces[k].tet_face);
+    }
+    k = end;
+  }
+  // Output in tet order, so the surface does not depend on the vertex numbering.
+  std::sort(boundary.begin(), boundary.end());
+
+  SurfaceMesh surface;
+  surface.triangles.reserve(boundary.size());
+  surface.triangle_tet.reserve(boundary.size());
+  surface.triangle_local_face.reserve(boundary.size());
+  for (const int tet_face : boundary) {
+    const int t = tet_face / 4;
+    const int k = tet_face % 4;
+    const Tet& tet = mesh.tets[static_cast<std::size_t>(t)];
+    const auto& local = k_tet_faces[static_cast<std::size_t>(k)];
+    surface.triangles.push_back({tet[static_cast<std::size_t>(local[0])], tet[static_cast<std::size_t>(local[1])],
+                                 tet[static_cast<std::size_t>(local[2])]});
+    surface.triangle_tet.push_back(t);
+    surface.triangle_local_face.push_back(k);
+    for (const int v : surface.triangles.back()) {
+      surface.vertices.push_back(v);
+    }
+  }
+  std::sort(surface.vertices.begin(), surface.vertices.end());
+  surface.vertices.erase(std::unique(surface.vertices.begin(), surface.vertices.end()), surface.vertices.end());
+  return surface;
+}
+
+TetAdjacency build_adjacency(const TetMesh& mesh) {
+  const int tet_count = mesh.tet_count();
+  const int vertex_count = mesh.vertex_count();
+  TetAdjacency adjacency;
+
+  // Face neighbours: after sorting, an interior face is a run of exactly two entries.
+  adjacency.face_neighbor.assign(static_cast<std::size_t>(tet_count), {-1, -1, -1, -1});
+  const std::vector<FaceKey> faces = sorted_faces(mesh);
+  for (std::size_t k = 1; k < faces.size(); ++k) {
+    if (faces[k].vertices == faces[k - 1].vertices) {
+      const int a = faces[k - 1].tet_face;
+      const int b = faces[k].tet_face;
+      adjacency.face_neighbor[static_cast<std::size_t>(a / 4)][static_cast<std::size_t>(a % 4)] = b / 4;
+      adjacency.face_neighbor[static_cast<std::size_t>(b / 4)][static_cast<std::size_t>(b % 4)] = a / 4;
+    }
+  }
+
+  // Edges: unique edges are numbered in lexicographic (v0, v1) order; the tets around an edge
+  // come out in increasing tet order because the sort breaks ties by tet.
+  std::vector<EdgeKey> edge_keys;
+  edge_keys.reserve(static_cast<std::size_t>(tet_count) * 6);
+  for (int t = 0; t < tet_count; ++t) {
+    const Tet& tet = mesh.tets[static_cast<std::size_t>(t)];
+    for (int k = 0; k < 6; ++k) {
+      const auto& local = k_tet_edges[static_cast<std::size_t>(k)];
+      const int a = tet[static_cast<std::size_t>(local[0])];
+      const int b = tet[static_cast<std::size_t>(local[1])];
+      edge_keys.push_back({{std::min(a, b), std::max(a, b)}, 6 * t + k});
+    }
+  }
+  std::sort(edge_keys.begin(), edge_keys.end(), [](const EdgeKey& a, const EdgeKey& b) {
+    return std::tie(a.vertices[0], a.vertices[1], a.tet_edge) < std::tie(b.vertices[0], b.vertices[1], b.tet_edge);
+  });
+  adjacency.tet_edges.assign(static_cast<std::size_t>(tet_count), {});
+  adjacency.edge_tets.reserve(edge_keys.size());
+  for (std::size_t k = 0; k < edge_keys.size(); ++k) {
+    if (k == 0 || edge_keys[k].vertices != edge_keys[k - 1].vertices) {
+      adjacency.edge_tets_begin.push_back(static_cast<int>(adjacency.edge_tets.size()));
+      adjacency.edges.push_back(edge_keys[k].vertices);
+    }
+    const int edge = static_cast<int>(adjacency.edges.size()) - 1;
+    const int t = edge_keys[k].tet_edge / 6;
+    adjacency.tet_edges[static_cast<std::size_t>(t)][static_cast<std::size_t>(edge_keys[k].tet_edge % 6)] = edge;
+    adjacency.edge_tets.push_back(t);
+  }
+  adjacency.edge_tets_begin.push_back(static_cast<int>(adjacency.edge_tets.size()));
+
+  // Vertex -> tets by counting sort (tets in increasing order around each vertex).
+  adjacency.vertex_tets_begin.assign(static_cast<std::size_t>(vertex_count) + 1, 0);
+  for (const Tet& tet : mesh.tets) {
+    for (const int v : tet) {
+      ++adjacency.vertex_tets_begin[static_cast<std::size_t>(v) + 1];
+    }
+  }
+  for (std::size_t v = 0; v < static_cast<std::size_t>(vertex_count); ++v) {
+    adjacency.vertex_tets_begin[v + 1] += adjacency.vertex_tets_begin[v];
+  }
+  adjacency.vertex_tets.resize(static_cast<std::size_t>(tet_count) * 4);
+  std::vector<int> fill(adjacency.vertex_tets_begin.begin(), adjacency.vertex_tets_begin.end() - 1);
+  for (int t = 0; t < tet_count; ++t) {
+    for (const int v : mesh.tets[static_cast<std::size_t>(t)]) {
+      adjacency.vertex_tets[static_cast<std::size_t>(fill[static_cast<std::size_t>(v)]++)] = t;
+    }
+  }
+  return adjacency;
+}
+
+}  // namespace tissue

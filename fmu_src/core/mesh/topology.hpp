@@ -1,0 +1,48 @@
+// Surface extraction and adjacency of a tet mesh: boundary triangles (outward-oriented),
+// face -> neighbour tet and edge -> tets, as the volume cutter (issue 3) walks them.
+#pragma once
+
+#include "core/mesh/tet_mesh.hpp"
+
+#include <array>
+#include <vector>
+
+namespace tissue {
+
+/// Local faces of a tet: face k is opposite vertex k, wound so that its normal points outward
+/// for a positively oriented tet.
+inline constexpr std::array<std::array<int, 3>, 4> k_tet_faces = {{{1, 2, 3}, {0, 3, 2}, {0, 1, 3}, {0, 2, 1}}};
+/// Local edges of a tet (pairs of local vertex indices).
+inline constexpr std::array<std::array<int, 2>, 6> k_tet_edges = {{{0, 1}, {0, 2}, {0, 3}, {1, 2}, {1, 3}, {2, 3}}};
+
+struct SurfaceMesh {
+  std::vector<std::array<int, 3>> triangles;  ///< mesh vertex ids, outward normal (right-hand rule)
+  std::vector<int> triangle_tet;              ///< the tet each triangle belongs to
+  std::vector<int> triangle_local_face;       ///< which local face (0..3) of that tet
+  std::vector<int> vertices;                  ///< sorted ids of vertices on the surface
+};
+
+/// Boundary faces: those that belong to exactly one tet, in tet order (then local-face order).
+/// Throws MeshError (no file, line 0) if a face is shared by more than two tets (overlapping elements).
+SurfaceMesh extract_surface(const TetMesh& mesh);
+
+struct TetAdjacency {
+  /// face_neighbor[t][k]: the tet across local face k of tet t, or -1 on the boundary.
+  std::vector<std::array<int, 4>> face_neighbor;
+  /// Unique edges (v0 < v1).
+  std::vector<std::array<int, 2>> edges;
+  /// tet_edges[t][k]: id of local edge k (k_tet_edges) of tet t.
+  std::vector<std::array<int, 6>> tet_edges;
+  /// CSR: the tets around edge e are edge_tets[edge_tets_begin[e] .. edge_tets_begin[e+1]).
+  std::vector<int> edge_tets_begin;
+  std::vector<int> edge_tets;
+  /// CSR: the tets around vertex v.
+  std::vector<int> vertex_tets_begin;
+  std::vector<int> vertex_tets;
+};
+
+/// Edges are numbered in lexicographic (v0, v1) order; the tets around an edge or a vertex are listed
+/// in increasing order. Throws MeshError like extract_surface for a face shared by more than two tets.
+TetAdjacency build_adjacency(const TetMesh& mesh);
+
+}  // namespace tissue

@@ -1,0 +1,27 @@
+// ShiftedSystem: the product with A = s K + diag(d), shared by the iterative solver and by the
+// residual check of the direct one.
+#include "core/solve/linear_solver.hpp"
+
+#include <string>
+
+namespace tissue {
+
+void ShiftedSystem::multiply(const Eigen::VectorXd& x, Eigen::VectorXd& y) const {
+  stiffness->multiply(x, y);
+  // Coefficient-wise and in place: Eigen evaluates this without a temporary.
+  y.array() = stiffness_scale * y.array() + diagonal->array() * x.array();
+}
+
+void ShiftedSystem::check_sizes(const Eigen::VectorXd& b, const Eigen::VectorXd& x) const {
+  if (stiffness == nullptr || diagonal == nullptr) throw SolverError("linear solve: the system has no stiffness or no diagonal");
+  const long n = rows();
+  const auto describe = [n](const char* what, long size) {
+    return std::string("linear solve: ") + what + " has length " + std::to_string(size) + ", the system has " +
+           std::to_string(n) + " rows";
+  };
+  if (diagonal->size() != n) throw SolverError(describe("the diagonal d", diagonal->size()));
+  if (b.size() != n) throw SolverError(describe("the right-hand side b", b.size()));
+  if (x.size() != n) throw SolverError(describe("the initial guess x", x.size()));
+}
+
+}  // namespace tissue

@@ -1,0 +1,238 @@
+// BlockSparseMatrix: block-row storage with reserved room, the product kernel used by PCG,
+// and the growth operations used by XFEM enrichment.
+//
+// Storage: the rows occupy consecutive slot ranges [row_begin, row_begin + row_capacity);
+// the first row_size slots of a range are in use. After the last row come the spare rows
+// (block_row_capacity() - block_rows() of them, m_spare_row_capacity slots each), which
+// append_block_row() hands out in order. Unused slots hold column -1 and zero values, so a
+// newly used slot is a zero block.
+#include "core/system/block_sparse_matrix.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+#include <string>
+#include <utility>
+
+namespace tissue {
+
+namespace {
+
+// Slots given to each spare row of a matrix that started empty (no mean row size to go by):
+// a vertex of a tet mesh typically couples to 10-20 others.
+constexpr int k_default_spare_row_capacity = 16;
+
+int spare_row_count(double fraction, int rows) {
+  return static_cast<int>(std::ceil(fraction * static_cast<double>(rows)));
+}
+
+size_t to_size(int i) { return static_cast<size_t>(i); }
+
+}  // namespace
+
+BlockSparseMatrix::BlockSparseMatrix(const std::vector<std::vector<int>>& pattern, Reserve reserve)
+    : m_reserve(reserve) {
+  if (!(reserve.extra_row_fraction >= 0.0) || !std::isfinite(reserve.extra_row_fraction) ||
+      reserve.row_capacity_factor < 1) {
+    throw std::invalid_argument("BlockSparseMatrix: reserve needs extra_row_fraction >= 0 and row_capacity_factor >= 1");
+  }
+  const int n = static_cast<int>(pattern.size());
+
+  // Sorted, duplicate-free columns per row, diagonal included.
+  std::vector<std::vector<int>> columns(to_size(n));
+  long total_capacity = 0;
+  for (int r = 0; r < n; ++r) {
+    std::vector<int>& row = columns[to_size(r)];
+    row = pattern[to_size(r)];
+    for (const int c : row) {
+      if (c < 0 || c >= n) {
+        throw std::invalid_argument("BlockSparseMatrix: block row " + std::to_string(r) + " lists column " +
+                                    std::to_string(c) + ", outside [0, " + std::to_string(n) + ")");
+      }
+    }
+    row.push_back(r);
+    std::sort(row.begin(), row.end());
+    row.erase(std::unique(row.begin(), row.end()), row.end());
+    total_capacity += static_cast<long>(row.size()) * reserve.row_capacity_factor;
+  }
+
+  const int spare_rows = spare_row_count(reserve.extra_row_fraction, n);
+  m_spare_row_capacity = n > 0 ? static_cast<int>((total_capacity + n - 1) / n) : k_default_spare_row_capacity;
+  const long slot_count = total_capacity + static_cast<long>(spare_rows) * m_spare_row_capacity;
+  if (slot_count > (1L << 31) / 9 - 1) throw std::length_error("BlockSparseMatrix: too many blocks for int slot indices");
+
+  m_row_begin.resize(to_size(n));
+  m_row_size.resize(to_size(n));
+  m_row_capacity.resize(to_size(n));
+  m_diagonal_slot.resize(to_size(n));
+  m_column.assign(static_cast<size_t>(slot_count), -1);
+  m_values.assign(9 * static_cast<size_t>(slot_count), 0.0);
+
+  int begin = 0;
+  for (int r = 0; r < n; ++r) {
+    const std::vector<int>& row = columns[to_size(r)];
+    const int size = static_cast<int>(row.size());
+    m_row_begin[to_size(r)] = begin;
+    m_row_size[to_size(r)] = size;
+    m_row_capacity[to_size(r)] = size * reserve.row_capacity_factor;
+    for (int k = 0; k < size; ++k) {
+      m_column[to_size(begin + k)] = row[to_size(k)];
+      if (row[to_size(k)] == r) m_diagonal_slot[to_size(r)] = begin + k;
+    }
+    m_nonzero_blocks += size;
+    begin += m_row_capacity[to_size(r)];
+  }
+  m_block_row_capacity = n + spare_rows;
+}
+
+int BlockSparseMatrix::find_slot(int row, int col) const {
+  if (row < 0 || row >= block_rows()) return -1;
+  const int begin = m_row_begin[to_size(row)];
+  const int end = begin + m_row_size[to_size(row)];
+  for (int k = begin; k < end; ++k) {
+    if (m_column[to_size(k)] == col) return k;
+  }
+  return -1;
+}
+
+void BlockSparseMatrix::set_zero() {
+  // Only the used slots: unused slots are zero already (relayout and insert keep them so).
+  double* values = m_values.data();
+  const int n = block_rows();
+  for (int r = 0; r < n; ++r) {
+    double* first = values + 9 * to_size(m_row_begin[to_size(r)]);
+    std::fill(first, first + 9 * to_size(m_row_size[to_size(r)]), 0.0);
+  }
+}
+
+void BlockSparseMatrix::multiply(const Eigen::VectorXd& x, Eigen::VectorXd& y) const {
+  const int n = block_rows();
+  if (x.size() != rows()) {
+    throw std::invalid_argument("BlockSparseMatrix::multiply: x has length " + std::to_string(x.size()) + ", expected " +
+                                std::to_string(rows()));
+  }
+  if (&x == &y) throw std::invalid_argument("BlockSparseMatrix::multiply: x and y must be different vectors");
+  y.resize(rows());  // no-op (and no allocation) when the size is right
+
+  // The inner kernel of PCG: plain loops over raw arrays, three accumulators per block row,
+  // so that the compiler keeps them in registers and the slots are streamed once, in order.
+  const double* __restrict xv = x.data();
+  double* __restrict yv = y.data();
+  const double* __restrict values = m_values.data();
+  const int* __restrict column = m_column.data();
+  const int* row_begin = m_row_begin.data();
+  const int* row_size = m_row_size.data();
+  for (int r = 0; r < n; ++r) {
+    const int begin = row_begin[r];
+    const int end = begin + row_size[r];
+    double y0 = 0.0;
+    double y1 = 0.0;
+    double y2 = 0.0;
+    for (int k = begin; k < end; ++k) {
+      const double* b = values + 9 * static_cast<ptrdiff_t>(k);  // column-major 3x3
+      const double* xc = xv + 3 * static_cast<ptrdiff_t>(column[k]);
+      const double x0 = xc[0];
+      const double x1 = xc[1];
+      const double x2 = xc[2];
+      y0 += b[0] * x0 + b[3] * x1 + b[6] * x2;
+      y1 += b[1] * x0 + b[4] * x1 + b[7] * x2;
+      y2 += b[2] * x0 + b[5] * x1 + b[8] * x2;
+    }
+    yv[3 * r] = y0;
+    yv[3 * r + 1] = y1;
+    yv[3 * r + 2] = y2;
+  }
+}
+
+void BlockSparseMatrix::diagonal(Eigen::VectorXd& diagonal) const {
+  const int n = block_rows();
+  diagonal.resize(rows());
+  for (int r = 0; r < n; ++r) diagonal.segment<3>(3 * r) = block(m_diagonal_slot[to_size(r)]).diagonal();
+}
+
+void BlockSparseMatrix::relayout(int grow_row, int spare_rows) {
+  const int n = block_rows();
+  if (m_spare_row_capacity < 1) m_spare_row_capacity = k_default_spare_row_capacity;
+
+  std::vector<int> capacity(to_size(n));
+  long slot_count = 0;
+  for (int r = 0; r < n; ++r) {
+    const int size = m_row_size[to_size(r)];
+    int cap = std::max(m_row_capacity[to_size(r)], size * m_reserve.row_capacity_factor);
+    if (r == grow_row) cap = std::max(cap, 2 * size);  // geometric growth: overflow stays rare
+    capacity[to_size(r)] = std::max(cap, 1);
+    slot_count += capacity[to_size(r)];
+  }
+  slot_count += static_cast<long>(spare_rows) * m_spare_row_capacity;
+  if (slot_count > (1L << 31) / 9 - 1) throw std::length_error("BlockSparseMatrix: too many blocks for int slot indices");
+
+  std::vector<int> row_begin(to_size(n));
+  std::vector<int> column(static_cast<size_t>(slot_count), -1);
+  std::vector<double> values(9 * static_cast<size_t>(slot_count), 0.0);
+  std::vector<std::pair<int, int>> order;  // (column, old slot) of one row
+  int begin = 0;
+  for (int r = 0; r < n; ++r) {
+    row_begin[to_size(r)] = begin;
+    const int old_begin = m_row_begin[to_size(r)];
+    const int size = m_row_size[to_size(r)];
+    order.clear();
+    for (int k = 0; k < size; ++k) order.emplace_back(m_column[to_size(old_begin + k)], old_begin + k);
+    std::sort(order.begin(), order.end());  // appended blocks return to column order: better locality
+    for (int k = 0; k < size; ++k) {
+      const int slot = begin + k;
+      column[to_size(slot)] = order[to_size(k)].first;
+      std::copy_n(&m_values[9 * to_size(order[to_size(k)].second)], 9, &values[9 * to_size(slot)]);
+      if (order[to_size(k)].first == r) m_diagonal_slot[to_size(r)] = slot;
+    }
+    begin += capacity[to_size(r)];
+  }
+
+  m_row_begin = std::move(row_begin);
+  m_row_capacity = std::move(capacity);
+  m_column = std::move(column);
+  m_values = std::move(values);
+  m_block_row_capacity = n + spare_rows;
+  ++m_layout_revision;
+  ++m_pattern_revision;
+}
+
+int BlockSparseMatrix::append_block_row() {
+  int n = block_rows();
+  int begin = n == 0 ? 0 : m_row_begin[to_size(n - 1)] + m_row_capacity[to_size(n - 1)];
+  if (n >= m_block_row_capacity || m_spare_row_capacity < 1 || begin + m_spare_row_capacity > slot_capacity()) {
+    // Out of spare rows: reserve a fresh batch, as the constructor did, so that the next
+    // enrichments again grow in place.
+    relayout(-1, std::max(1, spare_row_count(m_reserve.extra_row_fraction, n)));
+    begin = n == 0 ? 0 : m_row_begin[to_size(n - 1)] + m_row_capacity[to_size(n - 1)];
+  }
+  m_row_begin.push_back(begin);
+  m_row_size.push_back(1);
+  m_row_capacity.push_back(m_spare_row_capacity);
+  m_diagonal_slot.push_back(begin);
+  m_column[to_size(begin)] = n;
+  std::fill_n(&m_values[9 * to_size(begin)], 9, 0.0);
+  ++m_nonzero_blocks;
+  ++m_pattern_revision;
+  return n;
+}
+
+int BlockSparseMatrix::insert_block(int row, int col) {
+  const int n = block_rows();
+  if (row < 0 || row >= n || col < 0 || col >= n) {
+    throw std::out_of_range("BlockSparseMatrix::insert_block: block (" + std::to_string(row) + ", " +
+                            std::to_string(col) + ") outside a matrix of " + std::to_string(n) + " block rows");
+  }
+  const int existing = find_slot(row, col);
+  if (existing >= 0) return existing;
+
+  if (m_row_size[to_size(row)] == m_row_capacity[to_size(row)]) relayout(row, m_block_row_capacity - n);
+  const int slot = m_row_begin[to_size(row)] + m_row_size[to_size(row)];
+  m_column[to_size(slot)] = col;
+  std::fill_n(&m_values[9 * to_size(slot)], 9, 0.0);
+  ++m_row_size[to_size(row)];
+  ++m_nonzero_blocks;
+  ++m_pattern_revision;
+  return slot;
+}
+
+}  // namespace tissue

@@ -1,0 +1,94 @@
+// BlockSparseMatrix: a square sparse matrix of 3x3 blocks, stored by block rows, with room
+// reserved ahead for the XFEM growth of issue 3 (spare block rows, spare slots per row).
+// Values live in "slots" (9 doubles each, column-major 3x3); assembly writes through slot
+// indices computed once (see assembly.hpp), so a normal step never searches or allocates.
+#pragma once
+
+#include <Eigen/Core>
+
+#include <cstdint>
+#include <vector>
+
+namespace tissue {
+
+/// Room reserved ahead for growth (the dissertation reserves 150% DOFs and doubles the row capacity).
+struct MatrixReserve {
+  double extra_row_fraction = 0.5;  ///< spare block rows, as a fraction of the initial rows (150% DOFs)
+  int row_capacity_factor = 2;      ///< each row gets room for this many times its initial blocks
+};
+
+class BlockSparseMatrix {
+ public:
+  using Reserve = MatrixReserve;
+
+  BlockSparseMatrix() = default;
+  /// `pattern[r]` lists the block columns present in block row r (any order, no duplicates needed;
+  /// duplicates are merged). The diagonal block of every row is always added.
+  explicit BlockSparseMatrix(const std::vector<std::vector<int>>& pattern, Reserve reserve = {});
+
+  [[nodiscard]] int block_rows() const { return static_cast<int>(m_row_begin.size()); }
+  [[nodiscard]] int rows() const { return 3 * block_rows(); }
+  [[nodiscard]] int nonzero_blocks() const { return m_nonzero_blocks; }
+  [[nodiscard]] long nonzeros() const { return 9L * m_nonzero_blocks; }
+
+  /// Slot of block (row, col), or -1 if absent. Searches: for set-up code, not for a step.
+  [[nodiscard]] int find_slot(int row, int col) const;
+
+  [[nodiscard]] Eigen::Map<Eigen::Matrix3d> block(int slot) { return Eigen::Map<Eigen::Matrix3d>(&m_values[9 * static_cast<size_t>(slot)]); }
+  [[nodiscard]] Eigen::Map<const Eigen::Matrix3d> block(int slot) const {
+    return Eigen::Map<const Eigen::Matrix3d>(&m_values[9 * static_cast<size_t>(slot)]);
+  }
+
+  /// Zeroes all values (pattern kept).
+  void set_zero();
+
+  /// y = A x, both of length rows(). y is overwritten. No allocation.
+  void multiply(const Eigen::VectorXd& x, Eigen::VectorXd& y) const;
+
+  /// The scalar diagonal (length rows()) into `diagonal` (resized if needed).
+  void diagonal(Eigen::VectorXd& diagonal) const;
+
+  // --- Iteration over the pattern (for conversions such as CHOLMOD) ---
+  [[nodiscard]] int row_begin(int row) const { return m_row_begin[static_cast<size_t>(row)]; }
+  [[nodiscard]] int row_size(int row) const { return m_row_size[static_cast<size_t>(row)]; }
+  /// Block column of a slot.
+  [[nodiscard]] int slot_column(int slot) const { return m_column[static_cast<size_t>(slot)]; }
+
+  // --- Growth (XFEM) ---
+  /// Appends an empty block row (with its diagonal block) and returns its index. Uses a spare row
+  /// when one is reserved; otherwise re-lays out the storage (see layout_revision()).
+  int append_block_row();
+  /// Returns the slot of block (row, col), inserting it into the spare room of `row` if absent.
+  /// New blocks are zero. When the row has no room left, the storage is re-laid out and
+  /// layout_revision() changes: every slot index held elsewhere must then be looked up again.
+  int insert_block(int row, int col);
+
+  /// Changes whenever the set of blocks changes (append_block_row, insert_block of a new block).
+  [[nodiscard]] std::uint64_t pattern_revision() const { return m_pattern_revision; }
+  /// Changes only when existing slots moved (storage re-laid out). Rare: room is reserved ahead.
+  [[nodiscard]] std::uint64_t layout_revision() const { return m_layout_revision; }
+  /// Reserved capacity, in block rows and in slots.
+  [[nodiscard]] int block_row_capacity() const { return m_block_row_capacity; }
+  [[nodiscard]] int slot_capacity() const { return static_cast<int>(m_column.size()); }
+
+ private:
+  /// Rebuilds the storage with room to spare: every row keeps at least its capacity (and
+  /// row_size * row_capacity_factor), `grow_row` (or -1) at least doubles, and `spare_rows`
+  /// empty rows of m_spare_row_capacity slots follow the last row. Rows come out sorted.
+  void relayout(int grow_row, int spare_rows);
+
+  std::vector<int> m_row_begin;     // first slot of each block row
+  std::vector<int> m_row_size;      // blocks in use in each row
+  std::vector<int> m_row_capacity;  // slots reserved for each row
+  std::vector<int> m_column;        // block column of each slot (-1 = unused)
+  std::vector<double> m_values;     // 9 per slot, column-major 3x3
+  std::vector<int> m_diagonal_slot; // slot of the diagonal block of each row (always present)
+  int m_nonzero_blocks = 0;
+  int m_spare_row_capacity = 0;     // slots given to each spare (appended) row
+  int m_block_row_capacity = 0;
+  Reserve m_reserve;
+  std::uint64_t m_pattern_revision = 0;
+  std::uint64_t m_layout_revision = 0;
+};
+
+}  // namespace tissue

@@ -1,0 +1,41 @@
+// DynamicsModel: the semi-discrete equations of motion M a + D v + f_int(u) = f_ext on the
+// unknowns of a body (3 per free vertex; enriched DOFs join later), as the integrators see them.
+// Integrators call this interface; the FEM implements it (fem/deformable_body.hpp).
+#pragma once
+
+#include "core/fem/material.hpp"
+#include "core/system/block_sparse_matrix.hpp"
+
+#include <Eigen/Core>
+
+namespace tissue {
+
+class DynamicsModel {
+ public:
+  virtual ~DynamicsModel() = default;
+
+  /// Number of unknowns.
+  [[nodiscard]] virtual int dof_count() const = 0;
+  /// Lumped (diagonal) mass per unknown [kg].
+  [[nodiscard]] virtual const Eigen::VectorXd& mass_kg() const = 0;
+  /// D = alpha M + beta K.
+  [[nodiscard]] virtual const RayleighDamping& damping() const = 0;
+  /// External force per unknown [N] (gravity; contact later).
+  [[nodiscard]] virtual const Eigen::VectorXd& external_force_n() const = 0;
+
+  /// Computes f_int(u) into `internal_force_n` (overwritten, length dof_count()) and, when
+  /// `update_tangent`, refreshes tangent() = d f_int / d u (the co-rotational R K R^T).
+  virtual void evaluate(const Eigen::VectorXd& displacement_m, Eigen::VectorXd& internal_force_n,
+                        bool update_tangent) = 0;
+  /// The tangent stiffness of the last evaluate() with update_tangent [N/m].
+  [[nodiscard]] virtual const BlockSparseMatrix& tangent() const = 0;
+};
+
+/// The state an integrator advances: displacement and velocity per unknown, and time.
+struct DynamicState {
+  Eigen::VectorXd displacement_m;
+  Eigen::VectorXd velocity_m_per_s;
+  double time_s = 0.0;
+};
+
+}  // namespace tissue

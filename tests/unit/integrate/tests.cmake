@@ -1,0 +1,3 @@
+tissue_add_test(test_integrate LABELS unit SOURCES integrate/test_backward_euler.cpp)
+# Counts operator new across steps; its own executable because it replaces the global allocator.
+tissue_add_test(test_step_allocations LABELS unit SOURCES integrate/test_step_allocations.cpp)

@@ -1,0 +1,185 @@
+// Tests of the CHOLMOD solver: agreement with dense LLT and with PCG, reuse of the symbolic
+// analysis while the pattern is unchanged (and redoing it when it changes), and refusal of an
+// indefinite matrix.
+#include "core/solve/linear_solver.hpp"
+
+#include "solve/test_systems.hpp"
+
+#include <gtest/gtest.h>
+
+#include <Eigen/Dense>
+
+#include <limits>
+#include <string>
+#include <random>
+
+namespace tissue {
+namespace {
+
+void expect_matches_dense(CholmodSolver& solver, const test::TestSystem& system, double scale, std::mt19937& rng) {
+  const ShiftedSystem shifted = system.shifted(scale);
+  const Eigen::VectorXd b = test::random_vector(shifted.rows(), rng);
+  const Eigen::VectorXd expected = system.dense(scale).llt().solve(b);
+  Eigen::VectorXd x = Eigen::VectorXd::Zero(shifted.rows());
+  const SolveReport report = solver.solve(shifted, b, x);
+  EXPECT_TRUE(report.converged);
+  EXPECT_EQ(report.iterations, 0);
+  EXPECT_LE(report.relative_residual, 1e-12);
+  // The true residual, up to the rounding of the two products.
+  const double true_residual = (b - system.dense(scale) * x).norm() / b.norm();
+  EXPECT_NEAR(report.relative_residual, true_residual, 0.2 * true_residual + 1e-15);
+  EXPECT_LE((x - expected).norm(), 1e-10 * expected.norm());
+}
+
+TEST(Cholmod, AgreesWithDenseLlt) {
+  const test::TestSystem system = test::make_grid_system(5, 5, 5, 21);  // 375 unknowns
+  CholmodSolver solver;
+  EXPECT_EQ(solver.name(), "cholmod");
+  std::mt19937 rng(22);
+  for (const double scale : {1.0, 0.01, 100.0}) expect_matches_dense(solver, system, scale, rng);
+  EXPECT_EQ(solver.symbolic_analysis_count(), 1);
+}
+
+TEST(Cholmod, ReusesTheAnalysisUntilThePatternChanges) {
+  test::TestSystem system = test::make_grid_system(4, 4, 3, 23);
+  CholmodSolver solver;
+  std::mt19937 rng(24);
+  EXPECT_EQ(solver.symbolic_analysis_count(), 0);
+  expect_matches_dense(solver, system, 1.0, rng);
+  EXPECT_EQ(solver.symbolic_analysis_count(), 1);
+
+  // New values (as after a step's reassembly), new scale, new diagonal: same analysis.
+  system.add_edge(0, 1, test::random_spd_block(rng));
+  system.diagonal *= 2.0;
+  expect_matches_dense(solver, system, 3.0, rng);
+  EXPECT_EQ(solver.symbolic_analysis_count(), 1);
+
+  // A new coupling (a cut joins blocks 0 and 40) fits in the spare room: same layout, new pattern.
+  const auto layout = system.stiffness.layout_revision();
+  system.stiffness.insert_block(0, 40);
+  system.stiffness.insert_block(40, 0);
+  ASSERT_EQ(system.stiffness.layout_revision(), layout);
+  system.add_edge(0, 40, test::random_spd_block(rng));
+  expect_matches_dense(solver, system, 1.0, rng);
+  EXPECT_EQ(solver.symbolic_analysis_count(), 2);
+  expect_matches_dense(solver, system, 0.5, rng);
+  EXPECT_EQ(solver.symbolic_analysis_count(), 2);
+}
+
+TEST(Cholmod, FollowsRelayoutAndAppendedRows) {
+  test::TestSystem system = test::make_grid_system(3, 3, 3, 25, 0.05, {0.5, 1});  // rows are full
+  CholmodSolver solver;
+  std::mt19937 rng(26);
+  expect_matches_dense(solver, system, 1.0, rng);
+
+  // Overflow: the slots move (layout changes); the solver must not read through stale slots.
+  const auto layout = system.stiffness.layout_revision();
+  system.stiffness.insert_block(0, 26);
+  system.stiffness.insert_block(26, 0);
+  ASSERT_NE(system.stiffness.layout_revision(), layout);
+  system.add_edge(0, 26, test::random_spd_block(rng));
+  expect_matches_dense(solver, system, 1.0, rng);
+  EXPECT_EQ(solver.symbolic_analysis_count(), 2);
+
+  // An enriched DOF: a new block row coupled to row 13.
+  const int row = system.stiffness.append_block_row();
+  system.stiffness.insert_block(row, 13);
+  system.stiffness.insert_block(13, row);
+  const long n = system.stiffness.rows();
+  Eigen::MatrixXd grown = Eigen::MatrixXd::Zero(n, n);
+  grown.topLeftCorner(n - 3, n - 3) = system.dense_stiffness;
+  system.dense_stiffness = grown;
+  system.diagonal.conservativeResize(n);
+  system.diagonal.tail<3>().setConstant(0.07);
+  system.add_edge(row, 13, test::random_spd_block(rng));
+  expect_matches_dense(solver, system, 1.0, rng);
+  EXPECT_EQ(solver.symbolic_analysis_count(), 3);
+}
+
+TEST(Cholmod, DistinguishesMatricesWithTheSameRevision) {
+  // Two matrices of the same size, both at pattern revision 0, with different patterns.
+  const test::TestSystem grid = test::make_grid_system(4, 3, 2, 27);
+  const test::TestSystem other = test::make_grid_system(2, 3, 4, 28);
+  ASSERT_EQ(grid.stiffness.rows(), other.stiffness.rows());
+  ASSERT_EQ(grid.stiffness.pattern_revision(), other.stiffness.pattern_revision());
+  CholmodSolver solver;
+  std::mt19937 rng(29);
+  expect_matches_dense(solver, grid, 1.0, rng);
+  expect_matches_dense(solver, other, 1.0, rng);
+  EXPECT_EQ(solver.symbolic_analysis_count(), 2);
+}
+
+TEST(Cholmod, RefusesIndefiniteMatrixAndRecovers) {
+  const test::TestSystem system = test::make_grid_system(4, 4, 4, 30);
+  CholmodSolver solver;
+  std::mt19937 rng(31);
+  const Eigen::VectorXd b = test::random_vector(system.stiffness.rows(), rng);
+  Eigen::VectorXd x = Eigen::VectorXd::Zero(b.size());
+  EXPECT_THROW(solver.solve(system.shifted(-1.0), b, x), SolverError);
+  try {
+    solver.solve(system.shifted(-1.0), b, x);
+  } catch (const SolverError& error) {
+    EXPECT_NE(std::string(error.what()).find("not positive definite"), std::string::npos) << error.what();
+  }
+  // The same solver still works once the matrix is SPD again.
+  expect_matches_dense(solver, system, 1.0, rng);
+  EXPECT_EQ(solver.symbolic_analysis_count(), 1);
+
+  // Non-finite input is refused, not returned as a solution.
+  test::TestSystem poisoned = test::make_grid_system(2, 2, 2, 32);
+  poisoned.diagonal[4] = std::numeric_limits<double>::quiet_NaN();
+  Eigen::VectorXd y = Eigen::VectorXd::Zero(poisoned.diagonal.size());
+  EXPECT_THROW(solver.solve(poisoned.shifted(1.0), Eigen::VectorXd::Ones(y.size()), y), SolverError);
+}
+
+TEST(Cholmod, LargerSystemRefusesIndefiniteAndRecovers) {
+  // 3000 unknowns: large enough for CHOLMOD's supernodal path, whose failure handling differs
+  // from the simplicial one. Checked through the true residual (no dense reference).
+  const test::TestSystem system = test::make_grid_system(10, 10, 10, 36, 0.05, {}, false);
+  CholmodSolver solver;
+  std::mt19937 rng(37);
+  const Eigen::VectorXd b = test::random_vector(system.stiffness.rows(), rng);
+  Eigen::VectorXd x = Eigen::VectorXd::Zero(b.size());
+  EXPECT_THROW(solver.solve(system.shifted(-1.0), b, x), SolverError);
+  for (const double scale : {1.0, 2.0}) {
+    const SolveReport report = solver.solve(system.shifted(scale), b, x);
+    EXPECT_TRUE(report.converged);
+    EXPECT_LE(report.relative_residual, 1e-12);
+    Eigen::VectorXd product;
+    system.shifted(scale).multiply(x, product);
+    EXPECT_LE((b - product).norm(), 1e-12 * b.norm());
+  }
+  EXPECT_EQ(solver.symbolic_analysis_count(), 1);
+}
+
+TEST(Cholmod, ZeroRightHandSideAndSizeChecks) {
+  const test::TestSystem system = test::make_grid_system(3, 3, 3, 33);
+  const long n = system.stiffness.rows();
+  CholmodSolver solver;
+  Eigen::VectorXd x = Eigen::VectorXd::Ones(n);
+  const SolveReport report = solver.solve(system.shifted(1.0), Eigen::VectorXd::Zero(n), x);
+  EXPECT_TRUE(report.converged);
+  EXPECT_EQ(report.relative_residual, 0.0);
+  EXPECT_TRUE(x.isZero(0.0));
+  EXPECT_THROW(solver.solve(system.shifted(1.0), Eigen::VectorXd::Ones(n - 1), x), SolverError);
+  Eigen::VectorXd long_x = Eigen::VectorXd::Zero(n + 1);
+  EXPECT_THROW(solver.solve(system.shifted(1.0), Eigen::VectorXd::Ones(n), long_x), SolverError);
+}
+
+TEST(Cholmod, AgreesWithPcg) {
+  const test::TestSystem system = test::make_grid_system(6, 5, 4, 34);
+  std::mt19937 rng(35);
+  const ShiftedSystem shifted = system.shifted(1.0);
+  const Eigen::VectorXd b = test::random_vector(shifted.rows(), rng);
+  CholmodSolver cholmod;
+  PcgSolver pcg({1e-12, 10000});
+  Eigen::VectorXd direct = Eigen::VectorXd::Zero(shifted.rows());
+  Eigen::VectorXd iterative = Eigen::VectorXd::Zero(shifted.rows());
+  cholmod.solve(shifted, b, direct);
+  const SolveReport report = pcg.solve(shifted, b, iterative);
+  EXPECT_TRUE(report.converged);
+  EXPECT_LE((direct - iterative).norm(), 1e-8 * direct.norm());
+}
+
+}  // namespace
+}  // namespace tissue

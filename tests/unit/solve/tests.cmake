@@ -1,0 +1,1 @@
+tissue_add_test(test_solve LABELS unit SOURCES solve/test_pcg.cpp solve/test_cholmod.cpp)

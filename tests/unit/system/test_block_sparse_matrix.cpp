@@ -1,0 +1,324 @@
+// Tests of BlockSparseMatrix: the product against a dense reference, the reserved room
+// (slots stay valid while growth fits), re-layout on overflow, spare rows, and the pattern order.
+#include "core/system/block_sparse_matrix.hpp"
+
+#include <gtest/gtest.h>
+
+#include <Eigen/Dense>
+
+#include <algorithm>
+#include <map>
+#include <random>
+#include <stdexcept>
+#include <utility>
+#include <vector>
+
+namespace tissue {
+namespace {
+
+using BlockMap = std::map<std::pair<int, int>, Eigen::Matrix3d>;
+using Pattern = std::vector<std::vector<int>>;
+
+// A random structurally symmetric pattern: each row couples to a few random others.
+std::vector<std::vector<int>> random_symmetric_pattern(int n, int couplings_per_row, std::mt19937& rng) {
+  std::vector<std::vector<int>> pattern(static_cast<size_t>(n));
+  std::uniform_int_distribution<int> pick(0, n - 1);
+  for (int r = 0; r < n; ++r) {
+    for (int k = 0; k < couplings_per_row; ++k) {
+      const int c = pick(rng);
+      pattern[static_cast<size_t>(r)].push_back(c);
+      pattern[static_cast<size_t>(c)].push_back(r);
+    }
+  }
+  return pattern;
+}
+
+Eigen::Matrix3d random_block(std::mt19937& rng) {
+  std::uniform_real_distribution<double> value(-1.0, 1.0);
+  Eigen::Matrix3d b;
+  for (int i = 0; i < 9; ++i) b(i) = value(rng);
+  return b;
+}
+
+// Writes a random value into every block of the pattern and remembers it, independently of the storage.
+BlockMap fill_random(BlockSparseMatrix& matrix, const std::vector<std::vector<int>>& pattern, std::mt19937& rng) {
+  BlockMap blocks;
+  for (int r = 0; r < static_cast<int>(pattern.size()); ++r) {
+    std::vector<int> cols = pattern[static_cast<size_t>(r)];
+    cols.push_back(r);
+    for (const int c : cols) {
+      if (blocks.count({r, c}) != 0) continue;
+      const Eigen::Matrix3d b = random_block(rng);
+      const int slot = matrix.find_slot(r, c);
+      EXPECT_GE(slot, 0) << "block (" << r << ", " << c << ") missing";
+      matrix.block(slot) = b;
+      blocks[{r, c}] = b;
+    }
+  }
+  return blocks;
+}
+
+Eigen::MatrixXd dense_from(const BlockMap& blocks, int block_rows) {
+  Eigen::MatrixXd dense = Eigen::MatrixXd::Zero(3 * block_rows, 3 * block_rows);
+  for (const auto& [key, b] : blocks) dense.block<3, 3>(3 * key.first, 3 * key.second) = b;
+  return dense;
+}
+
+void expect_values(const BlockSparseMatrix& matrix, const BlockMap& blocks) {
+  for (const auto& [key, b] : blocks) {
+    const int slot = matrix.find_slot(key.first, key.second);
+    ASSERT_GE(slot, 0);
+    EXPECT_EQ(matrix.block(slot), b) << "block (" << key.first << ", " << key.second << ")";
+  }
+}
+
+void expect_product_matches(const BlockSparseMatrix& matrix, const BlockMap& blocks, std::mt19937& rng) {
+  const Eigen::MatrixXd dense = dense_from(blocks, matrix.block_rows());
+  std::uniform_real_distribution<double> value(-1.0, 1.0);
+  Eigen::VectorXd x(matrix.rows());
+  for (long i = 0; i < x.size(); ++i) x[i] = value(rng);
+  Eigen::VectorXd y;
+  matrix.multiply(x, y);
+  const Eigen::VectorXd expected = dense * x;
+  ASSERT_EQ(y.size(), expected.size());
+  EXPECT_LE((y - expected).norm(), 1e-12 * expected.norm());
+}
+
+TEST(BlockSparseMatrix, DefaultConstructedIsEmpty) {
+  BlockSparseMatrix matrix;
+  EXPECT_EQ(matrix.block_rows(), 0);
+  EXPECT_EQ(matrix.rows(), 0);
+  EXPECT_EQ(matrix.nonzero_blocks(), 0);
+  EXPECT_EQ(matrix.find_slot(0, 0), -1);
+  Eigen::VectorXd x(0);
+  Eigen::VectorXd y(5);
+  matrix.multiply(x, y);
+  EXPECT_EQ(y.size(), 0);
+  // It can still grow: the first append reserves room.
+  EXPECT_EQ(matrix.append_block_row(), 0);
+  EXPECT_EQ(matrix.rows(), 3);
+  EXPECT_GE(matrix.find_slot(0, 0), 0);
+  EXPECT_TRUE(matrix.block(matrix.find_slot(0, 0)).isZero());
+}
+
+TEST(BlockSparseMatrix, ConstructionMergesDuplicatesAddsDiagonalAndSortsColumns) {
+  const std::vector<std::vector<int>> pattern = {{3, 1, 3, 1}, {0}, {}, {0, 2, 2}};
+  const BlockSparseMatrix matrix(pattern, {0.5, 2});
+  EXPECT_EQ(matrix.block_rows(), 4);
+  EXPECT_EQ(matrix.rows(), 12);
+  // Rows: {0,1,3}, {0,1}, {2}, {0,2,3}.
+  EXPECT_EQ(matrix.nonzero_blocks(), 9);
+  EXPECT_EQ(matrix.nonzeros(), 81);
+  const std::vector<std::vector<int>> expected = {{0, 1, 3}, {0, 1}, {2}, {0, 2, 3}};
+  for (int r = 0; r < 4; ++r) {
+    ASSERT_EQ(matrix.row_size(r), static_cast<int>(expected[static_cast<size_t>(r)].size()));
+    for (int k = 0; k < matrix.row_size(r); ++k) {
+      EXPECT_EQ(matrix.slot_column(matrix.row_begin(r) + k), expected[static_cast<size_t>(r)][static_cast<size_t>(k)]);
+    }
+  }
+  // Reserve: 2 spare rows (ceil(0.5 * 4)); 18 slots for the rows, 2 * ceil(18 / 4) for the spares.
+  EXPECT_EQ(matrix.block_row_capacity(), 6);
+  EXPECT_EQ(matrix.slot_capacity(), 18 + 2 * 5);
+  EXPECT_EQ(matrix.find_slot(2, 0), -1);
+  EXPECT_EQ(matrix.find_slot(-1, 0), -1);
+  EXPECT_EQ(matrix.find_slot(4, 0), -1);
+  // Every used block starts at zero.
+  for (int r = 0; r < 4; ++r) {
+    for (int k = 0; k < matrix.row_size(r); ++k) EXPECT_TRUE(matrix.block(matrix.row_begin(r) + k).isZero());
+  }
+}
+
+TEST(BlockSparseMatrix, RejectsColumnsOutsideTheMatrix) {
+  EXPECT_THROW(BlockSparseMatrix(Pattern{{0, 2}, {1}}), std::invalid_argument);
+  EXPECT_THROW(BlockSparseMatrix(Pattern{{-1}}), std::invalid_argument);
+  EXPECT_THROW(BlockSparseMatrix(Pattern{{0}}, {-0.5, 2}), std::invalid_argument);
+  EXPECT_THROW(BlockSparseMatrix(Pattern{{0}}, {0.5, 0}), std::invalid_argument);
+}
+
+TEST(BlockSparseMatrix, MultiplyMatchesDenseReference) {
+  std::mt19937 rng(11);
+  for (const int n : {1, 7, 60, 300}) {
+    const auto pattern = random_symmetric_pattern(n, 4, rng);
+    BlockSparseMatrix matrix(pattern);
+    const BlockMap blocks = fill_random(matrix, pattern, rng);
+    EXPECT_EQ(matrix.nonzero_blocks(), static_cast<int>(blocks.size()));
+    expect_product_matches(matrix, blocks, rng);
+  }
+}
+
+TEST(BlockSparseMatrix, MultiplyRejectsWrongSizeAndAliasing) {
+  BlockSparseMatrix matrix(Pattern{{1}, {0}});
+  Eigen::VectorXd x = Eigen::VectorXd::Ones(5);
+  Eigen::VectorXd y;
+  EXPECT_THROW(matrix.multiply(x, y), std::invalid_argument);
+  x = Eigen::VectorXd::Ones(6);
+  EXPECT_THROW(matrix.multiply(x, x), std::invalid_argument);
+}
+
+TEST(BlockSparseMatrix, DiagonalAndSetZero) {
+  std::mt19937 rng(3);
+  const auto pattern = random_symmetric_pattern(20, 3, rng);
+  BlockSparseMatrix matrix(pattern);
+  const BlockMap blocks = fill_random(matrix, pattern, rng);
+  Eigen::VectorXd diagonal;
+  matrix.diagonal(diagonal);
+  EXPECT_EQ(diagonal, dense_from(blocks, 20).diagonal());
+
+  const int nonzero_blocks = matrix.nonzero_blocks();
+  const auto revision = matrix.pattern_revision();
+  matrix.set_zero();
+  EXPECT_EQ(matrix.nonzero_blocks(), nonzero_blocks);
+  EXPECT_EQ(matrix.pattern_revision(), revision);
+  for (const auto& [key, b] : blocks) EXPECT_TRUE(matrix.block(matrix.find_slot(key.first, key.second)).isZero());
+  Eigen::VectorXd y;
+  matrix.multiply(Eigen::VectorXd::Ones(matrix.rows()), y);
+  EXPECT_TRUE(y.isZero(0.0));
+}
+
+TEST(BlockSparseMatrix, InsertIntoSpareRoomKeepsSlotsAndValues) {
+  std::mt19937 rng(5);
+  // A chain: row r couples to r - 1 and r + 1, so there is plenty of absent (r, r + 5).
+  const int n = 30;
+  std::vector<std::vector<int>> pattern(n);
+  for (int r = 0; r + 1 < n; ++r) {
+    pattern[static_cast<size_t>(r)].push_back(r + 1);
+    pattern[static_cast<size_t>(r) + 1].push_back(r);
+  }
+  BlockSparseMatrix matrix(pattern, {0.5, 2});
+  BlockMap blocks = fill_random(matrix, pattern, rng);
+  std::map<std::pair<int, int>, int> slots;
+  for (const auto& [key, b] : blocks) slots[key] = matrix.find_slot(key.first, key.second);
+
+  const auto layout = matrix.layout_revision();
+  const auto pattern_revision = matrix.pattern_revision();
+  const int nonzero_blocks = matrix.nonzero_blocks();
+
+  // Row 5 holds {4, 5, 6} in 6 slots: three more blocks fit.
+  const int a = matrix.insert_block(5, 20);
+  const int b = matrix.insert_block(5, 0);
+  const int c = matrix.insert_block(5, 29);
+  EXPECT_EQ(matrix.layout_revision(), layout);
+  EXPECT_GT(matrix.pattern_revision(), pattern_revision);
+  EXPECT_EQ(matrix.nonzero_blocks(), nonzero_blocks + 3);
+  EXPECT_EQ(matrix.find_slot(5, 20), a);
+  EXPECT_EQ(matrix.find_slot(5, 0), b);
+  EXPECT_EQ(matrix.find_slot(5, 29), c);
+  for (const int slot : {a, b, c}) EXPECT_TRUE(matrix.block(slot).isZero());
+  // Every slot handed out before is still the slot of the same block, with the same value.
+  for (const auto& [key, slot] : slots) {
+    EXPECT_EQ(matrix.find_slot(key.first, key.second), slot);
+    EXPECT_EQ(matrix.block(slot), blocks[key]);
+  }
+  // Inserting a block that exists returns its slot and changes nothing.
+  const auto revision_after = matrix.pattern_revision();
+  EXPECT_EQ(matrix.insert_block(5, 20), a);
+  EXPECT_EQ(matrix.insert_block(7, 6), (slots[{7, 6}]));
+  EXPECT_EQ(matrix.pattern_revision(), revision_after);
+
+  // Values written into the new slots take part in the product.
+  for (const auto& [key, slot] : std::map<std::pair<int, int>, int>{{{5, 20}, a}, {{5, 0}, b}, {{5, 29}, c}}) {
+    const Eigen::Matrix3d value = random_block(rng);
+    matrix.block(slot) = value;
+    blocks[key] = value;
+  }
+  expect_product_matches(matrix, blocks, rng);
+  EXPECT_THROW(matrix.insert_block(5, n), std::out_of_range);
+  EXPECT_THROW(matrix.insert_block(-1, 0), std::out_of_range);
+}
+
+TEST(BlockSparseMatrix, OverflowRelaysOutAndKeepsValues) {
+  std::mt19937 rng(9);
+  const auto pattern = random_symmetric_pattern(40, 3, rng);
+  BlockSparseMatrix matrix(pattern, {0.5, 1});  // no room at all in the rows
+  BlockMap blocks = fill_random(matrix, pattern, rng);
+  const auto layout = matrix.layout_revision();
+  const auto pattern_revision = matrix.pattern_revision();
+
+  int row = 0;
+  int col = 0;
+  while (matrix.find_slot(row, col) >= 0) ++col;  // the first absent block of row 0
+  const int slot = matrix.insert_block(row, col);
+  EXPECT_NE(matrix.layout_revision(), layout);
+  EXPECT_NE(matrix.pattern_revision(), pattern_revision);
+  EXPECT_EQ(matrix.find_slot(row, col), slot);
+  EXPECT_TRUE(matrix.block(slot).isZero());
+  expect_values(matrix, blocks);  // looked up again: the slots moved, the values did not change
+  const Eigen::Matrix3d value = random_block(rng);
+  matrix.block(slot) = value;
+  blocks[{row, col}] = value;
+  expect_product_matches(matrix, blocks, rng);
+
+  // The re-laid-out row has room now: the next insertion into it does not move anything.
+  const auto layout_after = matrix.layout_revision();
+  ++col;
+  while (matrix.find_slot(row, col) >= 0) ++col;
+  matrix.insert_block(row, col);
+  EXPECT_EQ(matrix.layout_revision(), layout_after);
+  // Re-layout puts each row back in column order.
+  for (int k = 1; k < matrix.row_size(1); ++k) {
+    EXPECT_LT(matrix.slot_column(matrix.row_begin(1) + k - 1), matrix.slot_column(matrix.row_begin(1) + k));
+  }
+}
+
+TEST(BlockSparseMatrix, AppendUsesSpareRowsUntilTheyRunOut) {
+  std::mt19937 rng(13);
+  const int n = 10;
+  const auto pattern = random_symmetric_pattern(n, 2, rng);
+  BlockSparseMatrix matrix(pattern, {0.5, 2});
+  BlockMap blocks = fill_random(matrix, pattern, rng);
+  ASSERT_EQ(matrix.block_row_capacity(), 15);
+  const auto layout = matrix.layout_revision();
+  std::map<std::pair<int, int>, int> slots;
+  for (const auto& [key, b] : blocks) slots[key] = matrix.find_slot(key.first, key.second);
+
+  for (int k = 0; k < 5; ++k) {
+    const auto pattern_revision = matrix.pattern_revision();
+    const int row = matrix.append_block_row();
+    EXPECT_EQ(row, n + k);
+    EXPECT_EQ(matrix.block_rows(), n + k + 1);
+    EXPECT_GT(matrix.pattern_revision(), pattern_revision);
+    EXPECT_EQ(matrix.layout_revision(), layout);
+    const int diagonal = matrix.find_slot(row, row);
+    ASSERT_GE(diagonal, 0);
+    EXPECT_TRUE(matrix.block(diagonal).isZero());
+    // An enriched row couples to an old row and back; a spare row has room for it.
+    const int coupled = k % n;
+    const int forward = matrix.insert_block(row, coupled);
+    const int backward = matrix.insert_block(coupled, row);
+    EXPECT_EQ(matrix.layout_revision(), layout);
+    for (const auto& [key, slot] :
+         std::map<std::pair<int, int>, int>{{{row, row}, diagonal}, {{row, coupled}, forward}, {{coupled, row}, backward}}) {
+      const Eigen::Matrix3d value = random_block(rng);
+      matrix.block(slot) = value;
+      blocks[key] = value;
+      slots[key] = slot;
+    }
+  }
+  for (const auto& [key, slot] : slots) EXPECT_EQ(matrix.find_slot(key.first, key.second), slot);
+  expect_product_matches(matrix, blocks, rng);
+
+  // The sixth append finds no spare row: the storage is re-laid out, values kept, new spares reserved.
+  const int row = matrix.append_block_row();
+  EXPECT_EQ(row, 15);
+  EXPECT_NE(matrix.layout_revision(), layout);
+  EXPECT_GT(matrix.block_row_capacity(), 16);
+  blocks[{row, row}] = Eigen::Matrix3d::Zero();
+  expect_values(matrix, blocks);
+  expect_product_matches(matrix, blocks, rng);
+  const auto layout_after = matrix.layout_revision();
+  matrix.append_block_row();
+  EXPECT_EQ(matrix.layout_revision(), layout_after);
+}
+
+TEST(BlockSparseMatrix, NoSpareRowsMeansAppendRelaysOut) {
+  BlockSparseMatrix matrix(Pattern{{1}, {0}}, {0.0, 2});
+  EXPECT_EQ(matrix.block_row_capacity(), 2);
+  matrix.block(matrix.find_slot(0, 1)) = Eigen::Matrix3d::Identity();
+  const auto layout = matrix.layout_revision();
+  EXPECT_EQ(matrix.append_block_row(), 2);
+  EXPECT_NE(matrix.layout_revision(), layout);
+  EXPECT_EQ(matrix.block(matrix.find_slot(0, 1)), Eigen::Matrix3d::Identity());
+}
+
+}  // namespace
+}  // namespace tissue
