@@ -201,8 +201,9 @@ int BlockSparseMatrix::append_block_row() {
   int begin = n == 0 ? 0 : m_row_begin[to_size(n - 1)] + m_row_capacity[to_size(n - 1)];
   if (n >= m_block_row_capacity || m_spare_row_capacity < 1 || begin + m_spare_row_capacity > slot_capacity()) {
     // Out of spare rows: reserve a fresh batch, as the constructor did, so that the next
-    // enrichments again grow in place.
-    relayout(-1, std::max(1, spare_row_count(m_reserve.extra_row_fraction, n)));
+    // enrichments again grow in place; at least n/4 + 1 rows, so that growing row by row from a
+    // small (or empty) matrix re-lays out O(log n) times, not n times.
+    relayout(-1, std::max(spare_row_count(m_reserve.extra_row_fraction, n), n / 4 + 1));
     begin = n == 0 ? 0 : m_row_begin[to_size(n - 1)] + m_row_capacity[to_size(n - 1)];
   }
   m_row_begin.push_back(begin);

@@ -99,6 +99,10 @@ TEST(BlockSparseMatrix, DefaultConstructedIsEmpty) {
   EXPECT_EQ(matrix.rows(), 3);
   EXPECT_GE(matrix.find_slot(0, 0), 0);
   EXPECT_TRUE(matrix.block(matrix.find_slot(0, 0)).isZero());
+  // Growing row by row re-lays out geometrically rarely, not once per row.
+  for (int k = 1; k < 1000; ++k) EXPECT_EQ(matrix.append_block_row(), k);
+  EXPECT_LE(matrix.layout_revision(), 30U);
+  EXPECT_EQ(matrix.nonzero_blocks(), 1000);
 }
 
 TEST(BlockSparseMatrix, ConstructionMergesDuplicatesAddsDiagonalAndSortsColumns) {
