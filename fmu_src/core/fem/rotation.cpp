@@ -61,9 +61,9 @@ Eigen::Matrix3d rotation_by_svd(const Eigen::Matrix3d& deformation_gradient) {
 Eigen::Matrix3d extract_rotation(const Eigen::Matrix3d& f, Eigen::Quaterniond& warm_start,
                                  const RotationSettings& settings) {
   const double scale = f.cwiseAbs().maxCoeff();
-  if (!(scale > 0.0) || !std::isfinite(scale)) return warm_start.normalized().toRotationMatrix();  // F = 0 or not finite
-  Eigen::Quaterniond q = warm_start.normalized();
+  Eigen::Quaterniond q = warm_start;  // kept unit by every update below
   Eigen::Matrix3d r = q.toRotationMatrix();
+  if (!(scale > 0.0) || !std::isfinite(scale)) return r;  // F = 0 or not finite: nothing to extract
   bool converged = false;
   for (int iteration = 0; iteration < settings.max_iterations; ++iteration) {
     const NewtonStep step = rotation_step(r.transpose() * f, scale);

@@ -21,7 +21,8 @@ struct RotationSettings {
 /// costs ~150 flops and a warm start needs one or two. It updates a unit quaternion, so R is always
 /// a proper rotation. Where the Hessian is not positive definite it takes the step of Mueller,
 /// Bender, Chentanez, Macklin, "A robust method to extract the rotational part of deformations"
-/// (MIG 2016); without convergence in max_iterations the SVD decides. `warm_start` is updated.
+/// (MIG 2016); without convergence in max_iterations the SVD decides. `warm_start` (a unit
+/// quaternion) is updated.
 Eigen::Matrix3d extract_rotation(const Eigen::Matrix3d& deformation_gradient, Eigen::Quaterniond& warm_start,
                                  const RotationSettings& settings = {});
 

@@ -18,12 +18,6 @@ TetRest precompute_tet(const TetPositions& rest_positions_m) {
   return rest;
 }
 
-Eigen::Matrix3d deformation_gradient(const TetRest& rest, const TetPositions& positions_m) {
-  Eigen::Matrix3d f = Eigen::Matrix3d::Zero();
-  for (int i = 0; i < 4; ++i) f.noalias() += positions_m[static_cast<size_t>(i)] * rest.shape_gradients_per_m.col(i).transpose();
-  return f;
-}
-
 Eigen::Matrix3d linear_stiffness_block(const TetRest& rest, const LameParameters& lame, int i, int j) {
   const auto gi = rest.shape_gradients_per_m.col(i);
   const auto gj = rest.shape_gradients_per_m.col(j);

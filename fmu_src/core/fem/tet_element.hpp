@@ -26,7 +26,14 @@ struct TetRest {
 TetRest precompute_tet(const TetPositions& rest_positions_m);
 
 /// F = sum_i x_i grad(phi_i)^T (3x3), the deformation gradient for current positions x.
-Eigen::Matrix3d deformation_gradient(const TetRest& rest, const TetPositions& positions_m);
+/// Inline: it is in the innermost loop of every step.
+inline Eigen::Matrix3d deformation_gradient(const TetRest& rest, const TetPositions& positions_m) {
+  Eigen::Matrix3d f = positions_m[0] * rest.shape_gradients_per_m.col(0).transpose();
+  for (size_t i = 1; i < 4; ++i) {
+    f.noalias() += positions_m[i] * rest.shape_gradients_per_m.col(static_cast<Eigen::Index>(i)).transpose();
+  }
+  return f;
+}
 
 /// 3x3 block (i, j) of the linear stiffness: V [lambda g_i g_j^T + mu g_j g_i^T + mu (g_i . g_j) I].
 Eigen::Matrix3d linear_stiffness_block(const TetRest& rest, const LameParameters& lame, int i, int j);
