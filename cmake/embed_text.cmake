@@ -13,8 +13,8 @@ function(tissue_embed_text output input namespace function)
        "#include <string_view>\n"
        "namespace ${namespace} {\n"
        "std::string_view ${function}() {\n"
-       "  static constexpr std::string_view k_text = R\"tissue_embed(${content})tissue_embed\";\n"
-       "  return k_text;\n"
+       "  static constexpr std::string_view TEXT = R\"tissue_embed(${content})tissue_embed\";\n"
+       "  return TEXT;\n"
        "}\n"
        "}  // namespace ${namespace}\n")
   file(COPY_FILE "${output}.tmp" "${output}" ONLY_IF_DIFFERENT)

@@ -17,6 +17,8 @@ import os
 import subprocess
 import sys
 
+from make_bar import signed_volume  # one tet-volume formula for both generators
+
 TARGET_VERTICES = 826
 TARGET_TETS = 2301
 TOLERANCE = 0.15
@@ -123,14 +125,6 @@ def read_msh41(path):
             tets += [tuple(map(int, lines[p + n].split()[1:5])) for n in range(count)]
         p += count
     return tags, coords, tets, volumes
-
-
-def signed_volume(a, b, c, d):
-    u = [b[n] - a[n] for n in range(3)]
-    v = [c[n] - a[n] for n in range(3)]
-    w = [d[n] - a[n] for n in range(3)]
-    cross = (u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0])
-    return sum(cross[n] * w[n] for n in range(3)) / 6.0
 
 
 def check(coords, tets, volumes):

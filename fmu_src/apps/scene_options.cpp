@@ -26,7 +26,8 @@ Eigen::Vector3d parse_vector(const std::string& text, const std::string& what) {
     }
     ++count;
   }
-  if (count != 3 || std::getline(stream, item)) throw ParameterError(what + ": expected three numbers X,Y,Z, got '" + text + "'");
+  if (count != 3 || std::getline(stream, item))
+    throw ParameterError(what + ": expected three numbers X,Y,Z, got '" + text + "'");
   return value;
 }
 
@@ -49,7 +50,8 @@ void add_scene_options(CLI::App& app, SceneOptions& options) {
   app.add_option("--poisson", options.material.poisson_ratio, "Poisson's ratio")->capture_default_str();
   app.add_option("--density", options.material.density_kg_per_m3, "Density [kg/m^3]")->capture_default_str();
   app.add_option("--mass-damping", options.damping.mass_damping_per_s, "Rayleigh alpha [1/s]")->capture_default_str();
-  app.add_option("--stiffness-damping", options.damping.stiffness_damping_s, "Rayleigh beta [s]")->capture_default_str();
+  app.add_option("--stiffness-damping", options.damping.stiffness_damping_s, "Rayleigh beta [s]")
+      ->capture_default_str();
   app.add_option("--gravity", options.gravity, "Gravity GX,GY,GZ [m/s^2]")->capture_default_str();
 }
 
@@ -66,9 +68,8 @@ Scene make_scene(const SceneOptions& options) {
   settings.body.material = options.material;
   settings.body.damping = options.damping;
   settings.body.gravity_m_per_s2 = parse_vector(options.gravity, "--gravity");
-  settings.body.fixed_vertices = options.fixed_bou.empty()
-                                     ? vertices_at_minimum(scene.mesh, 0, options.fixed_fraction)
-                                     : read_bou(options.fixed_bou, scene.mesh.vertex_count());
+  settings.body.fixed_vertices = options.fixed_bou.empty() ? vertices_at_minimum(scene.mesh, 0, options.fixed_fraction)
+                                                           : read_bou(options.fixed_bou, scene.mesh.vertex_count());
   return scene;
 }
 

@@ -11,8 +11,8 @@
 namespace tissue::apps {
 
 struct SceneOptions {
-  std::string mesh = "frog";  ///< "frog" = the embedded default, else a .veg/.node/.ele/.msh path
-  std::string fixed_bou;      ///< Vega .bou (1-indexed); empty = vertices at the minimum x
+  std::string mesh = "frog";     ///< "frog" = the embedded default, else a .veg/.node/.ele/.msh path
+  std::string fixed_bou;         ///< Vega .bou (1-indexed); empty = vertices at the minimum x
   double fixed_fraction = 0.01;  ///< of the x extent, when no .bou is given
   int steps = 100;
   double step_size_s = 0.01;

@@ -26,8 +26,10 @@ void validate(const SolverSettings& settings) {
 std::unique_ptr<LinearSolver> make_linear_solver(const SolverSettings& settings) {
   validate(settings);
   switch (settings.kind) {
-    case LinearSolverKind::pcg: return std::make_unique<PcgSolver>(settings.pcg);
-    case LinearSolverKind::cholmod: return std::make_unique<CholmodSolver>();
+    case LinearSolverKind::pcg:
+      return std::make_unique<PcgSolver>(settings.pcg);
+    case LinearSolverKind::cholmod:
+      return std::make_unique<CholmodSolver>();
   }
   throw ParameterError("unknown linear solver kind");
 }

@@ -10,7 +10,7 @@ TetMesh load_default_mesh(MeshWarnings* warnings) {
 }
 
 TetMesh load_mesh(std::string_view name_or_path, MeshWarnings* warnings) {
-  if (name_or_path.empty() || name_or_path == k_default_mesh_name) return load_default_mesh(warnings);
+  if (name_or_path.empty() || name_or_path == DEFAULT_MESH_NAME) return load_default_mesh(warnings);
   return read_mesh(std::filesystem::path(std::string(name_or_path)), warnings);
 }
 

@@ -15,7 +15,7 @@ std::string_view frog_veg_text();
 namespace tissue {
 
 /// Name used in messages and by --mesh to mean the embedded frog.
-inline constexpr std::string_view k_default_mesh_name = "frog";
+inline constexpr std::string_view DEFAULT_MESH_NAME = "frog";
 
 /// Parses the embedded frog.
 TetMesh load_default_mesh(MeshWarnings* warnings = nullptr);

@@ -99,7 +99,8 @@ BENCHMARK(BM_CholmodFactorizeAndSolve)->Arg(0)->Arg(1)->Unit(benchmark::kMicrose
 void BM_RotationExtraction(benchmark::State& state) {
   // Warm-started, as in a step: a small rotation and stretch since the last call.
   const Eigen::Matrix3d increment = Eigen::AngleAxisd(1e-3, Eigen::Vector3d(1, 2, 3).normalized()).toRotationMatrix();
-  Eigen::Matrix3d f = Eigen::AngleAxisd(0.4, Eigen::Vector3d::UnitZ()).toRotationMatrix() * Eigen::Vector3d(1.1, 0.95, 1.0).asDiagonal();
+  Eigen::Matrix3d f = Eigen::AngleAxisd(0.4, Eigen::Vector3d::UnitZ()).toRotationMatrix() *
+                      Eigen::Vector3d(1.1, 0.95, 1.0).asDiagonal();
   Eigen::Quaterniond warm = Eigen::Quaterniond::Identity();
   for (auto _ : state) {
     f = increment * f;

@@ -12,24 +12,24 @@
 namespace tissue {
 namespace {
 
-constexpr double k_length_m = 0.2;
-constexpr double k_side_m = 0.01;
-const Material k_material{1.0e8, 0.3, 1000.0};
-constexpr double k_gravity = 9.81;
+constexpr double LENGTH_M = 0.2;
+constexpr double SIDE_M = 0.01;
+const Material MATERIAL{1.0e8, 0.3, 1000.0};
+constexpr double GRAVITY = 9.81;
 
 double euler_bernoulli_tip_deflection_m() {
-  const double load_n_per_m = k_material.density_kg_per_m3 * k_gravity * k_side_m * k_side_m;
-  const double second_moment_m4 = std::pow(k_side_m, 4) / 12.0;
-  return load_n_per_m * std::pow(k_length_m, 4) / (8.0 * k_material.young_modulus_pa * second_moment_m4);
+  const double load_n_per_m = MATERIAL.density_kg_per_m3 * GRAVITY * SIDE_M * SIDE_M;
+  const double second_moment_m4 = std::pow(SIDE_M, 4) / 12.0;
+  return load_n_per_m * std::pow(LENGTH_M, 4) / (8.0 * MATERIAL.young_modulus_pa * second_moment_m4);
 }
 
 // Static sag of the mean of the tip-face vertices, with `cells_across` cubes over the side.
 double simulated_tip_deflection_m(int cells_across) {
-  const double edge_m = k_side_m / cells_across;
-  TetMesh mesh = make_box_mesh(static_cast<int>(std::lround(k_length_m / edge_m)), cells_across, cells_across, edge_m);
+  const double edge_m = SIDE_M / cells_across;
+  TetMesh mesh = make_box_mesh(static_cast<int>(std::lround(LENGTH_M / edge_m)), cells_across, cells_across, edge_m);
   TissueSettings settings;
-  settings.body.material = k_material;
-  settings.body.gravity_m_per_s2 = {0.0, -k_gravity, 0.0};
+  settings.body.material = MATERIAL;
+  settings.body.gravity_m_per_s2 = {0.0, -GRAVITY, 0.0};
   settings.body.fixed_vertices = vertices_at_minimum(mesh, 0, 1e-6);
   settings.solver.kind = LinearSolverKind::cholmod;
   // The quasi-static limit of backward Euler: with h^2 K >> M each step is a Newton step on
@@ -37,7 +37,7 @@ double simulated_tip_deflection_m(int cells_across) {
   settings.step_size_s = 100.0;
   std::vector<int> tip;
   for (int v = 0; v < mesh.vertex_count(); ++v) {
-    if (mesh.rest_positions_m[static_cast<size_t>(v)].x() > k_length_m - 1e-9) tip.push_back(v);
+    if (mesh.rest_positions_m[static_cast<size_t>(v)].x() > LENGTH_M - 1e-9) tip.push_back(v);
   }
   Tissue tissue(std::move(mesh), settings);
   for (int step = 0; step < 8; ++step) tissue.step();
@@ -50,7 +50,7 @@ double simulated_tip_deflection_m(int cells_across) {
 
 TEST(Cantilever, SettlesToEulerBernoulliDeflectionWithErrorShrinkingUnderRefinement) {
   const double expected = euler_bernoulli_tip_deflection_m();
-  ASSERT_LT(expected, 0.02 * k_length_m);  // small deflection: the linear beam theory applies
+  ASSERT_LT(expected, 0.02 * LENGTH_M);  // small deflection: the linear beam theory applies
   double previous_error = 1.0;
   std::vector<double> errors;
   for (int cells_across : {1, 2, 4, 8}) {

@@ -54,7 +54,8 @@ TEST(Conservation, DampedUnloadedEnergyNeverIncreases) {
   state.displacement_m.setZero(body.dof_count());
   state.velocity_m_per_s.setZero(body.dof_count());
   for (int row = 0; row < body.dofs().free_vertex_count(); ++row) {
-    const double x = body.mesh().rest_positions_m[static_cast<size_t>(body.dofs().row_vertex[static_cast<size_t>(row)])].x();
+    const double x =
+        body.mesh().rest_positions_m[static_cast<size_t>(body.dofs().row_vertex[static_cast<size_t>(row)])].x();
     state.displacement_m(3 * row + 1) = 0.03 * (x / 0.1) * (x / 0.1);
   }
   BackwardEuler integrator(std::make_unique<CholmodSolver>());

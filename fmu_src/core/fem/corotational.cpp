@@ -16,7 +16,8 @@ TetPositions gather(const Eigen::VectorXd& positions_m, const Tet& tet) {
 }
 
 // Linear stress of the rotated-back strain eps = sym(R^T F) - I.
-Eigen::Matrix3d corotated_stress(const Eigen::Matrix3d& rotation, const Eigen::Matrix3d& f, const LameParameters& lame) {
+Eigen::Matrix3d corotated_stress(const Eigen::Matrix3d& rotation, const Eigen::Matrix3d& f,
+                                 const LameParameters& lame) {
   const Eigen::Matrix3d s = rotation.transpose() * f;
   Eigen::Matrix3d strain = 0.5 * (s + s.transpose());
   strain.diagonal().array() -= 1.0;
@@ -98,10 +99,9 @@ std::vector<double> lumped_vertex_masses(const TetMesh& mesh, double density_kg_
   std::vector<double> masses(static_cast<size_t>(mesh.vertex_count()), 0.0);
   for (const Tet& tet : mesh.tets) {
     const auto& p = mesh.rest_positions_m;
-    const double quarter_mass =
-        0.25 * density_kg_per_m3 *
-        signed_tet_volume(p[static_cast<size_t>(tet[0])], p[static_cast<size_t>(tet[1])], p[static_cast<size_t>(tet[2])],
-                          p[static_cast<size_t>(tet[3])]);
+    const double quarter_mass = 0.25 * density_kg_per_m3 *
+                                signed_tet_volume(p[static_cast<size_t>(tet[0])], p[static_cast<size_t>(tet[1])],
+                                                  p[static_cast<size_t>(tet[2])], p[static_cast<size_t>(tet[3])]);
     for (int v : tet) masses[static_cast<size_t>(v)] += quarter_mass;
   }
   return masses;

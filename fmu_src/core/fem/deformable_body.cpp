@@ -13,7 +13,8 @@ BodySettings checked(BodySettings settings, int vertex_count) {
   if (!settings.gravity_m_per_s2.allFinite()) throw ParameterError("gravity must be finite");
   for (int v : settings.fixed_vertices) {
     if (v < 0 || v >= vertex_count) {
-      throw ParameterError("fixed vertex " + std::to_string(v) + " is outside [0, " + std::to_string(vertex_count) + ")");
+      throw ParameterError("fixed vertex " + std::to_string(v) + " is outside [0, " + std::to_string(vertex_count) +
+                           ")");
     }
   }
   std::sort(settings.fixed_vertices.begin(), settings.fixed_vertices.end());
@@ -68,7 +69,8 @@ void DeformableBody::evaluate(const Eigen::VectorXd& displacement_m, Eigen::Vect
   m_elasticity.evaluate(m_positions_m, m_vertex_forces_n, update_tangent ? &m_tangent : nullptr, &m_slots);
   internal_force_n.resize(dof_count());
   for (int row = 0; row < m_dofs.free_vertex_count(); ++row) {
-    internal_force_n.segment<3>(3 * row) = m_vertex_forces_n.segment<3>(3 * m_dofs.row_vertex[static_cast<size_t>(row)]);
+    internal_force_n.segment<3>(3 * row) =
+        m_vertex_forces_n.segment<3>(3 * m_dofs.row_vertex[static_cast<size_t>(row)]);
   }
 }
 

@@ -33,8 +33,7 @@ class DeformableBody final : public DynamicsModel {
   [[nodiscard]] const Eigen::VectorXd& mass_kg() const override { return m_mass_kg; }
   [[nodiscard]] const RayleighDamping& damping() const override { return m_settings.damping; }
   [[nodiscard]] const Eigen::VectorXd& external_force_n() const override { return m_external_force_n; }
-  void evaluate(const Eigen::VectorXd& displacement_m, Eigen::VectorXd& internal_force_n,
-                bool update_tangent) override;
+  void evaluate(const Eigen::VectorXd& displacement_m, Eigen::VectorXd& internal_force_n, bool update_tangent) override;
   [[nodiscard]] const BlockSparseMatrix& tangent() const override { return m_tangent; }
 
   [[nodiscard]] const TetMesh& mesh() const { return m_mesh; }
@@ -61,8 +60,8 @@ class DeformableBody final : public DynamicsModel {
   Eigen::VectorXd m_external_force_n;
   BlockSparseMatrix m_tangent;
   std::vector<TetSlots> m_slots;
-  Eigen::VectorXd m_positions_m;        // all vertices
-  Eigen::VectorXd m_vertex_forces_n;    // all vertices
+  Eigen::VectorXd m_positions_m;      // all vertices
+  Eigen::VectorXd m_vertex_forces_n;  // all vertices
 };
 
 }  // namespace tissue

@@ -8,7 +8,7 @@
 namespace tissue {
 
 struct RotationSettings {
-  int max_iterations = 16;             ///< iterations of the fast method before falling back to the SVD
+  int max_iterations = 16;            ///< iterations of the fast method before falling back to the SVD
   double angle_tolerance_rad = 1e-6;  ///< stop after a Newton step smaller than this (error ~ its square)
 };
 

@@ -13,7 +13,7 @@ namespace {
 /// with its three neighbours; for odd i+j+k the roles swap. The four face diagonals of the
 /// central tet are then the ones a neighbour (of the other parity) uses too. Each row is
 /// already ordered for positive volume.
-constexpr int k_split[2][5][4] = {
+constexpr int SPLIT[2][5][4] = {
     {{0, 3, 6, 5}, {1, 0, 5, 3}, {2, 3, 6, 0}, {4, 5, 0, 6}, {7, 6, 3, 5}},
     {{1, 2, 4, 7}, {0, 1, 2, 4}, {3, 2, 1, 7}, {5, 4, 7, 1}, {6, 7, 4, 2}},
 };
@@ -41,7 +41,7 @@ TetMesh make_box_mesh(int nx, int ny, int nz, double cube_edge_m) {
     for (int j = 0; j < ny; ++j) {
       for (int i = 0; i < nx; ++i) {
         const int parity = (i + j + k) % 2;
-        for (const auto& local : k_split[parity]) {
+        for (const auto& local : SPLIT[parity]) {
           Tet tet{};
           for (std::size_t n = 0; n < 4; ++n) {
             const int c = local[n];

@@ -21,10 +21,10 @@ namespace {
 
 /// Beyond this many individual "inverted" warnings, the rest are summarised in one line
 /// (a whole file in the opposite convention would otherwise produce one message per tet).
-constexpr int k_max_inverted_messages = 100;
+constexpr int MAX_INVERTED_MESSAGES = 100;
 
-/// Relative threshold of the zero-volume check: |V| <= k_zero_volume_rel * diag^3 (mesh_io.hpp).
-constexpr double k_zero_volume_rel = 1e-12;
+/// Relative threshold of the zero-volume check: |V| <= ZERO_VOLUME_REL * diag^3 (mesh_io.hpp).
+constexpr double ZERO_VOLUME_REL = 1e-12;
 
 std::string location(const std::string& source, int line) {
   if (line > 0) {
@@ -267,7 +267,7 @@ void validate_impl(TetMesh& mesh, const std::string& vertex_source, const std::s
     upper = upper.cwiseMax(p);
   }
   const double diagonal_m = (upper - lower).norm();
-  const double zero_volume_m3 = k_zero_volume_rel * diagonal_m * diagonal_m * diagonal_m;
+  const double zero_volume_m3 = ZERO_VOLUME_REL * diagonal_m * diagonal_m * diagonal_m;
 
   std::vector<char> used(static_cast<std::size_t>(vertex_count), 0);
   int inverted = 0;
@@ -300,7 +300,7 @@ void validate_impl(TetMesh& mesh, const std::string& vertex_source, const std::s
     if (volume_m3 < 0.0) {
       std::swap(tet[2], tet[3]);
       ++inverted;
-      if (warnings != nullptr && inverted <= k_max_inverted_messages) {
+      if (warnings != nullptr && inverted <= MAX_INVERTED_MESSAGES) {
         warnings->messages.push_back(location(element_source, element_line(t)) + ": " + label +
                                      "inverted tet (negative volume), re-oriented by swapping its vertices 3 and 4");
       }
@@ -309,8 +309,8 @@ void validate_impl(TetMesh& mesh, const std::string& vertex_source, const std::s
       used[static_cast<std::size_t>(v)] = 1;
     }
   }
-  if (warnings != nullptr && inverted > k_max_inverted_messages) {
-    warnings->messages.push_back(element_source + ": " + std::to_string(inverted - k_max_inverted_messages) +
+  if (warnings != nullptr && inverted > MAX_INVERTED_MESSAGES) {
+    warnings->messages.push_back(element_source + ": " + std::to_string(inverted - MAX_INVERTED_MESSAGES) +
                                  " more inverted tets re-oriented (" + std::to_string(inverted) + " in all)");
   }
 

@@ -28,7 +28,7 @@ std::vector<FaceKey> sorted_faces(const TetMesh& mesh) {
   for (int t = 0; t < mesh.tet_count(); ++t) {
     const Tet& tet = mesh.tets[static_cast<std::size_t>(t)];
     for (int k = 0; k < 4; ++k) {
-      const auto& local = k_tet_faces[static_cast<std::size_t>(k)];
+      const auto& local = TET_FACES[static_cast<std::size_t>(k)];
       std::array<int, 3> key = {tet[static_cast<std::size_t>(local[0])], tet[static_cast<std::size_t>(local[1])],
                                 tet[static_cast<std::size_t>(local[2])]};
       std::sort(key.begin(), key.end());
@@ -79,7 +79,7 @@ SurfaceMesh extract_surface(const TetMesh& mesh) {
     const int t = tet_face / 4;
     const int k = tet_face % 4;
     const Tet& tet = mesh.tets[static_cast<std::size_t>(t)];
-    const auto& local = k_tet_faces[static_cast<std::size_t>(k)];
+    const auto& local = TET_FACES[static_cast<std::size_t>(k)];
     surface.triangles.push_back({tet[static_cast<std::size_t>(local[0])], tet[static_cast<std::size_t>(local[1])],
                                  tet[static_cast<std::size_t>(local[2])]});
     surface.triangle_tet.push_back(t);
@@ -117,7 +117,7 @@ TetAdjacency build_adjacency(const TetMesh& mesh) {
   for (int t = 0; t < tet_count; ++t) {
     const Tet& tet = mesh.tets[static_cast<std::size_t>(t)];
     for (int k = 0; k < 6; ++k) {
-      const auto& local = k_tet_edges[static_cast<std::size_t>(k)];
+      const auto& local = TET_EDGES[static_cast<std::size_t>(k)];
       const int a = tet[static_cast<std::size_t>(local[0])];
       const int b = tet[static_cast<std::size_t>(local[1])];
       edge_keys.push_back({{std::min(a, b), std::max(a, b)}, 6 * t + k});

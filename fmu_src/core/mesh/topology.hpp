@@ -11,9 +11,9 @@ namespace tissue {
 
 /// Local faces of a tet: face k is opposite vertex k, wound so that its normal points outward
 /// for a positively oriented tet.
-inline constexpr std::array<std::array<int, 3>, 4> k_tet_faces = {{{1, 2, 3}, {0, 3, 2}, {0, 1, 3}, {0, 2, 1}}};
+inline constexpr std::array<std::array<int, 3>, 4> TET_FACES = {{{1, 2, 3}, {0, 3, 2}, {0, 1, 3}, {0, 2, 1}}};
 /// Local edges of a tet (pairs of local vertex indices).
-inline constexpr std::array<std::array<int, 2>, 6> k_tet_edges = {{{0, 1}, {0, 2}, {0, 3}, {1, 2}, {1, 3}, {2, 3}}};
+inline constexpr std::array<std::array<int, 2>, 6> TET_EDGES = {{{0, 1}, {0, 2}, {0, 3}, {1, 2}, {1, 3}, {2, 3}}};
 
 struct SurfaceMesh {
   std::vector<std::array<int, 3>> triangles;  ///< mesh vertex ids, outward normal (right-hand rule)
@@ -31,7 +31,7 @@ struct TetAdjacency {
   std::vector<std::array<int, 4>> face_neighbor;
   /// Unique edges (v0 < v1).
   std::vector<std::array<int, 2>> edges;
-  /// tet_edges[t][k]: id of local edge k (k_tet_edges) of tet t.
+  /// tet_edges[t][k]: id of local edge k (TET_EDGES) of tet t.
   std::vector<std::array<int, 6>> tet_edges;
   /// CSR: the tets around edge e are edge_tets[edge_tets_begin[e] .. edge_tets_begin[e+1]).
   std::vector<int> edge_tets_begin;

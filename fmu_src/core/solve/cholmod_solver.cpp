@@ -84,8 +84,8 @@ struct CholmodSolver::Impl {
   void check_status(const char* what) const {
     if (common.status < 0) {
       throw SolverError(std::string("CholmodSolver: ") + what + " failed (CHOLMOD status " +
-                        std::to_string(common.status) + (common.status == CHOLMOD_OUT_OF_MEMORY ? ", out of memory" : "") +
-                        ")");
+                        std::to_string(common.status) +
+                        (common.status == CHOLMOD_OUT_OF_MEMORY ? ", out of memory" : "") + ")");
     }
   }
 
@@ -108,8 +108,8 @@ struct CholmodSolver::Impl {
       for (int slot = begin; slot < begin + stiffness.row_size(block_row); ++slot) {
         const int block_col = stiffness.slot_column(slot);
         if (block_col > block_row) continue;
-        for (int a = 0; a < 3; ++a) {      // scalar column j = 3 J + a of A (row of K)
-          for (int b = 0; b < 3; ++b) {    // scalar row i = 3 I + b of A (column of K)
+        for (int a = 0; a < 3; ++a) {    // scalar column j = 3 J + a of A (row of K)
+          for (int b = 0; b < 3; ++b) {  // scalar row i = 3 I + b of A (column of K)
             const int i = 3 * block_col + b;
             if (i > 3 * block_row + a) continue;
             column[a].emplace_back(i, 9 * slot + a + 3 * b);  // K block (a, b), column-major

@@ -13,7 +13,8 @@ void ShiftedSystem::multiply(const Eigen::VectorXd& x, Eigen::VectorXd& y) const
 }
 
 void ShiftedSystem::check_sizes(const Eigen::VectorXd& b, const Eigen::VectorXd& x) const {
-  if (stiffness == nullptr || diagonal == nullptr) throw SolverError("linear solve: the system has no stiffness or no diagonal");
+  if (stiffness == nullptr || diagonal == nullptr)
+    throw SolverError("linear solve: the system has no stiffness or no diagonal");
   const long n = rows();
   const auto describe = [n](const char* what, long size) {
     return std::string("linear solve: ") + what + " has length " + std::to_string(size) + ", the system has " +

@@ -20,7 +20,7 @@ namespace {
 
 // Slots given to each spare row of a matrix that started empty (no mean row size to go by):
 // a vertex of a tet mesh typically couples to 10-20 others.
-constexpr int k_default_spare_row_capacity = 16;
+constexpr int DEFAULT_SPARE_ROW_CAPACITY = 16;
 
 int spare_row_count(double fraction, int rows) {
   return static_cast<int>(std::ceil(fraction * static_cast<double>(rows)));
@@ -34,7 +34,8 @@ BlockSparseMatrix::BlockSparseMatrix(const std::vector<std::vector<int>>& patter
     : m_reserve(reserve) {
   if (!(reserve.extra_row_fraction >= 0.0) || !std::isfinite(reserve.extra_row_fraction) ||
       reserve.row_capacity_factor < 1) {
-    throw std::invalid_argument("BlockSparseMatrix: reserve needs extra_row_fraction >= 0 and row_capacity_factor >= 1");
+    throw std::invalid_argument(
+        "BlockSparseMatrix: reserve needs extra_row_fraction >= 0 and row_capacity_factor >= 1");
   }
   const int n = static_cast<int>(pattern.size());
 
@@ -57,9 +58,10 @@ BlockSparseMatrix::BlockSparseMatrix(const std::vector<std::vector<int>>& patter
   }
 
   const int spare_rows = spare_row_count(reserve.extra_row_fraction, n);
-  m_spare_row_capacity = n > 0 ? static_cast<int>((total_capacity + n - 1) / n) : k_default_spare_row_capacity;
+  m_spare_row_capacity = n > 0 ? static_cast<int>((total_capacity + n - 1) / n) : DEFAULT_SPARE_ROW_CAPACITY;
   const long slot_count = total_capacity + static_cast<long>(spare_rows) * m_spare_row_capacity;
-  if (slot_count > (1L << 31) / 9 - 1) throw std::length_error("BlockSparseMatrix: too many blocks for int slot indices");
+  if (slot_count > (1L << 31) / 9 - 1)
+    throw std::length_error("BlockSparseMatrix: too many blocks for int slot indices");
 
   m_row_begin.resize(to_size(n));
   m_row_size.resize(to_size(n));
@@ -108,8 +110,8 @@ void BlockSparseMatrix::set_zero() {
 void BlockSparseMatrix::multiply(const Eigen::VectorXd& x, Eigen::VectorXd& y) const {
   const int n = block_rows();
   if (x.size() != rows()) {
-    throw std::invalid_argument("BlockSparseMatrix::multiply: x has length " + std::to_string(x.size()) + ", expected " +
-                                std::to_string(rows()));
+    throw std::invalid_argument("BlockSparseMatrix::multiply: x has length " + std::to_string(x.size()) +
+                                ", expected " + std::to_string(rows()));
   }
   if (&x == &y) throw std::invalid_argument("BlockSparseMatrix::multiply: x and y must be different vectors");
   y.resize(rows());  // no-op (and no allocation) when the size is right
@@ -152,7 +154,7 @@ void BlockSparseMatrix::diagonal(Eigen::VectorXd& diagonal) const {
 
 void BlockSparseMatrix::relayout(int grow_row, int spare_rows) {
   const int n = block_rows();
-  if (m_spare_row_capacity < 1) m_spare_row_capacity = k_default_spare_row_capacity;
+  if (m_spare_row_capacity < 1) m_spare_row_capacity = DEFAULT_SPARE_ROW_CAPACITY;
 
   std::vector<int> capacity(to_size(n));
   long slot_count = 0;
@@ -164,7 +166,8 @@ void BlockSparseMatrix::relayout(int grow_row, int spare_rows) {
     slot_count += capacity[to_size(r)];
   }
   slot_count += static_cast<long>(spare_rows) * m_spare_row_capacity;
-  if (slot_count > (1L << 31) / 9 - 1) throw std::length_error("BlockSparseMatrix: too many blocks for int slot indices");
+  if (slot_count > (1L << 31) / 9 - 1)
+    throw std::length_error("BlockSparseMatrix: too many blocks for int slot indices");
 
   std::vector<int> row_begin(to_size(n));
   std::vector<int> column(static_cast<size_t>(slot_count), -1);

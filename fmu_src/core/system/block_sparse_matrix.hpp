@@ -34,7 +34,9 @@ class BlockSparseMatrix {
   /// Slot of block (row, col), or -1 if absent. Searches: for set-up code, not for a step.
   [[nodiscard]] int find_slot(int row, int col) const;
 
-  [[nodiscard]] Eigen::Map<Eigen::Matrix3d> block(int slot) { return Eigen::Map<Eigen::Matrix3d>(&m_values[9 * static_cast<size_t>(slot)]); }
+  [[nodiscard]] Eigen::Map<Eigen::Matrix3d> block(int slot) {
+    return Eigen::Map<Eigen::Matrix3d>(&m_values[9 * static_cast<size_t>(slot)]);
+  }
   [[nodiscard]] Eigen::Map<const Eigen::Matrix3d> block(int slot) const {
     return Eigen::Map<const Eigen::Matrix3d>(&m_values[9 * static_cast<size_t>(slot)]);
   }
@@ -77,14 +79,14 @@ class BlockSparseMatrix {
   /// empty rows of m_spare_row_capacity slots follow the last row. Rows come out sorted.
   void relayout(int grow_row, int spare_rows);
 
-  std::vector<int> m_row_begin;     // first slot of each block row
-  std::vector<int> m_row_size;      // blocks in use in each row
-  std::vector<int> m_row_capacity;  // slots reserved for each row
-  std::vector<int> m_column;        // block column of each slot (-1 = unused)
-  std::vector<double> m_values;     // 9 per slot, column-major 3x3
-  std::vector<int> m_diagonal_slot; // slot of the diagonal block of each row (always present)
+  std::vector<int> m_row_begin;      // first slot of each block row
+  std::vector<int> m_row_size;       // blocks in use in each row
+  std::vector<int> m_row_capacity;   // slots reserved for each row
+  std::vector<int> m_column;         // block column of each slot (-1 = unused)
+  std::vector<double> m_values;      // 9 per slot, column-major 3x3
+  std::vector<int> m_diagonal_slot;  // slot of the diagonal block of each row (always present)
   int m_nonzero_blocks = 0;
-  int m_spare_row_capacity = 0;     // slots given to each spare (appended) row
+  int m_spare_row_capacity = 0;  // slots given to each spare (appended) row
   int m_block_row_capacity = 0;
   Reserve m_reserve;
   std::uint64_t m_pattern_revision = 0;

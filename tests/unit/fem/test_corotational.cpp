@@ -13,7 +13,7 @@
 namespace tissue {
 namespace {
 
-const Material k_material{1.0e5, 0.4, 1000.0};
+const Material MATERIAL{1.0e5, 0.4, 1000.0};
 
 TetMesh one_tet() {
   TetMesh mesh;
@@ -38,7 +38,7 @@ Eigen::VectorXd rigidly_moved(const TetMesh& mesh, const Eigen::Matrix3d& rotati
 // The whole model on one tet with nothing fixed: forces and the assembled tangent as dense arrays.
 struct OneTetModel {
   TetMesh mesh = one_tet();
-  CorotationalElasticity model{mesh, k_material};
+  CorotationalElasticity model{mesh, MATERIAL};
   DofMap dofs = make_dof_map(4, {});
   BlockSparseMatrix tangent{stiffness_pattern(mesh, dofs)};
   std::vector<TetSlots> slots = make_tet_slots(mesh, dofs, tangent);
@@ -84,7 +84,8 @@ TEST(Corotational, ForceAndTangentEqualTheTextbookFormulas) {
   Matrix12d block_rotation = Matrix12d::Zero();
   for (int i = 0; i < 4; ++i) block_rotation.block<3, 3>(3 * i, 3 * i) = r;
   const Matrix12d k_e = linear_stiffness_matrix(tet.model.rest(0), tet.model.lame());
-  const Eigen::VectorXd expected = block_rotation * k_e * (block_rotation.transpose() * x - flatten(tet.mesh.rest_positions_m));
+  const Eigen::VectorXd expected =
+      block_rotation * k_e * (block_rotation.transpose() * x - flatten(tet.mesh.rest_positions_m));
   EXPECT_LT((f - expected).norm(), 1e-12 * expected.norm());
   const Matrix12d expected_tangent = block_rotation * k_e * block_rotation.transpose();
   EXPECT_LT((tet.dense_tangent() - expected_tangent).norm(), 1e-12 * expected_tangent.norm());

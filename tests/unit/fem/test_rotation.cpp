@@ -25,7 +25,8 @@ TEST(Rotation, MatchesPolarDecompositionForPositiveDeterminant) {
   for (int trial = 0; trial < 500; ++trial) {
     const Eigen::Matrix3d r_true = random_rotation(rng);
     const Eigen::Matrix3d u = random_rotation(rng);
-    const Eigen::Matrix3d s = u * Eigen::Vector3d(stretch(rng), stretch(rng), stretch(rng)).asDiagonal() * u.transpose();
+    const Eigen::Matrix3d s =
+        u * Eigen::Vector3d(stretch(rng), stretch(rng), stretch(rng)).asDiagonal() * u.transpose();
     const Eigen::Matrix3d f = r_true * s;  // polar decomposition by construction
     Eigen::Quaterniond cold = Eigen::Quaterniond::Identity();
     const Eigen::Matrix3d r = extract_rotation(f, cold);

@@ -1,8 +1,8 @@
 // Tests of the linear tet: shape gradients, volume and the stiffness K_e (eq. 3.12).
 #include "core/fem/tet_element.hpp"
 
-#include <Eigen/Eigenvalues>
 #include <gtest/gtest.h>
+#include <Eigen/Eigenvalues>
 
 #include <algorithm>
 

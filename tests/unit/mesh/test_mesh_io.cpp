@@ -17,8 +17,8 @@
 namespace tissue {
 namespace {
 
-const std::filesystem::path k_mesh_dir = TISSUE_MESH_DIR;
-const std::filesystem::path k_vega_dir = std::filesystem::path(TISSUE_SHARED_DIR) / "meshes" / "vega";
+const std::filesystem::path MESH_DIR = TISSUE_MESH_DIR;
+const std::filesystem::path VEGA_DIR = std::filesystem::path(TISSUE_SHARED_DIR) / "meshes" / "vega";
 
 /// Runs `load`, expects a MeshError, and checks its line, its 0-based element and that its
 /// message contains "<source>:<line>: " and every one of `fragments`.
@@ -97,7 +97,7 @@ class TempDir {
 
 // Two tets sharing the face (2, 3, 4): vertices 1-4 form a positive unit corner tet, vertex 5
 // lies beyond the face 2-3-4. Line numbers are referred to in the tests below.
-const std::string k_two_tets_veg =
+const std::string TWO_TETS_VEG =
     "# two tets\n"      // 1
     "*VERTICES\n"       // 2
     "5 3 0 0\n"         // 3
@@ -137,7 +137,7 @@ std::string replace_line(const std::string& text, int line, const std::string& r
 
 TEST(VegReader, ReadsVerticesAndTetsSkippingOtherSections) {
   MeshWarnings warnings;
-  const TetMesh mesh = parse_veg(k_two_tets_veg, "test.veg", &warnings);
+  const TetMesh mesh = parse_veg(TWO_TETS_VEG, "test.veg", &warnings);
   ASSERT_EQ(mesh.vertex_count(), 5);
   ASSERT_EQ(mesh.tet_count(), 2);
   EXPECT_EQ(mesh.tets[0], (Tet{0, 1, 2, 3}));
@@ -150,7 +150,7 @@ TEST(VegReader, ReadsVerticesAndTetsSkippingOtherSections) {
 
 TEST(VegReader, InvertedTetIsReorientedWithWarning) {
   // Element 2 written with its last two vertices the other way round: negative volume.
-  const std::string text = replace_line(k_two_tets_veg, 14, "2 2 3 5 4");
+  const std::string text = replace_line(TWO_TETS_VEG, 14, "2 2 3 5 4");
   MeshWarnings warnings;
   const TetMesh mesh = parse_veg(text, "test.veg", &warnings);
   ASSERT_EQ(warnings.messages.size(), 1U);
@@ -164,80 +164,79 @@ TEST(VegReader, InvertedTetIsReorientedWithWarning) {
 }
 
 TEST(VegReader, RefusesOutOfRangeVertexIndex) {
-  expect_veg_refused(replace_line(k_two_tets_veg, 14, "2 2 3 6 4"), 14, 1, {"element 2", "6", "out of range [1, 5]"});
-  expect_veg_refused(replace_line(k_two_tets_veg, 13, "1 0 2 3 4"), 13, 0, {"element 1", "0", "out of range"});
-  expect_veg_refused(replace_line(k_two_tets_veg, 13, "1 -3 2 3 4"), 13, 0, {"element 1", "-3", "out of range"});
+  expect_veg_refused(replace_line(TWO_TETS_VEG, 14, "2 2 3 6 4"), 14, 1, {"element 2", "6", "out of range [1, 5]"});
+  expect_veg_refused(replace_line(TWO_TETS_VEG, 13, "1 0 2 3 4"), 13, 0, {"element 1", "0", "out of range"});
+  expect_veg_refused(replace_line(TWO_TETS_VEG, 13, "1 -3 2 3 4"), 13, 0, {"element 1", "-3", "out of range"});
 }
 
 TEST(VegReader, RefusesNonFiniteCoordinates) {
-  expect_veg_refused(replace_line(k_two_tets_veg, 6, "3 0 nan 0"), 6, -1, {"vertex 3", "not finite"});
-  expect_veg_refused(replace_line(k_two_tets_veg, 7, "4 0 0 inf"), 7, -1, {"vertex 4", "not finite"});
-  expect_veg_refused(replace_line(k_two_tets_veg, 8, "5 1e999 1 1"), 8, -1, {"vertex 5", "not finite"});
-  expect_veg_refused(replace_line(k_two_tets_veg, 8, "5 -1e999 1 1"), 8, -1, {"vertex 5", "not finite"});
+  expect_veg_refused(replace_line(TWO_TETS_VEG, 6, "3 0 nan 0"), 6, -1, {"vertex 3", "not finite"});
+  expect_veg_refused(replace_line(TWO_TETS_VEG, 7, "4 0 0 inf"), 7, -1, {"vertex 4", "not finite"});
+  expect_veg_refused(replace_line(TWO_TETS_VEG, 8, "5 1e999 1 1"), 8, -1, {"vertex 5", "not finite"});
+  expect_veg_refused(replace_line(TWO_TETS_VEG, 8, "5 -1e999 1 1"), 8, -1, {"vertex 5", "not finite"});
   // Underflow is harmless: read as 0.
-  EXPECT_EQ(parse_veg(replace_line(k_two_tets_veg, 8, "5 1 1 1e-999"), "test.veg").rest_positions_m[4].z(), 0.0);
+  EXPECT_EQ(parse_veg(replace_line(TWO_TETS_VEG, 8, "5 1 1 1e-999"), "test.veg").rest_positions_m[4].z(), 0.0);
 }
 
 TEST(VegReader, RefusesNonNumericTokens) {
-  expect_veg_refused(replace_line(k_two_tets_veg, 5, "2 1 zero 0"), 5, -1, {"vertex 2", "'zero' is not a number"});
-  expect_veg_refused(replace_line(k_two_tets_veg, 5, "2 1 0.5x 0"), 5, -1, {"vertex 2", "'0.5x'"});
-  expect_veg_refused(replace_line(k_two_tets_veg, 14, "2 2 3 five 4"), 14, 1,
-                     {"element 2", "'five' is not an integer"});
-  expect_veg_refused(replace_line(k_two_tets_veg, 14, "2 2 3 5.0 4"), 14, 1, {"element 2", "'5.0'"});
-  expect_veg_refused(replace_line(k_two_tets_veg, 3, "five 3 0 0"), 3, -1, {"*VERTICES header", "'five'"});
+  expect_veg_refused(replace_line(TWO_TETS_VEG, 5, "2 1 zero 0"), 5, -1, {"vertex 2", "'zero' is not a number"});
+  expect_veg_refused(replace_line(TWO_TETS_VEG, 5, "2 1 0.5x 0"), 5, -1, {"vertex 2", "'0.5x'"});
+  expect_veg_refused(replace_line(TWO_TETS_VEG, 14, "2 2 3 five 4"), 14, 1, {"element 2", "'five' is not an integer"});
+  expect_veg_refused(replace_line(TWO_TETS_VEG, 14, "2 2 3 5.0 4"), 14, 1, {"element 2", "'5.0'"});
+  expect_veg_refused(replace_line(TWO_TETS_VEG, 3, "five 3 0 0"), 3, -1, {"*VERTICES header", "'five'"});
 }
 
 TEST(VegReader, RefusesWrongColumnCountsAndIds) {
-  expect_veg_refused(replace_line(k_two_tets_veg, 14, "2 2 3 5"), 14, 1, {"element 2", "expected 5 values"});
-  expect_veg_refused(replace_line(k_two_tets_veg, 14, "2 2 3 5 4 1"), 14, 1, {"element 2", "expected 5 values"});
-  expect_veg_refused(replace_line(k_two_tets_veg, 6, "3 0 1"), 6, -1, {"vertex 3", "expected 4 values"});
-  expect_veg_refused(replace_line(k_two_tets_veg, 6, "7 0 1 0"), 6, -1, {"vertex 3", "id 7 out of sequence"});
-  expect_veg_refused(replace_line(k_two_tets_veg, 14, "9 2 3 5 4"), 14, 1, {"element 2", "id 9 out of sequence"});
-  expect_veg_refused(replace_line(k_two_tets_veg, 11, "CUBIC"), 11, -1, {"'CUBIC' is not supported"});
-  expect_veg_refused(replace_line(k_two_tets_veg, 12, "2 8 0"), 12, -1, {"*ELEMENTS header", "expected 4"});
-  expect_veg_refused(replace_line(k_two_tets_veg, 3, "5 2 0 0"), 3, -1, {"*VERTICES header", "expected 3"});
+  expect_veg_refused(replace_line(TWO_TETS_VEG, 14, "2 2 3 5"), 14, 1, {"element 2", "expected 5 values"});
+  expect_veg_refused(replace_line(TWO_TETS_VEG, 14, "2 2 3 5 4 1"), 14, 1, {"element 2", "expected 5 values"});
+  expect_veg_refused(replace_line(TWO_TETS_VEG, 6, "3 0 1"), 6, -1, {"vertex 3", "expected 4 values"});
+  expect_veg_refused(replace_line(TWO_TETS_VEG, 6, "7 0 1 0"), 6, -1, {"vertex 3", "id 7 out of sequence"});
+  expect_veg_refused(replace_line(TWO_TETS_VEG, 14, "9 2 3 5 4"), 14, 1, {"element 2", "id 9 out of sequence"});
+  expect_veg_refused(replace_line(TWO_TETS_VEG, 11, "CUBIC"), 11, -1, {"'CUBIC' is not supported"});
+  expect_veg_refused(replace_line(TWO_TETS_VEG, 12, "2 8 0"), 12, -1, {"*ELEMENTS header", "expected 4"});
+  expect_veg_refused(replace_line(TWO_TETS_VEG, 3, "5 2 0 0"), 3, -1, {"*VERTICES header", "expected 3"});
 }
 
 TEST(VegReader, RefusesMissingSections) {
   // Drop *ELEMENTS and everything after it.
-  const std::string no_elements = k_two_tets_veg.substr(0, k_two_tets_veg.find("*ELEMENTS"));
+  const std::string no_elements = TWO_TETS_VEG.substr(0, TWO_TETS_VEG.find("*ELEMENTS"));
   expect_veg_refused(no_elements, 0, -1, {"missing *ELEMENTS section"});
-  std::string no_vertices = k_two_tets_veg;
+  std::string no_vertices = TWO_TETS_VEG;
   no_vertices.erase(no_vertices.find("*VERTICES"), no_vertices.find("*ELEMENTS") - no_vertices.find("*VERTICES"));
   expect_veg_refused(no_vertices, 0, -1, {"missing *VERTICES section"});
   expect_veg_refused("", 0, -1, {"missing *VERTICES"});
-  expect_veg_refused(replace_line(k_two_tets_veg, 11, ""), 12, -1, {"'2' is not supported"});
+  expect_veg_refused(replace_line(TWO_TETS_VEG, 11, ""), 12, -1, {"'2' is not supported"});
 }
 
 TEST(VegReader, RefusesWrongCountsAndTruncation) {
   // Header promises 6 vertices; the 6th "line" is the *ELEMENTS keyword on line 10.
-  expect_veg_refused(replace_line(k_two_tets_veg, 3, "6 3 0 0"), 10, -1, {"*VERTICES", "truncated", "expected 6"});
+  expect_veg_refused(replace_line(TWO_TETS_VEG, 3, "6 3 0 0"), 10, -1, {"*VERTICES", "truncated", "expected 6"});
   // Header promises 4 vertices; line 8 is one too many.
-  expect_veg_refused(replace_line(k_two_tets_veg, 3, "4 3 0 0"), 8, -1, {"*VERTICES", "more lines than the count 4"});
-  expect_veg_refused(replace_line(k_two_tets_veg, 12, "3 4 0"), 16, -1, {"*ELEMENTS", "truncated", "expected 3"});
-  expect_veg_refused(replace_line(k_two_tets_veg, 12, "1 4 0"), 14, -1, {"*ELEMENTS", "more lines than the count 1"});
+  expect_veg_refused(replace_line(TWO_TETS_VEG, 3, "4 3 0 0"), 8, -1, {"*VERTICES", "more lines than the count 4"});
+  expect_veg_refused(replace_line(TWO_TETS_VEG, 12, "3 4 0"), 16, -1, {"*ELEMENTS", "truncated", "expected 3"});
+  expect_veg_refused(replace_line(TWO_TETS_VEG, 12, "1 4 0"), 14, -1, {"*ELEMENTS", "more lines than the count 1"});
   // File cut after the first element: truncation is reported at the last line.
-  const std::string cut = k_two_tets_veg.substr(0, k_two_tets_veg.find("2 2 3 4 5"));
+  const std::string cut = TWO_TETS_VEG.substr(0, TWO_TETS_VEG.find("2 2 3 4 5"));
   expect_veg_refused(cut, 13, -1, {"*ELEMENTS", "truncated", "expected 2 elements, found 1"});
   // Cut in the middle of a vertex line.
-  const std::string cut_vertex = k_two_tets_veg.substr(0, k_two_tets_veg.find("3 0 1 0") + 4);
+  const std::string cut_vertex = TWO_TETS_VEG.substr(0, TWO_TETS_VEG.find("3 0 1 0") + 4);
   expect_veg_refused(cut_vertex, 6, -1, {"vertex 3", "expected 4 values"});
   // A stray data line before any section.
-  expect_veg_refused("1 2 3\n" + k_two_tets_veg, 1, -1, {"expected a *SECTION"});
+  expect_veg_refused("1 2 3\n" + TWO_TETS_VEG, 1, -1, {"expected a *SECTION"});
 }
 
 TEST(VegReader, RefusesZeroVolumeTets) {
-  expect_veg_refused(replace_line(k_two_tets_veg, 14, "2 2 3 2 4"), 14, 1, {"element 2", "zero-volume", "repeated"});
+  expect_veg_refused(replace_line(TWO_TETS_VEG, 14, "2 2 3 2 4"), 14, 1, {"element 2", "zero-volume", "repeated"});
   // Vertex 5 moved into the plane x + y + z = 1 of vertices 2, 3, 4.
-  expect_veg_refused(replace_line(k_two_tets_veg, 8, "5 0.5 0.25 0.25"), 14, 1, {"element 2", "zero-volume"});
+  expect_veg_refused(replace_line(TWO_TETS_VEG, 8, "5 0.5 0.25 0.25"), 14, 1, {"element 2", "zero-volume"});
   // The threshold is relative, 1e-12 * diag^3 = 5.2e-12 here (diagonal sqrt(3)): a lift of
   // 1e-12 gives a volume of 1.7e-13 (refused), a lift of 1e-9 gives 1.7e-10 (accepted).
-  expect_veg_refused(replace_line(k_two_tets_veg, 8, "5 0.5 0.25 0.250000000001"), 14, 1, {"element 2", "zero-volume"});
-  EXPECT_NO_THROW(parse_veg(replace_line(k_two_tets_veg, 8, "5 0.5 0.25 0.250000001"), "test.veg"));
+  expect_veg_refused(replace_line(TWO_TETS_VEG, 8, "5 0.5 0.25 0.250000000001"), 14, 1, {"element 2", "zero-volume"});
+  EXPECT_NO_THROW(parse_veg(replace_line(TWO_TETS_VEG, 8, "5 0.5 0.25 0.250000001"), "test.veg"));
 }
 
 TEST(VegReader, RefusesDuplicateTetsNamingBoth) {
-  std::string text = replace_line(k_two_tets_veg, 12, "3 4 0");
+  std::string text = replace_line(TWO_TETS_VEG, 12, "3 4 0");
   text = replace_line(text, 14, "2 2 3 4 5\n3 3 1 4 2");  // same vertex set as element 1
   expect_veg_refused(text, 15, 2, {"element 3", "duplicate of element 1", "line 13"});
 }
@@ -262,7 +261,7 @@ TEST(VegReader, ReadsVegaReferenceMeshes) {
   for (const Reference& reference : references) {
     SCOPED_TRACE(reference.file);
     MeshWarnings warnings;
-    const TetMesh mesh = read_mesh(k_vega_dir / reference.file, &warnings);
+    const TetMesh mesh = read_mesh(VEGA_DIR / reference.file, &warnings);
     EXPECT_EQ(mesh.vertex_count(), reference.vertices);
     EXPECT_EQ(mesh.tet_count(), reference.tets);
     expect_all_positive(mesh);
@@ -271,12 +270,12 @@ TEST(VegReader, ReadsVegaReferenceMeshes) {
     }
   }
   // The first vertex of the bridge, as written in the file.
-  const TetMesh bridge = read_veg(k_vega_dir / "simpleBridge/simpleBridge-ic_128_0.15_.1.veg");
+  const TetMesh bridge = read_veg(VEGA_DIR / "simpleBridge/simpleBridge-ic_128_0.15_.1.veg");
   EXPECT_EQ(bridge.rest_positions_m[0], Eigen::Vector3d(-6.75193, 1.76055, 0.961333));
 }
 
 TEST(BouReader, ReadsVegaFixedVertices) {
-  const std::vector<int> fixed = read_bou(k_vega_dir / "simpleBridge/simpleBridge.bou", 4000);
+  const std::vector<int> fixed = read_bou(VEGA_DIR / "simpleBridge/simpleBridge.bou", 4000);
   ASSERT_FALSE(fixed.empty());
   EXPECT_TRUE(std::is_sorted(fixed.begin(), fixed.end()));
   EXPECT_EQ(std::adjacent_find(fixed.begin(), fixed.end()), fixed.end());
@@ -378,7 +377,7 @@ TEST(TetgenReader, RefusesBadInputNamingTheRightFile) {
 
 // Node tags 10, 20, 30, 40 (one block) and 7 (a second block): non-contiguous. Elements: a
 // point and a triangle that must be ignored, two tets (tags 100 and 200).
-const std::string k_two_tets_msh =
+const std::string TWO_TETS_MSH =
     "$MeshFormat\n"        // 1
     "4.1 0 8\n"            // 2
     "$EndMeshFormat\n"     // 3
@@ -414,7 +413,7 @@ const std::string k_two_tets_msh =
 
 TEST(GmshReader, MapsNodeTagsAndKeepsOnlyTets) {
   MeshWarnings warnings;
-  const TetMesh mesh = parse_gmsh(k_two_tets_msh, "test.msh", &warnings);
+  const TetMesh mesh = parse_gmsh(TWO_TETS_MSH, "test.msh", &warnings);
   ASSERT_EQ(mesh.vertex_count(), 5);
   ASSERT_EQ(mesh.tet_count(), 2);
   EXPECT_EQ(mesh.tets[0], (Tet{0, 1, 2, 3}));
@@ -425,58 +424,58 @@ TEST(GmshReader, MapsNodeTagsAndKeepsOnlyTets) {
 
 TEST(GmshReader, InvertedTetWarningUsesTheElementTag) {
   MeshWarnings warnings;
-  const TetMesh mesh = parse_gmsh(replace_line(k_two_tets_msh, 31, "200 20 30 7 40"), "test.msh", &warnings);
+  const TetMesh mesh = parse_gmsh(replace_line(TWO_TETS_MSH, 31, "200 20 30 7 40"), "test.msh", &warnings);
   ASSERT_EQ(warnings.messages.size(), 1U);
   EXPECT_EQ(warnings.messages[0].rfind("test.msh:31: element 200: inverted", 0), 0U) << warnings.messages[0];
   expect_all_positive(mesh);
 }
 
 TEST(GmshReader, RefusesWrongFormat) {
-  expect_gmsh_refused(replace_line(k_two_tets_msh, 2, "2.2 0 8"), 2, -1, {"version 2.2 is not supported"});
-  expect_gmsh_refused(replace_line(k_two_tets_msh, 2, "4.1 1 8"), 2, -1, {"binary"});
-  expect_gmsh_refused(k_two_tets_msh.substr(k_two_tets_msh.find("$PhysicalNames")), 1, -1, {"missing $MeshFormat"});
+  expect_gmsh_refused(replace_line(TWO_TETS_MSH, 2, "2.2 0 8"), 2, -1, {"version 2.2 is not supported"});
+  expect_gmsh_refused(replace_line(TWO_TETS_MSH, 2, "4.1 1 8"), 2, -1, {"binary"});
+  expect_gmsh_refused(TWO_TETS_MSH.substr(TWO_TETS_MSH.find("$PhysicalNames")), 1, -1, {"missing $MeshFormat"});
   expect_gmsh_refused("", 0, -1, {"missing $MeshFormat"});
 }
 
 TEST(GmshReader, RefusesMissingSections) {
-  std::string no_nodes = k_two_tets_msh;
+  std::string no_nodes = TWO_TETS_MSH;
   no_nodes.erase(no_nodes.find("$Nodes"), no_nodes.find("$Elements") - no_nodes.find("$Nodes"));
   expect_gmsh_refused(no_nodes, 8, -1, {"$Elements before $Nodes"});
-  const std::string only_format = k_two_tets_msh.substr(0, k_two_tets_msh.find("$Nodes"));
+  const std::string only_format = TWO_TETS_MSH.substr(0, TWO_TETS_MSH.find("$Nodes"));
   expect_gmsh_refused(only_format, 0, -1, {"missing $Nodes section"});
-  const std::string no_elements = k_two_tets_msh.substr(0, k_two_tets_msh.find("$Elements"));
+  const std::string no_elements = TWO_TETS_MSH.substr(0, TWO_TETS_MSH.find("$Elements"));
   expect_gmsh_refused(no_elements, 0, -1, {"missing $Elements section"});
-  expect_gmsh_refused(k_two_tets_msh.substr(0, k_two_tets_msh.find("$EndPhysicalNames")), 4, -1,
+  expect_gmsh_refused(TWO_TETS_MSH.substr(0, TWO_TETS_MSH.find("$EndPhysicalNames")), 4, -1,
                       {"$PhysicalNames: missing $EndPhysicalNames"});
 }
 
 TEST(GmshReader, RefusesUnknownNodeTagsAndBadNumbers) {
-  expect_gmsh_refused(replace_line(k_two_tets_msh, 31, "200 20 30 8 40"), 31, 1,
+  expect_gmsh_refused(replace_line(TWO_TETS_MSH, 31, "200 20 30 8 40"), 31, 1,
                       {"element 200", "node tag 8 is not in $Nodes"});
-  expect_gmsh_refused(replace_line(k_two_tets_msh, 17, "0 nan 0"), 17, -1, {"node 30", "not finite"});
-  expect_gmsh_refused(replace_line(k_two_tets_msh, 30, "100 10 20 x 40"), 30, 0, {"element 100", "'x'"});
-  expect_gmsh_refused(replace_line(k_two_tets_msh, 30, "100 10 20 30"), 30, 0, {"element 100", "expected 5"});
-  expect_gmsh_refused(replace_line(k_two_tets_msh, 12, "10"), 12, -1, {"node 10", "defined twice"});
-  expect_gmsh_refused(replace_line(k_two_tets_msh, 21, "1 1 1 0.25"), 21, -1, {"node 7", "expected 5 values"});
-  expect_gmsh_refused(replace_line(k_two_tets_msh, 31, "200 20 30 20 40"), 31, 1, {"element 200", "zero-volume"});
-  expect_gmsh_refused(replace_line(k_two_tets_msh, 31, "200 40 10 30 20"), 31, 1,
+  expect_gmsh_refused(replace_line(TWO_TETS_MSH, 17, "0 nan 0"), 17, -1, {"node 30", "not finite"});
+  expect_gmsh_refused(replace_line(TWO_TETS_MSH, 30, "100 10 20 x 40"), 30, 0, {"element 100", "'x'"});
+  expect_gmsh_refused(replace_line(TWO_TETS_MSH, 30, "100 10 20 30"), 30, 0, {"element 100", "expected 5"});
+  expect_gmsh_refused(replace_line(TWO_TETS_MSH, 12, "10"), 12, -1, {"node 10", "defined twice"});
+  expect_gmsh_refused(replace_line(TWO_TETS_MSH, 21, "1 1 1 0.25"), 21, -1, {"node 7", "expected 5 values"});
+  expect_gmsh_refused(replace_line(TWO_TETS_MSH, 31, "200 20 30 20 40"), 31, 1, {"element 200", "zero-volume"});
+  expect_gmsh_refused(replace_line(TWO_TETS_MSH, 31, "200 40 10 30 20"), 31, 1,
                       {"element 200", "duplicate of element 100", "line 30"});
 }
 
 TEST(GmshReader, RefusesWrongCountsAndTruncation) {
   // Header says 6 nodes, blocks hold 5.
-  expect_gmsh_refused(replace_line(k_two_tets_msh, 9, "2 6 7 40"), 21, -1, {"$Nodes", "says 6 nodes"});
+  expect_gmsh_refused(replace_line(TWO_TETS_MSH, 9, "2 6 7 40"), 21, -1, {"$Nodes", "says 6 nodes"});
   // Block says 5 nodes: tag lines run into the coordinates, then the section ends early.
-  expect_gmsh_refused(replace_line(k_two_tets_msh, 10, "3 1 0 5"), 15, -1, {"expected 1 values"});
+  expect_gmsh_refused(replace_line(TWO_TETS_MSH, 10, "3 1 0 5"), 15, -1, {"expected 1 values"});
   // Element block promises 3 tets.
-  expect_gmsh_refused(replace_line(k_two_tets_msh, 29, "3 1 4 3"), 32, -1, {"$Elements", "truncated"});
+  expect_gmsh_refused(replace_line(TWO_TETS_MSH, 29, "3 1 4 3"), 32, -1, {"$Elements", "truncated"});
   // Header says 5 elements.
-  expect_gmsh_refused(replace_line(k_two_tets_msh, 24, "3 5 1 200"), 31, -1, {"$Elements", "says 5 elements"});
+  expect_gmsh_refused(replace_line(TWO_TETS_MSH, 24, "3 5 1 200"), 31, -1, {"$Elements", "says 5 elements"});
   // File cut inside $Elements.
-  const std::string cut = k_two_tets_msh.substr(0, k_two_tets_msh.find("200 20 30 40 7"));
+  const std::string cut = TWO_TETS_MSH.substr(0, TWO_TETS_MSH.find("200 20 30 40 7"));
   expect_gmsh_refused(cut, 30, -1, {"$Elements", "truncated"});
   // No tets at all.
-  std::string no_tets = replace_line(k_two_tets_msh, 24, "2 2 1 200");
+  std::string no_tets = replace_line(TWO_TETS_MSH, 24, "2 2 1 200");
   no_tets = replace_line(no_tets, 29, "");
   no_tets = replace_line(no_tets, 30, "");
   no_tets = replace_line(no_tets, 31, "");
@@ -542,7 +541,7 @@ void expect_same_mesh(const TetMesh& a, const TetMesh& b, double tolerance_m) {
 
 TEST(ProjectMeshes, BarMatchesBoxGenerator) {
   MeshWarnings warnings;
-  const TetMesh bar = read_mesh(k_mesh_dir / "bar_40x8x8.veg", &warnings);
+  const TetMesh bar = read_mesh(MESH_DIR / "bar_40x8x8.veg", &warnings);
   EXPECT_EQ(bar.vertex_count(), 3321);
   EXPECT_EQ(bar.tet_count(), 12800);
   EXPECT_TRUE(warnings.messages.empty());
@@ -554,7 +553,7 @@ TEST(ProjectMeshes, BarMatchesBoxGenerator) {
 
 TEST(ProjectMeshes, BeamMatchesBoxGenerator) {
   MeshWarnings warnings;
-  const TetMesh beam = read_mesh(k_mesh_dir / "beam_10x2x2.veg", &warnings);
+  const TetMesh beam = read_mesh(MESH_DIR / "beam_10x2x2.veg", &warnings);
   EXPECT_EQ(beam.vertex_count(), 99);
   EXPECT_EQ(beam.tet_count(), 200);
   EXPECT_TRUE(warnings.messages.empty());
@@ -564,8 +563,8 @@ TEST(ProjectMeshes, BeamMatchesBoxGenerator) {
 TEST(ProjectMeshes, FrogMshAndVegAgree) {
   MeshWarnings msh_warnings;
   MeshWarnings veg_warnings;
-  const TetMesh from_msh = read_mesh(k_mesh_dir / "frog.msh", &msh_warnings);
-  const TetMesh from_veg = read_mesh(k_mesh_dir / "frog.veg", &veg_warnings);
+  const TetMesh from_msh = read_mesh(MESH_DIR / "frog.msh", &msh_warnings);
+  const TetMesh from_veg = read_mesh(MESH_DIR / "frog.veg", &veg_warnings);
   EXPECT_EQ(from_msh.vertex_count(), 817);
   EXPECT_EQ(from_msh.tet_count(), 2450);
   // Within 15% of the dissertation's frog (826 vertices, 2301 tets).

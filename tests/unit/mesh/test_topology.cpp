@@ -17,7 +17,7 @@
 namespace tissue {
 namespace {
 
-const std::filesystem::path k_mesh_dir = TISSUE_MESH_DIR;
+const std::filesystem::path MESH_DIR = TISSUE_MESH_DIR;
 
 const Eigen::Vector3d& position(const TetMesh& mesh, int v) {
   return mesh.rest_positions_m[static_cast<std::size_t>(v)];
@@ -103,7 +103,7 @@ void expect_watertight_surface(const TetMesh& mesh) {
   // Each triangle is the stated face of the stated tet.
   for (std::size_t s = 0; s < surface.triangles.size(); ++s) {
     const Tet& tet = mesh.tets[static_cast<std::size_t>(surface.triangle_tet[s])];
-    const auto& local = k_tet_faces[static_cast<std::size_t>(surface.triangle_local_face[s])];
+    const auto& local = TET_FACES[static_cast<std::size_t>(surface.triangle_local_face[s])];
     for (std::size_t k = 0; k < 3; ++k) {
       ASSERT_EQ(surface.triangles[s][k], tet[static_cast<std::size_t>(local[k])]);
     }
@@ -137,7 +137,7 @@ int check_adjacency(const TetMesh& mesh) {
       EXPECT_NE(other, t);
       const Tet& neighbour = mesh.tets[static_cast<std::size_t>(other)];
       std::set<int> face;
-      for (const int local : k_tet_faces[static_cast<std::size_t>(k)]) {
+      for (const int local : TET_FACES[static_cast<std::size_t>(k)]) {
         face.insert(tet[static_cast<std::size_t>(local)]);
       }
       int shared = 0;
@@ -152,7 +152,7 @@ int check_adjacency(const TetMesh& mesh) {
   // Interior faces have two sides, boundary faces one, and nothing else exists.
   std::map<std::array<int, 3>, int> face_count;
   for (const Tet& tet : mesh.tets) {
-    for (const auto& local : k_tet_faces) {
+    for (const auto& local : TET_FACES) {
       std::array<int, 3> key = {tet[static_cast<std::size_t>(local[0])], tet[static_cast<std::size_t>(local[1])],
                                 tet[static_cast<std::size_t>(local[2])]};
       std::sort(key.begin(), key.end());
@@ -179,8 +179,8 @@ int check_adjacency(const TetMesh& mesh) {
     const Tet& tet = mesh.tets[static_cast<std::size_t>(t)];
     for (std::size_t k = 0; k < 6; ++k) {
       const int e = adjacency.tet_edges[static_cast<std::size_t>(t)][k];
-      const int a = tet[static_cast<std::size_t>(k_tet_edges[k][0])];
-      const int b = tet[static_cast<std::size_t>(k_tet_edges[k][1])];
+      const int a = tet[static_cast<std::size_t>(TET_EDGES[k][0])];
+      const int b = tet[static_cast<std::size_t>(TET_EDGES[k][1])];
       EXPECT_EQ(adjacency.edges[static_cast<std::size_t>(e)], (std::array<int, 2>{std::min(a, b), std::max(a, b)}));
       const auto begin = adjacency.edge_tets.begin() + adjacency.edge_tets_begin[static_cast<std::size_t>(e)];
       const auto end = adjacency.edge_tets.begin() + adjacency.edge_tets_begin[static_cast<std::size_t>(e) + 1];
@@ -220,7 +220,7 @@ TEST(TetFaces, AreOutwardForPositiveTets) {
     orient(mesh);
     const Tet& tet = mesh.tets[0];
     for (std::size_t k = 0; k < 4; ++k) {
-      const auto& local = k_tet_faces[k];
+      const auto& local = TET_FACES[k];
       const std::array<int, 3> tri = {tet[static_cast<std::size_t>(local[0])], tet[static_cast<std::size_t>(local[1])],
                                       tet[static_cast<std::size_t>(local[2])]};
       // Face k is opposite vertex k, and its normal points away from it.
@@ -288,14 +288,14 @@ TEST(ExtractSurface, BoxMeshesAreConforming) {
 }
 
 TEST(ExtractSurface, BarFileIsConformingWithTheOuterArea) {
-  const TetMesh bar = read_mesh(k_mesh_dir / "bar_40x8x8.veg");
+  const TetMesh bar = read_mesh(MESH_DIR / "bar_40x8x8.veg");
   const SurfaceMesh surface = extract_surface(bar);
   EXPECT_NEAR(surface_area(bar, surface), 2 * (0.4 * 0.08 * 2 + 0.08 * 0.08), 1e-12);
   expect_watertight_surface(bar);
 }
 
 TEST(ExtractSurface, FrogIsOneClosedSurface) {
-  const TetMesh frog = read_mesh(k_mesh_dir / "frog.msh");
+  const TetMesh frog = read_mesh(MESH_DIR / "frog.msh");
   const SurfaceMesh surface = extract_surface(frog);
   expect_watertight_surface(frog);
   // A closed genus-0 surface: V - E + F = 2.
@@ -354,12 +354,12 @@ TEST(BuildAdjacency, CubesAreBallsByEuler) {
 }
 
 TEST(BuildAdjacency, BeamAndBarAreBallsByEuler) {
-  EXPECT_EQ(check_adjacency(read_mesh(k_mesh_dir / "beam_10x2x2.veg")), 1);
+  EXPECT_EQ(check_adjacency(read_mesh(MESH_DIR / "beam_10x2x2.veg")), 1);
   EXPECT_EQ(check_adjacency(make_box_mesh(4, 3, 2, 0.01)), 1);
-  EXPECT_EQ(check_adjacency(read_mesh(k_mesh_dir / "bar_40x8x8.veg")), 1);
+  EXPECT_EQ(check_adjacency(read_mesh(MESH_DIR / "bar_40x8x8.veg")), 1);
 }
 
-TEST(BuildAdjacency, FrogIsABallByEuler) { EXPECT_EQ(check_adjacency(read_mesh(k_mesh_dir / "frog.msh")), 1); }
+TEST(BuildAdjacency, FrogIsABallByEuler) { EXPECT_EQ(check_adjacency(read_mesh(MESH_DIR / "frog.msh")), 1); }
 
 }  // namespace
 }  // namespace tissue

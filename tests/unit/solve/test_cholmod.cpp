@@ -10,8 +10,8 @@
 #include <Eigen/Dense>
 
 #include <limits>
-#include <string>
 #include <random>
+#include <string>
 
 namespace tissue {
 namespace {

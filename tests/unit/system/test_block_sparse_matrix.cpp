@@ -290,8 +290,8 @@ TEST(BlockSparseMatrix, AppendUsesSpareRowsUntilTheyRunOut) {
     const int forward = matrix.insert_block(row, coupled);
     const int backward = matrix.insert_block(coupled, row);
     EXPECT_EQ(matrix.layout_revision(), layout);
-    for (const auto& [key, slot] :
-         std::map<std::pair<int, int>, int>{{{row, row}, diagonal}, {{row, coupled}, forward}, {{coupled, row}, backward}}) {
+    for (const auto& [key, slot] : std::map<std::pair<int, int>, int>{
+             {{row, row}, diagonal}, {{row, coupled}, forward}, {{coupled, row}, backward}}) {
       const Eigen::Matrix3d value = random_block(rng);
       matrix.block(slot) = value;
       blocks[key] = value;

@@ -1,0 +1,1 @@
+tissue_add_test(test_tissue LABELS unit SOURCES tissue/test_tissue.cpp)
