@@ -3,6 +3,7 @@
 // the documented counts; the bar/beam files equal the C++ box generator.
 #include "core/mesh/box_mesh.hpp"
 #include "core/mesh/mesh_io.hpp"
+#include "reference_meshes.hpp"
 
 #include <gtest/gtest.h>
 
@@ -18,7 +19,7 @@ namespace tissue {
 namespace {
 
 const std::filesystem::path MESH_DIR = TISSUE_MESH_DIR;
-const std::filesystem::path VEGA_DIR = std::filesystem::path(TISSUE_SHARED_DIR) / "meshes" / "vega";
+const std::filesystem::path VEGA_DIR = test_data::vega_reference_dir();
 
 /// Runs `load`, expects a MeshError, and checks its line, its 0-based element and that its
 /// message contains "<source>:<line>: " and every one of `fragments`.
@@ -246,6 +247,7 @@ TEST(VegReader, RefusesMissingFile) {
 }
 
 TEST(VegReader, ReadsVegaReferenceMeshes) {
+  TISSUE_SKIP_WITHOUT_VEGA_MESHES();
   struct Reference {
     const char* file;
     int vertices;
@@ -275,6 +277,7 @@ TEST(VegReader, ReadsVegaReferenceMeshes) {
 }
 
 TEST(BouReader, ReadsVegaFixedVertices) {
+  TISSUE_SKIP_WITHOUT_VEGA_MESHES();
   const std::vector<int> fixed = read_bou(VEGA_DIR / "simpleBridge/simpleBridge.bou", 4000);
   ASSERT_FALSE(fixed.empty());
   EXPECT_TRUE(std::is_sorted(fixed.begin(), fixed.end()));

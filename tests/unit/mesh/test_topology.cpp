@@ -4,6 +4,7 @@
 #include "core/mesh/box_mesh.hpp"
 #include "core/mesh/mesh_io.hpp"
 #include "core/mesh/topology.hpp"
+#include "reference_meshes.hpp"
 
 #include <gtest/gtest.h>
 #include <Eigen/Geometry>
@@ -313,7 +314,8 @@ TEST(ExtractSurface, FrogIsOneClosedSurface) {
 }
 
 TEST(ExtractSurface, VegaReferenceSurfacesAreClosed) {
-  const std::filesystem::path vega_dir = std::filesystem::path(TISSUE_SHARED_DIR) / "meshes" / "vega";
+  TISSUE_SKIP_WITHOUT_VEGA_MESHES();
+  const std::filesystem::path vega_dir = test_data::vega_reference_dir();
   for (const char* file : {"simpleBridge/simpleBridge-ic_128_0.15_.1.veg", "turtle/turtle-volumetric-homogeneous.veg",
                            "comb/comb.tet.veg", "beam3/beam3_tet.veg"}) {
     SCOPED_TRACE(file);
