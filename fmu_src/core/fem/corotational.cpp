@@ -15,12 +15,18 @@ TetPositions gather(const Eigen::VectorXd& positions_m, const Tet& tet) {
   return x;
 }
 
-// Linear stress of the rotated-back strain eps = sym(R^T F) - I.
-Eigen::Matrix3d corotated_stress(const Eigen::Matrix3d& rotation, const Eigen::Matrix3d& f,
-                                 const LameParameters& lame) {
+// The rotated-back (co-rotational) strain eps = sym(R^T F) - I.
+Eigen::Matrix3d corotated_strain(const Eigen::Matrix3d& rotation, const Eigen::Matrix3d& f) {
   const Eigen::Matrix3d s = rotation.transpose() * f;
   Eigen::Matrix3d strain = 0.5 * (s + s.transpose());
   strain.diagonal().array() -= 1.0;
+  return strain;
+}
+
+// Linear stress of the co-rotational strain.
+Eigen::Matrix3d corotated_stress(const Eigen::Matrix3d& rotation, const Eigen::Matrix3d& f,
+                                 const LameParameters& lame) {
+  const Eigen::Matrix3d strain = corotated_strain(rotation, f);
   Eigen::Matrix3d stress = 2.0 * lame.mu_pa * strain;
   stress.diagonal().array() += lame.lambda_pa * strain.trace();
   return stress;
@@ -86,9 +92,7 @@ double CorotationalElasticity::elastic_energy_j(const Eigen::VectorXd& positions
   for (size_t t = 0; t < m_tets.size(); ++t) {
     const Eigen::Matrix3d f = deformation_gradient(m_rest[t], gather(positions_m, m_tets[t]));
     Eigen::Quaterniond warm_start = m_warm_starts[t];  // a copy: reporting must not change the dynamics
-    const Eigen::Matrix3d s = extract_rotation(f, warm_start).transpose() * f;
-    Eigen::Matrix3d strain = 0.5 * (s + s.transpose());
-    strain.diagonal().array() -= 1.0;
+    const Eigen::Matrix3d strain = corotated_strain(extract_rotation(f, warm_start), f);
     energy += m_rest[t].volume_m3 *
               (m_lame.mu_pa * strain.squaredNorm() + 0.5 * m_lame.lambda_pa * strain.trace() * strain.trace());
   }
