@@ -72,6 +72,7 @@ int main(int argc, char** argv) {
   options.step_size_s = 0.01;
   options.fixed_fraction = 0.1;
   options.damping = {1.0, 0.01};
+  options.solver = "cholmod";  // exact solves, ~2x faster than strict PCG on the frog at this step
   int print_every = 10;
   std::string surface_obj;
   tissue::apps::add_scene_options(app, options);
