@@ -2,10 +2,9 @@
 // per-step figures. The main job until the real-time host (issue 5) exists.
 #include "apps/run_statistics.hpp"
 #include "apps/scene_options.hpp"
-
-#include <algorithm>
 #include "core/mesh/topology.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <exception>
