@@ -27,7 +27,12 @@ class CorotationalElasticity {
   [[nodiscard]] const TetRest& rest(int tet) const { return m_rest[static_cast<size_t>(tet)]; }
   [[nodiscard]] const Eigen::Matrix3d& rotation(int tet) const { return m_rotations[static_cast<size_t>(tet)]; }
 
-  /// One pass over the tets at the current positions (3 per vertex, [m]):
+  /// Hands `tet` over to another model (a cut tet, modelled by XfemElasticity): evaluate() and
+  /// elastic_energy_j() skip it from now on. Throws ParameterError for an id out of range.
+  void exclude(int tet);
+  [[nodiscard]] bool is_excluded(int tet) const { return m_excluded[static_cast<size_t>(tet)] != 0; }
+
+  /// One pass over the (not excluded) tets at the current positions (3 per vertex, [m]):
   /// updates each R_e (warm-started from the last step), adds the internal force f_int
   /// (the restoring force in M a + D v + f_int = f_ext, [N], 3 per vertex) into `internal_forces_n`,
   /// and, when `tangent` is given, adds R_e K_e R_e^T into it through `slots` (blocks whose slot is -1,
@@ -47,6 +52,7 @@ class CorotationalElasticity {
   std::vector<TetRest> m_rest;
   std::vector<Eigen::Matrix3d> m_rotations;
   std::vector<Eigen::Quaterniond> m_warm_starts;
+  std::vector<char> m_excluded;  // 1 = modelled elsewhere (cut)
   LameParameters m_lame;
 };
 

@@ -1,7 +1,24 @@
-// DeformableBody: scatter the unknowns to vertex positions, evaluate the FEM, gather forces back.
+// DeformableBody: scatter the unknowns to vertex positions, evaluate the FEM (uncut tets, cut
+// tets, point spring), gather forces back; grow the system in place when tets are cut.
+//
+// Enriched lumped mass and gravity (DESIGN section 4; eq. 4.16 is garbled). Lumping each part of a
+// cut tet as a full tet of mass w_p m gives the kinetic energy
+//   (m/4) sum_j [w_a |v_j + Psi_aj da_j|^2 + w_b |v_j + Psi_bj da_j|^2]
+// and, for a vertex with H_j = +1 (Psi_aj = 0, Psi_bj = -1), the mass blocks M^uu = m/4,
+// M^ua = -w_b m/4, M^aa = w_b m/4 (for H_j = -1: m/4, +w_a m/4, w_a m/4). The diagonal lumping
+// keeps M^uu (unchanged by the cut: total mass conserved) and M^aa = rho V_opposite(j) / 4, the mass
+// of the part on the other side of the cut, and drops M^ua. Gravity is the derivative of the same
+// lumped potential -sum_p (w_p m/4) g . p_pj: on u_j it stays m/4 g, on a_j it is
+//   Psi_opposite(j) rho V_opposite(j) / 4 g,   Psi_opposite(j) = -H_j,
+// i.e. -w_b m/4 g for a vertex above the cut and +w_a m/4 g for one below: pulling the ghost copy
+// (which belongs to the other part, at x_j + Psi_opposite a_j) down. With it the statics are exact
+// (the load of each part sits on that part). The dropped M^ua makes the dynamics of a piece cut
+// free inexact: translating the piece moves both u_j and a_j of its real vertices next to the cut,
+// so it carries an extra inertia 2 sum M^aa over those vertices (quantified in tests/unit/xfem).
 #include "core/fem/deformable_body.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <string>
 
 namespace tissue {
@@ -23,6 +40,50 @@ BodySettings checked(BodySettings settings, int vertex_count) {
   return settings;
 }
 
+// Per vertex: how many vertices share a tet with it (itself included), all and free ones.
+struct Neighbourhoods {
+  std::vector<int> all;
+  std::vector<int> free;
+};
+
+Neighbourhoods neighbourhoods(const TetMesh& mesh, const DofMap& dofs) {
+  std::vector<std::vector<int>> near(static_cast<size_t>(mesh.vertex_count()));
+  for (const Tet& tet : mesh.tets) {
+    for (const int a : tet)
+      near[static_cast<size_t>(a)].insert(near[static_cast<size_t>(a)].end(), tet.begin(), tet.end());
+  }
+  Neighbourhoods counts{std::vector<int>(near.size()), std::vector<int>(near.size())};
+  for (size_t v = 0; v < near.size(); ++v) {
+    std::sort(near[v].begin(), near[v].end());
+    near[v].erase(std::unique(near[v].begin(), near[v].end()), near[v].end());
+    counts.all[v] = static_cast<int>(near[v].size());
+    counts.free[v] = static_cast<int>(std::count_if(
+        near[v].begin(), near[v].end(), [&](int w) { return dofs.vertex_row[static_cast<size_t>(w)] >= 0; }));
+  }
+  return counts;
+}
+
+// Room one cut can ever need, so that cutting never overflows a row (DESIGN section 3: the matrix
+// grows in place). A u row holds its free neighbours and gains one u-a block per enriched
+// neighbour, fixed ones included: free + all (twice its blocks inside the body, more next to fixed
+// vertices). An enriched row holds a-u blocks with the free neighbours and a-a blocks with all.
+std::vector<int> u_row_capacities(const TetMesh& mesh, const DofMap& dofs) {
+  const Neighbourhoods counts = neighbourhoods(mesh, dofs);
+  std::vector<int> capacities(static_cast<size_t>(dofs.free_vertex_count()));
+  for (size_t row = 0; row < capacities.size(); ++row) {
+    const auto v = static_cast<size_t>(dofs.row_vertex[row]);
+    capacities[row] = counts.free[v] + counts.all[v];
+  }
+  return capacities;
+}
+
+std::vector<int> enriched_row_capacities(const TetMesh& mesh, const DofMap& dofs) {
+  const Neighbourhoods counts = neighbourhoods(mesh, dofs);
+  std::vector<int> capacities(counts.all.size());
+  for (size_t v = 0; v < capacities.size(); ++v) capacities[v] = counts.free[v] + counts.all[v];
+  return capacities;
+}
+
 }  // namespace
 
 DeformableBody::DeformableBody(TetMesh mesh, BodySettings settings)
@@ -31,8 +92,12 @@ DeformableBody::DeformableBody(TetMesh mesh, BodySettings settings)
       m_dofs(make_dof_map(m_mesh.vertex_count(), m_settings.fixed_vertices)),
       m_elasticity(m_mesh, m_settings.material),
       m_vertex_mass_kg(lumped_vertex_masses(m_mesh, m_settings.material.density_kg_per_m3)),
-      m_tangent(stiffness_pattern(m_mesh, m_dofs), m_settings.reserve),
-      m_slots(make_tet_slots(m_mesh, m_dofs, m_tangent)) {
+      m_tangent(stiffness_pattern(m_mesh, m_dofs), m_settings.reserve, u_row_capacities(m_mesh, m_dofs)),
+      m_slots(make_tet_slots(m_mesh, m_dofs, m_tangent)),
+      m_xfem(m_elasticity.lame()),
+      m_enriched_row_capacity(enriched_row_capacities(m_mesh, m_dofs)),
+      m_first_enriched_dof(static_cast<size_t>(m_mesh.vertex_count()), -1),
+      m_cut_index(static_cast<size_t>(m_mesh.tet_count()), -1) {
   const int rows = m_dofs.free_vertex_count();
   m_mass_kg.resize(3 * rows);
   m_external_force_n.resize(3 * rows);
@@ -44,6 +109,11 @@ DeformableBody::DeformableBody(TetMesh mesh, BodySettings settings)
   m_positions_m.resize(3 * m_mesh.vertex_count());
   m_vertex_forces_n.resize(3 * m_mesh.vertex_count());
   positions(Eigen::VectorXd::Zero(dof_count()), m_positions_m);
+  // Room for the enrichments the matrix has room for (the dissertation's 150% DOFs).
+  const int spare_rows = m_tangent.block_row_capacity() - m_tangent.block_rows();
+  m_enriched_dofs.reserve(static_cast<size_t>(spare_rows));
+  m_next_enriched_dof.reserve(static_cast<size_t>(spare_rows));
+  m_xfem.reserve(std::min(m_mesh.tet_count(), 2 * spare_rows));
 }
 
 double DeformableBody::total_mass_kg() const {
@@ -61,26 +131,312 @@ void DeformableBody::positions(const Eigen::VectorXd& displacement_m, Eigen::Vec
   }
 }
 
+void DeformableBody::check_unknowns(const Eigen::VectorXd& displacement_m) const {
+  if (displacement_m.size() != dof_count()) {
+    throw std::invalid_argument("DeformableBody: displacement has " + std::to_string(displacement_m.size()) +
+                                " unknowns, the body has " + std::to_string(dof_count()) +
+                                " (grow the state after enrich())");
+  }
+}
+
 void DeformableBody::evaluate(const Eigen::VectorXd& displacement_m, Eigen::VectorXd& internal_force_n,
                               bool update_tangent) {
+  check_unknowns(displacement_m);
   positions(displacement_m, m_positions_m);
   m_vertex_forces_n.setZero();
   if (update_tangent) m_tangent.set_zero();
-  m_elasticity.evaluate(m_positions_m, m_vertex_forces_n, update_tangent ? &m_tangent : nullptr, &m_slots);
+  BlockSparseMatrix* tangent = update_tangent ? &m_tangent : nullptr;
+  m_elasticity.evaluate(m_positions_m, m_vertex_forces_n, tangent, &m_slots);
   internal_force_n.resize(dof_count());
-  for (int row = 0; row < m_dofs.free_vertex_count(); ++row) {
+  const int u_rows = m_dofs.free_vertex_count();
+  internal_force_n.tail(3 * enriched_dof_count()).setZero();
+  m_xfem.evaluate(m_positions_m, displacement_m, m_vertex_forces_n, internal_force_n, tangent);
+
+  add_point_spring(tangent);
+
+  for (int row = 0; row < u_rows; ++row) {
     internal_force_n.segment<3>(3 * row) =
         m_vertex_forces_n.segment<3>(3 * m_dofs.row_vertex[static_cast<size_t>(row)]);
   }
 }
 
 double DeformableBody::elastic_energy_j(const Eigen::VectorXd& displacement_m) {
+  check_unknowns(displacement_m);
   positions(displacement_m, m_positions_m);
-  return m_elasticity.elastic_energy_j(m_positions_m);
+  return m_elasticity.elastic_energy_j(m_positions_m) + m_xfem.elastic_energy_j(m_positions_m, displacement_m);
 }
 
 double DeformableBody::kinetic_energy_j(const Eigen::VectorXd& velocity_m_per_s) const {
   return 0.5 * velocity_m_per_s.dot(m_mass_kg.cwiseProduct(velocity_m_per_s));
+}
+
+void DeformableBody::reset_rotations() {
+  m_elasticity.reset_rotations();
+  m_xfem.reset_rotations();
+}
+
+// --- XFEM ---
+
+int DeformableBody::find_enriched_dof(int vertex, int cut_id, int side) const {
+  if (vertex < 0 || vertex >= m_mesh.vertex_count()) return -1;
+  for (int k = m_first_enriched_dof[static_cast<size_t>(vertex)]; k >= 0;
+       k = m_next_enriched_dof[static_cast<size_t>(k)]) {
+    const EnrichedDof& dof = m_enriched_dofs[static_cast<size_t>(k)];
+    if (dof.cut_id == cut_id && dof.side == side) return k;
+  }
+  return -1;
+}
+
+void DeformableBody::check_cuts(std::span<const TetCut> cuts) const {
+  std::vector<int> tets;
+  tets.reserve(cuts.size());
+  for (size_t c = 0; c < cuts.size(); ++c) {
+    const TetCut& cut = cuts[c];
+    const std::string where = "enrich: cut " + std::to_string(c) + " (tet " + std::to_string(cut.tet) + "): ";
+    if (cut.tet < 0 || cut.tet >= m_mesh.tet_count()) {
+      throw ParameterError(where + "tet outside [0, " + std::to_string(m_mesh.tet_count()) + ")");
+    }
+    if (cut_tet_index(cut.tet) >= 0) throw ParameterError(where + "the tet is cut already (one cut per tet)");
+    bool above = false;
+    bool below = false;
+    for (const std::int8_t side : cut.side) {
+      if (side != 1 && side != -1) throw ParameterError(where + "a vertex side is neither +1 nor -1");
+      above = above || side == 1;
+      below = below || side == -1;
+    }
+    if (!above || !below) throw ParameterError(where + "all vertices on one side: the tet is not cut");
+    if (!std::isfinite(cut.volume_fraction_above) || !(cut.volume_fraction_above > 0.0) ||
+        !(cut.volume_fraction_above < 1.0)) {
+      throw ParameterError(where + "volume fraction " + std::to_string(cut.volume_fraction_above) +
+                           " is not in (0, 1)");
+    }
+    tets.push_back(cut.tet);
+  }
+  std::sort(tets.begin(), tets.end());
+  const auto twice = std::adjacent_find(tets.begin(), tets.end());
+  if (twice != tets.end()) throw ParameterError("enrich: tet " + std::to_string(*twice) + " is cut twice in one batch");
+}
+
+EnrichmentResult DeformableBody::enrich(std::span<const TetCut> cuts) {
+  check_cuts(cuts);
+  EnrichmentResult result;
+  const std::uint64_t layout_before = m_tangent.layout_revision();
+  const int u_rows = m_dofs.free_vertex_count();
+  const int old_dofs = enriched_dof_count();
+
+  // 1. The enriched unknowns: one per (vertex, cut id, side), appended as block rows.
+  std::vector<std::array<int, 4>> dof_of_cut(cuts.size());
+  for (size_t c = 0; c < cuts.size(); ++c) {
+    const TetCut& cut = cuts[c];
+    const Tet& tet = m_mesh.tets[static_cast<size_t>(cut.tet)];
+    for (size_t i = 0; i < 4; ++i) {
+      int k = find_enriched_dof(tet[i], cut.cut_id, cut.side[i]);
+      if (k < 0) {
+        k = enriched_dof_count();
+        const int row = m_tangent.append_block_row(m_enriched_row_capacity[static_cast<size_t>(tet[i])]);
+        if (row != u_rows + k) throw std::logic_error("enrich: the tangent's rows and the unknowns disagree");
+        m_enriched_dofs.push_back(EnrichedDof{tet[i], cut.cut_id, cut.side[i], row});
+        m_next_enriched_dof.push_back(m_first_enriched_dof[static_cast<size_t>(tet[i])]);
+        m_first_enriched_dof[static_cast<size_t>(tet[i])] = k;
+      }
+      dof_of_cut[c][i] = k;
+    }
+  }
+  result.new_enriched_dofs = enriched_dof_count() - old_dofs;
+
+  // 2. Mass and external force of the new unknowns start at zero, then each cut tet adds its share.
+  m_mass_kg.conservativeResize(dof_count());
+  m_external_force_n.conservativeResize(dof_count());
+  m_mass_kg.tail(3 * result.new_enriched_dofs).setZero();
+  m_external_force_n.tail(3 * result.new_enriched_dofs).setZero();
+
+  const double density = m_settings.material.density_kg_per_m3;
+  for (size_t c = 0; c < cuts.size(); ++c) {
+    const TetCut& cut = cuts[c];
+    CutTet cut_tet;
+    cut_tet.cut = cut;
+    cut_tet.vertices = m_mesh.tets[static_cast<size_t>(cut.tet)];
+    cut_tet.weight_above = cut.volume_fraction_above;
+    cut_tet.weight_below = 1.0 - cut.volume_fraction_above;
+    for (size_t i = 0; i < 4; ++i) cut_tet.enriched_row[i] = m_enriched_dofs[static_cast<size_t>(dof_of_cut[c][i])].row;
+
+    const TetRest& rest = m_elasticity.rest(cut.tet);
+    for (size_t i = 0; i < 4; ++i) {
+      // The part on the other side of the cut from vertex i, and Psi of vertex i in it (= -H_i).
+      const CutPart opposite = cut.side[i] == 1 ? CutPart::below : CutPart::above;
+      const double quarter_mass_kg = 0.25 * density * cut_tet.weight(opposite) * rest.volume_m3;
+      const int row = cut_tet.enriched_row[i];
+      m_mass_kg.segment<3>(3 * row).array() += quarter_mass_kg;
+      m_external_force_n.segment<3>(3 * row) +=
+          cut_tet.shift(static_cast<int>(i), opposite) * quarter_mass_kg * m_settings.gravity_m_per_s2;
+    }
+
+    // 3. Blocks u-a, a-u and a-a into the reserved room (u-u blocks exist already).
+    std::array<int, 8> rows{};
+    for (size_t i = 0; i < 4; ++i) {
+      rows[i] = vertex_block_row(cut_tet.vertices[i]);
+      rows[i + 4] = cut_tet.enriched_row[i];
+    }
+    for (size_t r = 0; r < 8; ++r) {
+      for (size_t col = 0; col < 8; ++col) {
+        if (r < 4 && col < 4) continue;
+        if (r >= 4 && col >= 4 && cut.side[r - 4] != cut.side[col - 4]) continue;  // identically zero
+        if (rows[r] < 0 || rows[col] < 0) continue;                                // a fixed vertex's u
+        m_tangent.insert_block(rows[r], rows[col]);
+      }
+    }
+
+    m_elasticity.exclude(cut.tet);
+    m_cut_index[static_cast<size_t>(cut.tet)] = m_xfem.cut_tet_count();
+    m_xfem.add(cut_tet, rest, m_elasticity.rotation(cut.tet));
+  }
+  result.new_cut_tets = static_cast<int>(cuts.size());
+
+  // 4. Slots: of the new cut tets only, unless the storage moved (rare: room is reserved ahead).
+  result.matrix_relayout = m_tangent.layout_revision() != layout_before;
+  if (result.matrix_relayout) {
+    refresh_all_slots();
+  } else {
+    for (int k = m_xfem.cut_tet_count() - result.new_cut_tets; k < m_xfem.cut_tet_count(); ++k)
+      refresh_cut_tet_slots(k);
+  }
+  return result;
+}
+
+void DeformableBody::refresh_cut_tet_slots(int cut_tet_index) {
+  const CutTet& cut_tet = m_xfem.cut_tets()[static_cast<size_t>(cut_tet_index)];
+  std::array<int, 8> rows{};
+  for (size_t i = 0; i < 4; ++i) {
+    rows[i] = vertex_block_row(cut_tet.vertices[i]);
+    rows[i + 4] = cut_tet.enriched_row[i];
+  }
+  CutTetSlots& slots = m_xfem.slots(cut_tet_index);
+  for (size_t r = 0; r < 8; ++r) {
+    for (size_t col = 0; col < 8; ++col) {
+      int slot = -1;
+      const bool zero_block = r >= 4 && col >= 4 && cut_tet.cut.side[r - 4] != cut_tet.cut.side[col - 4];
+      if (!zero_block && rows[r] >= 0 && rows[col] >= 0) {
+        slot = m_tangent.find_slot(rows[r], rows[col]);
+        if (slot < 0)
+          throw std::logic_error("enrich: a block of cut tet " + std::to_string(cut_tet.cut.tet) + " is missing");
+      }
+      slots[8 * r + col] = slot;
+    }
+  }
+}
+
+void DeformableBody::refresh_point_spring_slots() {
+  m_point_spring_slots.fill(-1);
+  if (!m_point_spring) return;
+  for (size_t i = 0; i < 3; ++i) {
+    for (size_t j = 0; j < 3; ++j) {
+      const int row = vertex_block_row(m_point_spring->vertices[i]);
+      const int col = vertex_block_row(m_point_spring->vertices[j]);
+      if (row >= 0 && col >= 0) m_point_spring_slots[3 * i + j] = m_tangent.find_slot(row, col);
+    }
+  }
+}
+
+void DeformableBody::refresh_all_slots() {
+  m_slots = make_tet_slots(m_mesh, m_dofs, m_tangent);
+  for (int k = 0; k < m_xfem.cut_tet_count(); ++k) refresh_cut_tet_slots(k);
+  refresh_point_spring_slots();
+}
+
+void DeformableBody::grow_state(DynamicState& state) const {
+  const Eigen::Index old_size = state.displacement_m.size();
+  if (old_size > dof_count() || state.velocity_m_per_s.size() != old_size) {
+    throw std::invalid_argument("grow_state: the state has " + std::to_string(old_size) + " displacements and " +
+                                std::to_string(state.velocity_m_per_s.size()) + " velocities, the body " +
+                                std::to_string(dof_count()) + " unknowns");
+  }
+  state.displacement_m.conservativeResize(dof_count());
+  state.velocity_m_per_s.conservativeResize(dof_count());
+  state.displacement_m.tail(dof_count() - old_size).setZero();
+  state.velocity_m_per_s.tail(dof_count() - old_size).setZero();
+}
+
+TetPositions DeformableBody::part_positions(const Eigen::VectorXd& displacement_m, int cut_tet_index,
+                                            CutPart part) const {
+  const CutTet& cut_tet = m_xfem.cut_tets().at(static_cast<size_t>(cut_tet_index));
+  TetPositions real_m;
+  TetPositions enrichment_m;
+  for (size_t j = 0; j < 4; ++j) {
+    const int vertex = cut_tet.vertices[j];
+    const int row = vertex_block_row(vertex);
+    real_m[j] = m_mesh.rest_positions_m[static_cast<size_t>(vertex)];
+    if (row >= 0) real_m[j] += displacement_m.segment<3>(3 * row);
+    enrichment_m[j] = displacement_m.segment<3>(3 * cut_tet.enriched_row[j]);
+  }
+  return cut_part_positions(cut_tet, part, real_m, enrichment_m);
+}
+
+double DeformableBody::part_mass_kg(int cut_tet_index, CutPart part) const {
+  const size_t k = static_cast<size_t>(cut_tet_index);
+  return m_settings.material.density_kg_per_m3 * m_xfem.cut_tets().at(k).weight(part) *
+         m_xfem.rest(cut_tet_index).volume_m3;
+}
+
+// --- Point spring ---
+
+void DeformableBody::add_point_spring(BlockSparseMatrix* tangent) {
+  m_point_spring_force_n.setZero();
+  if (!m_point_spring) return;
+  const PointSpring& spring = *m_point_spring;
+  Eigen::Vector3d point_m = Eigen::Vector3d::Zero();
+  for (size_t i = 0; i < 3; ++i) {
+    point_m += spring.weights[static_cast<Eigen::Index>(i)] * m_positions_m.segment<3>(3 * spring.vertices[i]);
+  }
+  // f_int gains k (x_p - target) w_i on vertex i; the body feels the opposite, k (target - x_p).
+  const Eigen::Vector3d stretch_force_n = spring.stiffness_n_per_m * (point_m - spring.target_m);
+  m_point_spring_force_n = -stretch_force_n;
+  for (size_t i = 0; i < 3; ++i) {
+    m_vertex_forces_n.segment<3>(3 * spring.vertices[i]) +=
+        spring.weights[static_cast<Eigen::Index>(i)] * stretch_force_n;
+  }
+  if (tangent == nullptr) return;
+  for (size_t i = 0; i < 3; ++i) {
+    for (size_t j = 0; j < 3; ++j) {
+      const int slot = m_point_spring_slots[3 * i + j];
+      if (slot < 0) continue;  // a fixed vertex
+      tangent->block(slot).diagonal().array() += spring.stiffness_n_per_m *
+                                                 spring.weights[static_cast<Eigen::Index>(i)] *
+                                                 spring.weights[static_cast<Eigen::Index>(j)];
+    }
+  }
+}
+
+void DeformableBody::set_point_spring(std::optional<PointSpring> spring) {
+  if (spring) {
+    const PointSpring& s = *spring;
+    for (const int v : s.vertices) {
+      if (v < 0 || v >= m_mesh.vertex_count()) {
+        throw ParameterError("point spring: vertex " + std::to_string(v) + " outside [0, " +
+                             std::to_string(m_mesh.vertex_count()) + ")");
+      }
+    }
+    if (!s.weights.allFinite() || std::abs(s.weights.sum() - 1.0) > 1e-6) {
+      throw ParameterError("point spring: weights must be finite and sum to 1");
+    }
+    if (!s.target_m.allFinite()) throw ParameterError("point spring: target must be finite");
+    if (!std::isfinite(s.stiffness_n_per_m) || s.stiffness_n_per_m < 0.0) {
+      throw ParameterError("point spring: stiffness must be finite and >= 0, got " +
+                           std::to_string(s.stiffness_n_per_m));
+    }
+    for (const int a : s.vertices) {
+      for (const int b : s.vertices) {
+        const int row = vertex_block_row(a);
+        const int col = vertex_block_row(b);
+        if (row >= 0 && col >= 0 && m_tangent.find_slot(row, col) < 0) {
+          throw ParameterError("point spring: vertices " + std::to_string(a) + " and " + std::to_string(b) +
+                               " share no tet");
+        }
+      }
+    }
+  }
+  m_point_spring = std::move(spring);
+  m_point_spring_force_n.setZero();
+  refresh_point_spring_slots();
 }
 
 }  // namespace tissue

@@ -1,9 +1,17 @@
 // DeformableBody: a tet mesh made into a DynamicsModel: co-rotational elasticity, lumped mass,
-// Rayleigh damping, gravity and fixed vertices (removed from the unknowns).
+// Rayleigh damping, gravity and fixed vertices (removed from the unknowns); XFEM cuts that grow the
+// system in place (issue 3); and the point spring through which god-object contact pulls the body.
+//
+// Unknowns (3 each): block rows [0, free_vertex_count()) are the displacements u of the free
+// vertices, in vertex order; then come the enriched unknowns a, one per (vertex, cut id, side),
+// in creation order. A fixed vertex has no u row but gets an enriched row when cut: its ghost copy
+// on the other side of the cut must be free to move.
 #pragma once
 
+#include "core/cut/tet_cut.hpp"
 #include "core/fem/corotational.hpp"
 #include "core/fem/material.hpp"
+#include "core/fem/xfem_elasticity.hpp"
 #include "core/mesh/tet_mesh.hpp"
 #include "core/system/assembly.hpp"
 #include "core/system/block_sparse_matrix.hpp"
@@ -11,6 +19,10 @@
 
 #include <Eigen/Core>
 
+#include <array>
+#include <cstdint>
+#include <optional>
+#include <span>
 #include <vector>
 
 namespace tissue {
@@ -23,13 +35,38 @@ struct BodySettings {
   BlockSparseMatrix::Reserve reserve;
 };
 
+/// A spring of stiffness k from a material point x_p = sum_i w_i x_i of the body (a point of a
+/// surface triangle) to a target: the body feels k (target - x_p), shared out with the weights.
+struct PointSpring {
+  std::array<int, 3> vertices{};  ///< mesh vertices (the 3 vertices of a surface triangle)
+  Eigen::Vector3d weights = Eigen::Vector3d::Constant(1.0 / 3.0);  ///< w_i, summing to 1
+  Eigen::Vector3d target_m = Eigen::Vector3d::Zero();
+  double stiffness_n_per_m = 0.0;
+};
+
+/// One enriched unknown a (3 components, one block row): listed once per (vertex, cut id, side),
+/// however many cut tets share it (dissertation figure 4.2).
+struct EnrichedDof {
+  int vertex = -1;
+  int cut_id = 0;
+  std::int8_t side = 0;  ///< H of the vertex for this cut: +1 above, -1 below
+  int row = -1;          ///< block row in the system (unknowns 3 row .. 3 row + 2)
+};
+
+/// What an enrichment changed.
+struct EnrichmentResult {
+  int new_cut_tets = 0;
+  int new_enriched_dofs = 0;     ///< new block rows (3 unknowns each), appended at the end
+  bool matrix_relayout = false;  ///< the tangent's storage was re-laid out (layout_revision() changed)
+};
+
 class DeformableBody final : public DynamicsModel {
  public:
   /// Throws ParameterError for invalid settings (material, damping, non-finite gravity,
   /// fixed vertex ids out of range).
   DeformableBody(TetMesh mesh, BodySettings settings);
 
-  [[nodiscard]] int dof_count() const override { return 3 * m_dofs.free_vertex_count(); }
+  [[nodiscard]] int dof_count() const override { return 3 * (m_dofs.free_vertex_count() + enriched_dof_count()); }
   [[nodiscard]] const Eigen::VectorXd& mass_kg() const override { return m_mass_kg; }
   [[nodiscard]] const RayleighDamping& damping() const override { return m_settings.damping; }
   [[nodiscard]] const Eigen::VectorXd& external_force_n() const override { return m_external_force_n; }
@@ -43,9 +80,57 @@ class DeformableBody final : public DynamicsModel {
   [[nodiscard]] const std::vector<double>& vertex_masses_kg() const { return m_vertex_mass_kg; }
   [[nodiscard]] double total_mass_kg() const;
 
-  /// Current positions of all vertices (3 per vertex) for a displacement of the unknowns.
+  /// Current (real) positions of all vertices (3 per vertex) for a displacement of the unknowns.
   void positions(const Eigen::VectorXd& displacement_m, Eigen::VectorXd& positions_m) const;
-  /// Elastic energy at displacement u. [J]
+
+  // --- XFEM cuts (dissertation 3.3, 4.2; DESIGN section 4) ---
+
+  /// Enriches completely cut tets (one cut per tet) and grows the system in place: enriched
+  /// unknowns are appended (listed once per (vertex, cut id, side)), their blocks inserted into the
+  /// tangent's reserved room (the u-u blocks and their slots are kept), mass and external force
+  /// extended. New enriched unknowns start at a = 0, da/dt = 0 (grow_state()): each part then
+  /// coincides with the deformed tet and the u forces do not change. Both parts' rotations start
+  /// from the tet's current rotation. Throws ParameterError, with nothing changed, if a cut names a
+  /// tet out of range or already cut (or twice), lacks a sign or has a sign other than +-1, or has
+  /// a volume fraction outside (0, 1) or not finite.
+  EnrichmentResult enrich(std::span<const TetCut> cuts);
+  EnrichmentResult enrich(const TetCut& cut) { return enrich(std::span<const TetCut>(&cut, 1)); }
+
+  /// Grows a state to dof_count() in place: existing entries unchanged, new ones (enriched a and
+  /// da/dt) zero. Call after enrich().
+  void grow_state(DynamicState& state) const;
+
+  [[nodiscard]] int enriched_dof_count() const { return static_cast<int>(m_enriched_dofs.size()); }
+  [[nodiscard]] const std::vector<EnrichedDof>& enriched_dofs() const { return m_enriched_dofs; }
+  /// Index into enriched_dofs() of the unknown of (vertex, cut id, side), or -1.
+  [[nodiscard]] int find_enriched_dof(int vertex, int cut_id, int side) const;
+  [[nodiscard]] const std::vector<CutTet>& cut_tets() const { return m_xfem.cut_tets(); }
+  /// Index into cut_tets() of a tet, or -1 if it is not cut.
+  [[nodiscard]] int cut_tet_index(int tet) const { return m_cut_index[static_cast<size_t>(tet)]; }
+  [[nodiscard]] const XfemElasticity& xfem() const { return m_xfem; }
+
+  /// Positions of the 4 vertices of part `part` of cut tet `cut_tet_index` (index into cut_tets()),
+  /// p_j = x_j + Psi_j a_j: the real vertices on the part's side, the ghost copies on the other. [m]
+  [[nodiscard]] TetPositions part_positions(const Eigen::VectorXd& displacement_m, int cut_tet_index,
+                                            CutPart part) const;
+  /// Rest mass of a part, rho w_p V. [kg]
+  [[nodiscard]] double part_mass_kg(int cut_tet_index, CutPart part) const;
+
+  // --- Point spring (god-object contact) ---
+
+  /// While set, evaluate() adds the spring's force k w_i (x_p - target) to f_int of each free
+  /// vertex i and k w_i w_j I to the tangent. Throws ParameterError (spring unchanged) unless the
+  /// vertices are in range, every pair of free ones shares a tet, weights and target are finite with
+  /// |sum w - 1| <= 1e-6, and 0 <= k < inf.
+  void set_point_spring(std::optional<PointSpring> spring);
+  [[nodiscard]] const std::optional<PointSpring>& point_spring() const { return m_point_spring; }
+  /// k (target - x_p) at the last evaluate(): the force the spring applies to the body (zero without
+  /// a spring). [N]
+  [[nodiscard]] Eigen::Vector3d point_spring_force_on_body_n() const { return m_point_spring_force_n; }
+
+  /// Forgets the rotation warm starts of all tets and parts (e.g. after a state was restored).
+  void reset_rotations();
+  /// Elastic energy at displacement u (cut tets: w_a E_a + w_b E_b). [J]
   [[nodiscard]] double elastic_energy_j(const Eigen::VectorXd& displacement_m);
   /// 1/2 v^T M v. [J]
   [[nodiscard]] double kinetic_energy_j(const Eigen::VectorXd& velocity_m_per_s) const;
@@ -62,6 +147,27 @@ class DeformableBody final : public DynamicsModel {
   std::vector<TetSlots> m_slots;
   Eigen::VectorXd m_positions_m;      // all vertices
   Eigen::VectorXd m_vertex_forces_n;  // all vertices
+
+  // Looks up every slot held (uncut tets, cut tets, point spring) again: after a relayout.
+  void refresh_all_slots();
+  void refresh_cut_tet_slots(int cut_tet_index);
+  void refresh_point_spring_slots();
+  void check_cuts(std::span<const TetCut> cuts) const;
+  void check_unknowns(const Eigen::VectorXd& displacement_m) const;
+  // Adds the spring's force to m_vertex_forces_n (and its stiffness to `tangent`), from m_positions_m.
+  void add_point_spring(BlockSparseMatrix* tangent);
+  [[nodiscard]] int vertex_block_row(int vertex) const { return m_dofs.vertex_row[static_cast<size_t>(vertex)]; }
+
+  XfemElasticity m_xfem;
+  std::vector<int> m_enriched_row_capacity;  // per vertex: blocks its enriched row may ever hold (one cut)
+  std::vector<EnrichedDof> m_enriched_dofs;
+  std::vector<int> m_first_enriched_dof;  // per vertex: first of its enriched unknowns, or -1
+  std::vector<int> m_next_enriched_dof;   // per enriched unknown: next one of the same vertex, or -1
+  std::vector<int> m_cut_index;           // per tet: index into cut_tets(), or -1
+
+  std::optional<PointSpring> m_point_spring;
+  std::array<int, 9> m_point_spring_slots{};  // [3 i + j]: block (row of vertex i, row of vertex j), -1 if fixed
+  Eigen::Vector3d m_point_spring_force_n = Eigen::Vector3d::Zero();
 };
 
 }  // namespace tissue

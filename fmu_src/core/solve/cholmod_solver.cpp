@@ -48,6 +48,7 @@ struct CholmodSolver::Impl {
   long rows = -1;
   bool pattern_valid = false;
   int analysis_count = 0;
+  long factored_rows = -1;  // rows of the valid numeric factor, -1 when there is none
 
   Eigen::VectorXd product;  // A x for the residual check
 
@@ -71,6 +72,7 @@ struct CholmodSolver::Impl {
   Impl& operator=(const Impl&) = delete;
 
   void free_pattern() {
+    factored_rows = -1;
     cholmod_free_factor(&factor, &common);
     cholmod_free_sparse(&matrix, &common);
     pattern_valid = false;
@@ -151,6 +153,23 @@ struct CholmodSolver::Impl {
     pattern_valid = true;
   }
 
+  // x = A^-1 b with the current numeric factor (rows = factor->n). Reuses the dense buffers.
+  void back_substitute(const Eigen::VectorXd& b, Eigen::VectorXd& x) {
+    const long n = b.size();
+    if (rhs == nullptr || static_cast<long>(rhs->nrow) != n) {
+      cholmod_free_dense(&rhs, &common);
+      rhs = cholmod_allocate_dense(static_cast<size_t>(n), 1, static_cast<size_t>(n), CHOLMOD_REAL, &common);
+      if (rhs == nullptr) throw SolverError("CholmodSolver: allocating b failed");
+    }
+    Eigen::Map<Eigen::VectorXd>(static_cast<double*>(rhs->x), n) = b;
+    const int solved = cholmod_solve2(CHOLMOD_A, factor, rhs, nullptr, &solution, nullptr, &work_y, &work_e, &common);
+    if (solved == 0 || solution == nullptr) {
+      check_status("solve");
+      throw SolverError("CholmodSolver: solve failed");
+    }
+    x = Eigen::Map<const Eigen::VectorXd>(static_cast<const double*>(solution->x), n);
+  }
+
   void fill_values(const ShiftedSystem& system) {
     const double* k_values = system.stiffness->block(0).data();  // slot 0 exists whenever n > 0
     const double scale = system.stiffness_scale;
@@ -168,19 +187,18 @@ CholmodSolver::~CholmodSolver() = default;
 
 int CholmodSolver::symbolic_analysis_count() const { return m_impl->analysis_count; }
 
-SolveReport CholmodSolver::solve(const ShiftedSystem& system, const Eigen::VectorXd& b, Eigen::VectorXd& x) {
-  system.check_sizes(b, x);
+bool CholmodSolver::has_factor() const { return m_impl->factored_rows >= 0; }
+
+void CholmodSolver::factorize(const ShiftedSystem& system) {
   Impl& impl = *m_impl;
+  impl.factored_rows = -1;
+  if (system.stiffness == nullptr || system.diagonal == nullptr)
+    throw SolverError("CholmodSolver: the system has no stiffness or no diagonal");
   const long n = system.rows();
-
-  SolveReport report;
-  const double b_norm = b.norm();
-  if (b_norm == 0.0) {  // x = 0 whatever A is; no factorization needed
-    x.setZero();
-    report.converged = true;
-    return report;
+  if (system.diagonal->size() != n) {
+    throw SolverError("CholmodSolver: the diagonal d has length " + std::to_string(system.diagonal->size()) +
+                      ", the system has " + std::to_string(n) + " rows");
   }
-
   if (!impl.pattern_current(*system.stiffness)) impl.build_pattern(*system.stiffness);
   impl.fill_values(system);
 
@@ -191,20 +209,36 @@ SolveReport CholmodSolver::solve(const ShiftedSystem& system, const Eigen::Vecto
                       std::to_string(impl.factor->minor) + " of " + std::to_string(n) + " rows, stiffness scale " +
                       std::to_string(system.stiffness_scale) + ")");
   }
+  impl.factored_rows = n;
+}
 
-  if (impl.rhs == nullptr || static_cast<long>(impl.rhs->nrow) != n) {
-    cholmod_free_dense(&impl.rhs, &impl.common);
-    impl.rhs = cholmod_allocate_dense(static_cast<size_t>(n), 1, static_cast<size_t>(n), CHOLMOD_REAL, &impl.common);
-    if (impl.rhs == nullptr) throw SolverError("CholmodSolver: allocating b failed");
+void CholmodSolver::solve_factored(const Eigen::VectorXd& b, Eigen::VectorXd& x) {
+  Impl& impl = *m_impl;
+  if (impl.factored_rows < 0) throw SolverError("CholmodSolver: solve_factored() without a factor (call factorize())");
+  if (b.size() != impl.factored_rows) {
+    throw SolverError("CholmodSolver: the right-hand side b has length " + std::to_string(b.size()) +
+                      ", the factor has " + std::to_string(impl.factored_rows) + " rows");
   }
-  Eigen::Map<Eigen::VectorXd>(static_cast<double*>(impl.rhs->x), n) = b;
-  const int solved = cholmod_solve2(CHOLMOD_A, impl.factor, impl.rhs, nullptr, &impl.solution, nullptr, &impl.work_y,
-                                    &impl.work_e, &impl.common);
-  if (solved == 0 || impl.solution == nullptr) {
-    impl.check_status("solve");
-    throw SolverError("CholmodSolver: solve failed");
+  impl.back_substitute(b, x);
+  if (!x.allFinite()) throw SolverError("CholmodSolver: the solution is not finite (non-finite values in A or b)");
+}
+
+SolveReport CholmodSolver::solve(const ShiftedSystem& system, const Eigen::VectorXd& b, Eigen::VectorXd& x) {
+  system.check_sizes(b, x);
+  Impl& impl = *m_impl;
+  const long n = system.rows();
+
+  SolveReport report;
+  const double b_norm = b.norm();
+  if (b_norm == 0.0) {  // x = 0 whatever A is; no factorization needed
+    impl.factored_rows = -1;
+    x.setZero();
+    report.converged = true;
+    return report;
   }
-  x = Eigen::Map<const Eigen::VectorXd>(static_cast<const double*>(impl.solution->x), n);
+
+  factorize(system);
+  impl.back_substitute(b, x);
 
   // The true residual: one product, cheap next to the factorization, and it catches a solve
   // spoiled by non-finite input.

@@ -79,6 +79,18 @@ class CholmodSolver final : public LinearSolver {
   CholmodSolver& operator=(const CholmodSolver&) = delete;
   SolveReport solve(const ShiftedSystem& system, const Eigen::VectorXd& b, Eigen::VectorXd& x) override;
   [[nodiscard]] std::string_view name() const override { return "cholmod"; }
+
+  /// Factor once, solve many (the contact stiffness needs three solves with one A): factorizes A
+  /// (reusing the symbolic analysis as solve() does) for solve_factored(). Throws SolverError if A
+  /// is not positive definite or the sizes are wrong; the previous factor is then gone.
+  void factorize(const ShiftedSystem& system);
+  /// Solves A x = b with the factor of the last factorize() (or of the last solve() with b != 0;
+  /// a solve() with b == 0 factorizes nothing and drops the factor). x is resized to A.rows().
+  /// Throws SolverError when there is no factor, b has the wrong length or x is not finite.
+  void solve_factored(const Eigen::VectorXd& b, Eigen::VectorXd& x);
+  /// Whether solve_factored() has a factor to use.
+  [[nodiscard]] bool has_factor() const;
+
   /// How many symbolic analyses were done so far (tests check it is reused).
   [[nodiscard]] int symbolic_analysis_count() const;
 

@@ -2,10 +2,10 @@
 // and the growth operations used by XFEM enrichment.
 //
 // Storage: the rows occupy consecutive slot ranges [row_begin, row_begin + row_capacity);
-// the first row_size slots of a range are in use. After the last row come the spare rows
-// (block_row_capacity() - block_rows() of them, m_spare_row_capacity slots each), which
-// append_block_row() hands out in order. Unused slots hold column -1 and zero values, so a
-// newly used slot is a zero block.
+// the first row_size slots of a range are in use. After the last row comes the spare room for
+// block_row_capacity() - block_rows() spare rows (m_spare_row_capacity slots each), which
+// append_block_row() hands out in order, as a pool: a row may take more than its share. Unused
+// slots hold column -1 and zero values, so a newly used slot is a zero block.
 #include "core/system/block_sparse_matrix.hpp"
 
 #include <algorithm>
@@ -30,7 +30,8 @@ size_t to_size(int i) { return static_cast<size_t>(i); }
 
 }  // namespace
 
-BlockSparseMatrix::BlockSparseMatrix(const std::vector<std::vector<int>>& pattern, Reserve reserve)
+BlockSparseMatrix::BlockSparseMatrix(const std::vector<std::vector<int>>& pattern, Reserve reserve,
+                                     const std::vector<int>& min_row_capacity)
     : m_reserve(reserve) {
   if (!(reserve.extra_row_fraction >= 0.0) || !std::isfinite(reserve.extra_row_fraction) ||
       reserve.row_capacity_factor < 1) {
@@ -38,9 +39,14 @@ BlockSparseMatrix::BlockSparseMatrix(const std::vector<std::vector<int>>& patter
         "BlockSparseMatrix: reserve needs extra_row_fraction >= 0 and row_capacity_factor >= 1");
   }
   const int n = static_cast<int>(pattern.size());
+  if (!min_row_capacity.empty() && min_row_capacity.size() != pattern.size()) {
+    throw std::invalid_argument("BlockSparseMatrix: min_row_capacity has " + std::to_string(min_row_capacity.size()) +
+                                " entries for " + std::to_string(n) + " rows");
+  }
 
   // Sorted, duplicate-free columns per row, diagonal included.
   std::vector<std::vector<int>> columns(to_size(n));
+  std::vector<int> capacity(to_size(n));
   long total_capacity = 0;
   for (int r = 0; r < n; ++r) {
     std::vector<int>& row = columns[to_size(r)];
@@ -54,7 +60,9 @@ BlockSparseMatrix::BlockSparseMatrix(const std::vector<std::vector<int>>& patter
     row.push_back(r);
     std::sort(row.begin(), row.end());
     row.erase(std::unique(row.begin(), row.end()), row.end());
-    total_capacity += static_cast<long>(row.size()) * reserve.row_capacity_factor;
+    capacity[to_size(r)] = static_cast<int>(row.size()) * reserve.row_capacity_factor;
+    if (!min_row_capacity.empty()) capacity[to_size(r)] = std::max(capacity[to_size(r)], min_row_capacity[to_size(r)]);
+    total_capacity += capacity[to_size(r)];
   }
 
   const int spare_rows = spare_row_count(reserve.extra_row_fraction, n);
@@ -76,7 +84,7 @@ BlockSparseMatrix::BlockSparseMatrix(const std::vector<std::vector<int>>& patter
     const int size = static_cast<int>(row.size());
     m_row_begin[to_size(r)] = begin;
     m_row_size[to_size(r)] = size;
-    m_row_capacity[to_size(r)] = size * reserve.row_capacity_factor;
+    m_row_capacity[to_size(r)] = capacity[to_size(r)];
     for (int k = 0; k < size; ++k) {
       m_column[to_size(begin + k)] = row[to_size(k)];
       if (row[to_size(k)] == r) m_diagonal_slot[to_size(r)] = begin + k;
@@ -199,19 +207,24 @@ void BlockSparseMatrix::relayout(int grow_row, int spare_rows) {
   ++m_pattern_revision;
 }
 
-int BlockSparseMatrix::append_block_row() {
+int BlockSparseMatrix::append_block_row(int min_capacity) {
   int n = block_rows();
   int begin = n == 0 ? 0 : m_row_begin[to_size(n - 1)] + m_row_capacity[to_size(n - 1)];
-  if (n >= m_block_row_capacity || m_spare_row_capacity < 1 || begin + m_spare_row_capacity > slot_capacity()) {
-    // Out of spare rows: reserve a fresh batch, as the constructor did, so that the next
+  int capacity = std::max(m_spare_row_capacity, min_capacity);
+  if (n >= m_block_row_capacity || capacity < 1 || begin + capacity > slot_capacity()) {
+    // Out of spare room: reserve a fresh batch, as the constructor did, so that the next
     // enrichments again grow in place; at least n/4 + 1 rows, so that growing row by row from a
-    // small (or empty) matrix re-lays out O(log n) times, not n times.
-    relayout(-1, std::max(spare_row_count(m_reserve.extra_row_fraction, n), n / 4 + 1));
+    // small (or empty) matrix re-lays out O(log n) times, not n times. The spare rows' room is a
+    // pool: a row that takes more than the spare-row capacity leaves less for the others.
+    const int per_row = m_spare_row_capacity > 0 ? m_spare_row_capacity : DEFAULT_SPARE_ROW_CAPACITY;
+    const int rows_for_this_one = (std::max(min_capacity, per_row) + per_row - 1) / per_row;
+    relayout(-1, std::max(spare_row_count(m_reserve.extra_row_fraction, n), n / 4 + 1) + rows_for_this_one);
+    capacity = std::max(m_spare_row_capacity, min_capacity);
     begin = n == 0 ? 0 : m_row_begin[to_size(n - 1)] + m_row_capacity[to_size(n - 1)];
   }
   m_row_begin.push_back(begin);
   m_row_size.push_back(1);
-  m_row_capacity.push_back(m_spare_row_capacity);
+  m_row_capacity.push_back(capacity);
   m_diagonal_slot.push_back(begin);
   m_column[to_size(begin)] = n;
   std::fill_n(&m_values[9 * to_size(begin)], 9, 0.0);

@@ -23,8 +23,11 @@ class BlockSparseMatrix {
 
   BlockSparseMatrix() = default;
   /// `pattern[r]` lists the block columns present in block row r (any order, no duplicates needed;
-  /// duplicates are merged). The diagonal block of every row is always added.
-  explicit BlockSparseMatrix(const std::vector<std::vector<int>>& pattern, Reserve reserve = {});
+  /// duplicates are merged). The diagonal block of every row is always added. Row r gets room for
+  /// max(its blocks * reserve.row_capacity_factor, min_row_capacity[r]) blocks (the second term
+  /// only when min_row_capacity is given: one entry per row).
+  explicit BlockSparseMatrix(const std::vector<std::vector<int>>& pattern, Reserve reserve = {},
+                             const std::vector<int>& min_row_capacity = {});
 
   [[nodiscard]] int block_rows() const { return static_cast<int>(m_row_begin.size()); }
   [[nodiscard]] int rows() const { return 3 * block_rows(); }
@@ -57,9 +60,12 @@ class BlockSparseMatrix {
   [[nodiscard]] int slot_column(int slot) const { return m_column[static_cast<size_t>(slot)]; }
 
   // --- Growth (XFEM) ---
-  /// Appends an empty block row (with its diagonal block) and returns its index. Uses a spare row
-  /// when one is reserved; otherwise re-lays out the storage (see layout_revision()).
-  int append_block_row();
+  /// Appends an empty block row (with its diagonal block) and returns its index. The row gets room
+  /// for max(min_capacity, the spare-row capacity) blocks, taken from the spare room after the last
+  /// row when it suffices; otherwise the storage is re-laid out (see layout_revision()). A caller
+  /// that knows how many blocks the row can ever hold (XFEM: twice the vertex's neighbourhood)
+  /// passes it, so that rows of high valence do not overflow later.
+  int append_block_row(int min_capacity = 0);
   /// Returns the slot of block (row, col), inserting it into the spare room of `row` if absent.
   /// New blocks are zero. When the row has no room left, the storage is re-laid out and
   /// layout_revision() changes: every slot index held elsewhere must then be looked up again.
@@ -86,7 +92,7 @@ class BlockSparseMatrix {
   std::vector<double> m_values;      // 9 per slot, column-major 3x3
   std::vector<int> m_diagonal_slot;  // slot of the diagonal block of each row (always present)
   int m_nonzero_blocks = 0;
-  int m_spare_row_capacity = 0;  // slots given to each spare (appended) row
+  int m_spare_row_capacity = 0;  // slots reserved per spare row (appended rows take at least this)
   int m_block_row_capacity = 0;
   Reserve m_reserve;
   std::uint64_t m_pattern_revision = 0;

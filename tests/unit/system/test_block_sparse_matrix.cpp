@@ -324,5 +324,49 @@ TEST(BlockSparseMatrix, NoSpareRowsMeansAppendRelaysOut) {
   EXPECT_EQ(matrix.block(matrix.find_slot(0, 1)), Eigen::Matrix3d::Identity());
 }
 
+TEST(BlockSparseMatrix, MinimumRowCapacityIsReservedAtConstruction) {
+  // Row 0 has 2 blocks (x2 = 4 slots) but asks for 6: four more columns fit without a re-layout.
+  BlockSparseMatrix matrix(Pattern{{1}, {0}, {}, {}, {}, {}}, {0.0, 2}, {6, 0, 0, 0, 0, 0});
+  const auto layout = matrix.layout_revision();
+  for (int c = 2; c < 6; ++c) matrix.insert_block(0, c);
+  EXPECT_EQ(matrix.layout_revision(), layout);
+  EXPECT_EQ(matrix.row_size(0), 6);
+  matrix.insert_block(1, 2);  // row 1 keeps its doubled room: 4 slots for its 2 blocks
+  matrix.insert_block(1, 3);
+  EXPECT_EQ(matrix.layout_revision(), layout);
+  matrix.insert_block(1, 4);
+  EXPECT_NE(matrix.layout_revision(), layout);
+  EXPECT_THROW(BlockSparseMatrix(Pattern{{1}, {0}}, {}, {3}), std::invalid_argument);
+}
+
+TEST(BlockSparseMatrix, AppendedRowTakesItsRoomFromTheSparePool) {
+  // 8 rows of 2 blocks: 4 slots per row, 4 spare rows of 4 slots = a pool of 16 slots.
+  std::mt19937 rng(5);
+  Pattern pattern(8);
+  for (int r = 0; r < 8; ++r) pattern[static_cast<size_t>(r)] = {(r + 1) % 8};
+  BlockSparseMatrix matrix(pattern, {0.5, 2});
+  BlockMap blocks = fill_random(matrix, pattern, rng);
+  const auto layout = matrix.layout_revision();
+  const int wide = matrix.append_block_row(10);  // a row of high valence: 10 of the 16 slots
+  for (int c = 0; c < 8; ++c) {
+    matrix.block(matrix.insert_block(wide, c)) = Eigen::Matrix3d::Identity() * c;
+    blocks[{wide, c}] = Eigen::Matrix3d::Identity() * c;
+  }
+  blocks[{wide, wide}] = Eigen::Matrix3d::Zero();
+  EXPECT_EQ(matrix.layout_revision(), layout);  // 9 blocks in 10 slots, all in place
+  matrix.append_block_row();                    // the remaining 6 slots hold one more row of 4
+  EXPECT_EQ(matrix.layout_revision(), layout);
+  blocks[{9, 9}] = Eigen::Matrix3d::Zero();
+  matrix.append_block_row();  // 2 slots left: the pool is empty before the spare rows are
+  EXPECT_NE(matrix.layout_revision(), layout);
+  blocks[{10, 10}] = Eigen::Matrix3d::Zero();
+  expect_values(matrix, blocks);
+  expect_product_matches(matrix, blocks, rng);
+  const auto layout_after = matrix.layout_revision();
+  matrix.append_block_row(40);  // wider than a fresh batch of spare rows: the batch grows to fit it
+  matrix.append_block_row();
+  EXPECT_EQ(matrix.layout_revision(), layout_after + 1);
+}
+
 }  // namespace
 }  // namespace tissue

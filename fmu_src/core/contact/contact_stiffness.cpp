@@ -1,0 +1,196 @@
+// Contact stiffness models (see contact_stiffness.hpp).
+#include "core/contact/contact_stiffness.hpp"
+
+#include "core/fem/material.hpp"
+#include "core/fem/tet_element.hpp"
+
+#include <Eigen/Dense>
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+#include <string>
+
+namespace tissue {
+
+ContactStiffnessModel parse_contact_stiffness_model(std::string_view name) {
+  if (name == "effective-static") return ContactStiffnessModel::effective_static;
+  if (name == "element-local") return ContactStiffnessModel::element_local;
+  throw ParameterError("unknown contact stiffness model '" + std::string(name) +
+                       "' (expected effective-static or element-local)");
+}
+
+std::string_view to_string(ContactStiffnessModel model) {
+  return model == ContactStiffnessModel::effective_static ? "effective-static" : "element-local";
+}
+
+ContactInterpolation contact_interpolation(const DofMap& dofs, const std::array<int, 3>& vertices,
+                                           const Eigen::Vector3d& weights) {
+  ContactInterpolation point;
+  point.weights = weights;
+  for (size_t k = 0; k < 3; ++k) {
+    const int v = vertices[k];
+    if (v < 0 || v >= static_cast<int>(dofs.vertex_row.size())) {
+      throw std::invalid_argument("contact interpolation: vertex " + std::to_string(v) + " outside [0, " +
+                                  std::to_string(dofs.vertex_row.size()) + ")");
+    }
+    point.rows[k] = dofs.vertex_row[static_cast<size_t>(v)];
+  }
+  return point;
+}
+
+ShiftedSystem static_contact_system(const BlockSparseMatrix& tangent, Eigen::VectorXd& diagonal) {
+  diagonal.setZero(tangent.rows());
+  return ShiftedSystem{&tangent, 1.0, &diagonal};
+}
+
+ShiftedSystem step_contact_system(const DynamicsModel& model, double step_size_s, Eigen::VectorXd& diagonal) {
+  if (!(step_size_s > 0.0) || !std::isfinite(step_size_s)) {
+    throw ParameterError("contact stiffness: step size must be finite and > 0 s, got " + std::to_string(step_size_s));
+  }
+  const double h = step_size_s;
+  const RayleighDamping& damping = model.damping();
+  diagonal = ((1.0 + h * damping.mass_damping_per_s) / (h * h)) * model.mass_kg();
+  return ShiftedSystem{&model.tangent(), 1.0 + damping.stiffness_damping_s / h, &diagonal};
+}
+
+void EffectiveContactStiffness::factorize(const ShiftedSystem& system) {
+  m_rows = 0;
+  m_solver.factorize(system);
+  m_rows = system.rows();
+}
+
+bool EffectiveContactStiffness::check(const ContactInterpolation& point) const {
+  if (!m_solver.has_factor() || m_rows == 0) {
+    throw SolverError("effective contact stiffness: no factorized matrix (call factorize())");
+  }
+  bool moves = false;
+  for (size_t k = 0; k < 3; ++k) {
+    const int row = point.rows[k];
+    if (row < -1 || 3 * row + 2 >= m_rows) {
+      throw std::invalid_argument("effective contact stiffness: block row " + std::to_string(row) +
+                                  " outside the factorized matrix of " + std::to_string(m_rows) + " rows");
+    }
+    moves = moves || (row >= 0 && point.weights[static_cast<Eigen::Index>(k)] != 0.0);
+  }
+  return moves;
+}
+
+void EffectiveContactStiffness::solve_columns(const ContactInterpolation& point, ResponseMatrix& response) {
+  // Column a of P holds w_k at scalar row 3 row_k + a; A Z = P column by column.
+  response.resize(m_rows, 3);
+  m_column.setZero(m_rows);
+  for (int axis = 0; axis < 3; ++axis) {
+    for (size_t k = 0; k < 3; ++k) {
+      if (point.rows[k] >= 0) m_column[3 * point.rows[k] + axis] += point.weights[static_cast<Eigen::Index>(k)];
+    }
+    m_solver.solve_factored(m_column, m_solution);
+    response.col(axis) = m_solution;
+    m_column.setZero();
+  }
+}
+
+namespace {
+
+// P^T X for X (n x 3): the rows of X at the point, weighted.
+Eigen::Matrix3d gather(const ContactInterpolation& point, const Eigen::Matrix<double, Eigen::Dynamic, 3>& x) {
+  Eigen::Matrix3d sum = Eigen::Matrix3d::Zero();
+  for (size_t k = 0; k < 3; ++k) {
+    if (point.rows[k] >= 0) sum += point.weights[static_cast<Eigen::Index>(k)] * x.middleRows<3>(3 * point.rows[k]);
+  }
+  return sum;
+}
+
+Eigen::Matrix3d symmetric_inverse(const Eigen::Matrix3d& m) {
+  const Eigen::Matrix3d inverse = (0.5 * (m + m.transpose())).inverse();
+  return 0.5 * (inverse + inverse.transpose());  // symmetric up to the solves' rounding
+}
+
+}  // namespace
+
+std::optional<Eigen::Matrix3d> EffectiveContactStiffness::stiffness_n_per_m(const ContactInterpolation& point) {
+  if (!check(point)) return std::nullopt;
+  solve_columns(point, m_response);
+  return symmetric_inverse(gather(point, m_response));  // (P^T A^-1 P)^-1
+}
+
+std::optional<Eigen::Matrix3d> EffectiveContactStiffness::stiffness_n_per_m(const ContactInterpolation& point,
+                                                                            const ContactInterpolation& spring_point,
+                                                                            double spring_stiffness_n_per_m) {
+  if (!(spring_stiffness_n_per_m >= 0.0) || !std::isfinite(spring_stiffness_n_per_m)) {
+    throw std::invalid_argument("effective contact stiffness: the spring stiffness must be finite and >= 0");
+  }
+  if (!check(point)) return std::nullopt;
+  if (spring_stiffness_n_per_m == 0.0 || !check(spring_point)) return stiffness_n_per_m(point);
+  // The factor is of A' = A + k U U^T (U interpolates the spring's point). Woodbury:
+  //   A^-1 = A'^-1 + A'^-1 U M^-1 U^T A'^-1,   M = I/k - U^T A'^-1 U,
+  // so P^T A^-1 P = P^T Z + (P^T W) M^-1 (P^T W)^T with Z = A'^-1 P, W = A'^-1 U. M ~ K_u / k^2 is
+  // formed with a cancellation of ~log10(k / K_u) digits, harmless for k up to ~1e6 K_u.
+  solve_columns(point, m_response);
+  solve_columns(spring_point, m_spring_response);
+  const Eigen::Matrix3d cross = gather(point, m_spring_response);  // P^T W
+  Eigen::Matrix3d m = -gather(spring_point, m_spring_response);    // -U^T W
+  m.diagonal().array() += 1.0 / spring_stiffness_n_per_m;
+  const Eigen::Matrix3d m_inverse = symmetric_inverse(m);
+  m_response += m_spring_response * (m_inverse * cross.transpose());  // A^-1 P
+  return symmetric_inverse(gather(point, m_response));
+}
+
+Eigen::Matrix3d element_local_contact_stiffness(const CorotationalElasticity& elasticity, int tet,
+                                                int opposite_local_vertex) {
+  if (tet < 0 || tet >= elasticity.tet_count()) {
+    throw std::invalid_argument("element-local contact stiffness: tet " + std::to_string(tet) + " outside [0, " +
+                                std::to_string(elasticity.tet_count()) + ")");
+  }
+  if (opposite_local_vertex < 0 || opposite_local_vertex > 3) {
+    throw std::invalid_argument("element-local contact stiffness: local vertex must be 0..3, got " +
+                                std::to_string(opposite_local_vertex));
+  }
+  const Eigen::Matrix3d& rotation = elasticity.rotation(tet);
+  const Eigen::Matrix3d block =
+      linear_stiffness_block(elasticity.rest(tet), elasticity.lame(), opposite_local_vertex, opposite_local_vertex);
+  return rotation * block * rotation.transpose();
+}
+
+Eigen::Matrix3d element_local_contact_stiffness(const CorotationalElasticity& elasticity, const SurfaceMesh& surface,
+                                                int triangle) {
+  if (triangle < 0 || triangle >= static_cast<int>(surface.triangle_tet.size())) {
+    throw std::invalid_argument("element-local contact stiffness: triangle " + std::to_string(triangle) +
+                                " is not a surface triangle");
+  }
+  return element_local_contact_stiffness(elasticity, surface.triangle_tet[static_cast<size_t>(triangle)],
+                                         surface.triangle_local_face[static_cast<size_t>(triangle)]);
+}
+
+double normal_stiffness_n_per_m(const Eigen::Matrix3d& stiffness, const Eigen::Vector3d& unit_normal) {
+  return unit_normal.dot(stiffness * unit_normal);
+}
+
+double frictionless_normal_stiffness_n_per_m(const Eigen::Matrix3d& stiffness, const Eigen::Vector3d& unit_normal) {
+  return 1.0 / unit_normal.dot(stiffness.ldlt().solve(unit_normal));
+}
+
+double recommended_contact_spring_stiffness_n_per_m(const DeformableBody& body, const SurfaceMesh& surface,
+                                                    double factor) {
+  if (!(factor > 0.0) || !std::isfinite(factor)) {
+    throw ParameterError("contact spring factor must be finite and > 0, got " + std::to_string(factor));
+  }
+  return factor * contact_stiffness_scale_n_per_m(body, surface);
+}
+
+double contact_stiffness_scale_n_per_m(const DeformableBody& body, const SurfaceMesh& surface) {
+  const TetMesh& mesh = body.mesh();
+  double length_sum = 0.0;
+  for (const auto& t : surface.triangles) {
+    for (size_t k = 0; k < 3; ++k) {
+      length_sum += (mesh.rest_positions_m[static_cast<size_t>(t[k])] -
+                     mesh.rest_positions_m[static_cast<size_t>(t[(k + 1) % 3])])
+                        .norm();
+    }
+  }
+  const double mean_edge_m = surface.triangles.empty() ? 0.0 : length_sum / (3.0 * surface.triangles.size());
+  const LameParameters& lame = body.elasticity().lame();
+  return (lame.lambda_pa + 2.0 * lame.mu_pa) * mean_edge_m;
+}
+
+}  // namespace tissue

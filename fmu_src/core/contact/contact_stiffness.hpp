@@ -1,0 +1,133 @@
+// The 3x3 contact stiffness K_c the haptic loop renders with (f = f0 + K_c (x - x0)) between
+// two tissue updates, in two models (DESIGN section 4, erratum on eq. 4.22):
+//
+// * effective_static (the reference): the stiffness of the whole constrained body at the
+//   contact point, K_c = (P^T K^-1 P)^-1, P (3n x 3) interpolating the contact point from the
+//   free unknowns (x_p = P^T u + fixed part). It is the force per unit displacement of the point
+//   when the rest of the body settles (static condensation); a quasi-static poke of the full
+//   model converges to K_c d as d -> 0 (tests/unit/contact). One factorization, three solves.
+// * element_local (the cheap option): eq. 4.23 with u_d = [d d d d] is a rigid translation of
+//   the tet and gives zero force for every valid K_e (the erratum). The repair used here pushes
+//   the contacted face (its three vertices) by d and holds the tet's fourth vertex:
+//     f = sum over the face vertices of (R K_e R^T u_d)_i = R K_oo R^T d   (rows of K_e sum to 0),
+//   K_oo the diagonal block of the opposite vertex o, i.e.
+//     K_local = (A / 3h) R [(lambda + 2 mu) n n^T + mu (I - n n^T)] R^T
+//   (A the face's area, h the tet's height over it, n its rest normal). Condensing R K_e R^T to
+//   the point with o held instead is singular (the tet rotates freely about o). It knows nothing of
+//   the rest of the body. Measured on the frog pinned by its belly (tests/unit/contact): 0.1-0.2
+//   times the effective normal stiffness on the back (too soft, as the dissertation found), up to
+//   ~240 times it on the slender legs (too stiff), and 1/140 of it next to the pins.
+#pragma once
+
+#include "core/fem/corotational.hpp"
+#include "core/fem/deformable_body.hpp"
+#include "core/mesh/topology.hpp"
+#include "core/solve/linear_solver.hpp"
+#include "core/system/assembly.hpp"
+#include "core/system/dynamics_model.hpp"
+
+#include <Eigen/Core>
+
+#include <array>
+#include <optional>
+#include <string_view>
+
+namespace tissue {
+
+enum class ContactStiffnessModel { effective_static, element_local };
+
+/// Parses "effective-static" / "element-local"; throws ParameterError otherwise.
+ContactStiffnessModel parse_contact_stiffness_model(std::string_view name);
+[[nodiscard]] std::string_view to_string(ContactStiffnessModel model);
+
+/// How the contact point moves with the unknowns: x_p = sum_k weights[k] x(vertex k); rows[k] is
+/// the block row of vertex k in the system, -1 for a fixed vertex (it does not move).
+struct ContactInterpolation {
+  std::array<int, 3> rows{-1, -1, -1};
+  Eigen::Vector3d weights = Eigen::Vector3d::Zero();
+};
+
+/// The interpolation of the point sum_k weights[k] x(vertices[k]) through the body's unknowns.
+ContactInterpolation contact_interpolation(const DofMap& dofs, const std::array<int, 3>& vertices,
+                                           const Eigen::Vector3d& weights);
+
+/// The matrix K_c is condensed from, for a body with fixed vertices: A = K (the tangent; SPD).
+/// `diagonal` is the zero shift it points to (resized here; keep it alive with the result).
+ShiftedSystem static_contact_system(const BlockSparseMatrix& tangent, Eigen::VectorXd& diagonal);
+
+/// For a body with nothing fixed K is singular (rigid motions), so K_c uses the backward-Euler
+/// step matrix divided by h^2: A = M/h^2 + D/h + K = ((1 + h alpha)/h^2) M + (1 + beta/h) K,
+/// the stiffness the point meets during one step (inertia and damping hold the body). It exceeds
+/// the static K_c (of any supported body) by the inertial part, ~ m_local / h^2.
+ShiftedSystem step_contact_system(const DynamicsModel& model, double step_size_s, Eigen::VectorXd& diagonal);
+
+/// K_c = (P^T A^-1 P)^-1 with CHOLMOD: factorize once per matrix, then any number of points
+/// (three solves each). The symbolic analysis is kept while the pattern does not change.
+class EffectiveContactStiffness {
+ public:
+  /// Throws SolverError when A is not positive definite (e.g. K of a body with nothing fixed).
+  void factorize(const ShiftedSystem& system);
+  /// K_c [N/m], symmetric positive definite; nothing when the point does not move with the
+  /// unknowns (all its weight on fixed vertices: a rigid support). Throws SolverError without a
+  /// factor, std::invalid_argument for a row outside the factorized matrix.
+  [[nodiscard]] std::optional<Eigen::Matrix3d> stiffness_n_per_m(const ContactInterpolation& point);
+  /// K_c of the tissue alone when the factorized matrix also holds the contact spring, k w_i w_j I
+  /// at the vertices of `spring_point` (DeformableBody's point spring is in its tangent while set):
+  /// the spring is taken out exactly (Sherman-Morrison-Woodbury, three more solves). Without that,
+  /// the matrix gives K_c + k I at the spring's own point. Throws std::invalid_argument for k < 0.
+  [[nodiscard]] std::optional<Eigen::Matrix3d> stiffness_n_per_m(const ContactInterpolation& point,
+                                                                 const ContactInterpolation& spring_point,
+                                                                 double spring_stiffness_n_per_m);
+  using ResponseMatrix = Eigen::Matrix<double, Eigen::Dynamic, 3>;
+  /// A^-1 P of the last stiffness_n_per_m() (rows() x 3; A without the spring): the displacement
+  /// field of a unit force at the point along each axis.
+  [[nodiscard]] const ResponseMatrix& unit_force_response() const { return m_response; }
+  /// x = A^-1 b with the same factor.
+  void solve(const Eigen::VectorXd& b, Eigen::VectorXd& x) { m_solver.solve_factored(b, x); }
+  [[nodiscard]] int rows() const { return m_rows; }
+
+ private:
+  /// Whether the point moves with the unknowns; throws as documented above.
+  [[nodiscard]] bool check(const ContactInterpolation& point) const;
+  /// response = A'^-1 P (A' the factorized matrix), three solves.
+  void solve_columns(const ContactInterpolation& point, ResponseMatrix& response);
+
+  CholmodSolver m_solver;
+  int m_rows = 0;
+  Eigen::VectorXd m_column;
+  Eigen::VectorXd m_solution;
+  ResponseMatrix m_response;
+  ResponseMatrix m_spring_response;
+};
+
+/// The element-local model (header): R K_oo R^T of tet `tet` with `opposite_local_vertex` (0..3) the
+/// vertex not on the contacted face, at the rotation of the last evaluate(). [N/m], SPD.
+Eigen::Matrix3d element_local_contact_stiffness(const CorotationalElasticity& elasticity, int tet,
+                                                int opposite_local_vertex);
+/// The same for a surface triangle (its tet and local face from `surface`).
+Eigen::Matrix3d element_local_contact_stiffness(const CorotationalElasticity& elasticity, const SurfaceMesh& surface,
+                                                int triangle);
+
+/// n^T K n: force along n per unit displacement along n, the tangential displacement held.
+double normal_stiffness_n_per_m(const Eigen::Matrix3d& stiffness, const Eigen::Vector3d& unit_normal);
+/// 1 / (n^T K^-1 n): force along n per unit normal displacement, the tangential force zero (a
+/// frictionless contact). <= normal_stiffness_n_per_m for SPD K.
+double frictionless_normal_stiffness_n_per_m(const Eigen::Matrix3d& stiffness, const Eigen::Vector3d& unit_normal);
+
+/// The scale of the effective normal contact stiffness of a body: (lambda + 2 mu) times the mean
+/// surface edge length at rest (the stiffness of a point load on a mesh of that spacing, up to a
+/// factor of order one). Measured on the frog pinned by its belly (tests/unit/contact), n^T K_c n at
+/// the triangle centroids is 0.0017 to 14 times this: the low end on the slender legs, the high end
+/// on triangles touching the pins, at most 2.2 on the rest (0.7-1.4 on the back).
+double contact_stiffness_scale_n_per_m(const DeformableBody& body, const SurfaceMesh& surface);
+
+/// A default for PointContactSettings::spring_stiffness_n_per_m: `factor` times
+/// contact_stiffness_scale_n_per_m. The spring's share of the contact's compliance, k_n / (k + k_n),
+/// is then at most ~2 / factor away from fixed vertices (14 / factor on triangles touching them,
+/// where the contact is nearly rigid anyway). A per-contact k from the K_c at the contact point
+/// would be tighter but would change the rendered stiffness from one touch to the next. Throws
+/// ParameterError unless factor > 0.
+double recommended_contact_spring_stiffness_n_per_m(const DeformableBody& body, const SurfaceMesh& surface,
+                                                    double factor = 100.0);
+
+}  // namespace tissue

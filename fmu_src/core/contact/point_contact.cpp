@@ -1,0 +1,83 @@
+// The god-object point contact (see point_contact.hpp).
+#include "core/contact/point_contact.hpp"
+
+#include "core/fem/material.hpp"
+
+#include <cmath>
+#include <stdexcept>
+#include <string>
+
+namespace tissue {
+
+void validate(const PointContactSettings& settings) {
+  if (!(settings.spring_stiffness_n_per_m > 0.0) || !std::isfinite(settings.spring_stiffness_n_per_m)) {
+    throw ParameterError("contact spring stiffness must be finite and > 0 N/m, got " +
+                         std::to_string(settings.spring_stiffness_n_per_m));
+  }
+}
+
+PointContact::PointContact(PointContactSettings settings) : m_settings(settings) { validate(m_settings); }
+
+bool PointContact::update(const Eigen::Vector3d& hip_previous_m, const Eigen::Vector3d& hip_m,
+                          const Eigen::VectorXd& positions_m, const SurfaceBvh& surface) {
+  if (!hip_m.allFinite() || !hip_previous_m.allFinite()) {
+    throw std::invalid_argument("point contact: the tool tip position is not finite");
+  }
+  if (positions_m.size() % 3 != 0) {
+    throw std::invalid_argument("point contact: positions must hold 3 values per vertex, got " +
+                                std::to_string(positions_m.size()));
+  }
+  const int vertex_count = static_cast<int>(positions_m.size() / 3);
+  if (m_adjacency.triangle_count != surface.triangle_count() ||
+      static_cast<int>(m_adjacency.begin.size()) != vertex_count + 1) {
+    m_adjacency.build(surface.triangles(), vertex_count);  // throws (state unchanged) for ids out of range
+  }
+
+  m_hip_m = hip_m;
+  SurfacePoint start = m_proxy;
+  if (!m_in_contact) {
+    surface.intersect_segment(hip_previous_m, hip_m, positions_m, m_segment_hits);
+    const Eigen::Vector3d motion = hip_m - hip_previous_m;
+    int entered = -1;
+    for (size_t k = 0; k < m_segment_hits.size() && entered < 0; ++k) {
+      const SurfaceBvh::SegmentHit& hit = m_segment_hits[k];
+      if (motion.dot(triangle_area_normal(surface.triangle(hit.triangle), positions_m)) < 0.0) {
+        entered = static_cast<int>(k);
+      }
+    }
+    if (entered < 0) return false;
+    const SurfaceBvh::SegmentHit& entry = m_segment_hits[static_cast<size_t>(entered)];
+    start = SurfacePoint{entry.triangle, entry.barycentric};
+  }
+
+  const SurfaceProjection projection =
+      slide_to_closest_point(hip_m, start, surface.triangles(), m_adjacency, positions_m);
+  if ((hip_m - projection.position_m).dot(projection.normal) >= 0.0) {  // the HIP is outside: separation
+    m_in_contact = false;
+    return false;
+  }
+  m_in_contact = true;
+  m_proxy = projection.point;
+  m_proxy_position_m = projection.position_m;
+  m_normal = projection.normal;
+  m_depth_m = projection.distance_m;
+  return true;
+}
+
+std::optional<PointSpring> PointContact::spring(const SurfaceBvh& surface) const {
+  if (!m_in_contact) return std::nullopt;
+  return PointSpring{surface.triangle(m_proxy.triangle), m_proxy.barycentric, m_hip_m,
+                     m_settings.spring_stiffness_n_per_m};
+}
+
+void PointContact::apply(const SurfaceBvh& surface, DeformableBody& body) const {
+  body.set_point_spring(spring(surface));
+}
+
+Eigen::Vector3d PointContact::force_on_tool_n(const SurfaceBvh& surface, const Eigen::VectorXd& positions_m) const {
+  if (!m_in_contact) return Eigen::Vector3d::Zero();
+  const Eigen::Vector3d proxy_m = surface_point_position_m(m_proxy, surface.triangles(), positions_m);
+  return m_settings.spring_stiffness_n_per_m * (proxy_m - m_hip_m);
+}
+
+}  // namespace tissue

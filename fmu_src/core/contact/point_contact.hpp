@@ -1,0 +1,100 @@
+// Point contact of the probe (dissertation 4.4.1; DESIGN section 4): a god-object proxy
+// (Zilles and Salisbury 1995) held on the deforming surface as a material point (triangle,
+// barycentric), and the implicit spring that applies the contact to the tissue.
+//
+// Why a spring to the HIP and not f = K_c d: the spring ties the proxy's material point x_p to
+// the haptic interaction point with stiffness k, and it enters the implicit step (force and
+// tangent), so the body answers with its full co-rotational response. At equilibrium
+//   f_int(u) - f_ext = k (HIP - x_p(u)) P,
+// i.e. the surface point sits on the HIP up to |f| / k, and the force is the quasi-static
+// reaction of the whole model to pushing the surface to the HIP (less |f| / k of depth: a
+// relative error k_n / (k + k_n) for a contact of normal stiffness k_n, hence k >> k_n). Because
+// the proxy is re-projected every step to the surface point closest to the HIP, the spring has no
+// tangential part at rest: the contact settles frictionless. f = K_c d with d measured to a proxy
+// that does not move the body would instead render a rigid wall of stiffness K_c that the tissue
+// never feels.
+//
+// The spring is isotropic (DeformableBody::PointSpring), so within a step it also holds the
+// material point tangentially; the re-projection then releases only the tangential stretch
+// |f_t| / k per step, and a tangential load relaxes by a factor (1 - k_t / k) per step (k_t the
+// tangential contact stiffness): with k = 100 k_t, ~100 steps per e-fold, felt as a viscous
+// stickiness. A spring acting along the normal only (k n n^T) would release it within the step;
+// a one-line change in spring() once PointSpring takes a direction (measured: the settled force in
+// ~100 instead of ~1000+ steps).
+#pragma once
+
+#include "core/collide/surface_bvh.hpp"
+#include "core/contact/surface_point.hpp"
+#include "core/fem/deformable_body.hpp"
+
+#include <Eigen/Core>
+
+#include <optional>
+#include <vector>
+
+namespace tissue {
+
+struct PointContactSettings {
+  /// Stiffness k of the spring from the proxy's material point to the HIP [N/m], finite and > 0.
+  /// Choose it >> the contact's normal stiffness: recommended_contact_spring_stiffness_n_per_m().
+  double spring_stiffness_n_per_m = 1.0e4;
+};
+
+/// Throws ParameterError unless the spring stiffness is finite and > 0.
+void validate(const PointContactSettings& settings);
+
+class PointContact {
+ public:
+  /// Throws ParameterError for invalid settings.
+  explicit PointContact(PointContactSettings settings = {});
+
+  /// One god-object update for the tool tip (HIP) moving from `hip_previous_m` to `hip_m`,
+  /// against the surface of `surface` (its triangles, refitted to `positions_m`, 3 per vertex).
+  /// * Not in contact: contact starts where the segment first enters the surface (crossing a
+  ///   triangle against its outward normal; exits, e.g. of a tool that began inside, are skipped)
+  ///   if the HIP is then inside. A surface moving over a resting tool does not start a contact.
+  /// * In contact (or just started): the proxy slides over the current surface to the locally
+  ///   closest point to the HIP (slide_to_closest_point; frictionless); contact ends when the HIP
+  ///   is on the outer side of the surface there (pseudo-normal test).
+  /// Returns in_contact(). Throws std::invalid_argument (state unchanged) for a non-finite HIP or
+  /// positions that do not cover the surface's vertices.
+  bool update(const Eigen::Vector3d& hip_previous_m, const Eigen::Vector3d& hip_m, const Eigen::VectorXd& positions_m,
+              const SurfaceBvh& surface);
+  /// Ends a contact (e.g. the tool mode changed).
+  void release() { m_in_contact = false; }
+
+  [[nodiscard]] bool in_contact() const { return m_in_contact; }
+  /// The proxy as a material point (meaningful while in contact).
+  [[nodiscard]] const SurfacePoint& proxy() const { return m_proxy; }
+  /// The proxy's position at the last update [m].
+  [[nodiscard]] const Eigen::Vector3d& proxy_position_m() const { return m_proxy_position_m; }
+  /// Unit outward (pseudo-)normal of the surface at the proxy at the last update.
+  [[nodiscard]] const Eigen::Vector3d& normal() const { return m_normal; }
+  /// The HIP of the last update [m].
+  [[nodiscard]] const Eigen::Vector3d& hip_m() const { return m_hip_m; }
+  /// |HIP - proxy| at the last update while in contact, else 0 [m].
+  [[nodiscard]] double penetration_depth_m() const { return m_in_contact ? m_depth_m : 0.0; }
+  [[nodiscard]] const PointContactSettings& settings() const { return m_settings; }
+
+  /// The spring from the proxy's material point to the HIP, for DeformableBody::set_point_spring;
+  /// nothing when not in contact.
+  [[nodiscard]] std::optional<PointSpring> spring(const SurfaceBvh& surface) const;
+  /// body.set_point_spring(spring(surface)).
+  void apply(const SurfaceBvh& surface, DeformableBody& body) const;
+  /// The force on the tool k (x_p - HIP) with the proxy's material point at `positions_m` (e.g.
+  /// after the step), i.e. minus the spring's force on the body; zero when not in contact. [N]
+  [[nodiscard]] Eigen::Vector3d force_on_tool_n(const SurfaceBvh& surface, const Eigen::VectorXd& positions_m) const;
+
+ private:
+  PointContactSettings m_settings;
+  bool m_in_contact = false;
+  SurfacePoint m_proxy;
+  Eigen::Vector3d m_proxy_position_m = Eigen::Vector3d::Zero();
+  Eigen::Vector3d m_normal = Eigen::Vector3d::Zero();
+  Eigen::Vector3d m_hip_m = Eigen::Vector3d::Zero();
+  double m_depth_m = 0.0;
+  VertexTriangles m_adjacency;                         // rebuilt when the surface grows (a cut)
+  std::vector<SurfaceBvh::SegmentHit> m_segment_hits;  // work buffer
+};
+
+}  // namespace tissue

@@ -1,0 +1,25 @@
+// TetCut: how one completely cut tet is split, as the volume cutter hands it to the XFEM
+// (dissertation 3.3, 4.3.2). One cut per tet.
+#pragma once
+
+#include <array>
+#include <cstdint>
+
+namespace tissue {
+
+struct TetCut {
+  int tet = -1;
+  /// Which cutting session (blade entry to blade exit) made the cut; enriched DOFs are per session.
+  int cut_id = 0;
+  /// H_i of each local vertex of the tet: +1 above the cut, -1 below (dissertation eq. 3.14).
+  /// Both signs occur.
+  std::array<std::int8_t, 4> side{};
+  /// V_a / V, the fraction of the rest volume above the cut (part a), exact for the cut surface
+  /// through the edge intersection points, clamped to [min_volume_fraction, 1 - min_volume_fraction].
+  double volume_fraction_above = 0.5;
+  /// Where the cut crosses local edge k (TET_EDGES[k] = {i, j}): the point is
+  /// (1 - r) X_i + r X_j in the rest configuration; -1 for an edge the cut does not cross.
+  std::array<double, 6> edge_ratio{-1.0, -1.0, -1.0, -1.0, -1.0, -1.0};
+};
+
+}  // namespace tissue

@@ -1,0 +1,115 @@
+// XFEM elasticity of completely cut tets (dissertation 3.3 and 4.2.1, DESIGN section 4): a cut tet
+// behaves as two full-shape co-rotational tets, part a above the cut (H = +1) and part b below
+// (H = -1), weighted by their rest volume fractions w_a = V_a / V and w_b = 1 - w_a. Part p places
+// local vertex j at p_pj = x_j + Psi_pj a_j with the shifted enrichment Psi_pj = (H_p - H_j) / 2
+// (eq. 3.15, 3.26-3.27), has its own deformation gradient and its own rotation R_p (warm-started
+// per part), and gives (eq. 3.31-3.32)
+//   f_i   = w_a Fa_i + w_b Fb_i,   f^a_i = w_a Psi_ai Fa_i + w_b Psi_bi Fb_i,
+//   Fp_i  = V R_p sigma(sym(R_p^T F_p) - I) g_i  (= [R_p K_e (R_p^T p_p - p0)]_i),
+// with the tangent blocks of eq. 4.3-4.6, w_p s_p(I) s_p(J) R_p K_ij R_p^T, where s_p = 1 for a
+// u unknown and Psi_pi for an enriched one.
+#pragma once
+
+#include "core/cut/tet_cut.hpp"
+#include "core/fem/material.hpp"
+#include "core/fem/rotation.hpp"
+#include "core/fem/tet_element.hpp"
+#include "core/mesh/tet_mesh.hpp"
+#include "core/system/block_sparse_matrix.hpp"
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+
+#include <array>
+#include <vector>
+
+namespace tissue {
+
+/// The two parts of a cut tet: part a lies above the cut (H = +1), part b below (H = -1).
+enum class CutPart { above, below };
+
+/// H of a part: +1 above, -1 below.
+constexpr int part_side(CutPart part) { return part == CutPart::above ? 1 : -1; }
+
+/// The shifted enrichment Psi_pi = (H_p - H_i) / 2 (eq. 3.15) of a vertex on side H_i in part p:
+/// 0 on the part's own side, -H_i (that is +-1) on the other side.
+constexpr double enrichment_shift(int vertex_side, CutPart part) {
+  return 0.5 * static_cast<double>(part_side(part) - vertex_side);
+}
+
+/// One completely cut tet as the XFEM models it.
+struct CutTet {
+  TetCut cut;                         ///< as the cutter gave it (tet, cut id, sides H_i, fraction, edge ratios)
+  Tet vertices{};                     ///< mesh vertex of each local vertex
+  double weight_above = 0.5;          ///< w_a = V_a / V
+  double weight_below = 0.5;          ///< w_b = 1 - w_a
+  std::array<int, 4> enriched_row{};  ///< block row of the enriched unknown a_i of each local vertex
+  /// The weight of a part (w_a or w_b).
+  [[nodiscard]] double weight(CutPart part) const { return part == CutPart::above ? weight_above : weight_below; }
+  /// Psi of local vertex i in part p.
+  [[nodiscard]] double shift(int i, CutPart part) const {
+    return enrichment_shift(cut.side[static_cast<size_t>(i)], part);
+  }
+};
+
+/// Slots of the 8x8 blocks of a cut tet, index 8 I + J: I < 4 is u of local vertex I, I >= 4 the
+/// enriched a of local vertex I - 4. -1 where there is no block: the u of a fixed vertex, and the
+/// a-a blocks of two vertices on opposite sides (Psi_pi Psi_pj = 0 in both parts, eq. 4.6).
+using CutTetSlots = std::array<int, 64>;
+
+/// Positions p_pj = x_j + Psi_pj a_j of the 4 vertices of part p (eq. 3.26-3.27), from the real
+/// positions x and the enriched displacements a of the tet's local vertices. [m]
+TetPositions cut_part_positions(const CutTet& cut_tet, CutPart part, const TetPositions& real_positions_m,
+                                const TetPositions& enrichment_m);
+
+class XfemElasticity {
+ public:
+  explicit XfemElasticity(const LameParameters& lame) : m_lame(lame) {}
+
+  /// Room for this many cut tets without reallocation.
+  void reserve(int cut_tets);
+
+  /// Adds a cut tet with its rest data. Both parts' rotations start from `rotation` (the tet's
+  /// rotation before the cut: with a = 0 both parts coincide with the tet). Slots start at -1 (set
+  /// them with slots() before the first evaluate with a tangent).
+  void add(const CutTet& cut_tet, const TetRest& rest, const Eigen::Matrix3d& rotation);
+
+  [[nodiscard]] int cut_tet_count() const { return static_cast<int>(m_cut_tets.size()); }
+  [[nodiscard]] const std::vector<CutTet>& cut_tets() const { return m_cut_tets; }
+  [[nodiscard]] const TetRest& rest(int k) const { return m_rest[static_cast<size_t>(k)]; }
+  [[nodiscard]] CutTetSlots& slots(int k) { return m_slots[static_cast<size_t>(k)]; }
+  [[nodiscard]] const CutTetSlots& slots(int k) const { return m_slots[static_cast<size_t>(k)]; }
+  /// R_p of cut tet k at the last evaluate().
+  [[nodiscard]] const Eigen::Matrix3d& rotation(int k, CutPart part) const {
+    return m_rotations[static_cast<size_t>(k)][part == CutPart::above ? 0 : 1];
+  }
+
+  /// One pass over the cut tets. `positions_m`: real positions of all vertices (3 per vertex);
+  /// `displacement_m`: the unknowns (the enriched a are read from the enriched rows). Adds f_i into
+  /// `vertex_forces_n` (3 per vertex), f^a_i into the enriched rows of `internal_force_n` (3 per
+  /// unknown) and, when `tangent` is given, the blocks of eq. 4.3-4.6 through the slots.
+  void evaluate(const Eigen::VectorXd& positions_m, const Eigen::VectorXd& displacement_m,
+                Eigen::VectorXd& vertex_forces_n, Eigen::VectorXd& internal_force_n, BlockSparseMatrix* tangent);
+
+  /// Sum over the cut tets of w_a E(part a) + w_b E(part b), with the rotations of these
+  /// positions (warm starts unchanged). [J]
+  [[nodiscard]] double elastic_energy_j(const Eigen::VectorXd& positions_m,
+                                        const Eigen::VectorXd& displacement_m) const;
+
+  /// Forgets the warm starts (rotations back to identity).
+  void reset_rotations();
+
+ private:
+  // Real positions and enriched displacements of the local vertices of cut tet k.
+  void gather(size_t k, const Eigen::VectorXd& positions_m, const Eigen::VectorXd& displacement_m, TetPositions& real_m,
+              TetPositions& enrichment_m) const;
+
+  LameParameters m_lame;
+  std::vector<CutTet> m_cut_tets;
+  std::vector<TetRest> m_rest;
+  std::vector<CutTetSlots> m_slots;
+  std::vector<std::array<Eigen::Matrix3d, 2>> m_rotations;       // [above, below]
+  std::vector<std::array<Eigen::Quaterniond, 2>> m_warm_starts;  // [above, below]
+};
+
+}  // namespace tissue

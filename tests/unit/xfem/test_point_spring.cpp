@@ -1,0 +1,213 @@
+// Tests of the point spring through which god-object contact pulls the body: its force and tangent
+// against the definition and finite differences, the static pull of a clamped bar against two
+// springs in series (the spring and the bar's compliance at the point, P^T K^-1 P), and the checks.
+#include "core/fem/deformable_body.hpp"
+#include "core/mesh/box_mesh.hpp"
+#include "xfem/xfem_test_helpers.hpp"
+
+#include <gtest/gtest.h>
+
+#include <Eigen/Dense>
+
+#include <cmath>
+#include <iostream>
+#include <limits>
+#include <optional>
+
+namespace tissue {
+namespace {
+
+using xfem_test::dense;
+
+// A bar of 1 cm cubes clamped at x = 0, no gravity.
+struct Bar {
+  TetMesh mesh;
+  DeformableBody body;
+
+  Bar(int cubes, double young_modulus_pa)
+      : mesh(make_box_mesh(cubes, 2, 2, 0.01)), body(mesh, settings(mesh, young_modulus_pa)) {}
+
+  static BodySettings settings(const TetMesh& mesh, double young_modulus_pa) {
+    BodySettings s;
+    s.material = Material{young_modulus_pa, 0.3, 1000.0};
+    s.gravity_m_per_s2.setZero();
+    for (int v = 0; v < mesh.vertex_count(); ++v) {
+      if (mesh.rest_positions_m[static_cast<size_t>(v)].x() < 1e-9) s.fixed_vertices.push_back(v);
+    }
+    return s;
+  }
+  // Three vertices of one tet, all with rest x equal to `x_m` when possible: a surface triangle.
+  std::array<int, 3> face_at(double x_m) const {
+    for (const Tet& tet : mesh.tets) {
+      std::array<int, 3> face{};
+      int count = 0;
+      for (int v : tet) {
+        if (count < 3 && std::abs(mesh.rest_positions_m[static_cast<size_t>(v)].x() - x_m) < 1e-9)
+          face[static_cast<size_t>(count++)] = v;
+      }
+      if (count == 3) return face;
+    }
+    throw std::logic_error("no face at that x");
+  }
+  Eigen::Vector3d point(const PointSpring& spring, const Eigen::VectorXd& positions_m) const {
+    Eigen::Vector3d p = Eigen::Vector3d::Zero();
+    for (int i = 0; i < 3; ++i)
+      p += spring.weights(i) * positions_m.segment<3>(3 * spring.vertices[static_cast<size_t>(i)]);
+    return p;
+  }
+};
+
+TEST(PointSpring, ForceAndTangentMatchTheDefinitionAndFiniteDifferences) {
+  Bar bar(3, 1e5);
+  // A triangle on the clamped face x = 0 shares a tet with free vertices; take one with a fixed vertex
+  // (its share is skipped, but it still places x_p) and one fully free.
+  for (const double face_x : {0.0, 0.03}) {
+    std::array<int, 3> triangle = bar.face_at(face_x);
+    if (face_x == 0.0) {
+      // Swap one clamped vertex for a free vertex of the same tet.
+      for (const Tet& tet : bar.mesh.tets) {
+        int hits = 0;
+        for (int v : tet) hits += v == triangle[0] || v == triangle[1];
+        if (hits < 2) continue;
+        for (int v : tet) {
+          if (bar.body.dofs().vertex_row[static_cast<size_t>(v)] >= 0) triangle[2] = v;
+        }
+        break;
+      }
+    }
+    const PointSpring spring{triangle, Eigen::Vector3d(0.2, 0.3, 0.5), Eigen::Vector3d(0.02, 0.013, 0.007), 250.0};
+    Eigen::VectorXd u(bar.body.dof_count());
+    for (Eigen::Index k = 0; k < u.size(); ++k) u(k) = 3e-4 * std::sin(1.3 * static_cast<double>(k));
+
+    Eigen::VectorXd f_without;
+    bar.body.set_point_spring(std::nullopt);
+    bar.body.evaluate(u, f_without, true);
+    const Eigen::MatrixXd k_without = dense(bar.body.tangent());
+    bar.body.set_point_spring(spring);
+    Eigen::VectorXd f_with;
+    bar.body.evaluate(u, f_with, true);
+    const Eigen::MatrixXd k_spring = dense(bar.body.tangent()) - k_without;
+    const Eigen::VectorXd f_spring = f_with - f_without;
+
+    Eigen::VectorXd positions;
+    bar.body.positions(u, positions);
+    const Eigen::Vector3d stretch = bar.point(spring, positions) - spring.target_m;
+    Eigen::VectorXd expected = Eigen::VectorXd::Zero(u.size());
+    for (int i = 0; i < 3; ++i) {
+      const int row = bar.body.dofs().vertex_row[static_cast<size_t>(spring.vertices[static_cast<size_t>(i)])];
+      if (row >= 0) expected.segment<3>(3 * row) += spring.stiffness_n_per_m * spring.weights(i) * stretch;
+    }
+    // Sums of a few products: round-off only, relative to the elastic forces they were added to.
+    EXPECT_LT((f_spring - expected).norm(), 1e-12 * f_with.norm());
+    EXPECT_LT((bar.body.point_spring_force_on_body_n() + spring.stiffness_n_per_m * stretch).norm(),
+              1e-12 * stretch.norm() * spring.stiffness_n_per_m);
+
+    // The spring is linear in u: central differences are exact up to round-off of f_int (~1e-16 |f|
+    // / step with |f| ~ 1 N and step 1e-6 m: 1e-10 N/m), far below k w_i w_j ~ 10 N/m.
+    const double step_m = 1e-6;
+    Eigen::MatrixXd numeric(u.size(), u.size());
+    for (Eigen::Index k = 0; k < u.size(); ++k) {
+      Eigen::VectorXd plus = u;
+      Eigen::VectorXd minus = u;
+      plus(k) += step_m;
+      minus(k) -= step_m;
+      Eigen::VectorXd f_plus;
+      Eigen::VectorXd f_minus;
+      bar.body.evaluate(plus, f_plus, false);
+      bar.body.evaluate(minus, f_minus, false);
+      bar.body.set_point_spring(std::nullopt);
+      Eigen::VectorXd e_plus;
+      Eigen::VectorXd e_minus;
+      bar.body.evaluate(plus, e_plus, false);
+      bar.body.evaluate(minus, e_minus, false);
+      bar.body.set_point_spring(spring);
+      numeric.col(k) = ((f_plus - e_plus) - (f_minus - e_minus)) / (2.0 * step_m);
+    }
+    EXPECT_LT((numeric - k_spring).norm(), 1e-6 * k_spring.norm());
+    EXPECT_GT(k_spring.norm(), 0.0);
+  }
+}
+
+TEST(PointSpring, PullOnAClampedBarIsTwoSpringsInSeries) {
+  // Static equilibrium of the bar pulled by the spring towards target = x_p0 + D: the point moves
+  // by d = C F with C = P^T K^-1 P (the bar's compliance at the point, from the rest tangent), and
+  // F = k (D - d), so F = (C + I/k)^-1 D. Linear elasticity holds to O(|D| / L) = 1e-4 (a 10 um
+  // pull on a 10 cm bar): 1e-3 relative covers the geometric nonlinearity.
+  Bar bar(10, 1e6);
+  const std::array<int, 3> triangle = bar.face_at(0.1);  // on the free end
+  const Eigen::Vector3d weights(0.25, 0.35, 0.4);
+
+  Eigen::VectorXd force;
+  bar.body.evaluate(Eigen::VectorXd::Zero(bar.body.dof_count()), force, true);
+  const Eigen::MatrixXd k = dense(bar.body.tangent());
+  Eigen::MatrixXd p = Eigen::MatrixXd::Zero(k.rows(), 3);
+  for (int i = 0; i < 3; ++i) {
+    const int row = bar.body.dofs().vertex_row[static_cast<size_t>(triangle[static_cast<size_t>(i)])];
+    p.block<3, 3>(3 * row, 0) += weights(i) * Eigen::Matrix3d::Identity();
+  }
+  const Eigen::Matrix3d compliance = p.transpose() * k.ldlt().solve(p);
+
+  const double spring_n_per_m = 2000.0;
+  for (const Eigen::Vector3d& pull : {Eigen::Vector3d(1e-5, 0.0, 0.0), Eigen::Vector3d(0.0, 0.3e-5, -1e-5)}) {
+    Eigen::VectorXd positions;
+    bar.body.positions(Eigen::VectorXd::Zero(bar.body.dof_count()), positions);
+    const PointSpring spring{triangle, weights, bar.point(PointSpring{triangle, weights, {}, 0.0}, positions) + pull,
+                             spring_n_per_m};
+    bar.body.set_point_spring(spring);
+    Eigen::VectorXd u = Eigen::VectorXd::Zero(bar.body.dof_count());
+    xfem_test::solve_static(bar.body, u);
+    bar.body.evaluate(u, force, false);
+    const Eigen::Vector3d f = bar.body.point_spring_force_on_body_n();
+    const Eigen::Vector3d expected = (compliance + Eigen::Matrix3d::Identity() / spring_n_per_m).inverse() * pull;
+    EXPECT_LT((f - expected).norm(), 1e-3 * expected.norm());
+    const int axis = pull.x() != 0.0 ? 0 : 2;
+    std::cout << "pull along "
+              << "xyz"[axis] << ": k_eff " << f(axis) / pull(axis) << " N/m, series of spring " << spring_n_per_m
+              << " and bar 1/C = " << 1.0 / compliance(axis, axis) << " N/m; relative error "
+              << (f - expected).norm() / expected.norm() << "\n";
+  }
+}
+
+TEST(PointSpring, RefusesBadSpringsAndKeepsTheOldOne) {
+  Bar bar(3, 1e5);
+  const std::array<int, 3> triangle = bar.face_at(0.03);
+  const PointSpring good{triangle, Eigen::Vector3d(0.2, 0.3, 0.5), Eigen::Vector3d(0.03, 0.0, 0.0), 10.0};
+  bar.body.set_point_spring(good);
+  const auto refused = [&](PointSpring bad) {
+    EXPECT_THROW(bar.body.set_point_spring(bad), ParameterError);
+    ASSERT_TRUE(bar.body.point_spring().has_value());
+    EXPECT_EQ(bar.body.point_spring()->vertices, good.vertices);
+  };
+  PointSpring bad = good;
+  bad.vertices[1] = bar.mesh.vertex_count();
+  refused(bad);
+  bad.vertices[1] = -1;
+  refused(bad);
+  bad = good;
+  bad.vertices[1] = 1;  // at x = 0.01: shares no tet with the end face at x = 0.03
+  refused(bad);
+  bad = good;
+  bad.weights = Eigen::Vector3d(0.2, 0.3, 0.4);
+  refused(bad);
+  bad.weights = Eigen::Vector3d(std::nan(""), 0.5, 0.5);
+  refused(bad);
+  bad = good;
+  bad.target_m.x() = std::numeric_limits<double>::infinity();
+  refused(bad);
+  bad = good;
+  bad.stiffness_n_per_m = -1.0;
+  refused(bad);
+  bad.stiffness_n_per_m = std::nan("");
+  refused(bad);
+
+  Eigen::VectorXd f;
+  bar.body.evaluate(Eigen::VectorXd::Zero(bar.body.dof_count()), f, false);
+  EXPECT_GT(bar.body.point_spring_force_on_body_n().norm(), 0.0);
+  bar.body.set_point_spring(std::nullopt);
+  EXPECT_EQ(bar.body.point_spring_force_on_body_n().norm(), 0.0);
+  bar.body.evaluate(Eigen::VectorXd::Zero(bar.body.dof_count()), f, false);
+  EXPECT_LT(f.norm(), 1e-12);  // at rest, no gravity, no spring: only round-off of the rest shape
+}
+
+}  // namespace
+}  // namespace tissue

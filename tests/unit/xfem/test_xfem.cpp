@@ -1,0 +1,495 @@
+// Tests of the cut-tet mechanics (dissertation 3.3, 4.2.1-4.2.3): the force equals eq. 3.30 written
+// with 12x12 matrices and is the gradient of the weighted energy; the tangent equals finite
+// differences where it is exact and the linear K^X of eq. 3.19-3.23 at rest; enriching a deformed
+// body leaves its u forces, u tangent and energy unchanged; enriched unknowns are listed once, fixed
+// vertices get one too; the enriched mass is the mass across the cut; bad cuts are refused.
+#include "core/fem/deformable_body.hpp"
+#include "core/mesh/box_mesh.hpp"
+#include "xfem/xfem_test_helpers.hpp"
+
+#include <gtest/gtest.h>
+
+#include <Eigen/Geometry>
+
+#include <limits>
+#include <map>
+#include <numeric>
+#include <random>
+#include <set>
+#include <tuple>
+
+namespace tissue {
+namespace {
+
+using xfem_test::dense;
+using xfem_test::Plane;
+
+using Matrix24d = Eigen::Matrix<double, 24, 24>;
+using Vector24d = Eigen::Matrix<double, 24, 1>;
+
+const Material MATERIAL{1.0e5, 0.4, 1000.0};
+
+TetMesh one_tet() {
+  TetMesh mesh;
+  mesh.rest_positions_m = {Eigen::Vector3d(0.0, 0.0, 0.0), Eigen::Vector3d(0.011, 0.001, -0.002),
+                           Eigen::Vector3d(0.002, 0.009, 0.001), Eigen::Vector3d(-0.001, 0.002, 0.012)};
+  mesh.tets = {Tet{0, 1, 2, 3}};
+  return mesh;
+}
+
+BodySettings free_settings() {
+  BodySettings settings;
+  settings.material = MATERIAL;
+  settings.gravity_m_per_s2.setZero();
+  return settings;
+}
+
+Vector12d flatten(const TetPositions& x) {
+  Vector12d flat;
+  for (int i = 0; i < 4; ++i) flat.segment<3>(3 * i) = x[static_cast<size_t>(i)];
+  return flat;
+}
+
+Matrix12d block_diagonal(const Eigen::Matrix3d& r) {
+  Matrix12d b = Matrix12d::Zero();
+  for (int i = 0; i < 4; ++i) b.block<3, 3>(3 * i, 3 * i) = r;
+  return b;
+}
+
+// One tet, nothing fixed, cut with the given sides: unknowns [u_0..u_3, a_0..a_3] (24), because the
+// enriched unknowns are created in local-vertex order.
+struct CutOneTet {
+  TetMesh mesh = one_tet();
+  DeformableBody body{mesh, free_settings()};
+  TetCut cut;
+
+  CutOneTet(std::array<std::int8_t, 4> side, double fraction_above) {
+    cut.tet = 0;
+    cut.side = side;
+    cut.volume_fraction_above = fraction_above;
+    body.enrich(cut);
+  }
+  [[nodiscard]] double psi(int i, CutPart part) const {
+    return enrichment_shift(cut.side[static_cast<size_t>(i)], part);
+  }
+  [[nodiscard]] double weight(CutPart part) const {
+    return part == CutPart::above ? cut.volume_fraction_above : 1.0 - cut.volume_fraction_above;
+  }
+  Vector24d force(const Vector24d& q) {
+    Eigen::VectorXd f;
+    body.evaluate(q, f, /*update_tangent=*/true);
+    return f;
+  }
+  Matrix24d tangent() const { return dense(body.tangent()); }
+
+  // The unknowns that put part a at `above` and part b at `below` (vertex positions): the real
+  // vertex of each side is its own part's vertex, and a_j = p_aj - p_bj (from eq. 3.26-3.27).
+  [[nodiscard]] Vector24d unknowns_for_parts(const TetPositions& above, const TetPositions& below) const {
+    Vector24d q;
+    for (size_t j = 0; j < 4; ++j) {
+      const Eigen::Vector3d& own = cut.side[j] == 1 ? above[j] : below[j];
+      q.segment<3>(3 * static_cast<Eigen::Index>(j)) = own - mesh.rest_positions_m[j];
+      q.segment<3>(12 + 3 * static_cast<Eigen::Index>(j)) = above[j] - below[j];
+    }
+    return q;
+  }
+
+  // Eq. 3.30 with 12x12 matrices: f^X = sum_p w_p S_p^T R_p K_e (R_p^T p_p - p0), S_p = [I, diag(Psi_p)],
+  // p_p = p0 + u + Psi_p a; R_p from the SVD (the reference, independent of the model's Newton).
+  [[nodiscard]] Vector24d reference_force(const Vector24d& q) const {
+    const TetRest& rest = body.elasticity().rest(0);
+    const Matrix12d k_e = linear_stiffness_matrix(rest, body.elasticity().lame());
+    TetPositions rest_x;
+    for (size_t j = 0; j < 4; ++j) rest_x[j] = mesh.rest_positions_m[j];
+    const Vector12d p0 = flatten(rest_x);
+    Vector24d f = Vector24d::Zero();
+    for (const CutPart part : {CutPart::above, CutPart::below}) {
+      Eigen::Matrix<double, 12, 24> s = Eigen::Matrix<double, 12, 24>::Zero();
+      s.leftCols<12>().setIdentity();
+      for (int j = 0; j < 4; ++j) s.block<3, 3>(3 * j, 12 + 3 * j) = psi(j, part) * Eigen::Matrix3d::Identity();
+      const Vector12d p = p0 + s * q;
+      TetPositions p_tet;
+      for (size_t j = 0; j < 4; ++j) p_tet[j] = p.segment<3>(3 * static_cast<Eigen::Index>(j));
+      const Matrix12d r = block_diagonal(rotation_by_svd(deformation_gradient(rest, p_tet)));
+      f += weight(part) * s.transpose() * (r * k_e * (r.transpose() * p - p0));
+    }
+    return f;
+  }
+};
+
+TetPositions moved(const TetMesh& mesh, const Eigen::Matrix3d& rotation, const Eigen::Vector3d& shift) {
+  TetPositions x;
+  for (size_t j = 0; j < 4; ++j) x[j] = rotation * mesh.rest_positions_m[j] + shift;
+  return x;
+}
+
+const std::array<std::array<std::int8_t, 4>, 3> SIDE_PATTERNS{{{1, 1, -1, -1}, {1, -1, -1, -1}, {-1, 1, 1, 1}}};
+
+TEST(XfemCutTet, ForceEqualsEquation330WithSeparateRotations) {
+  // Parts a and b turned by different large rotations, strained by up to 20% (jitter 2 mm on
+  // 1 cm edges). Both sides compute the same sums from the same K_e entries; the rotations agree
+  // to the Newton tolerance (angle error ~1e-12), so 1e-12 relative bounds both (measured: 1.4e-14).
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> jitter(-0.002, 0.002);
+  for (const auto& side : SIDE_PATTERNS) {
+    CutOneTet tet(side, 0.37);
+    for (int trial = 0; trial < 5; ++trial) {
+      const Eigen::Matrix3d ra =
+          Eigen::AngleAxisd(0.4 + 0.5 * trial, Eigen::Vector3d(1, 2, -0.5).normalized()).toRotationMatrix();
+      const Eigen::Matrix3d rb =
+          Eigen::AngleAxisd(-0.9 + 0.3 * trial, Eigen::Vector3d(-1, 0.3, 2).normalized()).toRotationMatrix();
+      TetPositions above = moved(tet.mesh, ra, Eigen::Vector3d(0.01, 0.0, 0.0));
+      TetPositions below = moved(tet.mesh, rb, Eigen::Vector3d(0.0, -0.02, 0.0));
+      for (size_t j = 0; j < 4; ++j) {
+        for (int c = 0; c < 3; ++c) {
+          above[j](c) += jitter(rng);
+          below[j](c) += jitter(rng);
+        }
+      }
+      const Vector24d q = tet.unknowns_for_parts(above, below);
+      const Vector24d f = tet.force(q);
+      const Vector24d expected = tet.reference_force(q);
+      EXPECT_LT((f - expected).norm(), 1e-12 * expected.norm()) << "trial " << trial;
+      // The enriched forces are not an afterthought: they carry a good share of the total.
+      EXPECT_GT(f.tail<12>().norm(), 0.1 * f.head<12>().norm());
+    }
+  }
+}
+
+TEST(XfemCutTet, ForceIsTheGradientOfTheWeightedEnergy) {
+  // With the polar rotation, V R sigma g_i is the exact gradient of the co-rotated energy, so f^X is
+  // the gradient of w_a E(p_a) + w_b E(p_b) in the 24 unknowns at any state. Central differences
+  // with step 1e-7 m: truncation ~step^2 f''' and round-off ~1e-16 E / step stay below 1e-8 of |f|
+  // (measured: 2e-11).
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> jitter(-0.002, 0.002);
+  CutOneTet tet({1, -1, 1, -1}, 0.62);
+  Vector24d q;
+  for (int k = 0; k < 24; ++k) q(k) = jitter(rng);
+  const Vector24d f = tet.force(q);
+  Vector24d numeric;
+  const double step_m = 1e-7;
+  for (int k = 0; k < 24; ++k) {
+    Vector24d plus = q;
+    Vector24d minus = q;
+    plus(k) += step_m;
+    minus(k) -= step_m;
+    numeric(k) = (tet.body.elastic_energy_j(plus) - tet.body.elastic_energy_j(minus)) / (2.0 * step_m);
+  }
+  EXPECT_LT((numeric - f).norm(), 1e-8 * f.norm());
+}
+
+TEST(XfemCutTet, TangentMatchesFiniteDifferencesAtRotatedRestStatesOfBothParts) {
+  // Each part rigidly moved (different rotations): both parts' rotated strains vanish, so the
+  // dR/dx terms the tangent (eq. 4.3-4.6) leaves out vanish too and it is the exact derivative.
+  // Tolerance as for the uncut tet (test_corotational): 1e-6 relative.
+  for (const auto& side : SIDE_PATTERNS) {
+    CutOneTet tet(side, 0.25);
+    const Eigen::Matrix3d ra = Eigen::AngleAxisd(1.1, Eigen::Vector3d(1, 1, 0).normalized()).toRotationMatrix();
+    const Eigen::Matrix3d rb = Eigen::AngleAxisd(-0.7, Eigen::Vector3d(0, 1, 2).normalized()).toRotationMatrix();
+    const Vector24d q = tet.unknowns_for_parts(moved(tet.mesh, ra, Eigen::Vector3d(0.01, 0.0, 0.0)),
+                                               moved(tet.mesh, rb, Eigen::Vector3d(0.0, 0.0, -0.005)));
+    tet.force(q);
+    const Matrix24d analytic = tet.tangent();
+    Matrix24d numeric;
+    const double step_m = 1e-7;
+    for (int k = 0; k < 24; ++k) {
+      Vector24d plus = q;
+      Vector24d minus = q;
+      plus(k) += step_m;
+      minus(k) -= step_m;
+      numeric.col(k) = (tet.force(plus) - tet.force(minus)) / (2.0 * step_m);
+    }
+    EXPECT_LT((numeric - analytic).norm(), 1e-6 * analytic.norm());
+    EXPECT_LT((analytic - analytic.transpose()).norm(), 1e-12 * analytic.norm());
+  }
+}
+
+TEST(XfemCutTet, TangentAtRestIsTheLinearXfemStiffness) {
+  // At rest R_a = R_b = I and eq. 4.3-4.6 reduce to the linear K^X of eq. 3.19-3.23, written here
+  // in its case form.
+  for (const auto& side : SIDE_PATTERNS) {
+    const double w_a = 0.3;
+    const double w_b = 1.0 - w_a;
+    CutOneTet tet(side, w_a);
+    tet.force(Vector24d::Zero());
+    const Matrix12d k = linear_stiffness_matrix(tet.body.elasticity().rest(0), tet.body.elasticity().lame());
+    Matrix24d expected = Matrix24d::Zero();
+    const auto side_factor = [&](int h) { return h == 1 ? -w_b : w_a; };  // eq. 3.21-3.22
+    for (int i = 0; i < 4; ++i) {
+      for (int j = 0; j < 4; ++j) {
+        const Eigen::Matrix3d k_ij = k.block<3, 3>(3 * i, 3 * j);
+        const int h_i = side[static_cast<size_t>(i)];
+        const int h_j = side[static_cast<size_t>(j)];
+        expected.block<3, 3>(3 * i, 3 * j) = k_ij;
+        expected.block<3, 3>(3 * i, 12 + 3 * j) = side_factor(h_j) * k_ij;
+        expected.block<3, 3>(12 + 3 * i, 3 * j) = side_factor(h_i) * k_ij;
+        const double aa = h_i != h_j ? 0.0 : (h_i == 1 ? w_b : w_a);  // eq. 3.23
+        expected.block<3, 3>(12 + 3 * i, 12 + 3 * j) = aa * k_ij;
+      }
+    }
+    EXPECT_LT((tet.tangent() - expected).norm(), 1e-12 * expected.norm());
+  }
+}
+
+TEST(XfemCutTet, PartPositionsAreRealVerticesAndGhostCopies) {
+  CutOneTet tet({1, -1, 1, -1}, 0.5);
+  Vector24d q;
+  for (int k = 0; k < 24; ++k) q(k) = 0.001 * k;
+  const TetPositions above = tet.body.part_positions(q, 0, CutPart::above);
+  const TetPositions below = tet.body.part_positions(q, 0, CutPart::below);
+  for (size_t j = 0; j < 4; ++j) {
+    const Eigen::Vector3d x = tet.mesh.rest_positions_m[j] + q.segment<3>(3 * static_cast<Eigen::Index>(j));
+    const Eigen::Vector3d a = q.segment<3>(12 + 3 * static_cast<Eigen::Index>(j));
+    // Above: own (H = +1) vertices real, the others x + a; below: own real, the others x - a.
+    EXPECT_EQ(above[j], tet.cut.side[j] == 1 ? x : Eigen::Vector3d(x + a));
+    EXPECT_EQ(below[j], tet.cut.side[j] == -1 ? x : Eigen::Vector3d(x - a));
+  }
+}
+
+// --- Enriching a body ---
+
+// A 4x2x2 box of 1 cm cubes fixed at x = 0, deformed by a random field with a large rotation.
+struct Box {
+  TetMesh mesh = make_box_mesh(4, 2, 2, 0.01);
+  DeformableBody body{mesh, settings(mesh)};
+
+  static BodySettings settings(const TetMesh& mesh) {
+    BodySettings s;
+    s.material = MATERIAL;
+    s.gravity_m_per_s2 = Eigen::Vector3d(0.0, 0.0, -9.81);
+    for (int v = 0; v < mesh.vertex_count(); ++v) {
+      if (mesh.rest_positions_m[static_cast<size_t>(v)].x() < 1e-9) s.fixed_vertices.push_back(v);
+    }
+    return s;
+  }
+  Eigen::VectorXd deformed(double angle_rad) const {
+    std::mt19937 rng(3);
+    std::uniform_real_distribution<double> jitter(-0.0005, 0.0005);
+    const Eigen::Matrix3d r =
+        Eigen::AngleAxisd(angle_rad, Eigen::Vector3d(0.3, 1, 0.2).normalized()).toRotationMatrix();
+    Eigen::VectorXd u(body.dof_count());
+    for (int row = 0; row < body.dofs().free_vertex_count(); ++row) {
+      const Eigen::Vector3d x =
+          mesh.rest_positions_m[static_cast<size_t>(body.dofs().row_vertex[static_cast<size_t>(row)])];
+      u.segment<3>(3 * row) = r * x - x + Eigen::Vector3d(jitter(rng), jitter(rng), jitter(rng));
+    }
+    return u;
+  }
+};
+
+// sum_p w_p Psi_pi [R K_e (R^T x - X)]_i over the cut tets of each enriched unknown, with the tet's
+// (uncut) SVD rotation: what f^a must be at a = 0, where both parts are the deformed tet.
+Eigen::VectorXd expected_enriched_forces(const DeformableBody& body, const Eigen::VectorXd& positions_m) {
+  Eigen::VectorXd f = Eigen::VectorXd::Zero(3 * body.enriched_dof_count());
+  const int u_rows = body.dofs().free_vertex_count();
+  for (const CutTet& cut_tet : body.cut_tets()) {
+    const TetRest& rest = body.elasticity().rest(cut_tet.cut.tet);
+    TetPositions x;
+    TetPositions x0;
+    for (size_t j = 0; j < 4; ++j) {
+      x[j] = positions_m.segment<3>(3 * cut_tet.vertices[j]);
+      x0[j] = body.mesh().rest_positions_m[static_cast<size_t>(cut_tet.vertices[j])];
+    }
+    const Matrix12d r = block_diagonal(rotation_by_svd(deformation_gradient(rest, x)));
+    const Vector12d tet_force =
+        r * linear_stiffness_matrix(rest, body.elasticity().lame()) * (r.transpose() * flatten(x) - flatten(x0));
+    for (int i = 0; i < 4; ++i) {
+      const double factor = cut_tet.weight_above * cut_tet.shift(i, CutPart::above) +
+                            cut_tet.weight_below * cut_tet.shift(i, CutPart::below);
+      f.segment<3>(3 * (cut_tet.enriched_row[static_cast<size_t>(i)] - u_rows)) += factor * tet_force.segment<3>(3 * i);
+    }
+  }
+  return f;
+}
+
+TEST(XfemEnrich, AtADeformedStateKeepsUForcesTangentAndEnergy) {
+  // With a = 0 both parts are the deformed tet and R_a = R_b = R, so f_i = (w_a + w_b) F_i,
+  // K^uu = (w_a + w_b) R K R^T and the energy are unchanged (to round-off: 1e-12 relative). The
+  // enriched forces are not zero in a stressed state: they are the crack-opening forces
+  // (w_a Psi_ai + w_b Psi_bi) F_i, zero only where the body is unstressed (rigid motion).
+  Box box;
+  const Eigen::VectorXd u = box.deformed(0.8);
+  Eigen::VectorXd f_before;
+  box.body.evaluate(u, f_before, true);
+  const Eigen::MatrixXd k_before = dense(box.body.tangent());
+  const double energy_before = box.body.elastic_energy_j(u);
+
+  const auto cuts = xfem_test::plane_cuts(box.mesh, Plane{Eigen::Vector3d(1, 0.2, 0.1).normalized(), 0.0213});
+  ASSERT_GE(cuts.size(), 10u);
+  box.body.enrich(cuts);
+  DynamicState state{u, Eigen::VectorXd::Zero(u.size())};
+  box.body.grow_state(state);
+  EXPECT_EQ(state.displacement_m.head(u.size()), u);
+  EXPECT_EQ(state.displacement_m.tail(state.displacement_m.size() - u.size()).norm(), 0.0);
+
+  Eigen::VectorXd f_after;
+  box.body.evaluate(state.displacement_m, f_after, true);
+  const Eigen::MatrixXd k_after = dense(box.body.tangent());
+  const Eigen::Index n_u = u.size();
+  EXPECT_LT((f_after.head(n_u) - f_before).norm(), 1e-12 * f_before.norm());
+  EXPECT_LT((k_after.topLeftCorner(n_u, n_u) - k_before).norm(), 1e-12 * k_before.norm());
+  EXPECT_NEAR(box.body.elastic_energy_j(state.displacement_m), energy_before, 1e-12 * energy_before);
+
+  Eigen::VectorXd positions;
+  box.body.positions(state.displacement_m, positions);
+  const Eigen::VectorXd expected = expected_enriched_forces(box.body, positions);
+  EXPECT_LT((f_after.tail(f_after.size() - n_u) - expected).norm(), 1e-12 * expected.norm());
+  EXPECT_GT(expected.norm(), 0.01 * f_before.norm());  // the crack-opening forces are real
+}
+
+TEST(XfemEnrich, UnstressedBodyFeelsNoEnrichedForce) {
+  // A rigid motion: every tet and part is stress-free, so all forces vanish. Scale of a 1% strain:
+  // E 0.01 (1 cm)^2 = 1e-3 N. What remains is the rotation's Newton tolerance (angle error ~1e-12,
+  // strain 1e-12, 1e-11 N per tet) and round-off: 1e-10 N overall (measured: 4.5e-13 N).
+  const TetMesh mesh = make_box_mesh(3, 2, 2, 0.01);
+  DeformableBody body(mesh, free_settings());
+  body.enrich(xfem_test::plane_cuts(mesh, Plane{Eigen::Vector3d(1, -0.3, 0.2).normalized(), 0.0151}));
+  ASSERT_GT(body.enriched_dof_count(), 0);
+  const Eigen::Matrix3d r = Eigen::AngleAxisd(2.0, Eigen::Vector3d(1, 2, 3).normalized()).toRotationMatrix();
+  Eigen::VectorXd q = Eigen::VectorXd::Zero(body.dof_count());
+  for (int v = 0; v < mesh.vertex_count(); ++v) {
+    const Eigen::Vector3d x = mesh.rest_positions_m[static_cast<size_t>(v)];
+    q.segment<3>(3 * v) = r * x - x + Eigen::Vector3d(0.1, -0.2, 0.3);
+  }
+  Eigen::VectorXd f;
+  body.evaluate(q, f, false);
+  EXPECT_LT(f.norm(), 1e-10);
+}
+
+TEST(XfemEnrich, ListsEnrichedVerticesOnceAndGivesFixedVerticesARow) {
+  Box box;
+  // x = 0.004 cuts the first layer of cubes, whose tets touch the fixed face x = 0.
+  const auto cuts = xfem_test::plane_cuts(box.mesh, Plane{Eigen::Vector3d::UnitX(), 0.004});
+  std::set<int> cut_vertices;
+  for (const TetCut& cut : cuts) {
+    for (int v : box.mesh.tets[static_cast<size_t>(cut.tet)]) cut_vertices.insert(v);
+  }
+  const int u_rows = box.body.dofs().free_vertex_count();
+  const EnrichmentResult result = box.body.enrich(cuts);
+  EXPECT_EQ(result.new_cut_tets, static_cast<int>(cuts.size()));
+  EXPECT_EQ(result.new_enriched_dofs, static_cast<int>(cut_vertices.size()));  // once, however many tets share it
+  EXPECT_EQ(box.body.enriched_dof_count(), static_cast<int>(cut_vertices.size()));
+  EXPECT_EQ(box.body.dof_count(), 3 * (u_rows + static_cast<int>(cut_vertices.size())));
+  EXPECT_EQ(box.body.tangent().block_rows(), u_rows + box.body.enriched_dof_count());
+  EXPECT_EQ(box.body.mesh().tet_count(), 4 * 2 * 2 * 5);  // the mesh is never remeshed
+
+  int fixed_enriched = 0;
+  for (int k = 0; k < box.body.enriched_dof_count(); ++k) {
+    const EnrichedDof& dof = box.body.enriched_dofs()[static_cast<size_t>(k)];
+    EXPECT_EQ(dof.row, u_rows + k);  // appended in creation order
+    EXPECT_EQ(box.body.find_enriched_dof(dof.vertex, dof.cut_id, dof.side), k);
+    if (box.body.dofs().vertex_row[static_cast<size_t>(dof.vertex)] < 0) ++fixed_enriched;
+  }
+  EXPECT_EQ(fixed_enriched, 9);  // the 3x3 vertices of the fixed face, all below the cut
+  for (const CutTet& cut_tet : box.body.cut_tets()) {
+    for (size_t i = 0; i < 4; ++i) {
+      const int k = box.body.find_enriched_dof(cut_tet.vertices[i], 0, cut_tet.cut.side[i]);
+      EXPECT_EQ(cut_tet.enriched_row[i], u_rows + k);
+    }
+    EXPECT_TRUE(box.body.elasticity().is_excluded(cut_tet.cut.tet));
+  }
+
+  // A second cut (another id) through a tet of the next cube, sharing enriched vertices at
+  // x = 0.01, makes new unknowns for all four of its vertices.
+  const int before = box.body.enriched_dof_count();
+  std::optional<TetCut> second;
+  for (int t = 5; t < 10 && !second; ++t)
+    second = xfem_test::plane_tet_cut(box.mesh, t, Plane{Eigen::Vector3d::UnitY(), 0.0051}, 1);
+  ASSERT_TRUE(second.has_value());
+  int shared = 0;
+  for (int v : box.mesh.tets[static_cast<size_t>(second->tet)])
+    shared += box.body.find_enriched_dof(v, 0, -1) >= 0 || box.body.find_enriched_dof(v, 0, 1) >= 0;
+  EXPECT_GT(shared, 0);
+  box.body.enrich(*second);
+  EXPECT_EQ(box.body.enriched_dof_count(), before + 4);
+}
+
+TEST(XfemEnrich, EnrichedMassIsTheMassAcrossTheCutAndTotalMassIsKept) {
+  // Enriched unknown of vertex i: sum over its cut tets of rho V_opposite(i) / 4, V_opposite from the
+  // clipped geometry (computed here from the plane, independently of the fractions handed over).
+  // Gravity on it: -H_i times that mass times g. The u masses do not change.
+  Box box;
+  const Plane plane{Eigen::Vector3d(1, 0.3, -0.2).normalized(), 0.0222};
+  const Eigen::VectorXd mass_before = box.body.mass_kg();
+  const Eigen::VectorXd force_before = box.body.external_force_n();
+  const double total_before = box.body.total_mass_kg();
+  box.body.enrich(xfem_test::plane_cuts(box.mesh, plane));
+
+  const int u_rows = box.body.dofs().free_vertex_count();
+  std::map<int, double> expected_mass;  // by enriched row
+  std::map<int, double> expected_force_z;
+  for (const CutTet& cut_tet : box.body.cut_tets()) {
+    const TetPositions x = xfem_test::tet_positions(box.mesh, cut_tet.cut.tet);
+    const double volume = signed_tet_volume(x[0], x[1], x[2], x[3]);
+    const double above = xfem_test::clipped_volume_fraction_above(x, plane) * volume;
+    for (size_t i = 0; i < 4; ++i) {
+      const double opposite_mass = 1000.0 * (cut_tet.cut.side[i] == 1 ? volume - above : above) / 4.0;
+      expected_mass[cut_tet.enriched_row[i]] += opposite_mass;
+      expected_force_z[cut_tet.enriched_row[i]] += -cut_tet.cut.side[i] * opposite_mass * -9.81;
+    }
+  }
+  ASSERT_EQ(static_cast<int>(expected_mass.size()), box.body.enriched_dof_count());
+  for (const auto& [row, mass] : expected_mass) {
+    for (int c = 0; c < 3; ++c) EXPECT_NEAR(box.body.mass_kg()(3 * row + c), mass, 1e-12 * mass);
+    EXPECT_NEAR(box.body.external_force_n()(3 * row + 2), expected_force_z[row], 1e-12 * mass * 9.81);
+    EXPECT_EQ(box.body.external_force_n()(3 * row), 0.0);
+  }
+  EXPECT_EQ(box.body.mass_kg().head(3 * u_rows), mass_before);
+  EXPECT_EQ(box.body.external_force_n().head(3 * u_rows), force_before);
+  EXPECT_EQ(box.body.total_mass_kg(), total_before);
+  EXPECT_NEAR(total_before, 1000.0 * 4 * 2 * 2 * 1e-6, 1e-12);
+
+  // The parts of each cut tet share its mass out exactly.
+  for (int k = 0; k < static_cast<int>(box.body.cut_tets().size()); ++k) {
+    const TetRest& rest = box.body.xfem().rest(k);
+    EXPECT_NEAR(box.body.part_mass_kg(k, CutPart::above) + box.body.part_mass_kg(k, CutPart::below),
+                1000.0 * rest.volume_m3, 1e-15);
+  }
+}
+
+TEST(XfemEnrich, RefusesBadCutsAndChangesNothing) {
+  Box box;
+  TetCut good;
+  good.tet = 7;
+  good.side = {1, -1, 1, 1};
+  good.volume_fraction_above = 0.4;
+  const auto refused = [&](const std::vector<TetCut>& cuts) {
+    const int dofs = box.body.dof_count();
+    const auto pattern = box.body.tangent().pattern_revision();
+    EXPECT_THROW(box.body.enrich(cuts), ParameterError);
+    EXPECT_EQ(box.body.dof_count(), dofs);
+    EXPECT_EQ(box.body.tangent().pattern_revision(), pattern);
+    EXPECT_EQ(box.body.cut_tets().size(), 0u);
+  };
+  auto bad = good;
+  bad.tet = -1;
+  refused({good, bad});
+  bad.tet = box.mesh.tet_count();
+  refused({good, bad});
+  bad = good;
+  bad.side = {1, 1, 1, 1};
+  refused({good, bad});
+  bad.side = {1, 0, -1, 1};
+  refused({good, bad});
+  bad = good;
+  for (double fraction : {0.0, 1.0, -0.1, std::nan(""), std::numeric_limits<double>::infinity()}) {
+    bad.volume_fraction_above = fraction;
+    refused({good, bad});
+  }
+  refused({good, good});  // the same tet twice
+
+  box.body.enrich(good);
+  EXPECT_EQ(box.body.cut_tets().size(), 1u);
+  EXPECT_THROW(box.body.enrich(good), ParameterError);  // one cut per tet
+  EXPECT_EQ(box.body.cut_tets().size(), 1u);
+
+  DynamicState too_long{Eigen::VectorXd::Zero(box.body.dof_count() + 3),
+                        Eigen::VectorXd::Zero(box.body.dof_count() + 3)};
+  EXPECT_THROW(box.body.grow_state(too_long), std::invalid_argument);
+  Eigen::VectorXd f;
+  EXPECT_THROW(box.body.evaluate(Eigen::VectorXd::Zero(3), f, false), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace tissue

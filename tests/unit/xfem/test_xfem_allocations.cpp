@@ -1,0 +1,62 @@
+// Real-time discipline (STYLE.md principle 6) with cuts and contact: once a body has been cut and
+// the point spring set, a backward-Euler step with PCG allocates nothing after the first. Counts
+// every global operator new in this executable.
+#include "core/fem/deformable_body.hpp"
+#include "core/integrate/backward_euler.hpp"
+#include "core/mesh/box_mesh.hpp"
+#include "xfem/xfem_test_helpers.hpp"
+
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <cstdlib>
+#include <memory>
+#include <new>
+
+namespace {
+std::atomic<long> g_allocations{0};
+}
+
+// GCC sees free() on memory from operator new and warns; here both sides are ours (malloc/free).
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wmismatched-new-delete"
+void* operator new(std::size_t size) {
+  g_allocations.fetch_add(1, std::memory_order_relaxed);
+  if (void* p = std::malloc(size == 0 ? 1 : size)) return p;
+  throw std::bad_alloc();
+}
+void operator delete(void* p) noexcept { std::free(p); }
+void operator delete(void* p, std::size_t) noexcept { std::free(p); }
+#pragma GCC diagnostic pop
+
+namespace tissue {
+namespace {
+
+TEST(XfemAllocations, StepOfACutBodyWithAPointSpringAllocatesNothing) {
+  const TetMesh mesh = make_box_mesh(12, 3, 3, 0.01);
+  BodySettings settings;
+  settings.damping = {0.5, 0.01};
+  for (int v = 0; v < mesh.vertex_count(); ++v) {
+    if (mesh.rest_positions_m[static_cast<size_t>(v)].x() < 1e-9) settings.fixed_vertices.push_back(v);
+  }
+  DeformableBody body(mesh, settings);
+  const Tet& tet = mesh.tets.back();
+  body.set_point_spring(PointSpring{
+      {tet[0], tet[1], tet[2]}, Eigen::Vector3d::Constant(1.0 / 3.0), Eigen::Vector3d(0.13, 0.02, 0.02), 100.0});
+  DynamicState state{Eigen::VectorXd::Zero(body.dof_count()), Eigen::VectorXd::Zero(body.dof_count())};
+  BackwardEuler integrator(std::make_unique<PcgSolver>(PcgSolver::Settings{1e-3, 10}));
+  integrator.step(body, state, 0.01);
+
+  const auto cuts = xfem_test::plane_cuts(mesh, xfem_test::Plane{Eigen::Vector3d(1, 0.1, 0.05).normalized(), 0.063});
+  ASSERT_GT(cuts.size(), 20u);
+  EXPECT_FALSE(body.enrich(cuts).matrix_relayout);
+  body.grow_state(state);
+  integrator.step(body, state, 0.01);  // sizes the work buffers to the grown system
+  const long before = g_allocations.load();
+  for (int i = 0; i < 20; ++i) integrator.step(body, state, 0.01);
+  EXPECT_EQ(g_allocations.load() - before, 0);
+  EXPECT_TRUE(state.displacement_m.allFinite());
+}
+
+}  // namespace
+}  // namespace tissue
