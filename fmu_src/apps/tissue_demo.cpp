@@ -42,7 +42,7 @@ int run(const tissue::apps::SceneOptions& options, int print_every, const std::s
   Eigen::VectorXd positions;
   for (int step = 1; step <= options.steps; ++step) {
     const auto start = std::chrono::steady_clock::now();
-    const tissue::StepReport report = tissue.step();
+    const tissue::StepReport report = tissue.step().dynamics;
     step_ms.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count());
     if (step % print_every != 0 && step != options.steps) continue;
     const Eigen::VectorXd& u = tissue.state().displacement_m;

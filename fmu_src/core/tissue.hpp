@@ -1,10 +1,20 @@
-// Tissue: the facade of the core, one specimen in one scene. Owns the body, the integrator and
-// the state; this is what the demo, tissue-bench and (issue 4) the FMU layer call.
+// Tissue: the facade of the core, one specimen in one scene. Owns the body, the integrator, the
+// state and the tool interaction (DESIGN section 3): each step takes the tool pose, sweeps the
+// scalpel through the volume cutter and enriches the completed tets, or updates the probe's
+// god-object contact, then integrates, refits the surface BVH and reports the contact outputs.
+// This is what the demo, tissue-bench and (issue 4) the FMU layer call.
 #pragma once
 
+#include "core/collide/surface_bvh.hpp"
+#include "core/contact/contact_stiffness.hpp"
+#include "core/contact/point_contact.hpp"
+#include "core/cut/volume_cutter.hpp"
 #include "core/fem/deformable_body.hpp"
 #include "core/integrate/integrator.hpp"
+#include "core/mesh/topology.hpp"
 #include "core/solve/linear_solver.hpp"
+
+#include <Eigen/Geometry>
 
 #include <memory>
 #include <string_view>
@@ -26,19 +36,81 @@ struct SolverSettings {
 void validate(const SolverSettings& settings);
 std::unique_ptr<LinearSolver> make_linear_solver(const SolverSettings& settings);
 
+enum class ToolMode { none, probe, scalpel };
+
+/// Parses "none" / "probe" / "scalpel"; throws ParameterError otherwise.
+ToolMode parse_tool_mode(std::string_view name);
+
+/// The tool as the host drives it. The tool axis is the local +z axis, from the tip toward the
+/// handle; the scalpel's cutting edge is the segment from the tip along that axis.
+struct ToolPose {
+  Eigen::Vector3d tip_position_m = Eigen::Vector3d::Zero();
+  Eigen::Quaterniond orientation = Eigen::Quaterniond::Identity();
+  ToolMode mode = ToolMode::none;
+};
+
+struct InteractionSettings {
+  bool contact_enabled = true;
+  bool cutting_enabled = true;
+  double blade_length_m = 0.03;  ///< length of the scalpel's cutting edge, > 0
+  CutterSettings cutter;
+  /// Stiffness of the implicit spring from the god-object's material point to the probe tip;
+  /// 0 chooses recommended_contact_spring_stiffness_n_per_m() (100 x the body's contact scale).
+  double contact_spring_stiffness_n_per_m = 0.0;
+  ContactStiffnessModel contact_stiffness_model = ContactStiffnessModel::effective_static;
+  /// The effective (reference) K_c costs a factorization: it is recomputed when a contact starts and
+  /// then every this many steps (>= 1); the element-local model is recomputed every step.
+  int contact_stiffness_refresh_steps = 10;
+};
+
+/// Throws ParameterError for an invalid setting.
+void validate(const InteractionSettings& settings);
+
 struct TissueSettings {
   BodySettings body;
   SolverSettings solver;
+  InteractionSettings interaction;
   double step_size_s = 1e-3;
+};
+
+/// The contact outputs of the last step (the haptic loop's input).
+struct ContactOutput {
+  bool active = false;
+  Eigen::Vector3d point_m = Eigen::Vector3d::Zero();  ///< the god-object (proxy) position
+  Eigen::Vector3d normal = Eigen::Vector3d::Zero();   ///< unit outward surface normal there
+  Eigen::Vector3d force_on_tool_n = Eigen::Vector3d::Zero();
+  Eigen::Matrix3d stiffness_n_per_m = Eigen::Matrix3d::Zero();  ///< K_c (model from the settings)
+  double penetration_depth_m = 0.0;                             ///< |tip - proxy|
+};
+
+/// What one Tissue step did, with wall times [s].
+struct TissueStepReport {
+  StepReport dynamics;
+  CutStepReport cut;            ///< default (not cutting) unless the scalpel swept
+  EnrichmentResult enrichment;  ///< cut tets and enriched unknowns added by this step
+  double cut_s = 0.0;           ///< volume cutter
+  double enrich_s = 0.0;        ///< enrichment and in-place growth
+  double contact_s = 0.0;       ///< god-object update and contact outputs
+  double refit_s = 0.0;         ///< surface BVH refit
+  double total_s = 0.0;
 };
 
 class Tissue {
  public:
   /// Throws ParameterError for invalid settings.
   Tissue(TetMesh mesh, TissueSettings settings);
+  // The cutter and the BVH hold references into the body: not copyable, not movable.
+  Tissue(const Tissue&) = delete;
+  Tissue& operator=(const Tissue&) = delete;
 
-  /// One backward-Euler step of step_size_s. Throws IntegrationError (state unchanged) on failure.
-  StepReport step();
+  /// The tool pose for the next step. Throws ParameterError (pose kept) for a non-finite position
+  /// or a non-finite or zero quaternion (it is normalized).
+  void set_tool(const ToolPose& pose);
+  [[nodiscard]] const ToolPose& tool() const { return m_tool; }
+
+  /// One step of step_size_s: tool interaction (cut or contact), backward Euler, BVH refit,
+  /// contact outputs. Throws IntegrationError (state unchanged) when the dynamics step fails.
+  TissueStepReport step();
 
   [[nodiscard]] const DeformableBody& body() const { return m_body; }
   [[nodiscard]] const DynamicState& state() const { return m_state; }
@@ -48,12 +120,41 @@ class Tissue {
   [[nodiscard]] double elastic_energy_j() { return m_body.elastic_energy_j(m_state.displacement_m); }
   /// Positions of all vertices, 3 per vertex [m].
   void vertex_positions(Eigen::VectorXd& positions_m) const { m_body.positions(m_state.displacement_m, positions_m); }
+  /// The same, as kept after the last step (what the BVH is refitted to).
+  [[nodiscard]] const Eigen::VectorXd& current_positions_m() const { return m_positions_m; }
+
+  [[nodiscard]] const SurfaceMesh& surface() const { return m_surface; }
+  [[nodiscard]] const SurfaceBvh& surface_bvh() const { return m_bvh; }
+  [[nodiscard]] const VolumeCutter& cutter() const { return m_cutter; }
+  [[nodiscard]] const PointContact& point_contact() const { return m_contact; }
+  [[nodiscard]] const ContactOutput& contact() const { return m_contact_output; }
+  /// The spring stiffness the contact uses (resolved from the settings) [N/m].
+  [[nodiscard]] double contact_spring_stiffness_n_per_m() const {
+    return m_contact.settings().spring_stiffness_n_per_m;
+  }
 
  private:
+  void interact_with_scalpel(const ToolPose& previous, TissueStepReport& report);
+  void interact_with_probe(const ToolPose& previous);
+  void update_contact_output();
+  [[nodiscard]] Blade blade(const ToolPose& pose) const;
+
   TissueSettings m_settings;
   DeformableBody m_body;
   std::unique_ptr<Integrator> m_integrator;
   DynamicState m_state;
+  SurfaceMesh m_surface;
+  TetAdjacency m_adjacency;
+  Eigen::VectorXd m_positions_m;
+  SurfaceBvh m_bvh;
+  VolumeCutter m_cutter;
+  PointContact m_contact;
+  EffectiveContactStiffness m_effective_stiffness;
+  Eigen::VectorXd m_contact_system_diagonal;
+  int m_steps_since_stiffness = 0;
+  ContactOutput m_contact_output;
+  ToolPose m_tool;
+  ToolPose m_previous_tool;
 };
 
 }  // namespace tissue
