@@ -1,5 +1,5 @@
 // DynamicsModel: the semi-discrete equations of motion M a + D v + f_int(u) = f_ext on the
-// unknowns of a body (3 per free vertex; enriched DOFs join later), as the integrators see them.
+// unknowns of a body (3 per free vertex, then 3 per enriched XFEM unknown), as the integrators see them.
 // Integrators call this interface; the FEM implements it (fem/deformable_body.hpp).
 #pragma once
 

@@ -5,15 +5,18 @@
 #include "core/tissue.hpp"
 
 #include <gtest/gtest.h>
+#include <Eigen/Eigenvalues>
+
+#include <limits>
 
 namespace tissue {
 namespace {
 
 TEST(FixedRegion, BoxAndMinimumSlabPickTheRightVertices) {
-  const TetMesh mesh = make_box_mesh(4, 2, 2, 0.01);  // 5 x 3 x 3 vertex grid
-  EXPECT_EQ(vertices_at_minimum(mesh, 0, 0.0).size(), 9u);   // the x = 0 face
+  const TetMesh mesh = make_box_mesh(4, 2, 2, 0.01);          // 5 x 3 x 3 vertex grid
+  EXPECT_EQ(vertices_at_minimum(mesh, 0, 0.0).size(), 9u);    // the x = 0 face
   EXPECT_EQ(vertices_at_minimum(mesh, 0, 0.25).size(), 18u);  // x <= 0.01: two layers
-  EXPECT_EQ(vertices_at_minimum(mesh, 2, 0.0).size(), 15u);  // the z = 0 face
+  EXPECT_EQ(vertices_at_minimum(mesh, 2, 0.0).size(), 15u);   // the z = 0 face
   const std::vector<int> corner = vertices_in_box(mesh, Eigen::Vector3d(-1, -1, -1), Eigen::Vector3d(1e-9, 1e-9, 1e-9));
   ASSERT_EQ(corner.size(), 1u);
   EXPECT_EQ(mesh.rest_positions_m[static_cast<size_t>(corner[0])].norm(), 0.0);
@@ -38,6 +41,71 @@ TEST(Tissue, RefusesInvalidSettingsWhenGiven) {
   EXPECT_THROW(make([](TissueSettings& s) { s.body.fixed_vertices = {1000}; }), ParameterError);
   EXPECT_THROW(make([](TissueSettings& s) { s.body.fixed_vertices = {-1}; }), ParameterError);
   EXPECT_THROW(parse_linear_solver_kind("gauss-seidel"), ParameterError);
+  EXPECT_THROW(make([](TissueSettings& s) { s.interaction.blade_length_m = 0.0; }), ParameterError);
+  EXPECT_THROW(make([](TissueSettings& s) { s.interaction.contact_spring_stiffness_n_per_m = -1.0; }), ParameterError);
+  EXPECT_THROW(make([](TissueSettings& s) { s.interaction.contact_stiffness_refresh_steps = 0; }), ParameterError);
+  EXPECT_THROW(make([](TissueSettings& s) { s.interaction.cutter.min_volume_fraction = 0.5; }), ParameterError);
+  EXPECT_THROW(make([](TissueSettings& s) { s.interaction.cutter.min_volume_fraction = 0.0; }), ParameterError);
+  EXPECT_THROW(parse_tool_mode("laser"), ParameterError);
+  EXPECT_EQ(parse_tool_mode("scalpel"), ToolMode::scalpel);
+}
+
+TEST(Tissue, RefusesABadToolPoseAndKeepsTheLastOne) {
+  const TetMesh mesh = make_box_mesh(2, 1, 1, 0.01);
+  Tissue tissue(mesh, TissueSettings{});
+  const ToolPose good{Eigen::Vector3d(0.1, 0.2, 0.3), Eigen::Quaterniond(2.0, 0.0, 0.0, 0.0), ToolMode::probe};
+  tissue.set_tool(good);
+  EXPECT_DOUBLE_EQ(tissue.tool().orientation.norm(), 1.0);  // normalized
+  ToolPose bad = good;
+  bad.tip_position_m.y() = std::nan("");
+  EXPECT_THROW(tissue.set_tool(bad), ParameterError);
+  bad = good;
+  bad.orientation = Eigen::Quaterniond(0.0, 0.0, 0.0, 0.0);
+  EXPECT_THROW(tissue.set_tool(bad), ParameterError);
+  bad.orientation = Eigen::Quaterniond(std::numeric_limits<double>::infinity(), 0.0, 0.0, 0.0);
+  EXPECT_THROW(tissue.set_tool(bad), ParameterError);
+  EXPECT_EQ(tissue.tool().tip_position_m, good.tip_position_m);
+}
+
+// A probe pressed into the top of a block clamped at its bottom: contact starts when the tip crosses
+// the surface, the tool is pushed back out (force along +z), the contact stiffness is SPD and, in
+// the linear regime, the settled force is K_c d to the spring's share of the compliance; lifting
+// the tip ends the contact.
+TEST(Tissue, ProbeTouchesPushesBackAndLetsGo) {
+  const TetMesh mesh = make_box_mesh(4, 4, 2, 0.01);  // 0.04 x 0.04 x 0.02 m
+  TissueSettings settings;
+  settings.body.fixed_vertices = vertices_at_minimum(mesh, 2, 0.0);
+  settings.body.gravity_m_per_s2.setZero();
+  settings.body.damping = RayleighDamping{20.0, 0.0};
+  settings.solver.kind = LinearSolverKind::cholmod;
+  settings.step_size_s = 0.01;
+  Tissue tissue(mesh, settings);
+  const Eigen::Vector3d above(0.0213, 0.0187, 0.025);
+  tissue.set_tool({above, Eigen::Quaterniond::Identity(), ToolMode::probe});
+  tissue.step();
+  EXPECT_FALSE(tissue.contact().active);
+  EXPECT_EQ(tissue.contact().force_on_tool_n, Eigen::Vector3d::Zero());
+  constexpr double DEPTH_M = 1e-4;
+  tissue.set_tool(
+      {Eigen::Vector3d(above.x(), above.y(), 0.02 - DEPTH_M), Eigen::Quaterniond::Identity(), ToolMode::probe});
+  for (int n = 0; n < 300; ++n) tissue.step();
+  const ContactOutput& contact = tissue.contact();
+  ASSERT_TRUE(contact.active);
+  EXPECT_GT(contact.force_on_tool_n.z(), 0.0);
+  EXPECT_LT(contact.force_on_tool_n.head<2>().norm(), 0.05 * contact.force_on_tool_n.z());
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eigen(contact.stiffness_n_per_m);
+  EXPECT_GT(eigen.eigenvalues().minCoeff(), 0.0);
+  EXPECT_LT((contact.stiffness_n_per_m - contact.stiffness_n_per_m.transpose()).norm(),
+            1e-9 * contact.stiffness_n_per_m.norm());
+  // Springs in series: f = (K_c^-1 + I/k)^-1 d along the normal, the tangential force ~0.
+  const double k_n = 1.0 / contact.stiffness_n_per_m.inverse()(2, 2);
+  const double k = tissue.contact_spring_stiffness_n_per_m();
+  const double expected = DEPTH_M / (1.0 / k_n + 1.0 / k);
+  EXPECT_NEAR(contact.force_on_tool_n.z(), expected, 0.02 * expected);
+  tissue.set_tool({above, Eigen::Quaterniond::Identity(), ToolMode::probe});
+  tissue.step();
+  EXPECT_FALSE(tissue.contact().active);
+  EXPECT_EQ(tissue.body().point_spring(), std::nullopt);
 }
 
 TEST(Tissue, FixedVerticesStayWhileTheFarEndStartsInFreeFall) {
