@@ -105,7 +105,9 @@ Tissue::Tissue(TetMesh mesh, TissueSettings settings)
                                                    BackwardEuler::Settings{m_settings.solver.warm_start})),
       m_surface(extract_surface(m_body.mesh())),
       m_adjacency(build_adjacency(m_body.mesh())),
-      m_positions_m(rest_positions(m_body)),
+      m_vertex_positions_m(rest_positions(m_body)),
+      m_positions_m(m_vertex_positions_m),
+      m_cut_surface(m_body.mesh().vertex_count()),
       m_bvh(m_surface.triangles, m_positions_m),
       m_cutter(m_body.mesh(), m_adjacency, m_surface, m_settings.interaction.cutter),
       m_contact(contact_settings(m_settings.interaction, m_body, m_surface)) {
@@ -133,14 +135,25 @@ void Tissue::interact_with_scalpel(const ToolPose& previous, TissueStepReport& r
   report.cut_s = seconds_since(cut_start);
   if (m_cutter.new_cuts().empty()) return;
   const auto enrich_start = std::chrono::steady_clock::now();
+  const int first_new = static_cast<int>(m_body.cut_tets().size());
   report.enrichment = m_body.enrich(m_cutter.new_cuts());
   m_body.grow_state(m_state);
+  // The opened faces join the surface (at the current state: both parts still coincide).
+  const int new_faces = m_cut_surface.add_cut_tets(m_body, first_new);
+  update_positions();
+  const auto& faces = m_cut_surface.triangles();
+  m_bvh.add_triangles(std::span(faces).last(static_cast<size_t>(new_faces)), m_positions_m);
   report.enrich_s = seconds_since(enrich_start);
 }
 
 void Tissue::interact_with_probe(const ToolPose& previous) {
   const bool was_in_contact = m_contact.in_contact();
   m_contact.update(previous.tip_position_m, m_tool.tip_position_m, m_positions_m, m_bvh);
+  // The probe touches the mesh's surface only: a cut face's corners are not vertices the spring can
+  // act on (they move with the enriched unknowns), so a probe reaching into a crack feels nothing.
+  if (m_contact.in_contact() && m_contact.proxy().triangle >= static_cast<int>(m_surface.triangles.size())) {
+    m_contact.release();
+  }
   m_contact.apply(m_bvh, m_body);
   if (m_contact.in_contact() && !was_in_contact) m_steps_since_stiffness = -1;  // a new contact: refresh K_c
 }
@@ -188,6 +201,12 @@ void Tissue::update_contact_output() {
   out.stiffness_n_per_m = stiffness ? *stiffness : Eigen::Matrix3d::Identity() * contact_spring_stiffness_n_per_m();
 }
 
+void Tissue::update_positions() {
+  m_body.positions(m_state.displacement_m, m_vertex_positions_m);
+  m_positions_m.head(m_vertex_positions_m.size()) = m_vertex_positions_m;
+  m_cut_surface.update_points(m_body, m_state.displacement_m, m_positions_m);
+}
+
 TissueStepReport Tissue::step() {
   const auto start = std::chrono::steady_clock::now();
   TissueStepReport report;
@@ -216,7 +235,7 @@ TissueStepReport Tissue::step() {
   m_previous_tool = m_tool;
 
   const auto refit_start = std::chrono::steady_clock::now();
-  m_body.positions(m_state.displacement_m, m_positions_m);
+  update_positions();
   m_bvh.refit(m_positions_m);
   report.refit_s = seconds_since(refit_start);
 

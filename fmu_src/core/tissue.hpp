@@ -8,6 +8,7 @@
 #include "core/collide/surface_bvh.hpp"
 #include "core/contact/contact_stiffness.hpp"
 #include "core/contact/point_contact.hpp"
+#include "core/cut/cut_surface.hpp"
 #include "core/cut/volume_cutter.hpp"
 #include "core/fem/deformable_body.hpp"
 #include "core/integrate/integrator.hpp"
@@ -120,8 +121,11 @@ class Tissue {
   [[nodiscard]] double elastic_energy_j() { return m_body.elastic_energy_j(m_state.displacement_m); }
   /// Positions of all vertices, 3 per vertex [m].
   void vertex_positions(Eigen::VectorXd& positions_m) const { m_body.positions(m_state.displacement_m, positions_m); }
-  /// The same, as kept after the last step (what the BVH is refitted to).
+  /// The positions after the last step, as the BVH is refitted to: the mesh vertices (3 each), then
+  /// the corners of the cut faces (cut_surface()).
   [[nodiscard]] const Eigen::VectorXd& current_positions_m() const { return m_positions_m; }
+  /// The faces the cuts opened; they are in the surface BVH after the mesh's surface triangles.
+  [[nodiscard]] const CutSurface& cut_surface() const { return m_cut_surface; }
 
   [[nodiscard]] const SurfaceMesh& surface() const { return m_surface; }
   [[nodiscard]] const SurfaceBvh& surface_bvh() const { return m_bvh; }
@@ -137,6 +141,7 @@ class Tissue {
   void interact_with_scalpel(const ToolPose& previous, TissueStepReport& report);
   void interact_with_probe(const ToolPose& previous);
   void update_contact_output();
+  void update_positions();
   [[nodiscard]] Blade blade(const ToolPose& pose) const;
 
   TissueSettings m_settings;
@@ -145,7 +150,9 @@ class Tissue {
   DynamicState m_state;
   SurfaceMesh m_surface;
   TetAdjacency m_adjacency;
+  Eigen::VectorXd m_vertex_positions_m;
   Eigen::VectorXd m_positions_m;
+  CutSurface m_cut_surface;
   SurfaceBvh m_bvh;
   VolumeCutter m_cutter;
   PointContact m_contact;

@@ -151,6 +151,23 @@ TEST(ScalpelCut, CompleteCutReleasesTheFreePieceIntoFreeFall) {
   const double ideal = free_fall_drop_m(steps);
   EXPECT_GT(drop / ideal, 0.85);
   EXPECT_LT(drop, ideal * 1.0 + 1e-3);
+  // The opened faces: one per piece, each of the beam's cross-section area (0.02 x 0.02 m, to the
+  // strain), facing outward: +x on the clamped piece (tilted by its sag); the falling piece tumbles
+  // (it pivoted on its last connection), so only its face's area is checked.
+  const Eigen::VectorXd& x = tissue.current_positions_m();
+  Eigen::Vector3d falling_face = Eigen::Vector3d::Zero();
+  Eigen::Vector3d clamped_face = Eigen::Vector3d::Zero();
+  for (const auto& t : tissue.cut_surface().triangles()) {
+    const Eigen::Vector3d a = x.segment<3>(3 * t[0]), b = x.segment<3>(3 * t[1]), c = x.segment<3>(3 * t[2]);
+    (a.z() < -0.05 ? falling_face : clamped_face) += 0.5 * (b - a).cross(c - a);
+  }
+  const double section_m2 = SIDE_M * SIDE_M;
+  EXPECT_NEAR(falling_face.norm(), section_m2, 0.03 * section_m2);
+  EXPECT_NEAR(clamped_face.norm(), section_m2, 0.03 * section_m2);
+  EXPECT_GT(clamped_face.x(), 0.99 * clamped_face.norm());
+  EXPECT_EQ(tissue.surface_bvh().triangle_count(),
+            static_cast<int>(tissue.surface().triangles.size() + tissue.cut_surface().triangles().size()));
+
   // The clamped end barely moves (millimetre-scale sag against a 0.18 m fall).
   EXPECT_LT(std::abs(mean_z_displacement(tissue, 0.0, 0.02) - clamp_before), 1e-3);
 }

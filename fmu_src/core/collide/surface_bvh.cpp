@@ -190,6 +190,25 @@ int SurfaceBvh::add_triangle(const std::array<int, 3>& triangle, const Eigen::Ve
   return id;
 }
 
+int SurfaceBvh::add_triangles(std::span<const std::array<int, 3>> triangles, const Eigen::VectorXd& positions_m) {
+  const int first = triangle_count();
+  for (size_t k = 0; k < triangles.size(); ++k) check_triangle(triangles[k], first + static_cast<int>(k), positions_m);
+  if (triangles.empty()) return first;
+  if (!m_tree) m_tree = std::make_unique<Tree>();
+  const double margin = box_margin(positions_m);
+  for (const std::array<int, 3>& triangle : triangles) {
+    const int id = triangle_count();
+    m_triangles.push_back(triangle);
+    btDbvtNode* leaf = m_tree->dbvt.insert(triangle_box(triangle, positions_m, margin), nullptr);
+    leaf->dataAsInt = id;
+    m_tree->leaves.push_back(leaf);
+    m_tree->required_position_count = std::max(m_tree->required_position_count, required_position_count(triangle));
+  }
+  compute_refit_order(m_tree->dbvt, m_tree->refit_order);
+  refit(positions_m);
+  return first;
+}
+
 void SurfaceBvh::intersect_segment(const Eigen::Vector3d& a, const Eigen::Vector3d& b,
                                    const Eigen::VectorXd& positions_m, std::vector<SegmentHit>& hits) const {
   hits.clear();

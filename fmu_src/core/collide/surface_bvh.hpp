@@ -11,6 +11,7 @@
 
 #include <array>
 #include <memory>
+#include <span>
 #include <vector>
 
 namespace tissue {
@@ -36,6 +37,9 @@ class SurfaceBvh {
 
   /// Inserts a triangle (a cut face) and returns its id (= the previous triangle_count()).
   int add_triangle(const std::array<int, 3>& triangle, const Eigen::VectorXd& positions_m);
+  /// Inserts several triangles (the faces of one step's cuts) with one refit-order update and one
+  /// refit. Returns the id of the first. Throws std::invalid_argument (nothing added) for a bad id.
+  int add_triangles(std::span<const std::array<int, 3>> triangles, const Eigen::VectorXd& positions_m);
 
   struct SegmentHit {
     int triangle = -1;
