@@ -3,9 +3,12 @@
 
 #include "core/integrate/backward_euler.hpp"
 
+#include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <string>
+#include <type_traits>
 
 namespace tissue {
 
@@ -54,6 +57,62 @@ Eigen::VectorXd rest_positions(const DeformableBody& body) {
   Eigen::VectorXd positions_m;
   body.positions(Eigen::VectorXd::Zero(body.dof_count()), positions_m);
   return positions_m;
+}
+
+// FNV-1a (64 bit) over the bytes of trivially copyable values: the model fingerprint.
+class Fingerprint {
+ public:
+  template <class T>
+  void add(const T& value) {
+    static_assert(std::is_trivially_copyable_v<T>);
+    const auto* bytes = reinterpret_cast<const unsigned char*>(&value);
+    for (size_t k = 0; k < sizeof(T); ++k) m_hash = (m_hash ^ bytes[k]) * 0x100000001b3ULL;
+  }
+  template <class T>
+  void add_all(const std::vector<T>& values) {
+    add(values.size());
+    for (const T& value : values) add(value);
+  }
+  [[nodiscard]] std::uint64_t value() const { return m_hash; }
+
+ private:
+  std::uint64_t m_hash = 0xcbf29ce484222325ULL;
+};
+
+std::uint64_t model_fingerprint_of(const TetMesh& mesh, const TissueSettings& settings) {
+  Fingerprint f;
+  for (const Eigen::Vector3d& x : mesh.rest_positions_m) f.add(std::array<double, 3>{x.x(), x.y(), x.z()});
+  f.add_all(mesh.tets);
+  const BodySettings& body = settings.body;
+  f.add(body.material.young_modulus_pa);
+  f.add(body.material.poisson_ratio);
+  f.add(body.material.density_kg_per_m3);
+  f.add(body.damping.mass_damping_per_s);
+  f.add(body.damping.stiffness_damping_s);
+  f.add(std::array<double, 3>{body.gravity_m_per_s2.x(), body.gravity_m_per_s2.y(), body.gravity_m_per_s2.z()});
+  f.add_all(body.fixed_vertices);
+  f.add(body.reserve.extra_row_fraction);  // field by field: a struct's padding bytes are not values
+  f.add(body.reserve.row_capacity_factor);
+  f.add(settings.solver.kind);
+  f.add(settings.solver.pcg.tolerance);
+  f.add(settings.solver.pcg.max_iterations);
+  f.add(settings.solver.warm_start);
+  const InteractionSettings& interaction = settings.interaction;
+  f.add(interaction.contact_enabled);
+  f.add(interaction.cutting_enabled);
+  f.add(interaction.blade_length_m);
+  f.add(interaction.cutter.vertex_snap_fraction);
+  f.add(interaction.cutter.min_volume_fraction);
+  f.add(interaction.contact_spring_stiffness_n_per_m);
+  f.add(interaction.contact_stiffness_model);
+  f.add(interaction.contact_stiffness_refresh_steps);
+  f.add(settings.step_size_s);
+  return f.value();
+}
+
+bool same_cut(const TetCut& a, const TetCut& b) {
+  return a.tet == b.tet && a.cut_id == b.cut_id && a.side == b.side &&
+         a.volume_fraction_above == b.volume_fraction_above && a.edge_ratio == b.edge_ratio;
 }
 
 PointContactSettings contact_settings(const InteractionSettings& settings, const DeformableBody& body,
@@ -110,7 +169,8 @@ Tissue::Tissue(TetMesh mesh, TissueSettings settings)
       m_cut_surface(m_body.mesh().vertex_count()),
       m_bvh(m_surface.triangles, m_positions_m),
       m_cutter(m_body.mesh(), m_adjacency, m_surface, m_settings.interaction.cutter),
-      m_contact(contact_settings(m_settings.interaction, m_body, m_surface)) {
+      m_contact(contact_settings(m_settings.interaction, m_body, m_surface)),
+      m_model_fingerprint(model_fingerprint_of(m_body.mesh(), m_settings)) {
   m_state.displacement_m.setZero(m_body.dof_count());
   m_state.velocity_m_per_s.setZero(m_body.dof_count());
 }
@@ -135,15 +195,111 @@ void Tissue::interact_with_scalpel(const ToolPose& previous, TissueStepReport& r
   report.cut_s = seconds_since(cut_start);
   if (m_cutter.new_cuts().empty()) return;
   const auto enrich_start = std::chrono::steady_clock::now();
+  report.enrichment = apply_cuts(m_cutter.new_cuts());
+  report.enrich_s = seconds_since(enrich_start);
+}
+
+EnrichmentResult Tissue::apply_cuts(std::span<const TetCut> cuts) {
   const int first_new = static_cast<int>(m_body.cut_tets().size());
-  report.enrichment = m_body.enrich(m_cutter.new_cuts());
+  const EnrichmentResult result = m_body.enrich(cuts);
   m_body.grow_state(m_state);
+  m_cut_history.insert(m_cut_history.end(), cuts.begin(), cuts.end());
+  m_cut_batch_ends.push_back(static_cast<int>(m_cut_history.size()));
   // The opened faces join the surface (at the current state: both parts still coincide).
   const int new_faces = m_cut_surface.add_cut_tets(m_body, first_new);
   update_positions();
   const auto& faces = m_cut_surface.triangles();
   m_bvh.add_triangles(std::span(faces).last(static_cast<size_t>(new_faces)), m_positions_m);
-  report.enrich_s = seconds_since(enrich_start);
+  return result;
+}
+
+void Tissue::save(TissueSnapshot& snapshot) const {
+  snapshot.model_fingerprint = m_model_fingerprint;
+  snapshot.cuts = m_cut_history;
+  snapshot.cut_batch_ends = m_cut_batch_ends;
+  snapshot.dynamics = m_state;
+  m_body.save_rotations(snapshot.rotations);
+  snapshot.integrator_state = m_integrator->internal_state();
+  m_cutter.save(snapshot.cutter);
+  snapshot.contact = m_contact.state();
+  snapshot.point_spring = m_body.point_spring();
+  snapshot.tool = m_tool;
+  snapshot.previous_tool = m_previous_tool;
+  snapshot.contact_output = m_contact_output;
+  snapshot.steps_since_stiffness = m_steps_since_stiffness;
+}
+
+bool Tissue::has_cuts_of(const TissueSnapshot& snapshot) const {
+  return snapshot.cut_batch_ends == m_cut_batch_ends && snapshot.cuts.size() == m_cut_history.size() &&
+         std::equal(snapshot.cuts.begin(), snapshot.cuts.end(), m_cut_history.begin(), same_cut);
+}
+
+void Tissue::restore(const TissueSnapshot& snapshot) {
+  if (snapshot.model_fingerprint != m_model_fingerprint) {
+    throw StateError("the state was saved from another model (the mesh or a parameter differs)");
+  }
+  int previous_end = 0;
+  for (const int end : snapshot.cut_batch_ends) {
+    if (end <= previous_end) throw StateError("the state's cut batches are not increasing");
+    previous_end = end;
+  }
+  if (static_cast<size_t>(previous_end) != snapshot.cuts.size()) {
+    throw StateError("the state's cut batches do not add up to its cuts");
+  }
+  if (!has_cuts_of(snapshot)) {
+    if (!m_cut_batch_ends.empty()) {
+      throw StateError("the state has other cuts than this instance; restore it into a fresh instance");
+    }
+    try {
+      int begin = 0;
+      for (const int end : snapshot.cut_batch_ends) {
+        apply_cuts(std::span(snapshot.cuts).subspan(static_cast<size_t>(begin), static_cast<size_t>(end - begin)));
+        begin = end;
+      }
+    } catch (const std::invalid_argument& error) {
+      throw StateError(std::string("the state's cuts cannot be replayed: ") + error.what());
+    }
+  }
+  // Check everything before changing anything.
+  const Eigen::Index dofs = m_body.dof_count();
+  const DynamicState& dynamics = snapshot.dynamics;
+  if (dynamics.displacement_m.size() != dofs || dynamics.velocity_m_per_s.size() != dofs) {
+    throw StateError("the state has " + std::to_string(dynamics.displacement_m.size()) + " unknowns, the model " +
+                     std::to_string(dofs));
+  }
+  if (!dynamics.displacement_m.allFinite() || !dynamics.velocity_m_per_s.allFinite() ||
+      !std::isfinite(dynamics.time_s)) {
+    throw StateError("the state holds a non-finite displacement, velocity or time");
+  }
+  const DeformableBody::Rotations& rotations = snapshot.rotations;
+  const size_t tets = static_cast<size_t>(m_body.mesh().tet_count());
+  if (rotations.tets.size() != tets || rotations.tet_warm_starts.size() != tets ||
+      rotations.parts.size() != m_body.cut_tets().size() ||
+      rotations.part_warm_starts.size() != m_body.cut_tets().size()) {
+    throw StateError("the state's rotations do not match the mesh and its cuts");
+  }
+  const PointContact::State& contact = snapshot.contact;
+  if (contact.in_contact && (contact.proxy.triangle < 0 || contact.proxy.triangle >= m_bvh.triangle_count())) {
+    throw StateError("the state's contact is on a triangle the surface does not have");
+  }
+  const std::optional<PointSpring> old_spring = m_body.point_spring();
+  try {
+    m_body.set_point_spring(snapshot.point_spring);
+    m_cutter.restore(snapshot.cutter);
+  } catch (const std::invalid_argument& error) {
+    m_body.set_point_spring(old_spring);
+    throw StateError(std::string("the state is inconsistent: ") + error.what());
+  }
+  m_body.restore_rotations(rotations);
+  m_state = dynamics;
+  m_integrator->restore_internal_state(snapshot.integrator_state);
+  m_contact.restore(contact);
+  m_tool = snapshot.tool;
+  m_previous_tool = snapshot.previous_tool;
+  m_contact_output = snapshot.contact_output;
+  m_steps_since_stiffness = snapshot.steps_since_stiffness;
+  update_positions();
+  m_bvh.refit(m_positions_m);
 }
 
 void Tissue::interact_with_probe(const ToolPose& previous) {

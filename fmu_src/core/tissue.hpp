@@ -17,8 +17,13 @@
 
 #include <Eigen/Geometry>
 
+#include <cstdint>
 #include <memory>
+#include <optional>
+#include <span>
+#include <stdexcept>
 #include <string_view>
+#include <vector>
 
 namespace tissue {
 
@@ -96,6 +101,31 @@ struct TissueStepReport {
   double total_s = 0.0;
 };
 
+/// A saved state that cannot be restored here (another model, a malformed or inconsistent state).
+class StateError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+/// Everything a Tissue carries from one step to the next, so that a restored instance continues
+/// bitwise as the saved one would have (FMI get/set/serialize FMU state). The cuts are kept as the
+/// history of enrichments, batch by batch, so that a fresh instance replays the same growth.
+struct TissueSnapshot {
+  std::uint64_t model_fingerprint = 0;  ///< of the mesh and settings (Tissue::model_fingerprint())
+  std::vector<TetCut> cuts;             ///< every enriched cut, in order
+  std::vector<int> cut_batch_ends;      ///< after enrichment k, cuts [0, cut_batch_ends[k]) were applied
+  DynamicState dynamics;
+  DeformableBody::Rotations rotations;
+  Eigen::VectorXd integrator_state;
+  VolumeCutter::SessionState cutter;
+  PointContact::State contact;
+  std::optional<PointSpring> point_spring;
+  ToolPose tool;
+  ToolPose previous_tool;
+  ContactOutput contact_output;
+  int steps_since_stiffness = 0;
+};
+
 class Tissue {
  public:
   /// Throws ParameterError for invalid settings.
@@ -132,6 +162,17 @@ class Tissue {
   [[nodiscard]] const VolumeCutter& cutter() const { return m_cutter; }
   [[nodiscard]] const PointContact& point_contact() const { return m_contact; }
   [[nodiscard]] const ContactOutput& contact() const { return m_contact_output; }
+  /// A hash of the mesh and every setting: a snapshot restores only into a Tissue of the same value.
+  [[nodiscard]] std::uint64_t model_fingerprint() const { return m_model_fingerprint; }
+  void save(TissueSnapshot& snapshot) const;
+  /// True when the snapshot's cuts are exactly the cuts made here, so restore() works in place.
+  [[nodiscard]] bool has_cuts_of(const TissueSnapshot& snapshot) const;
+  /// Restores a snapshot of this model: in place when has_cuts_of(snapshot), by replaying the cuts
+  /// when nothing was cut here yet (a fresh instance). Throws StateError otherwise, or when the
+  /// snapshot is of another model or inconsistent; the instance is then unchanged, except when the
+  /// replay of cuts into a fresh instance fails (discard it).
+  void restore(const TissueSnapshot& snapshot);
+
   /// The spring stiffness the contact uses (resolved from the settings) [N/m].
   [[nodiscard]] double contact_spring_stiffness_n_per_m() const {
     return m_contact.settings().spring_stiffness_n_per_m;
@@ -142,6 +183,8 @@ class Tissue {
   void interact_with_probe(const ToolPose& previous);
   void update_contact_output();
   void update_positions();
+  /// Enriches `cuts` (one batch), grows the state, adds the opened faces to the surface and the BVH.
+  EnrichmentResult apply_cuts(std::span<const TetCut> cuts);
   [[nodiscard]] Blade blade(const ToolPose& pose) const;
 
   TissueSettings m_settings;
@@ -162,6 +205,9 @@ class Tissue {
   ContactOutput m_contact_output;
   ToolPose m_tool;
   ToolPose m_previous_tool;
+  std::uint64_t m_model_fingerprint = 0;
+  std::vector<TetCut> m_cut_history;
+  std::vector<int> m_cut_batch_ends;
 };
 
 }  // namespace tissue

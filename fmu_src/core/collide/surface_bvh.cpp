@@ -258,6 +258,9 @@ void SurfaceBvh::overlap_box(const Eigen::Vector3d& lower, const Eigen::Vector3d
   if (!m_tree) return;
   const auto touches = [&](const btDbvtVolume& box) { return boxes_overlap(lower, upper, box); };
   for_each_touched_leaf(m_tree->dbvt.m_root, touches, [&](int id) { triangles.push_back(id); });
+  // In id order, not tree order: the tree's shape depends on the insertion history, and a restored
+  // state (rebuilt tree) must see the same order as the instance it was saved from.
+  std::sort(triangles.begin(), triangles.end());
 }
 
 std::vector<SurfaceBvh::NodeShape> SurfaceBvh::shape() const {

@@ -60,7 +60,7 @@ class SurfaceBvh {
                         std::vector<SphereHit>& hits) const;
 
   /// Ids of the triangles whose (refitted) boxes overlap the box [lower, upper]: candidates only,
-  /// in no particular order. `triangles` is cleared first.
+  /// in ascending id order (independent of the tree shape). `triangles` is cleared first.
   void overlap_box(const Eigen::Vector3d& lower, const Eigen::Vector3d& upper, std::vector<int>& triangles) const;
 
   /// One node of the tree, for tests and diagnostics.

@@ -79,6 +79,27 @@ class PointContact {
   /// The spring from the proxy's material point to the HIP, for DeformableBody::set_point_spring;
   /// nothing when not in contact.
   [[nodiscard]] std::optional<PointSpring> spring(const SurfaceBvh& surface) const;
+
+  /// What the contact carries from step to step (the work buffers and the adjacency are rebuilt).
+  struct State {
+    bool in_contact = false;
+    SurfacePoint proxy;
+    Eigen::Vector3d proxy_position_m = Eigen::Vector3d::Zero();
+    Eigen::Vector3d normal = Eigen::Vector3d::Zero();
+    Eigen::Vector3d hip_m = Eigen::Vector3d::Zero();
+    double depth_m = 0.0;
+  };
+  [[nodiscard]] State state() const {
+    return State{m_in_contact, m_proxy, m_proxy_position_m, m_normal, m_hip_m, m_depth_m};
+  }
+  void restore(const State& state) {
+    m_in_contact = state.in_contact;
+    m_proxy = state.proxy;
+    m_proxy_position_m = state.proxy_position_m;
+    m_normal = state.normal;
+    m_hip_m = state.hip_m;
+    m_depth_m = state.depth_m;
+  }
   /// body.set_point_spring(spring(surface)).
   void apply(const SurfaceBvh& surface, DeformableBody& body) const;
   /// The force on the tool k (x_p - HIP) with the proxy's material point at `positions_m` (e.g.

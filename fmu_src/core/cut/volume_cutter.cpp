@@ -155,6 +155,49 @@ void VolumeCutter::end_cut() {
   m_active.clear();
 }
 
+void VolumeCutter::save(SessionState& state) const {
+  state.cutting = m_cutting;
+  state.cut_id = m_cut_id;
+  state.tet_cut_session = m_tet_cut_session;
+  state.tet_ignored_session = m_tet_ignored_session;
+  state.edge_session = m_edge_session;
+  state.edge_ratio = m_edge_ratio;
+  state.edge_upper_end = m_edge_upper_end;
+  state.active = m_active;
+}
+
+void VolumeCutter::restore(const SessionState& state) {
+  const auto fail = [](const std::string& what) { throw std::invalid_argument("VolumeCutter::restore: " + what); };
+  const size_t tets = m_tet_cut_session.size();
+  const size_t edges = m_edge_session.size();
+  if (state.tet_cut_session.size() != tets || state.tet_ignored_session.size() != tets ||
+      state.edge_session.size() != edges || state.edge_ratio.size() != edges || state.edge_upper_end.size() != edges) {
+    fail("the state is of another mesh (" + std::to_string(state.tet_cut_session.size()) + " tets, " +
+         std::to_string(state.edge_session.size()) + " edges; this one has " + std::to_string(tets) + " and " +
+         std::to_string(edges) + ")");
+  }
+  if (state.cut_id < -1 || (state.cutting && state.cut_id < 0)) fail("bad session id " + std::to_string(state.cut_id));
+  const auto session_ok = [&](int session) { return session >= -1 && session <= state.cut_id; };
+  if (!std::all_of(state.tet_cut_session.begin(), state.tet_cut_session.end(), session_ok) ||
+      !std::all_of(state.tet_ignored_session.begin(), state.tet_ignored_session.end(), session_ok) ||
+      !std::all_of(state.edge_session.begin(), state.edge_session.end(), session_ok)) {
+    fail("a tet or edge names a session after " + std::to_string(state.cut_id));
+  }
+  if (!std::all_of(state.active.begin(), state.active.end(),
+                   [&](int tet) { return tet >= 0 && static_cast<size_t>(tet) < tets; })) {
+    fail("an active tet is out of range");
+  }
+  if (state.active.size() > tets) fail("more active tets than the mesh has");
+  m_cutting = state.cutting;
+  m_cut_id = state.cut_id;
+  std::copy(state.tet_cut_session.begin(), state.tet_cut_session.end(), m_tet_cut_session.begin());
+  std::copy(state.tet_ignored_session.begin(), state.tet_ignored_session.end(), m_tet_ignored_session.begin());
+  std::copy(state.edge_session.begin(), state.edge_session.end(), m_edge_session.begin());
+  std::copy(state.edge_ratio.begin(), state.edge_ratio.end(), m_edge_ratio.begin());
+  std::copy(state.edge_upper_end.begin(), state.edge_upper_end.end(), m_edge_upper_end.begin());
+  m_active.assign(state.active.begin(), state.active.end());
+}
+
 void VolumeCutter::validate(const Blade& previous, const Blade& current, const Eigen::VectorXd& positions_m,
                             const SurfaceBvh& bvh) const {
   if (!is_finite(previous) || !is_finite(current)) {

@@ -103,6 +103,23 @@ class VolumeCutter {
   /// Ends the session (the tool changed mode): tets cut partially stay uncut.
   void end_cut();
 
+  /// What the cutter carries from step to step: the open session and every session's record of the
+  /// tets and edges it cut. (The search stamps are per step and not part of it.)
+  struct SessionState {
+    bool cutting = false;
+    int cut_id = -1;
+    std::vector<int> tet_cut_session;
+    std::vector<int> tet_ignored_session;
+    std::vector<int> edge_session;
+    std::vector<double> edge_ratio;
+    std::vector<std::int8_t> edge_upper_end;
+    std::vector<int> active;
+  };
+  void save(SessionState& state) const;
+  /// Throws std::invalid_argument (nothing changed) when the sizes do not match the mesh or an id
+  /// is out of range.
+  void restore(const SessionState& state);
+
  private:
   struct Sweep;  // the two sweep triangles and their boundary, for one step
 

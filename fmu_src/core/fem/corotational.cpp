@@ -7,6 +7,7 @@
 #include "core/fem/corotational_kernel.hpp"
 
 #include <cassert>
+#include <stdexcept>
 #include <string>
 
 namespace tissue {
@@ -41,6 +42,17 @@ void CorotationalElasticity::exclude(int tet) {
                          std::to_string(tet_count()) + ")");
   }
   m_excluded[static_cast<size_t>(tet)] = 1;
+}
+
+void CorotationalElasticity::restore_rotations(const std::vector<Eigen::Matrix3d>& rotations,
+                                               const std::vector<Eigen::Quaterniond>& warm_starts) {
+  if (rotations.size() != m_tets.size() || warm_starts.size() != m_tets.size()) {
+    throw std::invalid_argument("co-rotational elasticity: expected one rotation and warm start per tet (" +
+                                std::to_string(m_tets.size()) + "), got " + std::to_string(rotations.size()) +
+                                " and " + std::to_string(warm_starts.size()));
+  }
+  m_rotations = rotations;
+  m_warm_starts = warm_starts;
 }
 
 void CorotationalElasticity::reset_rotations() {

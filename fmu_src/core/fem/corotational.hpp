@@ -46,6 +46,12 @@ class CorotationalElasticity {
 
   /// Forgets the warm starts (rotations back to identity), e.g. after a state was restored.
   void reset_rotations();
+  /// The rotations and their warm starts, per tet (what a saved state must carry to continue bitwise).
+  [[nodiscard]] const std::vector<Eigen::Matrix3d>& rotations() const { return m_rotations; }
+  [[nodiscard]] const std::vector<Eigen::Quaterniond>& warm_starts() const { return m_warm_starts; }
+  /// Sets both; throws std::invalid_argument (nothing changed) unless there is one of each per tet.
+  void restore_rotations(const std::vector<Eigen::Matrix3d>& rotations,
+                         const std::vector<Eigen::Quaterniond>& warm_starts);
 
  private:
   std::vector<Tet> m_tets;

@@ -19,6 +19,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <stdexcept>
 #include <string>
 
 namespace tissue {
@@ -168,6 +169,23 @@ double DeformableBody::elastic_energy_j(const Eigen::VectorXd& displacement_m) {
 
 double DeformableBody::kinetic_energy_j(const Eigen::VectorXd& velocity_m_per_s) const {
   return 0.5 * velocity_m_per_s.dot(m_mass_kg.cwiseProduct(velocity_m_per_s));
+}
+
+void DeformableBody::save_rotations(Rotations& rotations) const {
+  rotations.tets = m_elasticity.rotations();
+  rotations.tet_warm_starts = m_elasticity.warm_starts();
+  rotations.parts = m_xfem.rotations();
+  rotations.part_warm_starts = m_xfem.warm_starts();
+}
+
+void DeformableBody::restore_rotations(const Rotations& rotations) {
+  if (rotations.parts.size() != m_xfem.cut_tets().size() ||
+      rotations.part_warm_starts.size() != m_xfem.cut_tets().size()) {
+    throw std::invalid_argument("body: the saved rotations are of " + std::to_string(rotations.parts.size()) +
+                                " cut tets, the body has " + std::to_string(m_xfem.cut_tets().size()));
+  }
+  m_elasticity.restore_rotations(rotations.tets, rotations.tet_warm_starts);
+  m_xfem.restore_rotations(rotations.parts, rotations.part_warm_starts);
 }
 
 void DeformableBody::reset_rotations() {

@@ -130,6 +130,17 @@ class DeformableBody final : public DynamicsModel {
 
   /// Forgets the rotation warm starts of all tets and parts (e.g. after a state was restored).
   void reset_rotations();
+  /// The rotations and warm starts of all tets and cut-tet parts: with u, v they make the state a
+  /// step continues from bitwise.
+  struct Rotations {
+    std::vector<Eigen::Matrix3d> tets;
+    std::vector<Eigen::Quaterniond> tet_warm_starts;
+    std::vector<std::array<Eigen::Matrix3d, 2>> parts;  ///< per cut tet, [above, below]
+    std::vector<std::array<Eigen::Quaterniond, 2>> part_warm_starts;
+  };
+  void save_rotations(Rotations& rotations) const;
+  /// Throws std::invalid_argument (nothing changed) when the sizes do not match the mesh and cuts.
+  void restore_rotations(const Rotations& rotations);
   /// Elastic energy at displacement u (cut tets: w_a E_a + w_b E_b). [J]
   [[nodiscard]] double elastic_energy_j(const Eigen::VectorXd& displacement_m);
   /// 1/2 v^T M v. [J]

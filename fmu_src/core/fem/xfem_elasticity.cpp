@@ -6,6 +6,8 @@
 #include "core/fem/corotational_kernel.hpp"
 
 #include <cassert>
+#include <stdexcept>
+#include <string>
 
 namespace tissue {
 namespace {
@@ -42,6 +44,17 @@ void XfemElasticity::add(const CutTet& cut_tet, const TetRest& rest, const Eigen
   m_rotations.push_back({rotation, rotation});
   const Eigen::Quaterniond warm_start(rotation);
   m_warm_starts.push_back({warm_start, warm_start});
+}
+
+void XfemElasticity::restore_rotations(const std::vector<std::array<Eigen::Matrix3d, 2>>& rotations,
+                                       const std::vector<std::array<Eigen::Quaterniond, 2>>& warm_starts) {
+  if (rotations.size() != m_cut_tets.size() || warm_starts.size() != m_cut_tets.size()) {
+    throw std::invalid_argument("XFEM: expected the parts' rotations of " + std::to_string(m_cut_tets.size()) +
+                                " cut tets, got " + std::to_string(rotations.size()) + " and " +
+                                std::to_string(warm_starts.size()));
+  }
+  m_rotations = rotations;
+  m_warm_starts = warm_starts;
 }
 
 void XfemElasticity::reset_rotations() {

@@ -98,6 +98,12 @@ class XfemElasticity {
 
   /// Forgets the warm starts (rotations back to identity).
   void reset_rotations();
+  /// The parts' rotations and warm starts per cut tet ([above, below]).
+  [[nodiscard]] const std::vector<std::array<Eigen::Matrix3d, 2>>& rotations() const { return m_rotations; }
+  [[nodiscard]] const std::vector<std::array<Eigen::Quaterniond, 2>>& warm_starts() const { return m_warm_starts; }
+  /// Sets both; throws std::invalid_argument (nothing changed) unless there is one of each per cut tet.
+  void restore_rotations(const std::vector<std::array<Eigen::Matrix3d, 2>>& rotations,
+                         const std::vector<std::array<Eigen::Quaterniond, 2>>& warm_starts);
 
  private:
   // Real positions and enriched displacements of the local vertices of cut tet k.

@@ -22,6 +22,11 @@ class BackwardEuler final : public Integrator {
   StepReport step(DynamicsModel& model, DynamicState& state, double step_size_s) override;
   [[nodiscard]] std::string_view name() const override { return "backward-euler"; }
   [[nodiscard]] const LinearSolver& solver() const { return *m_solver; }
+  /// The last velocity change (the next solve's warm start when enabled).
+  [[nodiscard]] Eigen::VectorXd internal_state() const override { return m_velocity_change; }
+  void restore_internal_state(const Eigen::VectorXd& internal_state) override {
+    m_velocity_change = internal_state;
+  }
 
  private:
   std::unique_ptr<LinearSolver> m_solver;

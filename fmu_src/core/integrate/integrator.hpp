@@ -29,6 +29,11 @@ class Integrator {
   /// step cannot be taken, e.g. the linear solver fails or the result is not finite.
   virtual StepReport step(DynamicsModel& model, DynamicState& state, double step_size_s) = 0;
   [[nodiscard]] virtual std::string_view name() const = 0;
+  /// What the integrator carries from one step to the next beyond the DynamicState (a warm start,
+  /// a history), packed in one vector, so that a saved state continues bitwise; empty if nothing.
+  [[nodiscard]] virtual Eigen::VectorXd internal_state() const = 0;
+  /// Restores internal_state(); throws std::invalid_argument (nothing changed) for a wrong size.
+  virtual void restore_internal_state(const Eigen::VectorXd& internal_state) = 0;
 };
 
 }  // namespace tissue

@@ -1,1 +1,1 @@
-tissue_add_test(test_tissue LABELS unit SOURCES tissue/test_tissue.cpp)
+tissue_add_test(test_tissue LABELS unit SOURCES tissue/test_tissue.cpp tissue/test_tissue_state.cpp)

@@ -1,0 +1,257 @@
+// TissueSnapshot <-> bytes (see tissue_snapshot_io.hpp).
+#include "core/tissue_snapshot_io.hpp"
+
+#include <cstring>
+#include <string>
+#include <type_traits>
+
+namespace tissue {
+namespace {
+
+constexpr std::uint64_t MAGIC = 0x31305353'49535354ULL;  // "TSSISS01" read as little-endian bytes
+constexpr std::uint32_t VERSION = 1;
+
+class Writer {
+ public:
+  template <class T>
+  void put(const T& value) {
+    static_assert(std::is_arithmetic_v<T> || std::is_enum_v<T>);
+    const auto* bytes = reinterpret_cast<const std::uint8_t*>(&value);
+    m_bytes.insert(m_bytes.end(), bytes, bytes + sizeof(T));
+  }
+  void put(const Eigen::VectorXd& v) {
+    put(static_cast<std::uint64_t>(v.size()));
+    for (Eigen::Index k = 0; k < v.size(); ++k) put(v(k));
+  }
+  void put(const Eigen::Vector3d& v) {
+    for (int k = 0; k < 3; ++k) put(v(k));
+  }
+  void put(const Eigen::Matrix3d& m) {
+    for (int k = 0; k < 9; ++k) put(m(k));
+  }
+  void put(const Eigen::Quaterniond& q) {
+    for (int k = 0; k < 4; ++k) put(q.coeffs()(k));
+  }
+  template <class T>
+  void put_all(const std::vector<T>& values) {
+    put(static_cast<std::uint64_t>(values.size()));
+    for (const T& value : values) put_item(value);
+  }
+  std::vector<std::uint8_t> take() { return std::move(m_bytes); }
+
+  template <class T>
+  void put_item(const T& value) {
+    put(value);
+  }
+  template <class T, size_t N>
+  void put_item(const std::array<T, N>& values) {
+    for (const T& value : values) put(value);
+  }
+  void put_item(const TetCut& cut) {
+    put(cut.tet);
+    put(cut.cut_id);
+    put_item(cut.side);
+    put(cut.volume_fraction_above);
+    put_item(cut.edge_ratio);
+  }
+
+ private:
+  std::vector<std::uint8_t> m_bytes;
+};
+
+class Reader {
+ public:
+  explicit Reader(std::span<const std::uint8_t> bytes) : m_bytes(bytes) {}
+
+  template <class T>
+  T get() {
+    static_assert(std::is_arithmetic_v<T> || std::is_enum_v<T>);
+    need(sizeof(T));
+    T value;
+    std::memcpy(&value, m_bytes.data() + m_offset, sizeof(T));
+    m_offset += sizeof(T);
+    return value;
+  }
+  /// A count of items of at least `item_bytes` each, checked against the bytes left.
+  size_t count(size_t item_bytes) {
+    const auto n = get<std::uint64_t>();
+    if (item_bytes > 0 && n > (m_bytes.size() - m_offset) / item_bytes) fail("a length exceeds the data");
+    return static_cast<size_t>(n);
+  }
+  void get(Eigen::VectorXd& v) {
+    v.resize(static_cast<Eigen::Index>(count(sizeof(double))));
+    for (Eigen::Index k = 0; k < v.size(); ++k) v(k) = get<double>();
+  }
+  void get(Eigen::Vector3d& v) {
+    for (int k = 0; k < 3; ++k) v(k) = get<double>();
+  }
+  void get(Eigen::Matrix3d& m) {
+    for (int k = 0; k < 9; ++k) m(k) = get<double>();
+  }
+  void get(Eigen::Quaterniond& q) {
+    for (int k = 0; k < 4; ++k) q.coeffs()(k) = get<double>();
+  }
+  template <class T>
+  void get(T& value) {
+    value = get<T>();
+  }
+  template <class T, size_t N>
+  void get(std::array<T, N>& values) {
+    for (T& value : values) get(value);
+  }
+  void get(TetCut& cut) {
+    get(cut.tet);
+    get(cut.cut_id);
+    get(cut.side);
+    get(cut.volume_fraction_above);
+    get(cut.edge_ratio);
+  }
+  template <class T>
+  void get_all(std::vector<T>& values, size_t item_bytes) {
+    values.resize(count(item_bytes));
+    for (T& value : values) get(value);
+  }
+  bool get_bool() {
+    const auto b = get<std::uint8_t>();
+    if (b > 1) fail("a flag is neither 0 nor 1");
+    return b == 1;
+  }
+  void finish() const {
+    if (m_offset != m_bytes.size()) fail("trailing bytes after the state");
+  }
+  [[noreturn]] static void fail(const std::string& what) { throw StateError("serialized state: " + what); }
+
+ private:
+  void need(size_t n) const {
+    if (n > m_bytes.size() - m_offset) fail("truncated");
+  }
+  std::span<const std::uint8_t> m_bytes;
+  size_t m_offset = 0;
+};
+
+void put_tool(Writer& w, const ToolPose& tool) {
+  w.put(tool.tip_position_m);
+  w.put(tool.orientation);
+  w.put(static_cast<std::int32_t>(tool.mode));
+}
+
+ToolPose get_tool(Reader& r) {
+  ToolPose tool;
+  r.get(tool.tip_position_m);
+  r.get(tool.orientation);
+  const auto mode = r.get<std::int32_t>();
+  if (mode < 0 || mode > 2) Reader::fail("bad tool mode " + std::to_string(mode));
+  tool.mode = static_cast<ToolMode>(mode);
+  return tool;
+}
+
+}  // namespace
+
+std::vector<std::uint8_t> serialize_snapshot(const TissueSnapshot& s) {
+  Writer w;
+  w.put(MAGIC);
+  w.put(VERSION);
+  w.put(s.model_fingerprint);
+  w.put_all(s.cuts);
+  w.put_all(s.cut_batch_ends);
+  w.put(s.dynamics.displacement_m);
+  w.put(s.dynamics.velocity_m_per_s);
+  w.put(s.dynamics.time_s);
+  w.put_all(s.rotations.tets);
+  w.put_all(s.rotations.tet_warm_starts);
+  w.put_all(s.rotations.parts);
+  w.put_all(s.rotations.part_warm_starts);
+  w.put(s.integrator_state);
+  const VolumeCutter::SessionState& c = s.cutter;
+  w.put(static_cast<std::uint8_t>(c.cutting));
+  w.put(c.cut_id);
+  w.put_all(c.tet_cut_session);
+  w.put_all(c.tet_ignored_session);
+  w.put_all(c.edge_session);
+  w.put_all(c.edge_ratio);
+  w.put_all(c.edge_upper_end);
+  w.put_all(c.active);
+  w.put(static_cast<std::uint8_t>(s.contact.in_contact));
+  w.put(s.contact.proxy.triangle);
+  w.put(s.contact.proxy.barycentric);
+  w.put(s.contact.proxy_position_m);
+  w.put(s.contact.normal);
+  w.put(s.contact.hip_m);
+  w.put(s.contact.depth_m);
+  w.put(static_cast<std::uint8_t>(s.point_spring.has_value()));
+  if (s.point_spring) {
+    w.put_item(s.point_spring->vertices);
+    w.put(s.point_spring->weights);
+    w.put(s.point_spring->target_m);
+    w.put(s.point_spring->stiffness_n_per_m);
+  }
+  put_tool(w, s.tool);
+  put_tool(w, s.previous_tool);
+  const ContactOutput& o = s.contact_output;
+  w.put(static_cast<std::uint8_t>(o.active));
+  w.put(o.point_m);
+  w.put(o.normal);
+  w.put(o.force_on_tool_n);
+  w.put(o.stiffness_n_per_m);
+  w.put(o.penetration_depth_m);
+  w.put(s.steps_since_stiffness);
+  return w.take();
+}
+
+TissueSnapshot deserialize_snapshot(std::span<const std::uint8_t> bytes) {
+  Reader r(bytes);
+  if (r.get<std::uint64_t>() != MAGIC) Reader::fail("not a tissue state (bad magic)");
+  if (const auto version = r.get<std::uint32_t>(); version != VERSION) {
+    Reader::fail("version " + std::to_string(version) + " is not " + std::to_string(VERSION));
+  }
+  TissueSnapshot s;
+  r.get(s.model_fingerprint);
+  r.get_all(s.cuts, 4 + 4 + 4 + 8 + 48);
+  r.get_all(s.cut_batch_ends, 4);
+  r.get(s.dynamics.displacement_m);
+  r.get(s.dynamics.velocity_m_per_s);
+  r.get(s.dynamics.time_s);
+  r.get_all(s.rotations.tets, 72);
+  r.get_all(s.rotations.tet_warm_starts, 32);
+  r.get_all(s.rotations.parts, 144);
+  r.get_all(s.rotations.part_warm_starts, 64);
+  r.get(s.integrator_state);
+  VolumeCutter::SessionState& c = s.cutter;
+  c.cutting = r.get_bool();
+  r.get(c.cut_id);
+  r.get_all(c.tet_cut_session, 4);
+  r.get_all(c.tet_ignored_session, 4);
+  r.get_all(c.edge_session, 4);
+  r.get_all(c.edge_ratio, 8);
+  r.get_all(c.edge_upper_end, 1);
+  r.get_all(c.active, 4);
+  s.contact.in_contact = r.get_bool();
+  r.get(s.contact.proxy.triangle);
+  r.get(s.contact.proxy.barycentric);
+  r.get(s.contact.proxy_position_m);
+  r.get(s.contact.normal);
+  r.get(s.contact.hip_m);
+  r.get(s.contact.depth_m);
+  if (r.get_bool()) {
+    PointSpring spring;
+    r.get(spring.vertices);
+    r.get(spring.weights);
+    r.get(spring.target_m);
+    r.get(spring.stiffness_n_per_m);
+    s.point_spring = spring;
+  }
+  s.tool = get_tool(r);
+  s.previous_tool = get_tool(r);
+  ContactOutput& o = s.contact_output;
+  o.active = r.get_bool();
+  r.get(o.point_m);
+  r.get(o.normal);
+  r.get(o.force_on_tool_n);
+  r.get(o.stiffness_n_per_m);
+  r.get(o.penetration_depth_m);
+  r.get(s.steps_since_stiffness);
+  r.finish();
+  return s;
+}
+
+}  // namespace tissue

@@ -1,0 +1,332 @@
+// The table of the Tissue FMU's variables: a copy of modelDescription/Tissue.xml in code, one entry
+// per variable in value-reference order. Edit both together; tests/fmu/test_model_description.cpp
+// fails, naming the variable and attribute, when they differ.
+#include "fmi3/variables.hpp"
+
+#include <algorithm>
+
+namespace tissue::fmi3 {
+namespace {
+
+// Builds one VariableInfo by named steps: VariableInfo is an aggregate of many string_views, and
+// positional or partial designated initializers are easy to misorder (and GCC warns on the latter).
+class Entry {
+ public:
+  constexpr Entry(Vr vr, std::string_view name, VariableType type, Causality causality, Variability variability)
+      : m_info{vr, name, type, causality, variability, {}, {}, {}, {}, {}, {}, 0, {}} {}
+
+  constexpr Entry& unit(std::string_view unit) {
+    m_info.unit = unit;
+    return *this;
+  }
+  constexpr Entry& declared_type(std::string_view declared_type) {
+    m_info.declared_type = declared_type;
+    return *this;
+  }
+  constexpr Entry& start(std::string_view start) {
+    m_info.start = start;
+    return *this;
+  }
+  constexpr Entry& min(std::string_view min) {
+    m_info.min = min;
+    return *this;
+  }
+  constexpr Entry& max(std::string_view max) {
+    m_info.max = max;
+    return *this;
+  }
+  constexpr Entry& shape(Dimension rows) {
+    m_info.dimensions = {rows, Dimension{}};
+    m_info.rank = 1;
+    return *this;
+  }
+  constexpr Entry& shape(Dimension rows, Dimension columns) {
+    m_info.dimensions = {rows, columns};
+    m_info.rank = 2;
+    return *this;
+  }
+  constexpr Entry& describe(std::string_view description) {
+    m_info.description = description;
+    return *this;
+  }
+  // Implicit so that the table below can list entries directly.
+  constexpr operator VariableInfo() const { return m_info; }
+
+ private:
+  VariableInfo m_info;
+};
+
+constexpr Entry parameter(Vr vr, std::string_view name, VariableType type) {
+  return {vr, name, type, Causality::parameter, Variability::fixed};
+}
+constexpr Entry structural_parameter(Vr vr, std::string_view name, VariableType type) {
+  return {vr, name, type, Causality::structural_parameter, Variability::fixed};
+}
+constexpr Entry input(Vr vr, std::string_view name, VariableType type, Variability variability) {
+  return {vr, name, type, Causality::input, variability};
+}
+constexpr Entry output(Vr vr, std::string_view name, VariableType type, Variability variability) {
+  return {vr, name, type, Causality::output, variability};
+}
+
+constexpr Dimension fixed_size(std::uint64_t size) { return {size, -1}; }
+constexpr Dimension sized_by(Vr structural_parameter) { return {0, static_cast<std::int64_t>(structural_parameter)}; }
+
+using enum VariableType;
+using enum Variability;
+
+constexpr auto VARIABLES = std::to_array<VariableInfo>({
+    Entry(Vr::time, "time", float64, Causality::independent, continuous).unit("s").describe("Simulation time"),
+
+    // Parameters.
+    parameter(Vr::mesh, "mesh", string)
+        .start("frog")
+        .describe("Tetrahedral mesh of the specimen: \"frog\" for the embedded default frog (also shipped as "
+                  "resources/frog.veg), otherwise a file name in the FMU's resources folder or an absolute path "
+                  "(.veg, .node/.ele, or Gmsh .msh 4.1)"),
+    parameter(Vr::young_modulus, "material.youngModulus", float64)
+        .unit("Pa")
+        .start("1e5")
+        .describe("Young's modulus E of the co-rotational linear material; must be > 0"),
+    parameter(Vr::poisson_ratio, "material.poissonRatio", float64)
+        .unit("1")
+        .start("0.4")
+        .min("0")
+        .describe("Poisson's ratio nu; must be < 0.5"),
+    parameter(Vr::density, "material.density", float64)
+        .unit("kg/m3")
+        .start("1000")
+        .describe("Mass density rho; must be > 0"),
+    parameter(Vr::damping_alpha, "damping.alpha", float64)
+        .unit("1/s")
+        .start("1")
+        .min("0")
+        .describe("Rayleigh damping D = alpha M + beta K: the mass-proportional coefficient alpha"),
+    parameter(Vr::damping_beta, "damping.beta", float64)
+        .unit("s")
+        .start("0.001")
+        .min("0")
+        .describe("Rayleigh damping D = alpha M + beta K: the stiffness-proportional coefficient beta"),
+    parameter(Vr::gravity, "gravity", float64)
+        .unit("m/s2")
+        .start("0 0 -9.81")
+        .shape(fixed_size(3))
+        .describe("Gravitational acceleration (x y z)"),
+    parameter(Vr::fixed_axis, "fixedRegion.axis", int32)
+        .start("2")
+        .min("-1")
+        .max("2")
+        .describe("Which vertices are held at their rest positions: -1 none; 0, 1, 2 those whose x, y, z lies within "
+                  "fixedRegion.fraction of the mesh's extent from its minimum"),
+    parameter(Vr::fixed_fraction, "fixedRegion.fraction", float64)
+        .unit("1")
+        .start("0.25")
+        .min("0")
+        .max("1")
+        .describe("Thickness of the fixed slab as a fraction of the mesh's extent along fixedRegion.axis"),
+    parameter(Vr::linear_solver, "integrator.linearSolver", enumeration)
+        .declared_type("LinearSolver")
+        .start("1")
+        .describe("Linear solver of the backward-Euler step"),
+    parameter(Vr::pcg_tolerance, "integrator.pcgTolerance", float64)
+        .unit("1")
+        .start("0.001")
+        .describe("PCG stopping tolerance on the relative residual; must be > 0"),
+    parameter(Vr::pcg_max_iterations, "integrator.pcgMaxIterations", int32)
+        .start("10")
+        .min("1")
+        .describe("PCG iteration cap per step"),
+    parameter(Vr::warm_start, "integrator.warmStart", boolean)
+        .start("false")
+        .describe("PCG starts from the previous step's velocity change instead of zero"),
+    parameter(Vr::step_size, "stepSize", float64)
+        .unit("s")
+        .start("0.001")
+        .describe("Internal backward-Euler step; must be > 0. A communication step must be a whole multiple of it"),
+    parameter(Vr::contact_enabled, "scene.contact", boolean)
+        .start("true")
+        .describe("Probe contact on; when false the contact structures are not built and the probe does not touch "
+                  "the tissue"),
+    parameter(Vr::cutting_enabled, "scene.cutting", boolean)
+        .start("true")
+        .describe("Cutting on; when false the scalpel does not cut and the cutter is not built"),
+    parameter(Vr::mesh_output_enabled, "scene.meshOutput", boolean)
+        .start("true")
+        .describe("Surface-mesh output on; when false surface.vertexPositions and surface.triangles are not filled"),
+    parameter(Vr::probe_radius, "tool.probeRadius", float64)
+        .unit("m")
+        .start("0")
+        .min("0")
+        .describe("Radius of the probe's spherical tip; 0 = a point probe"),
+    parameter(Vr::blade_length, "tool.bladeLength", float64)
+        .unit("m")
+        .start("0.03")
+        .describe("Length of the scalpel's cutting edge, from the tip along the tool axis; must be > 0"),
+    parameter(Vr::contact_spring_stiffness, "contact.springStiffness", float64)
+        .unit("N/m")
+        .start("0")
+        .min("0")
+        .describe("Stiffness of the implicit spring that ties the god-object to the probe tip; 0 = automatic (100 "
+                  "times the body's contact stiffness scale)"),
+    parameter(Vr::contact_stiffness_model, "contact.stiffnessModel", enumeration)
+        .declared_type("ContactStiffnessModel")
+        .start("1")
+        .describe("How contact.stiffness is computed"),
+    parameter(Vr::contact_stiffness_refresh_steps, "contact.stiffnessRefreshSteps", int32)
+        .start("10")
+        .min("1")
+        .describe("The effectiveStatic contact stiffness is recomputed when a contact starts and then every this "
+                  "many internal steps"),
+    parameter(Vr::min_volume_fraction, "cutter.minVolumeFraction", float64)
+        .unit("1")
+        .start("0.001")
+        .describe("Smallest volume fraction either side of a cut tetrahedron is given (keeps slivers stiff and "
+                  "massive enough); in (0, 0.5)"),
+
+    // Structural parameters.
+    structural_parameter(Vr::vertex_capacity, "surface.vertexCapacity", uint64)
+        .start("8192")
+        .min("1")
+        .describe("Rows of surface.vertexPositions: the most surface vertices that can be output"),
+    structural_parameter(Vr::triangle_capacity, "surface.triangleCapacity", uint64)
+        .start("8192")
+        .min("1")
+        .describe("Rows of surface.triangles: the most surface triangles that can be output"),
+
+    // Inputs.
+    input(Vr::tool_position, "tool.position", float64, continuous)
+        .unit("m")
+        .start("0 0 0")
+        .shape(fixed_size(3))
+        .describe("Position of the tool tip (x y z)"),
+    input(Vr::tool_orientation, "tool.orientation", float64, continuous)
+        .unit("1")
+        .start("1 0 0 0")
+        .shape(fixed_size(4))
+        .describe("Orientation of the tool as a unit quaternion (w x y z), local to world; the tool axis is the "
+                  "local +z axis, from the tip toward the handle"),
+    input(Vr::tool_mode, "tool.mode", enumeration, discrete)
+        .declared_type("ToolMode")
+        .start("0")
+        .describe("What the tool does: none, probe or scalpel"),
+
+    // Outputs.
+    output(Vr::contact_active, "contact.active", boolean, discrete).describe("The probe is in contact with the tissue"),
+    output(Vr::contact_point, "contact.point", float64, continuous)
+        .unit("m")
+        .shape(fixed_size(3))
+        .describe("Contact point on the deformed surface (the god-object position); meaningful while contact.active"),
+    output(Vr::contact_normal, "contact.normal", float64, continuous)
+        .unit("1")
+        .shape(fixed_size(3))
+        .describe("Unit outward surface normal at contact.point; meaningful while contact.active"),
+    output(Vr::contact_force, "contact.force", float64, continuous)
+        .unit("N")
+        .shape(fixed_size(3))
+        .describe("Force of the tissue on the tool"),
+    output(Vr::contact_stiffness, "contact.stiffness", float64, continuous)
+        .unit("N/m")
+        .shape(fixed_size(3), fixed_size(3))
+        .describe("Contact stiffness K_c (row-major 3x3) for rendering f = f0 + K_c (x - x0) between tissue updates"),
+    output(Vr::contact_depth, "contact.depth", float64, continuous)
+        .unit("m")
+        .describe("Penetration depth: distance from the tool tip to contact.point"),
+    output(Vr::vertex_count, "surface.vertexCount", uint64, discrete)
+        .describe("Rows of surface.vertexPositions in use (at most surface.vertexCapacity)"),
+    output(Vr::triangle_count, "surface.triangleCount", uint64, discrete)
+        .describe("Rows of surface.triangles in use (at most surface.triangleCapacity)"),
+    output(Vr::surface_revision, "surface.revision", uint64, discrete)
+        .describe("Changes when the surface topology changes (a cut); re-read surface.triangles then"),
+    output(Vr::vertex_positions, "surface.vertexPositions", float64, continuous)
+        .unit("m")
+        .shape(sized_by(Vr::vertex_capacity), fixed_size(3))
+        .describe("Deformed surface vertex positions (x y z per row): the mesh vertices in mesh order, then the "
+                  "corners of the cut faces; rows from surface.vertexCount on are 0"),
+    output(Vr::triangles, "surface.triangles", uint32, discrete)
+        .shape(sized_by(Vr::triangle_capacity), fixed_size(3))
+        .describe("Surface triangles as 0-based rows of surface.vertexPositions, counter-clockwise seen from "
+                  "outside; rows from surface.triangleCount on are 0"),
+    output(Vr::cut_tets, "cutTets", uint64, discrete).describe("Number of tetrahedra cut so far"),
+    output(Vr::enriched_vertices, "enrichedVertices", uint64, discrete)
+        .describe("Number of enriched (XFEM) vertex unknowns the cuts added"),
+    output(Vr::dofs, "dofs", uint64, discrete)
+        .describe("Number of degrees of freedom of the system (3 per free vertex and per enriched unknown)"),
+    output(Vr::kinetic_energy, "kineticEnergy", float64, continuous).unit("J").describe("Kinetic energy of the body"),
+    output(Vr::elastic_energy, "elasticEnergy", float64, continuous)
+        .unit("J")
+        .describe("Elastic strain energy of the body"),
+});
+
+// find_variable(vr) binary-searches, so the order is part of the table's contract.
+constexpr bool strictly_ordered_by_value_reference() {
+  return std::ranges::adjacent_find(
+             VARIABLES, [](const VariableInfo& a, const VariableInfo& b) { return a.vr >= b.vr; }) == VARIABLES.end();
+}
+static_assert(strictly_ordered_by_value_reference(), "the variable table must be in increasing value-reference order");
+
+}  // namespace
+
+std::span<const VariableInfo> variables() { return VARIABLES; }
+
+const VariableInfo* find_variable(std::uint32_t vr) {
+  const auto it = std::ranges::lower_bound(VARIABLES, vr, {},
+                                           [](const VariableInfo& v) { return static_cast<std::uint32_t>(v.vr); });
+  return it != VARIABLES.end() && static_cast<std::uint32_t>(it->vr) == vr ? &*it : nullptr;
+}
+
+const VariableInfo* find_variable(std::string_view name) {
+  const auto it = std::ranges::find(VARIABLES, name, &VariableInfo::name);
+  return it != VARIABLES.end() ? &*it : nullptr;
+}
+
+std::string_view to_string(VariableType type) {
+  switch (type) {
+    case VariableType::float64:
+      return "Float64";
+    case VariableType::int32:
+      return "Int32";
+    case VariableType::uint32:
+      return "UInt32";
+    case VariableType::uint64:
+      return "UInt64";
+    case VariableType::boolean:
+      return "Boolean";
+    case VariableType::string:
+      return "String";
+    case VariableType::enumeration:
+      return "Enumeration";
+  }
+  return "";
+}
+
+std::string_view to_string(Causality causality) {
+  switch (causality) {
+    case Causality::independent:
+      return "independent";
+    case Causality::structural_parameter:
+      return "structuralParameter";
+    case Causality::parameter:
+      return "parameter";
+    case Causality::input:
+      return "input";
+    case Causality::output:
+      return "output";
+  }
+  return "";
+}
+
+std::string_view to_string(Variability variability) {
+  switch (variability) {
+    case Variability::fixed:
+      return "fixed";
+    case Variability::tunable:
+      return "tunable";
+    case Variability::discrete:
+      return "discrete";
+    case Variability::continuous:
+      return "continuous";
+  }
+  return "";
+}
+
+}  // namespace tissue::fmi3

@@ -1,0 +1,205 @@
+// Saving and restoring a Tissue (what FMI's get/set/serialize FMU state stand on): a session on the
+// frog (a probe press, then a scalpel stroke across the body) saved at any step and restored, in
+// place or into a fresh instance through bytes, continues bitwise as the original; a state of
+// another model, a truncated or corrupt buffer, or cuts the instance cannot undo are refused with
+// the instance unchanged.
+#include "core/fixed_region.hpp"
+#include "core/mesh/mesh_io.hpp"
+#include "core/tissue.hpp"
+#include "core/tissue_snapshot_io.hpp"
+
+#include <gtest/gtest.h>
+
+#include <string>
+
+namespace tissue {
+namespace {
+
+TetMesh frog() { return read_veg(std::string(TISSUE_MESH_DIR) + "/frog.veg"); }
+
+TissueSettings frog_settings(const TetMesh& mesh) {
+  TissueSettings settings;
+  settings.body.gravity_m_per_s2 = {0.0, 0.0, -9.81};
+  settings.body.damping = RayleighDamping{1.0, 1e-3};
+  settings.body.fixed_vertices = vertices_at_minimum(mesh, 2, 0.25);
+  settings.solver.pcg = PcgSolver::Settings{1e-3, 10};
+  settings.step_size_s = 0.01;
+  settings.interaction.blade_length_m = 0.1;
+  return settings;
+}
+
+// The scripted session: probe pressed into the back (steps 0-19), tool away (20-21), a vertical
+// scalpel drawn across the body at mid length (22-61), tool away (62-).
+class Session {
+ public:
+  explicit Session(const TetMesh& mesh) {
+    Eigen::Vector3d lower = mesh.rest_positions_m[0], upper = lower;
+    for (const Eigen::Vector3d& x : mesh.rest_positions_m) {
+      lower = lower.cwiseMin(x);
+      upper = upper.cwiseMax(x);
+    }
+    m_lower = lower;
+    m_upper = upper;
+    m_centre = 0.5 * (lower + upper);
+  }
+  void set_top(double z) { m_top_z = z; }
+  [[nodiscard]] ToolPose pose(int step) const {
+    const Eigen::Quaterniond upright = Eigen::Quaterniond::Identity();  // tool axis +z
+    if (step < 20) {
+      const double depth = 0.004 * std::min(1.0, step / 10.0);
+      return {Eigen::Vector3d(m_centre.x(), m_centre.y(), m_top_z + 0.002 - depth), upright, ToolMode::probe};
+    }
+    if (step >= 22 && step < 62) {
+      const double s = (step - 22) / 39.0;
+      const double y = (m_lower.y() - 0.01) + s * (m_upper.y() - m_lower.y() + 0.02);
+      return {Eigen::Vector3d(m_centre.x(), y, m_lower.z() - 0.01), upright, ToolMode::scalpel};
+    }
+    return {Eigen::Vector3d(m_centre.x(), m_upper.y() + 0.05, m_upper.z() + 0.05), upright, ToolMode::none};
+  }
+  [[nodiscard]] const Eigen::Vector3d& centre() const { return m_centre; }
+  [[nodiscard]] const Eigen::Vector3d& upper() const { return m_upper; }
+
+ private:
+  Eigen::Vector3d m_lower, m_upper, m_centre;
+  double m_top_z = 0.0;
+};
+
+// The top of the frog's back above its centre, from the surface BVH.
+double top_of_back(const Tissue& tissue, const Session& session) {
+  std::vector<SurfaceBvh::SegmentHit> hits;
+  const Eigen::Vector3d above(session.centre().x(), session.centre().y(), session.upper().z() + 0.1);
+  const Eigen::Vector3d below(session.centre().x(), session.centre().y(), session.centre().z());
+  tissue.surface_bvh().intersect_segment(above, below, tissue.current_positions_m(), hits);
+  EXPECT_FALSE(hits.empty());
+  return hits.empty() ? session.upper().z() : (above + hits.front().segment_parameter * (below - above)).z();
+}
+
+void run(Tissue& tissue, const Session& session, int from, int to) {
+  for (int n = from; n < to; ++n) {
+    tissue.set_tool(session.pose(n));
+    tissue.step();
+  }
+}
+
+bool bitwise_equal(const Eigen::VectorXd& a, const Eigen::VectorXd& b) {
+  return a.size() == b.size() && (a.array() == b.array()).all();
+}
+
+void expect_same_continuation(const Tissue& original, const Tissue& restored) {
+  EXPECT_EQ(original.body().cut_tets().size(), restored.body().cut_tets().size());
+  EXPECT_EQ(original.body().dof_count(), restored.body().dof_count());
+  EXPECT_TRUE(bitwise_equal(original.state().displacement_m, restored.state().displacement_m));
+  EXPECT_TRUE(bitwise_equal(original.state().velocity_m_per_s, restored.state().velocity_m_per_s));
+  EXPECT_EQ(original.time_s(), restored.time_s());
+  EXPECT_TRUE(bitwise_equal(original.current_positions_m(), restored.current_positions_m()));
+  EXPECT_EQ(original.contact().active, restored.contact().active);
+  EXPECT_TRUE(original.contact().force_on_tool_n == restored.contact().force_on_tool_n);
+  EXPECT_TRUE(original.contact().stiffness_n_per_m == restored.contact().stiffness_n_per_m);
+}
+
+constexpr int LAST_STEP = 80;
+
+class TissueState : public ::testing::TestWithParam<int> {};
+
+TEST_P(TissueState, SerializedIntoAFreshInstanceContinuesBitwise) {
+  const int saved_at = GetParam();
+  const TetMesh mesh = frog();
+  Session session(mesh);
+  Tissue original(mesh, frog_settings(mesh));
+  session.set_top(top_of_back(original, session));
+  run(original, session, 0, saved_at);
+  TissueSnapshot snapshot;
+  original.save(snapshot);
+  const std::vector<std::uint8_t> bytes = serialize_snapshot(snapshot);
+  run(original, session, saved_at, LAST_STEP);
+  ASSERT_GT(original.body().cut_tets().size(), 50u) << "the stroke should cut across the body";
+
+  Tissue fresh(mesh, frog_settings(mesh));
+  fresh.restore(deserialize_snapshot(bytes));
+  run(fresh, session, saved_at, LAST_STEP);
+  expect_same_continuation(original, fresh);
+}
+
+// Pressing (contact and its stiffness refresh), before the stroke, mid-stroke (a session open and
+// tets partly cut) and after it.
+INSTANTIATE_TEST_SUITE_P(SavedAtStep, TissueState, ::testing::Values(15, 21, 40, 70));
+
+TEST(TissueState, RestoredInPlaceRepeatsTheSameSteps) {
+  const TetMesh mesh = frog();
+  Session session(mesh);
+  Tissue tissue(mesh, frog_settings(mesh));
+  session.set_top(top_of_back(tissue, session));
+  run(tissue, session, 0, 64);
+  TissueSnapshot snapshot;
+  tissue.save(snapshot);
+  run(tissue, session, 64, LAST_STEP);
+  const DynamicState first = tissue.state();
+  ASSERT_TRUE(tissue.has_cuts_of(snapshot));
+  tissue.restore(snapshot);
+  EXPECT_TRUE(bitwise_equal(tissue.state().displacement_m, snapshot.dynamics.displacement_m));
+  run(tissue, session, 64, LAST_STEP);
+  EXPECT_TRUE(bitwise_equal(tissue.state().displacement_m, first.displacement_m));
+  EXPECT_TRUE(bitwise_equal(tissue.state().velocity_m_per_s, first.velocity_m_per_s));
+}
+
+TEST(TissueState, RefusesWhatItCannotRestoreAndKeepsItsState) {
+  const TetMesh mesh = frog();
+  Session session(mesh);
+  Tissue tissue(mesh, frog_settings(mesh));
+  session.set_top(top_of_back(tissue, session));
+  run(tissue, session, 0, 30);
+  TissueSnapshot before_cuts;
+  tissue.save(before_cuts);
+  run(tissue, session, 30, 64);
+  ASSERT_FALSE(tissue.has_cuts_of(before_cuts));
+  const DynamicState kept = tissue.state();
+  const auto expect_kept = [&] {
+    EXPECT_TRUE(bitwise_equal(tissue.state().displacement_m, kept.displacement_m));
+    EXPECT_EQ(tissue.time_s(), kept.time_s);
+  };
+  // Cuts cannot be undone in place: a fresh instance must take that state.
+  EXPECT_THROW(tissue.restore(before_cuts), StateError);
+  expect_kept();
+
+  // Another model: other material, other mesh.
+  TissueSettings stiffer = frog_settings(mesh);
+  stiffer.body.material.young_modulus_pa *= 2.0;
+  Tissue other(mesh, stiffer);
+  TissueSnapshot saved;
+  tissue.save(saved);
+  EXPECT_THROW(other.restore(saved), StateError);
+  EXPECT_EQ(other.time_s(), 0.0);
+
+  // Truncated, corrupt, trailing bytes.
+  std::vector<std::uint8_t> bytes = serialize_snapshot(saved);
+  for (const size_t keep : {size_t{0}, size_t{7}, size_t{12}, bytes.size() / 2, bytes.size() - 1}) {
+    EXPECT_THROW((void)deserialize_snapshot(std::span(bytes).first(keep)), StateError) << keep;
+  }
+  std::vector<std::uint8_t> corrupt = bytes;
+  corrupt[0] ^= 0xff;
+  EXPECT_THROW((void)deserialize_snapshot(corrupt), StateError);
+  std::vector<std::uint8_t> longer = bytes;
+  longer.push_back(0);
+  EXPECT_THROW((void)deserialize_snapshot(longer), StateError);
+  // A length field made huge must be refused, not allocated: the cut count follows magic,
+  // version and fingerprint (8 + 4 + 8 bytes).
+  std::vector<std::uint8_t> huge = bytes;
+  for (size_t k = 20; k < 28; ++k) huge[k] = 0xff;
+  EXPECT_THROW((void)deserialize_snapshot(huge), StateError);
+
+  // A state whose unknowns do not match its cuts.
+  TissueSnapshot inconsistent = saved;
+  inconsistent.dynamics.displacement_m.conservativeResize(inconsistent.dynamics.displacement_m.size() - 3);
+  EXPECT_THROW(tissue.restore(inconsistent), StateError);
+  expect_kept();
+  inconsistent = saved;
+  inconsistent.dynamics.velocity_m_per_s(0) = std::nan("");
+  EXPECT_THROW(tissue.restore(inconsistent), StateError);
+  expect_kept();
+  // The round trip of a good state restores it.
+  tissue.restore(deserialize_snapshot(bytes));
+  expect_kept();
+}
+
+}  // namespace
+}  // namespace tissue
