@@ -1,0 +1,350 @@
+// The Tissue FMU as an importer sees it (host/importer on build/<preset>/fmus/Tissue.fmu):
+// * with no parameter set, a working frog; a normal session answers fmi3OK throughout;
+// * a probe pressed into the back pushes the tool out along the surface normal; a scalpel stroke
+//   across the body cuts tets, adds unknowns and changes the surface revision;
+// * the same session split by get/set FMU state, or by serialize/deserialize into a fresh instance,
+//   continues bitwise identically; two instances side by side do not affect each other;
+// * bad use answers fmi3Error with a message and the instance stays usable.
+#include "importer/fmu3.hpp"
+#include "importer/fmu3_instance.hpp"
+#include "importer/fmu_error.hpp"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <limits>
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace tissue::host {
+namespace {
+
+constexpr double STEP_S = 0.01;  // communication step (10 internal steps of the default 1 ms)
+
+const Fmu3& tissue_fmu() {
+  static const Fmu3 fmu(TISSUE_FMU_PATH);
+  return fmu;
+}
+
+const Fmu3Functions& fmu_functions() { return tissue_fmu().functions(); }
+
+struct Outputs {
+  std::vector<double> positions, force, normal;
+  std::vector<std::uint64_t> counters;  // vertexCount, triangleCount, revision, cutTets, enrichedVertices, dofs
+  bool active = false;
+};
+
+class Session {
+ public:
+  explicit Session(std::string name = "frog", bool logging = true)
+      : m_instance(tissue_fmu(), std::move(name), logging) {}
+
+  Fmu3Instance& fmu() { return m_instance; }
+  double time() const { return m_time; }
+
+  void start(double blade_length_m = 0.1) {
+    ASSERT_EQ(m_instance.set_float64("tool.bladeLength", {blade_length_m}), fmi3OK) << m_instance.log_text();
+    ASSERT_EQ(m_instance.enter_initialization_mode(std::nullopt, 0.0, std::nullopt), fmi3OK) << m_instance.log_text();
+    ASSERT_EQ(m_instance.exit_initialization_mode(), fmi3OK) << m_instance.log_text();
+  }
+  void tool(const std::array<double, 3>& position, std::int64_t mode) {
+    ASSERT_EQ(m_instance.set_float64("tool.position", {position[0], position[1], position[2]}), fmi3OK);
+    ASSERT_EQ(m_instance.set_int64("tool.mode", {mode}), fmi3OK);
+  }
+  void step() {
+    const DoStepResult result = m_instance.do_step(m_time, STEP_S);
+    ASSERT_EQ(result.status, fmi3OK) << m_instance.log_text();
+    m_time += STEP_S;
+  }
+  void set_time(double t) { m_time = t; }
+  Outputs outputs() {
+    Outputs o;
+    EXPECT_EQ(m_instance.get_float64("surface.vertexPositions", o.positions), fmi3OK);
+    EXPECT_EQ(m_instance.get_float64("contact.force", o.force), fmi3OK);
+    EXPECT_EQ(m_instance.get_float64("contact.normal", o.normal), fmi3OK);
+    for (const char* name :
+         {"surface.vertexCount", "surface.triangleCount", "surface.revision", "cutTets", "enrichedVertices", "dofs"}) {
+      std::vector<std::uint64_t> value;
+      EXPECT_EQ(m_instance.get_uint64(name, value), fmi3OK);
+      o.counters.push_back(value.at(0));
+    }
+    std::vector<bool> active;
+    EXPECT_EQ(m_instance.get_boolean("contact.active", active), fmi3OK);
+    o.active = active.at(0);
+    return o;
+  }
+
+ private:
+  Fmu3Instance m_instance;
+  double m_time = 0.0;
+};
+
+// The frog's extent and the top of its back (from the surface output at rest).
+struct FrogGeometry {
+  std::array<double, 3> lower{}, upper{}, centre{};
+  std::array<double, 3> top{};  // the highest vertex
+};
+
+FrogGeometry geometry(const Outputs& rest) {
+  FrogGeometry g;
+  const std::size_t vertices = rest.counters.at(0);
+  for (int a = 0; a < 3; ++a) {
+    g.lower[a] = std::numeric_limits<double>::infinity();
+    g.upper[a] = -g.lower[a];
+  }
+  for (std::size_t v = 0; v < vertices; ++v) {
+    for (int a = 0; a < 3; ++a) {
+      g.lower[a] = std::min(g.lower[a], rest.positions[3 * v + a]);
+      g.upper[a] = std::max(g.upper[a], rest.positions[3 * v + a]);
+    }
+    if (rest.positions[3 * v + 2] >= g.top[2])
+      g.top = {rest.positions[3 * v], rest.positions[3 * v + 1], rest.positions[3 * v + 2]};
+  }
+  for (int a = 0; a < 3; ++a) g.centre[a] = 0.5 * (g.lower[a] + g.upper[a]);
+  return g;
+}
+
+// The scripted session, one tool input per communication step n: the probe descends onto the top of
+// the back and on 10 mm below where it was at rest (the frog sags under gravity meanwhile) (n < 30), the tool is put
+// away (30, 31), a vertical scalpel is drawn across the body at mid length (32..91), put away after.
+void drive(Session& s, const FrogGeometry& g, int n) {
+  if (n < 30) {
+    const double z = g.top[2] + 0.002 - 0.012 * std::min(1.0, n / 20.0);
+    s.tool({g.top[0], g.top[1], z}, 1);
+  } else if (n >= 32 && n < 92) {
+    const double f = (n - 32) / 59.0;
+    const double y = g.lower[1] - 0.01 + f * (g.upper[1] - g.lower[1] + 0.02);
+    s.tool({g.centre[0], y, g.lower[2] - 0.01}, 2);
+  } else {
+    s.tool({g.centre[0], g.upper[1] + 0.05, g.upper[2] + 0.05}, 0);
+  }
+}
+
+constexpr int LAST = 100;
+
+void run(Session& s, const FrogGeometry& g, int from, int to) {
+  for (int n = from; n < to; ++n) {
+    drive(s, g, n);
+    s.step();
+    if (::testing::Test::HasFatalFailure()) return;
+  }
+}
+
+FrogGeometry rest_geometry() {
+  Session probe;
+  probe.start();
+  return geometry(probe.outputs());
+}
+
+TEST(TissueFmu, WithNoParameterSetIsAWorkingFrog) {
+  Fmu3Instance fmu(tissue_fmu(), "defaults", true);
+  ASSERT_EQ(fmu.enter_initialization_mode(std::nullopt, 0.0, std::nullopt), fmi3OK) << fmu.log_text();
+  ASSERT_EQ(fmu.exit_initialization_mode(), fmi3OK) << fmu.log_text();
+  double t = 0.0;
+  for (int n = 0; n < 20; ++n, t += STEP_S) ASSERT_EQ(fmu.do_step(t, STEP_S).status, fmi3OK) << fmu.log_text();
+  std::vector<std::uint64_t> vertices, triangles, dofs;
+  ASSERT_EQ(fmu.get_uint64("surface.vertexCount", vertices), fmi3OK);
+  ASSERT_EQ(fmu.get_uint64("surface.triangleCount", triangles), fmi3OK);
+  ASSERT_EQ(fmu.get_uint64("dofs", dofs), fmi3OK);
+  EXPECT_EQ(vertices[0], 817u);  // the embedded frog
+  EXPECT_GT(triangles[0], 1000u);
+  EXPECT_GT(dofs[0], 1000u);
+  std::vector<double> time, kinetic;
+  ASSERT_EQ(fmu.get_float64("time", time), fmi3OK);
+  EXPECT_NEAR(time[0], 0.2, 1e-12);
+  ASSERT_EQ(fmu.get_float64("kineticEnergy", kinetic), fmi3OK);
+  EXPECT_TRUE(std::isfinite(kinetic[0]));
+  EXPECT_GT(kinetic[0], 0.0);  // it sags under gravity
+  EXPECT_EQ(fmu.terminate(), fmi3OK);
+  for (const LogRecord& record : fmu.log()) EXPECT_EQ(record.status, fmi3OK) << record.message;
+}
+
+TEST(TissueFmu, ProbePushesBackAndScalpelCuts) {
+  const FrogGeometry g = rest_geometry();
+  Session s;
+  s.start();
+  const Outputs rest = s.outputs();
+  run(s, g, 0, 30);
+  ASSERT_FALSE(HasFatalFailure());
+  const Outputs pressed = s.outputs();
+  std::vector<double> depth;
+  s.fmu().get_float64("contact.depth", depth);
+  ASSERT_TRUE(pressed.active) << "top " << g.top[0] << " " << g.top[1] << " " << g.top[2] << " lower z " << g.lower[2]
+                              << " vertex z now " << pressed.positions[2];
+  // The tissue pushes the tool back out: along the outward normal, mostly up.
+  const double along_normal = pressed.force[0] * pressed.normal[0] + pressed.force[1] * pressed.normal[1] +
+                              pressed.force[2] * pressed.normal[2];
+  EXPECT_GT(along_normal, 0.0);
+  EXPECT_GT(pressed.force[2], 0.0);
+  run(s, g, 30, LAST);
+  ASSERT_FALSE(HasFatalFailure());
+  const Outputs cut = s.outputs();
+  EXPECT_FALSE(cut.active);
+  EXPECT_GT(cut.counters[3], 50u);               // cut tets
+  EXPECT_GT(cut.counters[4], 0u);                // enriched vertices
+  EXPECT_GT(cut.counters[5], rest.counters[5]);  // more unknowns
+  EXPECT_GT(cut.counters[2], rest.counters[2]);  // the surface revision changed
+  EXPECT_GT(cut.counters[1], rest.counters[1]);  // the cut faces joined the surface
+  EXPECT_GT(cut.counters[0], rest.counters[0]);
+  for (const LogRecord& record : s.fmu().log()) EXPECT_EQ(record.status, fmi3OK) << record.message;
+}
+
+bool same(const Outputs& a, const Outputs& b) {
+  return a.positions == b.positions && a.force == b.force && a.counters == b.counters && a.active == b.active;
+}
+
+TEST(TissueFmu, SplitByGetAndSetStateContinuesBitwise) {
+  const FrogGeometry g = rest_geometry();
+  Session s;
+  s.start();
+  run(s, g, 0, 50);  // mid-stroke
+  fmi3FMUState state = nullptr;
+  ASSERT_EQ(s.fmu().get_fmu_state(state), fmi3OK) << s.fmu().log_text();
+  const double saved_time = s.time();
+  run(s, g, 50, LAST);
+  const Outputs first = s.outputs();
+  ASSERT_EQ(s.fmu().set_fmu_state(state), fmi3OK) << s.fmu().log_text();  // back across the cuts
+  s.set_time(saved_time);
+  run(s, g, 50, LAST);
+  EXPECT_TRUE(same(first, s.outputs()));
+  EXPECT_EQ(s.fmu().free_fmu_state(state), fmi3OK);
+  EXPECT_EQ(state, nullptr);
+}
+
+TEST(TissueFmu, SerializedIntoAFreshInstanceContinuesBitwise) {
+  const FrogGeometry g = rest_geometry();
+  Session s;
+  s.start();
+  run(s, g, 0, 40);
+  fmi3FMUState state = nullptr;
+  ASSERT_EQ(s.fmu().get_fmu_state(state), fmi3OK);
+  std::vector<std::uint8_t> bytes;
+  ASSERT_EQ(s.fmu().serialize_fmu_state(state, bytes), fmi3OK) << s.fmu().log_text();
+  ASSERT_EQ(s.fmu().free_fmu_state(state), fmi3OK);
+  const double saved_time = s.time();
+  run(s, g, 40, LAST);
+  const Outputs first = s.outputs();
+
+  Session fresh("fresh");
+  fresh.start();
+  fmi3FMUState restored = nullptr;
+  ASSERT_EQ(fresh.fmu().deserialize_fmu_state(bytes, restored), fmi3OK) << fresh.fmu().log_text();
+  ASSERT_EQ(fresh.fmu().set_fmu_state(restored), fmi3OK) << fresh.fmu().log_text();
+  ASSERT_EQ(fresh.fmu().free_fmu_state(restored), fmi3OK);
+  fresh.set_time(saved_time);
+  run(fresh, g, 40, LAST);
+  EXPECT_TRUE(same(first, fresh.outputs()));
+}
+
+TEST(TissueFmu, TwoInstancesSideBySideDoNotAffectEachOther) {
+  const FrogGeometry g = rest_geometry();
+  Session alone("alone");
+  alone.start();
+  run(alone, g, 0, LAST);
+  const Outputs expected = alone.outputs();
+
+  Session a("a"), b("b");
+  a.start();
+  b.start();
+  for (int n = 0; n < LAST; ++n) {  // b pokes and cuts while a only hangs; interleaved
+    drive(a, g, n);
+    a.step();
+    b.tool({g.centre[0], g.centre[1], g.upper[2] + 0.1}, 0);
+    b.step();
+    ASSERT_FALSE(HasFatalFailure());
+  }
+  EXPECT_TRUE(same(expected, a.outputs()));
+  EXPECT_EQ(b.outputs().counters[3], 0u);
+}
+
+// --- bad use ---
+
+class BadUse : public ::testing::Test {
+ protected:
+  void expect_error(fmi3Status status, const std::string& what) {
+    EXPECT_EQ(status, fmi3Error) << what;
+    const std::vector<LogRecord> log = m_fmu.log();
+    ASSERT_FALSE(log.empty()) << what << ": no message";
+    EXPECT_EQ(log.back().status, fmi3Error) << what;
+    EXPECT_FALSE(log.back().message.empty());
+    m_fmu.clear_log();
+  }
+  Fmu3Instance m_fmu{tissue_fmu(), "bad", true};
+};
+
+TEST_F(BadUse, CallsInTheWrongStateAreRefused) {
+  expect_error(m_fmu.do_step(0.0, STEP_S).status, "doStep before initialization");
+  std::vector<double> values;
+  expect_error(m_fmu.get_float64("contact.force", values), "get before initialization");
+  expect_error(m_fmu.exit_initialization_mode(), "exit before enter");
+  ASSERT_EQ(m_fmu.enter_initialization_mode(std::nullopt, 0.0, std::nullopt), fmi3OK);
+  expect_error(m_fmu.set_uint64("surface.vertexCapacity", {100}), "structural parameter in initialization mode");
+  ASSERT_EQ(m_fmu.exit_initialization_mode(), fmi3OK);
+  expect_error(m_fmu.set_float64("material.youngModulus", {2e5}), "fixed parameter in step mode");
+  expect_error(m_fmu.do_step(1.0, STEP_S).status, "doStep at another time");
+  expect_error(m_fmu.do_step(0.0, 0.0105).status, "a step not a multiple of the internal step");
+  expect_error(fmu_functions().fmi3EnterEventMode(m_fmu.handle()), "event mode");
+  ASSERT_EQ(m_fmu.do_step(0.0, STEP_S).status, fmi3OK) << m_fmu.log_text();  // still usable
+  ASSERT_EQ(m_fmu.terminate(), fmi3OK);
+  expect_error(m_fmu.do_step(STEP_S, STEP_S).status, "doStep after terminate");
+  ASSERT_EQ(m_fmu.reset(), fmi3OK);
+  ASSERT_EQ(m_fmu.enter_initialization_mode(std::nullopt, 0.0, std::nullopt), fmi3OK);
+}
+
+TEST_F(BadUse, UnknownReferencesWrongSizesAndBadValuesAreRefused) {
+  const auto& f = fmu_functions();
+  const fmi3ValueReference unknown = 9999, gravity = 7, mode = 32;
+  double value = 1.0;
+  expect_error(f.fmi3SetFloat64(m_fmu.handle(), &unknown, 1, &value, 1), "unknown value reference");
+  expect_error(f.fmi3SetFloat64(m_fmu.handle(), &gravity, 1, &value, 1), "gravity with one value");
+  expect_error(f.fmi3SetInt32(m_fmu.handle(), &mode, 1, nullptr, 0), "an enumeration set as Int32");
+  expect_error(m_fmu.set_float64("material.poissonRatio", {0.5}), "nu = 0.5");
+  expect_error(m_fmu.set_float64("material.youngModulus", {0.0}), "E = 0");
+  expect_error(m_fmu.set_float64("material.youngModulus", {-1.0}), "E < 0");
+  expect_error(m_fmu.set_float64("tool.position", {0.0, std::nan(""), 0.0}), "NaN tool position");
+  expect_error(m_fmu.set_float64("tool.orientation", {std::numeric_limits<double>::infinity(), 0, 0, 0}),
+               "Inf orientation");
+  expect_error(m_fmu.set_float64("tool.orientation", {0, 0, 0, 0}), "zero quaternion");
+  expect_error(m_fmu.set_int64("tool.mode", {3}), "unknown tool mode");
+  expect_error(m_fmu.set_uint64("surface.triangleCapacity", {0}), "capacity 0");
+  // Nothing of it stuck: the defaults run.
+  ASSERT_EQ(m_fmu.enter_initialization_mode(std::nullopt, 0.0, std::nullopt), fmi3OK);
+  std::vector<double> nu, position;
+  ASSERT_EQ(m_fmu.get_float64("material.poissonRatio", nu), fmi3OK);
+  EXPECT_EQ(nu[0], 0.4);
+  ASSERT_EQ(m_fmu.get_float64("tool.position", position), fmi3OK);
+  EXPECT_EQ(position, (std::vector<double>{0.0, 0.0, 0.0}));
+  ASSERT_EQ(m_fmu.exit_initialization_mode(), fmi3OK) << m_fmu.log_text();
+  std::vector<double> too_small(3);
+  const fmi3ValueReference positions = 53;
+  expect_error(f.fmi3GetFloat64(m_fmu.handle(), &positions, 1, too_small.data(), too_small.size()),
+               "vertex positions into 3 values");
+  expect_error(m_fmu.set_float64("tool.position", {0.0, 0.0, std::numeric_limits<double>::infinity()}),
+               "Inf tool position in step mode");
+  ASSERT_EQ(m_fmu.do_step(0.0, STEP_S).status, fmi3OK) << m_fmu.log_text();
+}
+
+TEST_F(BadUse, AMissingOrMalformedMeshIsRefused) {
+  ASSERT_EQ(m_fmu.set_string("mesh", {"no_such_mesh.veg"}), fmi3OK);
+  ASSERT_EQ(m_fmu.enter_initialization_mode(std::nullopt, 0.0, std::nullopt), fmi3OK);
+  expect_error(m_fmu.exit_initialization_mode(), "a missing mesh resource");
+  const std::filesystem::path bad = std::filesystem::temp_directory_path() / "tissue_fmu_bad_mesh.veg";
+  std::ofstream(bad) << "*VERTICES\n2 3 0 0\n1 0 0 0\n2 nan 0 0\n*ELEMENTS\nTET\n1 4 0\n1 1 2 1 2\n";
+  ASSERT_EQ(m_fmu.set_string("mesh", {bad.string()}), fmi3OK);
+  expect_error(m_fmu.exit_initialization_mode(), "a malformed mesh");
+  std::filesystem::remove(bad);
+  ASSERT_EQ(m_fmu.set_string("mesh", {"frog"}), fmi3OK);
+  ASSERT_EQ(m_fmu.exit_initialization_mode(), fmi3OK) << m_fmu.log_text();
+}
+
+TEST(TissueFmu, RefusesAWrongInstantiationToken) {
+  EXPECT_THROW(Fmu3Instance(tissue_fmu(), "wrong", "{00000000-0000-0000-0000-000000000000}", true), FmuError);
+}
+
+}  // namespace
+}  // namespace tissue::host
