@@ -163,16 +163,27 @@ Tissue::Tissue(TetMesh mesh, TissueSettings settings)
       m_integrator(std::make_unique<BackwardEuler>(make_linear_solver(m_settings.solver),
                                                    BackwardEuler::Settings{m_settings.solver.warm_start})),
       m_surface(extract_surface(m_body.mesh())),
-      m_adjacency(build_adjacency(m_body.mesh())),
+      // Only what the scene requires (DESIGN section 1): the edge adjacency and the cutter only with
+      // cutting, the surface BVH only with contact or cutting.
+      m_adjacency(m_settings.interaction.cutting_enabled ? build_adjacency(m_body.mesh()) : TetAdjacency{}),
       m_vertex_positions_m(rest_positions(m_body)),
       m_positions_m(m_vertex_positions_m),
       m_cut_surface(m_body.mesh().vertex_count()),
-      m_bvh(m_surface.triangles, m_positions_m),
-      m_cutter(m_body.mesh(), m_adjacency, m_surface, m_settings.interaction.cutter),
+      m_bvh(m_settings.interaction.cutting_enabled || m_settings.interaction.contact_enabled ? m_surface.triangles
+                                                                                            : std::vector<std::array<int, 3>>{},
+            m_positions_m),
       m_contact(contact_settings(m_settings.interaction, m_body, m_surface)),
       m_model_fingerprint(model_fingerprint_of(m_body.mesh(), m_settings)) {
   m_state.displacement_m.setZero(m_body.dof_count());
   m_state.velocity_m_per_s.setZero(m_body.dof_count());
+  if (m_settings.interaction.cutting_enabled) {
+    m_cutter.emplace(m_body.mesh(), m_adjacency, m_surface, m_settings.interaction.cutter);
+  }
+}
+
+const VolumeCutter& Tissue::cutter() const {
+  if (!m_cutter) throw std::logic_error("Tissue::cutter: cutting is off in this scene (no cutter was built)");
+  return *m_cutter;
 }
 
 void Tissue::set_tool(const ToolPose& pose) {
@@ -191,11 +202,11 @@ Blade Tissue::blade(const ToolPose& pose) const {
 
 void Tissue::interact_with_scalpel(const ToolPose& previous, TissueStepReport& report) {
   const auto cut_start = std::chrono::steady_clock::now();
-  report.cut = m_cutter.step(blade(previous), blade(m_tool), m_positions_m, m_bvh);
+  report.cut = m_cutter->step(blade(previous), blade(m_tool), m_positions_m, m_bvh);
   report.cut_s = seconds_since(cut_start);
-  if (m_cutter.new_cuts().empty()) return;
+  if (m_cutter->new_cuts().empty()) return;
   const auto enrich_start = std::chrono::steady_clock::now();
-  report.enrichment = apply_cuts(m_cutter.new_cuts());
+  report.enrichment = apply_cuts(m_cutter->new_cuts());
   report.enrich_s = seconds_since(enrich_start);
 }
 
@@ -220,7 +231,7 @@ void Tissue::save(TissueSnapshot& snapshot) const {
   snapshot.dynamics = m_state;
   m_body.save_rotations(snapshot.rotations);
   snapshot.integrator_state = m_integrator->internal_state();
-  m_cutter.save(snapshot.cutter);
+  if (m_cutter) m_cutter->save(snapshot.cutter);
   snapshot.contact = m_contact.state();
   snapshot.point_spring = m_body.point_spring();
   snapshot.tool = m_tool;
@@ -285,7 +296,7 @@ void Tissue::restore(const TissueSnapshot& snapshot) {
   const std::optional<PointSpring> old_spring = m_body.point_spring();
   try {
     m_body.set_point_spring(snapshot.point_spring);
-    m_cutter.restore(snapshot.cutter);
+    if (m_cutter) m_cutter->restore(snapshot.cutter);
   } catch (const std::invalid_argument& error) {
     m_body.set_point_spring(old_spring);
     throw StateError(std::string("the state is inconsistent: ") + error.what());
@@ -373,8 +384,8 @@ TissueStepReport Tissue::step() {
   const bool scalpel = m_tool.mode == ToolMode::scalpel && interaction.cutting_enabled;
   if (scalpel && previous.mode == ToolMode::scalpel) {
     interact_with_scalpel(previous, report);
-  } else if (m_cutter.cutting()) {
-    m_cutter.end_cut();
+  } else if (m_cutter && m_cutter->cutting()) {
+    m_cutter->end_cut();
   }
 
   const auto contact_start = std::chrono::steady_clock::now();

@@ -158,8 +158,11 @@ class Tissue {
   [[nodiscard]] const CutSurface& cut_surface() const { return m_cut_surface; }
 
   [[nodiscard]] const SurfaceMesh& surface() const { return m_surface; }
+  /// Over the surface and the cut faces; empty (no tree) when neither contact nor cutting is on.
   [[nodiscard]] const SurfaceBvh& surface_bvh() const { return m_bvh; }
-  [[nodiscard]] const VolumeCutter& cutter() const { return m_cutter; }
+  /// Throws std::logic_error when cutting is off (no cutter is built then).
+  [[nodiscard]] const VolumeCutter& cutter() const;
+  [[nodiscard]] bool has_cutter() const { return m_cutter.has_value(); }
   [[nodiscard]] const PointContact& point_contact() const { return m_contact; }
   [[nodiscard]] const ContactOutput& contact() const { return m_contact_output; }
   /// A hash of the mesh and every setting: a snapshot restores only into a Tissue of the same value.
@@ -197,7 +200,7 @@ class Tissue {
   Eigen::VectorXd m_positions_m;
   CutSurface m_cut_surface;
   SurfaceBvh m_bvh;
-  VolumeCutter m_cutter;
+  std::optional<VolumeCutter> m_cutter;  // only with cutting enabled
   PointContact m_contact;
   EffectiveContactStiffness m_effective_stiffness;
   Eigen::VectorXd m_contact_system_diagonal;

@@ -682,17 +682,33 @@ bool TissueInstance::do_step(double current_time_s, double step_s, double& last_
                         " s is not a whole multiple of stepSize " + std::to_string(h) + " s");
   }
   tissue.set_tool(tool_pose());
+  const std::size_t cuts_before = tissue.body().cut_tets().size();
+  const bool contact_before = tissue.contact().active;
+  const auto log_events = [&] {
+    if (!m_logger) return;
+    const std::size_t cuts = tissue.body().cut_tets().size();
+    if (cuts != cuts_before) {
+      m_logger(0, "logEvents", "t = " + std::to_string(m_start_time_s + tissue.time_s()) + " s: " +
+                                   std::to_string(cuts - cuts_before) + " tets cut (" + std::to_string(cuts) + " in all)");
+    }
+    if (tissue.contact().active != contact_before) {
+      m_logger(0, "logEvents", std::string("contact ") + (tissue.contact().active ? "started" : "ended") + " at t = " +
+                                   std::to_string(m_start_time_s + tissue.time_s()) + " s");
+    }
+  };
   for (long n = 0; n < static_cast<long>(count); ++n) {
     try {
       tissue.step();
     } catch (const IntegrationError& error) {
       update_surface_counters();
+      log_events();
       last_successful_time_s = m_start_time_s + tissue.time_s();
       warn(std::string("doStep: an internal step failed: ") + error.what());
       return false;
     }
   }
   update_surface_counters();
+  log_events();
   last_successful_time_s = m_start_time_s + tissue.time_s();
   return true;
 }

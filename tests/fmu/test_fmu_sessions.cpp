@@ -191,7 +191,34 @@ TEST(TissueFmu, ProbePushesBackAndScalpelCuts) {
   EXPECT_GT(cut.counters[2], rest.counters[2]);  // the surface revision changed
   EXPECT_GT(cut.counters[1], rest.counters[1]);  // the cut faces joined the surface
   EXPECT_GT(cut.counters[0], rest.counters[0]);
-  for (const LogRecord& record : s.fmu().log()) EXPECT_EQ(record.status, fmi3OK) << record.message;
+  bool cut_logged = false, contact_logged = false;
+  for (const LogRecord& record : s.fmu().log()) {
+    EXPECT_EQ(record.status, fmi3OK) << record.message;
+    if (record.category == "logEvents") {
+      cut_logged |= record.message.find("tets cut") != std::string::npos;
+      contact_logged |= record.message.find("contact started") != std::string::npos;
+    }
+  }
+  EXPECT_TRUE(cut_logged);
+  EXPECT_TRUE(contact_logged);
+}
+
+TEST(TissueFmu, SceneSwitchesTurnOffWhatTheyName) {
+  const FrogGeometry g = rest_geometry();
+  Session s("switched");
+  ASSERT_EQ(s.fmu().set_boolean("scene.cutting", {false}), fmi3OK);
+  ASSERT_EQ(s.fmu().set_boolean("scene.meshOutput", {false}), fmi3OK);
+  s.start();
+  run(s, g, 0, 30);
+  ASSERT_FALSE(HasFatalFailure());
+  EXPECT_TRUE(s.outputs().active);  // contact stays on
+  run(s, g, 30, LAST);
+  ASSERT_FALSE(HasFatalFailure());
+  const Outputs o = s.outputs();
+  EXPECT_EQ(o.counters[3], 0u);  // the scalpel cut nothing
+  EXPECT_EQ(o.counters[0], 0u);  // no surface output
+  EXPECT_EQ(o.counters[1], 0u);
+  EXPECT_TRUE(std::all_of(o.positions.begin(), o.positions.end(), [](double x) { return x == 0.0; }));
 }
 
 bool same(const Outputs& a, const Outputs& b) {

@@ -8,6 +8,7 @@
 #include <Eigen/Eigenvalues>
 
 #include <limits>
+#include <memory>
 
 namespace tissue {
 namespace {
@@ -106,6 +107,45 @@ TEST(Tissue, ProbeTouchesPushesBackAndLetsGo) {
   tissue.step();
   EXPECT_FALSE(tissue.contact().active);
   EXPECT_EQ(tissue.body().point_spring(), std::nullopt);
+}
+
+TEST(Tissue, BuildsOnlyWhatTheSceneRequires) {
+  const TetMesh mesh = make_box_mesh(10, 2, 2, 0.01);
+  const auto run_scene = [&](bool contact, bool cutting) {
+    TissueSettings settings;
+    settings.body.fixed_vertices = vertices_at_minimum(mesh, 0, 0.0);
+    settings.interaction.contact_enabled = contact;
+    settings.interaction.cutting_enabled = cutting;
+    settings.interaction.blade_length_m = 0.06;
+    auto tissue = std::make_unique<Tissue>(mesh, settings);
+    EXPECT_EQ(tissue->has_cutter(), cutting);
+    EXPECT_EQ(tissue->surface_bvh().triangle_count() > 0, contact || cutting);
+    // A scalpel stroke across the beam, then a probe pressed onto its top.
+    for (int n = 0; n <= 30; ++n) {
+      const double y = -0.005 + 0.03 * n / 30.0;
+      tissue->set_tool({Eigen::Vector3d(0.0553, y, -0.02), Eigen::Quaterniond::Identity(), ToolMode::scalpel});
+      tissue->step();
+    }
+    tissue->set_tool({Eigen::Vector3d(0.0853, 0.0107, 0.025), Eigen::Quaterniond::Identity(), ToolMode::probe});
+    tissue->step();
+    tissue->set_tool({Eigen::Vector3d(0.0853, 0.0107, 0.019), Eigen::Quaterniond::Identity(), ToolMode::probe});
+    tissue->step();
+    return tissue;
+  };
+  const auto everything = run_scene(true, true);
+  EXPECT_EQ(everything->body().cut_tets().size(), 20u);
+  EXPECT_TRUE(everything->contact().active);
+  const auto no_cutting = run_scene(true, false);
+  EXPECT_TRUE(no_cutting->body().cut_tets().empty());
+  EXPECT_THROW((void)no_cutting->cutter(), std::logic_error);
+  EXPECT_TRUE(no_cutting->contact().active);
+  const auto no_contact = run_scene(false, true);
+  EXPECT_EQ(no_contact->body().cut_tets().size(), 20u);
+  EXPECT_FALSE(no_contact->contact().active);
+  const auto neither = run_scene(false, false);
+  EXPECT_TRUE(neither->body().cut_tets().empty());
+  EXPECT_FALSE(neither->contact().active);
+  EXPECT_TRUE(neither->state().displacement_m.allFinite());
 }
 
 TEST(Tissue, FixedVerticesStayWhileTheFarEndStartsInFreeFall) {
