@@ -28,8 +28,10 @@ struct Instance {
   std::unique_ptr<TissueInstance> model;
   std::string name;
 
+  // Warnings and errors always reach the importer (as Reference-FMUs does); calls and events only
+  // with logging on and their category enabled.
   void message(fmi3Status status, const char* category, const std::string& text) const {
-    if (log == nullptr || !logging_on) return;
+    if (log == nullptr || (status == fmi3OK && !logging_on)) return;
     const std::string category_name(category);
     if (category_name == "logCalls" && !log_calls) return;
     if (category_name == "logEvents" && !log_events) return;

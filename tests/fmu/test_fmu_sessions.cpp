@@ -369,6 +369,19 @@ TEST_F(BadUse, AMissingOrMalformedMeshIsRefused) {
   ASSERT_EQ(m_fmu.exit_initialization_mode(), fmi3OK) << m_fmu.log_text();
 }
 
+TEST(TissueFmu, ErrorsReachTheImporterEvenWithLoggingOff) {
+  Fmu3Instance quiet(tissue_fmu(), "quiet", false);
+  EXPECT_EQ(quiet.set_float64("material.poissonRatio", {0.5}), fmi3Error);
+  ASSERT_EQ(quiet.log().size(), 1u);
+  EXPECT_EQ(quiet.log()[0].status, fmi3Error);
+  EXPECT_NE(quiet.log()[0].message.find("poissonRatio"), std::string::npos);
+  quiet.clear_log();
+  ASSERT_EQ(quiet.enter_initialization_mode(std::nullopt, 0.0, std::nullopt), fmi3OK);
+  ASSERT_EQ(quiet.exit_initialization_mode(), fmi3OK);
+  ASSERT_EQ(quiet.do_step(0.0, STEP_S).status, fmi3OK);
+  EXPECT_TRUE(quiet.log().empty()) << quiet.log_text();  // nothing but errors and warnings
+}
+
 TEST(TissueFmu, RefusesAWrongInstantiationToken) {
   EXPECT_THROW(Fmu3Instance(tissue_fmu(), "wrong", "{00000000-0000-0000-0000-000000000000}", true), FmuError);
 }
