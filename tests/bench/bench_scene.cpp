@@ -5,29 +5,11 @@
 #include "core/fixed_region.hpp"
 #include "core/tissue.hpp"
 #include "resources/default_mesh.hpp"
+#include "support/counting_new.hpp"
 
 #include <benchmark/benchmark.h>
 
-#include <atomic>
-#include <cstdlib>
 #include <memory>
-#include <new>
-
-namespace {
-std::atomic<std::size_t> g_allocated_bytes{0};
-}  // namespace
-
-// GCC sees free() on memory from operator new and warns; here both sides are ours (malloc/free).
-#pragma GCC diagnostic push
-#pragma GCC diagnostic ignored "-Wmismatched-new-delete"
-void* operator new(std::size_t size) {
-  g_allocated_bytes += size;
-  if (void* p = std::malloc(size == 0 ? 1 : size)) return p;
-  throw std::bad_alloc();
-}
-void operator delete(void* p) noexcept { std::free(p); }
-void operator delete(void* p, std::size_t) noexcept { std::free(p); }
-#pragma GCC diagnostic pop
 
 namespace tissue {
 namespace {
