@@ -169,8 +169,9 @@ Tissue::Tissue(TetMesh mesh, TissueSettings settings)
       m_vertex_positions_m(rest_positions(m_body)),
       m_positions_m(m_vertex_positions_m),
       m_cut_surface(m_body.mesh().vertex_count()),
-      m_bvh(m_settings.interaction.cutting_enabled || m_settings.interaction.contact_enabled ? m_surface.triangles
-                                                                                            : std::vector<std::array<int, 3>>{},
+      m_bvh(m_settings.interaction.cutting_enabled || m_settings.interaction.contact_enabled
+                ? m_surface.triangles
+                : std::vector<std::array<int, 3>>{},
             m_positions_m),
       m_contact(contact_settings(m_settings.interaction, m_body, m_surface)),
       m_model_fingerprint(model_fingerprint_of(m_body.mesh(), m_settings)) {
@@ -257,10 +258,10 @@ void Tissue::restore(const TissueSnapshot& snapshot) {
   if (static_cast<size_t>(previous_end) != snapshot.cuts.size()) {
     throw StateError("the state's cut batches do not add up to its cuts");
   }
+  if (!can_restore(snapshot)) {
+    throw StateError("the state has other cuts than this instance; restore it into a fresh instance");
+  }
   if (!has_cuts_of(snapshot)) {
-    if (!m_cut_batch_ends.empty()) {
-      throw StateError("the state has other cuts than this instance; restore it into a fresh instance");
-    }
     try {
       int begin = 0;
       for (const int end : snapshot.cut_batch_ends) {

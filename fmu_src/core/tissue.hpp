@@ -170,10 +170,15 @@ class Tissue {
   void save(TissueSnapshot& snapshot) const;
   /// True when the snapshot's cuts are exactly the cuts made here, so restore() works in place.
   [[nodiscard]] bool has_cuts_of(const TissueSnapshot& snapshot) const;
+  /// True when restore() can take the snapshot here: it has the same cuts, or nothing was cut here
+  /// yet (the snapshot's cuts are replayed). Cuts cannot be undone: otherwise use a fresh Tissue.
+  [[nodiscard]] bool can_restore(const TissueSnapshot& snapshot) const {
+    return m_cut_batch_ends.empty() || has_cuts_of(snapshot);
+  }
   /// Restores a snapshot of this model: in place when has_cuts_of(snapshot), by replaying the cuts
-  /// when nothing was cut here yet (a fresh instance). Throws StateError otherwise, or when the
-  /// snapshot is of another model or inconsistent; the instance is then unchanged, except when the
-  /// replay of cuts into a fresh instance fails (discard it).
+  /// when nothing was cut here yet (a fresh instance). Throws StateError unless can_restore(), or
+  /// when the snapshot is of another model or inconsistent; the instance is then unchanged, except
+  /// when the replay of cuts into a fresh instance fails (discard it).
   void restore(const TissueSnapshot& snapshot);
 
   /// The spring stiffness the contact uses (resolved from the settings) [N/m].

@@ -441,8 +441,7 @@ void TissueInstance::get_uint64(std::span<const std::uint32_t> vrs, std::span<st
     ensure_built();
     const Tissue& tissue = *m_tissue;
     const auto vertices = static_cast<std::uint64_t>(tissue.current_positions_m().size() / 3);
-    const auto triangles =
-        static_cast<std::uint64_t>(tissue.surface().triangles.size() + tissue.cut_surface().triangles().size());
+    const auto triangles = static_cast<std::uint64_t>(surface_triangle_count());
     const bool out = m_parameters.mesh_output_enabled;
     switch (info.vr) {
       case Vr::vertex_count:
@@ -609,7 +608,7 @@ void TissueInstance::build() {
   m_tissue->set_tool(tool_pose());
   m_dirty = false;
   m_surface_revision = 0;
-  m_surface_triangles = m_tissue->surface().triangles.size();
+  m_surface_triangles = surface_triangle_count();
   m_capacity_warned = false;
 }
 
@@ -630,8 +629,12 @@ ToolPose TissueInstance::tool_pose() const {
   return pose;
 }
 
+std::size_t TissueInstance::surface_triangle_count() const {
+  return m_tissue->surface().triangles.size() + m_tissue->cut_surface().triangles().size();
+}
+
 void TissueInstance::update_surface_counters() {
-  const std::size_t triangles = m_tissue->surface().triangles.size() + m_tissue->cut_surface().triangles().size();
+  const std::size_t triangles = surface_triangle_count();
   if (triangles != m_surface_triangles) {
     ++m_surface_revision;
     m_surface_triangles = triangles;
@@ -688,12 +691,14 @@ bool TissueInstance::do_step(double current_time_s, double step_s, double& last_
     if (!m_logger) return;
     const std::size_t cuts = tissue.body().cut_tets().size();
     if (cuts != cuts_before) {
-      m_logger(0, "logEvents", "t = " + std::to_string(m_start_time_s + tissue.time_s()) + " s: " +
-                                   std::to_string(cuts - cuts_before) + " tets cut (" + std::to_string(cuts) + " in all)");
+      m_logger(0, "logEvents",
+               "t = " + std::to_string(m_start_time_s + tissue.time_s()) + " s: " + std::to_string(cuts - cuts_before) +
+                   " tets cut (" + std::to_string(cuts) + " in all)");
     }
     if (tissue.contact().active != contact_before) {
-      m_logger(0, "logEvents", std::string("contact ") + (tissue.contact().active ? "started" : "ended") + " at t = " +
-                                   std::to_string(m_start_time_s + tissue.time_s()) + " s");
+      m_logger(0, "logEvents",
+               std::string("contact ") + (tissue.contact().active ? "started" : "ended") +
+                   " at t = " + std::to_string(m_start_time_s + tissue.time_s()) + " s");
     }
   };
   for (long n = 0; n < static_cast<long>(count); ++n) {
@@ -740,7 +745,6 @@ std::unique_ptr<InstanceSnapshot> TissueInstance::save() const {
   m_tissue->save(snapshot->tissue);
   snapshot->inputs = m_inputs;
   snapshot->surface_revision = m_surface_revision;
-  snapshot->surface_triangles = m_surface_triangles;
   return snapshot;
 }
 
@@ -750,7 +754,7 @@ void TissueInstance::restore(const InstanceSnapshot& snapshot) {
   }
   ensure_built();
   try {
-    if (m_tissue->has_cuts_of(snapshot.tissue) || m_tissue->body().cut_tets().empty()) {
+    if (m_tissue->can_restore(snapshot.tissue)) {
       m_tissue->restore(snapshot.tissue);
     } else {
       // Cuts cannot be undone in place: a fresh Tissue replays the snapshot's.
@@ -763,7 +767,7 @@ void TissueInstance::restore(const InstanceSnapshot& snapshot) {
   }
   m_inputs = snapshot.inputs;
   m_surface_revision = snapshot.surface_revision;
-  m_surface_triangles = snapshot.surface_triangles;
+  m_surface_triangles = surface_triangle_count();
 }
 
 std::vector<std::uint8_t> TissueInstance::serialize(const InstanceSnapshot& snapshot) const {
@@ -776,12 +780,11 @@ std::vector<std::uint8_t> TissueInstance::serialize(const InstanceSnapshot& snap
   for (int k = 0; k < 4; ++k) put(snapshot.inputs.orientation_wxyz(k));
   put(snapshot.inputs.mode);
   put(snapshot.surface_revision);
-  put(snapshot.surface_triangles);
   return bytes;
 }
 
 std::unique_ptr<InstanceSnapshot> TissueInstance::deserialize(std::span<const std::uint8_t> bytes) const {
-  constexpr std::size_t TAIL = 7 * sizeof(double) + 3 * sizeof(std::uint64_t);
+  constexpr std::size_t TAIL = 7 * sizeof(double) + sizeof(std::int64_t) + sizeof(std::uint64_t);
   if (bytes.size() < TAIL) throw InstanceError("deserialize FMU state: too few bytes");
   auto snapshot = std::make_unique<InstanceSnapshot>();
   try {
@@ -798,7 +801,6 @@ std::unique_ptr<InstanceSnapshot> TissueInstance::deserialize(std::span<const st
   for (int k = 0; k < 4; ++k) get(snapshot->inputs.orientation_wxyz(k));
   get(snapshot->inputs.mode);
   get(snapshot->surface_revision);
-  get(snapshot->surface_triangles);
   if (snapshot->inputs.mode < 0 || snapshot->inputs.mode > 2 || !snapshot->inputs.position_m.allFinite() ||
       !snapshot->inputs.orientation_wxyz.allFinite()) {
     throw InstanceError("deserialize FMU state: bad tool inputs");

@@ -66,7 +66,6 @@ struct InstanceSnapshot {
   TissueSnapshot tissue;
   ToolInputs inputs;
   std::uint64_t surface_revision = 0;
-  std::uint64_t surface_triangles = 0;
 };
 
 class TissueInstance {
@@ -121,6 +120,8 @@ class TissueInstance {
   [[nodiscard]] TissueSettings settings(const TetMesh& mesh) const;
   [[nodiscard]] ToolPose tool_pose() const;
   void update_surface_counters();
+  /// Triangles of the surface output: the mesh's surface and the cut faces.
+  [[nodiscard]] std::size_t surface_triangle_count() const;
   void warn(const std::string& message) const;
 
   std::string m_name;
@@ -134,7 +135,7 @@ class TissueInstance {
   TetMesh m_mesh;       // as loaded: a fresh Tissue for a restored state with other cuts
   std::unique_ptr<Tissue> m_tissue;
   std::uint64_t m_surface_revision = 0;
-  std::uint64_t m_surface_triangles = 0;
+  std::uint64_t m_surface_triangles = 0;  // at the last revision check
   mutable bool m_capacity_warned = false;
   mutable std::vector<std::string> m_string_buffer;
 };

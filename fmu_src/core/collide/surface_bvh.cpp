@@ -176,18 +176,7 @@ void SurfaceBvh::refit(const Eigen::VectorXd& positions_m) {
 }
 
 int SurfaceBvh::add_triangle(const std::array<int, 3>& triangle, const Eigen::VectorXd& positions_m) {
-  if (!m_tree) m_tree = std::make_unique<Tree>();
-  const int id = triangle_count();
-  check_triangle(triangle, id, positions_m);
-  m_triangles.push_back(triangle);
-  btDbvtNode* leaf = m_tree->dbvt.insert(triangle_box(triangle, positions_m, box_margin(positions_m)), nullptr);
-  leaf->dataAsInt = id;
-  m_tree->leaves.push_back(leaf);
-  m_tree->required_position_count = std::max(m_tree->required_position_count, required_position_count(triangle));
-  compute_refit_order(m_tree->dbvt, m_tree->refit_order);
-  // The other boxes were fitted to the positions of the last refit; fit the whole tree to these.
-  refit(positions_m);
-  return id;
+  return add_triangles(std::span(&triangle, 1), positions_m);
 }
 
 int SurfaceBvh::add_triangles(std::span<const std::array<int, 3>> triangles, const Eigen::VectorXd& positions_m) {
@@ -205,6 +194,7 @@ int SurfaceBvh::add_triangles(std::span<const std::array<int, 3>> triangles, con
     m_tree->required_position_count = std::max(m_tree->required_position_count, required_position_count(triangle));
   }
   compute_refit_order(m_tree->dbvt, m_tree->refit_order);
+  // The other boxes were fitted to the positions of the last refit; fit the whole tree to these.
   refit(positions_m);
   return first;
 }
