@@ -20,9 +20,17 @@ std::vector<int> vertices_in_box(const TetMesh& mesh, const Eigen::Vector3d& min
   return vertices;
 }
 
+void validate(const MinimumSlab& slab) {
+  if (slab.axis < 0 || slab.axis > 2) {
+    throw ParameterError("fixed region: axis must be 0, 1 or 2, got " + std::to_string(slab.axis));
+  }
+  if (!(slab.fraction >= 0.0 && slab.fraction <= 1.0)) {
+    throw ParameterError("fixed region: fraction must be in [0, 1], got " + std::to_string(slab.fraction));
+  }
+}
+
 std::vector<int> vertices_at_minimum(const TetMesh& mesh, int axis, double fraction) {
-  if (axis < 0 || axis > 2) throw ParameterError("fixed region: axis must be 0, 1 or 2, got " + std::to_string(axis));
-  if (!(fraction >= 0.0 && fraction <= 1.0)) throw ParameterError("fixed region: fraction must be in [0, 1]");
+  validate(MinimumSlab{axis, fraction});
   double lowest = std::numeric_limits<double>::infinity();
   double highest = -lowest;
   for (const Eigen::Vector3d& p : mesh.rest_positions_m) {

@@ -41,11 +41,7 @@ std::unique_ptr<LinearSolver> make_linear_solver(const SolverSettings& settings)
 namespace {
 
 TissueSettings checked(TissueSettings settings) {
-  if (!(settings.step_size_s > 0.0) || !std::isfinite(settings.step_size_s)) {
-    throw ParameterError("step size must be finite and > 0 s, got " + std::to_string(settings.step_size_s));
-  }
-  validate(settings.solver);
-  validate(settings.interaction);
+  validate(settings);
   return settings;
 }
 
@@ -133,6 +129,17 @@ ToolMode parse_tool_mode(std::string_view name) {
   throw ParameterError("unknown tool mode '" + std::string(name) + "' (expected none, probe or scalpel)");
 }
 
+void validate(const TissueSettings& settings) {
+  if (!(settings.step_size_s > 0.0) || !std::isfinite(settings.step_size_s)) {
+    throw ParameterError("step size must be finite and > 0 s, got " + std::to_string(settings.step_size_s));
+  }
+  validate(settings.body.material);
+  validate(settings.body.damping);
+  if (!settings.body.gravity_m_per_s2.allFinite()) throw ParameterError("gravity must be finite");
+  validate(settings.solver);
+  validate(settings.interaction);
+}
+
 void validate(const InteractionSettings& settings) {
   if (!(settings.blade_length_m > 0.0) || !std::isfinite(settings.blade_length_m)) {
     throw ParameterError("blade length must be finite and > 0 m, got " + std::to_string(settings.blade_length_m));
@@ -146,15 +153,7 @@ void validate(const InteractionSettings& settings) {
     throw ParameterError("contact stiffness refresh must be >= 1 step, got " +
                          std::to_string(settings.contact_stiffness_refresh_steps));
   }
-  const CutterSettings& cutter = settings.cutter;
-  if (!(cutter.min_volume_fraction > 0.0 && cutter.min_volume_fraction < 0.5)) {
-    throw ParameterError("minimum volume fraction must be in (0, 0.5), got " +
-                         std::to_string(cutter.min_volume_fraction));
-  }
-  if (!(cutter.vertex_snap_fraction >= 0.0 && cutter.vertex_snap_fraction < 0.5)) {
-    throw ParameterError("vertex snap fraction must be in [0, 0.5), got " +
-                         std::to_string(cutter.vertex_snap_fraction));
-  }
+  validate(settings.cutter);
 }
 
 Tissue::Tissue(TetMesh mesh, TissueSettings settings)
@@ -187,11 +186,16 @@ const VolumeCutter& Tissue::cutter() const {
   return *m_cutter;
 }
 
-void Tissue::set_tool(const ToolPose& pose) {
+void validate(const ToolPose& pose) {
   if (!pose.tip_position_m.allFinite()) throw ParameterError("tool position must be finite");
   const double norm = pose.orientation.coeffs().norm();
-  if (!std::isfinite(norm) || !(norm > 1e-12))
+  if (!std::isfinite(norm) || !(norm > 1e-12)) {
     throw ParameterError("tool orientation must be a finite, non-zero quaternion");
+  }
+}
+
+void Tissue::set_tool(const ToolPose& pose) {
+  validate(pose);
   m_tool = pose;
   m_tool.orientation.normalize();
 }

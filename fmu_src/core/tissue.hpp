@@ -55,6 +55,9 @@ struct ToolPose {
   ToolMode mode = ToolMode::none;
 };
 
+/// Throws ParameterError for a non-finite position or a non-finite or zero quaternion.
+void validate(const ToolPose& pose);
+
 struct InteractionSettings {
   bool contact_enabled = true;
   bool cutting_enabled = true;
@@ -78,6 +81,10 @@ struct TissueSettings {
   InteractionSettings interaction;
   double step_size_s = 1e-3;
 };
+
+/// Throws ParameterError for an invalid setting (step size, material, damping, gravity, solver,
+/// interaction); fixed vertices and mesh-dependent settings are checked by DeformableBody.
+void validate(const TissueSettings& settings);
 
 /// The contact outputs of the last step (the haptic loop's input).
 struct ContactOutput {

@@ -1,9 +1,10 @@
 // TissueSnapshot <-> bytes (see tissue_snapshot_io.hpp).
 #include "core/tissue_snapshot_io.hpp"
 
-#include <cstring>
+#include "serial/byte_stream.hpp"
+
+#include <array>
 #include <string>
-#include <type_traits>
 
 namespace tissue {
 namespace {
@@ -11,14 +12,10 @@ namespace {
 constexpr std::uint64_t MAGIC = 0x31305353'49535354ULL;  // "TSSISS01" read as little-endian bytes
 constexpr std::uint32_t VERSION = 1;
 
-class Writer {
+// The core's Eigen types and cut records on top of the shared byte stream.
+class Writer : public serial::ByteWriter {
  public:
-  template <class T>
-  void put(const T& value) {
-    static_assert(std::is_arithmetic_v<T> || std::is_enum_v<T>);
-    const auto* bytes = reinterpret_cast<const std::uint8_t*>(&value);
-    m_bytes.insert(m_bytes.end(), bytes, bytes + sizeof(T));
-  }
+  using serial::ByteWriter::put;
   void put(const Eigen::VectorXd& v) {
     put(static_cast<std::uint64_t>(v.size()));
     for (Eigen::Index k = 0; k < v.size(); ++k) put(v(k));
@@ -37,7 +34,6 @@ class Writer {
     put(static_cast<std::uint64_t>(values.size()));
     for (const T& value : values) put_item(value);
   }
-  std::vector<std::uint8_t> take() { return std::move(m_bytes); }
 
   template <class T>
   void put_item(const T& value) {
@@ -54,30 +50,13 @@ class Writer {
     put(cut.volume_fraction_above);
     put_item(cut.edge_ratio);
   }
-
- private:
-  std::vector<std::uint8_t> m_bytes;
 };
 
-class Reader {
+class Reader : public serial::ByteReader {
  public:
-  explicit Reader(std::span<const std::uint8_t> bytes) : m_bytes(bytes) {}
+  using serial::ByteReader::ByteReader;
+  using serial::ByteReader::get;
 
-  template <class T>
-  T get() {
-    static_assert(std::is_arithmetic_v<T> || std::is_enum_v<T>);
-    need(sizeof(T));
-    T value;
-    std::memcpy(&value, m_bytes.data() + m_offset, sizeof(T));
-    m_offset += sizeof(T);
-    return value;
-  }
-  /// A count of items of at least `item_bytes` each, checked against the bytes left.
-  size_t count(size_t item_bytes) {
-    const auto n = get<std::uint64_t>();
-    if (item_bytes > 0 && n > (m_bytes.size() - m_offset) / item_bytes) fail("a length exceeds the data");
-    return static_cast<size_t>(n);
-  }
   void get(Eigen::VectorXd& v) {
     v.resize(static_cast<Eigen::Index>(count(sizeof(double))));
     for (Eigen::Index k = 0; k < v.size(); ++k) v(k) = get<double>();
@@ -90,10 +69,6 @@ class Reader {
   }
   void get(Eigen::Quaterniond& q) {
     for (int k = 0; k < 4; ++k) q.coeffs()(k) = get<double>();
-  }
-  template <class T>
-  void get(T& value) {
-    value = get<T>();
   }
   template <class T, size_t N>
   void get(std::array<T, N>& values) {
@@ -111,22 +86,6 @@ class Reader {
     values.resize(count(item_bytes));
     for (T& value : values) get(value);
   }
-  bool get_bool() {
-    const auto b = get<std::uint8_t>();
-    if (b > 1) fail("a flag is neither 0 nor 1");
-    return b == 1;
-  }
-  void finish() const {
-    if (m_offset != m_bytes.size()) fail("trailing bytes after the state");
-  }
-  [[noreturn]] static void fail(const std::string& what) { throw StateError("serialized state: " + what); }
-
- private:
-  void need(size_t n) const {
-    if (n > m_bytes.size() - m_offset) fail("truncated");
-  }
-  std::span<const std::uint8_t> m_bytes;
-  size_t m_offset = 0;
 };
 
 void put_tool(Writer& w, const ToolPose& tool) {
@@ -140,7 +99,7 @@ ToolPose get_tool(Reader& r) {
   r.get(tool.tip_position_m);
   r.get(tool.orientation);
   const auto mode = r.get<std::int32_t>();
-  if (mode < 0 || mode > 2) Reader::fail("bad tool mode " + std::to_string(mode));
+  if (mode < 0 || mode > 2) serial::ByteReader::fail("bad tool mode " + std::to_string(mode));
   tool.mode = static_cast<ToolMode>(mode);
   return tool;
 }
@@ -198,11 +157,13 @@ std::vector<std::uint8_t> serialize_snapshot(const TissueSnapshot& s) {
   return w.take();
 }
 
-TissueSnapshot deserialize_snapshot(std::span<const std::uint8_t> bytes) {
+namespace {
+
+TissueSnapshot read_snapshot(std::span<const std::uint8_t> bytes) {
   Reader r(bytes);
-  if (r.get<std::uint64_t>() != MAGIC) Reader::fail("not a tissue state (bad magic)");
+  if (r.get<std::uint64_t>() != MAGIC) serial::ByteReader::fail("not a tissue state (bad magic)");
   if (const auto version = r.get<std::uint32_t>(); version != VERSION) {
-    Reader::fail("version " + std::to_string(version) + " is not " + std::to_string(VERSION));
+    serial::ByteReader::fail("version " + std::to_string(version) + " is not " + std::to_string(VERSION));
   }
   TissueSnapshot s;
   r.get(s.model_fingerprint);
@@ -252,6 +213,16 @@ TissueSnapshot deserialize_snapshot(std::span<const std::uint8_t> bytes) {
   r.get(s.steps_since_stiffness);
   r.finish();
   return s;
+}
+
+}  // namespace
+
+TissueSnapshot deserialize_snapshot(std::span<const std::uint8_t> bytes) {
+  try {
+    return read_snapshot(bytes);
+  } catch (const serial::FormatError& error) {
+    throw StateError(error.what());
+  }
 }
 
 }  // namespace tissue

@@ -1,96 +1,89 @@
-// The Tissue FMU's C ABI: every FMI 3.0 function. Each one checks its arguments, calls the
-// TissueInstance, catches everything and answers a status, logging the reason of any status worse
-// than fmi3OK through the importer's callback. Interfaces the FMU does not offer (Model Exchange,
-// Scheduled Execution, clocks, event mode, derivatives, other integer widths, binaries) answer
-// fmi3Error with the reason. Nothing here throws or aborts across the ABI.
-#include "fmi3/tissue_instance.hpp"
+// The C ABI of every FMU of the project: all FMI 3.0 functions over the layer's Instance
+// (instance.hpp), compiled into each FMU's shared library, which supplies model_description() and
+// make_model() (model.hpp). Each function checks its arguments, runs through Instance::run (the
+// state table checked once on entry, everything caught, the reason of any status worse than fmi3OK
+// logged, the standard's transition after an error), and answers a status. Interfaces the FMUs do
+// not offer (Model Exchange, Scheduled Execution, clocks, event mode, derivatives, other integer
+// widths, binaries) answer fmi3Error with the reason. Nothing here throws or aborts across the ABI.
+#include "fmi3/instance.hpp"
+#include "fmi3/model.hpp"
 
 #include "fmi3_abi.h"
 
-#include <cstdarg>
-#include <exception>
+#include <algorithm>
+#include <memory>
 #include <new>
 #include <string>
 #include <vector>
 
 namespace {
 
-using tissue::fmi3::InstanceError;
-using tissue::fmi3::InstanceSnapshot;
-using tissue::fmi3::TissueInstance;
+using tissue::fmi3::Call;
+using tissue::fmi3::Instance;
+using tissue::fmi3::InstanceState;
+using tissue::fmi3::Status;
+using tissue::fmi3::VariableError;
 
-struct Instance {
-  fmi3InstanceEnvironment environment = nullptr;
-  fmi3LogMessageCallback log = nullptr;
-  bool logging_on = false;
-  bool log_calls = false;
-  bool log_events = true;
-  std::unique_ptr<TissueInstance> model;
-  std::string name;
+fmi3Status to_fmi(Status status) { return static_cast<fmi3Status>(status); }
 
-  // Warnings and errors always reach the importer (as Reference-FMUs does); calls and events only
-  // with logging on and their category enabled.
-  void message(fmi3Status status, const char* category, const std::string& text) const {
-    if (log == nullptr || (status == fmi3OK && !logging_on)) return;
-    const std::string category_name(category);
-    if (category_name == "logCalls" && !log_calls) return;
-    if (category_name == "logEvents" && !log_events) return;
-    log(environment, status, category, text.c_str());
-  }
-};
+static_assert(static_cast<int>(Status::ok) == fmi3OK && static_cast<int>(Status::warning) == fmi3Warning &&
+              static_cast<int>(Status::discard) == fmi3Discard && static_cast<int>(Status::error) == fmi3Error &&
+              static_cast<int>(Status::fatal) == fmi3Fatal);
 
-const char* category_of(fmi3Status status) {
-  switch (status) {
-    case fmi3Warning:
-      return "logStatusWarning";
-    case fmi3Discard:
-    case fmi3Error:
-      return "logStatusError";
-    case fmi3Fatal:
-      return "logStatusFatal";
-    default:
-      return "logCalls";
-  }
-}
-
-// Runs `body` on the instance, answering fmi3Error (with the reason logged) for anything thrown.
+// Runs `body` on the instance under `call`'s allowed states; `body` returns a Status (ok if void).
 template <class Body>
-fmi3Status guarded(fmi3Instance handle, const char* function, Body&& body) {
+fmi3Status run(fmi3Instance handle, Call call, const char* function, Body&& body) {
   if (handle == nullptr) return fmi3Error;
-  auto* instance = static_cast<Instance*>(handle);
-  try {
-    instance->message(fmi3OK, "logCalls", function);
-    return body(*instance);
-  } catch (const InstanceError& error) {
-    instance->message(fmi3Error, "logStatusError", std::string(function) + ": " + error.what());
-  } catch (const std::bad_alloc&) {
-    instance->message(fmi3Error, "logStatusError", std::string(function) + ": out of memory");
-  } catch (const std::exception& error) {
-    instance->message(fmi3Error, "logStatusError", std::string(function) + ": " + error.what());
-  } catch (...) {
-    instance->message(fmi3Error, "logStatusError", std::string(function) + ": unknown error");
-  }
-  return fmi3Error;
+  auto& instance = *static_cast<Instance*>(handle);
+  return to_fmi(instance.run(call, function, [&]() -> Status {
+    if constexpr (std::is_void_v<decltype(body(instance))>) {
+      body(instance);
+      return Status::ok;
+    } else {
+      return body(instance);
+    }
+  }));
 }
 
 fmi3Status not_offered(fmi3Instance handle, const char* function, const char* why) {
-  return guarded(handle, function, [&](Instance& instance) {
-    instance.message(fmi3Error, "logStatusError",
-                     std::string(function) + ": not offered by the Tissue FMU (" + why + ")");
-    return fmi3Error;
+  return run(handle, Call::not_offered, function, [&](Instance& instance) -> Status {
+    instance.log(Status::error, "logStatusError",
+                 std::string(function) + ": not offered by the " +
+                     std::string(instance.description().model_identifier) + " FMU (" + why + ")");
+    return Status::error;
   });
 }
 
 template <class T>
 std::span<const T> input_span(const T* data, size_t n) {
-  if (n > 0 && data == nullptr) throw InstanceError("a null array was passed with a non-zero length");
+  if (n > 0 && data == nullptr) throw VariableError("a null array was passed with a non-zero length");
   return std::span<const T>(data, n);
 }
 
 template <class T>
 std::span<T> output_span(T* data, size_t n) {
-  if (n > 0 && data == nullptr) throw InstanceError("a null array was passed with a non-zero length");
+  if (n > 0 && data == nullptr) throw VariableError("a null array was passed with a non-zero length");
   return std::span<T>(data, n);
+}
+
+template <class T>
+fmi3Status get_values(fmi3Instance handle, const char* function, const fmi3ValueReference vr[], size_t nvr, T values[],
+                      size_t n) {
+  return run(handle, Call::get_value, function,
+             [&](Instance& self) { self.get<T>(input_span(vr, nvr), output_span(values, n)); });
+}
+
+template <class T>
+fmi3Status set_values(fmi3Instance handle, const char* function, const fmi3ValueReference vr[], size_t nvr,
+                      const T values[], size_t n) {
+  return run(handle, Call::set_value, function,
+             [&](Instance& self) { self.set<T>(input_span(vr, nvr), input_span(values, n)); });
+}
+
+fmi3Instance instantiate_refused(fmi3InstanceEnvironment environment, fmi3LogMessageCallback log,
+                                 const std::string& why) {
+  if (log != nullptr) log(environment, fmi3Error, "logStatusError", why.c_str());
+  return nullptr;
 }
 
 }  // namespace
@@ -101,30 +94,13 @@ const char* fmi3GetVersion(void) { return fmi3Version; }
 
 fmi3Status fmi3SetDebugLogging(fmi3Instance instance, fmi3Boolean loggingOn, size_t nCategories,
                                const fmi3String categories[]) {
-  return guarded(instance, "fmi3SetDebugLogging", [&](Instance& self) {
-    const auto names = input_span(categories, nCategories);
-    bool calls = nCategories == 0, events = nCategories == 0;
-    for (const fmi3String name : names) {
-      const std::string category = name == nullptr ? "" : name;
-      if (category == "logCalls") {
-        calls = true;
-      } else if (category == "logEvents") {
-        events = true;
-      } else if (category != "logStatusWarning" && category != "logStatusError" && category != "logStatusFatal") {
-        throw InstanceError("unknown log category '" + category + "'");
-      }
-    }
-    self.logging_on = loggingOn;
-    self.log_calls = calls;
-    self.log_events = events;
-    return fmi3OK;
-  });
+  return run(instance, Call::set_debug_logging, "fmi3SetDebugLogging",
+             [&](Instance& self) { self.set_debug_logging(loggingOn, input_span(categories, nCategories)); });
 }
 
 fmi3Instance fmi3InstantiateModelExchange(fmi3String, fmi3String, fmi3String, fmi3Boolean, fmi3Boolean,
                                           fmi3InstanceEnvironment environment, fmi3LogMessageCallback log) {
-  if (log != nullptr) log(environment, fmi3Error, "logStatusError", "the Tissue FMU offers Co-Simulation only");
-  return nullptr;
+  return instantiate_refused(environment, log, "this FMU offers Co-Simulation only");
 }
 
 fmi3Instance fmi3InstantiateCoSimulation(fmi3String instanceName, fmi3String instantiationToken,
@@ -132,29 +108,23 @@ fmi3Instance fmi3InstantiateCoSimulation(fmi3String instanceName, fmi3String ins
                                          fmi3Boolean eventModeUsed, fmi3Boolean, const fmi3ValueReference[],
                                          size_t nRequiredIntermediateVariables, fmi3InstanceEnvironment environment,
                                          fmi3LogMessageCallback log, fmi3IntermediateUpdateCallback) {
-  const auto refuse = [&](const std::string& why) -> fmi3Instance {
-    if (log != nullptr) log(environment, fmi3Error, "logStatusError", ("fmi3InstantiateCoSimulation: " + why).c_str());
-    return nullptr;
+  const auto refuse = [&](const std::string& why) {
+    return instantiate_refused(environment, log, "fmi3InstantiateCoSimulation: " + why);
   };
   try {
+    const tissue::fmi3::ModelDescription& description = tissue::fmi3::model_description();
     if (instanceName == nullptr || instanceName[0] == '\0') return refuse("the instance name is missing");
-    if (instantiationToken == nullptr || tissue::fmi3::INSTANTIATION_TOKEN != instantiationToken) {
+    if (instantiationToken == nullptr || description.instantiation_token != instantiationToken) {
       return refuse(std::string("the instantiation token '") + (instantiationToken ? instantiationToken : "(null)") +
-                    "' is not this FMU's " + std::string(tissue::fmi3::INSTANTIATION_TOKEN));
+                    "' is not this FMU's " + std::string(description.instantiation_token));
     }
     if (eventModeUsed) return refuse("event mode is not offered (hasEventMode is false)");
     if (nRequiredIntermediateVariables > 0) return refuse("intermediate updates are not offered");
-    auto instance = std::make_unique<Instance>();
-    instance->environment = environment;
-    instance->log = log;
-    instance->logging_on = loggingOn;
-    instance->name = instanceName;
-    const Instance* raw = instance.get();
-    instance->model =
-        std::make_unique<TissueInstance>(instanceName, resourcePath == nullptr ? "" : resourcePath,
-                                         [raw](int status, const char* category, const std::string& text) {
-                                           raw->message(static_cast<fmi3Status>(status), category, text);
-                                         });
+    auto logger = [environment, log](Status status, const char* category, const char* message) {
+      if (log != nullptr) log(environment, to_fmi(status), category, message);
+    };
+    auto instance = std::make_unique<Instance>(description, instanceName, resourcePath == nullptr ? "" : resourcePath,
+                                               loggingOn, logger);
     return instance.release();
   } catch (const std::exception& error) {
     return refuse(error.what());
@@ -167,25 +137,20 @@ fmi3Instance fmi3InstantiateScheduledExecution(fmi3String, fmi3String, fmi3Strin
                                                fmi3InstanceEnvironment environment, fmi3LogMessageCallback log,
                                                fmi3ClockUpdateCallback, fmi3LockPreemptionCallback,
                                                fmi3UnlockPreemptionCallback) {
-  if (log != nullptr) log(environment, fmi3Error, "logStatusError", "the Tissue FMU offers Co-Simulation only");
-  return nullptr;
+  return instantiate_refused(environment, log, "this FMU offers Co-Simulation only");
 }
 
 void fmi3FreeInstance(fmi3Instance instance) { delete static_cast<Instance*>(instance); }
 
 fmi3Status fmi3EnterInitializationMode(fmi3Instance instance, fmi3Boolean, fmi3Float64, fmi3Float64 startTime,
                                        fmi3Boolean, fmi3Float64) {
-  return guarded(instance, "fmi3EnterInitializationMode", [&](Instance& self) {
-    self.model->enter_initialization_mode(startTime);
-    return fmi3OK;
-  });
+  return run(instance, Call::enter_initialization_mode, "fmi3EnterInitializationMode",
+             [&](Instance& self) { self.enter_initialization_mode(startTime); });
 }
 
 fmi3Status fmi3ExitInitializationMode(fmi3Instance instance) {
-  return guarded(instance, "fmi3ExitInitializationMode", [&](Instance& self) {
-    self.model->exit_initialization_mode();
-    return fmi3OK;
-  });
+  return run(instance, Call::exit_initialization_mode, "fmi3ExitInitializationMode",
+             [&](Instance& self) { self.exit_initialization_mode(); });
 }
 
 fmi3Status fmi3EnterEventMode(fmi3Instance instance) {
@@ -193,17 +158,11 @@ fmi3Status fmi3EnterEventMode(fmi3Instance instance) {
 }
 
 fmi3Status fmi3Terminate(fmi3Instance instance) {
-  return guarded(instance, "fmi3Terminate", [&](Instance& self) {
-    self.model->terminate();
-    return fmi3OK;
-  });
+  return run(instance, Call::terminate, "fmi3Terminate", [&](Instance& self) { self.terminate(); });
 }
 
 fmi3Status fmi3Reset(fmi3Instance instance) {
-  return guarded(instance, "fmi3Reset", [&](Instance& self) {
-    self.model->reset();
-    return fmi3OK;
-  });
+  return run(instance, Call::reset, "fmi3Reset", [&](Instance& self) { self.reset(); });
 }
 
 #define TISSUE_NOT_OFFERED_GET_SET(Type, CType)                                                                \
@@ -221,113 +180,25 @@ TISSUE_NOT_OFFERED_GET_SET(Int16, fmi3Int16)
 TISSUE_NOT_OFFERED_GET_SET(UInt16, fmi3UInt16)
 #undef TISSUE_NOT_OFFERED_GET_SET
 
-fmi3Status fmi3GetFloat64(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr, fmi3Float64 values[],
-                          size_t n) {
-  return guarded(instance, "fmi3GetFloat64", [&](Instance& self) {
-    self.model->get_float64(input_span(vr, nvr), output_span(values, n));
-    return fmi3OK;
-  });
-}
+// The typed get/set: one line each, the table decides the rest.
+#define TISSUE_GET_SET(Type, CType)                                                                                \
+  fmi3Status fmi3Get##Type(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr, CType values[],       \
+                           size_t n) {                                                                             \
+    return get_values(instance, "fmi3Get" #Type, vr, nvr, values, n);                                              \
+  }                                                                                                                \
+  fmi3Status fmi3Set##Type(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr, const CType values[], \
+                           size_t n) {                                                                             \
+    return set_values(instance, "fmi3Set" #Type, vr, nvr, values, n);                                              \
+  }
 
-fmi3Status fmi3SetFloat64(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr, const fmi3Float64 values[],
-                          size_t n) {
-  return guarded(instance, "fmi3SetFloat64", [&](Instance& self) {
-    self.model->set_float64(input_span(vr, nvr), input_span(values, n));
-    return fmi3OK;
-  });
-}
-
-fmi3Status fmi3GetInt32(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr, fmi3Int32 values[],
-                        size_t n) {
-  return guarded(instance, "fmi3GetInt32", [&](Instance& self) {
-    self.model->get_int32(input_span(vr, nvr), output_span(values, n));
-    return fmi3OK;
-  });
-}
-
-fmi3Status fmi3SetInt32(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr, const fmi3Int32 values[],
-                        size_t n) {
-  return guarded(instance, "fmi3SetInt32", [&](Instance& self) {
-    self.model->set_int32(input_span(vr, nvr), input_span(values, n));
-    return fmi3OK;
-  });
-}
-
-fmi3Status fmi3GetUInt32(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr, fmi3UInt32 values[],
-                         size_t n) {
-  return guarded(instance, "fmi3GetUInt32", [&](Instance& self) {
-    self.model->get_uint32(input_span(vr, nvr), output_span(values, n));
-    return fmi3OK;
-  });
-}
-
-fmi3Status fmi3SetUInt32(fmi3Instance instance, const fmi3ValueReference[], size_t, const fmi3UInt32[], size_t) {
-  return not_offered(instance, "fmi3SetUInt32", "the only UInt32 variable, surface.triangles, is an output");
-}
-
-fmi3Status fmi3GetInt64(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr, fmi3Int64 values[],
-                        size_t n) {
-  return guarded(instance, "fmi3GetInt64", [&](Instance& self) {
-    self.model->get_int64(input_span(vr, nvr), output_span(values, n));
-    return fmi3OK;
-  });
-}
-
-fmi3Status fmi3SetInt64(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr, const fmi3Int64 values[],
-                        size_t n) {
-  return guarded(instance, "fmi3SetInt64", [&](Instance& self) {
-    self.model->set_int64(input_span(vr, nvr), input_span(values, n));
-    return fmi3OK;
-  });
-}
-
-fmi3Status fmi3GetUInt64(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr, fmi3UInt64 values[],
-                         size_t n) {
-  return guarded(instance, "fmi3GetUInt64", [&](Instance& self) {
-    self.model->get_uint64(input_span(vr, nvr), output_span(values, n));
-    return fmi3OK;
-  });
-}
-
-fmi3Status fmi3SetUInt64(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr, const fmi3UInt64 values[],
-                         size_t n) {
-  return guarded(instance, "fmi3SetUInt64", [&](Instance& self) {
-    self.model->set_uint64(input_span(vr, nvr), input_span(values, n));
-    return fmi3OK;
-  });
-}
-
-fmi3Status fmi3GetBoolean(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr, fmi3Boolean values[],
-                          size_t n) {
-  return guarded(instance, "fmi3GetBoolean", [&](Instance& self) {
-    self.model->get_boolean(input_span(vr, nvr), output_span(values, n));
-    return fmi3OK;
-  });
-}
-
-fmi3Status fmi3SetBoolean(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr, const fmi3Boolean values[],
-                          size_t n) {
-  return guarded(instance, "fmi3SetBoolean", [&](Instance& self) {
-    self.model->set_boolean(input_span(vr, nvr), input_span(values, n));
-    return fmi3OK;
-  });
-}
-
-fmi3Status fmi3GetString(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr, fmi3String values[],
-                         size_t n) {
-  return guarded(instance, "fmi3GetString", [&](Instance& self) {
-    self.model->get_string(input_span(vr, nvr), output_span(values, n));
-    return fmi3OK;
-  });
-}
-
-fmi3Status fmi3SetString(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr, const fmi3String values[],
-                         size_t n) {
-  return guarded(instance, "fmi3SetString", [&](Instance& self) {
-    self.model->set_string(input_span(vr, nvr), input_span(values, n));
-    return fmi3OK;
-  });
-}
+TISSUE_GET_SET(Float64, fmi3Float64)
+TISSUE_GET_SET(Int32, fmi3Int32)
+TISSUE_GET_SET(UInt32, fmi3UInt32)
+TISSUE_GET_SET(Int64, fmi3Int64)
+TISSUE_GET_SET(UInt64, fmi3UInt64)
+TISSUE_GET_SET(Boolean, fmi3Boolean)
+TISSUE_GET_SET(String, fmi3String)
+#undef TISSUE_GET_SET
 
 fmi3Status fmi3GetBinary(fmi3Instance instance, const fmi3ValueReference[], size_t, size_t[], fmi3Binary[], size_t) {
   return not_offered(instance, "fmi3GetBinary", "no Binary variable");
@@ -356,61 +227,55 @@ fmi3Status fmi3GetVariableDependencies(fmi3Instance instance, fmi3ValueReference
 }
 
 fmi3Status fmi3GetFMUState(fmi3Instance instance, fmi3FMUState* state) {
-  return guarded(instance, "fmi3GetFMUState", [&](Instance& self) {
-    if (state == nullptr) throw InstanceError("the state pointer is null");
-    std::unique_ptr<InstanceSnapshot> snapshot = self.model->save();
-    if (*state != nullptr) delete static_cast<InstanceSnapshot*>(*state);  // the standard: overwrite it
-    *state = snapshot.release();
-    return fmi3OK;
+  return run(instance, Call::get_fmu_state, "fmi3GetFMUState", [&](Instance& self) {
+    if (state == nullptr) throw VariableError("the state pointer is null");
+    std::unique_ptr<InstanceState> saved = self.save();
+    if (*state != nullptr) delete static_cast<InstanceState*>(*state);  // the standard: overwrite it
+    *state = saved.release();
   });
 }
 
 fmi3Status fmi3SetFMUState(fmi3Instance instance, fmi3FMUState state) {
-  return guarded(instance, "fmi3SetFMUState", [&](Instance& self) {
-    if (state == nullptr) throw InstanceError("the state is null");
-    self.model->restore(*static_cast<const InstanceSnapshot*>(state));
-    return fmi3OK;
+  return run(instance, Call::set_fmu_state, "fmi3SetFMUState", [&](Instance& self) {
+    if (state == nullptr) throw VariableError("the state is null");
+    self.restore(*static_cast<const InstanceState*>(state));
   });
 }
 
 fmi3Status fmi3FreeFMUState(fmi3Instance instance, fmi3FMUState* state) {
-  return guarded(instance, "fmi3FreeFMUState", [&](Instance&) {
-    if (state == nullptr) return fmi3OK;
-    delete static_cast<InstanceSnapshot*>(*state);
+  return run(instance, Call::free_fmu_state, "fmi3FreeFMUState", [&](Instance&) {
+    if (state == nullptr) return;
+    delete static_cast<InstanceState*>(*state);
     *state = nullptr;
-    return fmi3OK;
   });
 }
 
 fmi3Status fmi3SerializedFMUStateSize(fmi3Instance instance, fmi3FMUState state, size_t* size) {
-  return guarded(instance, "fmi3SerializedFMUStateSize", [&](Instance& self) {
-    if (state == nullptr || size == nullptr) throw InstanceError("null state or size");
-    *size = self.model->serialize(*static_cast<const InstanceSnapshot*>(state)).size();
-    return fmi3OK;
+  return run(instance, Call::serialize_fmu_state, "fmi3SerializedFMUStateSize", [&](Instance& self) {
+    if (state == nullptr || size == nullptr) throw VariableError("null state or size");
+    *size = self.serialize(*static_cast<const InstanceState*>(state)).size();
   });
 }
 
 fmi3Status fmi3SerializeFMUState(fmi3Instance instance, fmi3FMUState state, fmi3Byte serializedState[], size_t size) {
-  return guarded(instance, "fmi3SerializeFMUState", [&](Instance& self) {
-    if (state == nullptr) throw InstanceError("the state is null");
-    const std::vector<std::uint8_t> bytes = self.model->serialize(*static_cast<const InstanceSnapshot*>(state));
+  return run(instance, Call::serialize_fmu_state, "fmi3SerializeFMUState", [&](Instance& self) {
+    if (state == nullptr) throw VariableError("the state is null");
+    const std::vector<std::uint8_t> bytes = self.serialize(*static_cast<const InstanceState*>(state));
     if (size != bytes.size() || (size > 0 && serializedState == nullptr)) {
-      throw InstanceError("the buffer holds " + std::to_string(size) + " bytes, the state needs " +
+      throw VariableError("the buffer holds " + std::to_string(size) + " bytes, the state needs " +
                           std::to_string(bytes.size()) + " (fmi3SerializedFMUStateSize)");
     }
     std::copy(bytes.begin(), bytes.end(), serializedState);
-    return fmi3OK;
   });
 }
 
 fmi3Status fmi3DeserializeFMUState(fmi3Instance instance, const fmi3Byte serializedState[], size_t size,
                                    fmi3FMUState* state) {
-  return guarded(instance, "fmi3DeserializeFMUState", [&](Instance& self) {
-    if (state == nullptr) throw InstanceError("the state pointer is null");
-    std::unique_ptr<InstanceSnapshot> snapshot = self.model->deserialize(input_span(serializedState, size));
-    if (*state != nullptr) delete static_cast<InstanceSnapshot*>(*state);
-    *state = snapshot.release();
-    return fmi3OK;
+  return run(instance, Call::serialize_fmu_state, "fmi3DeserializeFMUState", [&](Instance& self) {
+    if (state == nullptr) throw VariableError("the state pointer is null");
+    std::unique_ptr<InstanceState> saved = self.deserialize(input_span(serializedState, size));
+    if (*state != nullptr) delete static_cast<InstanceState*>(*state);
+    *state = saved.release();
   });
 }
 
@@ -532,18 +397,14 @@ fmi3Status fmi3GetOutputDerivatives(fmi3Instance instance, const fmi3ValueRefere
 fmi3Status fmi3DoStep(fmi3Instance instance, fmi3Float64 currentCommunicationPoint, fmi3Float64 communicationStepSize,
                       fmi3Boolean, fmi3Boolean* eventHandlingNeeded, fmi3Boolean* terminateSimulation,
                       fmi3Boolean* earlyReturn, fmi3Float64* lastSuccessfulTime) {
-  return guarded(instance, "fmi3DoStep", [&](Instance& self) {
+  return run(instance, Call::do_step, "fmi3DoStep", [&](Instance& self) {
     if (eventHandlingNeeded != nullptr) *eventHandlingNeeded = false;
     if (terminateSimulation != nullptr) *terminateSimulation = false;
     if (earlyReturn != nullptr) *earlyReturn = false;
     double last = currentCommunicationPoint;
-    const bool done = self.model->do_step(currentCommunicationPoint, communicationStepSize, last);
+    const Status status = self.do_step(currentCommunicationPoint, communicationStepSize, last);
     if (lastSuccessfulTime != nullptr) *lastSuccessfulTime = last;
-    if (!done) {
-      self.message(fmi3Discard, category_of(fmi3Discard), "fmi3DoStep: stopped at t = " + std::to_string(last) + " s");
-      return fmi3Discard;
-    }
-    return fmi3OK;
+    return status;
   });
 }
 

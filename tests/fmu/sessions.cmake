@@ -1,6 +1,18 @@
 # Sessions on the built Tissue.fmu through the host's importer (never linking the core).
 add_executable(test_fmu_sessions ${CMAKE_CURRENT_LIST_DIR}/test_fmu_sessions.cpp)
 target_link_libraries(test_fmu_sessions PRIVATE tissue::fmi_importer tissue::warnings GTest::gtest GTest::gtest_main)
-target_compile_definitions(test_fmu_sessions PRIVATE TISSUE_FMU_PATH="${TISSUE_FMU_PATH}")
+target_compile_definitions(test_fmu_sessions PRIVATE TISSUE_FMU_PATH="${TISSUE_TISSUE_FMU_PATH}")
 add_dependencies(test_fmu_sessions tissue_fmu_package)
 gtest_discover_tests(test_fmu_sessions PROPERTIES LABELS "fmu" DISCOVERY_TIMEOUT 60)
+
+# tissue_add_range_test(<name> FMU <path> PACKAGE <target>): declared min/max = enforced range.
+function(tissue_add_range_test name)
+  cmake_parse_arguments(ARG "" "FMU;PACKAGE" "" ${ARGN})
+  add_executable(${name} ${CMAKE_CURRENT_LIST_DIR}/test_fmu_ranges.cpp)
+  target_link_libraries(${name} PRIVATE tissue::fmi_importer tissue::warnings GTest::gtest GTest::gtest_main)
+  target_compile_definitions(${name} PRIVATE TISSUE_FMU_PATH="${ARG_FMU}")
+  add_dependencies(${name} ${ARG_PACKAGE})
+  gtest_discover_tests(${name} PROPERTIES LABELS "fmu" DISCOVERY_TIMEOUT 60 TEST_PREFIX "${name}.")
+endfunction()
+
+tissue_add_range_test(test_tissue_fmu_ranges FMU ${TISSUE_TISSUE_FMU_PATH} PACKAGE tissue_fmu_package)

@@ -4,7 +4,8 @@
 //   across the body cuts tets, adds unknowns and changes the surface revision;
 // * the same session split by get/set FMU state, or by serialize/deserialize into a fresh instance,
 //   continues bitwise identically; two instances side by side do not affect each other;
-// * bad use answers fmi3Error with a message and the instance stays usable.
+// * bad use answers fmi3Error with a message; the instance then takes only fmi3SetFMUState (the
+//   session continues from a saved state) or fmi3Reset, as FMI 3.0 says, and nothing refused sticks.
 #include "importer/fmu3.hpp"
 #include "importer/fmu3_instance.hpp"
 #include "importer/fmu_error.hpp"
@@ -290,6 +291,10 @@ TEST(TissueFmu, TwoInstancesSideBySideDoNotAffectEachOther) {
 }
 
 // --- bad use ---
+// FMI 3.0: a call the instance refuses answers fmi3Error, and the instance is then in the error
+// state: every call but fmi3SetFMUState (back to a saved state), fmi3Reset and fmi3FreeInstance is
+// refused (values stay readable, for debugging). Each case below checks that, and that the saved
+// state (or a reset) leads on and that the refused call changed nothing.
 
 class BadUse : public ::testing::Test {
  protected:
@@ -301,24 +306,54 @@ class BadUse : public ::testing::Test {
     EXPECT_FALSE(log.back().message.empty());
     m_fmu.clear_log();
   }
+  // After an error: stuck until rolled back (set FMU state) or reset.
+  void expect_stuck(const std::string& what) {
+    EXPECT_EQ(m_fmu.enter_initialization_mode(std::nullopt, 0.0, std::nullopt), fmi3Error) << what;
+    EXPECT_EQ(m_fmu.do_step(m_time, STEP_S).status, fmi3Error) << what;
+    EXPECT_EQ(m_fmu.set_float64("tool.position", {0.0, 0.0, 0.0}), fmi3Error) << what;
+    const std::vector<LogRecord> log = m_fmu.log();
+    ASSERT_FALSE(log.empty());
+    EXPECT_NE(log.back().message.find("after an error"), std::string::npos) << log.back().message;
+    m_fmu.clear_log();
+  }
+  // Error, stuck, then back to `saved` and on: the session continues as if the call was never made.
+  void expect_rollback(fmi3Status status, const std::string& what, fmi3FMUState saved) {
+    expect_error(status, what);
+    expect_stuck(what);
+    ASSERT_EQ(m_fmu.set_fmu_state(saved), fmi3OK) << what << ": " << m_fmu.log_text();
+  }
+  void start() {
+    ASSERT_EQ(m_fmu.enter_initialization_mode(std::nullopt, 0.0, std::nullopt), fmi3OK);
+    ASSERT_EQ(m_fmu.exit_initialization_mode(), fmi3OK) << m_fmu.log_text();
+  }
   Fmu3Instance m_fmu{tissue_fmu(), "bad", true};
+  double m_time = 0.0;
 };
 
 TEST_F(BadUse, CallsInTheWrongStateAreRefused) {
   expect_error(m_fmu.do_step(0.0, STEP_S).status, "doStep before initialization");
+  expect_stuck("doStep before initialization");
+  ASSERT_EQ(m_fmu.reset(), fmi3OK);
   std::vector<double> values;
   expect_error(m_fmu.get_float64("contact.force", values), "get before initialization");
+  ASSERT_EQ(m_fmu.reset(), fmi3OK);
   expect_error(m_fmu.exit_initialization_mode(), "exit before enter");
+  ASSERT_EQ(m_fmu.reset(), fmi3OK);
   ASSERT_EQ(m_fmu.enter_initialization_mode(std::nullopt, 0.0, std::nullopt), fmi3OK);
   expect_error(m_fmu.set_uint64("surface.vertexCapacity", {100}), "structural parameter in initialization mode");
-  ASSERT_EQ(m_fmu.exit_initialization_mode(), fmi3OK);
-  expect_error(m_fmu.set_float64("material.youngModulus", {2e5}), "fixed parameter in step mode");
-  expect_error(m_fmu.do_step(1.0, STEP_S).status, "doStep at another time");
-  expect_error(m_fmu.do_step(0.0, 0.0105).status, "a step not a multiple of the internal step");
-  expect_error(fmu_functions().fmi3EnterEventMode(m_fmu.handle()), "event mode");
-  ASSERT_EQ(m_fmu.do_step(0.0, STEP_S).status, fmi3OK) << m_fmu.log_text();  // still usable
+  ASSERT_EQ(m_fmu.reset(), fmi3OK);
+  start();
+  fmi3FMUState saved = nullptr;
+  ASSERT_EQ(m_fmu.get_fmu_state(saved), fmi3OK);
+  expect_rollback(m_fmu.set_float64("material.youngModulus", {2e5}), "fixed parameter in step mode", saved);
+  expect_rollback(m_fmu.do_step(1.0, STEP_S).status, "doStep at another time", saved);
+  expect_rollback(m_fmu.do_step(0.0, 0.0105).status, "a step not a multiple of the internal step", saved);
+  expect_rollback(fmu_functions().fmi3EnterEventMode(m_fmu.handle()), "event mode", saved);
+  ASSERT_EQ(m_fmu.do_step(0.0, STEP_S).status, fmi3OK) << m_fmu.log_text();  // on from the saved state
   ASSERT_EQ(m_fmu.terminate(), fmi3OK);
   expect_error(m_fmu.do_step(STEP_S, STEP_S).status, "doStep after terminate");
+  EXPECT_EQ(m_fmu.get_float64("contact.force", values), fmi3OK) << "values stay readable after an error";
+  ASSERT_EQ(m_fmu.free_fmu_state(saved), fmi3OK);
   ASSERT_EQ(m_fmu.reset(), fmi3OK);
   ASSERT_EQ(m_fmu.enter_initialization_mode(std::nullopt, 0.0, std::nullopt), fmi3OK);
 }
@@ -327,46 +362,68 @@ TEST_F(BadUse, UnknownReferencesWrongSizesAndBadValuesAreRefused) {
   const auto& f = fmu_functions();
   const fmi3ValueReference unknown = 9999, gravity = 7, mode = 32;
   double value = 1.0;
-  expect_error(f.fmi3SetFloat64(m_fmu.handle(), &unknown, 1, &value, 1), "unknown value reference");
-  expect_error(f.fmi3SetFloat64(m_fmu.handle(), &gravity, 1, &value, 1), "gravity with one value");
-  expect_error(f.fmi3SetInt32(m_fmu.handle(), &mode, 1, nullptr, 0), "an enumeration set as Int32");
-  expect_error(m_fmu.set_float64("material.poissonRatio", {0.5}), "nu = 0.5");
-  expect_error(m_fmu.set_float64("material.youngModulus", {0.0}), "E = 0");
-  expect_error(m_fmu.set_float64("material.youngModulus", {-1.0}), "E < 0");
-  expect_error(m_fmu.set_float64("tool.position", {0.0, std::nan(""), 0.0}), "NaN tool position");
-  expect_error(m_fmu.set_float64("tool.orientation", {std::numeric_limits<double>::infinity(), 0, 0, 0}),
-               "Inf orientation");
-  expect_error(m_fmu.set_float64("tool.orientation", {0, 0, 0, 0}), "zero quaternion");
-  expect_error(m_fmu.set_int64("tool.mode", {3}), "unknown tool mode");
-  expect_error(m_fmu.set_uint64("surface.triangleCapacity", {0}), "capacity 0");
-  // Nothing of it stuck: the defaults run.
-  ASSERT_EQ(m_fmu.enter_initialization_mode(std::nullopt, 0.0, std::nullopt), fmi3OK);
-  std::vector<double> nu, position;
+  // Before initialization there is no state to roll back to: each refusal is followed by a reset,
+  // and the value read back (readable in the error state) shows the refused call changed nothing.
+  const auto refused_then_reset = [&](fmi3Status status, const std::string& what) {
+    expect_error(status, what);
+    expect_stuck(what);
+    std::vector<double> nu, position;
+    EXPECT_EQ(m_fmu.get_float64("material.poissonRatio", nu), fmi3OK);
+    EXPECT_EQ(nu, std::vector<double>{0.4}) << what;
+    EXPECT_EQ(m_fmu.get_float64("tool.position", position), fmi3OK);
+    EXPECT_EQ(position, (std::vector<double>{0.0, 0.0, 0.0})) << what;
+    ASSERT_EQ(m_fmu.reset(), fmi3OK);
+  };
+  refused_then_reset(f.fmi3SetFloat64(m_fmu.handle(), &unknown, 1, &value, 1), "unknown value reference");
+  refused_then_reset(f.fmi3SetFloat64(m_fmu.handle(), &gravity, 1, &value, 1), "gravity with one value");
+  refused_then_reset(f.fmi3SetInt32(m_fmu.handle(), &mode, 1, nullptr, 0), "an enumeration set as Int32");
+  refused_then_reset(m_fmu.set_float64("material.poissonRatio", {0.5}), "nu = 0.5");
+  refused_then_reset(m_fmu.set_float64("material.youngModulus", {0.0}), "E = 0");
+  refused_then_reset(m_fmu.set_float64("material.youngModulus", {-1.0}), "E < 0");
+  refused_then_reset(m_fmu.set_float64("tool.position", {0.0, std::nan(""), 0.0}), "NaN tool position");
+  refused_then_reset(m_fmu.set_float64("tool.orientation", {std::numeric_limits<double>::infinity(), 0, 0, 0}),
+                     "Inf orientation");
+  refused_then_reset(m_fmu.set_float64("tool.orientation", {0, 0, 0, 0}), "zero quaternion");
+  refused_then_reset(m_fmu.set_int64("tool.mode", {3}), "unknown tool mode");
+  refused_then_reset(m_fmu.set_uint64("surface.triangleCapacity", {0}), "capacity 0");
+  // Two variables in one call, the second refused: the first is not set either.
+  const fmi3ValueReference nu_and_e[] = {3, 2};
+  const double values[] = {0.3, -5.0};
+  expect_error(f.fmi3SetFloat64(m_fmu.handle(), nu_and_e, 2, values, 2), "a good value and a bad one");
+  std::vector<double> nu;
   ASSERT_EQ(m_fmu.get_float64("material.poissonRatio", nu), fmi3OK);
   EXPECT_EQ(nu[0], 0.4);
-  ASSERT_EQ(m_fmu.get_float64("tool.position", position), fmi3OK);
-  EXPECT_EQ(position, (std::vector<double>{0.0, 0.0, 0.0}));
-  ASSERT_EQ(m_fmu.exit_initialization_mode(), fmi3OK) << m_fmu.log_text();
+  ASSERT_EQ(m_fmu.reset(), fmi3OK);
+
+  // In step mode the session rolls back to a saved state and continues as if nothing happened.
+  start();
+  fmi3FMUState saved = nullptr;
+  ASSERT_EQ(m_fmu.get_fmu_state(saved), fmi3OK);
   std::vector<double> too_small(3);
   const fmi3ValueReference positions = 53;
-  expect_error(f.fmi3GetFloat64(m_fmu.handle(), &positions, 1, too_small.data(), too_small.size()),
-               "vertex positions into 3 values");
-  expect_error(m_fmu.set_float64("tool.position", {0.0, 0.0, std::numeric_limits<double>::infinity()}),
-               "Inf tool position in step mode");
+  expect_rollback(f.fmi3GetFloat64(m_fmu.handle(), &positions, 1, too_small.data(), too_small.size()),
+                  "vertex positions into 3 values", saved);
+  expect_rollback(m_fmu.set_float64("tool.position", {0.0, 0.0, std::numeric_limits<double>::infinity()}),
+                  "Inf tool position in step mode", saved);
   ASSERT_EQ(m_fmu.do_step(0.0, STEP_S).status, fmi3OK) << m_fmu.log_text();
+  ASSERT_EQ(m_fmu.free_fmu_state(saved), fmi3OK);
 }
 
 TEST_F(BadUse, AMissingOrMalformedMeshIsRefused) {
   ASSERT_EQ(m_fmu.set_string("mesh", {"no_such_mesh.veg"}), fmi3OK);
   ASSERT_EQ(m_fmu.enter_initialization_mode(std::nullopt, 0.0, std::nullopt), fmi3OK);
   expect_error(m_fmu.exit_initialization_mode(), "a missing mesh resource");
+  expect_stuck("a missing mesh resource");
+  ASSERT_EQ(m_fmu.reset(), fmi3OK);
   const std::filesystem::path bad = std::filesystem::temp_directory_path() / "tissue_fmu_bad_mesh.veg";
   std::ofstream(bad) << "*VERTICES\n2 3 0 0\n1 0 0 0\n2 nan 0 0\n*ELEMENTS\nTET\n1 4 0\n1 1 2 1 2\n";
   ASSERT_EQ(m_fmu.set_string("mesh", {bad.string()}), fmi3OK);
+  ASSERT_EQ(m_fmu.enter_initialization_mode(std::nullopt, 0.0, std::nullopt), fmi3OK);
   expect_error(m_fmu.exit_initialization_mode(), "a malformed mesh");
   std::filesystem::remove(bad);
-  ASSERT_EQ(m_fmu.set_string("mesh", {"frog"}), fmi3OK);
-  ASSERT_EQ(m_fmu.exit_initialization_mode(), fmi3OK) << m_fmu.log_text();
+  ASSERT_EQ(m_fmu.reset(), fmi3OK);
+  ASSERT_EQ(m_fmu.enter_initialization_mode(std::nullopt, 0.0, std::nullopt), fmi3OK);
+  ASSERT_EQ(m_fmu.exit_initialization_mode(), fmi3OK) << m_fmu.log_text();  // the reset restored mesh = "frog"
 }
 
 TEST(TissueFmu, ErrorsReachTheImporterEvenWithLoggingOff) {
@@ -376,6 +433,7 @@ TEST(TissueFmu, ErrorsReachTheImporterEvenWithLoggingOff) {
   EXPECT_EQ(quiet.log()[0].status, fmi3Error);
   EXPECT_NE(quiet.log()[0].message.find("poissonRatio"), std::string::npos);
   quiet.clear_log();
+  ASSERT_EQ(quiet.reset(), fmi3OK);
   ASSERT_EQ(quiet.enter_initialization_mode(std::nullopt, 0.0, std::nullopt), fmi3OK);
   ASSERT_EQ(quiet.exit_initialization_mode(), fmi3OK);
   ASSERT_EQ(quiet.do_step(0.0, STEP_S).status, fmi3OK);

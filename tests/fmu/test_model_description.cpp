@@ -1,8 +1,11 @@
-// modelDescription/Tissue.xml against the FMI 3.0 schema (xmllint) and against the variable table
-// in fmu_src/fmi3/variables.cpp: the XML is the contract importers read, the table is what the FMU
-// codes against, and this test is what keeps them one. A difference names the variable and the
-// attribute. Also checks what the schema cannot: the standard's defaults, ModelStructure, units.
-#include "fmi3/variables.hpp"
+// An FMU's modelDescription XML against the FMI 3.0 schema (xmllint) and against its variable table
+// in code (fmu_src/<fmu>/variables.cpp): the XML is the contract importers read, the table is what the
+// FMI layer drives everything from (starts, ranges, sizes, which calls may set what), and this test
+// keeps them one: every start value, range, unit, shape, description and enumeration item. A
+// difference names the variable and the attribute. Also checks what the schema cannot: the
+// standard's defaults, ModelStructure, units. Built once per FMU (tests/fmu/model_description.cmake):
+// TISSUE_FMU_VARIABLES_HEADER declares TISSUE_FMU_DESCRIPTION(), the FMU's fmi3::ModelDescription.
+#include TISSUE_FMU_VARIABLES_HEADER
 
 #include <gtest/gtest.h>
 #include <pugixml.hpp>
@@ -20,6 +23,11 @@
 
 namespace tissue::fmi3 {
 namespace {
+
+const ModelDescription& description() { return TISSUE_FMU_DESCRIPTION(); }
+std::span<const VariableInfo> variables() { return description().variables; }
+const VariableInfo* find_variable(std::uint32_t vr) { return description().find(vr); }
+const VariableInfo* find_variable(std::string_view name) { return description().find(name); }
 
 constexpr const char* XML_PATH = TISSUE_MODEL_DESCRIPTION_XML;
 constexpr const char* SCHEMA_DIR = TISSUE_FMI3_SCHEMA_DIR;
@@ -105,7 +113,9 @@ constexpr std::array<std::pair<std::string_view, std::string Resolved::*>, 11> C
 }};
 
 std::string format_dimension(std::uint64_t size, std::optional<std::uint64_t> size_vr) {
-  return size_vr ? "[vr " + std::to_string(*size_vr) + "]" : "[" + std::to_string(size) + "]";
+  std::string text = size_vr ? "[vr " : "[";
+  text.append(std::to_string(size_vr ? *size_vr : size)).append("]");
+  return text;
 }
 
 Resolved from_code(const VariableInfo& info) {
@@ -170,9 +180,9 @@ std::map<std::uint32_t, pugi::xml_node> xml_variables() {
   std::set<std::string> names;
   for (const pugi::xml_node variable : root().child("ModelVariables").children()) {
     const std::uint32_t vr = variable.attribute("valueReference").as_uint();
-    if (!by_vr.emplace(vr, variable).second) ADD_FAILURE() << "Tissue.xml: value reference " << vr << " used twice";
+    if (!by_vr.emplace(vr, variable).second) ADD_FAILURE() << "the XML: value reference " << vr << " used twice";
     if (!names.insert(variable.attribute("name").value()).second) {
-      ADD_FAILURE() << "Tissue.xml: name " << variable.attribute("name").value() << " used twice";
+      ADD_FAILURE() << "the XML: name " << variable.attribute("name").value() << " used twice";
     }
   }
   return by_vr;
@@ -202,14 +212,15 @@ TEST(ModelDescription, IdentifiesTheFmuAsTheCodeDoes) {
   const pugi::xml_node description = root();
   ASSERT_FALSE(description.empty()) << XML_PATH << " has no fmiModelDescription";
   EXPECT_STREQ(description.attribute("fmiVersion").value(), "3.0");
-  EXPECT_STREQ(description.attribute("modelName").value(), "Tissue");
-  EXPECT_EQ(std::string_view(description.attribute("instantiationToken").value()), INSTANTIATION_TOKEN)
-      << "instantiationToken differs from INSTANTIATION_TOKEN in fmi3/variables.hpp";
+  EXPECT_EQ(std::string_view(description.attribute("modelName").value()), fmi3::description().model_identifier);
+  EXPECT_EQ(std::string_view(description.attribute("instantiationToken").value()),
+            fmi3::description().instantiation_token)
+      << "instantiationToken differs from the code's";
   EXPECT_STREQ(description.attribute("variableNamingConvention").value(), "structured");
   const pugi::xml_node co_simulation = description.child("CoSimulation");
   ASSERT_FALSE(co_simulation.empty()) << "no CoSimulation element";
-  EXPECT_EQ(std::string_view(co_simulation.attribute("modelIdentifier").value()), MODEL_IDENTIFIER)
-      << "modelIdentifier differs from MODEL_IDENTIFIER in fmi3/variables.hpp";
+  EXPECT_EQ(std::string_view(co_simulation.attribute("modelIdentifier").value()), fmi3::description().model_identifier)
+      << "modelIdentifier differs from the code's";
   // Rollback is part of the product (DESIGN section 5).
   EXPECT_TRUE(co_simulation.attribute("canGetAndSetFMUState").as_bool());
   EXPECT_TRUE(co_simulation.attribute("canSerializeFMUState").as_bool());
@@ -220,45 +231,57 @@ TEST(ModelDescription, EveryVariableEqualsTheCodeTable) {
   const auto xml = xml_variables();
   std::map<std::uint32_t, const VariableInfo*> code;
   for (const VariableInfo& info : variables()) code.emplace(static_cast<std::uint32_t>(info.vr), &info);
-  EXPECT_EQ(xml.size(), variables().size()) << "Tissue.xml and variables.cpp have different numbers of variables";
+  EXPECT_EQ(xml.size(), variables().size()) << "the XML and variables.cpp have different numbers of variables";
 
   for (const auto& [vr, node] : xml) {
     if (!code.contains(vr)) {
       ADD_FAILURE() << "vr " << vr << " (" << node.attribute("name").value()
-                    << ") is in Tissue.xml but not in variables.cpp";
+                    << ") is in the XML but not in variables.cpp";
     }
   }
   for (const auto& [vr, info] : code) {
     const auto it = xml.find(vr);
     if (it == xml.end()) {
-      ADD_FAILURE() << "vr " << vr << " (" << info->name << ") is in variables.cpp but not in Tissue.xml";
+      ADD_FAILURE() << "vr " << vr << " (" << info->name << ") is in variables.cpp but not in the XML";
       continue;
     }
     const Resolved from_file = from_xml(it->second);
     const Resolved from_table = from_code(*info);
     for (const auto& [attribute, field] : COMPARED) {
       if (from_file.*field != from_table.*field) {
-        ADD_FAILURE() << "vr " << vr << " (" << info->name << "): " << attribute << " differs: Tissue.xml \""
+        ADD_FAILURE() << "vr " << vr << " (" << info->name << "): " << attribute << " differs: XML \""
                       << from_file.*field << "\", variables.cpp \"" << from_table.*field << "\"";
       }
     }
   }
 }
 
+// "Type.item" (built by appending: GCC 12 warns falsely on operator+ chains here).
+std::string item_key(std::string_view type, std::string_view item) {
+  std::string key(type);
+  key.append(".").append(item);
+  return key;
+}
+
 TEST(ModelDescription, EnumerationTypesHaveTheDocumentedItems) {
   using Items = std::vector<std::pair<std::string, long long>>;
-  const std::map<std::string, Items> expected = {
-      {"LinearSolver", {{"pcg", 1}, {"cholmod", 2}}},
-      {"ContactStiffnessModel", {{"effectiveStatic", 1}, {"elementLocal", 2}}},
-      {"ToolMode", {{"none", 0}, {"probe", 1}, {"scalpel", 2}}},
-  };
+  std::map<std::string, Items> expected;  // the code's enumeration types (the layer checks values against them)
+  std::map<std::string, std::string> descriptions;
+  for (const EnumerationType& type : description().enumerations) {
+    Items& items = expected[std::string(type.name)];
+    for (const EnumerationItem& item : type.items) {
+      items.emplace_back(std::string(item.name), item.value);
+      descriptions[item_key(type.name, item.name)] = item.description;
+    }
+  }
   std::map<std::string, Items> actual;
   for (const pugi::xml_node type : root().child("TypeDefinitions").children("EnumerationType")) {
     Items& items = actual[type.attribute("name").value()];
     for (const pugi::xml_node item : type.children("Item")) {
       items.emplace_back(item.attribute("name").value(), item.attribute("value").as_llong());
-      EXPECT_FALSE(std::string_view(item.attribute("description").value()).empty())
-          << type.attribute("name").value() << "." << item.attribute("name").value() << " has no description";
+      const std::string key = item_key(type.attribute("name").value(), item.attribute("name").value());
+      EXPECT_FALSE(std::string_view(item.attribute("description").value()).empty()) << key << " has no description";
+      EXPECT_EQ(descriptions[key], item.attribute("description").value()) << key << ": description differs";
     }
   }
   EXPECT_EQ(actual, expected);
@@ -352,9 +375,11 @@ TEST(VariableTable, IsOrderedAndFindableByValueReferenceAndName) {
     EXPECT_EQ(find_variable(vr), &info) << info.name;
     EXPECT_EQ(find_variable(info.name), &info) << info.name;
   }
-  EXPECT_EQ(find_variable(std::uint32_t{26}), nullptr);
-  EXPECT_EQ(find_variable(std::uint32_t{1000}), nullptr);
-  EXPECT_EQ(find_variable(std::string_view("material.youngsModulus")), nullptr);
+  std::uint32_t missing = 0;
+  while (std::ranges::any_of(variables(), [&](const VariableInfo& info) { return info.vr == missing; })) ++missing;
+  EXPECT_EQ(find_variable(missing), nullptr);
+  EXPECT_EQ(find_variable(std::uint32_t{100000}), nullptr);
+  EXPECT_EQ(find_variable(std::string_view("no.such.variable")), nullptr);
   EXPECT_EQ(find_variable(std::string_view("")), nullptr);
 }
 

@@ -3,6 +3,7 @@
 
 #include "core/collide/geometry.hpp"
 #include "core/cut/cut_geometry.hpp"
+#include "core/fem/material.hpp"
 
 #include <Eigen/Geometry>
 
@@ -106,17 +107,21 @@ struct VolumeCutter::Sweep {
   }
 };
 
+void validate(const CutterSettings& settings) {
+  if (!(settings.vertex_snap_fraction >= 0.0 && settings.vertex_snap_fraction < 0.5)) {
+    throw ParameterError("cutter: vertex snap fraction must be in [0, 0.5), got " +
+                         std::to_string(settings.vertex_snap_fraction));
+  }
+  if (!(settings.min_volume_fraction > 0.0 && settings.min_volume_fraction < 0.5)) {
+    throw ParameterError("cutter: minimum volume fraction must be in (0, 0.5), got " +
+                         std::to_string(settings.min_volume_fraction));
+  }
+}
+
 VolumeCutter::VolumeCutter(const TetMesh& mesh, const TetAdjacency& adjacency, const SurfaceMesh& surface,
                            CutterSettings settings)
     : m_mesh(mesh), m_adjacency(adjacency), m_surface(surface), m_settings(settings) {
-  if (!(settings.vertex_snap_fraction >= 0.0 && settings.vertex_snap_fraction < 0.5)) {
-    throw std::invalid_argument("VolumeCutter: vertex_snap_fraction must be in [0, 0.5), got " +
-                                std::to_string(settings.vertex_snap_fraction));
-  }
-  if (!(settings.min_volume_fraction > 0.0 && settings.min_volume_fraction < 0.5)) {
-    throw std::invalid_argument("VolumeCutter: min_volume_fraction must be in (0, 0.5), got " +
-                                std::to_string(settings.min_volume_fraction));
-  }
+  tissue::validate(settings);
   const std::size_t tets = mesh.tets.size();
   const std::size_t edges = adjacency.edges.size();
   if (adjacency.face_neighbor.size() != tets || adjacency.tet_edges.size() != tets ||

@@ -58,6 +58,9 @@ struct CutterSettings {
   double min_volume_fraction = 1e-3;
 };
 
+/// Throws ParameterError unless both fractions are in their ranges (the one place they are checked).
+void validate(const CutterSettings& settings);
+
 /// What one step did (dissertation table 6.4 reports `seconds` and `newly_cut_tets`).
 struct CutStepReport {
   bool cutting = false;         ///< a session is open after the step

@@ -1,82 +1,32 @@
-// The table of the Tissue FMU's variables: a copy of modelDescription/Tissue.xml in code, one entry
+// The table of the Tissue FMU's variables: modelDescription/Tissue.xml in code, one entry
 // per variable in value-reference order. Edit both together; tests/fmu/test_model_description.cpp
 // fails, naming the variable and attribute, when they differ.
-#include "fmi3/variables.hpp"
+#include "tissue_fmu/variables.hpp"
 
 #include <algorithm>
 
-namespace tissue::fmi3 {
+namespace tissue::tissue_fmu {
 namespace {
 
-// Builds one VariableInfo by named steps: VariableInfo is an aggregate of many string_views, and
-// positional or partial designated initializers are easy to misorder (and GCC warns on the latter).
-class Entry {
- public:
-  constexpr Entry(Vr vr, std::string_view name, VariableType type, Causality causality, Variability variability)
-      : m_info{vr, name, type, causality, variability, {}, {}, {}, {}, {}, {}, 0, {}} {}
-
-  constexpr Entry& unit(std::string_view unit) {
-    m_info.unit = unit;
-    return *this;
-  }
-  constexpr Entry& declared_type(std::string_view declared_type) {
-    m_info.declared_type = declared_type;
-    return *this;
-  }
-  constexpr Entry& start(std::string_view start) {
-    m_info.start = start;
-    return *this;
-  }
-  constexpr Entry& min(std::string_view min) {
-    m_info.min = min;
-    return *this;
-  }
-  constexpr Entry& max(std::string_view max) {
-    m_info.max = max;
-    return *this;
-  }
-  constexpr Entry& shape(Dimension rows) {
-    m_info.dimensions = {rows, Dimension{}};
-    m_info.rank = 1;
-    return *this;
-  }
-  constexpr Entry& shape(Dimension rows, Dimension columns) {
-    m_info.dimensions = {rows, columns};
-    m_info.rank = 2;
-    return *this;
-  }
-  constexpr Entry& describe(std::string_view description) {
-    m_info.description = description;
-    return *this;
-  }
-  // Implicit so that the table below can list entries directly.
-  constexpr operator VariableInfo() const { return m_info; }
-
- private:
-  VariableInfo m_info;
-};
-
-constexpr Entry parameter(Vr vr, std::string_view name, VariableType type) {
-  return {vr, name, type, Causality::parameter, Variability::fixed};
-}
-constexpr Entry structural_parameter(Vr vr, std::string_view name, VariableType type) {
-  return {vr, name, type, Causality::structural_parameter, Variability::fixed};
-}
-constexpr Entry input(Vr vr, std::string_view name, VariableType type, Variability variability) {
-  return {vr, name, type, Causality::input, variability};
-}
-constexpr Entry output(Vr vr, std::string_view name, VariableType type, Variability variability) {
-  return {vr, name, type, Causality::output, variability};
-}
-
-constexpr Dimension fixed_size(std::uint64_t size) { return {size, -1}; }
-constexpr Dimension sized_by(Vr structural_parameter) { return {0, static_cast<std::int64_t>(structural_parameter)}; }
+using fmi3::Causality;
+using fmi3::Entry;
+using fmi3::EnumerationItem;
+using fmi3::EnumerationType;
+using fmi3::fixed_size;
+using fmi3::input;
+using fmi3::output;
+using fmi3::parameter;
+using fmi3::sized_by;
+using fmi3::structural_parameter;
+using fmi3::Variability;
+using fmi3::VariableInfo;
+using fmi3::VariableType;
 
 using enum VariableType;
 using enum Variability;
 
 constexpr auto VARIABLES = std::to_array<VariableInfo>({
-    Entry(Vr::time, "time", float64, Causality::independent, continuous).unit("s").describe("Simulation time"),
+    fmi3::independent_time(Vr::time),
 
     // Parameters.
     parameter(Vr::mesh, "mesh", string)
@@ -257,76 +207,34 @@ constexpr auto VARIABLES = std::to_array<VariableInfo>({
         .describe("Elastic strain energy of the body"),
 });
 
-// find_variable(vr) binary-searches, so the order is part of the table's contract.
-constexpr bool strictly_ordered_by_value_reference() {
-  return std::ranges::adjacent_find(
-             VARIABLES, [](const VariableInfo& a, const VariableInfo& b) { return a.vr >= b.vr; }) == VARIABLES.end();
-}
-static_assert(strictly_ordered_by_value_reference(), "the variable table must be in increasing value-reference order");
+static_assert(fmi3::strictly_ordered(VARIABLES), "the variable table must be in increasing value-reference order");
+
+constexpr auto LINEAR_SOLVER_ITEMS = std::to_array<EnumerationItem>({
+    {"pcg", 1,
+     "Jacobi-preconditioned conjugate gradients (iterative; integrator.pcgTolerance, integrator.pcgMaxIterations)"},
+    {"cholmod", 2, "Sparse Cholesky factorization (CHOLMOD, direct, exact)"},
+});
+constexpr auto CONTACT_STIFFNESS_ITEMS = std::to_array<EnumerationItem>({
+    {"effectiveStatic", 1,
+     "Stiffness of the whole constrained body at the contact point (static condensation; the reference)"},
+    {"elementLocal", 2, "Stiffness of the contacted tetrahedron alone (cheap, approximate)"},
+});
+constexpr auto TOOL_MODE_ITEMS = std::to_array<EnumerationItem>({
+    {"none", 0, "The tool does not interact"},
+    {"probe", 1, "The tool tip pushes the surface (god-object contact)"},
+    {"scalpel", 2, "The blade cuts the tissue"},
+});
+const auto ENUMERATIONS = std::to_array<EnumerationType>({
+    {"LinearSolver", "Linear solver of the backward-Euler step", LINEAR_SOLVER_ITEMS},
+    {"ContactStiffnessModel", "How the 3x3 contact stiffness K_c is computed", CONTACT_STIFFNESS_ITEMS},
+    {"ToolMode", "What the tool does to the tissue", TOOL_MODE_ITEMS},
+});
 
 }  // namespace
 
-std::span<const VariableInfo> variables() { return VARIABLES; }
-
-const VariableInfo* find_variable(std::uint32_t vr) {
-  const auto it = std::ranges::lower_bound(VARIABLES, vr, {},
-                                           [](const VariableInfo& v) { return static_cast<std::uint32_t>(v.vr); });
-  return it != VARIABLES.end() && static_cast<std::uint32_t>(it->vr) == vr ? &*it : nullptr;
+const fmi3::ModelDescription& tissue_model_description() {
+  static const fmi3::ModelDescription description{MODEL_IDENTIFIER, INSTANTIATION_TOKEN, VARIABLES, ENUMERATIONS};
+  return description;
 }
 
-const VariableInfo* find_variable(std::string_view name) {
-  const auto it = std::ranges::find(VARIABLES, name, &VariableInfo::name);
-  return it != VARIABLES.end() ? &*it : nullptr;
-}
-
-std::string_view to_string(VariableType type) {
-  switch (type) {
-    case VariableType::float64:
-      return "Float64";
-    case VariableType::int32:
-      return "Int32";
-    case VariableType::uint32:
-      return "UInt32";
-    case VariableType::uint64:
-      return "UInt64";
-    case VariableType::boolean:
-      return "Boolean";
-    case VariableType::string:
-      return "String";
-    case VariableType::enumeration:
-      return "Enumeration";
-  }
-  return "";
-}
-
-std::string_view to_string(Causality causality) {
-  switch (causality) {
-    case Causality::independent:
-      return "independent";
-    case Causality::structural_parameter:
-      return "structuralParameter";
-    case Causality::parameter:
-      return "parameter";
-    case Causality::input:
-      return "input";
-    case Causality::output:
-      return "output";
-  }
-  return "";
-}
-
-std::string_view to_string(Variability variability) {
-  switch (variability) {
-    case Variability::fixed:
-      return "fixed";
-    case Variability::tunable:
-      return "tunable";
-    case Variability::discrete:
-      return "discrete";
-    case Variability::continuous:
-      return "continuous";
-  }
-  return "";
-}
-
-}  // namespace tissue::fmi3
+}  // namespace tissue::tissue_fmu

@@ -1,0 +1,173 @@
+// The FMI 3.0 layer's description of a model: its identity and its variable table (name, type,
+// causality, variability, unit, start, range, dimensions, description) and enumeration types, as
+// the model's modelDescription XML declares them. The XML is the contract importers read; each FMU
+// writes its table once (fmu_src/<fmu>/variables.cpp) and tests/fmu/test_model_description.cpp
+// keeps the two equal. The layer drives everything from this table: which calls may set a
+// variable, the start values, array sizes and typed get/set. Plain C++, no FMI headers.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <span>
+#include <string_view>
+
+namespace tissue::fmi3 {
+
+using ValueReference = std::uint32_t;
+
+/// The element type in the XML. An enumeration is got and set as Int64 in FMI 3.
+enum class VariableType { float64, int32, uint32, int64, uint64, boolean, string, enumeration };
+enum class Causality { independent, structural_parameter, parameter, input, output };
+enum class Variability { fixed, tunable, discrete, continuous };
+
+/// One array dimension: a fixed size, or the value reference of a structural parameter (size_vr >= 0).
+struct Dimension {
+  std::uint64_t size = 0;
+  std::int64_t size_vr = -1;
+};
+
+struct VariableInfo {
+  ValueReference vr;
+  std::string_view name;
+  VariableType type;
+  Causality causality;
+  Variability variability;
+  std::string_view unit;           ///< "" for none
+  std::string_view declared_type;  ///< enumeration type name, else ""
+  /// As written in the XML ("" for outputs and the independent variable); arrays space separated;
+  /// booleans "true"/"false".
+  std::string_view start;
+  std::string_view min, max;  ///< as in the XML, "" when absent
+  std::array<Dimension, 2> dimensions;
+  int rank = 0;  ///< 0 = scalar
+  std::string_view description;
+
+  /// Parameters, structural parameters and inputs hold a value the importer sets (ValueStore).
+  [[nodiscard]] constexpr bool is_stored() const {
+    return causality == Causality::parameter || causality == Causality::structural_parameter ||
+           causality == Causality::input;
+  }
+};
+
+struct EnumerationItem {
+  std::string_view name;
+  std::int64_t value;
+  std::string_view description;
+};
+
+struct EnumerationType {
+  std::string_view name;
+  std::string_view description;
+  std::span<const EnumerationItem> items;
+};
+
+/// Everything the layer knows of one FMU model.
+struct ModelDescription {
+  std::string_view model_identifier;
+  std::string_view instantiation_token;
+  std::span<const VariableInfo> variables;  ///< in strictly increasing value-reference order
+  std::span<const EnumerationType> enumerations;
+
+  /// nullptr if no variable has this value reference / name.
+  [[nodiscard]] const VariableInfo* find(ValueReference vr) const;
+  [[nodiscard]] const VariableInfo* find(std::string_view name) const;
+  [[nodiscard]] const EnumerationType* find_enumeration(std::string_view name) const;
+};
+
+/// Builds one VariableInfo by named steps: VariableInfo is an aggregate of many string_views, and
+/// positional or partial designated initializers are easy to misorder (and GCC warns on the latter).
+class Entry {
+ public:
+  constexpr Entry(ValueReference vr, std::string_view name, VariableType type, Causality causality,
+                  Variability variability)
+      : m_info{vr, name, type, causality, variability, {}, {}, {}, {}, {}, {}, 0, {}} {}
+
+  constexpr Entry& unit(std::string_view unit) {
+    m_info.unit = unit;
+    return *this;
+  }
+  constexpr Entry& declared_type(std::string_view declared_type) {
+    m_info.declared_type = declared_type;
+    return *this;
+  }
+  constexpr Entry& start(std::string_view start) {
+    m_info.start = start;
+    return *this;
+  }
+  constexpr Entry& min(std::string_view min) {
+    m_info.min = min;
+    return *this;
+  }
+  constexpr Entry& max(std::string_view max) {
+    m_info.max = max;
+    return *this;
+  }
+  constexpr Entry& shape(Dimension rows) {
+    m_info.dimensions = {rows, Dimension{}};
+    m_info.rank = 1;
+    return *this;
+  }
+  constexpr Entry& shape(Dimension rows, Dimension columns) {
+    m_info.dimensions = {rows, columns};
+    m_info.rank = 2;
+    return *this;
+  }
+  constexpr Entry& describe(std::string_view description) {
+    m_info.description = description;
+    return *this;
+  }
+  // Implicit so that a table can list entries directly.
+  constexpr operator VariableInfo() const { return m_info; }  // NOLINT(google-explicit-constructor)
+
+ private:
+  VariableInfo m_info;
+};
+
+template <class Vr>
+constexpr Entry parameter(Vr vr, std::string_view name, VariableType type) {
+  return {static_cast<ValueReference>(vr), name, type, Causality::parameter, Variability::fixed};
+}
+template <class Vr>
+constexpr Entry tunable_parameter(Vr vr, std::string_view name, VariableType type) {
+  return {static_cast<ValueReference>(vr), name, type, Causality::parameter, Variability::tunable};
+}
+template <class Vr>
+constexpr Entry structural_parameter(Vr vr, std::string_view name, VariableType type) {
+  return {static_cast<ValueReference>(vr), name, type, Causality::structural_parameter, Variability::fixed};
+}
+template <class Vr>
+constexpr Entry input(Vr vr, std::string_view name, VariableType type, Variability variability) {
+  return {static_cast<ValueReference>(vr), name, type, Causality::input, variability};
+}
+template <class Vr>
+constexpr Entry output(Vr vr, std::string_view name, VariableType type, Variability variability) {
+  return {static_cast<ValueReference>(vr), name, type, Causality::output, variability};
+}
+template <class Vr>
+constexpr Entry independent_time(Vr vr) {
+  return Entry(static_cast<ValueReference>(vr), "time", VariableType::float64, Causality::independent,
+               Variability::continuous)
+      .unit("s")
+      .describe("Simulation time");
+}
+
+constexpr Dimension fixed_size(std::uint64_t size) { return {size, -1}; }
+template <class Vr>
+constexpr Dimension sized_by(Vr structural_parameter) {
+  return {0, static_cast<std::int64_t>(structural_parameter)};
+}
+
+/// True if the table is in strictly increasing value-reference order (find() binary-searches).
+constexpr bool strictly_ordered(std::span<const VariableInfo> variables) {
+  for (std::size_t k = 1; k < variables.size(); ++k) {
+    if (variables[k - 1].vr >= variables[k].vr) return false;
+  }
+  return true;
+}
+
+/// The FMI spelling: "Float64", "structuralParameter", "continuous", ...
+std::string_view to_string(VariableType type);
+std::string_view to_string(Causality causality);
+std::string_view to_string(Variability variability);
+
+}  // namespace tissue::fmi3

@@ -1,0 +1,365 @@
+// TissueModel (see tissue_model.hpp).
+#include "tissue_fmu/tissue_model.hpp"
+
+#include "core/fixed_region.hpp"
+#include "core/tissue_snapshot_io.hpp"
+#include "resources/default_mesh.hpp"
+
+#include <Eigen/Geometry>
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <string>
+
+namespace tissue::tissue_fmu {
+namespace {
+
+using fmi3::ValueStore;
+using fmi3::VariableError;
+using fmi3::VariableInfo;
+
+fmi3::ValueReference vr(Vr v) { return static_cast<fmi3::ValueReference>(v); }
+
+// The largest capacity an importer is asked to allocate rows for (a bound on the arrays' size).
+constexpr std::uint64_t MAX_CAPACITY = 1ULL << 26U;
+
+struct TissueState final : fmi3::ModelState {
+  TissueSnapshot tissue;
+  std::uint64_t surface_revision = 0;
+};
+
+LinearSolverKind linear_solver(std::int64_t item) {
+  return item == 1 ? LinearSolverKind::pcg : LinearSolverKind::cholmod;
+}
+
+ContactStiffnessModel stiffness_model(std::int64_t item) {
+  return item == 1 ? ContactStiffnessModel::effective_static : ContactStiffnessModel::element_local;
+}
+
+}  // namespace
+
+TissueSettings tissue_settings(const ValueStore& values, const TetMesh* mesh) {
+  TissueSettings s;
+  s.body.material.young_modulus_pa = values.float64(vr(Vr::young_modulus));
+  s.body.material.poisson_ratio = values.float64(vr(Vr::poisson_ratio));
+  s.body.material.density_kg_per_m3 = values.float64(vr(Vr::density));
+  s.body.damping.mass_damping_per_s = values.float64(vr(Vr::damping_alpha));
+  s.body.damping.stiffness_damping_s = values.float64(vr(Vr::damping_beta));
+  const std::span<const double> gravity = values.float64_array(vr(Vr::gravity));
+  s.body.gravity_m_per_s2 = Eigen::Vector3d(gravity[0], gravity[1], gravity[2]);
+  const int axis = values.int32(vr(Vr::fixed_axis));
+  if (axis != -1) {
+    const MinimumSlab slab{axis, values.float64(vr(Vr::fixed_fraction))};
+    validate(slab);
+    if (mesh != nullptr) s.body.fixed_vertices = vertices_at_minimum(*mesh, slab.axis, slab.fraction);
+  }
+  s.solver.kind = linear_solver(values.int64(vr(Vr::linear_solver)));
+  s.solver.pcg = PcgSolver::Settings{values.float64(vr(Vr::pcg_tolerance)), values.int32(vr(Vr::pcg_max_iterations))};
+  s.solver.warm_start = values.boolean(vr(Vr::warm_start));
+  s.step_size_s = values.float64(vr(Vr::step_size));
+  InteractionSettings& i = s.interaction;
+  i.contact_enabled = values.boolean(vr(Vr::contact_enabled));
+  i.cutting_enabled = values.boolean(vr(Vr::cutting_enabled));
+  i.blade_length_m = values.float64(vr(Vr::blade_length));
+  i.cutter.min_volume_fraction = values.float64(vr(Vr::min_volume_fraction));
+  i.contact_spring_stiffness_n_per_m = values.float64(vr(Vr::contact_spring_stiffness));
+  i.contact_stiffness_model = stiffness_model(values.int64(vr(Vr::contact_stiffness_model)));
+  i.contact_stiffness_refresh_steps = values.int32(vr(Vr::contact_stiffness_refresh_steps));
+  validate(s);
+  return s;
+}
+
+ToolPose tool_pose(const ValueStore& values) {
+  ToolPose pose;
+  const std::span<const double> p = values.float64_array(vr(Vr::tool_position));
+  const std::span<const double> q = values.float64_array(vr(Vr::tool_orientation));
+  pose.tip_position_m = Eigen::Vector3d(p[0], p[1], p[2]);
+  pose.orientation = Eigen::Quaterniond(q[0], q[1], q[2], q[3]);
+  pose.mode = static_cast<ToolMode>(values.int64(vr(Vr::tool_mode)));
+  validate(pose);
+  pose.orientation.normalize();
+  // A ball-ended probe touches with the pole of its ball along the tool axis (toward the tip).
+  const double radius_m = values.float64(vr(Vr::probe_radius));
+  if (pose.mode == ToolMode::probe && radius_m > 0.0) {
+    pose.tip_position_m -= radius_m * (pose.orientation * Eigen::Vector3d::UnitZ());
+  }
+  return pose;
+}
+
+TissueModel::TissueModel(const fmi3::ModelContext& context, const ValueStore& values)
+    : m_context(context), m_values(values) {}
+
+void TissueModel::validate(const ValueStore& values) const {
+  (void)tissue_settings(values, nullptr);
+  if (!(values.float64(vr(Vr::probe_radius)) >= 0.0)) {
+    throw ParameterError("tool.probeRadius must be >= 0 m, got " +
+                         std::to_string(values.float64(vr(Vr::probe_radius))));
+  }
+  for (const Vr capacity : {Vr::vertex_capacity, Vr::triangle_capacity}) {
+    const std::uint64_t rows = values.uint64(vr(capacity));
+    if (rows < 1 || rows > MAX_CAPACITY) {
+      throw VariableError(std::string(tissue_model_description().find(vr(capacity))->name) +
+                          " must be in [1, 2^26], got " + std::to_string(rows));
+    }
+  }
+  (void)tool_pose(values);
+}
+
+// --- the model ---
+
+void TissueModel::build() {
+  const std::string& name = m_values.string(vr(Vr::mesh));
+  if (name.empty()) throw VariableError("mesh must be a non-empty name or path");
+  TetMesh mesh;
+  if (name == DEFAULT_MESH_NAME) {
+    mesh = load_default_mesh();
+  } else {
+    std::filesystem::path path(name);
+    if (path.is_relative()) {
+      if (m_context.resource_path.empty()) {
+        throw VariableError("mesh '" + name + "' is relative, but no resource path was given");
+      }
+      path = std::filesystem::path(m_context.resource_path) / path;
+    }
+    try {
+      mesh = load_mesh(path.string());
+    } catch (const std::exception& error) {
+      throw VariableError("mesh '" + name + "' cannot be loaded: " + error.what());
+    }
+  }
+  auto tissue = std::make_unique<Tissue>(mesh, tissue_settings(m_values, &mesh));
+  m_mesh = std::move(mesh);
+  m_tissue = std::move(tissue);
+  m_tissue->set_tool(tool_pose(m_values));
+  m_dirty = false;
+  m_surface_revision = 0;
+  m_surface_triangles = surface_triangle_count();
+  m_capacity_warned = false;
+}
+
+void TissueModel::ensure_built() {
+  if (m_dirty || !m_tissue) build();
+}
+
+std::size_t TissueModel::surface_triangle_count() const {
+  return m_tissue->surface().triangles.size() + m_tissue->cut_surface().triangles().size();
+}
+
+void TissueModel::update_surface_counters() {
+  const std::size_t triangles = surface_triangle_count();
+  if (triangles != m_surface_triangles) {
+    ++m_surface_revision;
+    m_surface_triangles = triangles;
+  }
+  if (!m_values.boolean(vr(Vr::mesh_output_enabled)) || m_capacity_warned) return;
+  const auto vertices = static_cast<std::uint64_t>(m_tissue->current_positions_m().size() / 3);
+  const std::uint64_t vertex_capacity = m_values.uint64(vr(Vr::vertex_capacity));
+  const std::uint64_t triangle_capacity = m_values.uint64(vr(Vr::triangle_capacity));
+  if (vertices > vertex_capacity || triangles > triangle_capacity) {
+    m_capacity_warned = true;
+    m_context.log(fmi3::LogLevel::warning,
+                  "the surface (" + std::to_string(vertices) + " vertices, " + std::to_string(triangles) +
+                      " triangles) outgrew surface.vertexCapacity / surface.triangleCapacity (" +
+                      std::to_string(vertex_capacity) + ", " + std::to_string(triangle_capacity) +
+                      "): the arrays hold the first ones only; instantiate with larger capacities");
+  }
+}
+
+void TissueModel::enter_initialization_mode(double start_time_s) { m_start_time_s = start_time_s; }
+
+void TissueModel::exit_initialization_mode() { ensure_built(); }
+
+fmi3::StepOutcome TissueModel::do_step(double current_time_s, double step_s) {
+  Tissue& tissue = *m_tissue;
+  const double now = m_start_time_s + tissue.time_s();
+  const double h = m_values.float64(vr(Vr::step_size));
+  if (std::abs(current_time_s - now) > 1e-9 * std::max({1.0, std::abs(now), h})) {
+    throw VariableError("doStep: the communication point " + std::to_string(current_time_s) +
+                        " s is not the instance's time " + std::to_string(now) + " s");
+  }
+  const double count = std::round(step_s / h);
+  if (count < 1.0 || std::abs(count * h - step_s) > 1e-9 * step_s) {
+    throw VariableError("doStep: the communication step " + std::to_string(step_s) +
+                        " s is not a whole multiple of stepSize " + std::to_string(h) + " s");
+  }
+  tissue.set_tool(tool_pose(m_values));
+  const std::size_t cuts_before = tissue.body().cut_tets().size();
+  const bool contact_before = tissue.contact().active;
+  const auto log_events = [&] {
+    const std::size_t cuts = tissue.body().cut_tets().size();
+    if (cuts != cuts_before) {
+      m_context.log(fmi3::LogLevel::event, "t = " + std::to_string(m_start_time_s + tissue.time_s()) +
+                                               " s: " + std::to_string(cuts - cuts_before) + " tets cut (" +
+                                               std::to_string(cuts) + " in all)");
+    }
+    if (tissue.contact().active != contact_before) {
+      m_context.log(fmi3::LogLevel::event, std::string("contact ") + (tissue.contact().active ? "started" : "ended") +
+                                               " at t = " + std::to_string(m_start_time_s + tissue.time_s()) + " s");
+    }
+  };
+  for (long n = 0; n < static_cast<long>(count); ++n) {
+    try {
+      tissue.step();
+    } catch (const IntegrationError& error) {
+      update_surface_counters();
+      log_events();
+      m_context.log(fmi3::LogLevel::warning, std::string("doStep: an internal step failed: ") + error.what());
+      return {false, m_start_time_s + tissue.time_s()};
+    }
+  }
+  update_surface_counters();
+  log_events();
+  return {true, m_start_time_s + tissue.time_s()};
+}
+
+void TissueModel::reset() {
+  m_start_time_s = 0.0;
+  m_tissue.reset();
+  m_dirty = true;
+  m_surface_revision = 0;
+}
+
+// --- outputs ---
+
+void TissueModel::get_float64(const VariableInfo& info, std::span<double> out) {
+  ensure_built();
+  Tissue& tissue = *m_tissue;
+  const ContactOutput& contact = tissue.contact();
+  const auto put3 = [&](const Eigen::Vector3d& v) {
+    for (int k = 0; k < 3; ++k) out[static_cast<std::size_t>(k)] = v(k);
+  };
+  switch (static_cast<Vr>(info.vr)) {
+    case Vr::time:
+      out[0] = m_start_time_s + tissue.time_s();
+      return;
+    case Vr::contact_point:
+      put3(contact.point_m);
+      return;
+    case Vr::contact_normal:
+      put3(contact.normal);
+      return;
+    case Vr::contact_force:
+      put3(contact.force_on_tool_n);
+      return;
+    case Vr::contact_stiffness:
+      for (int r = 0; r < 3; ++r) {
+        for (int c = 0; c < 3; ++c) out[static_cast<std::size_t>(3 * r + c)] = contact.stiffness_n_per_m(r, c);
+      }
+      return;
+    case Vr::contact_depth:
+      out[0] = contact.penetration_depth_m;
+      return;
+    case Vr::kinetic_energy:
+      out[0] = tissue.kinetic_energy_j();
+      return;
+    case Vr::elastic_energy:
+      out[0] = tissue.elastic_energy_j();
+      return;
+    case Vr::vertex_positions: {
+      std::fill(out.begin(), out.end(), 0.0);
+      if (!m_values.boolean(vr(Vr::mesh_output_enabled))) return;
+      const Eigen::VectorXd& x = tissue.current_positions_m();
+      const std::size_t count = std::min<std::size_t>(static_cast<std::size_t>(x.size()), out.size());
+      std::copy(x.data(), x.data() + count, out.begin());
+      return;
+    }
+    default:
+      Model::get_float64(info, out);
+  }
+}
+
+void TissueModel::get_uint32(const VariableInfo& info, std::span<std::uint32_t> out) {
+  if (static_cast<Vr>(info.vr) != Vr::triangles) Model::get_uint32(info, out);
+  ensure_built();
+  std::fill(out.begin(), out.end(), 0U);
+  if (!m_values.boolean(vr(Vr::mesh_output_enabled))) return;
+  std::size_t at = 0;
+  const auto put = [&](const std::array<int, 3>& triangle) {
+    if (at + 3 > out.size()) return;
+    for (const int v : triangle) out[at++] = static_cast<std::uint32_t>(v);
+  };
+  for (const auto& triangle : m_tissue->surface().triangles) put(triangle);
+  for (const auto& triangle : m_tissue->cut_surface().triangles()) put(triangle);
+}
+
+void TissueModel::get_uint64(const VariableInfo& info, std::span<std::uint64_t> out) {
+  ensure_built();
+  const Tissue& tissue = *m_tissue;
+  const auto vertices = static_cast<std::uint64_t>(tissue.current_positions_m().size() / 3);
+  const auto triangles = static_cast<std::uint64_t>(surface_triangle_count());
+  const bool mesh_out = m_values.boolean(vr(Vr::mesh_output_enabled));
+  switch (static_cast<Vr>(info.vr)) {
+    case Vr::vertex_count:
+      out[0] = mesh_out ? std::min(vertices, m_values.uint64(vr(Vr::vertex_capacity))) : 0;
+      return;
+    case Vr::triangle_count:
+      out[0] = mesh_out ? std::min(triangles, m_values.uint64(vr(Vr::triangle_capacity))) : 0;
+      return;
+    case Vr::surface_revision:
+      out[0] = m_surface_revision;
+      return;
+    case Vr::cut_tets:
+      out[0] = tissue.body().cut_tets().size();
+      return;
+    case Vr::enriched_vertices:
+      out[0] = static_cast<std::uint64_t>(tissue.body().enriched_dof_count());
+      return;
+    case Vr::dofs:
+      out[0] = static_cast<std::uint64_t>(tissue.body().dof_count());
+      return;
+    default:
+      Model::get_uint64(info, out);
+  }
+}
+
+void TissueModel::get_boolean(const VariableInfo& info, std::span<bool> out) {
+  if (static_cast<Vr>(info.vr) != Vr::contact_active) Model::get_boolean(info, out);
+  ensure_built();
+  out[0] = m_tissue->contact().active;
+}
+
+// --- FMU states ---
+
+std::unique_ptr<fmi3::ModelState> TissueModel::save() const {
+  if (!m_tissue || m_dirty) throw VariableError("get FMU state: there is no model state before the model is built");
+  auto state = std::make_unique<TissueState>();
+  m_tissue->save(state->tissue);
+  state->surface_revision = m_surface_revision;
+  return state;
+}
+
+void TissueModel::restore(const fmi3::ModelState& model_state) {
+  const auto* state = dynamic_cast<const TissueState*>(&model_state);
+  if (state == nullptr) throw VariableError("set FMU state: not a Tissue FMU state");
+  ensure_built();
+  try {
+    if (m_tissue->can_restore(state->tissue)) {
+      m_tissue->restore(state->tissue);
+    } else {
+      // Cuts cannot be undone in place: a fresh Tissue replays the snapshot's.
+      auto fresh = std::make_unique<Tissue>(m_mesh, tissue_settings(m_values, &m_mesh));
+      fresh->restore(state->tissue);
+      m_tissue = std::move(fresh);
+    }
+  } catch (const StateError& error) {
+    throw VariableError(std::string("set FMU state: ") + error.what());
+  }
+  m_surface_revision = state->surface_revision;
+  m_surface_triangles = surface_triangle_count();
+}
+
+void TissueModel::serialize(const fmi3::ModelState& model_state, serial::ByteWriter& writer) const {
+  const auto& state = dynamic_cast<const TissueState&>(model_state);
+  writer.put_bytes(serialize_snapshot(state.tissue));
+  writer.put(state.surface_revision);
+}
+
+std::unique_ptr<fmi3::ModelState> TissueModel::deserialize(serial::ByteReader& reader) const {
+  auto state = std::make_unique<TissueState>();
+  state->tissue = deserialize_snapshot(reader.get_bytes());
+  reader.get(state->surface_revision);
+  return state;
+}
+
+}  // namespace tissue::tissue_fmu

@@ -1,0 +1,66 @@
+// The Tissue FMU's model behind the FMI layer (fmi3/model.hpp): the core's Tissue built from the
+// parameters in the layer's ValueStore, stepped by doStep, its outputs (contact, surface mesh
+// arrays, counters, energies) and its states. Range checks are the core's own validate()s.
+#pragma once
+
+#include "core/mesh/tet_mesh.hpp"
+#include "core/tissue.hpp"
+#include "fmi3/model.hpp"
+#include "tissue_fmu/variables.hpp"
+
+#include <cstdint>
+#include <memory>
+#include <span>
+#include <string>
+
+namespace tissue::tissue_fmu {
+
+/// The core's settings from the FMU's parameters; fixed vertices only if `mesh` is given. Throws
+/// ParameterError for values the core refuses.
+TissueSettings tissue_settings(const fmi3::ValueStore& values, const TetMesh* mesh);
+/// The tool pose for the core from the tool inputs (a ball probe touches with its pole).
+ToolPose tool_pose(const fmi3::ValueStore& values);
+
+class TissueModel final : public fmi3::Model {
+ public:
+  TissueModel(const fmi3::ModelContext& context, const fmi3::ValueStore& values);
+
+  void validate(const fmi3::ValueStore& values) const override;
+  void parameters_changed() override { m_dirty = true; }
+  void enter_initialization_mode(double start_time_s) override;
+  void exit_initialization_mode() override;
+  fmi3::StepOutcome do_step(double current_time_s, double step_s) override;
+  void reset() override;
+
+  void get_float64(const fmi3::VariableInfo& info, std::span<double> values) override;
+  void get_uint32(const fmi3::VariableInfo& info, std::span<std::uint32_t> values) override;
+  void get_uint64(const fmi3::VariableInfo& info, std::span<std::uint64_t> values) override;
+  void get_boolean(const fmi3::VariableInfo& info, std::span<bool> values) override;
+
+  [[nodiscard]] std::unique_ptr<fmi3::ModelState> save() const override;
+  void restore(const fmi3::ModelState& state) override;
+  void serialize(const fmi3::ModelState& state, serial::ByteWriter& writer) const override;
+  [[nodiscard]] std::unique_ptr<fmi3::ModelState> deserialize(serial::ByteReader& reader) const override;
+
+  /// The core, once built; for tests and benchmarks of the layer.
+  [[nodiscard]] Tissue* tissue() { return m_tissue.get(); }
+
+ private:
+  void build();
+  void ensure_built();
+  void update_surface_counters();
+  /// Triangles of the surface output: the mesh's surface and the cut faces.
+  [[nodiscard]] std::size_t surface_triangle_count() const;
+
+  fmi3::ModelContext m_context;
+  const fmi3::ValueStore& m_values;
+  double m_start_time_s = 0.0;
+  bool m_dirty = true;  // a parameter changed since the Tissue was built
+  TetMesh m_mesh;       // as loaded: a fresh Tissue for a restored state with other cuts
+  std::unique_ptr<Tissue> m_tissue;
+  std::uint64_t m_surface_revision = 0;
+  std::uint64_t m_surface_triangles = 0;  // at the last revision check
+  bool m_capacity_warned = false;
+};
+
+}  // namespace tissue::tissue_fmu
