@@ -61,12 +61,13 @@ Instance::Instance(const ModelDescription& description, std::string name, std::s
   m_model->validate(m_values);  // the start values must run: a table that says otherwise is a bug
 }
 
-void Instance::log(Status status, const char* category, const std::string& message) const {
+// Takes C strings so that a call with logging off costs no allocation (the haptic loop calls at 1 kHz).
+void Instance::log(Status status, const char* category, const char* message) const {
   if (!m_logger || (status == Status::ok && !m_logging_on)) return;
   const std::string_view name(category);
   if (name == "logCalls" && !m_log_calls) return;
   if (name == "logEvents" && !m_log_events) return;
-  m_logger(status, category, message.c_str());
+  m_logger(status, category, message);
 }
 
 void Instance::log_exception(const char* function, Status status) const noexcept {

@@ -66,7 +66,10 @@ class Instance {
 
   /// Logs through the importer: warnings and errors always (as Reference-FMUs does), calls and
   /// events only with logging on and their category enabled.
-  void log(Status status, const char* category, const std::string& message) const;
+  void log(Status status, const char* category, const char* message) const;
+  void log(Status status, const char* category, const std::string& message) const {
+    log(status, category, message.c_str());
+  }
 
  private:
   const VariableInfo& variable(ValueReference vr, bool setting) const;

@@ -17,3 +17,6 @@ endfunction()
 tissue_add_description_test(test_fmu_description XML ${PROJECT_SOURCE_DIR}/modelDescription/Tissue.xml
                             HEADER tissue_fmu/variables.hpp DESCRIPTION tissue::tissue_fmu::tissue_model_description
                             LIBRARY tissue::tissue_fmu_variables)
+tissue_add_description_test(test_haptic_loop_description XML ${PROJECT_SOURCE_DIR}/modelDescription/HapticLoop.xml
+                            HEADER haptic_loop/variables.hpp DESCRIPTION tissue::haptic_fmu::haptic_loop_model_description
+                            LIBRARY tissue::haptic_loop_variables)

@@ -16,3 +16,4 @@ function(tissue_add_range_test name)
 endfunction()
 
 tissue_add_range_test(test_tissue_fmu_ranges FMU ${TISSUE_TISSUE_FMU_PATH} PACKAGE tissue_fmu_package)
+tissue_add_range_test(test_haptic_loop_fmu_ranges FMU ${TISSUE_HAPTICLOOP_FMU_PATH} PACKAGE hapticloop_fmu_package)

@@ -1,0 +1,17 @@
+#include "haptic_loop/core/contact_force.hpp"
+
+namespace tissue::haptic {
+
+Eigen::Vector3d intermediate_force(const TissueSample& sample, const Eigen::Vector3d& tool_position_m) {
+  return sample.force_on_tool_n - sample.contact_stiffness_n_per_m * (tool_position_m - sample.tool_position_m);
+}
+
+Eigen::Vector3d unilateral_force(const Eigen::Vector3d& force_n, const TissueSample& sample,
+                                 const Eigen::Vector3d& tool_position_m) {
+  const Eigen::Vector3d& normal = sample.contact_normal;
+  const bool outside = (tool_position_m - sample.contact_point_m).dot(normal) > 0.0;
+  if (outside || force_n.dot(normal) < 0.0) return Eigen::Vector3d::Zero();
+  return force_n;
+}
+
+}  // namespace tissue::haptic

@@ -1,0 +1,196 @@
+#include "haptic_loop/core/haptic_renderer.hpp"
+
+#include "haptic_loop/core/contact_force.hpp"
+#include "haptic_loop/core/force_limits.hpp"
+#include "haptic_loop/core/velocity_filter.hpp"
+
+#include <cmath>
+#include <stdexcept>
+#include <string>
+
+namespace tissue::haptic {
+
+namespace {
+
+void require(bool ok, const char* setting, double value, const char* range) {
+  if (!ok) {
+    throw ParameterError(std::string("RendererSettings.") + setting + " = " + std::to_string(value) + ": must be " +
+                         range);
+  }
+}
+
+std::array<double, 3> to_array(const Eigen::Vector3d& v) { return {v.x(), v.y(), v.z()}; }
+
+Eigen::Vector3d to_vector(const std::array<double, 3>& a) { return {a[0], a[1], a[2]}; }
+
+bool all_finite(const std::array<double, 3>& a) {
+  return std::isfinite(a[0]) && std::isfinite(a[1]) && std::isfinite(a[2]);
+}
+
+/// Relative slack on |f| <= max_force_n for a restored command: the clamp scales by max / |f|,
+/// which can land an ulp or two above max.
+constexpr double FORCE_BOUND_SLACK = 1e-12;
+
+}  // namespace
+
+void validate(const RendererSettings& settings) {
+  require(std::isfinite(settings.max_force_n) && settings.max_force_n > 0.0, "max_force_n", settings.max_force_n,
+          "finite and > 0");
+  require(settings.max_force_rate_n_per_s > 0.0, "max_force_rate_n_per_s", settings.max_force_rate_n_per_s,
+          "> 0 (+infinity: no limit)");
+  require(std::isfinite(settings.velocity_filter_cutoff_hz) && settings.velocity_filter_cutoff_hz > 0.0,
+          "velocity_filter_cutoff_hz", settings.velocity_filter_cutoff_hz, "finite and > 0");
+  validate(settings.cutting);
+}
+
+HapticRenderer::HapticRenderer(RendererSettings settings) : m_settings(settings) { validate(m_settings); }
+
+void HapticRenderer::set_sample(const TissueSample& sample) {
+  TissueSample prepared = sample;
+  const SampleRepair repair = prepare_sample(prepared);  // throws before anything changes
+  m_sample = prepared;
+  m_has_sample = true;
+  m_last_sample_repaired = repair.stiffness_repaired;
+}
+
+Eigen::Vector3d HapticRenderer::tick(const Eigen::Vector3d& device_position_m, ToolMode mode, double dt_s) {
+  if (!(std::isfinite(dt_s) && dt_s > 0.0)) {
+    throw std::invalid_argument("HapticRenderer::tick: dt_s = " + std::to_string(dt_s) + ", must be finite and > 0");
+  }
+  TickReport report;
+  const double max_change_n = m_settings.max_force_rate_n_per_s * dt_s;  // +inf stays +inf
+
+  if (!device_position_m.allFinite()) {
+    // Where the hand is is unknown: render nothing, release the force at the rate limit, book
+    // nothing (the motion over this tick is unknown) and restart the velocity afterwards.
+    report.position_rejected = true;
+    m_has_previous_position = false;
+    m_filtered_velocity_m_per_s.setZero();
+    const LimitedForce released = limit_rate(m_commanded_force_n, Eigen::Vector3d::Zero(), max_change_n);
+    m_commanded_force_n = released.force_n;
+    m_commanded_damping_n.setZero();
+    report.rate_limited = released.acted;
+    report.commanded_force_n = m_commanded_force_n;
+    report.observed_energy_j = report.predicted_energy_j = m_observer.energy_j();
+    m_report = report;
+    return m_commanded_force_n;
+  }
+
+  // Motion over the tick that just ended; the observer books the force held over it.
+  Eigen::Vector3d motion_m_per_s = Eigen::Vector3d::Zero();  // backward difference
+  if (m_has_previous_position) {
+    const Eigen::Vector3d displacement_m = device_position_m - m_previous_position_m;
+    m_observer.book(m_commanded_force_n, m_commanded_damping_n, displacement_m);
+    motion_m_per_s = displacement_m / dt_s;
+  }
+  m_previous_position_m = device_position_m;
+  m_has_previous_position = true;
+  m_filtered_velocity_m_per_s +=
+      low_pass_gain(dt_s, m_settings.velocity_filter_cutoff_hz) * (motion_m_per_s - m_filtered_velocity_m_per_s);
+
+  // The environment: contact (probe or scalpel, as the sample says) and cutting (scalpel).
+  if (m_has_sample && mode != ToolMode::none) {
+    if (m_sample.contact_active) {
+      report.contact_force_n =
+          unilateral_force(intermediate_force(m_sample, device_position_m), m_sample, device_position_m);
+    }
+    if (mode == ToolMode::scalpel) {
+      report.cutting_force_n =
+          cutting_force(m_settings.cutting, m_sample.blade_depth_m, m_filtered_velocity_m_per_s, motion_m_per_s);
+    }
+  }
+  const Eigen::Vector3d environment_n = report.contact_force_n + report.cutting_force_n;
+  if (environment_n.isZero(0.0) && m_commanded_force_n.isZero(0.0)) m_observer.drop_credit();
+
+  // Limits, then the controller on what the limits let through, then the limits on its sum.
+  LimitedForce clamped = clamp_magnitude(environment_n, m_settings.max_force_n);
+  LimitedForce limited = limit_rate(m_commanded_force_n, clamped.force_n, max_change_n);
+  Eigen::Vector3d command_n = limited.force_n;
+  Eigen::Vector3d damping_n = Eigen::Vector3d::Zero();
+  if (m_settings.passivity_control) {
+    const PassivityAction action = passivity_damping(m_observer.energy_j(), command_n, motion_m_per_s, dt_s);
+    if (action.damping_n_s_per_m > 0.0) {
+      clamped = clamp_magnitude(command_n + action.damping_force_n, m_settings.max_force_n);
+      limited = limit_rate(m_commanded_force_n, clamped.force_n, max_change_n);
+      damping_n = limited.force_n - command_n;
+      command_n = limited.force_n;
+      report.passivity_acted = true;
+      report.damping_n_s_per_m = action.damping_n_s_per_m;
+    }
+  }
+
+  m_commanded_force_n = command_n;
+  m_commanded_damping_n = damping_n;
+  report.passivity_force_n = damping_n;
+  report.commanded_force_n = command_n;
+  report.velocity_m_per_s = m_filtered_velocity_m_per_s;
+  report.observed_energy_j = m_observer.energy_j();
+  report.predicted_energy_j = m_observer.energy_j() - command_n.dot(motion_m_per_s) * dt_s;
+  report.clamped = clamped.acted;
+  report.rate_limited = limited.acted;
+  m_report = report;
+  return command_n;
+}
+
+void HapticRenderer::reset() { *this = HapticRenderer(m_settings); }
+
+RendererState HapticRenderer::save_state() const {
+  RendererState state;
+  state.has_sample = m_has_sample;
+  state.contact_active = m_sample.contact_active;
+  state.sample_time_s = m_sample.time_s;
+  state.contact_point_m = to_array(m_sample.contact_point_m);
+  state.contact_normal = to_array(m_sample.contact_normal);
+  state.force_on_tool_n = to_array(m_sample.force_on_tool_n);
+  Eigen::Map<Eigen::Matrix3d>(state.contact_stiffness_n_per_m.data()) = m_sample.contact_stiffness_n_per_m;
+  state.tool_position_m = to_array(m_sample.tool_position_m);
+  state.blade_depth_m = m_sample.blade_depth_m;
+  state.has_previous_position = m_has_previous_position;
+  state.previous_position_m = to_array(m_previous_position_m);
+  state.filtered_velocity_m_per_s = to_array(m_filtered_velocity_m_per_s);
+  state.commanded_force_n = to_array(m_commanded_force_n);
+  state.commanded_damping_n = to_array(m_commanded_damping_n);
+  state.observed_energy_j = m_observer.energy_j();
+  state.dissipated_energy_j = m_observer.dissipated_j();
+  return state;
+}
+
+void HapticRenderer::restore_state(const RendererState& state) {
+  TissueSample sample;
+  sample.time_s = state.sample_time_s;
+  sample.contact_active = state.contact_active;
+  sample.contact_point_m = to_vector(state.contact_point_m);
+  sample.contact_normal = to_vector(state.contact_normal);
+  sample.force_on_tool_n = to_vector(state.force_on_tool_n);
+  sample.contact_stiffness_n_per_m = Eigen::Map<const Eigen::Matrix3d>(state.contact_stiffness_n_per_m.data());
+  sample.tool_position_m = to_vector(state.tool_position_m);
+  sample.blade_depth_m = state.blade_depth_m;
+  // The saved sample was prepared already: check it the same way, but keep its exact numbers so
+  // that a restored renderer continues bitwise as the saved one.
+  TissueSample check = sample;
+  if (prepare_sample(check).stiffness_repaired) {
+    throw std::invalid_argument("RendererState: contact_stiffness_n_per_m is not symmetric positive semi-definite");
+  }
+  const bool motion_finite = all_finite(state.previous_position_m) && all_finite(state.filtered_velocity_m_per_s);
+  const bool command_finite = all_finite(state.commanded_force_n) && all_finite(state.commanded_damping_n);
+  if (!motion_finite || !command_finite || !std::isfinite(state.observed_energy_j) ||
+      !std::isfinite(state.dissipated_energy_j)) {
+    throw std::invalid_argument("RendererState: a motion, force or energy value is not finite");
+  }
+  if (to_vector(state.commanded_force_n).norm() > m_settings.max_force_n * (1.0 + FORCE_BOUND_SLACK)) {
+    throw std::invalid_argument("RendererState: commanded_force_n exceeds max_force_n");
+  }
+
+  m_sample = sample;
+  m_has_sample = state.has_sample;
+  m_last_sample_repaired = false;
+  m_has_previous_position = state.has_previous_position;
+  m_previous_position_m = to_vector(state.previous_position_m);
+  m_filtered_velocity_m_per_s = to_vector(state.filtered_velocity_m_per_s);
+  m_commanded_force_n = to_vector(state.commanded_force_n);
+  m_commanded_damping_n = to_vector(state.commanded_damping_n);
+  m_observer.set(state.observed_energy_j, state.dissipated_energy_j);
+  m_report = TickReport{};
+}
+
+}  // namespace tissue::haptic

@@ -1,0 +1,149 @@
+// The haptic rendering core of the HapticLoop FMU (DESIGN section 5): every 1 ms tick it turns the
+// device position, the tool mode and the tissue's latest sample into the force to command on the
+// device. The pieces, each in its own file with one job, in the order a tick applies them:
+//   1. contact_force.hpp: intermediate representation f0 - K_c (x - x0), then the unilateral
+//      constraint against the contact plane;
+//   2. cutting_force.hpp: fracture-mechanics cutting resistance (scalpel mode), from the filtered
+//      velocity (velocity_filter.hpp);
+//   3. force_limits.hpp: clamp to max_force_n, then rate limit against the previous command;
+//   4. passivity.hpp: the passivity controller adds damping if the one-port would turn active, and
+//      its sum goes through the same clamp and rate limit; the observer books the force finally
+//      commanded, at the next tick, with the displacement it acted over.
+// The observer must see what the device really applied, so it comes after every piece that changes
+// the force; the controller must come after the limits so that what it plans is what is commanded
+// (its own output is limited too, and whatever that withholds stays in the observed deficit).
+// Sign convention: forces on the tool; see tissue_sample.hpp. SI units.
+//
+// Real-time: tick() and set_sample() allocate nothing (except on the throwing paths) and do no I/O.
+#pragma once
+
+#include "haptic_loop/core/cutting_force.hpp"
+#include "haptic_loop/core/parameter_error.hpp"
+#include "haptic_loop/core/passivity.hpp"
+#include "haptic_loop/core/tissue_sample.hpp"
+
+#include <Eigen/Core>
+
+#include <array>
+#include <type_traits>
+
+namespace tissue::haptic {
+
+struct RendererSettings {
+  /// Largest force magnitude ever commanded [N], finite and > 0. 3.3 N: the peak force of the
+  /// 3D Systems Touch (formerly Phantom Omni) at its nominal position, from the maker's data sheet
+  /// (its continuous force is 0.88 N; holding more for long is the device driver's concern).
+  double max_force_n = 3.3;
+  /// Largest change of the commanded force per second [N/s], > 0; +infinity turns the limiter off.
+  /// 300 N/s: above what a legitimate contact needs (a 2000 N/m contact, about the stiffest a
+  /// desktop device renders, met at a brisk 0.1 m/s asks for 200 N/s, so contacts are not softened),
+  /// while a full-scale step (3.3 N, a cut releasing tension, a contact appearing under a resting
+  /// tool) is spread over 11 ms, i.e. 11 ticks instead of one. An engineering choice, not a
+  /// published figure.
+  double max_force_rate_n_per_s = 300.0;
+  /// Time-domain passivity controller on (passivity.hpp). The observer always runs.
+  bool passivity_control = true;
+  /// Cut-off of the velocity low-pass [Hz], finite and > 0 (velocity_filter.hpp). 30 Hz: above the
+  /// bandwidth of voluntary hand motion (below about 10 Hz), with a lag of 5.3 ms.
+  double velocity_filter_cutoff_hz = 30.0;
+  CuttingSettings cutting;
+};
+
+/// Throws ParameterError naming the first setting out of range (with its value and the range).
+void validate(const RendererSettings& settings);
+
+/// What one tick did, for logging and tests.
+struct TickReport {
+  Eigen::Vector3d contact_force_n = Eigen::Vector3d::Zero();    ///< intermediate representation, unilateral
+  Eigen::Vector3d cutting_force_n = Eigen::Vector3d::Zero();    ///< cutting resistance
+  Eigen::Vector3d passivity_force_n = Eigen::Vector3d::Zero();  ///< the controller's share of the command
+  Eigen::Vector3d commanded_force_n = Eigen::Vector3d::Zero();  ///< what tick() returned
+  Eigen::Vector3d velocity_m_per_s = Eigen::Vector3d::Zero();   ///< filtered hand velocity
+  double observed_energy_j = 0.0;                               ///< E through the previous tick (passivity.hpp)
+  double predicted_energy_j = 0.0;                              ///< E - f . v dt with the force commanded now
+  double damping_n_s_per_m = 0.0;                               ///< alpha the controller asked for (0: it did not act)
+  bool clamped = false;                                         ///< the clamp changed the commanded force
+  bool rate_limited = false;                                    ///< the rate limiter changed the commanded force
+  bool passivity_acted = false;                                 ///< the controller added damping
+  bool position_rejected = false;                               ///< the device position was not finite
+};
+
+/// Everything a tick carries forward, as plain numbers (for the FMU's get/set FMU state; memcpy-able).
+struct RendererState {
+  // The current tissue sample (after prepare_sample), matrices column-major.
+  bool has_sample = false;
+  bool contact_active = false;
+  double sample_time_s = 0.0;
+  std::array<double, 3> contact_point_m{};
+  std::array<double, 3> contact_normal{};
+  std::array<double, 3> force_on_tool_n{};
+  std::array<double, 9> contact_stiffness_n_per_m{};
+  std::array<double, 3> tool_position_m{};
+  double blade_depth_m = 0.0;
+  // Motion.
+  bool has_previous_position = false;
+  std::array<double, 3> previous_position_m{};
+  std::array<double, 3> filtered_velocity_m_per_s{};
+  // The command held on the device now, its controller share, and the observer.
+  std::array<double, 3> commanded_force_n{};
+  std::array<double, 3> commanded_damping_n{};
+  double observed_energy_j = 0.0;
+  double dissipated_energy_j = 0.0;
+
+  bool operator==(const RendererState&) const = default;  ///< member-wise (padding is not compared)
+};
+static_assert(std::is_trivially_copyable_v<RendererState>);
+
+class HapticRenderer {
+ public:
+  /// Throws ParameterError for invalid settings.
+  explicit HapticRenderer(RendererSettings settings = {});
+
+  /// A new tissue sample arrived; it replaces the previous one (zero-order hold until the next).
+  /// Throws std::invalid_argument (naming the field; the renderer unchanged) for a sample that
+  /// prepare_sample() refuses: non-finite numbers, negative blade depth, a non-unit normal.
+  void set_sample(const TissueSample& sample);
+
+  /// One haptic tick: the device (hand) position now, the tool mode, the tick length. Returns the
+  /// force to command on the device [N], finite, |f| <= max_force_n, and |f - f_previous| <=
+  /// max_force_rate_n_per_s dt_s. A non-finite device position renders no contact and releases the
+  /// force toward zero at the rate limit (no kick); the observer books nothing over ticks whose
+  /// motion is unknown, and the velocity restarts from the next finite position.
+  /// Throws std::invalid_argument unless dt_s is finite and > 0 (a caller's error; state unchanged).
+  Eigen::Vector3d tick(const Eigen::Vector3d& device_position_m, ToolMode mode, double dt_s);
+
+  /// Back to the state after construction (no sample, no motion, no force, zero energy).
+  void reset();
+
+  RendererState save_state() const;
+  /// Throws std::invalid_argument (renderer unchanged) for a state this renderer could not have
+  /// saved: non-finite numbers, a commanded force above max_force_n, an invalid sample.
+  void restore_state(const RendererState& state);
+
+  const RendererSettings& settings() const { return m_settings; }
+  const TickReport& last_tick() const { return m_report; }
+  bool has_sample() const { return m_has_sample; }
+  /// The sample being rendered, as prepare_sample() left it.
+  const TissueSample& sample() const { return m_sample; }
+  /// Whether prepare_sample() had to project the last sample's K_c to symmetric PSD.
+  bool last_sample_repaired() const { return m_last_sample_repaired; }
+  /// Energy the renderer (the one-port behind the device) has absorbed [J]; see passivity.hpp.
+  double observed_energy_j() const { return m_observer.energy_j(); }
+  /// Energy the passivity controller's damping has taken from the hand since construction [J].
+  double dissipated_energy_j() const { return m_observer.dissipated_j(); }
+
+ private:
+  RendererSettings m_settings;
+  TissueSample m_sample;
+  bool m_has_sample = false;
+  bool m_last_sample_repaired = false;
+  bool m_has_previous_position = false;
+  Eigen::Vector3d m_previous_position_m = Eigen::Vector3d::Zero();
+  Eigen::Vector3d m_filtered_velocity_m_per_s = Eigen::Vector3d::Zero();
+  Eigen::Vector3d m_commanded_force_n = Eigen::Vector3d::Zero();
+  Eigen::Vector3d m_commanded_damping_n = Eigen::Vector3d::Zero();
+  PassivityObserver m_observer;
+  TickReport m_report;
+};
+
+}  // namespace tissue::haptic

@@ -1,0 +1,56 @@
+#include "haptic_loop/core/tissue_sample.hpp"
+
+#include <Eigen/Eigenvalues>
+
+#include <cmath>
+#include <stdexcept>
+#include <string>
+
+namespace tissue::haptic {
+
+namespace {
+
+constexpr double NORMAL_LENGTH_TOLERANCE = 1e-6;
+/// K_c differing from its PSD projection by less than this (relative, Frobenius) is rounding.
+constexpr double STIFFNESS_ROUNDING = 1e-12;
+
+void require_finite(bool finite, const char* field) {
+  if (!finite) throw std::invalid_argument(std::string("TissueSample: ") + field + " is not finite");
+}
+
+}  // namespace
+
+SampleRepair prepare_sample(TissueSample& sample) {
+  require_finite(std::isfinite(sample.time_s), "time_s");
+  require_finite(sample.contact_point_m.allFinite(), "contact_point_m");
+  require_finite(sample.contact_normal.allFinite(), "contact_normal");
+  require_finite(sample.force_on_tool_n.allFinite(), "force_on_tool_n");
+  require_finite(sample.contact_stiffness_n_per_m.allFinite(), "contact_stiffness_n_per_m");
+  require_finite(sample.tool_position_m.allFinite(), "tool_position_m");
+  require_finite(std::isfinite(sample.blade_depth_m), "blade_depth_m");
+  if (sample.blade_depth_m < 0.0) throw std::invalid_argument("TissueSample: blade_depth_m is negative");
+  const double normal_length = sample.contact_normal.norm();
+  if (sample.contact_active && !(std::abs(normal_length - 1.0) <= NORMAL_LENGTH_TOLERANCE)) {
+    throw std::invalid_argument("TissueSample: contact_normal is not a unit vector (length " +
+                                std::to_string(normal_length) + ")");
+  }
+
+  // Everything checked: from here on the sample is only repaired.
+  if (sample.contact_active) sample.contact_normal /= normal_length;
+  SampleRepair repair;
+  const Eigen::Matrix3d symmetric =
+      0.5 * (sample.contact_stiffness_n_per_m + sample.contact_stiffness_n_per_m.transpose());
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eigen(symmetric);
+  Eigen::Vector3d eigenvalues = eigen.eigenvalues();
+  Eigen::Matrix3d projected = symmetric;
+  if (eigenvalues.minCoeff() < 0.0) {
+    eigenvalues = eigenvalues.cwiseMax(0.0);
+    projected = eigen.eigenvectors() * eigenvalues.asDiagonal() * eigen.eigenvectors().transpose();
+  }
+  const double change = (projected - sample.contact_stiffness_n_per_m).norm();
+  repair.stiffness_repaired = change > STIFFNESS_ROUNDING * sample.contact_stiffness_n_per_m.norm();
+  sample.contact_stiffness_n_per_m = projected;
+  return repair;
+}
+
+}  // namespace tissue::haptic
