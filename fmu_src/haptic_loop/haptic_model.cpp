@@ -108,8 +108,8 @@ void HapticModel::take_tissue_sample() {
     // A bad sample must not stop the hand's loop: the previous one stays, and it is counted.
     ++m_samples_refused;
     if (m_samples_refused == 1) {
-      m_context.log(fmi3::LogLevel::warning, std::string("tissue sample refused, the previous one kept: ") +
-                                                 error.what());
+      m_context.log(fmi3::LogLevel::warning,
+                    std::string("tissue sample refused, the previous one kept: ") + error.what());
     }
   }
 }

@@ -11,11 +11,11 @@ namespace {
 
 using fmi3::EnumerationItem;
 using fmi3::EnumerationType;
-using fmi3::VariableInfo;
 using fmi3::fixed_size;
 using fmi3::input;
 using fmi3::output;
 using fmi3::parameter;
+using fmi3::VariableInfo;
 
 using enum fmi3::VariableType;
 using enum fmi3::Variability;

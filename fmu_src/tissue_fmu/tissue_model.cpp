@@ -222,6 +222,22 @@ void TissueModel::reset() {
 
 // --- outputs ---
 
+double TissueModel::blade_depth_m() {
+  const Tissue& tissue = *m_tissue;
+  const ToolPose& tool = tissue.tool();
+  if (tool.mode != ToolMode::scalpel || !tissue.has_cutter() || !tissue.cutter().cutting()) return 0.0;
+  // The edge runs from the tip along the tool axis; from the handle end (outside while a cut
+  // starts), the first crossing of the mesh's own surface is where the blade enters the tissue.
+  const double length_m = tissue.settings().interaction.blade_length_m;
+  const Eigen::Vector3d handle_m = tool.tip_position_m + length_m * (tool.orientation * Eigen::Vector3d::UnitZ());
+  tissue.surface_bvh().intersect_segment(handle_m, tool.tip_position_m, tissue.current_positions_m(), m_blade_hits);
+  const auto mesh_triangles = static_cast<int>(tissue.surface().triangles.size());
+  for (const SurfaceBvh::SegmentHit& hit : m_blade_hits) {
+    if (hit.triangle < mesh_triangles) return (1.0 - hit.segment_parameter) * length_m;
+  }
+  return length_m;  // no crossing while cutting: the whole edge is inside
+}
+
 void TissueModel::get_float64(const VariableInfo& info, std::span<double> out) {
   ensure_built();
   Tissue& tissue = *m_tissue;
@@ -255,6 +271,9 @@ void TissueModel::get_float64(const VariableInfo& info, std::span<double> out) {
       return;
     case Vr::elastic_energy:
       out[0] = tissue.elastic_energy_j();
+      return;
+    case Vr::blade_depth:
+      out[0] = blade_depth_m();
       return;
     case Vr::vertex_positions: {
       std::fill(out.begin(), out.end(), 0.0);

@@ -12,6 +12,7 @@
 #include <memory>
 #include <span>
 #include <string>
+#include <vector>
 
 namespace tissue::tissue_fmu {
 
@@ -51,6 +52,8 @@ class TissueModel final : public fmi3::Model {
   void update_surface_counters();
   /// Triangles of the surface output: the mesh's surface and the cut faces.
   [[nodiscard]] std::size_t surface_triangle_count() const;
+  /// Length of the blade inside the tissue while the scalpel cuts (0 otherwise).
+  [[nodiscard]] double blade_depth_m();
 
   fmi3::ModelContext m_context;
   const fmi3::ValueStore& m_values;
@@ -61,6 +64,7 @@ class TissueModel final : public fmi3::Model {
   std::uint64_t m_surface_revision = 0;
   std::uint64_t m_surface_triangles = 0;  // at the last revision check
   bool m_capacity_warned = false;
+  std::vector<SurfaceBvh::SegmentHit> m_blade_hits;  // scratch of blade_depth_m()
 };
 
 }  // namespace tissue::tissue_fmu

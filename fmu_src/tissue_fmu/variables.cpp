@@ -205,6 +205,10 @@ constexpr auto VARIABLES = std::to_array<VariableInfo>({
     output(Vr::elastic_energy, "elasticEnergy", float64, continuous)
         .unit("J")
         .describe("Elastic strain energy of the body"),
+    output(Vr::blade_depth, "cut.bladeDepth", float64, continuous)
+        .unit("m")
+        .describe("Length of the scalpel's cutting edge inside the tissue while it cuts (0 otherwise): the haptic "
+                  "loop's cutting force is proportional to it"),
 });
 
 static_assert(fmi3::strictly_ordered(VARIABLES), "the variable table must be in increasing value-reference order");

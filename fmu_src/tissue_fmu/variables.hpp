@@ -62,7 +62,8 @@ enum class Vr : std::uint32_t {
   enriched_vertices = 61,
   dofs = 62,
   kinetic_energy = 63,
-  elastic_energy = 64
+  elastic_energy = 64,
+  blade_depth = 65
 };
 
 /// The Tissue FMU's description: identity, variables, enumeration types.

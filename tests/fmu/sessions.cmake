@@ -17,3 +17,21 @@ endfunction()
 
 tissue_add_range_test(test_tissue_fmu_ranges FMU ${TISSUE_TISSUE_FMU_PATH} PACKAGE tissue_fmu_package)
 tissue_add_range_test(test_haptic_loop_fmu_ranges FMU ${TISSUE_HAPTICLOOP_FMU_PATH} PACKAGE hapticloop_fmu_package)
+
+# Sessions on the built HapticLoop.fmu, driven as the real-time host drives it.
+add_executable(test_haptic_loop_sessions ${CMAKE_CURRENT_LIST_DIR}/test_haptic_loop_sessions.cpp)
+target_link_libraries(test_haptic_loop_sessions PRIVATE tissue::fmi_importer tissue::warnings GTest::gtest
+                                                        GTest::gtest_main)
+target_compile_definitions(test_haptic_loop_sessions PRIVATE HAPTIC_LOOP_FMU_PATH="${TISSUE_HAPTICLOOP_FMU_PATH}")
+add_dependencies(test_haptic_loop_sessions hapticloop_fmu_package)
+gtest_discover_tests(test_haptic_loop_sessions PROPERTIES LABELS "fmu" DISCOVERY_TIMEOUT 60)
+
+# The haptic path through the FMU allocates nothing; its own executable because it replaces the
+# global operator new (which HapticLoop.so binds to as well).
+add_executable(test_haptic_loop_allocations ${CMAKE_CURRENT_LIST_DIR}/test_haptic_loop_allocations.cpp)
+target_link_libraries(test_haptic_loop_allocations PRIVATE tissue::fmi_importer tissue::warnings GTest::gtest
+                                                           GTest::gtest_main)
+target_include_directories(test_haptic_loop_allocations PRIVATE ${PROJECT_SOURCE_DIR}/tests)
+target_compile_definitions(test_haptic_loop_allocations PRIVATE HAPTIC_LOOP_FMU_PATH="${TISSUE_HAPTICLOOP_FMU_PATH}")
+add_dependencies(test_haptic_loop_allocations hapticloop_fmu_package)
+gtest_discover_tests(test_haptic_loop_allocations PROPERTIES LABELS "fmu" DISCOVERY_TIMEOUT 60)

@@ -1,0 +1,173 @@
+// tissue-host: drives the Tissue FMU next to the HapticLoop FMU (DESIGN section 5), loading both
+// through host/importer like any FMI importer would (it never links libtissue).
+//   tissue-host run SCENARIO.toml [--offline] [--output DIR] [--record FILE.csv] ...
+//   tissue-host info FILE.fmu
+//   tissue-host bench [--steps N] ...
+#include "importer/fmu3.hpp"
+#include "importer/fmu3_instance.hpp"
+#include "importer/fmu_error.hpp"
+#include "scenario/scenario.hpp"
+#include "session/fmu_links.hpp"
+#include "session/session.hpp"
+
+#include <CLI/CLI.hpp>
+
+#include <unistd.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <iomanip>
+#include <iostream>
+#include <vector>
+
+namespace {
+
+using namespace tissue::host;
+
+// build/<preset>/host/tissue-host -> build/<preset>/fmus, where the build packages the FMUs.
+std::filesystem::path default_fmu_dir() {
+  std::error_code error;
+  const std::filesystem::path exe = std::filesystem::read_symlink("/proc/self/exe", error);
+  if (!error) {
+    const std::filesystem::path next_to_build = exe.parent_path().parent_path() / "fmus";
+    if (std::filesystem::exists(next_to_build / "Tissue.fmu")) return next_to_build;
+  }
+  return TISSUE_DEFAULT_FMU_DIR;
+}
+
+int run_command(const std::string& scenario_file, SessionOptions options, bool quiet) {
+  const Scenario scenario = load_scenario(scenario_file);
+  if (!quiet) {
+    std::cout << "tissue-host: " << scenario.name << " (" << scenario.duration_s << " s, "
+              << (options.offline ? "offline" : "real time") << ")";
+    if (!scenario.description.empty()) std::cout << ": " << scenario.description;
+    std::cout << std::endl;
+    options.progress = &std::cout;
+  }
+  const SessionSummary summary = run_session(scenario, options);
+  print_summary(std::cout, summary, options.output_dir);
+  if (!summary.realtime_priority && !options.offline && !quiet) {
+    std::cout << "  note: " << summary.realtime_priority_note << "\n";
+  }
+  return summary.nan_detected || summary.tissue_errors > 0 || summary.haptic_errors > 0 ? 3 : 0;
+}
+
+int info_command(const std::string& fmu_file) {
+  const Fmu3 fmu(fmu_file);
+  const ModelDescription& d = fmu.description();
+  std::cout << d.model_name() << " (FMI " << d.fmi_version() << ", binary reports " << fmu.version() << ")\n";
+  if (!d.description().empty()) std::cout << "  " << d.description() << "\n";
+  std::cout << "  instantiation token " << d.instantiation_token() << "\n";
+  std::cout << "  co-simulation: get/set FMU state " << (d.co_simulation().can_get_and_set_fmu_state ? "yes" : "no")
+            << ", serialize " << (d.co_simulation().can_serialize_fmu_state ? "yes" : "no") << "\n";
+  std::cout << "  " << d.variables().size() << " variables:\n";
+  for (const ModelVariable& v : d.variables()) {
+    std::string shape;  // appended piecewise: GCC 12 warns falsely (-Wrestrict) on operator+ chains
+    for (const Dimension& dim : v.dimensions) {
+      shape.append("[");
+      if (!dim.start) shape.append("vr ");
+      shape.append(std::to_string(dim.start ? *dim.start : dim.value_reference.value_or(0))).append("]");
+    }
+    std::cout << "    " << std::setw(4) << v.value_reference << "  " << std::left << std::setw(30) << (v.name + shape)
+              << std::setw(12) << v.type << std::setw(20) << v.causality << std::setw(6) << v.unit
+              << (v.start ? "start " + *v.start : std::string()) << std::right << "\n";
+  }
+  return 0;
+}
+
+double percentile(std::vector<double> values, double q) {
+  std::sort(values.begin(), values.end());
+  const auto index = static_cast<std::size_t>(std::ceil(q * static_cast<double>(values.size()))) - 1;
+  return values[std::min(values.size() - 1, index)];
+}
+
+int bench_command(const std::filesystem::path& fmu_dir, int steps, double tissue_step_s) {
+  // The two FMUs' step costs through the importer, as the session calls them (offline, one thread).
+  const Fmu3 tissue_fmu(fmu_dir / "Tissue.fmu");
+  const Fmu3 haptic_fmu(fmu_dir / "HapticLoop.fmu");
+  TissueLink tissue(tissue_fmu, {});
+  HapticLink haptic(haptic_fmu, {});
+  std::vector<double> tissue_ms, haptic_us;
+  TissueOutputs outputs;
+  ToolCommand away;
+  away.position_m = {0.0, 0.0, 1.0};
+  tissue.set_tool(away);
+  for (int k = 0; k < steps; ++k) {
+    const auto start = std::chrono::steady_clock::now();
+    (void)tissue.step(k * tissue_step_s, tissue_step_s);
+    tissue_ms.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count());
+    tissue.read(outputs);
+  }
+  DevicePose pose;
+  HapticOutputs out;
+  for (int n = 0; n < 10 * steps; ++n) {
+    const auto start = std::chrono::steady_clock::now();
+    haptic.set_device(pose);
+    (void)haptic.step(n * 1e-3, 1e-3);
+    haptic.read(out);
+    haptic_us.push_back(std::chrono::duration<double, std::micro>(std::chrono::steady_clock::now() - start).count());
+  }
+  std::cout << "Tissue doStep (" << tissue_step_s * 1e3 << " ms, default parameters, tool away), " << steps
+            << " steps: p50 " << percentile(tissue_ms, 0.5) << " ms, p99 " << percentile(tissue_ms, 0.99) << " ms\n";
+  std::cout << "HapticLoop tick (set device, doStep 1 ms, get outputs), " << 10 * steps << " ticks: p50 "
+            << percentile(haptic_us, 0.5) << " us, p99 " << percentile(haptic_us, 0.99) << " us\n";
+  return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"tissue-host: the real-time haptic host of the tissue FMUs"};
+  app.require_subcommand(1);
+
+  std::string scenario_file;
+  SessionOptions options;
+  std::string output_dir = "session";
+  std::string record_file;
+  std::string fmu_dir;
+  bool no_priority = false;
+  bool quiet = false;
+  CLI::App* run = app.add_subcommand("run", "Run a scenario (host/scenarios/*.toml) in real time or offline");
+  run->add_option("scenario", scenario_file, "Scenario file (TOML)")->required()->check(CLI::ExistingFile);
+  run->add_flag("--offline", options.offline, "Same schedule without sleeping; bitwise reproducible");
+  run->add_option("--output,-o", output_dir, "Folder for summary.json, log.csv, frames, final.png")
+      ->capture_default_str();
+  run->add_option("--record", record_file, "Also write the device poses as a CSV a replay device plays back");
+  run->add_option("--fmu-dir", fmu_dir, "Where Tissue.fmu and HapticLoop.fmu are (default: the build's fmus/)");
+  run->add_flag("--no-rt-priority", no_priority, "Do not ask for SCHED_FIFO");
+  run->add_flag("--quiet,-q", quiet, "Only the summary");
+
+  std::string fmu_file;
+  CLI::App* info = app.add_subcommand("info", "Describe an FMU (variables, capabilities)");
+  info->add_option("fmu", fmu_file, "FMU file")->required()->check(CLI::ExistingFile);
+
+  int bench_steps = 200;
+  double bench_step_s = 0.01;
+  CLI::App* bench = app.add_subcommand("bench", "Time the two FMUs' steps through the importer");
+  bench->add_option("--steps", bench_steps, "Tissue steps")->check(CLI::Range(1, 1000000))->capture_default_str();
+  bench->add_option("--step", bench_step_s, "Tissue communication step [s]")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  bench->add_option("--fmu-dir", fmu_dir, "Where Tissue.fmu and HapticLoop.fmu are");
+
+  CLI11_PARSE(app, argc, argv);
+  try {
+    const std::filesystem::path fmus = fmu_dir.empty() ? default_fmu_dir() : std::filesystem::path(fmu_dir);
+    if (run->parsed()) {
+      options.output_dir = output_dir;
+      options.fmu_dir = fmus;
+      options.realtime_priority = !no_priority;
+      if (!record_file.empty()) options.record = record_file;
+      return run_command(scenario_file, options, quiet);
+    }
+    if (info->parsed()) return info_command(fmu_file);
+    if (bench->parsed()) return bench_command(fmus, bench_steps, bench_step_s);
+  } catch (const std::exception& error) {
+    std::cerr << "tissue-host: " << error.what() << "\n";
+    return 2;
+  }
+  return 0;
+}

@@ -1,0 +1,299 @@
+// load_scenario (see scenario.hpp), on toml++ (Debian's libtomlplusplus-dev).
+#include "scenario/scenario.hpp"
+
+#define TOML_EXCEPTIONS 1
+#include <toml++/toml.h>
+
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+#include <set>
+#include <sstream>
+
+namespace tissue::host {
+namespace {
+
+class Reader {
+ public:
+  explicit Reader(std::string origin) : m_origin(std::move(origin)) {}
+
+  [[noreturn]] void fail(const std::string& key, const std::string& why) const {
+    throw ScenarioError(m_origin + ": " + key + ": " + why);
+  }
+
+  double number(const toml::node& node, const std::string& key) const {
+    if (const auto* f = node.as_floating_point()) return check_finite(f->get(), key);
+    if (const auto* i = node.as_integer()) return static_cast<double>(i->get());
+    fail(key, "must be a number");
+  }
+  double check_finite(double value, const std::string& key) const {
+    if (!std::isfinite(value)) fail(key, "must be finite");
+    return value;
+  }
+  double positive(const toml::node& node, const std::string& key) const {
+    const double value = number(node, key);
+    if (!(value > 0.0)) fail(key, "must be > 0, got " + std::to_string(value));
+    return value;
+  }
+  template <std::size_t N>
+  std::array<double, N> numbers(const toml::node& node, const std::string& key) const {
+    const auto* array = node.as_array();
+    if (array == nullptr || array->size() != N) fail(key, "must be an array of " + std::to_string(N) + " numbers");
+    std::array<double, N> values{};
+    for (std::size_t k = 0; k < N; ++k) values[k] = number(*array->get(k), key);
+    return values;
+  }
+  std::string string(const toml::node& node, const std::string& key) const {
+    if (const auto* s = node.as_string()) return s->get();
+    fail(key, "must be a string");
+  }
+  bool boolean(const toml::node& node, const std::string& key) const {
+    if (const auto* b = node.as_boolean()) return b->get();
+    fail(key, "must be true or false");
+  }
+  // Refuses keys the scenario format does not have (a typo would otherwise be silently ignored).
+  void only(const toml::table& table, const std::string& where, std::initializer_list<std::string_view> keys) const {
+    for (const auto& [key, value] : table) {
+      if (std::find(keys.begin(), keys.end(), key.str()) == keys.end()) {
+        fail(where.empty() ? std::string(key.str()) : where + "." + std::string(key.str()), "unknown key");
+      }
+    }
+  }
+
+ private:
+  std::string m_origin;
+};
+
+ToolMode tool_mode(const Reader& r, const toml::node& node, const std::string& key) {
+  const std::string name = r.string(node, key);
+  if (name == "none") return ToolMode::none;
+  if (name == "probe") return ToolMode::probe;
+  if (name == "scalpel") return ToolMode::scalpel;
+  r.fail(key, "must be \"none\", \"probe\" or \"scalpel\", got \"" + name + "\"");
+}
+
+std::vector<ParameterSetting> parameters(const Reader& r, const toml::table* table, const std::string& where) {
+  std::vector<ParameterSetting> settings;
+  if (table == nullptr) return settings;
+  for (const auto& [key, node] : *table) {
+    const std::string name(key.str());
+    const std::string full = where + "." + name;
+    ParameterSetting setting{name, 0.0};
+    if (const auto* f = node.as_floating_point()) {
+      setting.value = r.check_finite(f->get(), full);
+    } else if (const auto* i = node.as_integer()) {
+      setting.value = i->get();
+    } else if (const auto* b = node.as_boolean()) {
+      setting.value = b->get();
+    } else if (const auto* s = node.as_string()) {
+      setting.value = s->get();
+    } else if (const auto* a = node.as_array()) {
+      std::vector<double> values;
+      for (const toml::node& element : *a) values.push_back(r.number(element, full));
+      setting.value = values;
+    } else {
+      r.fail(full, "must be a number, boolean, string or array of numbers");
+    }
+    settings.push_back(std::move(setting));
+  }
+  return settings;
+}
+
+Waypoint waypoint(const Reader& r, const toml::node& node, const std::string& key) {
+  const auto* table = node.as_table();
+  if (table == nullptr) r.fail(key, "must be a table { t = ..., position = [...] or at = [...], mode = ... }");
+  r.only(*table, key, {"t", "position", "at", "orientation", "axis", "mode"});
+  Waypoint w;
+  const toml::node* t = table->get("t");
+  if (t == nullptr) r.fail(key + ".t", "is missing");
+  w.time_s = r.number(*t, key + ".t");
+  const toml::node* position = table->get("position");
+  const toml::node* at = table->get("at");
+  if ((position == nullptr) == (at == nullptr)) r.fail(key, "needs exactly one of position (m) or at (box fractions)");
+  w.box_relative = at != nullptr;
+  w.position = r.numbers<3>(position != nullptr ? *position : *at, key + (position != nullptr ? ".position" : ".at"));
+  const toml::node* orientation = table->get("orientation");
+  const toml::node* axis = table->get("axis");
+  if (orientation != nullptr && axis != nullptr) r.fail(key, "give orientation (quaternion) or axis, not both");
+  if (orientation != nullptr) {
+    w.orientation_wxyz = r.numbers<4>(*orientation, key + ".orientation");
+    const double norm =
+        std::sqrt(w.orientation_wxyz[0] * w.orientation_wxyz[0] + w.orientation_wxyz[1] * w.orientation_wxyz[1] +
+                  w.orientation_wxyz[2] * w.orientation_wxyz[2] + w.orientation_wxyz[3] * w.orientation_wxyz[3]);
+    if (!(norm > 1e-12)) r.fail(key + ".orientation", "must be a non-zero quaternion (w x y z)");
+    for (double& c : w.orientation_wxyz) c /= norm;
+  }
+  if (axis != nullptr) {
+    // The tool axis (tip toward handle) in the scene: the rotation taking +z onto it.
+    const std::array<double, 3> a = r.numbers<3>(*axis, key + ".axis");
+    const double norm = std::sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2]);
+    if (!(norm > 1e-12)) r.fail(key + ".axis", "must be a non-zero vector");
+    const std::array<double, 3> d{a[0] / norm, a[1] / norm, a[2] / norm};
+    if (d[2] < -1.0 + 1e-12) {
+      w.orientation_wxyz = {0.0, 1.0, 0.0, 0.0};  // half turn about x
+    } else {
+      // q = (1 + z.d, z x d) normalized, z = (0, 0, 1): z x d = (-d_y, d_x, 0).
+      std::array<double, 4> q{1.0 + d[2], -d[1], d[0], 0.0};
+      const double qn = std::sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2]);
+      for (double& c : q) c /= qn;
+      w.orientation_wxyz = q;
+    }
+  }
+  if (const toml::node* mode = table->get("mode")) w.mode = tool_mode(r, *mode, key + ".mode");
+  return w;
+}
+
+}  // namespace
+
+Scenario parse_scenario(const std::string& text, const std::filesystem::path& origin) {
+  const Reader r(origin.string());
+  toml::table root;
+  try {
+    root = toml::parse(text, origin.string());
+  } catch (const toml::parse_error& error) {
+    std::ostringstream message;
+    message << origin.string() << ":" << error.source().begin.line << ": " << error.description();
+    throw ScenarioError(message.str());
+  }
+  r.only(root, "", {"scenario", "tissue", "haptic", "device", "realtime", "output", "expect"});
+  Scenario s;
+  s.file = origin;
+  const std::filesystem::path base = origin.has_parent_path() ? origin.parent_path() : std::filesystem::path(".");
+  const auto relative_to_file = [&](const std::string& path) {
+    const std::filesystem::path p(path);
+    return p.is_absolute() ? p : base / p;
+  };
+
+  const toml::table* scenario = root["scenario"].as_table();
+  if (scenario == nullptr) r.fail("scenario", "the [scenario] table is missing");
+  r.only(*scenario, "scenario", {"name", "description", "duration"});
+  if (const toml::node* n = scenario->get("name")) s.name = r.string(*n, "scenario.name");
+  if (s.name.empty()) s.name = origin.stem().string();
+  if (const toml::node* n = scenario->get("description")) s.description = r.string(*n, "scenario.description");
+  const toml::node* duration = scenario->get("duration");
+  if (duration == nullptr) r.fail("scenario.duration", "is missing (seconds)");
+  s.duration_s = r.positive(*duration, "scenario.duration");
+  if (s.duration_s > 24.0 * 3600.0) r.fail("scenario.duration", "longer than a day");
+
+  if (const toml::table* tissue = root["tissue"].as_table()) {
+    r.only(*tissue, "tissue", {"fmu", "communication_step", "mesh", "parameters"});
+    if (const toml::node* n = tissue->get("fmu")) s.tissue_fmu = relative_to_file(r.string(*n, "tissue.fmu"));
+    if (const toml::node* n = tissue->get("communication_step")) {
+      s.tissue_step_s = r.positive(*n, "tissue.communication_step");
+    }
+    s.tissue_parameters = parameters(r, tissue->get_as<toml::table>("parameters"), "tissue.parameters");
+    if (const toml::node* n = tissue->get("mesh")) {
+      // A mesh file next to the scenario: the FMU is given its absolute path.
+      const std::filesystem::path mesh = relative_to_file(r.string(*n, "tissue.mesh"));
+      if (!std::filesystem::exists(mesh)) r.fail("tissue.mesh", "no file " + mesh.string());
+      s.tissue_parameters.insert(s.tissue_parameters.begin(),
+                                 ParameterSetting{"mesh", std::filesystem::absolute(mesh).lexically_normal().string()});
+    }
+  }
+  // Unless the scenario says otherwise, one internal step per communication step: the frog's
+  // backward-Euler step at 10 ms is stable and takes a fraction of its slot (docs/BENCHMARKS.md).
+  if (std::none_of(s.tissue_parameters.begin(), s.tissue_parameters.end(),
+                   [](const ParameterSetting& p) { return p.name == "stepSize"; })) {
+    s.tissue_parameters.push_back(ParameterSetting{"stepSize", s.tissue_step_s});
+  }
+  if (const toml::table* haptic = root["haptic"].as_table()) {
+    r.only(*haptic, "haptic", {"fmu", "period", "parameters"});
+    if (const toml::node* n = haptic->get("fmu")) s.haptic_fmu = relative_to_file(r.string(*n, "haptic.fmu"));
+    if (const toml::node* n = haptic->get("period")) s.haptic_period_s = r.positive(*n, "haptic.period");
+    s.haptic_parameters = parameters(r, haptic->get_as<toml::table>("parameters"), "haptic.parameters");
+  }
+  // The tissue step is a whole number of haptic periods: the slots line up with the ticks.
+  const double ticks = std::round(s.tissue_step_s / s.haptic_period_s);
+  if (ticks < 1.0 || std::abs(ticks * s.haptic_period_s - s.tissue_step_s) > 1e-9 * s.tissue_step_s) {
+    r.fail("tissue.communication_step",
+           "must be a whole multiple of haptic.period (" + std::to_string(s.haptic_period_s) + " s)");
+  }
+
+  const toml::table* device = root["device"].as_table();
+  if (device == nullptr) r.fail("device", "the [device] table is missing");
+  r.only(*device, "device", {"kind", "waypoints", "file", "address", "port", "allow_remote"});
+  const toml::node* kind = device->get("kind");
+  const std::string kind_name = kind != nullptr ? r.string(*kind, "device.kind") : "scripted";
+  if (kind_name == "scripted") {
+    s.device.kind = DeviceKind::scripted;
+    const toml::array* waypoints = device->get_as<toml::array>("waypoints");
+    if (waypoints == nullptr || waypoints->empty()) r.fail("device.waypoints", "a scripted device needs waypoints");
+    for (std::size_t k = 0; k < waypoints->size(); ++k) {
+      s.device.waypoints.push_back(waypoint(r, *waypoints->get(k), "device.waypoints[" + std::to_string(k) + "]"));
+    }
+    for (std::size_t k = 1; k < s.device.waypoints.size(); ++k) {
+      if (!(s.device.waypoints[k].time_s > s.device.waypoints[k - 1].time_s)) {
+        r.fail("device.waypoints[" + std::to_string(k) + "].t", "waypoint times must increase");
+      }
+    }
+  } else if (kind_name == "replay") {
+    s.device.kind = DeviceKind::replay;
+    const toml::node* file = device->get("file");
+    if (file == nullptr) r.fail("device.file", "a replay device needs the CSV file --record wrote");
+    s.device.replay_file = relative_to_file(r.string(*file, "device.file"));
+  } else if (kind_name == "udp") {
+    s.device.kind = DeviceKind::udp;
+    if (const toml::node* n = device->get("address")) s.device.udp_address = r.string(*n, "device.address");
+    if (const toml::node* n = device->get("port")) {
+      const double port = r.number(*n, "device.port");
+      if (port < 1 || port > 65535 || port != std::floor(port)) r.fail("device.port", "must be in 1..65535");
+      s.device.udp_port = static_cast<std::uint16_t>(port);
+    }
+    if (const toml::node* n = device->get("allow_remote"))
+      s.device.udp_allow_remote = r.boolean(*n, "device.allow_remote");
+  } else {
+    r.fail("device.kind", "must be \"scripted\", \"replay\" or \"udp\", got \"" + kind_name + "\"");
+  }
+
+  if (const toml::table* realtime = root["realtime"].as_table()) {
+    r.only(*realtime, "realtime", {"overrun_policy", "max_catch_up_slots"});
+    if (const toml::node* n = realtime->get("overrun_policy")) {
+      const std::string policy = r.string(*n, "realtime.overrun_policy");
+      if (policy == "catch_up") {
+        s.overrun_policy = OverrunPolicy::catch_up;
+      } else if (policy == "skip") {
+        s.overrun_policy = OverrunPolicy::skip;
+      } else {
+        r.fail("realtime.overrun_policy", "must be \"catch_up\" or \"skip\"");
+      }
+    }
+    if (const toml::node* n = realtime->get("max_catch_up_slots")) {
+      const double slots = r.number(*n, "realtime.max_catch_up_slots");
+      if (slots < 1 || slots > 100 || slots != std::floor(slots))
+        r.fail("realtime.max_catch_up_slots", "must be in 1..100");
+      s.max_catch_up_slots = static_cast<int>(slots);
+    }
+  }
+  if (const toml::table* output = root["output"].as_table()) {
+    r.only(*output, "output", {"frame_rate", "png"});
+    if (const toml::node* n = output->get("frame_rate")) {
+      s.frame_rate_hz = r.number(*n, "output.frame_rate");
+      if (s.frame_rate_hz < 0.0 || s.frame_rate_hz > 1000.0) r.fail("output.frame_rate", "must be in [0, 1000] Hz");
+    }
+    if (const toml::node* n = output->get("png")) s.write_png = r.boolean(*n, "output.png");
+  }
+  if (const toml::table* expect = root["expect"].as_table()) {
+    r.only(*expect, "expect", {"min_cut_tets", "max_cut_tets", "contact"});
+    const auto count = [&](const char* key) -> std::optional<std::uint64_t> {
+      const toml::node* n = expect->get(key);
+      if (n == nullptr) return std::nullopt;
+      const double value = r.number(*n, std::string("expect.") + key);
+      if (value < 0 || value != std::floor(value)) r.fail(std::string("expect.") + key, "must be a count");
+      return static_cast<std::uint64_t>(value);
+    };
+    s.expect.min_cut_tets = count("min_cut_tets");
+    s.expect.max_cut_tets = count("max_cut_tets");
+    if (const toml::node* n = expect->get("contact")) s.expect.contact = r.boolean(*n, "expect.contact");
+  }
+  return s;
+}
+
+Scenario load_scenario(const std::filesystem::path& file) {
+  std::ifstream in(file);
+  if (!in) throw ScenarioError(file.string() + ": cannot be read");
+  std::ostringstream text;
+  text << in.rdbuf();
+  return parse_scenario(text.str(), file);
+}
+
+}  // namespace tissue::host

@@ -1,0 +1,261 @@
+// TissueLink, HapticLink and apply_parameters (see fmu_links.hpp).
+#include "session/fmu_links.hpp"
+
+#include "importer/fmu_error.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace tissue::host {
+namespace {
+
+fmi3ValueReference vr(const Fmu3Instance& instance, std::string_view name) {
+  return instance.description().variable(name).value_reference;
+}
+
+void expect_ok(fmi3Status status, Fmu3Instance& instance, const std::string& what) {
+  if (status == fmi3OK || status == fmi3Warning) return;
+  throw FmuError(what + " failed (" + status_name(status) + "): " + instance.log_text());
+}
+
+bool all_finite(std::span<const double> values) {
+  return std::all_of(values.begin(), values.end(), [](double v) { return std::isfinite(v); });
+}
+
+}  // namespace
+
+void apply_parameters(Fmu3Instance& instance, const std::vector<ParameterSetting>& parameters,
+                      const std::string& where) {
+  for (const ParameterSetting& p : parameters) {
+    const std::string key = where + "." + p.name;
+    const ModelVariable* variable = instance.description().find_variable(p.name);
+    if (variable == nullptr) throw ScenarioError(key + ": the FMU has no variable of this name");
+    if (variable->causality != "parameter" && variable->causality != "structuralParameter") {
+      throw ScenarioError(key + ": is a " + variable->causality + ", not a parameter");
+    }
+    const auto* number = std::get_if<double>(&p.value);
+    const auto* integer = std::get_if<std::int64_t>(&p.value);
+    const auto* flag = std::get_if<bool>(&p.value);
+    const auto* text = std::get_if<std::string>(&p.value);
+    const auto* numbers = std::get_if<std::vector<double>>(&p.value);
+    fmi3Status status = fmi3Error;
+    const std::string& type = variable->type;
+    if (type == "Float64") {
+      if (numbers != nullptr) {
+        status = instance.set_float64(p.name, *numbers);
+      } else if (number != nullptr || integer != nullptr) {
+        status = instance.set_float64(p.name, {number != nullptr ? *number : static_cast<double>(*integer)});
+      } else {
+        throw ScenarioError(key + ": a Float64 needs a number");
+      }
+    } else if (type == "Int32" && integer != nullptr) {
+      if (*integer < std::numeric_limits<std::int32_t>::min() || *integer > std::numeric_limits<std::int32_t>::max()) {
+        throw ScenarioError(key + ": out of the Int32 range");
+      }
+      status = instance.set_int32(p.name, {static_cast<std::int32_t>(*integer)});
+    } else if (type == "UInt64" && integer != nullptr) {
+      if (*integer < 0) throw ScenarioError(key + ": must be >= 0");
+      status = instance.set_uint64(p.name, {static_cast<std::uint64_t>(*integer)});
+    } else if (type == "Boolean" && flag != nullptr) {
+      status = instance.set_boolean(p.name, {*flag});
+    } else if (type == "String" && text != nullptr) {
+      status = instance.set_string(p.name, {*text});
+    } else if (type == "Enumeration" && (integer != nullptr || text != nullptr)) {
+      std::int64_t item = integer != nullptr ? *integer : -1;
+      if (text != nullptr) {
+        const auto& types = instance.description().type_definitions();
+        const auto type_it = std::find_if(types.begin(), types.end(),
+                                          [&](const TypeDefinition& t) { return t.name == variable->declared_type; });
+        bool found = false;
+        if (type_it != types.end()) {
+          for (const EnumerationItem& candidate : type_it->items) {
+            if (candidate.name == *text) {
+              item = candidate.value;
+              found = true;
+            }
+          }
+        }
+        if (!found) throw ScenarioError(key + ": \"" + *text + "\" is not an item of " + variable->declared_type);
+      }
+      status = instance.set_int64(p.name, {item});
+    } else {
+      throw ScenarioError(key + ": the value does not fit the variable's type " + type);
+    }
+    if (status != fmi3OK) {
+      const std::string log = instance.log_text();
+      instance.clear_log();
+      throw ScenarioError(key + ": refused by the FMU: " + log);
+    }
+  }
+}
+
+// --- Tissue ---
+
+TissueLink::TissueLink(const Fmu3& fmu, const std::vector<ParameterSetting>& parameters)
+    : m_instance(fmu, "tissue", false),
+      m_tool_position(vr(m_instance, "tool.position")),
+      m_tool_orientation(vr(m_instance, "tool.orientation")),
+      m_tool_mode(vr(m_instance, "tool.mode")),
+      m_float_outputs{vr(m_instance, "contact.point"), vr(m_instance, "contact.normal"),
+                      vr(m_instance, "contact.force"), vr(m_instance, "contact.stiffness"),
+                      vr(m_instance, "cut.bladeDepth")},
+      m_contact_active(vr(m_instance, "contact.active")),
+      m_vertex_count(vr(m_instance, "surface.vertexCount")),
+      m_triangle_count(vr(m_instance, "surface.triangleCount")),
+      m_positions(vr(m_instance, "surface.vertexPositions")),
+      m_triangles(vr(m_instance, "surface.triangles")),
+      m_cut_tets(vr(m_instance, "cutTets")),
+      m_enriched(vr(m_instance, "enrichedVertices")) {
+  apply_parameters(m_instance, parameters, "tissue.parameters");
+  expect_ok(m_instance.enter_initialization_mode(std::nullopt, 0.0, std::nullopt), m_instance,
+            "Tissue: enter initialization mode");
+  expect_ok(m_instance.exit_initialization_mode(), m_instance, "Tissue: exit initialization mode");
+  std::vector<std::uint64_t> capacity;
+  expect_ok(m_instance.get_uint64("surface.vertexCapacity", capacity), m_instance, "Tissue: vertex capacity");
+  m_vertex_capacity = static_cast<std::size_t>(capacity.at(0));
+  expect_ok(m_instance.get_uint64("surface.triangleCapacity", capacity), m_instance, "Tissue: triangle capacity");
+  m_triangle_capacity = static_cast<std::size_t>(capacity.at(0));
+  std::vector<double> blade;
+  expect_ok(m_instance.get_float64("tool.bladeLength", blade), m_instance, "Tissue: blade length");
+  m_blade_length_m = blade.at(0);
+  m_float_buffer.resize(3 + 3 + 3 + 9 + 1);
+  SurfaceFrame rest;
+  read_surface(rest);
+  m_mesh_triangles = rest.triangle_count();
+  const std::size_t vertices = rest.vertex_count();
+  m_rest_lower.fill(std::numeric_limits<double>::infinity());
+  m_rest_upper.fill(-std::numeric_limits<double>::infinity());
+  std::vector<bool> used(vertices, false);
+  for (const std::uint32_t v : rest.triangles) used[v] = true;
+  for (std::size_t v = 0; v < vertices; ++v) {
+    if (!used[v]) continue;
+    for (std::size_t a = 0; a < 3; ++a) {
+      m_rest_lower[a] = std::min(m_rest_lower[a], rest.positions_m[3 * v + a]);
+      m_rest_upper[a] = std::max(m_rest_upper[a], rest.positions_m[3 * v + a]);
+    }
+  }
+}
+
+void TissueLink::set_tool(const ToolCommand& tool) {
+  m_last_tool = tool;
+  const std::array<fmi3ValueReference, 2> vrs{m_tool_position, m_tool_orientation};
+  std::array<double, 7> values{};
+  std::copy(tool.position_m.begin(), tool.position_m.end(), values.begin());
+  std::copy(tool.orientation_wxyz.begin(), tool.orientation_wxyz.end(), values.begin() + 3);
+  (void)m_instance.set_float64(vrs, values);
+  const std::array<fmi3Int64, 1> mode{tool.mode};
+  (void)m_instance.set_int64(std::span<const fmi3ValueReference>(&m_tool_mode, 1), mode);
+}
+
+DoStepResult TissueLink::step(double time_s, double step_s) { return m_instance.do_step(time_s, step_s); }
+
+void TissueLink::read(TissueOutputs& out) {
+  (void)m_instance.get_float64(m_float_outputs, m_float_buffer);
+  const double* f = m_float_buffer.data();
+  std::copy(f, f + 3, out.contact_point_m.begin());
+  std::copy(f + 3, f + 6, out.contact_normal.begin());
+  std::copy(f + 6, f + 9, out.contact_force_n.begin());
+  std::copy(f + 9, f + 18, out.contact_stiffness_n_per_m.begin());
+  out.blade_depth_m = f[18];
+  out.finite = all_finite(m_float_buffer);
+  std::array<fmi3Boolean, 1> active{};
+  (void)m_instance.get_boolean(std::span<const fmi3ValueReference>(&m_contact_active, 1), active);
+  out.contact_active = active[0];
+  std::array<fmi3UInt64, 2> counters{};
+  const std::array<fmi3ValueReference, 2> counter_vrs{m_cut_tets, m_enriched};
+  (void)m_instance.get_uint64(counter_vrs, counters);
+  out.cut_tets = counters[0];
+  out.enriched_vertices = counters[1];
+  out.tool_position_m = m_last_tool.position_m;
+}
+
+void TissueLink::read_surface(SurfaceFrame& frame) {
+  std::array<fmi3UInt64, 2> counts{};
+  const std::array<fmi3ValueReference, 2> count_vrs{m_vertex_count, m_triangle_count};
+  (void)m_instance.get_uint64(count_vrs, counts);
+  frame.positions_m.resize(3 * m_vertex_capacity);
+  frame.triangles.resize(3 * m_triangle_capacity);
+  (void)m_instance.get_float64(std::span<const fmi3ValueReference>(&m_positions, 1), frame.positions_m);
+  (void)m_instance.get_uint32(std::span<const fmi3ValueReference>(&m_triangles, 1), frame.triangles);
+  frame.positions_m.resize(3 * static_cast<std::size_t>(counts[0]));
+  frame.triangles.resize(3 * static_cast<std::size_t>(counts[1]));
+  frame.mesh_triangle_count =
+      std::min(m_mesh_triangles == 0 ? frame.triangle_count() : m_mesh_triangles, frame.triangle_count());
+}
+
+// --- HapticLoop ---
+
+HapticLink::HapticLink(const Fmu3& fmu, const std::vector<ParameterSetting>& parameters)
+    : m_instance(fmu, "haptic", false),
+      m_device_float{vr(m_instance, "device.position"), vr(m_instance, "device.orientation")},
+      m_device_mode(vr(m_instance, "device.toolMode")),
+      m_tissue_float{vr(m_instance, "tissue.time"),
+                     vr(m_instance, "tissue.contactPoint"),
+                     vr(m_instance, "tissue.contactNormal"),
+                     vr(m_instance, "tissue.contactForce"),
+                     vr(m_instance, "tissue.contactStiffness"),
+                     vr(m_instance, "tissue.toolPosition"),
+                     vr(m_instance, "tissue.bladeDepth")},
+      m_tissue_active(vr(m_instance, "tissue.contactActive")),
+      m_out_float{vr(m_instance, "tool.position"), vr(m_instance, "tool.orientation"), vr(m_instance, "device.force")},
+      m_out_energy{vr(m_instance, "passivity.observedEnergy"), vr(m_instance, "passivity.dissipatedEnergy")},
+      m_out_mode(vr(m_instance, "tool.mode")),
+      m_out_flags{vr(m_instance, "force.clamped"), vr(m_instance, "force.rateLimited"),
+                  vr(m_instance, "passivity.acted")} {
+  apply_parameters(m_instance, parameters, "haptic.parameters");
+  expect_ok(m_instance.enter_initialization_mode(std::nullopt, 0.0, std::nullopt), m_instance,
+            "HapticLoop: enter initialization mode");
+  expect_ok(m_instance.exit_initialization_mode(), m_instance, "HapticLoop: exit initialization mode");
+  std::vector<double> max_force;
+  expect_ok(m_instance.get_float64("device.maxForce", max_force), m_instance, "HapticLoop: max force");
+  m_max_force_n = max_force.at(0);
+}
+
+void HapticLink::set_device(const DevicePose& pose) {
+  std::array<double, 7> values{};
+  std::copy(pose.position_m.begin(), pose.position_m.end(), values.begin());
+  std::copy(pose.orientation_wxyz.begin(), pose.orientation_wxyz.end(), values.begin() + 3);
+  (void)m_instance.set_float64(m_device_float, values);
+  const std::array<fmi3Int64, 1> mode{static_cast<fmi3Int64>(pose.mode)};
+  (void)m_instance.set_int64(std::span<const fmi3ValueReference>(&m_device_mode, 1), mode);
+}
+
+void HapticLink::set_tissue(const TissueOutputs& t) {
+  std::array<double, 1 + 3 + 3 + 3 + 9 + 3 + 1> values{};
+  auto* p = values.data();
+  *p++ = t.time_s;
+  p = std::copy(t.contact_point_m.begin(), t.contact_point_m.end(), p);
+  p = std::copy(t.contact_normal.begin(), t.contact_normal.end(), p);
+  p = std::copy(t.contact_force_n.begin(), t.contact_force_n.end(), p);
+  p = std::copy(t.contact_stiffness_n_per_m.begin(), t.contact_stiffness_n_per_m.end(), p);
+  p = std::copy(t.tool_position_m.begin(), t.tool_position_m.end(), p);
+  *p = t.blade_depth_m;
+  (void)m_instance.set_float64(m_tissue_float, values);
+  const std::array<fmi3Boolean, 1> active{t.contact_active};
+  (void)m_instance.set_boolean(std::span<const fmi3ValueReference>(&m_tissue_active, 1), active);
+}
+
+DoStepResult HapticLink::step(double time_s, double step_s) { return m_instance.do_step(time_s, step_s); }
+
+void HapticLink::read(HapticOutputs& out) {
+  std::array<double, 10> values{};
+  (void)m_instance.get_float64(m_out_float, values);
+  std::copy(values.begin(), values.begin() + 3, out.tool.position_m.begin());
+  std::copy(values.begin() + 3, values.begin() + 7, out.tool.orientation_wxyz.begin());
+  std::copy(values.begin() + 7, values.end(), out.device_force_n.begin());
+  std::array<double, 2> energy{};
+  (void)m_instance.get_float64(m_out_energy, energy);
+  out.observed_energy_j = energy[0];
+  out.dissipated_energy_j = energy[1];
+  std::array<fmi3Int64, 1> mode{};
+  (void)m_instance.get_int64(std::span<const fmi3ValueReference>(&m_out_mode, 1), mode);
+  out.tool.mode = mode[0];
+  std::array<fmi3Boolean, 3> flags{};
+  (void)m_instance.get_boolean(m_out_flags, flags);
+  out.clamped = flags[0];
+  out.rate_limited = flags[1];
+  out.passivity_acted = flags[2];
+}
+
+}  // namespace tissue::host

@@ -1,0 +1,110 @@
+// The host's two FMU instances as the session uses them: the Tissue FMU (tool pose in; contact,
+// counters and surface out) and the HapticLoop FMU (device and tissue sample in; tool pose and
+// device force out). Value references are looked up once by name; the calls of a step or a tick
+// are the importer's thin calls on preallocated buffers (no allocation, no exception). Scenario
+// parameters are applied by name, converted to each variable's type, and refused with the key.
+#pragma once
+
+#include "device/device.hpp"
+#include "importer/fmu3.hpp"
+#include "importer/fmu3_instance.hpp"
+#include "output/surface_frame.hpp"
+#include "scenario/scenario.hpp"
+
+#include <array>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace tissue::host {
+
+/// Haptic side -> dynamics side: the tool the tissue steps with.
+struct ToolCommand {
+  double time_s = 0.0;
+  std::array<double, 3> position_m{};
+  std::array<double, 4> orientation_wxyz{1.0, 0.0, 0.0, 0.0};
+  std::int64_t mode = 0;
+};
+
+/// Dynamics side -> haptic side: the tissue's outputs after a step, and the time they are for.
+struct TissueOutputs {
+  double time_s = 0.0;
+  bool contact_active = false;
+  std::array<double, 3> contact_point_m{}, contact_normal{}, contact_force_n{};
+  std::array<double, 9> contact_stiffness_n_per_m{};
+  std::array<double, 3> tool_position_m{};
+  double blade_depth_m = 0.0;
+  std::uint64_t cut_tets = 0, enriched_vertices = 0;
+  bool finite = true;  ///< every number above is finite
+};
+
+/// What the haptic loop outputs after a tick.
+struct HapticOutputs {
+  ToolCommand tool;
+  std::array<double, 3> device_force_n{};
+  double observed_energy_j = 0.0, dissipated_energy_j = 0.0;
+  bool clamped = false, rate_limited = false, passivity_acted = false;
+};
+
+/// Applies scenario parameters by name; throws ScenarioError naming `where`.name for a variable
+/// the FMU does not have, a value of the wrong kind, or a value the FMU refuses (with its log).
+void apply_parameters(Fmu3Instance& instance, const std::vector<ParameterSetting>& parameters,
+                      const std::string& where);
+
+class TissueLink {
+ public:
+  /// Instantiates, applies the parameters, initializes at t = 0. Throws ScenarioError / FmuError.
+  TissueLink(const Fmu3& fmu, const std::vector<ParameterSetting>& parameters);
+
+  void set_tool(const ToolCommand& tool);
+  DoStepResult step(double time_s, double step_s);
+  void read(TissueOutputs& outputs);
+  /// The surface into `frame` (its vectors keep their capacity: no allocation after the first).
+  void read_surface(SurfaceFrame& frame);
+  /// Axis-aligned box of the surface at rest (after initialization).
+  [[nodiscard]] const std::array<double, 3>& rest_lower() const { return m_rest_lower; }
+  [[nodiscard]] const std::array<double, 3>& rest_upper() const { return m_rest_upper; }
+  [[nodiscard]] std::size_t mesh_triangle_count() const { return m_mesh_triangles; }
+  [[nodiscard]] double blade_length_m() const { return m_blade_length_m; }
+  [[nodiscard]] Fmu3Instance& instance() { return m_instance; }
+
+ private:
+  Fmu3Instance m_instance;
+  fmi3ValueReference m_tool_position, m_tool_orientation, m_tool_mode;
+  std::array<fmi3ValueReference, 5> m_float_outputs{};  // point, normal, force, stiffness, blade depth
+  fmi3ValueReference m_contact_active, m_vertex_count, m_triangle_count, m_positions, m_triangles, m_cut_tets,
+      m_enriched;
+  std::size_t m_vertex_capacity = 0, m_triangle_capacity = 0;
+  std::vector<double> m_float_buffer;
+  std::array<double, 3> m_rest_lower{}, m_rest_upper{};
+  std::size_t m_mesh_triangles = 0;
+  double m_blade_length_m = 0.0;
+  ToolCommand m_last_tool;
+};
+
+class HapticLink {
+ public:
+  HapticLink(const Fmu3& fmu, const std::vector<ParameterSetting>& parameters);
+
+  void set_device(const DevicePose& pose);
+  /// A new tissue sample (only finite outputs are passed on; the caller checks `finite`).
+  void set_tissue(const TissueOutputs& tissue);
+  DoStepResult step(double time_s, double step_s);
+  void read(HapticOutputs& outputs);
+  [[nodiscard]] double max_force_n() const { return m_max_force_n; }
+  [[nodiscard]] Fmu3Instance& instance() { return m_instance; }
+
+ private:
+  Fmu3Instance m_instance;
+  std::array<fmi3ValueReference, 2> m_device_float{};  // position, orientation
+  fmi3ValueReference m_device_mode;
+  std::array<fmi3ValueReference, 7> m_tissue_float{};  // time, point, normal, force, stiffness, tool position, depth
+  fmi3ValueReference m_tissue_active;
+  std::array<fmi3ValueReference, 3> m_out_float{};  // tool position, tool orientation, device force
+  std::array<fmi3ValueReference, 2> m_out_energy{};
+  fmi3ValueReference m_out_mode;
+  std::array<fmi3ValueReference, 3> m_out_flags{};
+  double m_max_force_n = 0.0;
+};
+
+}  // namespace tissue::host

@@ -1,0 +1,68 @@
+// One haptic session (DESIGN section 5, dissertation 5.1.3): the HapticLoop FMU ticked at 1 kHz
+// on a haptic thread with absolute deadlines, the Tissue FMU stepped on a dynamics thread, the two
+// exchanging snapshots (LatestValue) at the start and end of each tissue step; a device in, forces
+// out; frames, a log and a summary written to one folder. `offline` runs the same schedule on one
+// thread without sleeping: the result of tissue step k reaches the haptic loop at the start of slot
+// k + 1 (the real-time worst case), so two offline runs are byte-identical.
+#pragma once
+
+#include "device/device.hpp"
+#include "scenario/scenario.hpp"
+
+#include <cstdint>
+#include <filesystem>
+#include <iosfwd>
+#include <optional>
+#include <string>
+
+namespace tissue::host {
+
+struct SessionOptions {
+  std::filesystem::path output_dir = "session";
+  bool offline = false;
+  std::optional<std::filesystem::path> record;  ///< write the device poses as a replayable CSV
+  std::filesystem::path fmu_dir;                ///< where Tissue.fmu and HapticLoop.fmu are by default
+  std::ostream* progress = nullptr;             ///< a progress line while the run goes (nullptr: quiet)
+  bool realtime_priority = true;                ///< try SCHED_FIFO for the two threads
+};
+
+struct Percentiles {
+  double p50 = 0.0, p99 = 0.0, max = 0.0;
+};
+
+struct SessionSummary {
+  std::string scenario;
+  bool offline = false;
+  double sim_time_s = 0.0, wall_time_s = 0.0, realtime_factor = 0.0;
+  double haptic_rate_hz = 0.0;
+  Percentiles haptic_period_us;
+  std::uint64_t haptic_ticks = 0, deadline_misses = 0;
+  Percentiles tissue_step_ms, tissue_step_before_cut_ms, tissue_step_during_cut_ms;
+  double tissue_step_s = 0.0;
+  std::uint64_t tissue_steps = 0, tissue_overruns = 0, skipped_slots = 0, catch_up_slots = 0;
+  std::uint64_t tissue_discards = 0, tissue_errors = 0, haptic_errors = 0, samples_not_finite = 0;
+  std::uint64_t cut_tets = 0, enriched_vertices = 0;
+  bool contact_seen = false;
+  double max_device_force_n = 0.0, device_max_force_n = 0.0;
+  double passivity_dissipated_j = 0.0, passivity_observed_j = 0.0;
+  bool nan_detected = false;
+  std::string device_name;
+  DeviceCounters device;
+  std::uint64_t frames_written = 0, frames_dropped = 0;
+  bool realtime_priority = false;
+  std::string realtime_priority_note;
+  std::string first_error;
+  std::string overrun_policy;
+
+  [[nodiscard]] std::string to_json() const;
+};
+
+/// Runs the scenario; writes summary.json, log.csv, frames/*.vtu with surface.pvd and final.png into
+/// options.output_dir. Throws ScenarioError / FmuError / std::runtime_error when it cannot start;
+/// failures during the run are counted in the summary.
+SessionSummary run_session(const Scenario& scenario, const SessionOptions& options);
+
+/// The summary in a few lines, and where the outputs are.
+void print_summary(std::ostream& out, const SessionSummary& summary, const std::filesystem::path& output_dir);
+
+}  // namespace tissue::host

@@ -1,0 +1,14 @@
+# Tests of host/device/ (label "host"): the UDP packet format and UdpDevice over loopback, with
+# the driver-side UdpSender; and tissue-udp-sender, a scripted driver built on the same class.
+add_executable(test_udp_device
+  ${CMAKE_CURRENT_LIST_DIR}/test_udp_device.cpp
+  ${CMAKE_CURRENT_LIST_DIR}/udp_sender.cpp)
+target_include_directories(test_udp_device PRIVATE ${CMAKE_CURRENT_LIST_DIR} ${PROJECT_SOURCE_DIR}/tests)
+target_link_libraries(test_udp_device PRIVATE tissue::host_device GTest::gtest GTest::gtest_main tissue::warnings)
+gtest_discover_tests(test_udp_device PROPERTIES LABELS "host" DISCOVERY_TIMEOUT 60)
+
+add_executable(tissue-udp-sender
+  ${CMAKE_CURRENT_LIST_DIR}/udp_sender_main.cpp
+  ${CMAKE_CURRENT_LIST_DIR}/udp_sender.cpp)
+target_include_directories(tissue-udp-sender PRIVATE ${CMAKE_CURRENT_LIST_DIR})
+target_link_libraries(tissue-udp-sender PRIVATE tissue::host_device tissue::warnings)

@@ -1,0 +1,11 @@
+# Sessions of tissue-host (label "host"): every scenario offline, reproducibility, record and
+# replay, the real-time threads (the tsan preset's data-race check), scenario files refused.
+if(NOT TARGET tissue::host_session)
+  return()
+endif()
+add_executable(test_host_session ${CMAKE_CURRENT_LIST_DIR}/test_session.cpp)
+target_link_libraries(test_host_session PRIVATE tissue::host_session GTest::gtest GTest::gtest_main tissue::warnings)
+target_compile_definitions(test_host_session PRIVATE TISSUE_SCENARIO_DIR="${PROJECT_SOURCE_DIR}/host/scenarios"
+                                                     TISSUE_FMU_DIR="${CMAKE_BINARY_DIR}/fmus")
+add_dependencies(test_host_session tissue_fmu_package hapticloop_fmu_package)
+gtest_discover_tests(test_host_session PROPERTIES LABELS "host" DISCOVERY_TIMEOUT 60)

@@ -1,0 +1,168 @@
+// tissue-host's sessions (host/session) on the built Tissue.fmu and HapticLoop.fmu:
+// * every scenario in host/scenarios runs offline with the cut counts it expects, the device force
+//   never above the device's maximum, no NaN, and two offline runs write byte-identical logs and
+//   frames;
+// * a recorded session replayed offline is the same session;
+// * the threaded real-time path runs a short session with both threads (under the tsan preset this
+//   is the data-race check);
+// * scenario files with mistakes are refused naming the key.
+#include "scenario/scenario.hpp"
+#include "session/session.hpp"
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+namespace tissue::host {
+namespace {
+
+const std::filesystem::path SCENARIOS = TISSUE_SCENARIO_DIR;
+const std::filesystem::path FMUS = TISSUE_FMU_DIR;
+
+std::filesystem::path fresh_dir(const std::string& name) {
+  const std::filesystem::path dir = std::filesystem::temp_directory_path() / ("tissue_host_test_" + name);
+  std::filesystem::remove_all(dir);
+  return dir;
+}
+
+std::string contents(const std::filesystem::path& file) {
+  std::ifstream in(file, std::ios::binary);
+  std::ostringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
+SessionSummary run_offline(const Scenario& scenario, const std::filesystem::path& dir,
+                           std::optional<std::filesystem::path> record = std::nullopt) {
+  SessionOptions options;
+  options.offline = true;
+  options.output_dir = dir;
+  options.fmu_dir = FMUS;
+  options.record = std::move(record);
+  return run_session(scenario, options);
+}
+
+// Every frame file and the logs of two runs, byte for byte.
+void expect_same_outputs(const std::filesystem::path& a, const std::filesystem::path& b) {
+  EXPECT_EQ(contents(a / "log.csv"), contents(b / "log.csv"));
+  EXPECT_EQ(contents(a / "surface.pvd"), contents(b / "surface.pvd"));
+  std::vector<std::string> frames;
+  for (const auto& entry : std::filesystem::directory_iterator(a / "frames")) {
+    frames.push_back(entry.path().filename().string());
+  }
+  ASSERT_FALSE(frames.empty());
+  for (const std::string& frame : frames) {
+    EXPECT_EQ(contents(a / "frames" / frame), contents(b / "frames" / frame)) << frame;
+  }
+  EXPECT_EQ(contents(a / "final.png"), contents(b / "final.png"));
+}
+
+class EveryScenario : public ::testing::TestWithParam<std::string> {};
+
+TEST_P(EveryScenario, RunsOfflineAsExpectedAndReproducibly) {
+  const Scenario scenario = load_scenario(SCENARIOS / (GetParam() + ".toml"));
+  const std::filesystem::path first = fresh_dir(GetParam() + "_1"), second = fresh_dir(GetParam() + "_2");
+  const SessionSummary a = run_offline(scenario, first);
+  EXPECT_FALSE(a.nan_detected);
+  EXPECT_EQ(a.tissue_errors, 0u) << a.first_error;
+  EXPECT_EQ(a.haptic_errors, 0u);
+  EXPECT_LE(a.max_device_force_n, a.device_max_force_n + 1e-12);
+  if (scenario.expect.min_cut_tets) {
+    EXPECT_GE(a.cut_tets, *scenario.expect.min_cut_tets);
+  }
+  if (scenario.expect.max_cut_tets) {
+    EXPECT_LE(a.cut_tets, *scenario.expect.max_cut_tets);
+  }
+  if (scenario.expect.contact) {
+    EXPECT_EQ(a.contact_seen, *scenario.expect.contact);
+  }
+  EXPECT_GT(a.frames_written, 0u);
+  EXPECT_TRUE(std::filesystem::exists(first / "summary.json"));
+  const SessionSummary b = run_offline(scenario, second);
+  EXPECT_EQ(b.cut_tets, a.cut_tets);
+  expect_same_outputs(first, second);
+}
+
+INSTANTIATE_TEST_SUITE_P(HostScenarios, EveryScenario,
+                         ::testing::Values("poke_frog", "cut_frog_complete", "cut_frog_partial", "beam_two_cuts",
+                                           "careless_hand"));
+
+TEST(Replay, ARecordedSessionReplayedIsTheSameSession) {
+  const Scenario scripted = load_scenario(SCENARIOS / "cut_frog_partial.toml");
+  const std::filesystem::path recorded = fresh_dir("recorded"), replayed = fresh_dir("replayed");
+  std::filesystem::create_directories(recorded);
+  const std::filesystem::path recording = recorded / "hand.csv";
+  const SessionSummary original = run_offline(scripted, recorded, recording);
+  Scenario replay = scripted;
+  replay.device = DeviceConfig{};
+  replay.device.kind = DeviceKind::replay;
+  replay.device.replay_file = recording;
+  const SessionSummary again = run_offline(replay, replayed);
+  EXPECT_EQ(again.cut_tets, original.cut_tets);
+  EXPECT_GT(original.cut_tets, 0u);
+  EXPECT_EQ(contents(recorded / "log.csv"), contents(replayed / "log.csv"));
+}
+
+TEST(RealTime, BothThreadsRunAShortSessionOnTheirDeadlines) {
+  Scenario scenario = load_scenario(SCENARIOS / "poke_frog.toml");
+  scenario.duration_s = 0.6;
+  scenario.write_png = false;
+  SessionOptions options;
+  options.output_dir = fresh_dir("realtime");
+  options.fmu_dir = FMUS;
+  options.realtime_priority = false;
+  const SessionSummary s = run_session(scenario, options);
+  EXPECT_EQ(s.haptic_ticks, 600u);
+  EXPECT_FALSE(s.nan_detected);
+  EXPECT_EQ(s.haptic_errors, 0u);
+  EXPECT_EQ(s.tissue_errors, 0u) << s.first_error;
+  EXPECT_GT(s.tissue_steps, 0u);
+  EXPECT_GT(s.wall_time_s, 0.59);  // it kept wall time (no sleeping would finish far sooner)
+  EXPECT_LE(s.max_device_force_n, s.device_max_force_n + 1e-12);
+  // Every tick was logged with its session time.
+  std::ifstream log(options.output_dir / "log.csv");
+  std::string line;
+  std::size_t rows = 0;
+  while (std::getline(log, line)) ++rows;
+  EXPECT_EQ(rows, 601u);
+}
+
+TEST(ScenarioFile, MistakesAreRefusedNamingTheKey) {
+  const auto refused = [](const std::string& text, const std::string& key) {
+    try {
+      (void)parse_scenario(text, "test.toml");
+      ADD_FAILURE() << "accepted: " << text;
+    } catch (const ScenarioError& error) {
+      EXPECT_NE(std::string(error.what()).find(key), std::string::npos) << error.what();
+    }
+  };
+  const std::string device = "\n[device]\nwaypoints = [ { t = 0.0, position = [0, 0, 0] } ]\n";
+  refused("[scenario]\nduration = 1.0\n[device]\nkind = \"scripted\"\n", "device.waypoints");
+  refused("[scenario]\nduration = -1.0\n" + device, "scenario.duration");
+  refused("[scenario]\nduration = 1.0\ncolour = 3\n" + device, "scenario.colour");
+  refused("[scenario]\nduration = 1.0\n[tissue]\ncommunication_step = 0.0105\n" + device, "tissue.communication_step");
+  refused(
+      "[scenario]\nduration = 1.0\n[device]\nwaypoints = [ { t = 1.0, position = [0, 0, 0] }, "
+      "{ t = 0.5, position = [0, 0, 0] } ]\n",
+      "device.waypoints[1].t");
+  refused("[scenario]\nduration = 1.0\n[device]\nwaypoints = [ { t = 0.0, position = [0, 0, 0], mode = \"knife\" } ]\n",
+          "mode");
+  refused("[scenario]\nduration = 1.0\n[device]\nkind = \"joystick\"\n", "device.kind");
+  refused("[scenario\nduration = 1.0\n", "test.toml:1");
+  refused("[scenario]\nduration = 1.0\n[device]\nkind = \"udp\"\nport = 70000\n", "device.port");
+}
+
+TEST(ScenarioFile, AParameterTheFmuRefusesStopsTheSessionBeforeItStarts) {
+  Scenario scenario = load_scenario(SCENARIOS / "poke_frog.toml");
+  scenario.tissue_parameters.push_back(ParameterSetting{"material.poissonRatio", 0.5});
+  EXPECT_THROW((void)run_offline(scenario, fresh_dir("refused")), ScenarioError);
+  scenario.tissue_parameters.back() = ParameterSetting{"material.colour", 1.0};
+  EXPECT_THROW((void)run_offline(scenario, fresh_dir("refused")), ScenarioError);
+}
+
+}  // namespace
+}  // namespace tissue::host
