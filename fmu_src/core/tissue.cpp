@@ -111,12 +111,15 @@ bool same_cut(const TetCut& a, const TetCut& b) {
          a.volume_fraction_above == b.volume_fraction_above && a.edge_ratio == b.edge_ratio;
 }
 
-PointContactSettings contact_settings(const InteractionSettings& settings, const DeformableBody& body,
+PointContactSettings contact_settings(const TissueSettings& settings, const DeformableBody& body,
                                       const SurfaceMesh& surface) {
   PointContactSettings contact;
-  contact.spring_stiffness_n_per_m = settings.contact_spring_stiffness_n_per_m > 0.0
-                                         ? settings.contact_spring_stiffness_n_per_m
-                                         : recommended_contact_spring_stiffness_n_per_m(body, surface);
+  const double stiffness = settings.interaction.contact_spring_stiffness_n_per_m;
+  contact.spring_stiffness_n_per_m =
+      stiffness > 0.0 ? stiffness : recommended_contact_spring_stiffness_n_per_m(body, surface);
+  // The spring stands for the rigid tool: the backward-Euler step must not damp it (issue 9).
+  contact.spring_tangent_fraction =
+      undamped_tangent_fraction(settings.step_size_s, settings.body.damping.stiffness_damping_s);
   return contact;
 }
 
@@ -172,7 +175,7 @@ Tissue::Tissue(TetMesh mesh, TissueSettings settings)
                 ? m_surface.triangles
                 : std::vector<std::array<int, 3>>{},
             m_positions_m),
-      m_contact(contact_settings(m_settings.interaction, m_body, m_surface)),
+      m_contact(contact_settings(m_settings, m_body, m_surface)),
       m_model_fingerprint(model_fingerprint_of(m_body.mesh(), m_settings)) {
   m_state.displacement_m.setZero(m_body.dof_count());
   m_state.velocity_m_per_s.setZero(m_body.dof_count());
@@ -364,8 +367,10 @@ void Tissue::update_contact_output() {
   const std::optional<PointSpring>& spring = m_body.point_spring();
   std::optional<Eigen::Matrix3d> stiffness;
   if (spring) {
+    // What the factorized matrix holds of the spring: its share of the tangent, times the scale.
+    const double in_matrix = system.stiffness_scale * spring->tangent_fraction * spring->stiffness_n_per_m;
     stiffness = m_effective_stiffness.stiffness_n_per_m(
-        point, contact_interpolation(m_body.dofs(), spring->vertices, spring->weights), spring->stiffness_n_per_m);
+        point, contact_interpolation(m_body.dofs(), spring->vertices, spring->weights), in_matrix);
   } else {
     stiffness = m_effective_stiffness.stiffness_n_per_m(point);
   }

@@ -10,7 +10,7 @@ namespace tissue {
 namespace {
 
 constexpr std::uint64_t MAGIC = 0x31305353'49535354ULL;  // "TSSISS01" read as little-endian bytes
-constexpr std::uint32_t VERSION = 1;
+constexpr std::uint32_t VERSION = 2;                     // 2: PointSpring::tangent_fraction
 
 // The core's Eigen types and cut records on top of the shared byte stream.
 class Writer : public serial::ByteWriter {
@@ -143,6 +143,7 @@ std::vector<std::uint8_t> serialize_snapshot(const TissueSnapshot& s) {
     w.put(s.point_spring->weights);
     w.put(s.point_spring->target_m);
     w.put(s.point_spring->stiffness_n_per_m);
+    w.put(s.point_spring->tangent_fraction);
   }
   put_tool(w, s.tool);
   put_tool(w, s.previous_tool);
@@ -199,6 +200,7 @@ TissueSnapshot read_snapshot(std::span<const std::uint8_t> bytes) {
     r.get(spring.weights);
     r.get(spring.target_m);
     r.get(spring.stiffness_n_per_m);
+    r.get(spring.tangent_fraction);
     s.point_spring = spring;
   }
   s.tool = get_tool(r);

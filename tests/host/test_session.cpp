@@ -11,6 +11,8 @@
 
 #include <gtest/gtest.h>
 
+#include <array>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -44,6 +46,24 @@ SessionSummary run_offline(const Scenario& scenario, const std::filesystem::path
   options.fmu_dir = FMUS;
   options.record = std::move(record);
   return run_session(scenario, options);
+}
+
+// The largest change of the device force from one tick to the next in log.csv [N].
+double largest_force_step_n(const std::filesystem::path& log_file) {
+  std::ifstream log(log_file);
+  std::string line;
+  std::getline(log, line);  // header
+  std::array<double, 3> previous{};
+  double largest = 0.0;
+  while (std::getline(log, line)) {
+    std::vector<double> fields;
+    std::stringstream row(line);
+    for (std::string field; std::getline(row, field, ',');) fields.push_back(std::stod(field));
+    const std::array<double, 3> force{fields.at(8), fields.at(9), fields.at(10)};
+    largest = std::max(largest, std::hypot(force[0] - previous[0], force[1] - previous[1], force[2] - previous[2]));
+    previous = force;
+  }
+  return largest;
 }
 
 // Every frame file and the logs of two runs, byte for byte.
@@ -81,6 +101,9 @@ TEST_P(EveryScenario, RunsOfflineAsExpectedAndReproducibly) {
     EXPECT_EQ(a.contact_seen, *scenario.expect.contact);
   }
   EXPECT_GT(a.frames_written, 0u);
+  // No kick, whatever the hand or the cuts do: the HapticLoop's rate limit (device.maxForceRate,
+  // 300 N/s by default) over a 1 ms tick, plus rounding.
+  EXPECT_LE(largest_force_step_n(first / "log.csv"), 300.0 * 1e-3 + 1e-9);
   EXPECT_TRUE(std::filesystem::exists(first / "summary.json"));
   const SessionSummary b = run_offline(scenario, second);
   EXPECT_EQ(b.cut_tets, a.cut_tets);

@@ -14,6 +14,10 @@ void validate(const PointContactSettings& settings) {
     throw ParameterError("contact spring stiffness must be finite and > 0 N/m, got " +
                          std::to_string(settings.spring_stiffness_n_per_m));
   }
+  if (!(settings.spring_tangent_fraction > 0.0 && settings.spring_tangent_fraction <= 1.0)) {
+    throw ParameterError("contact spring tangent fraction must be in (0, 1], got " +
+                         std::to_string(settings.spring_tangent_fraction));
+  }
 }
 
 PointContact::PointContact(PointContactSettings settings) : m_settings(settings) { validate(m_settings); }
@@ -67,7 +71,7 @@ bool PointContact::update(const Eigen::Vector3d& hip_previous_m, const Eigen::Ve
 std::optional<PointSpring> PointContact::spring(const SurfaceBvh& surface) const {
   if (!m_in_contact) return std::nullopt;
   return PointSpring{surface.triangle(m_proxy.triangle), m_proxy.barycentric, m_hip_m,
-                     m_settings.spring_stiffness_n_per_m};
+                     m_settings.spring_stiffness_n_per_m, m_settings.spring_tangent_fraction};
 }
 
 void PointContact::apply(const SurfaceBvh& surface, DeformableBody& body) const {

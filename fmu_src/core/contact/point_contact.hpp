@@ -14,6 +14,15 @@
 // that does not move the body would instead render a rigid wall of stiffness K_c that the tissue
 // never feels.
 //
+// The spring is not Rayleigh-damped (issue 9). It stands for the rigid tool, not for tissue, but
+// in the tangent whole it would be damped as tissue is, beta k v_p against a fixed frame: the tool
+// dragged a viscous beta k v (beta = 0.01 s, k ~ 1e5 N/m, a 5.75 cm/s press: 60 N where the tissue
+// gives 2 N). It enters the tangent with the share undamped_tangent_fraction(h, beta)
+// (spring_tangent_fraction), so the backward-Euler step takes it undamped; the tissue keeps its
+// own damping, and pressing at a speed v the tool feels the quasi-static force plus beta K_n v
+// (K_n the contact's normal stiffness; tests/physics/test_contact_press.cpp). The force on the
+// tool is the spring's at the end of the step, k (x_p - HIP), the reaction of the body.
+//
 // The spring is isotropic (DeformableBody::PointSpring), so within a step it also holds the
 // material point tangentially; the re-projection then releases only the tangential stretch
 // |f_t| / k per step, and a tangential load relaxes by a factor (1 - k_t / k) per step (k_t the
@@ -38,9 +47,13 @@ struct PointContactSettings {
   /// Stiffness k of the spring from the proxy's material point to the HIP [N/m], finite and > 0.
   /// Choose it >> the contact's normal stiffness: recommended_contact_spring_stiffness_n_per_m().
   double spring_stiffness_n_per_m = 1.0e4;
+  /// The spring's PointSpring::tangent_fraction, in (0, 1]: undamped_tangent_fraction(h, beta) for
+  /// the backward-Euler step of h the spring acts in (the spring is not tissue: see above); 1
+  /// damps it like tissue, beta k, which the tool then feels as a drag of beta k v.
+  double spring_tangent_fraction = 1.0;
 };
 
-/// Throws ParameterError unless the spring stiffness is finite and > 0.
+/// Throws ParameterError unless the spring stiffness is finite and > 0 and its tangent fraction in (0, 1].
 void validate(const PointContactSettings& settings);
 
 class PointContact {

@@ -417,7 +417,7 @@ void DeformableBody::add_point_spring(BlockSparseMatrix* tangent) {
     for (size_t j = 0; j < 3; ++j) {
       const int slot = m_point_spring_slots[3 * i + j];
       if (slot < 0) continue;  // a fixed vertex
-      tangent->block(slot).diagonal().array() += spring.stiffness_n_per_m *
+      tangent->block(slot).diagonal().array() += spring.tangent_fraction * spring.stiffness_n_per_m *
                                                  spring.weights[static_cast<Eigen::Index>(i)] *
                                                  spring.weights[static_cast<Eigen::Index>(j)];
     }
@@ -440,6 +440,10 @@ void DeformableBody::set_point_spring(std::optional<PointSpring> spring) {
     if (!std::isfinite(s.stiffness_n_per_m) || s.stiffness_n_per_m < 0.0) {
       throw ParameterError("point spring: stiffness must be finite and >= 0, got " +
                            std::to_string(s.stiffness_n_per_m));
+    }
+    if (!(s.tangent_fraction > 0.0 && s.tangent_fraction <= 1.0)) {
+      throw ParameterError("point spring: the tangent fraction must be in (0, 1], got " +
+                           std::to_string(s.tangent_fraction));
     }
     for (const int a : s.vertices) {
       for (const int b : s.vertices) {

@@ -42,6 +42,11 @@ struct PointSpring {
   Eigen::Vector3d weights = Eigen::Vector3d::Constant(1.0 / 3.0);  ///< w_i, summing to 1
   Eigen::Vector3d target_m = Eigen::Vector3d::Zero();
   double stiffness_n_per_m = 0.0;
+  /// The share of k entered in tangent(), in (0, 1]. 1 makes tangent() = d f_int / du; but the
+  /// integrators damp the tangent (D = alpha M + beta K), which damps the spring like tissue,
+  /// beta k against a fixed frame. undamped_tangent_fraction() (backward_euler.hpp) takes the
+  /// damping out of a backward-Euler step. The force is k (x_p - target) whatever the share.
+  double tangent_fraction = 1.0;
 };
 
 /// One enriched unknown a (3 components, one block row): listed once per (vertex, cut id, side),
@@ -119,9 +124,9 @@ class DeformableBody final : public DynamicsModel {
   // --- Point spring (god-object contact) ---
 
   /// While set, evaluate() adds the spring's force k w_i (x_p - target) to f_int of each free
-  /// vertex i and k w_i w_j I to the tangent. Throws ParameterError (spring unchanged) unless the
-  /// vertices are in range, every pair of free ones shares a tet, weights and target are finite with
-  /// |sum w - 1| <= 1e-6, and 0 <= k < inf.
+  /// vertex i and c k w_i w_j I to the tangent (c its tangent_fraction). Throws ParameterError
+  /// (spring unchanged) unless the vertices are in range, every pair of free ones shares a tet,
+  /// weights and target are finite with |sum w - 1| <= 1e-6, 0 <= k < inf and 0 < c <= 1.
   void set_point_spring(std::optional<PointSpring> spring);
   [[nodiscard]] const std::optional<PointSpring>& point_spring() const { return m_point_spring; }
   /// k (target - x_p) at the last evaluate(): the force the spring applies to the body (zero without

@@ -14,6 +14,18 @@ double seconds_since(std::chrono::steady_clock::time_point start) {
 
 }  // namespace
 
+double undamped_tangent_fraction(double step_size_s, double stiffness_damping_s) {
+  if (!(step_size_s > 0.0) || !std::isfinite(step_size_s)) {
+    throw ParameterError("undamped tangent fraction: step size must be finite and > 0 s, got " +
+                         std::to_string(step_size_s));
+  }
+  if (!(stiffness_damping_s >= 0.0) || !std::isfinite(stiffness_damping_s)) {
+    throw ParameterError("undamped tangent fraction: beta must be finite and >= 0 s, got " +
+                         std::to_string(stiffness_damping_s));
+  }
+  return step_size_s / (step_size_s + stiffness_damping_s);
+}
+
 BackwardEuler::BackwardEuler(std::unique_ptr<LinearSolver> solver, Settings settings)
     : m_solver(std::move(solver)), m_settings(settings) {
   if (!m_solver) throw std::invalid_argument("BackwardEuler needs a linear solver");

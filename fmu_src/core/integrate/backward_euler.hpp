@@ -11,6 +11,13 @@
 
 namespace tissue {
 
+/// The share of a stiffness k to enter in the tangent so that this step takes it undamped: the
+/// matrix holds (h beta + h^2) K and the right side (beta + h) K v, so k h / (h + beta) in K
+/// contributes h^2 k and h k v, the undamped step of k (its force, k times the stretch, is entered
+/// whole). For the god-object's contact spring, which stands for the rigid tool, not for tissue
+/// (point_contact.hpp). Throws ParameterError unless h > 0 and beta >= 0 are finite.
+double undamped_tangent_fraction(double step_size_s, double stiffness_damping_s);
+
 class BackwardEuler final : public Integrator {
  public:
   struct Settings {

@@ -34,7 +34,9 @@ SettledPress press_and_hold(DeformableBody& body, const SurfaceMesh& surface, do
   Eigen::VectorXd x;
   body.positions(state.displacement_m, x);
   SurfaceBvh bvh(surface.triangles, x);
-  PointContact contact(PointContactSettings{spring_n_per_m});
+  const double step_size_s = 1e-2;
+  PointContact contact(
+      PointContactSettings{spring_n_per_m, undamped_tangent_fraction(step_size_s, body.damping().stiffness_damping_s)});
   Eigen::Vector3d hip_previous = hip_outside;
   SettledPress press;
   int quiet_steps = 0;
@@ -45,7 +47,7 @@ SettledPress press_and_hold(DeformableBody& body, const SurfaceMesh& surface, do
     EXPECT_TRUE(contact.update(hip_previous, hip, x, bvh));
     hip_previous = hip;
     contact.apply(bvh, body);
-    integrator.step(body, state, 1e-2);
+    integrator.step(body, state, step_size_s);
     body.positions(state.displacement_m, x);
     press.force_on_tool_n = contact.force_on_tool_n(bvh, x);
     press.proxy_m = surface_point_position_m(contact.proxy(), surface.triangles, x);

@@ -98,6 +98,7 @@ TEST(PointContact, StartsWhenTheToolEntersAndEndsWhenItLeaves) {
   EXPECT_EQ(spring->weights, contact.proxy().barycentric);
   EXPECT_EQ(spring->target_m, contact.hip_m());
   EXPECT_EQ(spring->stiffness_n_per_m, 2000.0);
+  EXPECT_EQ(spring->tangent_fraction, contact.settings().spring_tangent_fraction);
 
   // Sliding deeper and sideways: the proxy is the surface point closest to the HIP.
   const Eigen::Vector3d hip = x - 1.5e-3 * n + 2e-3 * tangent;
@@ -129,6 +130,8 @@ TEST(PointContact, StartsWhenTheToolEntersAndEndsWhenItLeaves) {
   contact.release();
   EXPECT_FALSE(contact.in_contact());
   EXPECT_THROW(PointContact(PointContactSettings{0.0}), ParameterError);
+  EXPECT_THROW(PointContact(PointContactSettings{2000.0, 0.0}), ParameterError);
+  EXPECT_THROW(PointContact(PointContactSettings{2000.0, 1.5}), ParameterError);
 }
 
 TEST(PointContact, TheNearSideHoldsAToolPushedThroughAThinSlab) {

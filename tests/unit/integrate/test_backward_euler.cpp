@@ -11,8 +11,11 @@ namespace {
 
 class Oscillators final : public DynamicsModel {
  public:
-  Oscillators(int count, double mass_kg, double stiffness_n_per_m, RayleighDamping damping)
+  // The tangent holds tangent_fraction k (1: the derivative of the force k u).
+  Oscillators(int count, double mass_kg, double stiffness_n_per_m, RayleighDamping damping,
+              double tangent_fraction = 1.0)
       : m_stiffness_n_per_m(stiffness_n_per_m),
+        m_tangent_fraction(tangent_fraction),
         m_damping(damping),
         m_mass(Eigen::VectorXd::Constant(3 * count, mass_kg)),
         m_external(Eigen::VectorXd::Zero(3 * count)),
@@ -26,7 +29,8 @@ class Oscillators final : public DynamicsModel {
     f = m_stiffness_n_per_m * u;
     if (!update_tangent) return;
     for (int row = 0; row < m_tangent.block_rows(); ++row) {
-      m_tangent.block(m_tangent.find_slot(row, row)) = m_stiffness_n_per_m * Eigen::Matrix3d::Identity();
+      m_tangent.block(m_tangent.find_slot(row, row)) =
+          m_tangent_fraction * m_stiffness_n_per_m * Eigen::Matrix3d::Identity();
     }
   }
   const BlockSparseMatrix& tangent() const override { return m_tangent; }
@@ -38,6 +42,7 @@ class Oscillators final : public DynamicsModel {
     return pattern;
   }
   double m_stiffness_n_per_m;
+  double m_tangent_fraction;
   RayleighDamping m_damping;
   Eigen::VectorXd m_mass, m_external;
   BlockSparseMatrix m_tangent;
@@ -76,6 +81,30 @@ TEST(BackwardEuler, DampsAnUndampedOscillatorAtTheKnownRate) {
   const double amplitude = std::hypot(state.displacement_m(0), state.velocity_m_per_s(0) / w);
   const double expected = std::pow(1.0 + (w * h) * (w * h), -0.5 * steps);
   EXPECT_NEAR(amplitude, expected, 1e-10);
+}
+
+TEST(BackwardEuler, AStiffnessEnteredWithTheUndampedFractionIsNotRayleighDamped) {
+  // The god-object's contact spring: beta = 0.01 s would damp it like tissue; entered in the tangent
+  // with the share h / (h + beta) it is stepped exactly as the undamped oscillator above
+  // (amplitude factor 1/sqrt(1 + (w h)^2) per step), whatever beta.
+  const double h = 0.05;
+  const double w = 2.0;
+  const int steps = 40;
+  const auto amplitude = [&](double beta, double tangent_fraction) {
+    Oscillators model(1, 0.5, 2.0, {0.0, beta}, tangent_fraction);
+    BackwardEuler integrator(std::make_unique<CholmodSolver>());
+    DynamicState state{Eigen::VectorXd::Constant(3, 1.0), Eigen::VectorXd::Zero(3), 0.0};
+    for (int i = 0; i < steps; ++i) integrator.step(model, state, h);
+    return std::hypot(state.displacement_m(0), state.velocity_m_per_s(0) / w);
+  };
+  const double undamped = std::pow(1.0 + (w * h) * (w * h), -0.5 * steps);
+  for (const double beta : {0.01, 0.1, 1.0}) {
+    EXPECT_NEAR(amplitude(beta, undamped_tangent_fraction(h, beta)), undamped, 1e-12) << beta;
+  }
+  EXPECT_LT(amplitude(1.0, 1.0), 0.5 * undamped);  // entered whole, it is damped
+  EXPECT_EQ(undamped_tangent_fraction(h, 0.0), 1.0);
+  EXPECT_THROW((void)undamped_tangent_fraction(0.0, 0.01), ParameterError);
+  EXPECT_THROW((void)undamped_tangent_fraction(h, -1.0), ParameterError);
 }
 
 TEST(BackwardEuler, RefusesBadStepsAndLeavesTheStateUnchanged) {

@@ -109,6 +109,38 @@ TEST(Tissue, ProbeTouchesPushesBackAndLetsGo) {
   EXPECT_EQ(tissue.body().point_spring(), std::nullopt);
 }
 
+// A body with nothing fixed condenses its contact stiffness from the step matrix
+// M/h^2 + D/h + K, which holds the contact spring while the probe touches, scaled like K; the
+// spring is taken out exactly, whatever share of it the tangent holds (issue 9: it enters the
+// tangent with the share that keeps Rayleigh damping off it).
+TEST(Tissue, FreeBodyContactStiffnessLeavesTheSpringOut) {
+  const TetMesh mesh = make_box_mesh(4, 4, 2, 0.01);
+  TissueSettings settings;
+  settings.body.gravity_m_per_s2.setZero();
+  settings.body.damping = RayleighDamping{1.0, 0.01};
+  settings.solver.kind = LinearSolverKind::cholmod;
+  settings.step_size_s = 0.01;
+  Tissue tissue(mesh, settings);
+  const Eigen::Vector3d above(0.0213, 0.0187, 0.025);
+  tissue.set_tool({above, Eigen::Quaterniond::Identity(), ToolMode::probe});
+  tissue.step();
+  tissue.set_tool(
+      {Eigen::Vector3d(above.x(), above.y(), 0.02 - 1e-4), Eigen::Quaterniond::Identity(), ToolMode::probe});
+  tissue.step();  // the contact starts: K_c from the tangent of this step, at rest
+  ASSERT_TRUE(tissue.contact().active);
+
+  DeformableBody body(mesh, settings.body);
+  Eigen::VectorXd internal_force, diagonal;
+  body.evaluate(Eigen::VectorXd::Zero(body.dof_count()), internal_force, /*update_tangent=*/true);
+  EffectiveContactStiffness reference;
+  reference.factorize(step_contact_system(body, settings.step_size_s, diagonal));
+  const SurfacePoint& proxy = tissue.point_contact().proxy();
+  const std::optional<Eigen::Matrix3d> k_c = reference.stiffness_n_per_m(
+      contact_interpolation(body.dofs(), tissue.surface_bvh().triangle(proxy.triangle), proxy.barycentric));
+  ASSERT_TRUE(k_c.has_value());
+  EXPECT_LT((tissue.contact().stiffness_n_per_m - *k_c).norm(), 1e-9 * k_c->norm());
+}
+
 TEST(Tissue, BuildsOnlyWhatTheSceneRequires) {
   const TetMesh mesh = make_box_mesh(10, 2, 2, 0.01);
   const auto run_scene = [&](bool contact, bool cutting) {

@@ -125,6 +125,15 @@ TEST(PointSpring, ForceAndTangentMatchTheDefinitionAndFiniteDifferences) {
     }
     EXPECT_LT((numeric - k_spring).norm(), 1e-6 * k_spring.norm());
     EXPECT_GT(k_spring.norm(), 0.0);
+
+    // A tangent fraction c scales the spring's tangent only (the undamped contact spring).
+    PointSpring shared = spring;
+    shared.tangent_fraction = 0.25;
+    bar.body.set_point_spring(shared);
+    Eigen::VectorXd f_shared;
+    bar.body.evaluate(u, f_shared, true);
+    EXPECT_LT((f_shared - f_with).norm(), 1e-12 * f_with.norm());
+    EXPECT_LT(((dense(bar.body.tangent()) - k_without) - 0.25 * k_spring).norm(), 1e-6 * k_spring.norm());
   }
 }
 
@@ -199,6 +208,11 @@ TEST(PointSpring, RefusesBadSpringsAndKeepsTheOldOne) {
   refused(bad);
   bad.stiffness_n_per_m = std::nan("");
   refused(bad);
+  bad = good;
+  for (const double fraction : {0.0, -0.5, 1.5, std::nan("")}) {
+    bad.tangent_fraction = fraction;
+    refused(bad);
+  }
 
   Eigen::VectorXd f;
   bar.body.evaluate(Eigen::VectorXd::Zero(bar.body.dof_count()), f, false);
