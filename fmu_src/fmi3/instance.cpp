@@ -121,7 +121,7 @@ Status Instance::do_step(double current_time_s, double step_s, double& last_succ
   }
   const StepOutcome outcome = m_model->do_step(current_time_s, step_s);
   last_successful_time_s = outcome.last_successful_time_s;
-  if (outcome.completed) return Status::ok;
+  if (outcome.completed) return outcome.warning ? Status::warning : Status::ok;
   log(Status::discard, "logStatusError",
       "fmi3DoStep: stopped at t = " + std::to_string(outcome.last_successful_time_s) + " s");
   return Status::discard;

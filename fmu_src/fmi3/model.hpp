@@ -39,6 +39,7 @@ class ModelState {
 struct StepOutcome {
   bool completed = true;
   double last_successful_time_s = 0.0;
+  bool warning = false;  ///< completed, with something the log explains (fmi3Warning)
 };
 
 class Model {

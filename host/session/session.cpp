@@ -295,7 +295,7 @@ class Session {
     }
     m_haptic.set_device(pose);
     const DoStepResult result = m_haptic.step(t, m_period_s);
-    if (result.status != fmi3OK) ++m_summary.haptic_errors;
+    if (result.status != fmi3OK && result.status != fmi3Warning) ++m_summary.haptic_errors;
     m_haptic.read(m_haptic_out);
     std::array<double, 3> force = m_haptic_out.device_force_n;
     if (!finite3(force)) {
@@ -431,6 +431,7 @@ class Session {
       while (!go.load(std::memory_order_acquire)) std::this_thread::yield();
       const Nanoseconds period = to_ns(m_period_s);
       Nanoseconds previous_wake = 0;
+      if (m_options.haptic_thread_started) m_options.haptic_thread_started();
       for (std::uint64_t n = 0; n < m_ticks; ++n) {
         const Nanoseconds deadline = start + static_cast<Nanoseconds>(n) * period;
         sleep_until_ns(deadline);

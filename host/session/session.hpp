@@ -11,6 +11,7 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <functional>
 #include <iosfwd>
 #include <optional>
 #include <string>
@@ -24,6 +25,9 @@ struct SessionOptions {
   std::filesystem::path fmu_dir;                ///< where Tissue.fmu and HapticLoop.fmu are by default
   std::ostream* progress = nullptr;             ///< a progress line while the run goes (nullptr: quiet)
   bool realtime_priority = true;                ///< try SCHED_FIFO for the two threads
+  /// Called on the haptic thread right before its first tick (real time only); tests use it to
+  /// watch that thread (e.g. count its allocations).
+  std::function<void()> haptic_thread_started;
 };
 
 struct Percentiles {

@@ -9,3 +9,22 @@ target_compile_definitions(test_host_session PRIVATE TISSUE_SCENARIO_DIR="${PROJ
                                                      TISSUE_FMU_DIR="${CMAKE_BINARY_DIR}/fmus")
 add_dependencies(test_host_session tissue_fmu_package hapticloop_fmu_package)
 gtest_discover_tests(test_host_session PROPERTIES LABELS "host" DISCOVERY_TIMEOUT 60)
+
+# The haptic thread allocates nothing (its own executable: it replaces operator new).
+add_executable(test_host_session_allocations ${CMAKE_CURRENT_LIST_DIR}/test_session_allocations.cpp)
+target_link_libraries(test_host_session_allocations PRIVATE tissue::host_session GTest::gtest GTest::gtest_main
+                                                            tissue::warnings)
+target_compile_definitions(test_host_session_allocations
+                           PRIVATE TISSUE_SCENARIO_DIR="${PROJECT_SOURCE_DIR}/host/scenarios"
+                                   TISSUE_FMU_DIR="${CMAKE_BINARY_DIR}/fmus")
+add_dependencies(test_host_session_allocations tissue_fmu_package hapticloop_fmu_package)
+gtest_discover_tests(test_host_session_allocations PROPERTIES LABELS "host" DISCOVERY_TIMEOUT 60)
+
+# The UDP device end to end through a real-time session, with the test sender as the driver.
+add_executable(test_host_session_udp ${CMAKE_CURRENT_LIST_DIR}/test_session_udp.cpp ${CMAKE_CURRENT_LIST_DIR}/udp_sender.cpp)
+target_include_directories(test_host_session_udp PRIVATE ${CMAKE_CURRENT_LIST_DIR})
+target_link_libraries(test_host_session_udp PRIVATE tissue::host_session GTest::gtest GTest::gtest_main tissue::warnings)
+target_compile_definitions(test_host_session_udp PRIVATE TISSUE_SCENARIO_DIR="${PROJECT_SOURCE_DIR}/host/scenarios"
+                                                         TISSUE_FMU_DIR="${CMAKE_BINARY_DIR}/fmus")
+add_dependencies(test_host_session_udp tissue_fmu_package hapticloop_fmu_package)
+gtest_discover_tests(test_host_session_udp PROPERTIES LABELS "host" DISCOVERY_TIMEOUT 60)

@@ -1,0 +1,60 @@
+// The haptic thread of a real-time tissue-host session allocates nothing (STYLE "real-time
+// discipline"; issue 9): operator new is replaced by one that counts the calls made on a thread
+// that asked to be counted, and the session's haptic_thread_started hook asks for its haptic
+// thread, right before the first tick. A short poke session (device read, HapticLoop doStep
+// through the importer, tissue samples taken, force written, log rows) at 1 kHz.
+#include "scenario/scenario.hpp"
+#include "session/session.hpp"
+
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <cstdlib>
+#include <filesystem>
+#include <new>
+
+namespace {
+
+thread_local bool t_counted = false;
+std::atomic<long> g_counted_allocations{0};
+
+}  // namespace
+
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wmismatched-new-delete"
+void* operator new(std::size_t size) {
+  if (t_counted) g_counted_allocations.fetch_add(1, std::memory_order_relaxed);
+  if (void* p = std::malloc(size == 0 ? 1 : size)) return p;
+  throw std::bad_alloc();
+}
+void operator delete(void* p) noexcept { std::free(p); }
+void operator delete(void* p, std::size_t) noexcept { std::free(p); }
+#pragma GCC diagnostic pop
+
+namespace tissue::host {
+namespace {
+
+TEST(HapticThread, AllocatesNothingAfterStart) {
+  // The counter works: an allocation on a counted thread is seen.
+  t_counted = true;
+  void* probe = ::operator new(16);  // a direct call: the compiler may not elide it
+  t_counted = false;
+  ::operator delete(probe);
+  ASSERT_EQ(g_counted_allocations.exchange(0), 1);
+
+  Scenario scenario = load_scenario(std::filesystem::path(TISSUE_SCENARIO_DIR) / "poke_frog.toml");
+  scenario.duration_s = 1.0;  // the probe reaches the back at 0.3 s: contact samples are taken
+  scenario.write_png = false;
+  SessionOptions options;
+  options.output_dir = std::filesystem::temp_directory_path() / "tissue_host_test_allocations";
+  options.fmu_dir = TISSUE_FMU_DIR;
+  options.realtime_priority = false;
+  options.haptic_thread_started = [] { t_counted = true; };
+  const SessionSummary summary = run_session(scenario, options);
+  EXPECT_TRUE(summary.contact_seen);
+  EXPECT_EQ(summary.haptic_ticks, 1000u);
+  EXPECT_EQ(g_counted_allocations.load(), 0);
+}
+
+}  // namespace
+}  // namespace tissue::host
