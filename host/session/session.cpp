@@ -299,7 +299,7 @@ class Session {
     m_haptic.read(m_haptic_out);
     std::array<double, 3> force = m_haptic_out.device_force_n;
     if (!finite3(force)) {
-      m_summary.nan_detected = true;
+      m_haptic_nan = true;
       force = {0.0, 0.0, 0.0};
     }
     const std::array<double, 3> sent = m_device->write_force(t, force);
@@ -339,7 +339,7 @@ class Session {
     }
     m_tissue.read(out);
     out.time_s = reached_s;
-    if (!out.finite) m_summary.nan_detected = true;
+    if (!out.finite) m_tissue_nan = true;
     m_summary.contact_seen = m_summary.contact_seen || out.contact_active;
     // Steps are "during cuts" from the first step with the scalpel in the tissue.
     m_cutting_seen = m_cutting_seen || (scalpel && out.blade_depth_m > 0.0) || out.cut_tets > 0;
@@ -558,7 +558,7 @@ class Session {
     m_summary.passivity_dissipated_j = last.dissipated_energy_j;
     m_summary.passivity_observed_j = last.observed_energy_j;
     m_summary.device = m_device->counters();
-    if (!std::isfinite(m_summary.max_device_force_n)) m_summary.nan_detected = true;
+    m_summary.nan_detected = m_haptic_nan || m_tissue_nan || !std::isfinite(m_summary.max_device_force_n);
 
     const std::filesystem::path& dir = m_options.output_dir;
     {
@@ -601,16 +601,18 @@ class Session {
   std::vector<double> m_periods_s;
   double m_last_tissue_time_s = 0.0;
   bool m_contact = false;
+  bool m_haptic_nan = false;
   // Dynamics thread's own.
   std::vector<double> m_step_s;
   std::vector<std::uint8_t> m_step_cutting;
   bool m_cutting_seen = false;
+  bool m_tissue_nan = false;
   bool m_tissue_failed = false;
   double m_tissue_time_s = 0.0;
   double m_next_frame_s = 0.0;
   TissueOutputs m_last_outputs;
   std::atomic<std::uint64_t> m_cut_tets{0};  // for the progress line
-  // Written by one thread each (fields disjoint), read after both are joined.
+  // Written by one thread each (each field by one thread only), read after both are joined.
   SessionSummary m_summary;
 };
 
