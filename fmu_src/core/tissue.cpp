@@ -225,7 +225,7 @@ EnrichmentResult Tissue::apply_cuts(std::span<const TetCut> cuts) {
   m_cut_history.insert(m_cut_history.end(), cuts.begin(), cuts.end());
   m_cut_batch_ends.push_back(static_cast<int>(m_cut_history.size()));
   // The opened faces join the surface (at the current state: both parts still coincide).
-  const int new_faces = m_cut_surface.add_cut_tets(m_body, first_new);
+  const int new_faces = m_cut_surface.add_cut_tets(m_body, first_new, m_surface);
   update_positions();
   const auto& faces = m_cut_surface.triangles();
   m_bvh.add_triangles(std::span(faces).last(static_cast<size_t>(new_faces)), m_positions_m);

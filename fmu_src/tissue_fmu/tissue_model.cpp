@@ -143,7 +143,9 @@ void TissueModel::ensure_built() {
 }
 
 std::size_t TissueModel::surface_triangle_count() const {
-  return m_tissue->surface().triangles.size() + m_tissue->cut_surface().triangles().size();
+  const CutSurface& cuts = m_tissue->cut_surface();
+  return m_tissue->surface().triangles.size() - cuts.replaced_triangles().size() + cuts.skin_triangles().size() +
+         cuts.triangles().size();
 }
 
 void TissueModel::update_surface_counters() {
@@ -293,13 +295,25 @@ void TissueModel::get_uint32(const VariableInfo& info, std::span<std::uint32_t> 
   ensure_built();
   std::fill(out.begin(), out.end(), 0U);
   if (!m_values.boolean(vr(Vr::mesh_output_enabled))) return;
+  // The mesh's surface without the triangles of cut tets, their pieces either side of the cut (the
+  // skin), then the cut faces: corners beyond the mesh vertices follow the parts (cut_surface.hpp).
   std::size_t at = 0;
   const auto put = [&](const std::array<int, 3>& triangle) {
     if (at + 3 > out.size()) return;
     for (const int v : triangle) out[at++] = static_cast<std::uint32_t>(v);
   };
-  for (const auto& triangle : m_tissue->surface().triangles) put(triangle);
-  for (const auto& triangle : m_tissue->cut_surface().triangles()) put(triangle);
+  const CutSurface& cuts = m_tissue->cut_surface();
+  const auto& mesh_triangles = m_tissue->surface().triangles;
+  auto replaced = cuts.replaced_triangles().begin();
+  for (std::size_t t = 0; t < mesh_triangles.size(); ++t) {
+    if (replaced != cuts.replaced_triangles().end() && *replaced == static_cast<int>(t)) {
+      ++replaced;
+      continue;
+    }
+    put(mesh_triangles[t]);
+  }
+  for (const auto& triangle : cuts.skin_triangles()) put(triangle);
+  for (const auto& triangle : cuts.triangles()) put(triangle);
 }
 
 void TissueModel::get_uint64(const VariableInfo& info, std::span<std::uint64_t> out) {
@@ -317,6 +331,9 @@ void TissueModel::get_uint64(const VariableInfo& info, std::span<std::uint64_t> 
       return;
     case Vr::surface_revision:
       out[0] = m_surface_revision;
+      return;
+    case Vr::cut_triangle_count:
+      out[0] = mesh_out ? std::min<std::uint64_t>(tissue.cut_surface().triangles().size(), triangles) : 0;
       return;
     case Vr::cut_tets:
       out[0] = tissue.body().cut_tets().size();

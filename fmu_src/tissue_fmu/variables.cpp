@@ -195,7 +195,10 @@ constexpr auto VARIABLES = std::to_array<VariableInfo>({
     output(Vr::triangles, "surface.triangles", uint32, discrete)
         .shape(sized_by(Vr::triangle_capacity), fixed_size(3))
         .describe("Surface triangles as 0-based rows of surface.vertexPositions, counter-clockwise seen from "
-                  "outside; rows from surface.triangleCount on are 0"),
+                  "outside: the mesh's surface (where a cut crosses a surface triangle, its pieces either side of "
+                  "the cut), then the faces the cuts opened; rows from surface.triangleCount on are 0"),
+    output(Vr::cut_triangle_count, "surface.cutTriangleCount", uint64, discrete)
+        .describe("How many of the surface.triangleCount rows, at the end, are faces the cuts opened"),
     output(Vr::cut_tets, "cutTets", uint64, discrete).describe("Number of tetrahedra cut so far"),
     output(Vr::enriched_vertices, "enrichedVertices", uint64, discrete)
         .describe("Number of enriched (XFEM) vertex unknowns the cuts added"),

@@ -58,6 +58,7 @@ enum class Vr : std::uint32_t {
   surface_revision = 52,
   vertex_positions = 53,
   triangles = 54,
+  cut_triangle_count = 55,
   cut_tets = 60,
   enriched_vertices = 61,
   dofs = 62,

@@ -106,7 +106,8 @@ TissueLink::TissueLink(const Fmu3& fmu, const std::vector<ParameterSetting>& par
       m_positions(vr(m_instance, "surface.vertexPositions")),
       m_triangles(vr(m_instance, "surface.triangles")),
       m_cut_tets(vr(m_instance, "cutTets")),
-      m_enriched(vr(m_instance, "enrichedVertices")) {
+      m_enriched(vr(m_instance, "enrichedVertices")),
+      m_cut_triangles(vr(m_instance, "surface.cutTriangleCount")) {
   apply_parameters(m_instance, parameters, "tissue.parameters");
   expect_ok(m_instance.enter_initialization_mode(std::nullopt, 0.0, std::nullopt), m_instance,
             "Tissue: enter initialization mode");
@@ -122,7 +123,6 @@ TissueLink::TissueLink(const Fmu3& fmu, const std::vector<ParameterSetting>& par
   m_float_buffer.resize(3 + 3 + 3 + 9 + 1);
   SurfaceFrame rest;
   read_surface(rest);
-  m_mesh_triangles = rest.triangle_count();
   const std::size_t vertices = rest.vertex_count();
   m_rest_lower.fill(std::numeric_limits<double>::infinity());
   m_rest_upper.fill(-std::numeric_limits<double>::infinity());
@@ -171,8 +171,8 @@ void TissueLink::read(TissueOutputs& out) {
 }
 
 void TissueLink::read_surface(SurfaceFrame& frame) {
-  std::array<fmi3UInt64, 2> counts{};
-  const std::array<fmi3ValueReference, 2> count_vrs{m_vertex_count, m_triangle_count};
+  std::array<fmi3UInt64, 3> counts{};
+  const std::array<fmi3ValueReference, 3> count_vrs{m_vertex_count, m_triangle_count, m_cut_triangles};
   (void)m_instance.get_uint64(count_vrs, counts);
   frame.positions_m.resize(3 * m_vertex_capacity);
   frame.triangles.resize(3 * m_triangle_capacity);
@@ -180,8 +180,8 @@ void TissueLink::read_surface(SurfaceFrame& frame) {
   (void)m_instance.get_uint32(std::span<const fmi3ValueReference>(&m_triangles, 1), frame.triangles);
   frame.positions_m.resize(3 * static_cast<std::size_t>(counts[0]));
   frame.triangles.resize(3 * static_cast<std::size_t>(counts[1]));
-  frame.mesh_triangle_count =
-      std::min(m_mesh_triangles == 0 ? frame.triangle_count() : m_mesh_triangles, frame.triangle_count());
+  // The cut faces are the last rows; the rest is the skin.
+  frame.mesh_triangle_count = frame.triangle_count() - std::min<std::size_t>(counts[2], frame.triangle_count());
 }
 
 // --- HapticLoop ---

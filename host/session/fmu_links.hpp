@@ -64,7 +64,6 @@ class TissueLink {
   /// Axis-aligned box of the surface at rest (after initialization).
   [[nodiscard]] const std::array<double, 3>& rest_lower() const { return m_rest_lower; }
   [[nodiscard]] const std::array<double, 3>& rest_upper() const { return m_rest_upper; }
-  [[nodiscard]] std::size_t mesh_triangle_count() const { return m_mesh_triangles; }
   [[nodiscard]] double blade_length_m() const { return m_blade_length_m; }
   [[nodiscard]] Fmu3Instance& instance() { return m_instance; }
 
@@ -73,11 +72,10 @@ class TissueLink {
   fmi3ValueReference m_tool_position, m_tool_orientation, m_tool_mode;
   std::array<fmi3ValueReference, 5> m_float_outputs{};  // point, normal, force, stiffness, blade depth
   fmi3ValueReference m_contact_active, m_vertex_count, m_triangle_count, m_positions, m_triangles, m_cut_tets,
-      m_enriched;
+      m_enriched, m_cut_triangles;
   std::size_t m_vertex_capacity = 0, m_triangle_capacity = 0;
   std::vector<double> m_float_buffer;
   std::array<double, 3> m_rest_lower{}, m_rest_upper{};
-  std::size_t m_mesh_triangles = 0;
   double m_blade_length_m = 0.0;
   ToolCommand m_last_tool;
 };

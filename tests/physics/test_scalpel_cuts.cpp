@@ -8,9 +8,12 @@
 #include "core/mesh/box_mesh.hpp"
 #include "core/tissue.hpp"
 
-#include <Eigen/Eigenvalues>
 #include <gtest/gtest.h>
+#include <Eigen/Eigenvalues>
+#include <Eigen/Geometry>
 
+#include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <vector>
@@ -75,6 +78,55 @@ double free_fall_drop_m(int steps) {
     drop += STEP_S * velocity;
   }
   return drop;
+}
+
+// The longest edge [m] of the triangles, at the current positions.
+double longest_edge_m(const Eigen::VectorXd& x, const std::vector<std::array<int, 3>>& triangles) {
+  double longest = 0.0;
+  for (const auto& t : triangles) {
+    for (int c = 0; c < 3; ++c) {
+      const int a = t[static_cast<size_t>(c)], b = t[static_cast<size_t>((c + 1) % 3)];
+      longest = std::max(longest, (x.segment<3>(3 * a) - x.segment<3>(3 * b)).norm());
+    }
+  }
+  return longest;
+}
+
+// The surface output after a complete cut (tissue_fmu: the mesh's surface without the replaced
+// triangles, the skin pieces, the cut faces): once the free piece has fallen 2 cm, no output
+// triangle spans the opening. The replaced originals would (that is the defect the skin fixes).
+TEST(ScalpelCut, NoSurfaceTriangleStretchesAcrossTheOpening) {
+  TetMesh mesh = make_box_mesh(10, 2, 2, 0.01);
+  Tissue tissue(mesh, beam_settings(mesh));
+  sweep(tissue, 0.0553, -0.005, 0.025);
+  const double tip_before = mean_z_displacement(tissue, 0.09, 0.1);
+  while (mean_z_displacement(tissue, 0.09, 0.1) - tip_before > -0.02) tissue.step();
+  const CutSurface& cuts = tissue.cut_surface();
+  const auto& mesh_triangles = tissue.surface().triangles;
+  // The cut layer's outside: 4 sides of 2 squares of 1 cm, 2 triangles each.
+  ASSERT_EQ(cuts.replaced_triangles().size(), 16u);
+  std::vector<std::array<int, 3>> output, replaced;
+  for (size_t t = 0; t < mesh_triangles.size(); ++t) {
+    const bool is_replaced =
+        std::binary_search(cuts.replaced_triangles().begin(), cuts.replaced_triangles().end(), static_cast<int>(t));
+    (is_replaced ? replaced : output).push_back(mesh_triangles[t]);
+  }
+  output.insert(output.end(), cuts.skin_triangles().begin(), cuts.skin_triangles().end());
+  output.insert(output.end(), cuts.triangles().begin(), cuts.triangles().end());
+  const Eigen::VectorXd& x = tissue.current_positions_m();
+  // A face diagonal of a 1 cm cube is 1.41 cm; the skin's pieces are parts of such triangles and
+  // the beam's strain is small, so nothing longer than 1.5 cm may appear.
+  EXPECT_LT(longest_edge_m(x, output), 0.015);
+  EXPECT_GT(longest_edge_m(x, replaced), 0.02);
+  // The pieces cover the replaced triangles: 16 half squares of 1 cm^2, up to the small strain.
+  double skin_area = 0.0;
+  for (const auto& t : cuts.skin_triangles()) {
+    skin_area +=
+        0.5 *
+        (x.segment<3>(3 * t[1]) - x.segment<3>(3 * t[0])).cross(x.segment<3>(3 * t[2]) - x.segment<3>(3 * t[0])).norm();
+  }
+  const double replaced_area = 16 * 0.5e-4;
+  EXPECT_NEAR(skin_area, replaced_area, 0.05 * replaced_area);
 }
 
 TEST(ScalpelCut, CompleteCutReleasesTheFreePieceIntoFreeFall) {

@@ -5,9 +5,25 @@
 
 #include <Eigen/Geometry>
 
+#include <algorithm>
+
 namespace tissue {
 
-int CutSurface::add_cut_tets(const DeformableBody& body, int first_cut_tet) {
+namespace {
+
+// The crossing on the local edge a-b as a ratio from a: edge_ratio is stored along TET_EDGES' order.
+double ratio_from(const TetCut& cut, int a, int b) {
+  for (int e = 0; e < 6; ++e) {
+    const auto& edge = TET_EDGES[static_cast<size_t>(e)];
+    if (edge[0] == a && edge[1] == b) return cut.edge_ratio[static_cast<size_t>(e)];
+    if (edge[0] == b && edge[1] == a) return 1.0 - cut.edge_ratio[static_cast<size_t>(e)];
+  }
+  return 0.5;  // unreachable for two distinct local vertices
+}
+
+}  // namespace
+
+int CutSurface::add_cut_tets(const DeformableBody& body, int first_cut_tet, const SurfaceMesh& surface) {
   const auto& cut_tets = body.cut_tets();
   const TetMesh& mesh = body.mesh();
   const int triangles_before = static_cast<int>(m_triangles.size());
@@ -65,6 +81,34 @@ int CutSurface::add_cut_tets(const DeformableBody& body, int first_cut_tet) {
         std::array<int, 3> triangle{first_point, first_point + t, first_point + t + 1};
         if (!keep_order) std::swap(triangle[1], triangle[2]);
         m_triangles.push_back(triangle);
+      }
+    }
+
+    // The skin: the tet's surface triangles (triangle_tet is in tet order), split along the cut.
+    const auto [first, last] = std::equal_range(surface.triangle_tet.begin(), surface.triangle_tet.end(), cut.tet);
+    for (auto it = first; it != last; ++it) {
+      const int triangle_index = static_cast<int>(it - surface.triangle_tet.begin());
+      const std::array<int, 3>& triangle = surface.triangles[static_cast<size_t>(triangle_index)];
+      std::array<int, 3> local{};
+      for (int c = 0; c < 3; ++c) {
+        for (int i = 0; i < 4; ++i) {
+          if (tet[static_cast<size_t>(i)] == triangle[static_cast<size_t>(c)]) local[static_cast<size_t>(c)] = i;
+        }
+      }
+      m_replaced.insert(std::upper_bound(m_replaced.begin(), m_replaced.end(), triangle_index), triangle_index);
+      for (CutPart part : {CutPart::above, CutPart::below}) {
+        const int side = part == CutPart::above ? 1 : -1;
+        std::vector<int> polygon;  // walked in the triangle's order, so the winding stays outward
+        for (int c = 0; c < 3; ++c) {
+          const int a = local[static_cast<size_t>(c)];
+          const int b = local[static_cast<size_t>((c + 1) % 3)];
+          if (cut.side[static_cast<size_t>(a)] == side) polygon.push_back(triangle[static_cast<size_t>(c)]);
+          if (cut.side[static_cast<size_t>(a)] != cut.side[static_cast<size_t>(b)]) {
+            polygon.push_back(m_vertex_count + static_cast<int>(m_points.size()));
+            m_points.push_back(Point{k, part, a, b, ratio_from(cut, a, b)});
+          }
+        }
+        for (size_t t = 1; t + 1 < polygon.size(); ++t) m_skin.push_back({polygon[0], polygon[t], polygon[t + 1]});
       }
     }
   }
