@@ -414,7 +414,7 @@ class Session {
   void run_realtime() {
     if (m_options.realtime_priority) {
       // Locking memory keeps page faults out of the loops; it may be refused like the priority.
-      (void)mlockall(MCL_CURRENT | MCL_FUTURE);
+      (void)mlockall(MCL_CURRENT);
     }
     FramePipe pipe(8);
     std::atomic<int> ready{0};
@@ -506,7 +506,7 @@ class Session {
     });
 
     while (ready.load() < 2) std::this_thread::yield();
-    start = now_ns() + 2'000'000;  // 2 ms from now: both threads are waiting
+    start = now_ns() + 20'000'000;  // 20 ms from now: both threads are waiting
     go.store(true, std::memory_order_release);
 
     FrameWriter writer(m_options.output_dir);

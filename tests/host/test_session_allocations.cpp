@@ -53,7 +53,7 @@ TEST(HapticThread, AllocatesNothingAfterStart) {
   const SessionSummary summary = run_session(scenario, options);
   // Contact samples reach the haptic thread when the tissue keeps pace (a sanitizer build's tissue
   // steps overrun their slots many times over, and the probe may never reach the back).
-  if (summary.tissue_overruns == 0) {
+  if (summary.sim_time_s > 0.9 * scenario.duration_s) {
     EXPECT_TRUE(summary.contact_seen);
   }
   EXPECT_EQ(summary.haptic_ticks, 1000u);

@@ -78,7 +78,7 @@ TEST(UdpSession, PosesDriveTheProbeForcesComeBackBadPacketsAreCountedSilenceZero
   EXPECT_EQ(s.tissue_errors, 0u) << s.first_error;
   // The poses reach the tissue and the probe touches the back (when the tissue keeps pace: a
   // sanitizer build's steps overrun their slots many times over).
-  const bool kept_pace = s.tissue_overruns == 0;
+  const bool kept_pace = s.sim_time_s > 0.9 * scenario.duration_s;
   if (kept_pace) {
     EXPECT_TRUE(s.contact_seen) << "the poses did not reach the tissue";
   }
