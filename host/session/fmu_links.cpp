@@ -170,6 +170,11 @@ void TissueLink::read(TissueOutputs& out) {
   out.tool_position_m = m_last_tool.position_m;
 }
 
+void TissueLink::reserve(SurfaceFrame& frame) const {
+  frame.positions_m.reserve(3 * m_vertex_capacity);
+  frame.triangles.reserve(3 * m_triangle_capacity);
+}
+
 void TissueLink::read_surface(SurfaceFrame& frame) {
   std::array<fmi3UInt64, 3> counts{};
   const std::array<fmi3ValueReference, 3> count_vrs{m_vertex_count, m_triangle_count, m_cut_triangles};

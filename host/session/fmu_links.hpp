@@ -61,6 +61,8 @@ class TissueLink {
   void read(TissueOutputs& outputs);
   /// The surface into `frame` (its vectors keep their capacity: no allocation after the first).
   void read_surface(SurfaceFrame& frame);
+  /// Gives `frame` the capacity read_surface() needs, so that reading into it allocates nothing.
+  void reserve(SurfaceFrame& frame) const;
   /// Axis-aligned box of the surface at rest (after initialization).
   [[nodiscard]] const std::array<double, 3>& rest_lower() const { return m_rest_lower; }
   [[nodiscard]] const std::array<double, 3>& rest_upper() const { return m_rest_upper; }

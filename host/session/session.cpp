@@ -21,6 +21,7 @@
 #include <charconv>
 #include <cmath>
 #include <condition_variable>
+#include <cstdlib>
 #include <cstring>
 #include <deque>
 #include <fstream>
@@ -179,6 +180,11 @@ class FramePipe {
  public:
   explicit FramePipe(std::size_t pool) {
     for (std::size_t k = 0; k < pool; ++k) m_free.push_back(std::make_unique<SurfaceFrame>());
+  }
+  /// Sizes every frame's arrays once, before the run, so that capturing allocates nothing.
+  template <class Prepare>
+  void prepare(Prepare&& prepare_frame) {
+    for (auto& frame : m_free) prepare_frame(*frame);
   }
   std::unique_ptr<SurfaceFrame> take_free() {
     const std::lock_guard lock(m_mutex);
@@ -412,11 +418,8 @@ class Session {
   }
 
   void run_realtime() {
-    if (m_options.realtime_priority) {
-      // Locking memory keeps page faults out of the loops; it may be refused like the priority.
-      (void)mlockall(MCL_CURRENT);
-    }
     FramePipe pipe(8);
+    pipe.prepare([&](SurfaceFrame& frame) { m_tissue.reserve(frame); });
     std::atomic<int> ready{0};
     std::atomic<bool> go{false};
     std::atomic<bool> haptic_done{false};
@@ -436,7 +439,15 @@ class Session {
         const Nanoseconds deadline = start + static_cast<Nanoseconds>(n) * period;
         sleep_until_ns(deadline);
         const Nanoseconds woke = now_ns();
-        if (n > 0) m_periods_s.push_back(static_cast<double>(woke - previous_wake) * 1e-9);
+        if (n == 0) m_summary.haptic_first_tick_late_us = static_cast<double>(woke - deadline) * 1e-3;
+        if (n > 0) {
+          const double period_s = static_cast<double>(woke - previous_wake) * 1e-9;
+          m_periods_s.push_back(period_s);
+          if (period_s > m_longest_period_s) {
+            m_longest_period_s = period_s;
+            m_summary.haptic_period_max_at_s = static_cast<double>(n) * m_period_s;
+          }
+        }
         previous_wake = woke;
         haptic_tick(n);
         if (now_ns() > deadline + period) ++m_summary.deadline_misses;  // the next tick starts late
@@ -506,6 +517,13 @@ class Session {
     });
 
     while (ready.load() < 2) std::this_thread::yield();
+    if (m_options.realtime_priority) {
+      // Everything mapped now, the two threads' stacks and the frames included, is locked in
+      // memory: no page fault in the loops. Not future mappings (MCL_FUTURE): then each large
+      // allocation of the dynamics thread populated and locked its pages under the address-space
+      // lock and stalled the haptic thread. May be refused like the priority.
+      (void)mlockall(MCL_CURRENT);
+    }
     start = now_ns() + 20'000'000;  // 20 ms from now: both threads are waiting
     go.store(true, std::memory_order_release);
 
@@ -602,6 +620,7 @@ class Session {
   double m_last_tissue_time_s = 0.0;
   bool m_contact = false;
   bool m_haptic_nan = false;
+  double m_longest_period_s = 0.0;
   // Dynamics thread's own.
   std::vector<double> m_step_s;
   std::vector<std::uint8_t> m_step_cutting;
@@ -649,6 +668,8 @@ std::string SessionSummary::to_json() const {
   out << "  \"haptic_rate_hz\": " << haptic_rate_hz << ",\n";
   out << "  \"haptic_ticks\": " << haptic_ticks << ",\n";
   json_percentiles(out, "haptic_period_us", haptic_period_us);
+  out << "  \"haptic_period_max_at_s\": " << haptic_period_max_at_s << ",\n";
+  out << "  \"haptic_first_tick_late_us\": " << haptic_first_tick_late_us << ",\n";
   out << "  \"deadline_misses\": " << deadline_misses << ",\n";
   out << "  \"tissue_communication_step_s\": " << tissue_step_s << ",\n";
   out << "  \"tissue_steps\": " << tissue_steps << ",\n";
@@ -684,7 +705,18 @@ std::string SessionSummary::to_json() const {
   return out.str();
 }
 
+// The Tissue FMU's sparse Cholesky (Debian's CHOLMOD) parallelizes some loops with OpenMP, whose
+// worker pool outlives the call and spins while idle: on two cores it would compete with the
+// haptic thread. Before the FMUs are loaded (libgomp reads its settings when it is loaded), the
+// host limits OpenMP to the calling thread and lets idle workers sleep, unless the user set these.
+static void keep_solver_libraries_on_the_calling_thread() {
+  setenv("OMP_THREAD_LIMIT", "1", 0);
+  setenv("OMP_WAIT_POLICY", "PASSIVE", 0);
+  setenv("OPENBLAS_NUM_THREADS", "1", 0);
+}
+
 SessionSummary run_session(const Scenario& scenario, const SessionOptions& options) {
+  keep_solver_libraries_on_the_calling_thread();
   Session session(scenario, options);
   return session.run();
 }

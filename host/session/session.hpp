@@ -40,6 +40,8 @@ struct SessionSummary {
   double sim_time_s = 0.0, wall_time_s = 0.0, realtime_factor = 0.0;
   double haptic_rate_hz = 0.0;
   Percentiles haptic_period_us;
+  double haptic_period_max_at_s = 0.0;     ///< session time of the longest period (where to look)
+  double haptic_first_tick_late_us = 0.0;  ///< how late the first tick woke
   std::uint64_t haptic_ticks = 0, deadline_misses = 0;
   Percentiles tissue_step_ms, tissue_step_before_cut_ms, tissue_step_during_cut_ms;
   double tissue_step_s = 0.0;
