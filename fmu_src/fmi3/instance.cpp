@@ -13,30 +13,6 @@ namespace {
 constexpr std::uint64_t STATE_MAGIC = 0x45544154'53334946ULL;  // "FI3STATE" as little-endian bytes
 constexpr std::uint32_t STATE_VERSION = 1;
 
-template <class T>
-constexpr bool is_type(VariableType type) {
-  if constexpr (std::is_same_v<T, double>) return type == VariableType::float64;
-  if constexpr (std::is_same_v<T, std::int32_t>) return type == VariableType::int32;
-  if constexpr (std::is_same_v<T, std::uint32_t>) return type == VariableType::uint32;
-  if constexpr (std::is_same_v<T, std::int64_t>)
-    return type == VariableType::int64 || type == VariableType::enumeration;
-  if constexpr (std::is_same_v<T, std::uint64_t>) return type == VariableType::uint64;
-  if constexpr (std::is_same_v<T, bool>) return type == VariableType::boolean;
-  if constexpr (std::is_same_v<T, const char*>) return type == VariableType::string;
-  return false;
-}
-
-template <class T>
-constexpr const char* type_name() {
-  if constexpr (std::is_same_v<T, double>) return "Float64";
-  if constexpr (std::is_same_v<T, std::int32_t>) return "Int32";
-  if constexpr (std::is_same_v<T, std::uint32_t>) return "UInt32";
-  if constexpr (std::is_same_v<T, std::int64_t>) return "Int64";
-  if constexpr (std::is_same_v<T, std::uint64_t>) return "UInt64";
-  if constexpr (std::is_same_v<T, bool>) return "Boolean";
-  return "String";
-}
-
 }  // namespace
 
 Instance::Instance(const ModelDescription& description, std::string name, std::string resource_path, bool logging_on,
@@ -137,6 +113,16 @@ void Instance::reset() {
 
 // --- values ---
 
+template <class T>
+const VariableInfo& Instance::variable(ValueReference vr, bool setting) const {
+  const VariableInfo& info = variable(vr, setting);
+  if (!accepts<T>(info.type)) {
+    throw VariableError(std::string(info.name) + " (value reference " + std::to_string(vr) + ") is of type " +
+                        std::string(to_string(info.type)) + ", not " + std::string(accessor_name<T>()));
+  }
+  return info;
+}
+
 const VariableInfo& Instance::variable(ValueReference vr, bool setting) const {
   const VariableInfo* info = m_description.find(vr);
   if (info == nullptr) throw VariableError("unknown value reference " + std::to_string(vr));
@@ -166,11 +152,7 @@ template <class T>
 void Instance::get(std::span<const ValueReference> vrs, std::span<T> values) {
   std::size_t at = 0;
   for (const ValueReference vr : vrs) {
-    const VariableInfo& info = variable(vr, false);
-    if (!is_type<T>(info.type)) {
-      throw VariableError(std::string(info.name) + " (value reference " + std::to_string(vr) + ") is of type " +
-                          std::string(to_string(info.type)) + ", not " + type_name<T>());
-    }
+    const VariableInfo& info = variable<T>(vr, false);
     const std::size_t n = element_count(info);
     if (at + n > values.size()) {
       throw VariableError("too few values for " + std::string(info.name) + ": it has " + std::to_string(n));
@@ -190,7 +172,7 @@ void Instance::get(std::span<const ValueReference> vrs, std::span<T> values) {
     } else if constexpr (std::is_same_v<T, bool>) {
       m_model->get_boolean(info, out);
     } else {
-      throw VariableError("no " + std::string(type_name<T>()) + " output " + std::string(info.name));
+      throw VariableError("no " + std::string(accessor_name<T>()) + " output " + std::string(info.name));
     }
   }
   if (at != values.size()) {
@@ -206,11 +188,7 @@ void Instance::set(std::span<const ValueReference> vrs, std::span<const T> value
   bool parameter_set = false;
   std::size_t at = 0;
   for (const ValueReference vr : vrs) {
-    const VariableInfo& info = variable(vr, true);
-    if (!is_type<T>(info.type)) {
-      throw VariableError(std::string(info.name) + " (value reference " + std::to_string(vr) + ") is of type " +
-                          std::string(to_string(info.type)) + ", not " + type_name<T>());
-    }
+    const VariableInfo& info = variable<T>(vr, true);
     const std::size_t n = m_candidate.count(info);
     if (at + n > values.size()) {
       throw VariableError("too few values for " + std::string(info.name) + ": it takes " + std::to_string(n));

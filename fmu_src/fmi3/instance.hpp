@@ -73,6 +73,9 @@ class Instance {
 
  private:
   const VariableInfo& variable(ValueReference vr, bool setting) const;
+  /// As above, and refused unless the variable's type is got and set as T.
+  template <class T>
+  const VariableInfo& variable(ValueReference vr, bool setting) const;
   [[nodiscard]] std::size_t element_count(const VariableInfo& info) const;
   void log_exception(const char* function, Status status) const noexcept;
 

@@ -1,6 +1,10 @@
 // Model's default output getters: a variable the model has no value of is refused.
 #include "fmi3/model.hpp"
 
+#include <algorithm>
+#include <cmath>
+#include <string>
+
 namespace tissue::fmi3 {
 namespace {
 
@@ -9,6 +13,20 @@ namespace {
 }
 
 }  // namespace
+
+long whole_internal_steps(double model_time_s, double current_time_s, double step_s, double internal_step_s) {
+  const double h = internal_step_s;
+  if (std::abs(current_time_s - model_time_s) > 1e-9 * std::max({1.0, std::abs(model_time_s), h})) {
+    throw VariableError("doStep: the communication point " + std::to_string(current_time_s) +
+                        " s is not the instance's time " + std::to_string(model_time_s) + " s");
+  }
+  const double count = std::round(step_s / h);
+  if (count < 1.0 || std::abs(count * h - step_s) > 1e-9 * step_s) {
+    throw VariableError("doStep: the communication step " + std::to_string(step_s) +
+                        " s is not a whole multiple of stepSize " + std::to_string(h) + " s");
+  }
+  return static_cast<long>(count);
+}
 
 void Model::get_float64(const VariableInfo& info, std::span<double>) { no_value(info, "Float64"); }
 void Model::get_uint32(const VariableInfo& info, std::span<std::uint32_t>) { no_value(info, "UInt32"); }

@@ -42,6 +42,12 @@ struct StepOutcome {
   bool warning = false;  ///< completed, with something the log explains (fmi3Warning)
 };
 
+/// How many internal steps of `internal_step_s` a doStep over `step_s` from `current_time_s` takes,
+/// for a model at `model_time_s`: the one rule of every FMU of the project. Throws VariableError
+/// unless the communication point is the model's time and the step a whole multiple of the internal
+/// step (both to 1e-9, relative).
+long whole_internal_steps(double model_time_s, double current_time_s, double step_s, double internal_step_s);
+
 class Model {
  public:
   virtual ~Model() = default;

@@ -49,20 +49,6 @@ T parse_number(const std::string& word, const VariableInfo& info) {
   return value;
 }
 
-// Which FMI types a C++ value type reads and writes.
-template <class T>
-bool accepts(VariableType type) {
-  if constexpr (std::is_same_v<T, double>) return type == VariableType::float64;
-  if constexpr (std::is_same_v<T, std::int32_t>) return type == VariableType::int32;
-  if constexpr (std::is_same_v<T, std::uint32_t>) return type == VariableType::uint32;
-  if constexpr (std::is_same_v<T, std::int64_t>)
-    return type == VariableType::int64 || type == VariableType::enumeration;
-  if constexpr (std::is_same_v<T, std::uint64_t>) return type == VariableType::uint64;
-  if constexpr (std::is_same_v<T, bool>) return type == VariableType::boolean;
-  if constexpr (std::is_same_v<T, const char*>) return type == VariableType::string;
-  return false;
-}
-
 }  // namespace
 
 ValueStore::ValueStore(const ModelDescription& model) : m_model(&model) {

@@ -10,6 +10,7 @@
 #include <cstdint>
 #include <span>
 #include <string_view>
+#include <type_traits>
 
 namespace tissue::fmi3 {
 
@@ -155,6 +156,33 @@ constexpr Dimension fixed_size(std::uint64_t size) { return {size, -1}; }
 template <class Vr>
 constexpr Dimension sized_by(Vr structural_parameter) {
   return {0, static_cast<std::int64_t>(structural_parameter)};
+}
+
+/// True if the C++ value type T gets and sets variables of `type` (an enumeration is Int64 in FMI 3);
+/// T is double, std::int32_t, std::uint32_t, std::int64_t, std::uint64_t, bool or const char*.
+template <class T>
+constexpr bool accepts(VariableType type) {
+  if constexpr (std::is_same_v<T, double>) return type == VariableType::float64;
+  if constexpr (std::is_same_v<T, std::int32_t>) return type == VariableType::int32;
+  if constexpr (std::is_same_v<T, std::uint32_t>) return type == VariableType::uint32;
+  if constexpr (std::is_same_v<T, std::int64_t>)
+    return type == VariableType::int64 || type == VariableType::enumeration;
+  if constexpr (std::is_same_v<T, std::uint64_t>) return type == VariableType::uint64;
+  if constexpr (std::is_same_v<T, bool>) return type == VariableType::boolean;
+  if constexpr (std::is_same_v<T, const char*>) return type == VariableType::string;
+  return false;
+}
+
+/// The FMI name of the accessor of T ("Float64", ..., "String").
+template <class T>
+constexpr std::string_view accessor_name() {
+  if constexpr (std::is_same_v<T, double>) return "Float64";
+  if constexpr (std::is_same_v<T, std::int32_t>) return "Int32";
+  if constexpr (std::is_same_v<T, std::uint32_t>) return "UInt32";
+  if constexpr (std::is_same_v<T, std::int64_t>) return "Int64";
+  if constexpr (std::is_same_v<T, std::uint64_t>) return "UInt64";
+  if constexpr (std::is_same_v<T, bool>) return "Boolean";
+  return "String";
 }
 
 /// True if the table is in strictly increasing value-reference order (find() binary-searches).

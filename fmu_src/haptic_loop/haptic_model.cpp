@@ -116,22 +116,14 @@ void HapticModel::take_tissue_sample() {
 
 fmi3::StepOutcome HapticModel::do_step(double current_time_s, double step_s) {
   const double tick_s = m_values.float64(vr(Vr::step_size));
-  if (std::abs(current_time_s - m_time_s) > 1e-9 * std::max(1.0, std::abs(m_time_s))) {
-    throw VariableError("doStep: the communication point " + std::to_string(current_time_s) +
-                        " s is not the instance's time " + std::to_string(m_time_s) + " s");
-  }
-  const double ticks = std::round(step_s / tick_s);
-  if (ticks < 1.0 || std::abs(ticks * tick_s - step_s) > 1e-9 * step_s) {
-    throw VariableError("doStep: the communication step " + std::to_string(step_s) +
-                        " s is not a whole multiple of stepSize " + std::to_string(tick_s) + " s");
-  }
+  const long ticks = fmi3::whole_internal_steps(m_time_s, current_time_s, step_s, tick_s);
   const std::uint64_t refused_before = m_samples_refused;
   take_tissue_sample();
   const auto mode = static_cast<haptic::ToolMode>(m_values.int64(vr(Vr::device_tool_mode)));
   const Eigen::Vector3d position_m = tool_position();
-  for (long n = 0; n < static_cast<long>(ticks); ++n) m_renderer.tick(position_m, mode, tick_s);
+  for (long n = 0; n < ticks; ++n) m_renderer.tick(position_m, mode, tick_s);
   // Whole ticks from the communication point: no drift from adding step_s.
-  m_time_s = current_time_s + ticks * tick_s;
+  m_time_s = current_time_s + static_cast<double>(ticks) * tick_s;
   // A refused sample does not stop the hand's loop, but the importer hears of it (fmi3Warning).
   return {true, m_time_s, m_samples_refused != refused_before};
 }

@@ -175,16 +175,7 @@ void TissueModel::exit_initialization_mode() { ensure_built(); }
 fmi3::StepOutcome TissueModel::do_step(double current_time_s, double step_s) {
   Tissue& tissue = *m_tissue;
   const double now = m_start_time_s + tissue.time_s();
-  const double h = m_values.float64(vr(Vr::step_size));
-  if (std::abs(current_time_s - now) > 1e-9 * std::max({1.0, std::abs(now), h})) {
-    throw VariableError("doStep: the communication point " + std::to_string(current_time_s) +
-                        " s is not the instance's time " + std::to_string(now) + " s");
-  }
-  const double count = std::round(step_s / h);
-  if (count < 1.0 || std::abs(count * h - step_s) > 1e-9 * step_s) {
-    throw VariableError("doStep: the communication step " + std::to_string(step_s) +
-                        " s is not a whole multiple of stepSize " + std::to_string(h) + " s");
-  }
+  const long count = fmi3::whole_internal_steps(now, current_time_s, step_s, m_values.float64(vr(Vr::step_size)));
   tissue.set_tool(tool_pose(m_values));
   const std::size_t cuts_before = tissue.body().cut_tets().size();
   const bool contact_before = tissue.contact().active;
@@ -200,7 +191,7 @@ fmi3::StepOutcome TissueModel::do_step(double current_time_s, double step_s) {
                                                " at t = " + std::to_string(m_start_time_s + tissue.time_s()) + " s");
     }
   };
-  for (long n = 0; n < static_cast<long>(count); ++n) {
+  for (long n = 0; n < count; ++n) {
     try {
       tissue.step();
     } catch (const IntegrationError& error) {

@@ -354,7 +354,6 @@ class Session {
     m_cut_tets.store(out.cut_tets, std::memory_order_relaxed);
     m_summary.cut_tets = out.cut_tets;
     m_summary.enriched_vertices = out.enriched_vertices;
-    m_tissue_time_s = reached_s;
   }
 
   bool frame_due(double time_s) const { return m_scenario.frame_rate_hz > 0.0 && time_s + 1e-9 >= m_next_frame_s; }
@@ -627,7 +626,6 @@ class Session {
   bool m_cutting_seen = false;
   bool m_tissue_nan = false;
   bool m_tissue_failed = false;
-  double m_tissue_time_s = 0.0;
   double m_next_frame_s = 0.0;
   TissueOutputs m_last_outputs;
   std::atomic<std::uint64_t> m_cut_tets{0};  // for the progress line
