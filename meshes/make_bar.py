@@ -2,7 +2,7 @@
 """Writes a box of nx x ny x nz cubes, each split into 5 tets, as a Vega .veg file.
 
 The same mesh (same vertex and tet numbering) is built in C++ by make_box_mesh()
-(fmu_src/core/mesh/box_mesh.cpp); test_mesh_io checks that the two agree, so a change to
+(libtissue/core/mesh/box_mesh.cpp); test_mesh_io checks that the two agree, so a change to
 the tables here must be made there too.
 
 Vertex (i, j, k) sits at (i*e, j*e, k*e) metres, e = --cube-edge, and has the 1-based id

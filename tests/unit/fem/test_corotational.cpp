@@ -4,6 +4,7 @@
 #include "core/fem/corotational.hpp"
 #include "core/mesh/box_mesh.hpp"
 #include "core/system/assembly.hpp"
+#include "core/system/rayleigh_damping.hpp"
 
 #include <gtest/gtest.h>
 

@@ -3,7 +3,7 @@
 // tangent as a dense matrix, and a Newton solve for static equilibrium.
 #pragma once
 
-#include "core/cut/tet_cut.hpp"
+#include "core/fem/tet_cut.hpp"
 #include "core/fem/deformable_body.hpp"
 #include "core/mesh/topology.hpp"
 #include "core/solve/linear_solver.hpp"

@@ -3,8 +3,8 @@
 // Integrators call this interface; the FEM implements it (fem/deformable_body.hpp).
 #pragma once
 
-#include "core/fem/material.hpp"
 #include "core/system/block_sparse_matrix.hpp"
+#include "core/system/rayleigh_damping.hpp"
 
 #include <Eigen/Core>
 

@@ -3,7 +3,7 @@
 // cut, and the exact rest volume of each part. Pure functions; the VolumeCutter calls them.
 #pragma once
 
-#include "core/cut/tet_cut.hpp"
+#include "core/fem/tet_cut.hpp"
 
 #include <Eigen/Core>
 

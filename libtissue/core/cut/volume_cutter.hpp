@@ -25,7 +25,7 @@
 #pragma once
 
 #include "core/collide/surface_bvh.hpp"
-#include "core/cut/tet_cut.hpp"
+#include "core/fem/tet_cut.hpp"
 #include "core/mesh/tet_mesh.hpp"
 #include "core/mesh/topology.hpp"
 

@@ -19,17 +19,6 @@ void validate(const Material& material) {
   }
 }
 
-void validate(const RayleighDamping& damping) {
-  if (!std::isfinite(damping.mass_damping_per_s) || damping.mass_damping_per_s < 0.0) {
-    throw ParameterError("damping: mass damping alpha must be finite and >= 0 1/s, got " +
-                         std::to_string(damping.mass_damping_per_s));
-  }
-  if (!std::isfinite(damping.stiffness_damping_s) || damping.stiffness_damping_s < 0.0) {
-    throw ParameterError("damping: stiffness damping beta must be finite and >= 0 s, got " +
-                         std::to_string(damping.stiffness_damping_s));
-  }
-}
-
 LameParameters lame_parameters(const Material& material) {
   const double e = material.young_modulus_pa;
   const double nu = material.poisson_ratio;

@@ -10,7 +10,7 @@
 // u unknown and Psi_pi for an enriched one.
 #pragma once
 
-#include "core/cut/tet_cut.hpp"
+#include "core/fem/tet_cut.hpp"
 #include "core/fem/material.hpp"
 #include "core/fem/rotation.hpp"
 #include "core/fem/tet_element.hpp"

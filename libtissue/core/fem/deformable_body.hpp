@@ -8,7 +8,7 @@
 // on the other side of the cut must be free to move.
 #pragma once
 
-#include "core/cut/tet_cut.hpp"
+#include "core/fem/tet_cut.hpp"
 #include "core/fem/corotational.hpp"
 #include "core/fem/material.hpp"
 #include "core/fem/xfem_elasticity.hpp"
