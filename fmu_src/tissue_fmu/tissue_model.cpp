@@ -27,10 +27,19 @@ constexpr std::uint64_t MAX_CAPACITY = 1ULL << 26U;
 struct TissueState final : fmi3::ModelState {
   TissueSnapshot tissue;
   std::uint64_t surface_revision = 0;
+  std::uint64_t integrator_iterations = 0;
 };
 
 LinearSolverKind linear_solver(std::int64_t item) {
   return item == 1 ? LinearSolverKind::pcg : LinearSolverKind::cholmod;
+}
+
+IntegratorKind integrator_kind(std::int64_t item) {
+  return item == 1 ? IntegratorKind::backward_euler : IntegratorKind::ida;
+}
+
+IdaLinearSolverKind ida_linear_solver(std::int64_t item) {
+  return item == 1 ? IdaLinearSolverKind::klu : IdaLinearSolverKind::krylov;
 }
 
 ContactStiffnessModel stiffness_model(std::int64_t item) {
@@ -54,6 +63,13 @@ TissueSettings tissue_settings(const ValueStore& values, const TetMesh* mesh) {
     validate(slab);
     if (mesh != nullptr) s.body.fixed_vertices = vertices_at_minimum(*mesh, slab.axis, slab.fraction);
   }
+  s.integrator.kind = integrator_kind(values.int64(vr(Vr::integrator_method)));
+  IdaSettings& ida = s.integrator.ida;
+  ida.relative_tolerance = values.float64(vr(Vr::ida_relative_tolerance));
+  ida.absolute_tolerance = values.float64(vr(Vr::ida_absolute_tolerance));
+  ida.max_order = values.int32(vr(Vr::ida_max_order));
+  ida.max_step_s = values.float64(vr(Vr::ida_max_step));
+  ida.linear_solver = ida_linear_solver(values.int64(vr(Vr::ida_linear_solver)));
   s.solver.kind = linear_solver(values.int64(vr(Vr::linear_solver)));
   s.solver.pcg = PcgSolver::Settings{values.float64(vr(Vr::pcg_tolerance)), values.int32(vr(Vr::pcg_max_iterations))};
   s.solver.warm_start = values.boolean(vr(Vr::warm_start));
@@ -66,6 +82,7 @@ TissueSettings tissue_settings(const ValueStore& values, const TetMesh* mesh) {
   i.contact_spring_stiffness_n_per_m = values.float64(vr(Vr::contact_spring_stiffness));
   i.contact_stiffness_model = stiffness_model(values.int64(vr(Vr::contact_stiffness_model)));
   i.contact_stiffness_refresh_steps = values.int32(vr(Vr::contact_stiffness_refresh_steps));
+  i.max_tool_speed_m_per_s = values.float64(vr(Vr::tool_max_speed));
   validate(s);
   return s;
 }
@@ -134,6 +151,7 @@ void TissueModel::build() {
   m_tissue->set_tool(tool_pose(m_values));
   m_dirty = false;
   m_surface_revision = 0;
+  m_integrator_iterations = 0;
   m_surface_triangles = surface_triangle_count();
   m_capacity_warned = false;
 }
@@ -191,10 +209,14 @@ fmi3::StepOutcome TissueModel::do_step(double current_time_s, double step_s) {
                                                " at t = " + std::to_string(m_start_time_s + tissue.time_s()) + " s");
     }
   };
+  // A step that fails leaves the time at the last internal step that succeeded (Tissue::step is
+  // all or nothing for the time and the state): doStep discards with that time, never half advanced.
   for (long n = 0; n < count; ++n) {
     try {
-      tissue.step();
-    } catch (const IntegrationError& error) {
+      const TissueStepReport report = tissue.step();
+      m_integrator_iterations += static_cast<std::uint64_t>(report.dynamics.newton_iterations) +
+                                 static_cast<std::uint64_t>(report.dynamics.linear_iterations);
+    } catch (const std::exception& error) {
       update_surface_counters();
       log_events();
       m_context.log(fmi3::LogLevel::warning, std::string("doStep: an internal step failed: ") + error.what());
@@ -335,6 +357,9 @@ void TissueModel::get_uint64(const VariableInfo& info, std::span<std::uint64_t> 
     case Vr::dofs:
       out[0] = static_cast<std::uint64_t>(tissue.body().dof_count());
       return;
+    case Vr::integrator_iterations:
+      out[0] = m_integrator_iterations;
+      return;
     default:
       Model::get_uint64(info, out);
   }
@@ -353,6 +378,7 @@ std::unique_ptr<fmi3::ModelState> TissueModel::save() const {
   auto state = std::make_unique<TissueState>();
   m_tissue->save(state->tissue);
   state->surface_revision = m_surface_revision;
+  state->integrator_iterations = m_integrator_iterations;
   return state;
 }
 
@@ -373,6 +399,7 @@ void TissueModel::restore(const fmi3::ModelState& model_state) {
     throw VariableError(std::string("set FMU state: ") + error.what());
   }
   m_surface_revision = state->surface_revision;
+  m_integrator_iterations = state->integrator_iterations;
   m_surface_triangles = surface_triangle_count();
 }
 
@@ -380,12 +407,14 @@ void TissueModel::serialize(const fmi3::ModelState& model_state, serial::ByteWri
   const auto& state = dynamic_cast<const TissueState&>(model_state);
   writer.put_bytes(serialize_snapshot(state.tissue));
   writer.put(state.surface_revision);
+  writer.put(state.integrator_iterations);
 }
 
 std::unique_ptr<fmi3::ModelState> TissueModel::deserialize(serial::ByteReader& reader) const {
   auto state = std::make_unique<TissueState>();
   state->tissue = deserialize_snapshot(reader.get_bytes());
   reader.get(state->surface_revision);
+  reader.get(state->integrator_iterations);
   return state;
 }
 

@@ -62,6 +62,7 @@ class TissueModel final : public fmi3::Model {
   TetMesh m_mesh;       // as loaded: a fresh Tissue for a restored state with other cuts
   std::unique_ptr<Tissue> m_tissue;
   std::uint64_t m_surface_revision = 0;
+  std::uint64_t m_integrator_iterations = 0;  ///< integrator.iterations
   std::uint64_t m_surface_triangles = 0;  // at the last revision check
   bool m_capacity_warned = false;
   std::vector<SurfaceBvh::SegmentHit> m_blade_hits;  // scratch of blade_depth_m()

@@ -212,6 +212,41 @@ constexpr auto VARIABLES = std::to_array<VariableInfo>({
         .unit("m")
         .describe("Length of the scalpel's cutting edge inside the tissue while it cuts (0 otherwise): the haptic "
                   "loop's cutting force is proportional to it"),
+    output(Vr::integrator_iterations, "integrator.iterations", uint64, discrete)
+        .describe("Iterations of the integrator so far: PCG iterations (backward Euler with PCG), IDA's Newton "
+                  "iterations plus its GMRES iterations (IDA); a direct solve counts none"),
+
+    parameter(Vr::integrator_method, "integrator.method", enumeration)
+        .declared_type("Integrator")
+        .start("1")
+        .describe("Time integrator: backward Euler (one linear solve per internal step) or SUNDIALS IDA "
+                  "(variable-order BDF with error control)"),
+    parameter(Vr::ida_relative_tolerance, "integrator.idaRelativeTolerance", float64)
+        .unit("1")
+        .start("0.0001")
+        .describe("IDA's relative error tolerance; must be > 0"),
+    parameter(Vr::ida_absolute_tolerance, "integrator.idaAbsoluteTolerance", float64)
+        .start("1e-08")
+        .describe("IDA's absolute error tolerance, in m on displacements and m/s on velocities; must be > 0"),
+    parameter(Vr::ida_max_order, "integrator.idaMaxOrder", int32)
+        .start("5")
+        .min("1")
+        .max("5")
+        .describe("Highest BDF order IDA may use"),
+    parameter(Vr::ida_max_step, "integrator.idaMaxStep", float64)
+        .unit("s")
+        .start("0")
+        .min("0")
+        .describe("Largest internal step IDA may take; 0: no limit below stepSize"),
+    parameter(Vr::ida_linear_solver, "integrator.idaLinearSolver", enumeration)
+        .declared_type("IdaLinearSolver")
+        .start("1")
+        .describe("Linear solver of IDA's Newton iteration"),
+    parameter(Vr::tool_max_speed, "tool.maxSpeed", float64)
+        .unit("m/s")
+        .start("5")
+        .describe("Fastest a hand moves the tool; a pose farther than this times the internal step from the last is "
+                  "approached at this speed (the tool is clamped, a scalpel sweeps the path in sub-steps); must be > 0"),
 });
 
 static_assert(fmi3::strictly_ordered(VARIABLES), "the variable table must be in increasing value-reference order");
@@ -220,6 +255,14 @@ constexpr auto LINEAR_SOLVER_ITEMS = std::to_array<EnumerationItem>({
     {"pcg", 1,
      "Jacobi-preconditioned conjugate gradients (iterative; integrator.pcgTolerance, integrator.pcgMaxIterations)"},
     {"cholmod", 2, "Sparse Cholesky factorization (CHOLMOD, direct, exact)"},
+});
+constexpr auto INTEGRATOR_ITEMS = std::to_array<EnumerationItem>({
+    {"backwardEuler", 1, "Semi-implicit backward Euler, one linear solve per internal step (integrator.linearSolver)"},
+    {"ida", 2, "SUNDIALS IDA: variable-order, variable-step BDF with error control (integrator.ida*)"},
+});
+constexpr auto IDA_LINEAR_SOLVER_ITEMS = std::to_array<EnumerationItem>({
+    {"klu", 1, "Sparse LU factorization of the Newton matrix (KLU, direct)"},
+    {"krylov", 2, "GMRES, preconditioned by eliminating the velocities and the diagonal of the rest (iterative)"},
 });
 constexpr auto CONTACT_STIFFNESS_ITEMS = std::to_array<EnumerationItem>({
     {"effectiveStatic", 1,
@@ -234,6 +277,8 @@ constexpr auto TOOL_MODE_ITEMS = std::to_array<EnumerationItem>({
 const auto ENUMERATIONS = std::to_array<EnumerationType>({
     {"LinearSolver", "Linear solver of the backward-Euler step", LINEAR_SOLVER_ITEMS},
     {"ContactStiffnessModel", "How the 3x3 contact stiffness K_c is computed", CONTACT_STIFFNESS_ITEMS},
+    {"Integrator", "Time integrator of the tissue", INTEGRATOR_ITEMS},
+    {"IdaLinearSolver", "Linear solver of IDA's Newton iteration", IDA_LINEAR_SOLVER_ITEMS},
     {"ToolMode", "What the tool does to the tissue", TOOL_MODE_ITEMS},
 });
 

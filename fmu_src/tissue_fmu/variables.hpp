@@ -64,7 +64,16 @@ enum class Vr : std::uint32_t {
   dofs = 62,
   kinetic_energy = 63,
   elastic_energy = 64,
-  blade_depth = 65
+  blade_depth = 65,
+  integrator_iterations = 66,
+  // parameters added with issue 10 (the integrator choice, the hand's speed limit)
+  integrator_method = 70,
+  ida_relative_tolerance = 71,
+  ida_absolute_tolerance = 72,
+  ida_max_order = 73,
+  ida_max_step = 74,
+  ida_linear_solver = 75,
+  tool_max_speed = 76
 };
 
 /// The Tissue FMU's description: identity, variables, enumeration types.

@@ -1,42 +1,16 @@
 // The Tissue facade.
 #include "core/tissue.hpp"
 
-#include "core/integrate/backward_euler.hpp"
-
 #include <algorithm>
 #include <array>
+#include <Eigen/Eigenvalues>
+
 #include <chrono>
 #include <cmath>
 #include <string>
 #include <type_traits>
 
 namespace tissue {
-
-LinearSolverKind parse_linear_solver_kind(std::string_view name) {
-  if (name == "pcg") return LinearSolverKind::pcg;
-  if (name == "cholmod") return LinearSolverKind::cholmod;
-  throw ParameterError("unknown linear solver '" + std::string(name) + "' (expected pcg or cholmod)");
-}
-
-void validate(const SolverSettings& settings) {
-  if (!(settings.pcg.tolerance > 0.0) || !std::isfinite(settings.pcg.tolerance)) {
-    throw ParameterError("PCG tolerance must be finite and > 0, got " + std::to_string(settings.pcg.tolerance));
-  }
-  if (settings.pcg.max_iterations < 1) {
-    throw ParameterError("PCG max iterations must be >= 1, got " + std::to_string(settings.pcg.max_iterations));
-  }
-}
-
-std::unique_ptr<LinearSolver> make_linear_solver(const SolverSettings& settings) {
-  validate(settings);
-  switch (settings.kind) {
-    case LinearSolverKind::pcg:
-      return std::make_unique<PcgSolver>(settings.pcg);
-    case LinearSolverKind::cholmod:
-      return std::make_unique<CholmodSolver>();
-  }
-  throw ParameterError("unknown linear solver kind");
-}
 
 namespace {
 
@@ -89,6 +63,14 @@ std::uint64_t model_fingerprint_of(const TetMesh& mesh, const TissueSettings& se
   f.add_all(body.fixed_vertices);
   f.add(body.reserve.extra_row_fraction);  // field by field: a struct's padding bytes are not values
   f.add(body.reserve.row_capacity_factor);
+  f.add(settings.integrator.kind);
+  const IdaSettings& ida = settings.integrator.ida;
+  f.add(ida.relative_tolerance);
+  f.add(ida.absolute_tolerance);
+  f.add(ida.max_order);
+  f.add(ida.max_step_s);
+  f.add(ida.linear_solver);
+  f.add(ida.max_internal_steps);
   f.add(settings.solver.kind);
   f.add(settings.solver.pcg.tolerance);
   f.add(settings.solver.pcg.max_iterations);
@@ -102,9 +84,14 @@ std::uint64_t model_fingerprint_of(const TetMesh& mesh, const TissueSettings& se
   f.add(interaction.contact_spring_stiffness_n_per_m);
   f.add(interaction.contact_stiffness_model);
   f.add(interaction.contact_stiffness_refresh_steps);
+  f.add(interaction.max_tool_speed_m_per_s);
   f.add(settings.step_size_s);
   return f.value();
 }
+
+// The largest turn of the blade one cutter sweep covers (its two triangles span the ruled surface
+// of a turning segment to within ~ L (1 - cos(angle / 2)), 0.1 mm for a 3 cm blade at 5 degrees).
+constexpr double MAX_SWEEP_ANGLE_RAD = 5.0 * 3.14159265358979323846 / 180.0;
 
 bool same_cut(const TetCut& a, const TetCut& b) {
   return a.tet == b.tet && a.cut_id == b.cut_id && a.side == b.side &&
@@ -112,14 +99,14 @@ bool same_cut(const TetCut& a, const TetCut& b) {
 }
 
 PointContactSettings contact_settings(const TissueSettings& settings, const DeformableBody& body,
-                                      const SurfaceMesh& surface) {
+                                      const SurfaceMesh& surface, const Integrator& integrator) {
   PointContactSettings contact;
   const double stiffness = settings.interaction.contact_spring_stiffness_n_per_m;
   contact.spring_stiffness_n_per_m =
       stiffness > 0.0 ? stiffness : recommended_contact_spring_stiffness_n_per_m(body, surface);
-  // The spring stands for the rigid tool: the backward-Euler step must not damp it (issue 9).
+  // The spring stands for the rigid tool: the step must not damp it (issue 9).
   contact.spring_tangent_fraction =
-      undamped_tangent_fraction(settings.step_size_s, settings.body.damping.stiffness_damping_s);
+      integrator.undamped_spring_fraction(settings.step_size_s, settings.body.damping.stiffness_damping_s);
   return contact;
 }
 
@@ -139,6 +126,7 @@ void validate(const TissueSettings& settings) {
   validate(settings.body.material);
   validate(settings.body.damping);
   if (!settings.body.gravity_m_per_s2.allFinite()) throw ParameterError("gravity must be finite");
+  validate(settings.integrator);
   validate(settings.solver);
   validate(settings.interaction);
 }
@@ -152,6 +140,10 @@ void validate(const InteractionSettings& settings) {
     throw ParameterError("contact spring stiffness must be finite and >= 0 N/m (0: automatic), got " +
                          std::to_string(settings.contact_spring_stiffness_n_per_m));
   }
+  if (!(settings.max_tool_speed_m_per_s > 0.0) || !std::isfinite(settings.max_tool_speed_m_per_s)) {
+    throw ParameterError("tool speed limit must be finite and > 0 m/s, got " +
+                         std::to_string(settings.max_tool_speed_m_per_s));
+  }
   if (settings.contact_stiffness_refresh_steps < 1) {
     throw ParameterError("contact stiffness refresh must be >= 1 step, got " +
                          std::to_string(settings.contact_stiffness_refresh_steps));
@@ -162,8 +154,7 @@ void validate(const InteractionSettings& settings) {
 Tissue::Tissue(TetMesh mesh, TissueSettings settings)
     : m_settings(checked(std::move(settings))),
       m_body(std::move(mesh), m_settings.body),
-      m_integrator(std::make_unique<BackwardEuler>(make_linear_solver(m_settings.solver),
-                                                   BackwardEuler::Settings{m_settings.solver.warm_start})),
+      m_integrator(make_integrator(m_settings.integrator, m_settings.solver)),
       m_surface(extract_surface(m_body.mesh())),
       // Only what the scene requires (DESIGN section 1): the edge adjacency and the cutter only with
       // cutting, the surface BVH only with contact or cutting.
@@ -175,7 +166,7 @@ Tissue::Tissue(TetMesh mesh, TissueSettings settings)
                 ? m_surface.triangles
                 : std::vector<std::array<int, 3>>{},
             m_positions_m),
-      m_contact(contact_settings(m_settings, m_body, m_surface)),
+      m_contact(contact_settings(m_settings, m_body, m_surface, *m_integrator)),
       m_model_fingerprint(model_fingerprint_of(m_body.mesh(), m_settings)) {
   m_state.displacement_m.setZero(m_body.dof_count());
   m_state.velocity_m_per_s.setZero(m_body.dof_count());
@@ -208,20 +199,64 @@ Blade Tissue::blade(const ToolPose& pose) const {
                                                               (pose.orientation * Eigen::Vector3d::UnitZ())};
 }
 
-void Tissue::interact_with_scalpel(const ToolPose& previous, TissueStepReport& report) {
-  const auto cut_start = std::chrono::steady_clock::now();
-  report.cut = m_cutter->step(blade(previous), blade(m_tool), m_positions_m, m_bvh);
-  report.cut_s = seconds_since(cut_start);
-  if (m_cutter->new_cuts().empty()) return;
-  const auto enrich_start = std::chrono::steady_clock::now();
-  report.enrichment = apply_cuts(m_cutter->new_cuts());
-  report.enrich_s = seconds_since(enrich_start);
+ToolPose reachable_pose(const ToolPose& previous, const ToolPose& target, double blade_length_m, double max_step_m) {
+  // Only a tool that interacts in both poses is held to the hand's speed; a mode switch or a tool
+  // that does nothing goes where it is put.
+  if (target.mode != previous.mode || target.mode == ToolMode::none || !(max_step_m > 0.0)) return target;
+  const Eigen::Vector3d axis_before = previous.orientation * Eigen::Vector3d::UnitZ();
+  const Eigen::Vector3d axis_after = target.orientation * Eigen::Vector3d::UnitZ();
+  const double tip_move_m = (target.tip_position_m - previous.tip_position_m).norm();
+  const double end_move_m =
+      (target.tip_position_m + blade_length_m * axis_after - previous.tip_position_m - blade_length_m * axis_before)
+          .norm();
+  const double move_m = std::max(tip_move_m, end_move_m);
+  if (!(move_m > max_step_m)) return target;
+  const double fraction = max_step_m / move_m;
+  ToolPose reached = target;
+  reached.tip_position_m = previous.tip_position_m + fraction * (target.tip_position_m - previous.tip_position_m);
+  reached.orientation = previous.orientation.slerp(fraction, target.orientation).normalized();
+  return reached;
+}
+
+int sweep_substeps(const ToolPose& from, const ToolPose& to) {
+  const double angle_rad = from.orientation.angularDistance(to.orientation);
+  return std::max(1, static_cast<int>(std::ceil(angle_rad / MAX_SWEEP_ANGLE_RAD)));
+}
+
+void Tissue::interact_with_scalpel(const ToolPose& previous, const ToolPose& current, TissueStepReport& report) {
+  // The blade sweeps two triangles per cutter step; a turning blade's surface is curved, so the
+  // step is cut in sub-sweeps of at most MAX_SWEEP_ANGLE_RAD, along the path the tool took.
+  const int substeps = sweep_substeps(previous, current);
+  ToolPose from = previous;
+  for (int k = 1; k <= substeps; ++k) {
+    const double fraction = static_cast<double>(k) / substeps;
+    ToolPose to = current;
+    if (k < substeps) {
+      to.tip_position_m = previous.tip_position_m + fraction * (current.tip_position_m - previous.tip_position_m);
+      to.orientation = previous.orientation.slerp(fraction, current.orientation).normalized();
+    }
+    const auto cut_start = std::chrono::steady_clock::now();
+    const CutStepReport cut = m_cutter->step(blade(from), blade(to), m_positions_m, m_bvh);
+    const int newly_cut = report.cut.newly_cut_tets + cut.newly_cut_tets;
+    report.cut = cut;
+    report.cut.newly_cut_tets = newly_cut;
+    report.cut_s += seconds_since(cut_start);
+    from = to;
+    if (m_cutter->new_cuts().empty()) continue;
+    const auto enrich_start = std::chrono::steady_clock::now();
+    const EnrichmentResult enriched = apply_cuts(m_cutter->new_cuts());
+    report.enrichment.new_cut_tets += enriched.new_cut_tets;
+    report.enrichment.new_enriched_dofs += enriched.new_enriched_dofs;
+    report.enrichment.matrix_relayout = report.enrichment.matrix_relayout || enriched.matrix_relayout;
+    report.enrich_s += seconds_since(enrich_start);
+  }
 }
 
 EnrichmentResult Tissue::apply_cuts(std::span<const TetCut> cuts) {
   const int first_new = static_cast<int>(m_body.cut_tets().size());
   const EnrichmentResult result = m_body.enrich(cuts);
   m_body.grow_state(m_state);
+  m_integrator->restart(Restart::system_grown);
   m_cut_history.insert(m_cut_history.end(), cuts.begin(), cuts.end());
   m_cut_batch_ends.push_back(static_cast<int>(m_cut_history.size()));
   // The opened faces join the surface (at the current state: both parts still coincide).
@@ -312,6 +347,7 @@ void Tissue::restore(const TissueSnapshot& snapshot) {
   m_body.restore_rotations(rotations);
   m_state = dynamics;
   m_integrator->restore_internal_state(snapshot.integrator_state);
+  m_integrator->restart(Restart::state_restored);
   m_contact.restore(contact);
   m_tool = snapshot.tool;
   m_previous_tool = snapshot.previous_tool;
@@ -321,9 +357,9 @@ void Tissue::restore(const TissueSnapshot& snapshot) {
   m_bvh.refit(m_positions_m);
 }
 
-void Tissue::interact_with_probe(const ToolPose& previous) {
+void Tissue::interact_with_probe(const ToolPose& previous, const ToolPose& current) {
   const bool was_in_contact = m_contact.in_contact();
-  m_contact.update(previous.tip_position_m, m_tool.tip_position_m, m_positions_m, m_bvh);
+  m_contact.update(previous.tip_position_m, current.tip_position_m, m_positions_m, m_bvh);
   // The probe touches the mesh's surface only: a cut face's corners are not vertices the spring can
   // act on (they move with the enriched unknowns), so a probe reaching into a crack feels nothing.
   if (m_contact.in_contact() && m_contact.proxy().triangle >= static_cast<int>(m_surface.triangles.size())) {
@@ -331,6 +367,7 @@ void Tissue::interact_with_probe(const ToolPose& previous) {
   }
   m_contact.apply(m_bvh, m_body);
   if (m_contact.in_contact() && !was_in_contact) m_steps_since_stiffness = -1;  // a new contact: refresh K_c
+  if (m_contact.in_contact() != was_in_contact) m_integrator->restart(Restart::contact_changed);
 }
 
 void Tissue::update_contact_output() {
@@ -343,7 +380,7 @@ void Tissue::update_contact_output() {
   out.point_m = surface_point_position_m(m_contact.proxy(), m_bvh.triangles(), m_positions_m);
   out.normal = m_contact.normal();
   out.force_on_tool_n = m_contact.force_on_tool_n(m_bvh, m_positions_m);
-  out.penetration_depth_m = (m_tool.tip_position_m - out.point_m).norm();
+  out.penetration_depth_m = (m_previous_tool.tip_position_m - out.point_m).norm();
 
   const int triangle = m_contact.proxy().triangle;
   if (m_settings.interaction.contact_stiffness_model == ContactStiffnessModel::element_local) {
@@ -356,26 +393,53 @@ void Tissue::update_contact_output() {
     return;
   }
   m_steps_since_stiffness = 1;
-  // The tangent of this step holds the contact spring; take it out exactly (Sherman-Morrison).
-  const bool has_fixed = !m_body.settings().fixed_vertices.empty();
-  const ShiftedSystem system = has_fixed
-                                   ? static_contact_system(m_body.tangent(), m_contact_system_diagonal)
-                                   : step_contact_system(m_body, m_settings.step_size_s, m_contact_system_diagonal);
-  m_effective_stiffness.factorize(system);
+  try {
+    out.stiffness_n_per_m = effective_contact_stiffness(triangle);
+  } catch (const std::exception&) {
+    // Neither matrix could be factorized (non-finite values): render the spring alone, counted.
+    ++m_contact_stiffness_fallbacks;
+    out.stiffness_n_per_m = Eigen::Matrix3d::Identity() * contact_spring_stiffness_n_per_m();
+  }
+}
+
+Eigen::Matrix3d Tissue::effective_contact_stiffness(int triangle) {
   const std::array<int, 3>& vertices = m_bvh.triangle(triangle);
   const ContactInterpolation point = contact_interpolation(m_body.dofs(), vertices, m_contact.proxy().barycentric);
   const std::optional<PointSpring>& spring = m_body.point_spring();
-  std::optional<Eigen::Matrix3d> stiffness;
-  if (spring) {
-    // What the factorized matrix holds of the spring: its share of the tangent, times the scale.
-    const double in_matrix = system.stiffness_scale * spring->tangent_fraction * spring->stiffness_n_per_m;
-    stiffness = m_effective_stiffness.stiffness_n_per_m(
-        point, contact_interpolation(m_body.dofs(), spring->vertices, spring->weights), in_matrix);
-  } else {
-    stiffness = m_effective_stiffness.stiffness_n_per_m(point);
+  // K_c of a factorized matrix; the tangent of this step holds the contact spring: take it out
+  // exactly (Sherman-Morrison). Nothing when the factor or K_c is unusable.
+  const auto condensed = [&](const ShiftedSystem& system) -> std::optional<Eigen::Matrix3d> {
+    try {
+      m_effective_stiffness.factorize(system);
+      std::optional<Eigen::Matrix3d> stiffness;
+      if (spring) {
+        // What the factorized matrix holds of the spring: its share of the tangent, times the scale.
+        const double in_matrix = system.stiffness_scale * spring->tangent_fraction * spring->stiffness_n_per_m;
+        stiffness = m_effective_stiffness.stiffness_n_per_m(
+            point, contact_interpolation(m_body.dofs(), spring->vertices, spring->weights), in_matrix);
+      } else {
+        stiffness = m_effective_stiffness.stiffness_n_per_m(point);
+      }
+      // A point on fixed vertices only is a rigid support: report the spring alone.
+      if (!stiffness) return Eigen::Matrix3d::Identity() * contact_spring_stiffness_n_per_m();
+      const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eigen(*stiffness, Eigen::EigenvaluesOnly);
+      if (!stiffness->allFinite() || !(eigen.eigenvalues().minCoeff() > 0.0)) return std::nullopt;
+      return stiffness;
+    } catch (const SolverError&) {
+      return std::nullopt;
+    }
+  };
+  // DESIGN section 4: the static K where the body is held; the step's Newton matrix, asked of the
+  // integrator, where nothing holds it, or where the static K fails because a cut set the
+  // contacted piece free (K singular there; issue 10).
+  if (!m_body.settings().fixed_vertices.empty()) {
+    if (const auto stiffness = condensed(static_contact_system(m_body.tangent(), m_contact_system_diagonal))) {
+      return *stiffness;
+    }
   }
-  // A point on fixed vertices only is a rigid support: report the spring alone.
-  out.stiffness_n_per_m = stiffness ? *stiffness : Eigen::Matrix3d::Identity() * contact_spring_stiffness_n_per_m();
+  const ShiftedSystem step = m_integrator->newton_stiffness(m_body, m_settings.step_size_s, m_contact_system_diagonal);
+  if (const auto stiffness = condensed(step)) return *stiffness;
+  throw SolverError("the contact stiffness cannot be condensed from the static or the step matrix");
 }
 
 void Tissue::update_positions() {
@@ -389,27 +453,32 @@ TissueStepReport Tissue::step() {
   TissueStepReport report;
   const ToolPose previous = m_previous_tool;
   const InteractionSettings& interaction = m_settings.interaction;
+  // DESIGN section 7: a pose farther than a hand can move in one step is approached at the hand's
+  // top speed; the tool catches up with it over the next steps.
+  const ToolPose current = reachable_pose(previous, m_tool, interaction.blade_length_m,
+                                          interaction.max_tool_speed_m_per_s * m_settings.step_size_s);
 
   // Collide and cut (DESIGN section 3): the blade's sweep since the last step.
-  const bool scalpel = m_tool.mode == ToolMode::scalpel && interaction.cutting_enabled;
+  const bool scalpel = current.mode == ToolMode::scalpel && interaction.cutting_enabled;
   if (scalpel && previous.mode == ToolMode::scalpel) {
-    interact_with_scalpel(previous, report);
+    interact_with_scalpel(previous, current, report);
   } else if (m_cutter && m_cutter->cutting()) {
     m_cutter->end_cut();
   }
 
   const auto contact_start = std::chrono::steady_clock::now();
-  const bool probe = m_tool.mode == ToolMode::probe && interaction.contact_enabled;
+  const bool probe = current.mode == ToolMode::probe && interaction.contact_enabled;
   if (probe) {
-    interact_with_probe(previous.mode == ToolMode::probe ? previous : m_tool);
+    interact_with_probe(previous.mode == ToolMode::probe ? previous : current, current);
   } else if (m_contact.in_contact() || m_body.point_spring()) {
     m_contact.release();
     m_body.set_point_spring(std::nullopt);
+    m_integrator->restart(Restart::contact_changed);
   }
   report.contact_s = seconds_since(contact_start);
 
   report.dynamics = m_integrator->step(m_body, m_state, m_settings.step_size_s);
-  m_previous_tool = m_tool;
+  m_previous_tool = current;
 
   const auto refit_start = std::chrono::steady_clock::now();
   update_positions();

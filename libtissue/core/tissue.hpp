@@ -12,6 +12,7 @@
 #include "core/cut/volume_cutter.hpp"
 #include "core/fem/deformable_body.hpp"
 #include "core/integrate/integrator.hpp"
+#include "core/integrate/integrator_factory.hpp"
 #include "core/mesh/topology.hpp"
 #include "core/solve/linear_solver.hpp"
 
@@ -26,21 +27,6 @@
 #include <vector>
 
 namespace tissue {
-
-enum class LinearSolverKind { pcg, cholmod };
-
-/// Parses "pcg" / "cholmod"; throws ParameterError otherwise.
-LinearSolverKind parse_linear_solver_kind(std::string_view name);
-
-struct SolverSettings {
-  LinearSolverKind kind = LinearSolverKind::pcg;
-  PcgSolver::Settings pcg;
-  bool warm_start = false;  ///< PCG starts from the previous step's velocity change (see BackwardEuler)
-};
-
-/// Throws ParameterError unless tolerance > 0 (finite) and max_iterations >= 1.
-void validate(const SolverSettings& settings);
-std::unique_ptr<LinearSolver> make_linear_solver(const SolverSettings& settings);
 
 enum class ToolMode { none, probe, scalpel };
 
@@ -58,6 +44,12 @@ struct ToolPose {
 /// Throws ParameterError for a non-finite position or a non-finite or zero quaternion.
 void validate(const ToolPose& pose);
 
+/// The pose a tool reaches from `previous` toward `target` when neither its tip nor its blade end
+/// (blade_length_m along the axis) may move more than max_step_m: `target` itself when it is
+/// within reach, when the mode changes or when the tool does nothing; otherwise the fraction of the
+/// way (position linear, orientation along the shorter arc) that moves the farther end max_step_m.
+ToolPose reachable_pose(const ToolPose& previous, const ToolPose& target, double blade_length_m, double max_step_m);
+
 struct InteractionSettings {
   bool contact_enabled = true;
   bool cutting_enabled = true;
@@ -70,6 +62,9 @@ struct InteractionSettings {
   /// The effective (reference) K_c costs a factorization: it is recomputed when a contact starts and
   /// then every this many steps (>= 1); the element-local model is recomputed every step.
   int contact_stiffness_refresh_steps = 10;
+  /// The fastest a hand moves the tool (tip or blade end) [m/s]: a pose farther than this times the
+  /// step from the last pose the tissue applied is approached at this speed (DESIGN section 7).
+  double max_tool_speed_m_per_s = 5.0;
 };
 
 /// Throws ParameterError for an invalid setting.
@@ -77,7 +72,8 @@ void validate(const InteractionSettings& settings);
 
 struct TissueSettings {
   BodySettings body;
-  SolverSettings solver;
+  IntegratorSettings integrator;  ///< which integrator, and IDA's settings
+  SolverSettings solver;          ///< backward Euler's linear solver
   InteractionSettings interaction;
   double step_size_s = 1e-3;
 };
@@ -145,6 +141,9 @@ class Tissue {
   /// or a non-finite or zero quaternion (it is normalized).
   void set_tool(const ToolPose& pose);
   [[nodiscard]] const ToolPose& tool() const { return m_tool; }
+  /// The pose the last step applied: tool() or, after an impossible jump, the pose on the way to it
+  /// that the hand's top speed reaches (InteractionSettings::max_tool_speed_m_per_s).
+  [[nodiscard]] const ToolPose& applied_tool() const { return m_previous_tool; }
 
   /// One step of step_size_s: tool interaction (cut or contact), backward Euler, BVH refit,
   /// contact outputs. Throws IntegrationError (state unchanged) when the dynamics step fails.
@@ -188,15 +187,22 @@ class Tissue {
   /// when the replay of cuts into a fresh instance fails (discard it).
   void restore(const TissueSnapshot& snapshot);
 
+  /// How many times K_c fell back to the spring alone (no matrix could be condensed).
+  [[nodiscard]] int contact_stiffness_fallbacks() const { return m_contact_stiffness_fallbacks; }
+  /// The integrator of the settings (backward Euler or IDA).
+  [[nodiscard]] const Integrator& integrator() const { return *m_integrator; }
+
   /// The spring stiffness the contact uses (resolved from the settings) [N/m].
   [[nodiscard]] double contact_spring_stiffness_n_per_m() const {
     return m_contact.settings().spring_stiffness_n_per_m;
   }
 
  private:
-  void interact_with_scalpel(const ToolPose& previous, TissueStepReport& report);
-  void interact_with_probe(const ToolPose& previous);
+  void interact_with_scalpel(const ToolPose& previous, const ToolPose& current, TissueStepReport& report);
+  void interact_with_probe(const ToolPose& previous, const ToolPose& current);
   void update_contact_output();
+  /// K_c at the proxy on `triangle` (DESIGN section 4). Throws SolverError when no matrix works.
+  Eigen::Matrix3d effective_contact_stiffness(int triangle);
   void update_positions();
   /// Enriches `cuts` (one batch), grows the state, adds the opened faces to the surface and the BVH.
   EnrichmentResult apply_cuts(std::span<const TetCut> cuts);
@@ -217,6 +223,7 @@ class Tissue {
   EffectiveContactStiffness m_effective_stiffness;
   Eigen::VectorXd m_contact_system_diagonal;
   int m_steps_since_stiffness = 0;
+  int m_contact_stiffness_fallbacks = 0;
   ContactOutput m_contact_output;
   ToolPose m_tool;
   ToolPose m_previous_tool;

@@ -44,24 +44,14 @@ ShiftedSystem static_contact_system(const BlockSparseMatrix& tangent, Eigen::Vec
   return ShiftedSystem{&tangent, 1.0, &diagonal};
 }
 
-ShiftedSystem step_contact_system(const DynamicsModel& model, double step_size_s, Eigen::VectorXd& diagonal) {
-  if (!(step_size_s > 0.0) || !std::isfinite(step_size_s)) {
-    throw ParameterError("contact stiffness: step size must be finite and > 0 s, got " + std::to_string(step_size_s));
-  }
-  const double h = step_size_s;
-  const RayleighDamping& damping = model.damping();
-  diagonal = ((1.0 + h * damping.mass_damping_per_s) / (h * h)) * model.mass_kg();
-  return ShiftedSystem{&model.tangent(), 1.0 + damping.stiffness_damping_s / h, &diagonal};
-}
-
 void EffectiveContactStiffness::factorize(const ShiftedSystem& system) {
   m_rows = 0;
-  m_solver.factorize(system);
+  m_solver.setup(system);
   m_rows = system.rows();
 }
 
 bool EffectiveContactStiffness::check(const ContactInterpolation& point) const {
-  if (!m_solver.has_factor() || m_rows == 0) {
+  if (!m_solver.is_set_up() || m_rows == 0) {
     throw SolverError("effective contact stiffness: no factorized matrix (call factorize())");
   }
   bool moves = false;
@@ -84,7 +74,7 @@ void EffectiveContactStiffness::solve_columns(const ContactInterpolation& point,
     for (size_t k = 0; k < 3; ++k) {
       if (point.rows[k] >= 0) m_column[3 * point.rows[k] + axis] += point.weights[static_cast<Eigen::Index>(k)];
     }
-    m_solver.solve_factored(m_column, m_solution);
+    (void)m_solver.solve(m_column, m_solution);
     response.col(axis) = m_solution;
     m_column.setZero();
   }

@@ -55,11 +55,10 @@ ContactInterpolation contact_interpolation(const DofMap& dofs, const std::array<
 /// `diagonal` is the zero shift it points to (resized here; keep it alive with the result).
 ShiftedSystem static_contact_system(const BlockSparseMatrix& tangent, Eigen::VectorXd& diagonal);
 
-/// For a body with nothing fixed K is singular (rigid motions), so K_c uses the backward-Euler
-/// step matrix divided by h^2: A = M/h^2 + D/h + K = ((1 + h alpha)/h^2) M + (1 + beta/h) K,
-/// the stiffness the point meets during one step (inertia and damping hold the body). It exceeds
-/// the static K_c (of any supported body) by the inertial part, ~ m_local / h^2.
-ShiftedSystem step_contact_system(const DynamicsModel& model, double step_size_s, Eigen::VectorXd& diagonal);
+// For a body with nothing fixed K is singular (rigid motions): K_c is condensed from the step's
+// Newton matrix instead, which the integrator gives (Integrator::newton_stiffness; backward Euler:
+// M/h^2 + D/h + K), the stiffness the point meets during one step. It exceeds the static K_c (of
+// any supported body) by the inertial part, ~ m_local / h^2.
 
 /// K_c = (P^T A^-1 P)^-1 with CHOLMOD: factorize once per matrix, then any number of points
 /// (three solves each). The symbolic analysis is kept while the pattern does not change.
@@ -83,7 +82,7 @@ class EffectiveContactStiffness {
   /// field of a unit force at the point along each axis.
   [[nodiscard]] const ResponseMatrix& unit_force_response() const { return m_response; }
   /// x = A^-1 b with the same factor.
-  void solve(const Eigen::VectorXd& b, Eigen::VectorXd& x) { m_solver.solve_factored(b, x); }
+  void solve(const Eigen::VectorXd& b, Eigen::VectorXd& x) { (void)m_solver.solve(b, x); }
   [[nodiscard]] int rows() const { return m_rows; }
 
  private:

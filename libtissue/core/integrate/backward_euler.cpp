@@ -26,6 +26,14 @@ double undamped_tangent_fraction(double step_size_s, double stiffness_damping_s)
   return step_size_s / (step_size_s + stiffness_damping_s);
 }
 
+ShiftedSystem BackwardEuler::newton_stiffness(const DynamicsModel& model, double step_size_s,
+                                             Eigen::VectorXd& diagonal) const {
+  if (!(step_size_s > 0.0) || !std::isfinite(step_size_s)) {
+    throw ParameterError("Newton matrix: step size must be finite and > 0 s, got " + std::to_string(step_size_s));
+  }
+  return newton_stiffness_system(model, 1.0 / step_size_s, diagonal);
+}
+
 BackwardEuler::BackwardEuler(std::unique_ptr<LinearSolver> solver, Settings settings)
     : m_solver(std::move(solver)), m_settings(settings) {
   if (!m_solver) throw std::invalid_argument("BackwardEuler needs a linear solver");
@@ -72,6 +80,7 @@ StepReport BackwardEuler::step(DynamicsModel& model, DynamicState& state, double
     throw IntegrationError(std::string("backward Euler: linear solve failed: ") + error.what());
   }
   report.solve_s = seconds_since(solve_start);
+  report.linear_iterations = report.solve.iterations;
   if (!m_velocity_change.allFinite()) {
     m_velocity_change.setZero();
     throw IntegrationError("backward Euler: the velocity update is not finite; state kept");

@@ -34,6 +34,14 @@ class BackwardEuler final : public Integrator {
   void restore_internal_state(const Eigen::VectorXd& internal_state) override {
     m_velocity_change = internal_state;
   }
+  /// One step depends on the state alone: nothing to forget (a grown system drops the warm start).
+  void restart(Restart /*why*/) override {}
+  /// (1/h^2) times this step's matrix: newton_stiffness_system with c = 1/h.
+  [[nodiscard]] ShiftedSystem newton_stiffness(const DynamicsModel& model, double step_size_s,
+                                               Eigen::VectorXd& diagonal) const override;
+  [[nodiscard]] double undamped_spring_fraction(double step_size_s, double stiffness_damping_s) const override {
+    return undamped_tangent_fraction(step_size_s, stiffness_damping_s);
+  }
 
  private:
   std::unique_ptr<LinearSolver> m_solver;

@@ -1,5 +1,18 @@
-// Integrator: advances a DynamicState of a DynamicsModel by one step. Backward Euler is one
-// implementation; SUNDIALS IDA (issue 5) is another, behind the same contract.
+// Integrator: advances a DynamicState of a DynamicsModel by one step. Backward Euler and SUNDIALS
+// IDA implement it; make_integrator() (integrator_factory.hpp) picks one from the settings.
+//
+// The contract, beyond step():
+// * restart(why): the system grew (a cut), a saved state was restored, or a contact began or
+//   ended. A one-step method has nothing to forget; a multistep method (IDA) drops its history and
+//   starts afresh (order 1, a new step size, new memory when the size changed) from the state it
+//   is given at the next step().
+// * internal_state(): what carries over between steps and can be saved with an FMU state (backward
+//   Euler's warm start). A multistep history cannot be exported: internal_state() is empty, and a
+//   restored state continues exactly as a restart at the restored point would (tests/unit/integrate).
+// * newton_stiffness(): the matrix of the step's Newton iteration in the unknowns u, scaled to a
+//   stiffness [N/m]: the stiffness a point of the body meets within one step (inertia and damping
+//   hold the rest). The contact's K_c of a body that nothing holds is condensed from it (DESIGN
+//   section 4), so the contact asks the integrator instead of re-deriving its matrix.
 #pragma once
 
 #include "core/solve/linear_solver.hpp"
@@ -17,10 +30,16 @@ class IntegrationError : public std::runtime_error {
 };
 
 struct StepReport {
-  double assembly_s = 0.0;  ///< forces and tangent (wall time)
-  double solve_s = 0.0;     ///< linear solve(s) (wall time)
-  SolveReport solve;        ///< of the (last) linear solve
+  double assembly_s = 0.0;      ///< forces and tangent (wall time)
+  double solve_s = 0.0;         ///< linear solve(s) (wall time)
+  SolveReport solve;            ///< of the (last) linear solve
+  int internal_steps = 1;       ///< steps the integrator took inside this one (IDA: error control)
+  int newton_iterations = 0;    ///< nonlinear iterations (0 for the linearized backward Euler)
+  long linear_iterations = 0;   ///< Krylov iterations of all solves (PCG, GMRES); 0 for direct solves
 };
+
+/// Why an integrator must start afresh at its next step.
+enum class Restart { system_grown, state_restored, contact_changed };
 
 class Integrator {
  public:
@@ -29,11 +48,31 @@ class Integrator {
   /// step cannot be taken, e.g. the linear solver fails or the result is not finite.
   virtual StepReport step(DynamicsModel& model, DynamicState& state, double step_size_s) = 0;
   [[nodiscard]] virtual std::string_view name() const = 0;
-  /// What the integrator carries from one step to the next beyond the DynamicState (a warm start,
-  /// a history), packed in one vector, so that a saved state continues bitwise; empty if nothing.
+  /// What the integrator carries from one step to the next beyond the DynamicState (a warm start),
+  /// packed in one vector, so that a saved state continues bitwise; empty if nothing (or nothing
+  /// that can be exported: a multistep history, see restart()).
   [[nodiscard]] virtual Eigen::VectorXd internal_state() const = 0;
   /// Restores internal_state(); throws std::invalid_argument (nothing changed) for a wrong size.
   virtual void restore_internal_state(const Eigen::VectorXd& internal_state) = 0;
+  /// The next step starts afresh (see the contract above).
+  virtual void restart(Restart why) = 0;
+  /// The Newton matrix of a step of `step_size_s` as a stiffness (see above); `diagonal` is the
+  /// shift it points to (resized here; keep it alive with the result). Throws ParameterError for
+  /// a step size that is not finite and > 0.
+  [[nodiscard]] virtual ShiftedSystem newton_stiffness(const DynamicsModel& model, double step_size_s,
+                                                       Eigen::VectorXd& diagonal) const = 0;
+  /// The share of a stiffness the point spring of the contact (the rigid tool) puts in the tangent,
+  /// so that the step does not damp it (backward Euler: h / (h + beta)); 1 where it cannot be kept
+  /// undamped that way.
+  [[nodiscard]] virtual double undamped_spring_fraction(double step_size_s, double stiffness_damping_s) const = 0;
 };
+
+/// The Newton matrix of the residual M a + D v + f_int(u) - f_ext in u, when the method ties
+/// v = c u + ... and a = c v + ... (c the leading coefficient [1/s]: 1/h for backward Euler, IDA's
+/// c_j for a BDF step), as a stiffness:
+///   A = (c^2 + c alpha) M + (1 + c beta) K,   K the model's tangent.
+/// Throws ParameterError unless c is finite and > 0.
+ShiftedSystem newton_stiffness_system(const DynamicsModel& model, double leading_coefficient_per_s,
+                                      Eigen::VectorXd& diagonal);
 
 }  // namespace tissue

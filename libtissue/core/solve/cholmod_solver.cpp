@@ -1,6 +1,6 @@
 // CholmodSolver: sparse Cholesky of A = s K + diag(d) with SuiteSparse CHOLMOD, the accurate
 // (reference) solver. The block matrix is converted to CHOLMOD's compressed-column form through
-// a value map built once per pattern, so a solve is: refill values, factorize, solve.
+// a value map built once per pattern, so a setup is: refill values, factorize; a solve: back-substitute.
 //
 // Choices, each for the real-time case of small to medium meshes (10^3 - 10^4 unknowns):
 // * Ordering: AMD only (nmethods = 1). The default also tries METIS/NESDIS when AMD fills much,
@@ -51,6 +51,7 @@ struct CholmodSolver::Impl {
   long factored_rows = -1;  // rows of the valid numeric factor, -1 when there is none
 
   Eigen::VectorXd product;  // A x for the residual check
+  ShiftedSystem factored_system{nullptr, 1.0, nullptr};  // of the valid factor
 
   Impl() {
     cholmod_start(&common);
@@ -187,11 +188,12 @@ CholmodSolver::~CholmodSolver() = default;
 
 int CholmodSolver::symbolic_analysis_count() const { return m_impl->analysis_count; }
 
-bool CholmodSolver::has_factor() const { return m_impl->factored_rows >= 0; }
+bool CholmodSolver::is_set_up() const { return m_impl->factored_rows >= 0; }
 
-void CholmodSolver::factorize(const ShiftedSystem& system) {
+void CholmodSolver::setup(const ShiftedSystem& system) {
   Impl& impl = *m_impl;
   impl.factored_rows = -1;
+  impl.factored_system = ShiftedSystem{nullptr, 1.0, nullptr};
   if (system.stiffness == nullptr || system.diagonal == nullptr)
     throw SolverError("CholmodSolver: the system has no stiffness or no diagonal");
   const long n = system.rows();
@@ -210,45 +212,33 @@ void CholmodSolver::factorize(const ShiftedSystem& system) {
                       std::to_string(system.stiffness_scale) + ")");
   }
   impl.factored_rows = n;
+  impl.factored_system = system;
 }
 
-void CholmodSolver::solve_factored(const Eigen::VectorXd& b, Eigen::VectorXd& x) {
+SolveReport CholmodSolver::solve(const Eigen::VectorXd& b, Eigen::VectorXd& x) {
   Impl& impl = *m_impl;
-  if (impl.factored_rows < 0) throw SolverError("CholmodSolver: solve_factored() without a factor (call factorize())");
-  if (b.size() != impl.factored_rows) {
+  if (impl.factored_rows < 0) throw SolverError("CholmodSolver: solve() without a factor (call setup())");
+  const long n = impl.factored_rows;
+  if (b.size() != n) {
     throw SolverError("CholmodSolver: the right-hand side b has length " + std::to_string(b.size()) +
-                      ", the factor has " + std::to_string(impl.factored_rows) + " rows");
+                      ", the factor has " + std::to_string(n) + " rows");
   }
-  impl.back_substitute(b, x);
-  if (!x.allFinite()) throw SolverError("CholmodSolver: the solution is not finite (non-finite values in A or b)");
-}
-
-SolveReport CholmodSolver::solve(const ShiftedSystem& system, const Eigen::VectorXd& b, Eigen::VectorXd& x) {
-  system.check_sizes(b, x);
-  Impl& impl = *m_impl;
-  const long n = system.rows();
-
   SolveReport report;
+  report.converged = true;
   const double b_norm = b.norm();
-  if (b_norm == 0.0) {  // x = 0 whatever A is; no factorization needed
-    impl.factored_rows = -1;
-    x.setZero();
-    report.converged = true;
+  if (b_norm == 0.0) {  // x = 0 whatever A is
+    x.setZero(n);
     return report;
   }
-
-  factorize(system);
   impl.back_substitute(b, x);
-
   // The true residual: one product, cheap next to the factorization, and it catches a solve
   // spoiled by non-finite input.
   impl.product.resize(n);
-  system.multiply(x, impl.product);
+  impl.factored_system.multiply(x, impl.product);
   report.relative_residual = (b - impl.product).norm() / b_norm;
   if (!std::isfinite(report.relative_residual)) {
     throw SolverError("CholmodSolver: the solution is not finite (non-finite values in K, d or b)");
   }
-  report.converged = true;
   return report;
 }
 

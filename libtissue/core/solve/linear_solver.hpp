@@ -40,13 +40,28 @@ class SolverError : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
+/// Setup and solve are split: an integrator sets up once per matrix and may solve several times
+/// (a Newton iteration, the contact stiffness's three columns).
 class LinearSolver {
  public:
   virtual ~LinearSolver() = default;
-  /// Solves A x = b. On entry x holds the initial guess (iterative solvers warm-start from it;
-  /// it must have length A.rows()). Work buffers are kept between calls: no allocation while the
-  /// size stays the same.
-  virtual SolveReport solve(const ShiftedSystem& system, const Eigen::VectorXd& b, Eigen::VectorXd& x) = 0;
+  /// Prepares solves with A: PCG takes its Jacobi preconditioner, CHOLMOD factorizes numerically
+  /// (reusing the symbolic analysis while K's pattern is unchanged). K and d must stay alive and
+  /// unchanged until the next setup(). Throws SolverError (A not positive definite, sizes wrong);
+  /// nothing is set up then.
+  virtual void setup(const ShiftedSystem& system) = 0;
+  /// Solves A x = b with the A of the last setup(). On entry x holds the initial guess (iterative
+  /// solvers warm-start from it and need length A.rows(); a direct solver resizes it). Work buffers
+  /// are kept between calls: no allocation while the size stays the same. Throws SolverError
+  /// without a setup, for a wrong length or a non-finite direct solution.
+  virtual SolveReport solve(const Eigen::VectorXd& b, Eigen::VectorXd& x) = 0;
+  /// setup(system), then solve(b, x).
+  SolveReport solve(const ShiftedSystem& system, const Eigen::VectorXd& b, Eigen::VectorXd& x) {
+    setup(system);
+    return solve(b, x);
+  }
+  /// Whether solve(b, x) has an A to use.
+  [[nodiscard]] virtual bool is_set_up() const = 0;
   [[nodiscard]] virtual std::string_view name() const = 0;
 };
 
@@ -59,37 +74,36 @@ class PcgSolver final : public LinearSolver {
     int max_iterations = 10000;
   };
   explicit PcgSolver(Settings settings);
-  SolveReport solve(const ShiftedSystem& system, const Eigen::VectorXd& b, Eigen::VectorXd& x) override;
+  using LinearSolver::solve;
+  void setup(const ShiftedSystem& system) override;
+  SolveReport solve(const Eigen::VectorXd& b, Eigen::VectorXd& x) override;
+  [[nodiscard]] bool is_set_up() const override { return m_system.stiffness != nullptr; }
   [[nodiscard]] std::string_view name() const override { return "pcg"; }
   [[nodiscard]] const Settings& settings() const { return m_settings; }
 
  private:
   Settings m_settings;
+  ShiftedSystem m_system{nullptr, 1.0, nullptr};  // of the last setup()
   Eigen::VectorXd m_residual, m_direction, m_preconditioned, m_product, m_inverse_diagonal;
 };
 
 /// Sparse Cholesky (SuiteSparse CHOLMOD, supernodal). The symbolic analysis (ordering, pattern of L)
-/// is computed once and reused while K.pattern_revision() and the size are unchanged; each solve
-/// refactorizes numerically. Throws SolverError if A is not positive definite.
+/// is computed once and reused while K.pattern_revision() and the size are unchanged; each setup()
+/// refactorizes numerically (throws SolverError if A is not positive definite), and any number of
+/// solves use that factor (the contact stiffness needs three with one A).
 class CholmodSolver final : public LinearSolver {
  public:
   CholmodSolver();
   ~CholmodSolver() override;
   CholmodSolver(const CholmodSolver&) = delete;
   CholmodSolver& operator=(const CholmodSolver&) = delete;
-  SolveReport solve(const ShiftedSystem& system, const Eigen::VectorXd& b, Eigen::VectorXd& x) override;
+  using LinearSolver::solve;
+  /// Factorizes A; the previous factor is gone even when this throws.
+  void setup(const ShiftedSystem& system) override;
+  /// x = A^-1 b with the factor; reports the true relative residual (one product with A).
+  SolveReport solve(const Eigen::VectorXd& b, Eigen::VectorXd& x) override;
+  [[nodiscard]] bool is_set_up() const override;
   [[nodiscard]] std::string_view name() const override { return "cholmod"; }
-
-  /// Factor once, solve many (the contact stiffness needs three solves with one A): factorizes A
-  /// (reusing the symbolic analysis as solve() does) for solve_factored(). Throws SolverError if A
-  /// is not positive definite or the sizes are wrong; the previous factor is then gone.
-  void factorize(const ShiftedSystem& system);
-  /// Solves A x = b with the factor of the last factorize() (or of the last solve() with b != 0;
-  /// a solve() with b == 0 factorizes nothing and drops the factor). x is resized to A.rows().
-  /// Throws SolverError when there is no factor, b has the wrong length or x is not finite.
-  void solve_factored(const Eigen::VectorXd& b, Eigen::VectorXd& x);
-  /// Whether solve_factored() has a factor to use.
-  [[nodiscard]] bool has_factor() const;
 
   /// How many symbolic analyses were done so far (tests check it is reused).
   [[nodiscard]] int symbolic_analysis_count() const;

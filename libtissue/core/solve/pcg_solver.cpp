@@ -18,9 +18,15 @@ PcgSolver::PcgSolver(Settings settings) : m_settings(settings) {
   if (settings.max_iterations < 0) throw SolverError("PcgSolver: max_iterations must be >= 0");
 }
 
-SolveReport PcgSolver::solve(const ShiftedSystem& system, const Eigen::VectorXd& b, Eigen::VectorXd& x) {
-  system.check_sizes(b, x);
+void PcgSolver::setup(const ShiftedSystem& system) {
+  m_system = ShiftedSystem{nullptr, 1.0, nullptr};
+  if (system.stiffness == nullptr || system.diagonal == nullptr)
+    throw SolverError("PcgSolver: the system has no stiffness or no diagonal");
   const long n = system.rows();
+  if (system.diagonal->size() != n) {
+    throw SolverError("PcgSolver: the diagonal d has length " + std::to_string(system.diagonal->size()) +
+                      ", the system has " + std::to_string(n) + " rows");
+  }
   if (m_residual.size() != n) {  // the only allocations: when the system grows
     m_residual.resize(n);
     m_direction.resize(n);
@@ -28,16 +34,7 @@ SolveReport PcgSolver::solve(const ShiftedSystem& system, const Eigen::VectorXd&
     m_product.resize(n);
     m_inverse_diagonal.resize(n);
   }
-
-  SolveReport report;
-  const double b_norm = b.norm();
-  if (b_norm == 0.0) {
-    x.setZero();
-    report.converged = true;
-    return report;
-  }
-
-  // Jacobi preconditioner from the diagonal of A; recomputed each solve as K changes every step.
+  // Jacobi preconditioner from the diagonal of A; taken at each setup as K changes every step.
   system.stiffness->diagonal(m_inverse_diagonal);
   m_inverse_diagonal = system.stiffness_scale * m_inverse_diagonal + *system.diagonal;
   for (long i = 0; i < n; ++i) {
@@ -47,6 +44,21 @@ SolveReport PcgSolver::solve(const ShiftedSystem& system, const Eigen::VectorXd&
                         std::to_string(a_ii));
     }
     m_inverse_diagonal[i] = 1.0 / a_ii;
+  }
+  m_system = system;
+}
+
+SolveReport PcgSolver::solve(const Eigen::VectorXd& b, Eigen::VectorXd& x) {
+  if (!is_set_up()) throw SolverError("PcgSolver: solve() without a setup()");
+  const ShiftedSystem& system = m_system;
+  system.check_sizes(b, x);
+
+  SolveReport report;
+  const double b_norm = b.norm();
+  if (b_norm == 0.0) {
+    x.setZero();
+    report.converged = true;
+    return report;
   }
 
   // r = b - A x, warm-started from the caller's x; a non-finite guess is replaced by zero.

@@ -3,6 +3,7 @@
 // definite; the element-local model is the repaired eq. 4.23 (the printed one gives zero force),
 // and its ratio to the reference is measured; the step-matrix variant for an unsupported body;
 // CHOLMOD's factor-once/solve-many.
+#include "core/integrate/integrator.hpp"
 #include "core/contact/contact_stiffness.hpp"
 #include "core/contact/quasi_static_poke.hpp"
 
@@ -233,7 +234,7 @@ TEST(EffectiveContactStiffness, StepMatrixServesABodyWithNothingFixed) {
   for (const double h : {1e-3, 10.0}) {
     Eigen::VectorXd diagonal;
     EffectiveContactStiffness step;
-    step.factorize(step_contact_system(frog.body, h, diagonal));
+    step.factorize(newton_stiffness_system(frog.body, 1.0 / (h), diagonal));
     const Eigen::Matrix3d k_step = *step.stiffness_n_per_m(frog.interpolation(point));
     EXPECT_GE(min_eigenvalue(k_step - k_static), -1e-9 * k_static.norm());
     if (h == 10.0) {
@@ -251,28 +252,28 @@ TEST(EffectiveContactStiffness, StepMatrixServesABodyWithNothingFixed) {
   free_body.evaluate(Eigen::VectorXd::Zero(free_body.dof_count()), force, true);
   EffectiveContactStiffness stiffness;
   EXPECT_THROW(stiffness.factorize(static_contact_system(free_body.tangent(), diagonal)), SolverError);
-  EXPECT_THROW(step_contact_system(free_body, 0.0, diagonal), ParameterError);
-  stiffness.factorize(step_contact_system(free_body, 1e-3, diagonal));
+  EXPECT_THROW(newton_stiffness_system(free_body, 1.0 / (0.0), diagonal), ParameterError);
+  stiffness.factorize(newton_stiffness_system(free_body, 1.0 / (1e-3), diagonal));
   const auto k_free = stiffness.stiffness_n_per_m(contact_interpolation(
       free_body.dofs(), frog.surface.triangles[static_cast<size_t>(point.triangle)], point.barycentric));
   ASSERT_TRUE(k_free.has_value());
   EXPECT_GT(min_eigenvalue(*k_free), 0.0);
 }
 
-TEST(CholmodSolver, FactorOnceSolveManyAgreesWithSolve) {
+TEST(CholmodSolver, SetUpOnceSolveManyAgreesWithSolve) {
   FrogAtRest frog;
   Eigen::VectorXd diagonal;
-  const ShiftedSystem system = step_contact_system(frog.body, 1e-2, diagonal);
+  const ShiftedSystem system = newton_stiffness_system(frog.body, 1.0 / (1e-2), diagonal);
   CholmodSolver solver;
   Eigen::VectorXd x;
-  EXPECT_FALSE(solver.has_factor());
-  EXPECT_THROW(solver.solve_factored(Eigen::VectorXd::Ones(system.rows()), x), SolverError);
-  solver.factorize(system);
-  EXPECT_TRUE(solver.has_factor());
-  EXPECT_THROW(solver.solve_factored(Eigen::VectorXd::Ones(3), x), SolverError);
+  EXPECT_FALSE(solver.is_set_up());
+  EXPECT_THROW(solver.solve(Eigen::VectorXd::Ones(system.rows()), x), SolverError);
+  solver.setup(system);
+  EXPECT_TRUE(solver.is_set_up());
+  EXPECT_THROW(solver.solve(Eigen::VectorXd::Ones(3), x), SolverError);
   for (int k = 0; k < 3; ++k) {
     const Eigen::VectorXd b = Eigen::VectorXd::Random(system.rows());
-    solver.solve_factored(b, x);
+    solver.solve(b, x);
     Eigen::VectorXd reference = Eigen::VectorXd::Zero(system.rows());
     CholmodSolver().solve(system, b, reference);
     EXPECT_LE((x - reference).norm(), 1e-13 * reference.norm());
@@ -281,10 +282,10 @@ TEST(CholmodSolver, FactorOnceSolveManyAgreesWithSolve) {
     EXPECT_LE((product - b).norm(), 1e-12 * b.norm());
   }
   EXPECT_EQ(solver.symbolic_analysis_count(), 1);
-  // A solve of b = 0 factorizes nothing and drops the factor.
-  Eigen::VectorXd zero = Eigen::VectorXd::Zero(system.rows());
-  solver.solve(system, Eigen::VectorXd::Zero(system.rows()), zero);
-  EXPECT_FALSE(solver.has_factor());
+  // b = 0 gives x = 0 and keeps the factor.
+  solver.solve(Eigen::VectorXd::Zero(system.rows()), x);
+  EXPECT_TRUE(x.isZero(0.0));
+  EXPECT_TRUE(solver.is_set_up());
 }
 
 TEST(ContactStiffnessModel, ParsesItsNames) {

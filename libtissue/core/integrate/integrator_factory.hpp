@@ -1,0 +1,48 @@
+// The integrator choice: settings, their range checks and names, and the factory that builds the
+// chosen integrator with its linear solver. The one place a name maps to an integrator.
+#pragma once
+
+#include "core/integrate/ida_integrator.hpp"
+#include "core/integrate/integrator.hpp"
+#include "core/solve/linear_solver.hpp"
+
+#include <memory>
+#include <string_view>
+
+namespace tissue {
+
+enum class LinearSolverKind { pcg, cholmod };
+
+/// Parses "pcg" / "cholmod"; throws ParameterError otherwise.
+LinearSolverKind parse_linear_solver_kind(std::string_view name);
+[[nodiscard]] std::string_view to_string(LinearSolverKind kind);
+
+/// Backward Euler's linear solver.
+struct SolverSettings {
+  LinearSolverKind kind = LinearSolverKind::pcg;
+  PcgSolver::Settings pcg;
+  bool warm_start = false;  ///< PCG starts from the previous step's velocity change (see BackwardEuler)
+};
+
+/// Throws ParameterError unless tolerance > 0 (finite) and max_iterations >= 1.
+void validate(const SolverSettings& settings);
+std::unique_ptr<LinearSolver> make_linear_solver(const SolverSettings& settings);
+
+enum class IntegratorKind { backward_euler, ida };
+
+/// Parses "backward-euler" / "ida"; throws ParameterError otherwise.
+IntegratorKind parse_integrator_kind(std::string_view name);
+[[nodiscard]] std::string_view to_string(IntegratorKind kind);
+
+struct IntegratorSettings {
+  IntegratorKind kind = IntegratorKind::backward_euler;
+  IdaSettings ida;  ///< used when kind is ida
+};
+
+/// Throws ParameterError for an invalid setting (IDA's are checked whatever the kind).
+void validate(const IntegratorSettings& settings);
+
+/// The integrator of `settings`; backward Euler gets the linear solver of `solver`.
+std::unique_ptr<Integrator> make_integrator(const IntegratorSettings& settings, const SolverSettings& solver);
+
+}  // namespace tissue
