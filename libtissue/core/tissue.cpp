@@ -91,6 +91,9 @@ std::uint64_t model_fingerprint_of(const TetMesh& mesh, const TissueSettings& se
 
 // The largest turn of the blade one cutter sweep covers (its two triangles span the ruled surface
 // of a turning segment to within ~ L (1 - cos(angle / 2)), 0.1 mm for a 3 cm blade at 5 degrees).
+// Below this fraction of the contact stiffness scale, a static K_c belongs to a piece nothing holds.
+constexpr double FREE_PIECE_STIFFNESS_FRACTION = 1e-6;
+
 constexpr double MAX_SWEEP_ANGLE_RAD = 5.0 * 3.14159265358979323846 / 180.0;
 
 bool same_cut(const TetCut& a, const TetCut& b) {
@@ -167,6 +170,7 @@ Tissue::Tissue(TetMesh mesh, TissueSettings settings)
                 : std::vector<std::array<int, 3>>{},
             m_positions_m),
       m_contact(contact_settings(m_settings, m_body, m_surface, *m_integrator)),
+      m_contact_stiffness_scale_n_per_m(contact_stiffness_scale_n_per_m(m_body, m_surface)),
       m_model_fingerprint(model_fingerprint_of(m_body.mesh(), m_settings)) {
   m_state.displacement_m.setZero(m_body.dof_count());
   m_state.velocity_m_per_s.setZero(m_body.dof_count());
@@ -203,15 +207,13 @@ ToolPose reachable_pose(const ToolPose& previous, const ToolPose& target, double
   // Only a tool that interacts in both poses is held to the hand's speed; a mode switch or a tool
   // that does nothing goes where it is put.
   if (target.mode != previous.mode || target.mode == ToolMode::none || !(max_step_m > 0.0)) return target;
-  const Eigen::Vector3d axis_before = previous.orientation * Eigen::Vector3d::UnitZ();
-  const Eigen::Vector3d axis_after = target.orientation * Eigen::Vector3d::UnitZ();
-  const double tip_move_m = (target.tip_position_m - previous.tip_position_m).norm();
-  const double end_move_m =
-      (target.tip_position_m + blade_length_m * axis_after - previous.tip_position_m - blade_length_m * axis_before)
-          .norm();
-  const double move_m = std::max(tip_move_m, end_move_m);
-  if (!(move_m > max_step_m)) return target;
-  const double fraction = max_step_m / move_m;
+  // With the position moved linearly and the orientation along the shorter arc, no point of the
+  // blade travels farther than |tip move| + L * turn angle: the fraction f of the way keeps every
+  // point's path, and so its chord, within f times that.
+  const double path_m = (target.tip_position_m - previous.tip_position_m).norm() +
+                        blade_length_m * previous.orientation.angularDistance(target.orientation);
+  if (!(path_m > max_step_m)) return target;
+  const double fraction = max_step_m / path_m;
   ToolPose reached = target;
   reached.tip_position_m = previous.tip_position_m + fraction * (target.tip_position_m - previous.tip_position_m);
   reached.orientation = previous.orientation.slerp(fraction, target.orientation).normalized();
@@ -433,7 +435,13 @@ Eigen::Matrix3d Tissue::effective_contact_stiffness(int triangle) {
   // integrator, where nothing holds it, or where the static K fails because a cut set the
   // contacted piece free (K singular there; issue 10).
   if (!m_body.settings().fixed_vertices.empty()) {
-    if (const auto stiffness = condensed(static_contact_system(m_body.tangent(), m_contact_system_diagonal))) {
+    const auto stiffness = condensed(static_contact_system(m_body.tangent(), m_contact_system_diagonal));
+    // CHOLMOD may factorize a singular K through rounding; the point of a free piece then comes out
+    // with a K_c at rounding level. Held points of the frog measure 0.0017 to 14 times the contact
+    // scale (contact_stiffness.hpp): below 1e-6 of it, the piece is taken as held by nothing.
+    if (stiffness && Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(*stiffness, Eigen::EigenvaluesOnly)
+                             .eigenvalues()
+                             .minCoeff() > FREE_PIECE_STIFFNESS_FRACTION * m_contact_stiffness_scale_n_per_m) {
       return *stiffness;
     }
   }

@@ -44,10 +44,11 @@ struct ToolPose {
 /// Throws ParameterError for a non-finite position or a non-finite or zero quaternion.
 void validate(const ToolPose& pose);
 
-/// The pose a tool reaches from `previous` toward `target` when neither its tip nor its blade end
-/// (blade_length_m along the axis) may move more than max_step_m: `target` itself when it is
-/// within reach, when the mode changes or when the tool does nothing; otherwise the fraction of the
-/// way (position linear, orientation along the shorter arc) that moves the farther end max_step_m.
+/// The pose a tool reaches from `previous` toward `target` when no point of its blade (blade_length_m
+/// along the axis from the tip) may travel more than max_step_m: `target` itself when it is within
+/// reach, when the mode changes or when the tool does nothing; otherwise the fraction of the way
+/// (position linear, orientation along the shorter arc) whose path bound |tip move| + L angle is
+/// max_step_m.
 ToolPose reachable_pose(const ToolPose& previous, const ToolPose& target, double blade_length_m, double max_step_m);
 
 struct InteractionSettings {
@@ -220,6 +221,7 @@ class Tissue {
   SurfaceBvh m_bvh;
   std::optional<VolumeCutter> m_cutter;  // only with cutting enabled
   PointContact m_contact;
+  double m_contact_stiffness_scale_n_per_m = 0.0;  ///< contact_stiffness_scale_n_per_m of the body
   EffectiveContactStiffness m_effective_stiffness;
   Eigen::VectorXd m_contact_system_diagonal;
   int m_steps_since_stiffness = 0;

@@ -1,1 +1,2 @@
-tissue_add_test(test_tissue LABELS unit SOURCES tissue/test_tissue.cpp tissue/test_tissue_state.cpp)
+tissue_add_test(test_tissue LABELS unit SOURCES tissue/test_tissue.cpp tissue/test_tissue_state.cpp
+                tissue/test_tissue_robustness.cpp)
