@@ -3,6 +3,8 @@
 //   tissue-host run SCENARIO.toml [--offline] [--output DIR] [--record FILE.csv] ...
 //   tissue-host info FILE.fmu
 //   tissue-host bench [--steps N] ...
+//   [mpirun -n N] tissue-host compare SCENARIO.toml [--settings FILE.toml] [--jobs N] [--output DIR] ...
+#include "compare/compare.hpp"
 #include "importer/fmu3.hpp"
 #include "importer/fmu3_instance.hpp"
 #include "importer/fmu_error.hpp"
@@ -11,6 +13,10 @@
 #include "session/session.hpp"
 
 #include <CLI/CLI.hpp>
+
+#ifdef TISSUE_HOST_MPI
+#include "compare/mpi_distribution.hpp"
+#endif
 
 #include <unistd.h>
 
@@ -118,6 +124,36 @@ int bench_command(const std::filesystem::path& fmu_dir, int steps, double tissue
   return 0;
 }
 
+// Under mpirun the ranks share the runs (MPI is initialized here only, never for `run`); rank 0
+// prints and writes. An error on one rank ends them all rather than leave the others waiting.
+int compare_command(CompareOptions options, bool quiet, int& argc, char**& argv) {
+  if (!quiet) {
+    options.progress = &std::cerr;
+    options.progress_in_place = isatty(STDERR_FILENO) != 0;
+  }
+#ifdef TISSUE_HOST_MPI
+  if (launched_by_mpi()) {
+    MpiDistribution mpi(argc, argv);
+    try {
+      const CompareReport report = run_compare(options, mpi);
+      if (mpi.rank() == 0) print_compare(std::cout, report, options.output_dir);
+      return 0;
+    } catch (const std::exception& error) {
+      std::cerr << "tissue-host compare" << (mpi.rank() == 0 ? "" : " (rank " + std::to_string(mpi.rank()) + ")")
+                << ": " << error.what() << std::endl;
+      if (mpi.size() > 1) MpiDistribution::abort_all(2);
+      return 2;
+    }
+  }
+#endif
+  (void)argc;
+  (void)argv;
+  SingleProcess one;
+  const CompareReport report = run_compare(options, one);
+  print_compare(std::cout, report, options.output_dir);
+  return 0;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -154,6 +190,28 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   bench->add_option("--fmu-dir", fmu_dir, "Where Tissue.fmu and HapticLoop.fmu are");
 
+  CompareOptions compare_options;
+  std::string compare_scenario, settings_file;
+  std::string compare_output = "compare";
+  double duration_s = 0.0;
+  CLI::App* compare =
+      app.add_subcommand("compare",
+                         "Run a scenario offline under several integrator settings against a reference: "
+                         "compare.csv, compare.png, recommendation.txt (also under mpirun)");
+  compare->add_option("scenario", compare_scenario, "Scenario file (TOML)")->required()->check(CLI::ExistingFile);
+  compare
+      ->add_option("--settings", settings_file,
+                   "TOML file with a [compare] table (default: the scenario's, else built-in)")
+      ->check(CLI::ExistingFile);
+  compare->add_option("--output,-o", compare_output, "Folder for the outputs")->capture_default_str();
+  compare->add_option("--jobs,-j", compare_options.jobs, "Runs at once in this process (threads), >= 1")
+      ->capture_default_str();
+  compare->add_option("--steps", compare_options.steps_s, "Internal steps [s] for every setting, e.g. 0.001,0.01")
+      ->delimiter(',');
+  compare->add_option("--duration", duration_s, "Run the scenario for DURATION seconds instead (e.g. shorter)");
+  compare->add_option("--fmu-dir", fmu_dir, "Where Tissue.fmu and HapticLoop.fmu are");
+  compare->add_flag("--quiet,-q", quiet, "No progress line");
+
   CLI11_PARSE(app, argc, argv);
   try {
     const std::filesystem::path fmus = fmu_dir.empty() ? default_fmu_dir() : std::filesystem::path(fmu_dir);
@@ -166,6 +224,14 @@ int main(int argc, char** argv) {
     }
     if (info->parsed()) return info_command(fmu_file);
     if (bench->parsed()) return bench_command(fmus, bench_steps, bench_step_s);
+    if (compare->parsed()) {
+      compare_options.scenario_file = compare_scenario;
+      if (!settings_file.empty()) compare_options.settings_file = settings_file;
+      compare_options.output_dir = compare_output;
+      compare_options.fmu_dir = fmus;
+      if (compare->count("--duration") > 0) compare_options.duration_s = duration_s;
+      return compare_command(compare_options, quiet, argc, argv);
+    }
   } catch (const std::exception& error) {
     std::cerr << "tissue-host: " << error.what() << "\n";
     return 2;

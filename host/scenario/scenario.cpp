@@ -1,8 +1,7 @@
 // load_scenario (see scenario.hpp), on toml++ (Debian's libtomlplusplus-dev).
 #include "scenario/scenario.hpp"
 
-#define TOML_EXCEPTIONS 1
-#include <toml++/toml.h>
+#include "scenario/parameter_table.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -145,6 +144,11 @@ Waypoint waypoint(const Reader& r, const toml::node& node, const std::string& ke
 
 }  // namespace
 
+std::vector<ParameterSetting> read_parameter_table(const toml::table& table, const std::string& where,
+                                                   const std::string& origin) {
+  return parameters(Reader(origin), &table, where);
+}
+
 Scenario parse_scenario(const std::string& text, const std::filesystem::path& origin) {
   const Reader r(origin.string());
   toml::table root;
@@ -155,7 +159,8 @@ Scenario parse_scenario(const std::string& text, const std::filesystem::path& or
     message << origin.string() << ":" << error.source().begin.line << ": " << error.description();
     throw ScenarioError(message.str());
   }
-  r.only(root, "", {"scenario", "tissue", "haptic", "device", "realtime", "output", "expect"});
+  // [compare] belongs to tissue-host compare (host/compare/compare_settings.*), which reads it itself.
+  r.only(root, "", {"scenario", "tissue", "haptic", "device", "realtime", "output", "expect", "compare"});
   Scenario s;
   s.file = origin;
   const std::filesystem::path base = origin.has_parent_path() ? origin.parent_path() : std::filesystem::path(".");

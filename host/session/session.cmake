@@ -15,9 +15,3 @@ target_link_libraries(tissue_host_session
   PUBLIC tissue::fmi_importer tissue::host_device tissue::host_output Threads::Threads
   PRIVATE tomlplusplus::tomlplusplus tissue::warnings)
 
-# tissue-host itself.
-find_package(CLI11 REQUIRED)
-add_executable(tissue-host ${CMAKE_CURRENT_LIST_DIR}/../app/main.cpp)
-target_link_libraries(tissue-host PRIVATE tissue::host_session CLI11::CLI11 tissue::warnings)
-target_compile_definitions(tissue-host PRIVATE TISSUE_DEFAULT_FMU_DIR="${CMAKE_BINARY_DIR}/fmus")
-add_dependencies(tissue-host tissue_fmu_package hapticloop_fmu_package)

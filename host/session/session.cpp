@@ -27,6 +27,7 @@
 #include <fstream>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <ostream>
 #include <sstream>
 #include <thread>
@@ -51,6 +52,13 @@ void sleep_until_ns(Nanoseconds deadline) {
   ts.tv_nsec = static_cast<long>(deadline % 1'000'000'000);
   while (clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &ts, nullptr) == EINTR) {
   }
+}
+
+// CPU time of the calling thread: what a doStep cost, whatever else the machine runs.
+Nanoseconds thread_cpu_ns() {
+  timespec ts{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+  return static_cast<Nanoseconds>(ts.tv_sec) * 1'000'000'000 + ts.tv_nsec;
 }
 
 Nanoseconds to_ns(double seconds) { return static_cast<Nanoseconds>(std::llround(seconds * 1e9)); }
@@ -247,7 +255,7 @@ class Session {
         m_options(options),
         m_tissue_fmu(fmu_path(scenario.tissue_fmu, options.fmu_dir, "Tissue.fmu")),
         m_haptic_fmu(fmu_path(scenario.haptic_fmu, options.fmu_dir, "HapticLoop.fmu")),
-        m_tissue(m_tissue_fmu, scenario.tissue_parameters),
+        m_tissue(m_tissue_fmu, with_overrides(scenario.tissue_parameters, options.tissue_parameter_overrides)),
         m_haptic(m_haptic_fmu, scenario.haptic_parameters),
         m_device(make_device(scenario.device, m_tissue)) {
     m_period_s = scenario.haptic_period_s;
@@ -264,7 +272,7 @@ class Session {
     m_summary.device_name = std::string(m_device->name());
     m_summary.device_max_force_n = m_haptic.max_force_n();
     m_summary.overrun_policy = scenario.overrun_policy == OverrunPolicy::catch_up ? "catch_up" : "skip";
-    std::filesystem::create_directories(options.output_dir);
+    if (options.write_outputs) std::filesystem::create_directories(options.output_dir);
     // The first tool command: the haptic loop's output before any tick (the device at t = 0).
     m_haptic.set_device(m_device->read(0.0));
     HapticOutputs initial;
@@ -273,6 +281,7 @@ class Session {
   }
 
   SessionSummary run() {
+    if (m_options.tissue_observer != nullptr) m_options.tissue_observer->started(m_tissue.instance());
     const Nanoseconds wall_start = now_ns();
     if (m_options.offline) {
       run_offline();
@@ -331,9 +340,12 @@ class Session {
     m_tissue.set_tool(m_tool_command.read_buffer());
     const bool scalpel = m_tool_command.read_buffer().mode == static_cast<std::int64_t>(ToolMode::scalpel);
     const double step_s = slots * m_slot_s;
+    TissueStepObserver* const observer = m_options.tissue_observer;
+    const Nanoseconds cpu_start = observer != nullptr ? thread_cpu_ns() : 0;
     const Nanoseconds start = now_ns();
     const DoStepResult result = m_tissue.step(time_s, step_s);
     const double seconds = static_cast<double>(now_ns() - start) * 1e-9;
+    const Nanoseconds cpu_end = observer != nullptr ? thread_cpu_ns() : 0;
     double reached_s = time_s + step_s;
     if (result.status == fmi3Discard) {
       ++m_summary.tissue_discards;
@@ -349,6 +361,16 @@ class Session {
     m_summary.contact_seen = m_summary.contact_seen || out.contact_active;
     // Steps are "during cuts" from the first step with the scalpel in the tissue.
     m_cutting_seen = m_cutting_seen || (scalpel && out.blade_depth_m > 0.0) || out.cut_tets > 0;
+    if (observer != nullptr) {
+      TissueStepInfo info;
+      info.index = m_step_s.size();
+      info.start_s = time_s;
+      info.reached_s = reached_s;
+      info.cpu_s = static_cast<double>(cpu_end - cpu_start) * 1e-9;
+      info.result = result;
+      info.outputs = &out;
+      observer->stepped(m_tissue.instance(), info);
+    }
     m_step_s.push_back(seconds);
     m_step_cutting.push_back(m_cutting_seen ? 1 : 0);
     m_cut_tets.store(out.cut_tets, std::memory_order_relaxed);
@@ -356,7 +378,9 @@ class Session {
     m_summary.enriched_vertices = out.enriched_vertices;
   }
 
-  bool frame_due(double time_s) const { return m_scenario.frame_rate_hz > 0.0 && time_s + 1e-9 >= m_next_frame_s; }
+  bool frame_due(double time_s) const {
+    return m_options.write_outputs && m_scenario.frame_rate_hz > 0.0 && time_s + 1e-9 >= m_next_frame_s;
+  }
   void capture_frame(SurfaceFrame& frame, double time_s) {
     m_tissue.read_surface(frame);
     frame.time_s = time_s;
@@ -377,7 +401,8 @@ class Session {
   }
 
   void run_offline() {
-    FrameWriter writer(m_options.output_dir);
+    std::optional<FrameWriter> writer;
+    if (m_options.write_outputs) writer.emplace(m_options.output_dir);
     SurfaceFrame frame;
     bool pending = false;
     TissueOutputs result;
@@ -398,7 +423,7 @@ class Session {
           pending = true;
           if (frame_due(tissue_time_s)) {
             capture_frame(frame, tissue_time_s);
-            writer.write(frame);
+            writer->write(frame);
           }
         }
       }
@@ -412,8 +437,10 @@ class Session {
     m_summary.haptic_ticks = m_ticks;
     m_summary.tissue_steps = m_step_s.size();
     m_summary.sim_time_s = static_cast<double>(m_ticks) * m_period_s;
-    m_summary.frames_written = writer.count();
-    writer.finish();
+    if (writer) {
+      m_summary.frames_written = writer->count();
+      writer->finish();
+    }
   }
 
   void run_realtime() {
@@ -526,11 +553,12 @@ class Session {
     start = now_ns() + 20'000'000;  // 20 ms from now: both threads are waiting
     go.store(true, std::memory_order_release);
 
-    FrameWriter writer(m_options.output_dir);
+    std::optional<FrameWriter> writer;
+    if (m_options.write_outputs) writer.emplace(m_options.output_dir);
     Nanoseconds next_progress = start + 1'000'000'000;
     const auto drain = [&](std::chrono::milliseconds timeout) {
       while (auto frame = pipe.wait_filled(timeout)) {
-        writer.write(*frame);
+        writer->write(*frame);
         pipe.give_back(std::move(frame));
         timeout = std::chrono::milliseconds(0);
       }
@@ -548,8 +576,10 @@ class Session {
     dynamics.join();
     m_summary.wall_time_s = static_cast<double>(haptic_end - start) * 1e-9;
     drain(std::chrono::milliseconds(0));
-    m_summary.frames_written = writer.count();
-    writer.finish();
+    if (writer) {
+      m_summary.frames_written = writer->count();
+      writer->finish();
+    }
     m_summary.haptic_ticks = m_ticks;
     m_summary.tissue_steps = m_step_s.size();
     m_summary.realtime_priority = haptic_priority.granted && dynamics_priority.granted;
@@ -576,6 +606,7 @@ class Session {
     m_summary.passivity_observed_j = last.observed_energy_j;
     m_summary.device = m_device->counters();
     m_summary.nan_detected = m_haptic_nan || m_tissue_nan || !std::isfinite(m_summary.max_device_force_n);
+    if (!m_options.write_outputs) return;
 
     const std::filesystem::path& dir = m_options.output_dir;
     {
@@ -707,10 +738,29 @@ std::string SessionSummary::to_json() const {
 // worker pool outlives the call and spins while idle: on two cores it would compete with the
 // haptic thread. Before the FMUs are loaded (libgomp reads its settings when it is loaded), the
 // host limits OpenMP to the calling thread and lets idle workers sleep, unless the user set these.
-static void keep_solver_libraries_on_the_calling_thread() {
-  setenv("OMP_THREAD_LIMIT", "1", 0);
-  setenv("OMP_WAIT_POLICY", "PASSIVE", 0);
-  setenv("OPENBLAS_NUM_THREADS", "1", 0);
+// Once per process: setenv races with getenv in other threads (tissue-host compare runs sessions
+// on several threads and calls this before starting them).
+void keep_solver_libraries_on_the_calling_thread() {
+  static std::once_flag once;
+  std::call_once(once, [] {
+    setenv("OMP_THREAD_LIMIT", "1", 0);
+    setenv("OMP_WAIT_POLICY", "PASSIVE", 0);
+    setenv("OPENBLAS_NUM_THREADS", "1", 0);
+  });
+}
+
+std::vector<ParameterSetting> with_overrides(std::vector<ParameterSetting> parameters,
+                                             const std::vector<ParameterSetting>& overrides) {
+  for (const ParameterSetting& o : overrides) {
+    const auto same =
+        std::find_if(parameters.begin(), parameters.end(), [&](const ParameterSetting& p) { return p.name == o.name; });
+    if (same != parameters.end()) {
+      same->value = o.value;
+    } else {
+      parameters.push_back(o);
+    }
+  }
+  return parameters;
 }
 
 SessionSummary run_session(const Scenario& scenario, const SessionOptions& options) {

@@ -7,6 +7,7 @@
 #pragma once
 
 #include "device/device.hpp"
+#include "importer/fmu3_instance.hpp"
 #include "scenario/scenario.hpp"
 
 #include <cstdint>
@@ -15,8 +16,32 @@
 #include <iosfwd>
 #include <optional>
 #include <string>
+#include <vector>
 
 namespace tissue::host {
+
+struct TissueOutputs;
+
+/// One Tissue doStep as an observer sees it (offline and real time, on the dynamics thread).
+struct TissueStepInfo {
+  std::uint64_t index = 0;                 ///< 0 for the first step
+  double start_s = 0.0;                    ///< tissue time at the start of the step
+  double reached_s = 0.0;                  ///< tissue time reached (the last good time after a discard)
+  double cpu_s = 0.0;                      ///< CPU time of the doStep call (CLOCK_THREAD_CPUTIME_ID)
+  DoStepResult result;                     ///< what doStep answered
+  const TissueOutputs* outputs = nullptr;  ///< what the session read after the step
+};
+
+/// Watches the Tissue FMU of a session step by step (tissue-host compare records and measures
+/// with it). Called on the thread that steps the tissue; the instance may be read, not stepped.
+class TissueStepObserver {
+ public:
+  virtual ~TissueStepObserver() = default;
+  /// After initialization, before the first step.
+  virtual void started(Fmu3Instance& tissue) = 0;
+  /// After each doStep and the session's read of the outputs.
+  virtual void stepped(Fmu3Instance& tissue, const TissueStepInfo& step) = 0;
+};
 
 struct SessionOptions {
   std::filesystem::path output_dir = "session";
@@ -28,6 +53,12 @@ struct SessionOptions {
   /// Called on the haptic thread right before its first tick (real time only); tests use it to
   /// watch that thread (e.g. count its allocations).
   std::function<void()> haptic_thread_started;
+  /// Tissue parameters set over the scenario's (same name: replaced in place; else appended).
+  std::vector<ParameterSetting> tissue_parameter_overrides;
+  /// Sees every tissue step (nullptr: none; then doStep's CPU time is not measured).
+  TissueStepObserver* tissue_observer = nullptr;
+  /// false: no files at all (no folder, log, frames, PNG, summary), for runs measured in memory.
+  bool write_outputs = true;
 };
 
 struct Percentiles {
@@ -67,6 +98,14 @@ struct SessionSummary {
 /// options.output_dir. Throws ScenarioError / FmuError / std::runtime_error when it cannot start;
 /// failures during the run are counted in the summary.
 SessionSummary run_session(const Scenario& scenario, const SessionOptions& options);
+
+/// The tissue parameters of a session: the scenario's with `overrides` set over them by name.
+std::vector<ParameterSetting> with_overrides(std::vector<ParameterSetting> parameters,
+                                             const std::vector<ParameterSetting>& overrides);
+
+/// Limits the FMUs' solver libraries (OpenMP, OpenBLAS) to the calling thread, before the FMUs load;
+/// once per process (setenv is not safe while other threads run: call it before starting any).
+void keep_solver_libraries_on_the_calling_thread();
 
 /// The summary in a few lines, and where the outputs are.
 void print_summary(std::ostream& out, const SessionSummary& summary, const std::filesystem::path& output_dir);
