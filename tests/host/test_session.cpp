@@ -112,7 +112,7 @@ TEST_P(EveryScenario, RunsOfflineAsExpectedAndReproducibly) {
 
 INSTANTIATE_TEST_SUITE_P(HostScenarios, EveryScenario,
                          ::testing::Values("poke_frog", "cut_frog_complete", "cut_frog_partial", "beam_two_cuts",
-                                           "careless_hand"));
+                                           "careless_hand", "cantilever_release"));
 
 TEST(Replay, ARecordedSessionReplayedIsTheSameSession) {
   const Scenario scripted = load_scenario(SCENARIOS / "cut_frog_partial.toml");
