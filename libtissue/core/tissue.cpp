@@ -107,6 +107,9 @@ PointContactSettings contact_settings(const TissueSettings& settings, const Defo
   const double stiffness = settings.interaction.contact_spring_stiffness_n_per_m;
   contact.spring_stiffness_n_per_m =
       stiffness > 0.0 ? stiffness : recommended_contact_spring_stiffness_n_per_m(body, surface);
+  // A surface that sags or swings onto a probe held still touches it (issue 10), up to half a mean
+  // surface edge deep: deeper, the tool was put inside, and snapping it out would kick the tissue.
+  contact.passed_over_depth_m = 0.5 * mean_surface_edge_m(body, surface);
   // The spring stands for the rigid tool: the step must not damp it (issue 9).
   contact.spring_tangent_fraction =
       integrator.undamped_spring_fraction(settings.step_size_s, settings.body.damping.stiffness_damping_s);

@@ -168,7 +168,7 @@ double recommended_contact_spring_stiffness_n_per_m(const DeformableBody& body, 
   return factor * contact_stiffness_scale_n_per_m(body, surface);
 }
 
-double contact_stiffness_scale_n_per_m(const DeformableBody& body, const SurfaceMesh& surface) {
+double mean_surface_edge_m(const DeformableBody& body, const SurfaceMesh& surface) {
   const TetMesh& mesh = body.mesh();
   double length_sum = 0.0;
   for (const auto& t : surface.triangles) {
@@ -178,9 +178,12 @@ double contact_stiffness_scale_n_per_m(const DeformableBody& body, const Surface
                         .norm();
     }
   }
-  const double mean_edge_m = surface.triangles.empty() ? 0.0 : length_sum / (3.0 * surface.triangles.size());
+  return surface.triangles.empty() ? 0.0 : length_sum / (3.0 * static_cast<double>(surface.triangles.size()));
+}
+
+double contact_stiffness_scale_n_per_m(const DeformableBody& body, const SurfaceMesh& surface) {
   const LameParameters& lame = body.elasticity().lame();
-  return (lame.lambda_pa + 2.0 * lame.mu_pa) * mean_edge_m;
+  return (lame.lambda_pa + 2.0 * lame.mu_pa) * mean_surface_edge_m(body, surface);
 }
 
 }  // namespace tissue

@@ -113,6 +113,9 @@ double normal_stiffness_n_per_m(const Eigen::Matrix3d& stiffness, const Eigen::V
 /// frictionless contact). <= normal_stiffness_n_per_m for SPD K.
 double frictionless_normal_stiffness_n_per_m(const Eigen::Matrix3d& stiffness, const Eigen::Vector3d& unit_normal);
 
+/// The mean edge length of the body's surface triangles at rest [m] (0 for no triangles).
+double mean_surface_edge_m(const DeformableBody& body, const SurfaceMesh& surface);
+
 /// The scale of the effective normal contact stiffness of a body: (lambda + 2 mu) times the mean
 /// surface edge length at rest (the stiffness of a point load on a mesh of that spacing, up to a
 /// factor of order one). Measured on the frog pinned by its belly (tests/unit/contact), n^T K_c n at

@@ -8,11 +8,21 @@
 #include <string>
 
 namespace tissue {
+namespace {
+
+// Length of the ray that decides whether a HIP is inside the surface (far beyond any specimen).
+constexpr double PASSED_OVER_RAY_M = 100.0;
+
+}  // namespace
 
 void validate(const PointContactSettings& settings) {
   if (!(settings.spring_stiffness_n_per_m > 0.0) || !std::isfinite(settings.spring_stiffness_n_per_m)) {
     throw ParameterError("contact spring stiffness must be finite and > 0 N/m, got " +
                          std::to_string(settings.spring_stiffness_n_per_m));
+  }
+  if (!(settings.passed_over_depth_m >= 0.0) || !std::isfinite(settings.passed_over_depth_m)) {
+    throw ParameterError("contact passed-over depth must be finite and >= 0 m, got " +
+                         std::to_string(settings.passed_over_depth_m));
   }
   if (!(settings.spring_tangent_fraction > 0.0 && settings.spring_tangent_fraction <= 1.0)) {
     throw ParameterError("contact spring tangent fraction must be in (0, 1], got " +
@@ -49,9 +59,26 @@ bool PointContact::update(const Eigen::Vector3d& hip_previous_m, const Eigen::Ve
         entered = static_cast<int>(k);
       }
     }
-    if (entered < 0) return false;
-    const SurfaceBvh::SegmentHit& entry = m_segment_hits[static_cast<size_t>(entered)];
-    start = SurfacePoint{entry.triangle, entry.barycentric};
+    if (entered >= 0) {
+      const SurfaceBvh::SegmentHit& entry = m_segment_hits[static_cast<size_t>(entered)];
+      start = SurfacePoint{entry.triangle, entry.barycentric};
+    } else {
+      if (!(m_settings.passed_over_depth_m > 0.0)) return false;
+      // Inside when a ray from the HIP crosses the surface an odd number of times (a direction off
+      // the axes, so that a ray along a grid's faces or edges is unlikely); start from its nearest hit.
+      const Eigen::Vector3d direction = Eigen::Vector3d(0.5279, 0.6173, 0.5832).normalized();
+      surface.intersect_segment(hip_m, hip_m + PASSED_OVER_RAY_M * direction, positions_m, m_segment_hits);
+      if (m_segment_hits.size() % 2 == 0) return false;
+      const SurfaceBvh::SegmentHit* nearest = &m_segment_hits.front();
+      for (const SurfaceBvh::SegmentHit& hit : m_segment_hits) {
+        if (hit.segment_parameter < nearest->segment_parameter) nearest = &hit;
+      }
+      start = SurfacePoint{nearest->triangle, nearest->barycentric};
+      const SurfaceProjection inside =
+          slide_to_closest_point(hip_m, start, surface.triangles(), m_adjacency, positions_m);
+      if (inside.distance_m > m_settings.passed_over_depth_m) return false;
+      start = inside.point;
+    }
   }
 
   const SurfaceProjection projection =

@@ -51,6 +51,9 @@ struct PointContactSettings {
   /// the backward-Euler step of h the spring acts in (the spring is not tissue: see above); 1
   /// damps it like tissue, beta k, which the tool then feels as a drag of beta k v.
   double spring_tangent_fraction = 1.0;
+  /// > 0: a HIP found inside the surface without crossing it (the surface moved over a tool that
+  /// stood still or moved less) starts a contact too, if it is at most this deep; 0: crossings only.
+  double passed_over_depth_m = 0.0;
 };
 
 /// Throws ParameterError unless the spring stiffness is finite and > 0 and its tangent fraction in (0, 1].
@@ -65,7 +68,9 @@ class PointContact {
   /// against the surface of `surface` (its triangles, refitted to `positions_m`, 3 per vertex).
   /// * Not in contact: contact starts where the segment first enters the surface (crossing a
   ///   triangle against its outward normal; exits, e.g. of a tool that began inside, are skipped)
-  ///   if the HIP is then inside. A surface moving over a resting tool does not start a contact.
+  ///   if the HIP is then inside. A surface that moved over the HIP (no crossing, the HIP inside
+  ///   by a ray's parity) starts a contact only with settings().passed_over_depth_m > 0 and the HIP
+  ///   at most that deep: a tool switched on deep inside the body does not snap to its surface.
   /// * In contact (or just started): the proxy slides over the current surface to the locally
   ///   closest point to the HIP (slide_to_closest_point; frictionless); contact ends when the HIP
   ///   is on the outer side of the surface there (pseudo-normal test).

@@ -141,6 +141,41 @@ TEST(TissueRobustness, AToolThatJumpsIsHeldToTheHandsTopSpeed) {
   EXPECT_LT(last.z(), -0.07);  // it keeps going where the hand is (at 5 mm per step)
 }
 
+// A probe lowered onto a sagging beam in 10 ms strokes, stepped at 1 ms: nine of every ten steps the
+// tool stands still while the beam sags and swings onto it. That contact must start (it never did:
+// only a tool segment crossing the surface started one); a probe switched on deep inside must not.
+TEST(TissueRobustness, ASurfaceMovingOntoARestingProbeTouchesIt) {
+  const TetMesh mesh = read_veg(std::string(TISSUE_MESH_DIR) + "/beam_10x2x2.veg");
+  Eigen::Vector3d lower = mesh.rest_positions_m[0], upper = lower;
+  for (const Eigen::Vector3d& x : mesh.rest_positions_m) {
+    lower = lower.cwiseMin(x);
+    upper = upper.cwiseMax(x);
+  }
+  TissueSettings settings;
+  settings.body.material.young_modulus_pa = 2e6;
+  settings.body.damping = RayleighDamping{1.0, 1e-3};
+  settings.body.fixed_vertices = vertices_at_minimum(mesh, 0, 0.01);
+  settings.step_size_s = 1e-3;
+  const double y = 0.5 * (lower.y() + upper.y());
+  Tissue tissue(mesh, settings);
+  int touched_at = -1;
+  for (int n = 0; n < 40 && touched_at < 0; ++n) {
+    tissue.set_tool({Eigen::Vector3d(0.07, y, upper.z() + 0.005 - 0.0005 * n), Eigen::Quaterniond::Identity(),
+                     ToolMode::probe});
+    for (int k = 0; k < 10; ++k) tissue.step();
+    if (tissue.contact().active) touched_at = n;
+  }
+  ASSERT_GE(touched_at, 0) << "the probe went 1.5 cm down into the beam without touching it";
+  // The tip reaches the rest top at n = 10; the beam sags under gravity meanwhile (about 1 mm at x = 7 cm).
+  EXPECT_LE(touched_at, 14);
+  EXPECT_LT(tissue.contact().penetration_depth_m, 0.001);
+
+  Tissue deep(mesh, settings);
+  deep.set_tool({Eigen::Vector3d(0.07, y, upper.z() - 0.008), Eigen::Quaterniond::Identity(), ToolMode::probe});
+  for (int k = 0; k < 5; ++k) deep.step();
+  EXPECT_FALSE(deep.contact().active) << "a probe switched on 8 mm inside snapped to the surface";
+}
+
 TetMesh frog() { return read_veg(std::string(TISSUE_MESH_DIR) + "/frog.veg"); }
 
 // Probe and scalpel alternating in strokes of random length, poses anywhere in and around the frog
