@@ -54,6 +54,20 @@ std::vector<Recommendation> recommend(const std::vector<CompareRow>& rows, const
                " CPU s per simulated s)";
     } else {
       r.text = use.name + ": no setting qualifies (" + bounds(use) + ", no failed step)";
+      // Say how far off the cheapest one at the use's step is, so that the gap is a number.
+      std::optional<std::size_t> cheapest;
+      for (std::size_t i = 0; i < rows.size(); ++i) {
+        const CompareRow& row = rows[i];
+        if (row.is_reference() || !row.comparable()) continue;
+        if (use.max_step_s && row.internal_step_s > *use.max_step_s * (1.0 + 1e-9)) continue;
+        if (!cheapest || *row.cpu_s_per_sim_s < *rows[*cheapest].cpu_s_per_sim_s) cheapest = i;
+      }
+      if (cheapest) {
+        const CompareRow& row = rows[*cheapest];
+        r.text += "; the cheapest at that step: " + row.setting + " @ " + step_label(row.internal_step_s) + ", " +
+                  number_text(*row.cpu_s_per_sim_s) + " CPU s per simulated s, RMS error " +
+                  number_text(*row.rms_error_m) + " m";
+      }
     }
     recommendations.push_back(std::move(r));
   }
