@@ -30,6 +30,16 @@ void validate(const PointContactSettings& settings) {
   }
 }
 
+bool PointContact::inside_by_parity(const Eigen::Vector3d& point_m, const Eigen::VectorXd& positions_m,
+                                    const SurfaceBvh& surface) {
+  // Inside when a ray from the point crosses the surface an odd number of times (a direction off
+  // the axes, so that a ray along a grid's faces or edges is unlikely). Leaves the hits of the ray
+  // in m_segment_hits.
+  const Eigen::Vector3d direction = Eigen::Vector3d(0.5279, 0.6173, 0.5832).normalized();
+  surface.intersect_segment(point_m, point_m + PASSED_OVER_RAY_M * direction, positions_m, m_segment_hits);
+  return m_segment_hits.size() % 2 == 1;
+}
+
 PointContact::PointContact(PointContactSettings settings) : m_settings(settings) { validate(m_settings); }
 
 bool PointContact::update(const Eigen::Vector3d& hip_previous_m, const Eigen::Vector3d& hip_m,
@@ -61,14 +71,12 @@ bool PointContact::update(const Eigen::Vector3d& hip_previous_m, const Eigen::Ve
     }
     if (entered >= 0) {
       const SurfaceBvh::SegmentHit& entry = m_segment_hits[static_cast<size_t>(entered)];
+      // The god-object holds a tool pushed through a thin part at the side it entered (no parity
+      // test here: that is the point of a proxy; tool.maxSpeed bounds how far a step can push).
       start = SurfacePoint{entry.triangle, entry.barycentric};
     } else {
       if (!(m_settings.passed_over_depth_m > 0.0)) return false;
-      // Inside when a ray from the HIP crosses the surface an odd number of times (a direction off
-      // the axes, so that a ray along a grid's faces or edges is unlikely); start from its nearest hit.
-      const Eigen::Vector3d direction = Eigen::Vector3d(0.5279, 0.6173, 0.5832).normalized();
-      surface.intersect_segment(hip_m, hip_m + PASSED_OVER_RAY_M * direction, positions_m, m_segment_hits);
-      if (m_segment_hits.size() % 2 == 0) return false;
+      if (!inside_by_parity(hip_m, positions_m, surface)) return false;
       const SurfaceBvh::SegmentHit* nearest = &m_segment_hits.front();
       for (const SurfaceBvh::SegmentHit& hit : m_segment_hits) {
         if (hit.segment_parameter < nearest->segment_parameter) nearest = &hit;

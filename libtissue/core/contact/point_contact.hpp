@@ -68,7 +68,8 @@ class PointContact {
   /// against the surface of `surface` (its triangles, refitted to `positions_m`, 3 per vertex).
   /// * Not in contact: contact starts where the segment first enters the surface (crossing a
   ///   triangle against its outward normal; exits, e.g. of a tool that began inside, are skipped)
-  ///   if the HIP is then inside. A surface that moved over the HIP (no crossing, the HIP inside
+  ///   if the HIP is then inside (the pseudo-normal at the proxy: a tool pushed through a thin part is
+  ///   held at the side it entered). A surface that moved over the HIP (no crossing, the HIP inside
   ///   by a ray's parity) starts a contact only with settings().passed_over_depth_m > 0 and the HIP
   ///   at most that deep: a tool switched on deep inside the body does not snap to its surface.
   /// * In contact (or just started): the proxy slides over the current surface to the locally
@@ -125,6 +126,8 @@ class PointContact {
   [[nodiscard]] Eigen::Vector3d force_on_tool_n(const SurfaceBvh& surface, const Eigen::VectorXd& positions_m) const;
 
  private:
+  /// Whether `point_m` is inside the surface by a ray's parity (the ray's hits stay in m_segment_hits).
+  bool inside_by_parity(const Eigen::Vector3d& point_m, const Eigen::VectorXd& positions_m, const SurfaceBvh& surface);
   PointContactSettings m_settings;
   bool m_in_contact = false;
   SurfacePoint m_proxy;
