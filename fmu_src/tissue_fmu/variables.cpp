@@ -131,7 +131,7 @@ constexpr auto VARIABLES = std::to_array<VariableInfo>({
         .unit("1")
         .start("0.001")
         .describe("Smallest volume fraction either side of a cut tetrahedron is given (keeps slivers stiff and "
-                  "massive enough); in (0, 0.5)"),
+                  "massive enough); in [1e-12, 0.5)"),
 
     // Structural parameters.
     structural_parameter(Vr::vertex_capacity, "surface.vertexCapacity", uint64)

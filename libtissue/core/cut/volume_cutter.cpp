@@ -11,6 +11,7 @@
 #include <array>
 #include <chrono>
 #include <stdexcept>
+#include <sstream>
 #include <string>
 
 namespace tissue {
@@ -112,9 +113,11 @@ void validate(const CutterSettings& settings) {
     throw ParameterError("cutter: vertex snap fraction must be in [0, 0.5), got " +
                          std::to_string(settings.vertex_snap_fraction));
   }
-  if (!(settings.min_volume_fraction > 0.0 && settings.min_volume_fraction < 0.5)) {
-    throw ParameterError("cutter: minimum volume fraction must be in (0, 0.5), got " +
-                         std::to_string(settings.min_volume_fraction));
+  if (!(settings.min_volume_fraction >= SMALLEST_MIN_VOLUME_FRACTION && settings.min_volume_fraction < 0.5)) {
+    std::ostringstream message;
+    message << "cutter: minimum volume fraction must be in [" << SMALLEST_MIN_VOLUME_FRACTION << ", 0.5), got "
+            << settings.min_volume_fraction;
+    throw ParameterError(message.str());
   }
 }
 

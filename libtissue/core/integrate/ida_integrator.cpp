@@ -454,6 +454,11 @@ StepReport IdaIntegrator::step(DynamicsModel& model, DynamicState& state, double
     const double end_s = state.time_s + step_size_s;
     impl.check(IDASetStopTime(impl.ida, end_s), "IDASetStopTime");
     const int flag = IDASolve(impl.ida, end_s, &reached_s, impl.y, impl.yp, IDA_NORMAL);
+    if (flag == IDA_TOO_MUCH_WORK) {
+      throw IntegrationError("IDA: more than " + std::to_string(m_settings.max_internal_steps) +
+                             " internal steps (IdaSettings::max_internal_steps) before t = " + std::to_string(end_s) +
+                             " s, at t = " + std::to_string(reached_s) + " s; state kept");
+    }
     if (flag < 0) {
       throw IntegrationError("IDA: the step failed (flag " + std::to_string(flag) + "): " + impl.last_error +
                              "; state kept");
