@@ -3,6 +3,7 @@
 
 #include "compare/compare_metrics.hpp"
 #include "compare/compare_settings.hpp"
+#include "output/json_text.hpp"
 
 #include <algorithm>
 #include <charconv>
@@ -35,21 +36,6 @@ std::vector<std::string> wrap(const std::string& text, std::size_t width) {
   }
   lines.push_back(rest);
   return lines;
-}
-
-std::string json_string(const std::string& text) {
-  std::string quoted = "\"";
-  for (const char c : text) {
-    if (c == '"' || c == '\\') {
-      quoted += '\\';
-      quoted += c;
-    } else if (static_cast<unsigned char>(c) < 0x20) {
-      quoted += ' ';
-    } else {
-      quoted += c;
-    }
-  }
-  return quoted + "\"";
 }
 
 template <class T>

@@ -5,6 +5,7 @@
 #include "device/scripted_device.hpp"
 #include "device/udp_device.hpp"
 #include "importer/fmu3.hpp"
+#include "output/json_text.hpp"
 #include "output/png_renderer.hpp"
 #include "output/pvd_writer.hpp"
 #include "output/vtu_writer.hpp"
@@ -666,21 +667,6 @@ class Session {
 
 void json_percentiles(std::ostringstream& out, const char* name, const Percentiles& p) {
   out << "  \"" << name << "\": {\"p50\": " << p.p50 << ", \"p99\": " << p.p99 << ", \"max\": " << p.max << "},\n";
-}
-
-std::string json_string(const std::string& text) {
-  std::string quoted = "\"";
-  for (const char c : text) {
-    if (c == '"' || c == '\\') {
-      quoted += '\\';
-      quoted += c;
-    } else if (static_cast<unsigned char>(c) < 0x20) {
-      quoted += ' ';
-    } else {
-      quoted += c;
-    }
-  }
-  return quoted + "\"";
 }
 
 }  // namespace

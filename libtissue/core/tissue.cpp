@@ -412,8 +412,9 @@ Eigen::Matrix3d Tissue::effective_contact_stiffness(int triangle) {
   const ContactInterpolation point = contact_interpolation(m_body.dofs(), vertices, m_contact.proxy().barycentric);
   const std::optional<PointSpring>& spring = m_body.point_spring();
   // K_c of a factorized matrix; the tangent of this step holds the contact spring: take it out
-  // exactly (Sherman-Morrison). Nothing when the factor or K_c is unusable.
-  const auto condensed = [&](const ShiftedSystem& system) -> std::optional<Eigen::Matrix3d> {
+  // exactly (Sherman-Morrison). Nothing when the factor fails or K_c is not finite or its smallest
+  // eigenvalue is not above `floor_n_per_m`.
+  const auto condensed = [&](const ShiftedSystem& system, double floor_n_per_m) -> std::optional<Eigen::Matrix3d> {
     try {
       m_effective_stiffness.factorize(system);
       std::optional<Eigen::Matrix3d> stiffness;
@@ -428,7 +429,7 @@ Eigen::Matrix3d Tissue::effective_contact_stiffness(int triangle) {
       // A point on fixed vertices only is a rigid support: report the spring alone.
       if (!stiffness) return Eigen::Matrix3d::Identity() * contact_spring_stiffness_n_per_m();
       const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eigen(*stiffness, Eigen::EigenvaluesOnly);
-      if (!stiffness->allFinite() || !(eigen.eigenvalues().minCoeff() > 0.0)) return std::nullopt;
+      if (!stiffness->allFinite() || !(eigen.eigenvalues().minCoeff() > floor_n_per_m)) return std::nullopt;
       return stiffness;
     } catch (const SolverError&) {
       return std::nullopt;
@@ -438,18 +439,16 @@ Eigen::Matrix3d Tissue::effective_contact_stiffness(int triangle) {
   // integrator, where nothing holds it, or where the static K fails because a cut set the
   // contacted piece free (K singular there; issue 10).
   if (!m_body.settings().fixed_vertices.empty()) {
-    const auto stiffness = condensed(static_contact_system(m_body.tangent(), m_contact_system_diagonal));
     // CHOLMOD may factorize a singular K through rounding; the point of a free piece then comes out
     // with a K_c at rounding level. Held points of the frog measure 0.0017 to 14 times the contact
     // scale (contact_stiffness.hpp): below 1e-6 of it, the piece is taken as held by nothing.
-    if (stiffness && Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(*stiffness, Eigen::EigenvaluesOnly)
-                             .eigenvalues()
-                             .minCoeff() > FREE_PIECE_STIFFNESS_FRACTION * m_contact_stiffness_scale_n_per_m) {
+    if (const auto stiffness = condensed(static_contact_system(m_body.tangent(), m_contact_system_diagonal),
+                                         FREE_PIECE_STIFFNESS_FRACTION * m_contact_stiffness_scale_n_per_m)) {
       return *stiffness;
     }
   }
   const ShiftedSystem step = m_integrator->newton_stiffness(m_body, m_settings.step_size_s, m_contact_system_diagonal);
-  if (const auto stiffness = condensed(step)) return *stiffness;
+  if (const auto stiffness = condensed(step, 0.0)) return *stiffness;
   throw SolverError("the contact stiffness cannot be condensed from the static or the step matrix");
 }
 
