@@ -257,10 +257,15 @@ void Tissue::interact_with_scalpel(const ToolPose& previous, const ToolPose& cur
   }
 }
 
-EnrichmentResult Tissue::apply_cuts(std::span<const TetCut> cuts) {
+EnrichmentResult Tissue::apply_cuts(std::span<const TetCut> cuts, std::span<const TetPositions> recorded_offsets_m) {
   const int first_new = static_cast<int>(m_body.cut_tets().size());
-  const EnrichmentResult result = m_body.enrich(cuts);
-  m_body.grow_state(m_state);
+  EnrichmentResult result;
+  if (recorded_offsets_m.empty()) {
+    result = m_body.enrich(cuts, m_state);
+  } else {
+    result = m_body.enrich(cuts, recorded_offsets_m);
+    m_body.grow_state(m_state);  // the snapshot's state replaces it after the replay
+  }
   m_integrator->restart(Restart::system_grown);
   m_cut_history.insert(m_cut_history.end(), cuts.begin(), cuts.end());
   m_cut_batch_ends.push_back(static_cast<int>(m_cut_history.size()));
@@ -276,6 +281,8 @@ void Tissue::save(TissueSnapshot& snapshot) const {
   snapshot.model_fingerprint = m_model_fingerprint;
   snapshot.cuts = m_cut_history;
   snapshot.cut_batch_ends = m_cut_batch_ends;
+  snapshot.cut_offsets.clear();
+  for (const CutTet& cut_tet : m_body.cut_tets()) snapshot.cut_offsets.push_back(cut_tet.enrichment_offset_m);
   snapshot.dynamics = m_state;
   m_body.save_rotations(snapshot.rotations);
   snapshot.integrator_state = m_integrator->internal_state();
@@ -289,8 +296,14 @@ void Tissue::save(TissueSnapshot& snapshot) const {
 }
 
 bool Tissue::has_cuts_of(const TissueSnapshot& snapshot) const {
+  const std::vector<CutTet>& cut_tets = m_body.cut_tets();
   return snapshot.cut_batch_ends == m_cut_batch_ends && snapshot.cuts.size() == m_cut_history.size() &&
-         std::equal(snapshot.cuts.begin(), snapshot.cuts.end(), m_cut_history.begin(), same_cut);
+         std::equal(snapshot.cuts.begin(), snapshot.cuts.end(), m_cut_history.begin(), same_cut) &&
+         snapshot.cut_offsets.size() == cut_tets.size() &&
+         std::equal(snapshot.cut_offsets.begin(), snapshot.cut_offsets.end(), cut_tets.begin(),
+                    [](const TetPositions& offsets, const CutTet& cut_tet) {
+                      return offsets == cut_tet.enrichment_offset_m;
+                    });
 }
 
 void Tissue::restore(const TissueSnapshot& snapshot) {
@@ -305,6 +318,10 @@ void Tissue::restore(const TissueSnapshot& snapshot) {
   if (static_cast<size_t>(previous_end) != snapshot.cuts.size()) {
     throw StateError("the state's cut batches do not add up to its cuts");
   }
+  if (snapshot.cut_offsets.size() != snapshot.cuts.size()) {
+    throw StateError("the state has " + std::to_string(snapshot.cut_offsets.size()) + " enrichment offsets for " +
+                     std::to_string(snapshot.cuts.size()) + " cuts");
+  }
   if (!can_restore(snapshot)) {
     throw StateError("the state has other cuts than this instance; restore it into a fresh instance");
   }
@@ -312,7 +329,9 @@ void Tissue::restore(const TissueSnapshot& snapshot) {
     try {
       int begin = 0;
       for (const int end : snapshot.cut_batch_ends) {
-        apply_cuts(std::span(snapshot.cuts).subspan(static_cast<size_t>(begin), static_cast<size_t>(end - begin)));
+        const auto first = static_cast<size_t>(begin);
+        const auto count = static_cast<size_t>(end - begin);
+        apply_cuts(std::span(snapshot.cuts).subspan(first, count), std::span(snapshot.cut_offsets).subspan(first, count));
         begin = end;
       }
     } catch (const std::invalid_argument& error) {

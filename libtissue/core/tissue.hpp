@@ -118,6 +118,7 @@ struct TissueSnapshot {
   std::uint64_t model_fingerprint = 0;  ///< of the mesh and settings (Tissue::model_fingerprint())
   std::vector<TetCut> cuts;             ///< every enriched cut, in order
   std::vector<int> cut_batch_ends;      ///< after enrichment k, cuts [0, cut_batch_ends[k]) were applied
+  std::vector<TetPositions> cut_offsets;  ///< per cut: CutTet::enrichment_offset_m when it was applied
   DynamicState dynamics;
   DeformableBody::Rotations rotations;
   Eigen::VectorXd integrator_state;
@@ -206,7 +207,8 @@ class Tissue {
   Eigen::Matrix3d effective_contact_stiffness(int triangle);
   void update_positions();
   /// Enriches `cuts` (one batch), grows the state, adds the opened faces to the surface and the BVH.
-  EnrichmentResult apply_cuts(std::span<const TetCut> cuts);
+  // Live (offsets empty: taken from the state) or replayed from a snapshot (its recorded offsets).
+  EnrichmentResult apply_cuts(std::span<const TetCut> cuts, std::span<const TetPositions> recorded_offsets_m = {});
   [[nodiscard]] Blade blade(const ToolPose& pose) const;
 
   TissueSettings m_settings;

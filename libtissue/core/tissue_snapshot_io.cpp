@@ -10,7 +10,7 @@ namespace tissue {
 namespace {
 
 constexpr std::uint64_t MAGIC = 0x31305353'49535354ULL;  // "TSSISS01" read as little-endian bytes
-constexpr std::uint32_t VERSION = 2;                     // 2: PointSpring::tangent_fraction
+constexpr std::uint32_t VERSION = 3;  // 2: PointSpring::tangent_fraction; 3: the cuts' enrichment offsets
 
 // The core's Eigen types and cut records on top of the shared byte stream.
 class Writer : public serial::ByteWriter {
@@ -113,6 +113,7 @@ std::vector<std::uint8_t> serialize_snapshot(const TissueSnapshot& s) {
   w.put(s.model_fingerprint);
   w.put_all(s.cuts);
   w.put_all(s.cut_batch_ends);
+  w.put_all(s.cut_offsets);
   w.put(s.dynamics.displacement_m);
   w.put(s.dynamics.velocity_m_per_s);
   w.put(s.dynamics.time_s);
@@ -170,6 +171,7 @@ TissueSnapshot read_snapshot(std::span<const std::uint8_t> bytes) {
   r.get(s.model_fingerprint);
   r.get_all(s.cuts, 4 + 4 + 4 + 8 + 48);
   r.get_all(s.cut_batch_ends, 4);
+  r.get_all(s.cut_offsets, 96);
   r.get(s.dynamics.displacement_m);
   r.get(s.dynamics.velocity_m_per_s);
   r.get(s.dynamics.time_s);

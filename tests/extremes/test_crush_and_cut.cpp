@@ -152,13 +152,6 @@ Case cube_cut_in_two(bool one_step) {
   c.id = one_step ? "CubeCutInOneStep" : "CubeCutAt1mps";
   c.label = one_step ? "cube cut in two in one step, each half hinged on a held edge"
                      : "cube cut in two at 1 m/s (tets completed over 3 steps of one stroke)";
-  if (!one_step) {
-    c.known_failures = {ALL_METHODS.begin(), ALL_METHODS.end()};
-    c.known_failure_note =
-        "enriched unknowns are one per (vertex, cut id, side) for a whole stroke, so a tet completed at a "
-        "later step takes over unknowns that have moved since, and its parts start displaced from it "
-        "(DeformableBody::enrich)";
-  }
   c.scene = [one_step] {
     Scene scene{make_box_mesh(1, 1, 1, 0.01), default_settings()};
     scene.settings.body.fixed_vertices = vertices_at_minimum(scene.mesh, 2, 0.0);

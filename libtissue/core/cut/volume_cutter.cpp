@@ -39,6 +39,11 @@ bool segment_touches_tet(const Eigen::Vector3d& a, const Eigen::Vector3d& b, con
 
 }  // namespace
 
+Blade swept_from(const Blade& previous, const Blade& current) {
+  return Blade{previous.tip_m - SWEEP_BACK_OVERLAP * (current.tip_m - previous.tip_m),
+               previous.handle_m - SWEEP_BACK_OVERLAP * (current.handle_m - previous.handle_m)};
+}
+
 /// The surface the blade sweeps between two steps, approximated by two triangles (algorithm 5's
 /// MakeSurface), wound alike: (tip0, handle0, tip1) and (handle0, handle1, tip1). "Above" is the
 /// side their normals point to, e.g. (handle0 - tip0) x (tip1 - tip0).
@@ -231,7 +236,7 @@ CutStepReport VolumeCutter::step(const Blade& previous, const Blade& current, co
   m_candidates.clear();
   m_seeds.clear();
   CutStepReport report;
-  const Sweep sweep(previous, current);
+  const Sweep sweep(swept_from(previous, current), current);
   const bool was_cutting = m_cutting;
   if (!was_cutting) {
     // Algorithm 5, first part: the blade (or, added, its sweep) meets the surface.

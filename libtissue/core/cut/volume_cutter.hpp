@@ -42,11 +42,22 @@ namespace tissue {
 /// seen, at that vertex, from every edge there, whatever the round-off.
 inline constexpr double EDGE_ROUND_OFF_EXTENSION = 1e-9;
 
+/// Each step's sweep starts this fraction of the tip's and of the handle's travel behind the
+/// previous blade. Blade and body both move between two steps, and an edge is tested at its
+/// current position only: an edge lying on the previous blade's line (a step that ended exactly on
+/// it) that the body then moves back by a hair would be missed by both sweeps. The overlap sees it;
+/// an edge crossed already keeps its first crossing.
+inline constexpr double SWEEP_BACK_OVERLAP = 0.1;
+
 /// The cutting edge: the segment from the tip to the handle [m].
 struct Blade {
   Eigen::Vector3d tip_m = Eigen::Vector3d::Zero();
   Eigen::Vector3d handle_m = Eigen::Vector3d::Zero();
 };
+
+/// Where a step's sweep starts: the previous blade moved back along each end's path by
+/// SWEEP_BACK_OVERLAP of its travel (the sweep ends at the current blade).
+Blade swept_from(const Blade& previous, const Blade& current);
 
 /// The floor of CutterSettings::min_volume_fraction. Below it a part's ghost unknowns weigh ~1e-16
 /// of their tet: a capped PCG solve moves them freely and the next enrichment gives them mass, so

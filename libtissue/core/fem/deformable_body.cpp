@@ -235,8 +235,45 @@ void DeformableBody::check_cuts(std::span<const TetCut> cuts) const {
   if (twice != tets.end()) throw ParameterError("enrich: tet " + std::to_string(*twice) + " is cut twice in one batch");
 }
 
-EnrichmentResult DeformableBody::enrich(std::span<const TetCut> cuts) {
+EnrichmentResult DeformableBody::enrich(std::span<const TetCut> cuts, DynamicState& state) {
+  const Eigen::Index size = dof_count();
+  if (state.displacement_m.size() != size || state.velocity_m_per_s.size() != size) {
+    throw std::invalid_argument("enrich: the state has " + std::to_string(state.displacement_m.size()) +
+                                " displacements and " + std::to_string(state.velocity_m_per_s.size()) +
+                                " velocities, the body " + std::to_string(size) + " unknowns");
+  }
   check_cuts(cuts);
+  // The offsets: the current a of each existing unknown a cut tet will join.
+  std::vector<TetPositions> offsets_m(cuts.size());
+  for (size_t c = 0; c < cuts.size(); ++c) {
+    const Tet& tet = m_mesh.tets[static_cast<size_t>(cuts[c].tet)];
+    for (size_t i = 0; i < 4; ++i) {
+      const int k = find_enriched_dof(tet[i], cuts[c].cut_id, cuts[c].side[i]);
+      offsets_m[c][i] = k < 0 ? Eigen::Vector3d::Zero()
+                              : Eigen::Vector3d(state.displacement_m.segment<3>(3 * m_enriched_dofs[static_cast<size_t>(k)].row));
+    }
+  }
+  const Eigen::VectorXd mass_before_kg = m_mass_kg;
+  const EnrichmentResult result = enrich(cuts, offsets_m);
+  grow_state(state);
+  // An existing unknown that gained mass keeps its momentum (an inelastic join of the new part).
+  for (Eigen::Index r = 0; r < mass_before_kg.size(); ++r) {
+    if (m_mass_kg(r) > mass_before_kg(r)) state.velocity_m_per_s(r) *= mass_before_kg(r) / m_mass_kg(r);
+  }
+  return result;
+}
+
+EnrichmentResult DeformableBody::enrich(std::span<const TetCut> cuts, std::span<const TetPositions> offsets_m) {
+  check_cuts(cuts);
+  if (!offsets_m.empty() && offsets_m.size() != cuts.size()) {
+    throw ParameterError("enrich: " + std::to_string(offsets_m.size()) + " offsets for " +
+                         std::to_string(cuts.size()) + " cuts");
+  }
+  for (const TetPositions& offsets : offsets_m) {
+    for (const Eigen::Vector3d& offset : offsets) {
+      if (!offset.allFinite()) throw ParameterError("enrich: an enrichment offset is not finite");
+    }
+  }
   EnrichmentResult result;
   const std::uint64_t layout_before = m_tangent.layout_revision();
   const int u_rows = m_dofs.free_vertex_count();
@@ -277,6 +314,7 @@ EnrichmentResult DeformableBody::enrich(std::span<const TetCut> cuts) {
     cut_tet.weight_above = cut.volume_fraction_above;
     cut_tet.weight_below = 1.0 - cut.volume_fraction_above;
     for (size_t i = 0; i < 4; ++i) cut_tet.enriched_row[i] = m_enriched_dofs[static_cast<size_t>(dof_of_cut[c][i])].row;
+    if (!offsets_m.empty()) cut_tet.enrichment_offset_m = offsets_m[c];
 
     const TetRest& rest = m_elasticity.rest(cut.tet);
     for (size_t i = 0; i < 4; ++i) {

@@ -98,8 +98,21 @@ class DeformableBody final : public DynamicsModel {
   /// from the tet's current rotation. Throws ParameterError, with nothing changed, if a cut names a
   /// tet out of range or already cut (or twice), lacks a sign or has a sign other than +-1, or has
   /// a volume fraction outside (0, 1) or not finite.
-  EnrichmentResult enrich(std::span<const TetCut> cuts);
+  ///
+  /// This form is for a body whose existing enriched unknowns are still at a = 0 (no step taken
+  /// since they were made, as in tests), or to replay recorded cuts: `offsets_m`, empty or one per
+  /// cut, are the CutTet::enrichment_offset_m they had when made (see cut_tets()).
+  EnrichmentResult enrich(std::span<const TetCut> cuts, std::span<const TetPositions> offsets_m = {});
   EnrichmentResult enrich(const TetCut& cut) { return enrich(std::span<const TetCut>(&cut, 1)); }
+
+  /// The form for a running body (a cut completed in the middle of a simulation): a tet that joins
+  /// an enriched unknown which exists already (made by a tet completed at an earlier step of the same
+  /// stroke, and moved since) records its current value as the offset, so that its parts start as
+  /// the tet was; the join is inelastic: the unknown's velocity is scaled by old mass / new mass
+  /// (its momentum kept, kinetic energy not gained). `state` is grown as by grow_state(). Throws
+  /// ParameterError for bad cuts and std::invalid_argument for a state of the wrong size, with
+  /// nothing changed.
+  EnrichmentResult enrich(std::span<const TetCut> cuts, DynamicState& state);
 
   /// Grows a state to dof_count() in place: existing entries unchanged, new ones (enriched a and
   /// da/dt) zero. Call after enrich().

@@ -22,7 +22,8 @@ TetPositions cut_part_positions(const CutTet& cut_tet, CutPart part, const TetPo
                                 const TetPositions& enrichment_m) {
   TetPositions p;
   for (int j = 0; j < 4; ++j)
-    p[to_size(j)] = real_positions_m[to_size(j)] + cut_tet.shift(j, part) * enrichment_m[to_size(j)];
+    p[to_size(j)] = real_positions_m[to_size(j)] +
+                    cut_tet.shift(j, part) * (enrichment_m[to_size(j)] - cut_tet.enrichment_offset_m[to_size(j)]);
   return p;
 }
 

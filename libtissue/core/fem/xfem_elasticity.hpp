@@ -44,6 +44,12 @@ struct CutTet {
   double weight_above = 0.5;          ///< w_a = V_a / V
   double weight_below = 0.5;          ///< w_b = 1 - w_a
   std::array<int, 4> enriched_row{};  ///< block row of the enriched unknown a_i of each local vertex
+  /// a_i when this tet joined an enriched unknown that existed already (a tet completed at a later
+  /// step of the same stroke; zero for an unknown it created). The parts place their vertices at
+  /// x_j + Psi_pj (a_j - offset_j), so they start as the tet was and the join adds no energy; from
+  /// then on they move with the shared unknown (a seam the size of the offset stays).
+  TetPositions enrichment_offset_m{Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero(),
+                                   Eigen::Vector3d::Zero()};
   /// The weight of a part (w_a or w_b).
   [[nodiscard]] double weight(CutPart part) const { return part == CutPart::above ? weight_above : weight_below; }
   /// Psi of local vertex i in part p.
@@ -57,8 +63,9 @@ struct CutTet {
 /// a-a blocks of two vertices on opposite sides (Psi_pi Psi_pj = 0 in both parts, eq. 4.6).
 using CutTetSlots = std::array<int, 64>;
 
-/// Positions p_pj = x_j + Psi_pj a_j of the 4 vertices of part p (eq. 3.26-3.27), from the real
-/// positions x and the enriched displacements a of the tet's local vertices. [m]
+/// Positions p_pj = x_j + Psi_pj (a_j - offset_j) of the 4 vertices of part p (eq. 3.26-3.27, with
+/// CutTet::enrichment_offset_m), from the real positions x and the enriched displacements a of the
+/// tet's local vertices. [m]
 TetPositions cut_part_positions(const CutTet& cut_tet, CutPart part, const TetPositions& real_positions_m,
                                 const TetPositions& enrichment_m);
 

@@ -167,7 +167,8 @@ class ReferenceCutter {
     std::vector<int> touched;  ///< tets the current blade touches, sorted (empty when not cutting after)
   };
 
-  Step step(const Blade& previous, const Blade& current) {
+  Step step(const Blade& previous_blade, const Blade& current) {
+    const Blade previous = swept_from(previous_blade, current);  // the cutter's sweep, with its overlap
     const SweepQuad sweep(previous, current);
     Step result;
     if (!m_cutting) {

@@ -113,6 +113,13 @@ TEST_P(TissueState, SerializedIntoAFreshInstanceContinuesBitwise) {
   const std::vector<std::uint8_t> bytes = serialize_snapshot(snapshot);
   run(original, session, saved_at, LAST_STEP);
   ASSERT_GT(original.body().cut_tets().size(), 50u) << "the stroke should cut across the body";
+  // The stroke completes tets over many steps: later ones join moved unknowns with offsets, which
+  // the replay into a fresh instance must reproduce.
+  int offsets = 0;
+  for (const CutTet& cut_tet : original.body().cut_tets()) {
+    for (const Eigen::Vector3d& offset : cut_tet.enrichment_offset_m) offsets += offset.norm() > 0.0;
+  }
+  EXPECT_GT(offsets, 0);
 
   Tissue fresh(mesh, frog_settings(mesh));
   fresh.restore(deserialize_snapshot(bytes));

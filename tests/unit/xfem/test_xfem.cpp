@@ -338,6 +338,52 @@ TEST(XfemEnrich, AtADeformedStateKeepsUForcesTangentAndEnergy) {
   EXPECT_GT(expected.norm(), 0.01 * f_before.norm());  // the crack-opening forces are real
 }
 
+TEST(XfemEnrich, ATetJoiningAMovedUnknownStartsAsTheTetWas) {
+  // A stroke completes its tets over several steps: the later ones share the enriched unknowns of
+  // the earlier ones, which have moved since. The joining tet's parts must start as the tet was:
+  // elastic energy and u forces unchanged by the enrichment (to round-off, 1e-12 relative; before
+  // the offsets the parts started displaced by Psi a: +9e-5 J here), and no kinetic
+  // energy gained (the join keeps the shared unknown's momentum, so it can only lose some).
+  Box box;
+  const auto cuts = xfem_test::plane_cuts(box.mesh, Plane{Eigen::Vector3d(1, 0.2, 0.1).normalized(), 0.0213});
+  ASSERT_GE(cuts.size(), 10u);
+  const size_t half = cuts.size() / 2;
+  DynamicState state{box.deformed(0.8), Eigen::VectorXd::Zero(box.body.dof_count())};
+  box.body.enrich(std::span(cuts).first(half), state);
+
+  // The earlier tets' parts move apart: every enriched unknown displaced and moving.
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> spread(-1.0, 1.0);
+  const Eigen::Index n_u = 3 * box.body.dofs().free_vertex_count();
+  for (Eigen::Index k = n_u; k < state.displacement_m.size(); ++k) {
+    state.displacement_m(k) = 0.0008 * spread(rng);
+    state.velocity_m_per_s(k) = 0.05 * spread(rng);
+  }
+  for (Eigen::Index k = 0; k < n_u; ++k) state.velocity_m_per_s(k) = 0.05 * spread(rng);
+  Eigen::VectorXd f_before;
+  box.body.evaluate(state.displacement_m, f_before, false);
+  const double energy_before = box.body.elastic_energy_j(state.displacement_m);
+  const double kinetic_before = box.body.kinetic_energy_j(state.velocity_m_per_s);
+  const Eigen::VectorXd velocity_before = state.velocity_m_per_s;
+  const Eigen::VectorXd displacement_before = state.displacement_m;
+
+  const EnrichmentResult result = box.body.enrich(std::span(cuts).subspan(half), state);
+  ASSERT_LT(result.new_enriched_dofs, 4 * static_cast<int>(cuts.size() - half));  // some are joined
+  int joined = 0;
+  for (size_t c = half; c < cuts.size(); ++c) {
+    for (const Eigen::Vector3d& offset : box.body.cut_tets()[c].enrichment_offset_m) joined += offset.norm() > 0.0;
+  }
+  EXPECT_GT(joined, 0);
+
+  Eigen::VectorXd f_after;
+  box.body.evaluate(state.displacement_m, f_after, false);
+  EXPECT_NEAR(box.body.elastic_energy_j(state.displacement_m), energy_before, 1e-12 * energy_before);
+  EXPECT_LT((f_after.head(n_u) - f_before.head(n_u)).norm(), 1e-12 * f_before.head(n_u).norm());
+  EXPECT_LE(box.body.kinetic_energy_j(state.velocity_m_per_s), kinetic_before * (1.0 + 1e-12));
+  EXPECT_EQ(state.velocity_m_per_s.head(n_u), velocity_before.head(n_u));  // real vertices untouched
+  EXPECT_EQ(state.displacement_m.head(displacement_before.size()), displacement_before);  // nothing moved
+}
+
 TEST(XfemEnrich, UnstressedBodyFeelsNoEnrichedForce) {
   // A rigid motion: every tet and part is stress-free, so all forces vanish. Scale of a 1% strain:
   // E 0.01 (1 cm)^2 = 1e-3 N. What remains is the rotation's Newton tolerance (angle error ~1e-12,
