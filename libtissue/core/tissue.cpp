@@ -71,6 +71,9 @@ std::uint64_t model_fingerprint_of(const TetMesh& mesh, const TissueSettings& se
   f.add(ida.max_step_s);
   f.add(ida.linear_solver);
   f.add(ida.max_internal_steps);
+  f.add(settings.integrator.newton.trigger_angle_rad);
+  f.add(settings.integrator.newton.max_iterations);
+  f.add(settings.integrator.newton.energy_guard_angle_rad);
   f.add(settings.solver.kind);
   f.add(settings.solver.pcg.tolerance);
   f.add(settings.solver.pcg.max_iterations);

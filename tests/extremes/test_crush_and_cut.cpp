@@ -177,10 +177,6 @@ Case hinged_cube() {
   c.label = "2 mm cube held on one edge (a hinge), swinging down";
   c.may_refuse = {Method::ida_krylov};
   c.refusal_note = "GMRES crawls as the cube turns about its hinge (1888 internal steps in one step)";
-  c.known_failures = {Method::euler_cholmod};
-  c.known_failure_note =
-      "one linearized backward-Euler step moves the nodes along straight lines; a tet turning ~0.1 rad in "
-      "a step reads that as stretch, and the exact solve keeps the energy (PCG's capped solve damps it)";
   c.scene = [] {
     Scene scene{make_box_mesh(1, 1, 1, 0.002), default_settings()};
     scene.settings.body.fixed_vertices =

@@ -115,6 +115,58 @@ DeformableBody::DeformableBody(TetMesh mesh, BodySettings settings)
   m_enriched_dofs.reserve(static_cast<size_t>(spare_rows));
   m_next_enriched_dof.reserve(static_cast<size_t>(spare_rows));
   m_xfem.reserve(std::min(m_mesh.tet_count(), 2 * spare_rows));
+  for (int t = 0; t < m_mesh.tet_count(); ++t) {
+    m_largest_shape_gradient_per_m =
+        std::max(m_largest_shape_gradient_per_m, m_elasticity.rest(t).shape_gradients_per_m.colwise().norm().maxCoeff());
+  }
+}
+
+namespace {
+
+// |axial vector of skew(R^T G)|, G = sum_i du_i grad(phi_i)^T: the angle a displacement increment
+// du turns a tet of rotation R (to first order).
+double turn_angle_rad(const TetRest& rest, const Eigen::Matrix3d& rotation, const TetPositions& increment_m) {
+  const Eigen::Matrix3d w = rotation.transpose() * deformation_gradient(rest, increment_m);
+  return 0.5 * Eigen::Vector3d(w(2, 1) - w(1, 2), w(0, 2) - w(2, 0), w(1, 0) - w(0, 1)).norm();
+}
+
+}  // namespace
+
+bool DeformableBody::turns_further_than(const Eigen::VectorXd& increment_m, double angle_rad) const {
+  if (increment_m.size() != dof_count()) {
+    throw std::invalid_argument("turns_further_than: the increment has " + std::to_string(increment_m.size()) +
+                                " entries, the body " + std::to_string(dof_count()) + " unknowns");
+  }
+  double largest_block_m = 0.0;
+  for (Eigen::Index row = 0; row < increment_m.size() / 3; ++row) {
+    largest_block_m = std::max(largest_block_m, increment_m.segment<3>(3 * row).norm());
+  }
+  // G = sum_{i>0} (dp_i - dp_0) grad(phi_i)^T with |dp_i - dp_0| <= 4 max|block| (a part's vertex
+  // moves by du + Psi da), so the angle is at most |G| <= 12 max|block| max|grad(phi)|.
+  if (12.0 * largest_block_m * m_largest_shape_gradient_per_m <= angle_rad) return false;
+  const auto vertex_increment = [&](int vertex) -> Eigen::Vector3d {
+    const int row = vertex_block_row(vertex);
+    return row < 0 ? Eigen::Vector3d::Zero() : Eigen::Vector3d(increment_m.segment<3>(3 * row));
+  };
+  TetPositions increment;
+  for (int t = 0; t < m_mesh.tet_count(); ++t) {
+    if (m_cut_index[static_cast<size_t>(t)] >= 0) continue;
+    const Tet& tet = m_mesh.tets[static_cast<size_t>(t)];
+    for (size_t j = 0; j < 4; ++j) increment[j] = vertex_increment(tet[j]);
+    if (turn_angle_rad(m_elasticity.rest(t), m_elasticity.rotation(t), increment) > angle_rad) return true;
+  }
+  for (int k = 0; k < m_xfem.cut_tet_count(); ++k) {
+    const CutTet& cut_tet = m_xfem.cut_tets()[static_cast<size_t>(k)];
+    for (const CutPart part : {CutPart::above, CutPart::below}) {
+      for (size_t j = 0; j < 4; ++j) {
+        increment[j] = vertex_increment(cut_tet.vertices[j]) +
+                       cut_tet.shift(static_cast<int>(j), part) *
+                           Eigen::Vector3d(increment_m.segment<3>(3 * cut_tet.enriched_row[j]));
+      }
+      if (turn_angle_rad(m_xfem.rest(k), m_xfem.rotation(k, part), increment) > angle_rad) return true;
+    }
+  }
+  return false;
 }
 
 double DeformableBody::total_mass_kg() const {
@@ -165,6 +217,19 @@ double DeformableBody::elastic_energy_j(const Eigen::VectorXd& displacement_m) {
   check_unknowns(displacement_m);
   positions(displacement_m, m_positions_m);
   return m_elasticity.elastic_energy_j(m_positions_m) + m_xfem.elastic_energy_j(m_positions_m, displacement_m);
+}
+
+double DeformableBody::potential_energy_j(const Eigen::VectorXd& displacement_m) {
+  double energy = elastic_energy_j(displacement_m) - m_external_force_n.dot(displacement_m);  // positions set
+  if (m_point_spring) {
+    Eigen::Vector3d point_m = Eigen::Vector3d::Zero();
+    for (size_t i = 0; i < 3; ++i) {
+      point_m += m_point_spring->weights[static_cast<Eigen::Index>(i)] *
+                 m_positions_m.segment<3>(3 * m_point_spring->vertices[i]);
+    }
+    energy += 0.5 * m_point_spring->stiffness_n_per_m * (point_m - m_point_spring->target_m).squaredNorm();
+  }
+  return energy;
 }
 
 double DeformableBody::kinetic_energy_j(const Eigen::VectorXd& velocity_m_per_s) const {

@@ -77,6 +77,12 @@ class DeformableBody final : public DynamicsModel {
   [[nodiscard]] const Eigen::VectorXd& external_force_n() const override { return m_external_force_n; }
   void evaluate(const Eigen::VectorXd& displacement_m, Eigen::VectorXd& internal_force_n, bool update_tangent) override;
   [[nodiscard]] const BlockSparseMatrix& tangent() const override { return m_tangent; }
+  /// First a bound, O(unknowns): no element (or cut part) turns further than 12 max|block of the
+  /// increment| max|grad(phi)|; past it, each tet and part: |axial(skew(R^T G))| with G the
+  /// gradient of the increment and R its rotation at the last evaluate().
+  [[nodiscard]] bool turns_further_than(const Eigen::VectorXd& increment_m, double angle_rad) const override;
+  /// elastic_energy_j + the point spring's k |x_p - target|^2 / 2 - f_ext . u. [J]
+  [[nodiscard]] double potential_energy_j(const Eigen::VectorXd& displacement_m) override;
 
   [[nodiscard]] const TetMesh& mesh() const { return m_mesh; }
   [[nodiscard]] const DofMap& dofs() const { return m_dofs; }
@@ -190,6 +196,7 @@ class DeformableBody final : public DynamicsModel {
   XfemElasticity m_xfem;
   std::vector<int> m_enriched_row_capacity;  // per vertex: blocks its enriched row may ever hold (one cut)
   std::vector<EnrichedDof> m_enriched_dofs;
+  double m_largest_shape_gradient_per_m = 0.0;  // max |grad(phi_i)| over the mesh: 1 / the lowest altitude
   std::vector<int> m_first_enriched_dof;  // per vertex: first of its enriched unknowns, or -1
   std::vector<int> m_next_enriched_dof;   // per enriched unknown: next one of the same vertex, or -1
   std::vector<int> m_cut_index;           // per tet: index into cut_tets(), or -1

@@ -1,6 +1,7 @@
 // Semi-implicit backward Euler step (see backward_euler.hpp).
 #include "core/integrate/backward_euler.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <string>
@@ -34,9 +35,25 @@ ShiftedSystem BackwardEuler::newton_stiffness(const DynamicsModel& model, double
   return newton_stiffness_system(model, 1.0 / step_size_s, diagonal);
 }
 
+void validate(const BackwardEuler::NewtonCorrections& newton) {
+  if (!(newton.trigger_angle_rad > 0.0)) {  // infinity allowed: never corrected
+    throw ParameterError("backward Euler: the Newton trigger angle must be > 0 rad (infinity: off), got " +
+                         std::to_string(newton.trigger_angle_rad));
+  }
+  if (!(newton.energy_guard_angle_rad > 0.0)) {
+    throw ParameterError("backward Euler: the energy guard angle must be > 0 rad (infinity: off), got " +
+                         std::to_string(newton.energy_guard_angle_rad));
+  }
+  if (newton.max_iterations < 1 || newton.max_iterations > 100) {
+    throw ParameterError("backward Euler: Newton corrections must be 1 to 100 iterations, got " +
+                         std::to_string(newton.max_iterations));
+  }
+}
+
 BackwardEuler::BackwardEuler(std::unique_ptr<LinearSolver> solver, Settings settings)
     : m_solver(std::move(solver)), m_settings(settings) {
   if (!m_solver) throw std::invalid_argument("BackwardEuler needs a linear solver");
+  validate(m_settings.newton);
 }
 
 StepReport BackwardEuler::step(DynamicsModel& model, DynamicState& state, double step_size_s) {
@@ -85,10 +102,92 @@ StepReport BackwardEuler::step(DynamicsModel& model, DynamicState& state, double
     m_velocity_change.setZero();
     throw IntegrationError("backward Euler: the velocity update is not finite; state kept");
   }
-  state.velocity_m_per_s += m_velocity_change;
-  state.displacement_m += h * state.velocity_m_per_s;
+  m_end_velocity.noalias() = state.velocity_m_per_s + m_velocity_change;
+  m_end_displacement.noalias() = h * m_end_velocity;  // the step's increment
+  if (model.turns_further_than(m_end_displacement, m_settings.newton.trigger_angle_rad)) {
+    correct(model, state, h, report);
+    m_velocity_change.noalias() = m_end_velocity - state.velocity_m_per_s;
+    m_end_displacement.noalias() = h * m_end_velocity;
+  }
+  const bool guard = model.turns_further_than(m_end_displacement, m_settings.newton.energy_guard_angle_rad);
+  state.displacement_m += h * m_end_velocity;
+  if (guard) report.energy_guarded = guard_energy(model, state, h);
+  state.velocity_m_per_s = m_end_velocity;
   state.time_s += h;
   return report;
+}
+
+// Energy projection (Dinev et al. 2018): E = 1/2 v^T M v + potential. If the step's end holds more
+// than its start, v1 = mean + s (v1 - mean), mean the mass-weighted mean velocity (so the momentum
+// is kept), with s in [0, 1) chosen to bring E back; if the mean motion alone is too much, it is
+// scaled too. `state` has u1 and still v0.
+bool BackwardEuler::guard_energy(DynamicsModel& model, const DynamicState& state, double h) {
+  const Eigen::VectorXd& mass = model.mass_kg();
+  const Eigen::Index blocks = mass.size() / 3;
+  Eigen::Vector3d momentum = Eigen::Vector3d::Zero();
+  Eigen::Vector3d mass_sum = Eigen::Vector3d::Zero();
+  for (Eigen::Index r = 0; r < blocks; ++r) {
+    momentum += mass.segment<3>(3 * r).cwiseProduct(m_end_velocity.segment<3>(3 * r));
+    mass_sum += mass.segment<3>(3 * r);
+  }
+  const Eigen::Vector3d mean_velocity = momentum.cwiseQuotient(mass_sum.cwiseMax(1e-300));
+  const double kinetic_before_j = 0.5 * state.velocity_m_per_s.dot(mass.cwiseProduct(state.velocity_m_per_s));
+  m_end_displacement.noalias() = state.displacement_m - h * m_end_velocity;  // u0
+  const double before_j = kinetic_before_j + model.potential_energy_j(m_end_displacement);
+  const double potential_after_j = model.potential_energy_j(state.displacement_m);
+  if (!std::isfinite(before_j) || !std::isfinite(potential_after_j)) return false;  // the model cannot say
+  const double mean_kinetic_j = 0.5 * mass_sum.dot(mean_velocity.cwiseProduct(mean_velocity));
+  const double kinetic_after_j = 0.5 * m_end_velocity.dot(mass.cwiseProduct(m_end_velocity));
+  const double relative_kinetic_j = std::max(0.0, kinetic_after_j - mean_kinetic_j);
+  if (kinetic_after_j + potential_after_j <= before_j) return false;
+  const double room_j = std::max(0.0, before_j - potential_after_j);
+  if (room_j >= mean_kinetic_j && relative_kinetic_j > 0.0) {
+    const double s = std::sqrt((room_j - mean_kinetic_j) / relative_kinetic_j);
+    for (Eigen::Index r = 0; r < blocks; ++r) {
+      m_end_velocity.segment<3>(3 * r) = mean_velocity + s * (m_end_velocity.segment<3>(3 * r) - mean_velocity);
+    }
+  } else {
+    m_end_velocity *= kinetic_after_j > 0.0 ? std::sqrt(room_j / kinetic_after_j) : 0.0;
+  }
+  return true;
+}
+
+// Newton on the backward-Euler equations in v1 (u1 = u0 + h v1):
+//   r(v1) = h (f_ext - f_int(u1) - alpha M v1 - beta K(u1) v1) - M (v1 - v0) = 0,
+// with the matrix of the step, (1 + h alpha) M + (h beta + h^2) K(u1), taken at each iterate.
+void BackwardEuler::correct(DynamicsModel& model, const DynamicState& state, double h, StepReport& report) {
+  const int n = model.dof_count();
+  const RayleighDamping& damping = model.damping();
+  const Eigen::VectorXd& mass = model.mass_kg();
+  for (int iteration = 0; iteration < m_settings.newton.max_iterations; ++iteration) {
+    const auto assembly_start = std::chrono::steady_clock::now();
+    m_end_displacement.noalias() = state.displacement_m + h * m_end_velocity;
+    model.evaluate(m_end_displacement, m_internal_force_n, /*update_tangent=*/true);
+    const BlockSparseMatrix& stiffness = model.tangent();
+    stiffness.multiply(m_end_velocity, m_stiffness_times_velocity);
+    m_rhs.noalias() = h * (model.external_force_n() - m_internal_force_n -
+                           damping.mass_damping_per_s * mass.cwiseProduct(m_end_velocity) -
+                           damping.stiffness_damping_s * m_stiffness_times_velocity) -
+                      mass.cwiseProduct(m_end_velocity - state.velocity_m_per_s);
+    m_system_diagonal.noalias() = (1.0 + h * damping.mass_damping_per_s) * mass;
+    const ShiftedSystem system{&stiffness, h * damping.stiffness_damping_s + h * h, &m_system_diagonal};
+    report.assembly_s += seconds_since(assembly_start);
+
+    const auto solve_start = std::chrono::steady_clock::now();
+    m_correction.setZero(n);
+    try {
+      report.solve = m_solver->solve(system, m_rhs, m_correction);
+    } catch (const SolverError& error) {
+      throw IntegrationError(std::string("backward Euler: a Newton correction's solve failed: ") + error.what());
+    }
+    report.solve_s += seconds_since(solve_start);
+    report.linear_iterations += report.solve.iterations;
+    if (!m_correction.allFinite()) throw IntegrationError("backward Euler: a Newton correction is not finite; state kept");
+    m_end_velocity += m_correction;
+    ++report.newton_iterations;
+    m_end_displacement.noalias() = h * m_correction;
+    if (!model.turns_further_than(m_end_displacement, 0.01 * m_settings.newton.trigger_angle_rad)) break;
+  }
 }
 
 }  // namespace tissue

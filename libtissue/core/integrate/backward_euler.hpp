@@ -2,6 +2,9 @@
 // erratum of DESIGN section 4: the left side of eq. 4.20 holds the tangent K):
 //   (M + h D + h^2 K) dv = h (f_ext - f_int(u) - D v - h K v),   v += dv,   u += h v.
 // One linear solve per step; with D = alpha M + beta K the matrix is (1 + h alpha) M + (h beta + h^2) K.
+// A step that turns some element far (a free piece tumbling, a 0.1 s step) is corrected by Newton
+// iterations on the backward-Euler equations: the linearized step moves the nodes along straight
+// lines, which the co-rotational energy reads as stretch, and an exact solve then gains energy.
 #pragma once
 
 #include "core/integrate/integrator.hpp"
@@ -20,13 +23,27 @@ double undamped_tangent_fraction(double step_size_s, double stiffness_damping_s)
 
 class BackwardEuler final : public Integrator {
  public:
+  /// Newton corrections of a step that turns elements far.
+  struct NewtonCorrections {
+    /// Corrected when the linearized step turns some element further than this [rad]
+    /// (DynamicsModel::turns_further_than); infinity: never (the dissertation's step).
+    double trigger_angle_rad = 0.05;
+    /// Iterations at most; they stop once a correction turns no element further than 1% of the trigger.
+    int max_iterations = 5;
+    /// A step that turns some element further than this [rad] is energy-guarded: if its energy
+    /// (kinetic + DynamicsModel::potential_energy_j) ends above where it began, the velocity is
+    /// scaled down until it does not (energy projection, Dinev et al. 2018). Infinity: never.
+    double energy_guard_angle_rad = 0.005;
+  };
   struct Settings {
     /// Start each solve from the previous step's dv instead of zero (matters for iterative solvers).
     bool warm_start = false;
+    NewtonCorrections newton;
   };
   explicit BackwardEuler(std::unique_ptr<LinearSolver> solver) : BackwardEuler(std::move(solver), Settings{}) {}
   BackwardEuler(std::unique_ptr<LinearSolver> solver, Settings settings);
   StepReport step(DynamicsModel& model, DynamicState& state, double step_size_s) override;
+  [[nodiscard]] const Settings& settings() const { return m_settings; }
   [[nodiscard]] std::string_view name() const override { return "backward-euler"; }
   [[nodiscard]] const LinearSolver& solver() const { return *m_solver; }
   /// The last velocity change (the next solve's warm start when enabled).
@@ -44,6 +61,10 @@ class BackwardEuler final : public Integrator {
   }
 
  private:
+  void correct(DynamicsModel& model, const DynamicState& state, double h, StepReport& report);
+  // Scales v1 (m_end_velocity) so that the step's energy does not rise; true if it did.
+  bool guard_energy(DynamicsModel& model, const DynamicState& state, double h);
+
   std::unique_ptr<LinearSolver> m_solver;
   Settings m_settings;
   Eigen::VectorXd m_internal_force_n;
@@ -51,6 +72,12 @@ class BackwardEuler final : public Integrator {
   Eigen::VectorXd m_rhs;
   Eigen::VectorXd m_system_diagonal;
   Eigen::VectorXd m_velocity_change;  // kept: the warm start of the next solve
+  Eigen::VectorXd m_end_displacement;  // the Newton iterate u0 + h v1
+  Eigen::VectorXd m_end_velocity;      // v1
+  Eigen::VectorXd m_correction;        // a Newton correction of v1
 };
+
+/// Throws ParameterError unless the trigger angle is > 0 (infinity: off) and 1 to 100 iterations.
+void validate(const BackwardEuler::NewtonCorrections& newton);
 
 }  // namespace tissue

@@ -36,6 +36,7 @@ struct StepReport {
   int internal_steps = 1;       ///< steps the integrator took inside this one (IDA: error control)
   int newton_iterations = 0;    ///< nonlinear iterations (0 for the linearized backward Euler)
   long linear_iterations = 0;   ///< Krylov iterations of all solves (PCG, GMRES); 0 for direct solves
+  bool energy_guarded = false;  ///< backward Euler scaled the velocity down so the energy did not rise
 };
 
 /// Why an integrator must start afresh at its next step.

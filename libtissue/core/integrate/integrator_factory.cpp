@@ -51,12 +51,13 @@ void validate(const IntegratorSettings& settings) {
     throw ParameterError("unknown integrator kind");
   }
   validate(settings.ida);
+  validate(settings.newton);
 }
 
 std::unique_ptr<Integrator> make_integrator(const IntegratorSettings& settings, const SolverSettings& solver) {
   validate(settings);
   if (settings.kind == IntegratorKind::ida) return std::make_unique<IdaIntegrator>(settings.ida);
-  return std::make_unique<BackwardEuler>(make_linear_solver(solver), BackwardEuler::Settings{solver.warm_start});
+  return std::make_unique<BackwardEuler>(make_linear_solver(solver), BackwardEuler::Settings{solver.warm_start, settings.newton});
 }
 
 }  // namespace tissue

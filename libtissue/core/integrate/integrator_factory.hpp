@@ -2,6 +2,7 @@
 // chosen integrator with its linear solver. The one place a name maps to an integrator.
 #pragma once
 
+#include "core/integrate/backward_euler.hpp"
 #include "core/integrate/ida_integrator.hpp"
 #include "core/integrate/integrator.hpp"
 #include "core/solve/linear_solver.hpp"
@@ -37,6 +38,7 @@ IntegratorKind parse_integrator_kind(std::string_view name);
 struct IntegratorSettings {
   IntegratorKind kind = IntegratorKind::backward_euler;
   IdaSettings ida;  ///< used when kind is ida
+  BackwardEuler::NewtonCorrections newton;  ///< used when kind is backward_euler
 };
 
 /// Throws ParameterError for an invalid setting (IDA's are checked whatever the kind).

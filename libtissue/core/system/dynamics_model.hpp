@@ -8,6 +8,8 @@
 
 #include <Eigen/Core>
 
+#include <limits>
+
 namespace tissue {
 
 class DynamicsModel {
@@ -29,6 +31,18 @@ class DynamicsModel {
                         bool update_tangent) = 0;
   /// The tangent stiffness of the last evaluate() with update_tangent [N/m].
   [[nodiscard]] virtual const BlockSparseMatrix& tangent() const = 0;
+  /// True when the displacement increment `increment_m` (from the state of the last evaluate())
+  /// turns some element further than `angle_rad`: a step linearized there strays from the
+  /// nonlinear model by about the square of that angle. Conservative (it may answer true for a
+  /// large stretch too). A model with nothing to turn answers false.
+  [[nodiscard]] virtual bool turns_further_than(const Eigen::VectorXd& /*increment_m*/, double /*angle_rad*/) const {
+    return false;
+  }
+  /// The potential of the model's forces at u: elastic energy plus that of any spring to a fixed
+  /// target, minus f_ext . u [J]; NaN for a model that cannot say (its steps are not energy-guarded).
+  [[nodiscard]] virtual double potential_energy_j(const Eigen::VectorXd& /*displacement_m*/) {
+    return std::numeric_limits<double>::quiet_NaN();
+  }
 };
 
 /// The state an integrator advances: displacement and velocity per unknown, and time.
