@@ -11,6 +11,7 @@
 #include "scenario/scenario.hpp"
 #include "session/fmu_links.hpp"
 #include "session/session.hpp"
+#include "view/live_view.hpp"
 
 #include <CLI/CLI.hpp>
 
@@ -18,15 +19,20 @@
 #include "compare/mpi_distribution.hpp"
 #endif
 
+#include <signal.h>
 #include <unistd.h>
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <iomanip>
 #include <iostream>
+#include <random>
+#include <sstream>
 #include <vector>
 
 namespace {
@@ -44,8 +50,9 @@ std::filesystem::path default_fmu_dir() {
   return TISSUE_DEFAULT_FMU_DIR;
 }
 
-int run_command(const std::string& scenario_file, SessionOptions options, bool quiet) {
-  const Scenario scenario = load_scenario(scenario_file);
+int run_command(const std::string& scenario_file, SessionOptions options, bool quiet, double duration_s) {
+  Scenario scenario = load_scenario(scenario_file);
+  if (duration_s > 0.0) scenario.duration_s = duration_s;
   if (!quiet) {
     std::cout << "tissue-host: " << scenario.name << " (" << scenario.duration_s << " s, "
               << (options.offline ? "offline" : "real time") << ")";
@@ -154,6 +161,20 @@ int compare_command(CompareOptions options, bool quiet, int& argc, char**& argv)
   return 0;
 }
 
+// Ctrl-C ends a real-time run early (its outputs written); a second one ends the process.
+std::atomic<bool> g_stop_requested{false};
+extern "C" void on_interrupt(int /*signal*/) {
+  if (g_stop_requested.exchange(true)) std::_Exit(130);
+}
+
+// 128 random bits as hex: the access token of a view that listens beyond loopback.
+std::string random_token() {
+  std::random_device random;
+  std::ostringstream out;
+  for (int k = 0; k < 4; ++k) out << std::hex << std::setw(8) << std::setfill('0') << random();
+  return out.str();
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -176,6 +197,20 @@ int main(int argc, char** argv) {
   run->add_option("--fmu-dir", fmu_dir, "Where Tissue.fmu and HapticLoop.fmu are (default: the build's fmus/)");
   run->add_flag("--no-rt-priority", no_priority, "Do not ask for SCHED_FIFO");
   run->add_flag("--quiet,-q", quiet, "Only the summary");
+  bool view = false, mouse = false;
+  int view_port = 8080;
+  std::string view_listen = "127.0.0.1";
+  run->add_flag("--view", view, "Serve a live 3D view of the session in the browser (http://127.0.0.1:PORT/)");
+  run->add_option("--port", view_port, "The live view's port (0: any free port)")
+      ->check(CLI::Range(0, 65535))
+      ->capture_default_str();
+  run->add_option("--view-listen", view_listen,
+                  "The address the view listens on; any but loopback needs the access token printed at start")
+      ->capture_default_str();
+  run->add_flag("--mouse", mouse, "The view's mouse and keyboard drive the tool (implies --view)");
+  double run_duration_s = 0.0;
+  run->add_option("--duration", run_duration_s, "Run for this many seconds instead of the scenario's duration")
+      ->check(CLI::PositiveNumber);
 
   std::string fmu_file;
   CLI::App* info = app.add_subcommand("info", "Describe an FMU (variables, capabilities)");
@@ -220,7 +255,33 @@ int main(int argc, char** argv) {
       options.fmu_dir = fmus;
       options.realtime_priority = !no_priority;
       if (!record_file.empty()) options.record = record_file;
-      return run_command(scenario_file, options, quiet);
+      if (!options.offline) {
+        options.stop = &g_stop_requested;
+        struct sigaction action {};
+        action.sa_handler = on_interrupt;
+        sigemptyset(&action.sa_mask);
+        sigaction(SIGINT, &action, nullptr);
+      }
+      if (view || mouse) {
+        SessionOptions::View v;
+        v.address = view_listen;
+        v.port = static_cast<std::uint16_t>(view_port);
+        v.static_dir = TISSUE_VIEW_DIR;
+        if (!is_loopback_address(view_listen)) {
+          v.token = random_token();
+          std::cerr << "tissue-host: WARNING: the live view listens on " << view_listen
+                    << ", not on loopback: anyone who can reach it and has the token can watch";
+          if (mouse) std::cerr << " and move the tool";
+          std::cerr << ". Token: " << v.token << "\n";
+        }
+        options.view = v;
+        options.browser_device = mouse;
+        options.view_started = [address = v.address, token = v.token](std::uint16_t port) {
+          std::cout << "live view: http://" << (address == "0.0.0.0" ? "127.0.0.1" : address) << ":" << port << "/"
+                    << (token.empty() ? "" : "?token=" + token) << std::endl;
+        };
+      }
+      return run_command(scenario_file, options, quiet, run_duration_s);
     }
     if (info->parsed()) return info_command(fmu_file);
     if (bench->parsed()) return bench_command(fmus, bench_steps, bench_step_s);

@@ -246,8 +246,10 @@ Scenario parse_scenario(const std::string& text, const std::filesystem::path& or
     }
     if (const toml::node* n = device->get("allow_remote"))
       s.device.udp_allow_remote = r.boolean(*n, "device.allow_remote");
+  } else if (kind_name == "browser") {
+    s.device.kind = DeviceKind::browser;  // the live view's mouse and keyboard (--view)
   } else {
-    r.fail("device.kind", "must be \"scripted\", \"replay\" or \"udp\", got \"" + kind_name + "\"");
+    r.fail("device.kind", "must be \"scripted\", \"replay\", \"udp\" or \"browser\", got \"" + kind_name + "\"");
   }
 
   if (const toml::table* realtime = root["realtime"].as_table()) {

@@ -41,7 +41,7 @@ struct Waypoint {
   ToolMode mode = ToolMode::none;
 };
 
-enum class DeviceKind { scripted, replay, udp };
+enum class DeviceKind { scripted, replay, udp, browser };
 
 struct DeviceConfig {
   DeviceKind kind = DeviceKind::scripted;

@@ -12,6 +12,6 @@ add_library(tissue::host_session ALIAS tissue_host_session)
 target_include_directories(tissue_host_session PUBLIC ${PROJECT_SOURCE_DIR}/host)
 target_compile_features(tissue_host_session PUBLIC cxx_std_20)
 target_link_libraries(tissue_host_session
-  PUBLIC tissue::fmi_importer tissue::host_device tissue::host_output Threads::Threads
+  PUBLIC tissue::fmi_importer tissue::host_device tissue::host_output tissue::host_view Threads::Threads
   PRIVATE tomlplusplus::tomlplusplus tissue::warnings)
 

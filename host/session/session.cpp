@@ -1,6 +1,9 @@
 // run_session (see session.hpp).
 #include "session/session.hpp"
 
+#include "view/browser_device.hpp"
+#include "view/live_view.hpp"
+
 #include "device/replay_device.hpp"
 #include "device/scripted_device.hpp"
 #include "device/udp_device.hpp"
@@ -166,6 +169,13 @@ std::unique_ptr<Device> make_device(const DeviceConfig& config, const TissueLink
     }
     case DeviceKind::replay:
       return std::make_unique<ReplayDevice>(config.replay_file);
+    case DeviceKind::browser: {
+      // Start put away, 2 cm above the middle of the body's top.
+      DevicePose pose;
+      for (std::size_t a = 0; a < 2; ++a) pose.position_m[a] = 0.5 * (tissue.rest_lower()[a] + tissue.rest_upper()[a]);
+      pose.position_m[2] = tissue.rest_upper()[2] + 0.02;
+      return std::make_unique<BrowserDevice>(pose);
+    }
     case DeviceKind::udp: {
       UdpDeviceSettings settings;
       settings.bind_address = config.udp_address;
@@ -175,6 +185,12 @@ std::unique_ptr<Device> make_device(const DeviceConfig& config, const TissueLink
     }
   }
   throw ScenarioError("device: unknown kind");
+}
+
+DeviceConfig browser_config() {
+  DeviceConfig config;
+  config.kind = DeviceKind::browser;
+  return config;
 }
 
 std::filesystem::path fmu_path(const std::filesystem::path& configured, const std::filesystem::path& fmu_dir,
@@ -258,7 +274,28 @@ class Session {
         m_haptic_fmu(fmu_path(scenario.haptic_fmu, options.fmu_dir, "HapticLoop.fmu")),
         m_tissue(m_tissue_fmu, with_overrides(scenario.tissue_parameters, options.tissue_parameter_overrides)),
         m_haptic(m_haptic_fmu, scenario.haptic_parameters),
-        m_device(make_device(scenario.device, m_tissue)) {
+        m_device(make_device(options.browser_device ? browser_config() : scenario.device, m_tissue)) {
+    if (options.view && options.offline) throw ScenarioError("--view: the live view needs a real-time run, not --offline");
+    if (!options.view && dynamic_cast<BrowserDevice*>(m_device.get()) != nullptr) {
+      throw ScenarioError("device: the browser device needs the live view (--view)");
+    }
+    if (options.view) {
+      const SessionOptions::View& view = *options.view;
+      if (!is_loopback_address(view.address) && view.token.empty()) {
+        throw ScenarioError("--view-listen " + view.address + ": a non-loopback address needs an access token");
+      }
+      LiveViewSettings settings;
+      settings.address = view.address;
+      settings.port = view.port;
+      settings.token = view.token;
+      settings.static_dir = view.static_dir;
+      settings.scenario = scenario.name;
+      settings.rest_lower = m_tissue.rest_lower();
+      settings.rest_upper = m_tissue.rest_upper();
+      settings.device_max_force_n = m_haptic.max_force_n();
+      settings.blade_length_m = m_tissue.blade_length_m();
+      m_view = std::make_unique<LiveView>(settings, dynamic_cast<BrowserDevice*>(m_device.get()));
+    }
     m_period_s = scenario.haptic_period_s;
     m_slot_s = scenario.tissue_step_s;
     m_ticks_per_slot = static_cast<std::uint64_t>(std::llround(m_slot_s / m_period_s));
@@ -383,6 +420,10 @@ class Session {
     return m_options.write_outputs && m_scenario.frame_rate_hz > 0.0 && time_s + 1e-9 >= m_next_frame_s;
   }
   void capture_frame(SurfaceFrame& frame, double time_s) {
+    fill_frame(frame, time_s);
+    m_next_frame_s += 1.0 / m_scenario.frame_rate_hz;
+  }
+  void fill_frame(SurfaceFrame& frame, double time_s) {
     m_tissue.read_surface(frame);
     frame.time_s = time_s;
     const ToolCommand& tool = m_tool_command.read_buffer();
@@ -397,7 +438,6 @@ class Session {
     frame.contact_active = m_last_outputs.contact_active;
     frame.contact_point_m = m_last_outputs.contact_point_m;
     frame.force_n = m_last_outputs.contact_force_n;
-    m_next_frame_s += 1.0 / m_scenario.frame_rate_hz;
     while (m_next_frame_s <= time_s + 1e-9) m_next_frame_s += 1.0 / m_scenario.frame_rate_hz;
   }
 
@@ -445,6 +485,28 @@ class Session {
   }
 
   void run_realtime() {
+    if (m_view) {
+      m_view->start();
+      if (m_options.view_started) m_options.view_started(m_view->port());
+    }
+    run_realtime_threads();
+    if (m_view) {
+      m_view->stop();
+      const LiveViewCounters c = m_view->counters();
+      m_summary.view = true;
+      m_summary.view_connections = c.server.connections;
+      m_summary.view_frames_sent = c.server.frames_sent;
+      m_summary.view_frames_skipped = c.server.frames_skipped;
+      m_summary.view_messages = c.server.messages;
+      m_summary.view_malformed = c.device.malformed + c.server.binary;
+      m_summary.view_oversized = c.server.oversized;
+      m_summary.view_flood = c.server.flood;
+      m_summary.view_out_of_order = c.device.out_of_order;
+      m_summary.view_withdrawals = c.device.watchdog_trips;
+    }
+  }
+
+  void run_realtime_threads() {
     FramePipe pipe(8);
     pipe.prepare([&](SurfaceFrame& frame) { m_tissue.reserve(frame); });
     std::atomic<int> ready{0};
@@ -454,6 +516,7 @@ class Session {
     Nanoseconds start = 0;
     Nanoseconds haptic_end = 0;
     Priority haptic_priority, dynamics_priority;
+    std::optional<std::uint64_t> stopped_at;  // haptic thread's, read after the join
 
     std::thread haptic([&] {
       if (m_options.realtime_priority) haptic_priority = try_fifo_priority(80);
@@ -463,6 +526,10 @@ class Session {
       Nanoseconds previous_wake = 0;
       if (m_options.haptic_thread_started) m_options.haptic_thread_started();
       for (std::uint64_t n = 0; n < m_ticks; ++n) {
+        if (m_options.stop != nullptr && m_options.stop->load(std::memory_order_relaxed)) {
+          stopped_at = n;  // asked to end early (Ctrl-C): the summary covers the ticks run
+          break;
+        }
         const Nanoseconds deadline = start + static_cast<Nanoseconds>(n) * period;
         sleep_until_ns(deadline);
         const Nanoseconds woke = now_ns();
@@ -478,6 +545,10 @@ class Session {
         previous_wake = woke;
         haptic_tick(n);
         if (now_ns() > deadline + period) ++m_summary.deadline_misses;  // the next tick starts late
+        if (m_view) {
+          m_view->record_tick(m_periods_s.empty() ? 0.0 : m_periods_s.back(), m_summary.deadline_misses,
+                              m_rows[n].force_n);
+        }
         ticks_done.store(n + 1, std::memory_order_relaxed);
       }
       haptic_end = now_ns();
@@ -503,6 +574,13 @@ class Session {
         TissueOutputs& out = m_tissue_sample.write_buffer();
         out = result;
         m_tissue_sample.publish();
+        if (m_view) {
+          m_view->publish_tissue(TissueLive{tissue_time_s, m_step_s.empty() ? 0.0 : m_step_s.back(), result.cut_tets});
+          if (m_view->frame_due()) {
+            fill_frame(m_view->frame_buffer(), tissue_time_s);
+            m_view->publish_frame();
+          }
+        }
         if (frame_due(tissue_time_s)) {
           if (auto frame = pipe.take_free()) {
             capture_frame(*frame, tissue_time_s);
@@ -575,6 +653,10 @@ class Session {
     }
     haptic.join();
     dynamics.join();
+    if (stopped_at) {
+      m_ticks = *stopped_at;
+      m_rows.resize(m_ticks);
+    }
     m_summary.wall_time_s = static_cast<double>(haptic_end - start) * 1e-9;
     drain(std::chrono::milliseconds(0));
     if (writer) {
@@ -639,6 +721,7 @@ class Session {
   TissueLink m_tissue;
   HapticLink m_haptic;
   std::unique_ptr<Device> m_device;
+  std::unique_ptr<LiveView> m_view;          // --view
   double m_period_s = 0.001, m_slot_s = 0.01;
   std::uint64_t m_ticks_per_slot = 10, m_ticks = 0;
   // Exchanged between the threads (dissertation 5.1.3).
@@ -713,6 +796,12 @@ std::string SessionSummary::to_json() const {
       << ", \"stale\": " << device.stale << ", \"watchdog_trips\": " << device.watchdog_trips << "},\n";
   out << "  \"frames_written\": " << frames_written << ",\n";
   out << "  \"frames_dropped\": " << frames_dropped << ",\n";
+  if (view) {
+    out << "  \"view\": {\"connections\": " << view_connections << ", \"frames_sent\": " << view_frames_sent
+        << ", \"frames_skipped\": " << view_frames_skipped << ", \"messages\": " << view_messages
+        << ", \"malformed\": " << view_malformed << ", \"oversized\": " << view_oversized << ", \"flood\": " << view_flood
+        << ", \"out_of_order\": " << view_out_of_order << ", \"withdrawals\": " << view_withdrawals << "},\n";
+  }
   out << "  \"realtime_priority\": " << (realtime_priority ? "true" : "false") << ",\n";
   out << "  \"realtime_priority_note\": " << json_string(realtime_priority_note) << ",\n";
   out << "  \"first_error\": " << json_string(first_error) << "\n";

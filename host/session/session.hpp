@@ -10,6 +10,7 @@
 #include "importer/fmu3_instance.hpp"
 #include "scenario/scenario.hpp"
 
+#include <atomic>
 #include <cstdint>
 #include <filesystem>
 #include <functional>
@@ -59,6 +60,20 @@ struct SessionOptions {
   TissueStepObserver* tissue_observer = nullptr;
   /// false: no files at all (no folder, log, frames, PNG, summary), for runs measured in memory.
   bool write_outputs = true;
+  /// The live view in the browser (real time only; VIEW_PROTOCOL.md).
+  struct View {
+    std::string address = "127.0.0.1";
+    std::uint16_t port = 8080;  ///< 0: any free port
+    std::string token;          ///< required when the address is not loopback
+    std::filesystem::path static_dir;
+  };
+  std::optional<View> view;
+  /// The mouse and keyboard of the view's pages drive the tool (replaces the scenario's device).
+  bool browser_device = false;
+  /// Called once the view listens, with its port (e.g. to print the address).
+  std::function<void(std::uint16_t port)> view_started;
+  /// Set (e.g. by Ctrl-C) to end a real-time run early; the outputs cover the time run.
+  const std::atomic<bool>* stop = nullptr;
 };
 
 struct Percentiles {
@@ -86,6 +101,9 @@ struct SessionSummary {
   std::string device_name;
   DeviceCounters device;
   std::uint64_t frames_written = 0, frames_dropped = 0;
+  bool view = false;
+  std::uint64_t view_connections = 0, view_frames_sent = 0, view_frames_skipped = 0, view_messages = 0,
+                view_malformed = 0, view_oversized = 0, view_flood = 0, view_out_of_order = 0, view_withdrawals = 0;
   bool realtime_priority = false;
   std::string realtime_priority_note;
   std::string first_error;

@@ -12,3 +12,8 @@ add_executable(tissue-udp-sender
   ${CMAKE_CURRENT_LIST_DIR}/udp_sender.cpp)
 target_include_directories(tissue-udp-sender PRIVATE ${CMAKE_CURRENT_LIST_DIR})
 target_link_libraries(tissue-udp-sender PRIVATE tissue::host_device tissue::warnings)
+
+# The live view's pieces (pose messages, frames, the browser device) without a browser.
+add_executable(test_view ${CMAKE_CURRENT_LIST_DIR}/test_view.cpp)
+target_link_libraries(test_view PRIVATE tissue::host_view GTest::gtest GTest::gtest_main tissue::warnings)
+gtest_discover_tests(test_view PROPERTIES LABELS "host" DISCOVERY_TIMEOUT 60)

@@ -187,5 +187,19 @@ TEST(ScenarioFile, AParameterTheFmuRefusesStopsTheSessionBeforeItStarts) {
   EXPECT_THROW((void)run_offline(scenario, fresh_dir("refused")), ScenarioError);
 }
 
+TEST(ScenarioFile, TheMouseNeedsTheLiveViewInRealTime) {
+  // frog_mouse.toml's device is the browser: offline, or without --view, nothing could drive it.
+  const Scenario scenario = load_scenario(SCENARIOS / "frog_mouse.toml");
+  EXPECT_EQ(scenario.device.kind, DeviceKind::browser);
+  EXPECT_THROW((void)run_offline(scenario, fresh_dir("mouse_offline")), ScenarioError);
+  SessionOptions options;
+  options.output_dir = fresh_dir("mouse_viewless");
+  options.fmu_dir = FMUS;
+  options.realtime_priority = false;
+  EXPECT_THROW((void)run_session(scenario, options), ScenarioError);
+  options.view = SessionOptions::View{"0.0.0.0", 0, "", ""};  // beyond loopback without a token
+  EXPECT_THROW((void)run_session(scenario, options), ScenarioError);
+}
+
 }  // namespace
 }  // namespace tissue::host

@@ -1,0 +1,51 @@
+// view_frame.cpp - see view_frame.hpp and VIEW_PROTOCOL.md for the layout.
+#include "view/view_frame.hpp"
+
+#include <bit>
+#include <cstring>
+
+namespace tissue::host {
+namespace {
+
+static_assert(std::endian::native == std::endian::little, "the view frame is written as little-endian memory");
+
+template <class T>
+void put(std::string& out, T value) {
+  char bytes[sizeof(T)];
+  std::memcpy(bytes, &value, sizeof(T));
+  out.append(bytes, sizeof(T));
+}
+
+void put_vector(std::string& out, const std::array<double, 3>& v) {
+  for (const double x : v) put(out, static_cast<float>(x));
+}
+
+}  // namespace
+
+void encode_view_frame(const SurfaceFrame& frame, const ViewOverlay& overlay, bool with_triangles, std::string& out) {
+  validate_surface_frame(frame, "view frame");
+  out.clear();
+  put(out, VIEW_FRAME_MAGIC);
+  put(out, static_cast<std::uint32_t>(with_triangles ? 1 : 0));
+  put(out, static_cast<std::uint32_t>(frame.vertex_count()));
+  put(out, static_cast<std::uint32_t>(frame.triangle_count()));
+  put(out, static_cast<std::uint32_t>(frame.mesh_triangle_count));
+  put(out, overlay.topology_revision);
+  put(out, frame.time_s);
+  // The tool is shown where it is even when put away (mode none), if its points are finite.
+  const bool tool_finite = detail::all_finite(frame.tool_tip_m.data(), 3) && detail::all_finite(frame.tool_handle_m.data(), 3);
+  put_vector(out, tool_finite ? frame.tool_tip_m : std::array<double, 3>{});
+  put_vector(out, tool_finite ? frame.tool_handle_m : std::array<double, 3>{});
+  put(out, static_cast<std::uint32_t>(frame.has_tool ? frame.tool_mode : 0));
+  put(out, static_cast<std::uint32_t>(frame.contact_active ? 1 : 0));
+  put_vector(out, frame.contact_point_m);
+  put_vector(out, overlay.device_force_n);
+  put(out, static_cast<float>(overlay.device_max_force_n));
+  put(out, std::uint32_t{0});
+  for (const double x : frame.positions_m) put(out, static_cast<float>(x));
+  if (with_triangles) {
+    for (const std::uint32_t index : frame.triangles) put(out, index);
+  }
+}
+
+}  // namespace tissue::host

@@ -1,0 +1,155 @@
+// The live view's pieces without a browser (label "host"): the page's pose message accepted only
+// in its exact shape; the binary frame laid out as VIEW_PROTOCOL.md says; the browser device
+// turning messages into the hand's pose, dropping out-of-order ones, withdrawing the tool when
+// its page disconnects or goes silent. The browser end to end: tests/host/browser/.
+#include "view/browser_device.hpp"
+#include "view/pose_message.hpp"
+#include "view/view_frame.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cstring>
+#include <string>
+#include <thread>
+
+namespace tissue::host {
+namespace {
+
+const std::string GOOD =
+    R"({"type":"pose","seq":7,"position_m":[0.01,-0.02,0.03],"orientation_wxyz":[2,0,0,0],"mode":"scalpel"})";
+
+TEST(ViewPoseMessage, AcceptsTheDocumentedShape) {
+  const auto message = parse_pose_message(GOOD);
+  ASSERT_TRUE(message.has_value());
+  EXPECT_EQ(message->seq, 7u);
+  EXPECT_DOUBLE_EQ(message->pose.position_m[1], -0.02);
+  EXPECT_DOUBLE_EQ(message->pose.orientation_wxyz[0], 1.0);  // normalized
+  EXPECT_EQ(message->pose.mode, ToolMode::scalpel);
+}
+
+TEST(ViewPoseMessage, RefusesEverythingElseWithAReason) {
+  const std::vector<std::string> bad = {
+      "",
+      "{",
+      GOOD.substr(0, GOOD.size() / 2),  // truncated
+      "[1,2,3]",
+      R"({"type":"nonsense"})",
+      R"({"type":"pose","seq":-1,"position_m":[0,0,0],"orientation_wxyz":[1,0,0,0],"mode":"probe"})",
+      R"({"type":"pose","seq":1.5,"position_m":[0,0,0],"orientation_wxyz":[1,0,0,0],"mode":"probe"})",
+      R"({"type":"pose","seq":1,"position_m":[0,0],"orientation_wxyz":[1,0,0,0],"mode":"probe"})",
+      R"({"type":"pose","seq":1,"position_m":["0","0","0"],"orientation_wxyz":[1,0,0,0],"mode":"probe"})",
+      R"({"type":"pose","seq":1,"position_m":[0,0,1e999],"orientation_wxyz":[1,0,0,0],"mode":"probe"})",
+      R"({"type":"pose","seq":1,"position_m":[0,0,0],"orientation_wxyz":[0,0,0,0],"mode":"probe"})",
+      R"({"type":"pose","seq":1,"position_m":[0,0,0],"orientation_wxyz":[1,0,0,0],"mode":"laser"})",
+      R"({"type":"pose","seq":1,"position_m":[0,0,0],"orientation_wxyz":[1,0,0,0]})",
+      std::string(600, ' ') + GOOD,  // oversized, even if valid inside
+  };
+  for (const std::string& text : bad) {
+    std::string why;
+    EXPECT_FALSE(parse_pose_message(text, &why).has_value()) << text;
+    EXPECT_FALSE(why.empty()) << text;
+  }
+}
+
+TEST(ViewFrame, HeaderPositionsAndTrianglesAsDocumented) {
+  SurfaceFrame frame;
+  frame.time_s = 1.25;
+  frame.positions_m = {0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1};
+  frame.triangles = {0, 2, 1, 0, 1, 3};
+  frame.mesh_triangle_count = 1;
+  frame.has_tool = true;
+  frame.tool_mode = 2;
+  frame.tool_tip_m = {0.1, 0.2, 0.3};
+  frame.tool_handle_m = {0.1, 0.2, 0.4};
+  frame.contact_active = true;
+  frame.contact_point_m = {0.5, 0.5, 0.5};
+  ViewOverlay overlay{{1.0, -2.0, 3.0}, 3.3, 4};
+  std::string plain, full;
+  encode_view_frame(frame, overlay, false, plain);
+  encode_view_frame(frame, overlay, true, full);
+  EXPECT_EQ(plain.size(), VIEW_FRAME_HEADER_BYTES + 4 * 12);
+  EXPECT_EQ(full.size(), VIEW_FRAME_HEADER_BYTES + 4 * 12 + 4 * 6);
+  const auto u32 = [&full](std::size_t offset) {
+    std::uint32_t v;
+    std::memcpy(&v, full.data() + offset, 4);
+    return v;
+  };
+  const auto f32 = [&full](std::size_t offset) {
+    float v;
+    std::memcpy(&v, full.data() + offset, 4);
+    return v;
+  };
+  double time;
+  std::memcpy(&time, full.data() + 24, 8);
+  EXPECT_EQ(u32(0), VIEW_FRAME_MAGIC);
+  EXPECT_EQ(u32(4), 1u);
+  EXPECT_EQ(u32(8), 4u);
+  EXPECT_EQ(u32(12), 2u);
+  EXPECT_EQ(u32(16), 1u);
+  EXPECT_EQ(u32(20), 4u);
+  EXPECT_EQ(time, 1.25);
+  EXPECT_FLOAT_EQ(f32(32 + 8), 0.3f);   // tip z
+  EXPECT_FLOAT_EQ(f32(44 + 8), 0.4f);   // handle z
+  EXPECT_EQ(u32(56), 2u);               // scalpel
+  EXPECT_EQ(u32(60), 1u);               // contact
+  EXPECT_FLOAT_EQ(f32(76 + 4), -2.0f);  // device force y
+  EXPECT_FLOAT_EQ(f32(88), 3.3f);
+  EXPECT_FLOAT_EQ(f32(96 + 4 * 3), 1.0f);                  // vertex 1 x
+  EXPECT_EQ(u32(96 + 4 * 12 + 4 * 5), 3u);                 // the last index
+  EXPECT_EQ(std::memcmp(&plain[4], "\0\0\0\0", 4), 0);     // no triangles flag
+  frame.positions_m[4] = std::nan("");
+  EXPECT_THROW(encode_view_frame(frame, overlay, false, plain), OutputError);
+}
+
+DevicePose away() {
+  DevicePose pose;
+  pose.position_m = {0.0, 0.0, 0.1};
+  return pose;
+}
+
+std::string pose_text(std::uint64_t seq, double x, const char* mode) {
+  return R"({"type":"pose","seq":)" + std::to_string(seq) + R"(,"position_m":[)" + std::to_string(x) +
+         R"(,0,0],"orientation_wxyz":[1,0,0,0],"mode":")" + mode + "\"}";
+}
+
+TEST(BrowserDevice, MessagesBecomeTheHandsPose) {
+  BrowserDevice device(away());
+  EXPECT_EQ(device.read(0.0).mode, ToolMode::none);
+  device.handle_message(1, pose_text(1, 0.01, "probe"));
+  DevicePose pose = device.read(0.001);
+  EXPECT_EQ(pose.mode, ToolMode::probe);
+  EXPECT_DOUBLE_EQ(pose.position_m[0], 0.01);
+  device.handle_message(1, pose_text(1, 0.02, "probe"));  // replayed seq
+  device.handle_message(1, pose_text(0, 0.03, "probe"));  // older
+  device.handle_message(1, "{\"type\":\"pose\"");         // truncated
+  EXPECT_DOUBLE_EQ(device.read(0.002).position_m[0], 0.01);
+  device.handle_message(2, pose_text(0, 0.04, "scalpel"));  // another page: its own sequence
+  EXPECT_EQ(device.read(0.003).mode, ToolMode::scalpel);
+  const DeviceCounters c = device.counters();
+  EXPECT_EQ(c.received, 5u);
+  EXPECT_EQ(c.accepted, 2u);
+  EXPECT_EQ(c.out_of_order, 2u);
+  EXPECT_EQ(c.malformed, 1u);
+}
+
+TEST(BrowserDevice, ADisconnectedOrSilentPageWithdrawsTheTool) {
+  BrowserDevice device(away());
+  device.handle_message(3, pose_text(1, 0.01, "scalpel"));
+  device.connection_closed(4);  // not the page holding the hand
+  EXPECT_EQ(device.read(0.0).mode, ToolMode::scalpel);
+  device.connection_closed(3);
+  DevicePose pose = device.read(0.001);
+  EXPECT_EQ(pose.mode, ToolMode::none);
+  EXPECT_DOUBLE_EQ(pose.position_m[0], 0.01);  // the pose is kept
+
+  device.handle_message(5, pose_text(1, 0.02, "probe"));
+  device.tick();
+  EXPECT_EQ(device.read(0.002).mode, ToolMode::probe);  // not silent yet
+  std::this_thread::sleep_for(BrowserDevice::SILENCE_LIMIT + std::chrono::milliseconds(100));
+  device.tick();
+  EXPECT_EQ(device.read(0.003).mode, ToolMode::none);
+  EXPECT_EQ(device.counters().watchdog_trips, 2u);
+}
+
+}  // namespace
+}  // namespace tissue::host
