@@ -35,6 +35,7 @@ def main():
     parser.add_argument("--mode", choices=["cut", "bad", "rate"], default="cut")
     parser.add_argument("--viewers", type=int, default=1)
     parser.add_argument("--seconds", type=float, default=4.0, help="how long the pages watch")
+    parser.add_argument("--rt", action="store_true", help="let the host ask for SCHED_FIFO (benchmarks)")
     args = parser.parse_args()
 
     out = pathlib.Path(args.out)
@@ -42,7 +43,7 @@ def main():
     duration = args.seconds + 14.0  # page start-up, the drag and the watch, with room
     host = subprocess.Popen(
         [args.host, "run", args.scenario, "--mouse", "--port", "0", "--output", str(out / "session"),
-         "--no-rt-priority", "--duration", str(duration)],
+         "--duration", str(duration)] + ([] if args.rt else ["--no-rt-priority"]),
         stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
     lines = []
     url = None
