@@ -277,7 +277,7 @@ class Session {
         m_device(make_device(options.browser_device ? browser_config() : scenario.device, m_tissue)) {
     if (options.view && options.offline) throw ScenarioError("--view: the live view needs a real-time run, not --offline");
     if (!options.view && dynamic_cast<BrowserDevice*>(m_device.get()) != nullptr) {
-      throw ScenarioError("device: the browser device needs the live view (--view)");
+      throw ScenarioError("device: the browser device needs the live view (run with --view or --mouse)");
     }
     if (options.view) {
       const SessionOptions::View& view = *options.view;

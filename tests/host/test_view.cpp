@@ -5,10 +5,18 @@
 #include "view/browser_device.hpp"
 #include "view/pose_message.hpp"
 #include "view/view_frame.hpp"
+#include "view/view_server.hpp"
+
+#include <arpa/inet.h>
+#include <netinet/in.h>
+#include <sys/socket.h>
+#include <unistd.h>
 
 #include <gtest/gtest.h>
 
 #include <cstring>
+#include <filesystem>
+#include <fstream>
 #include <string>
 #include <thread>
 
@@ -149,6 +157,57 @@ TEST(BrowserDevice, ADisconnectedOrSilentPageWithdrawsTheTool) {
   device.tick();
   EXPECT_EQ(device.read(0.003).mode, ToolMode::none);
   EXPECT_EQ(device.counters().watchdog_trips, 2u);
+}
+
+// One HTTP GET over loopback; the status line of the answer ("" if none).
+std::string http_status(std::uint16_t port, const std::string& resource) {
+  const int fd = socket(AF_INET, SOCK_STREAM, 0);
+  sockaddr_in address{};
+  address.sin_family = AF_INET;
+  address.sin_port = htons(port);
+  address.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  if (connect(fd, reinterpret_cast<sockaddr*>(&address), sizeof(address)) != 0) {
+    close(fd);
+    return "";
+  }
+  const std::string request = "GET " + resource + " HTTP/1.1\r\nHost: 127.0.0.1\r\nConnection: close\r\n\r\n";
+  (void)send(fd, request.data(), request.size(), 0);
+  std::string answer;
+  char buffer[4096];
+  for (ssize_t n; (n = recv(fd, buffer, sizeof(buffer), 0)) > 0;) answer.append(buffer, static_cast<std::size_t>(n));
+  close(fd);
+  return answer.substr(0, answer.find("\r\n"));
+}
+
+TEST(ViewServer, ATokenIsRequiredWhenSetAndOnlyTheFourFilesAreServed) {
+  const std::filesystem::path dir = std::filesystem::temp_directory_path() / "tissue_test_view_static";
+  std::filesystem::create_directories(dir);
+  for (const char* name : {"index.html", "view.js", "three.module.js", "OrbitControls.js"}) {
+    std::ofstream(dir / name) << "// " << name << "\n";
+  }
+  ViewServerSettings settings;
+  settings.port = 0;
+  settings.token = "s3cret";
+  settings.static_dir = dir.string();
+  ViewServer server(settings, [](std::uint64_t, const std::string&) {}, [](std::uint64_t) {}, [] {});
+  server.start();
+  ASSERT_GT(server.port(), 0);
+  EXPECT_EQ(http_status(server.port(), "/"), "HTTP/1.1 403 Forbidden");
+  EXPECT_EQ(http_status(server.port(), "/?token=wrong"), "HTTP/1.1 403 Forbidden");
+  EXPECT_EQ(http_status(server.port(), "/?token=s3cret"), "HTTP/1.1 200 OK");
+  EXPECT_EQ(http_status(server.port(), "/view.js?token=s3cret"), "HTTP/1.1 200 OK");
+  EXPECT_EQ(http_status(server.port(), "/../etc/passwd?token=s3cret"), "HTTP/1.1 404 Not Found");
+  EXPECT_EQ(server.counters().refused, 2u);
+  ViewServerSettings same_port = settings;
+  same_port.port = server.port();
+  ViewServer second(same_port, [](std::uint64_t, const std::string&) {}, [](std::uint64_t) {}, [] {});
+  EXPECT_THROW(second.start(), ViewServerError);  // the port is taken: a clear error, not a crash
+  server.stop();
+
+  ViewServerSettings missing = settings;
+  missing.static_dir = (dir / "nowhere").string();
+  ViewServer without_files(missing, [](std::uint64_t, const std::string&) {}, [](std::uint64_t) {}, [] {});
+  EXPECT_THROW(without_files.start(), ViewServerError);
 }
 
 }  // namespace
