@@ -5,6 +5,7 @@
 #include "core/mesh/mesh_io.hpp"
 #include "resources/default_mesh.hpp"
 
+#include <limits>
 #include <sstream>
 
 namespace tissue::apps {
@@ -53,6 +54,8 @@ void add_scene_options(CLI::App& app, SceneOptions& options) {
   app.add_option("--stiffness-damping", options.damping.stiffness_damping_s, "Rayleigh beta [s]")
       ->capture_default_str();
   app.add_option("--gravity", options.gravity, "Gravity GX,GY,GZ [m/s^2]")->capture_default_str();
+  app.add_flag("!--no-large-turn-protection", options.large_turn_protection,
+               "Backward Euler without Newton corrections and energy guard (the linearized step alone, as Vega's)");
 }
 
 Scene make_scene(const SceneOptions& options) {
@@ -67,6 +70,10 @@ Scene make_scene(const SceneOptions& options) {
   settings.solver.warm_start = options.warm_start;
   settings.body.material = options.material;
   settings.body.damping = options.damping;
+  if (!options.large_turn_protection) {
+    settings.integrator.newton.trigger_angle_rad = std::numeric_limits<double>::infinity();
+    settings.integrator.newton.energy_guard_angle_rad = std::numeric_limits<double>::infinity();
+  }
   settings.body.gravity_m_per_s2 = parse_vector(options.gravity, "--gravity");
   settings.body.fixed_vertices = options.fixed_bou.empty() ? vertices_at_minimum(scene.mesh, 0, options.fixed_fraction)
                                                            : read_bou(options.fixed_bou, scene.mesh.vertex_count());

@@ -23,6 +23,9 @@ struct SceneOptions {
   Material material{1.0e5, 0.4, 1000.0};
   RayleighDamping damping{0.0, 0.0};
   std::string gravity = "0,-9.81,0";
+  /// Backward Euler's large-turn protections (BackwardEuler::NewtonCorrections); "off" = the
+  /// dissertation's (and Vega's) linearized step alone.
+  bool large_turn_protection = true;
 };
 
 /// Registers the options on `app` (values are written into `options` when parsed).

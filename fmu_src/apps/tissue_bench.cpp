@@ -25,6 +25,7 @@ int run(const tissue::apps::SceneOptions& options) {
   tissue::Tissue tissue(std::move(scene.mesh), scene.settings);
 
   std::vector<double> step_ms, assembly_ms, solve_ms, iterations;
+  long newton_iterations = 0, guarded_steps = 0;
   step_ms.reserve(static_cast<size_t>(options.steps));
   assembly_ms.reserve(static_cast<size_t>(options.steps));
   solve_ms.reserve(static_cast<size_t>(options.steps));
@@ -36,6 +37,8 @@ int run(const tissue::apps::SceneOptions& options) {
     assembly_ms.push_back(1e3 * report.assembly_s);
     solve_ms.push_back(1e3 * report.solve_s);
     iterations.push_back(report.solve.iterations);
+    newton_iterations += report.newton_iterations;
+    guarded_steps += report.energy_guarded ? 1 : 0;
   }
   const Summary iteration_summary = tissue::apps::summarize(iterations);
   std::printf("{\n");
@@ -50,6 +53,8 @@ int run(const tissue::apps::SceneOptions& options) {
   std::printf("  \"assembly_ms\": %.6g,\n", tissue::apps::summarize(assembly_ms).median);
   std::printf("  \"solve_ms\": %.6g,\n", tissue::apps::summarize(solve_ms).median);
   std::printf("  \"cg_iterations\": {\"mean\": %.4g, \"max\": %.0f},\n", iteration_summary.mean, iteration_summary.max);
+  std::printf("  \"large_turn_protection\": %s,\n", options.large_turn_protection ? "true" : "false");
+  std::printf("  \"newton_iterations\": %ld,\n  \"energy_guarded_steps\": %ld,\n", newton_iterations, guarded_steps);
   std::printf("  \"final_kinetic_energy_J\": %.6g\n", tissue.kinetic_energy_j());
   std::printf("}\n");
   return 0;
