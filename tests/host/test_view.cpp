@@ -210,5 +210,53 @@ TEST(ViewServer, ATokenIsRequiredWhenSetAndOnlyTheFourFilesAreServed) {
   EXPECT_THROW(without_files.start(), ViewServerError);
 }
 
+TEST(ViewServer, APageThatDoesNotReadIsSkippedNotWaitedFor) {
+  // A client completes the WebSocket handshake and then never reads. Publishing goes on at once
+  // (publish_frame only swaps pointers); the server skips the page once more than
+  // max_buffered_bytes wait unsent, and counts it.
+  const std::filesystem::path dir = std::filesystem::temp_directory_path() / "tissue_test_view_static";
+  std::filesystem::create_directories(dir);
+  for (const char* name : {"index.html", "view.js", "three.module.js", "OrbitControls.js"}) {
+    std::ofstream(dir / name) << "// " << name << "\n";
+  }
+  ViewServerSettings settings;
+  settings.port = 0;
+  settings.static_dir = dir.string();
+  ViewServer server(settings, [](std::uint64_t, const std::string&) {}, [](std::uint64_t) {}, [] {});
+  server.start();
+  const int fd = socket(AF_INET, SOCK_STREAM, 0);
+  int small = 4096;  // a small receive buffer: the backlog builds in the server, not in the kernel
+  setsockopt(fd, SOL_SOCKET, SO_RCVBUF, &small, sizeof(small));
+  sockaddr_in address{};
+  address.sin_family = AF_INET;
+  address.sin_port = htons(server.port());
+  address.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  ASSERT_EQ(connect(fd, reinterpret_cast<sockaddr*>(&address), sizeof(address)), 0);
+  const std::string upgrade =
+      "GET /ws HTTP/1.1\r\nHost: 127.0.0.1\r\nUpgrade: websocket\r\nConnection: Upgrade\r\n"
+      "Sec-WebSocket-Key: dGhlIHNhbXBsZSBub25jZQ==\r\nSec-WebSocket-Version: 13\r\n\r\n";
+  ASSERT_EQ(send(fd, upgrade.data(), upgrade.size(), 0), static_cast<ssize_t>(upgrade.size()));
+  char reply[256];
+  ASSERT_GT(recv(fd, reply, sizeof(reply) - 1, 0), 0);  // "HTTP/1.1 101 Switching Protocols"...
+  reply[12] = '\0';
+  EXPECT_STREQ(reply, "HTTP/1.1 101");
+  for (int k = 0; k < 200 && server.counters().open == 0; ++k) std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  ASSERT_EQ(server.counters().open, 1u);
+
+  const auto frame = std::make_shared<const std::string>(1024 * 1024, 'x');  // beyond any kernel buffer within a few
+  for (int k = 0; k < 100; ++k) {
+    server.publish_frame(frame, frame, 1);
+    std::this_thread::sleep_for(std::chrono::milliseconds(2));  // let the server's thread flush
+  }
+  for (int k = 0; k < 100 && server.counters().frames_sent + server.counters().frames_skipped < 100; ++k) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  const ViewServerCounters c = server.counters();
+  EXPECT_GT(c.frames_skipped, 0u);
+  EXPECT_LT(c.frames_sent, 100u);
+  close(fd);
+  server.stop();
+}
+
 }  // namespace
 }  // namespace tissue::host
