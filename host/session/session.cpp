@@ -860,8 +860,13 @@ void print_summary(std::ostream& out, const SessionSummary& s, const std::filesy
       << s.max_device_force_n << " N (device maximum " << s.device_max_force_n << " N), passivity dissipated "
       << s.passivity_dissipated_j << " J, NaN " << (s.nan_detected ? "DETECTED" : "none") << "\n";
   if (!s.first_error.empty()) out << "  first error: " << s.first_error << "\n";
-  out << "  outputs in " << output_dir.string() << ": summary.json, log.csv, surface.pvd (frames/, " << s.frames_written
-      << " frames, open in ParaView), final.png\n";
+  out << "  outputs in " << output_dir.string() << ": summary.json, log.csv, ";
+  if (s.frames_written > 0) {
+    out << "surface.pvd (frames/, " << s.frames_written << " frames, open in ParaView), ";
+  } else {
+    out << "no frames (the scenario's frame_rate is 0), ";
+  }
+  out << "final.png\n";
 }
 
 }  // namespace tissue::host

@@ -12,11 +12,14 @@
 #include <gtest/gtest.h>
 
 #include <array>
+#include <atomic>
+#include <chrono>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
 #include <string>
+#include <thread>
 #include <vector>
 
 namespace tissue::host {
@@ -152,6 +155,36 @@ TEST(RealTime, BothThreadsRunAShortSessionOnTheirDeadlines) {
   std::size_t rows = 0;
   while (std::getline(log, line)) ++rows;
   EXPECT_EQ(rows, 601u);
+}
+
+TEST(RealTime, AStopRequestEndsTheRunWithItsOutputs) {
+  // Ctrl-C in tissue-host sets SessionOptions::stop: the run ends at the next tick, and the
+  // summary, the log and the picture cover the ticks run.
+  Scenario scenario = load_scenario(SCENARIOS / "poke_frog.toml");
+  scenario.duration_s = 30.0;
+  SessionOptions options;
+  options.output_dir = fresh_dir("stopped");
+  options.fmu_dir = FMUS;
+  options.realtime_priority = false;
+  std::atomic<bool> stop{false};
+  options.stop = &stop;
+  std::thread stopper([&stop] {
+    std::this_thread::sleep_for(std::chrono::milliseconds(700));
+    stop.store(true);
+  });
+  const SessionSummary s = run_session(scenario, options);
+  stopper.join();
+  EXPECT_GT(s.haptic_ticks, 100u);
+  EXPECT_LT(s.haptic_ticks, 10000u);  // not the 30000 of the scenario
+  EXPECT_LT(s.wall_time_s, 10.0);
+  EXPECT_EQ(s.tissue_errors, 0u);
+  std::ifstream log(options.output_dir / "log.csv");
+  std::string line;
+  std::size_t rows = 0;
+  while (std::getline(log, line)) ++rows;
+  EXPECT_EQ(rows, s.haptic_ticks + 1);
+  EXPECT_TRUE(std::filesystem::exists(options.output_dir / "summary.json"));
+  EXPECT_TRUE(std::filesystem::exists(options.output_dir / "final.png"));
 }
 
 TEST(ScenarioFile, MistakesAreRefusedNamingTheKey) {
