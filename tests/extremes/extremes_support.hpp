@@ -22,6 +22,7 @@
 #include "core/tissue.hpp"
 
 #include <Eigen/Core>
+#include <gtest/gtest.h>
 
 #include <array>
 #include <chrono>
@@ -29,6 +30,7 @@
 #include <memory>
 #include <string>
 #include <string_view>
+#include <tuple>
 #include <vector>
 
 namespace tissue::extremes {
@@ -217,3 +219,19 @@ std::string markdown_table();
 std::string case_test_name(const std::vector<Case>& cases, int index, Method method);
 
 }  // namespace tissue::extremes
+
+/// One parameterized suite `Extremes/<suite>.EndsBoundedOrRefused/<case id>_<method id>` over the
+/// cases `cases_function()` returns and every method, each test a run_case(). Use inside
+/// namespace tissue::extremes.
+#define TISSUE_EXTREMES_SUITE(suite, cases_function)                                                         \
+  class suite : public ::testing::TestWithParam<std::tuple<int, Method>> {};                                   \
+  TEST_P(suite, EndsBoundedOrRefused) {                                                                        \
+    run_case(cases_function()[static_cast<size_t>(std::get<0>(GetParam()))], std::get<1>(GetParam()));        \
+  }                                                                                                            \
+  INSTANTIATE_TEST_SUITE_P(Extremes, suite,                                                                    \
+                           ::testing::Combine(::testing::Range(0, static_cast<int>(cases_function().size())), \
+                                              ::testing::ValuesIn(ALL_METHODS)),                               \
+                           [](const auto& param_info) {                                                        \
+                             return case_test_name(cases_function(), std::get<0>(param_info.param),            \
+                                                   std::get<1>(param_info.param));                             \
+                           })

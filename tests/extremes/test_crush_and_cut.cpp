@@ -210,18 +210,7 @@ const std::vector<Case>& cases() {
   return all;
 }
 
-class CrushAndCut : public ::testing::TestWithParam<std::tuple<int, Method>> {};
-
-TEST_P(CrushAndCut, EndsBoundedOrRefused) {
-  run_case(cases()[static_cast<size_t>(std::get<0>(GetParam()))], std::get<1>(GetParam()));
-}
-
-INSTANTIATE_TEST_SUITE_P(Extremes, CrushAndCut,
-                         ::testing::Combine(::testing::Range(0, static_cast<int>(cases().size())),
-                                            ::testing::ValuesIn(ALL_METHODS)),
-                         [](const auto& param_info) {
-                           return case_test_name(cases(), std::get<0>(param_info.param), std::get<1>(param_info.param));
-                         });
+TISSUE_EXTREMES_SUITE(CrushAndCut, cases);
 
 }  // namespace
 }  // namespace tissue::extremes
