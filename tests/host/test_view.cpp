@@ -159,17 +159,26 @@ TEST(BrowserDevice, ADisconnectedOrSilentPageWithdrawsTheTool) {
   EXPECT_EQ(device.counters().watchdog_trips, 2u);
 }
 
-// One HTTP GET over loopback; the status line of the answer ("" if none).
-std::string http_status(std::uint16_t port, const std::string& resource) {
+// A TCP connection to the loopback port, with a receive buffer of `receive_buffer_bytes` when > 0;
+// -1 if it cannot connect.
+int connect_loopback(std::uint16_t port, int receive_buffer_bytes = 0) {
   const int fd = socket(AF_INET, SOCK_STREAM, 0);
+  if (receive_buffer_bytes > 0) setsockopt(fd, SOL_SOCKET, SO_RCVBUF, &receive_buffer_bytes, sizeof(receive_buffer_bytes));
   sockaddr_in address{};
   address.sin_family = AF_INET;
   address.sin_port = htons(port);
   address.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
   if (connect(fd, reinterpret_cast<sockaddr*>(&address), sizeof(address)) != 0) {
     close(fd);
-    return "";
+    return -1;
   }
+  return fd;
+}
+
+// One HTTP GET over loopback; the status line of the answer ("" if none).
+std::string http_status(std::uint16_t port, const std::string& resource) {
+  const int fd = connect_loopback(port);
+  if (fd < 0) return "";
   const std::string request = "GET " + resource + " HTTP/1.1\r\nHost: 127.0.0.1\r\nConnection: close\r\n\r\n";
   (void)send(fd, request.data(), request.size(), 0);
   std::string answer;
@@ -179,7 +188,8 @@ std::string http_status(std::uint16_t port, const std::string& resource) {
   return answer.substr(0, answer.find("\r\n"));
 }
 
-TEST(ViewServer, ATokenIsRequiredWhenSetAndOnlyTheFourFilesAreServed) {
+// Server settings on any free loopback port, with the four static files as small stand-ins.
+ViewServerSettings test_server_settings() {
   const std::filesystem::path dir = std::filesystem::temp_directory_path() / "tissue_test_view_static";
   std::filesystem::create_directories(dir);
   for (const char* name : {"index.html", "view.js", "three.module.js", "OrbitControls.js"}) {
@@ -187,8 +197,13 @@ TEST(ViewServer, ATokenIsRequiredWhenSetAndOnlyTheFourFilesAreServed) {
   }
   ViewServerSettings settings;
   settings.port = 0;
-  settings.token = "s3cret";
   settings.static_dir = dir.string();
+  return settings;
+}
+
+TEST(ViewServer, ATokenIsRequiredWhenSetAndOnlyTheFourFilesAreServed) {
+  ViewServerSettings settings = test_server_settings();
+  settings.token = "s3cret";
   ViewServer server(settings, [](std::uint64_t, const std::string&) {}, [](std::uint64_t) {}, [] {});
   server.start();
   ASSERT_GT(server.port(), 0);
@@ -205,7 +220,7 @@ TEST(ViewServer, ATokenIsRequiredWhenSetAndOnlyTheFourFilesAreServed) {
   server.stop();
 
   ViewServerSettings missing = settings;
-  missing.static_dir = (dir / "nowhere").string();
+  missing.static_dir += "/nowhere";
   ViewServer without_files(missing, [](std::uint64_t, const std::string&) {}, [](std::uint64_t) {}, [] {});
   EXPECT_THROW(without_files.start(), ViewServerError);
 }
@@ -214,24 +229,11 @@ TEST(ViewServer, APageThatDoesNotReadIsSkippedNotWaitedFor) {
   // A client completes the WebSocket handshake and then never reads. Publishing goes on at once
   // (publish_frame only swaps pointers); the server skips the page once more than
   // max_buffered_bytes wait unsent, and counts it.
-  const std::filesystem::path dir = std::filesystem::temp_directory_path() / "tissue_test_view_static";
-  std::filesystem::create_directories(dir);
-  for (const char* name : {"index.html", "view.js", "three.module.js", "OrbitControls.js"}) {
-    std::ofstream(dir / name) << "// " << name << "\n";
-  }
-  ViewServerSettings settings;
-  settings.port = 0;
-  settings.static_dir = dir.string();
-  ViewServer server(settings, [](std::uint64_t, const std::string&) {}, [](std::uint64_t) {}, [] {});
+  ViewServer server(test_server_settings(), [](std::uint64_t, const std::string&) {}, [](std::uint64_t) {}, [] {});
   server.start();
-  const int fd = socket(AF_INET, SOCK_STREAM, 0);
-  int small = 4096;  // a small receive buffer: the backlog builds in the server, not in the kernel
-  setsockopt(fd, SOL_SOCKET, SO_RCVBUF, &small, sizeof(small));
-  sockaddr_in address{};
-  address.sin_family = AF_INET;
-  address.sin_port = htons(server.port());
-  address.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-  ASSERT_EQ(connect(fd, reinterpret_cast<sockaddr*>(&address), sizeof(address)), 0);
+  // A small receive buffer: the backlog builds in the server, not in the kernel.
+  const int fd = connect_loopback(server.port(), 4096);
+  ASSERT_GE(fd, 0);
   const std::string upgrade =
       "GET /ws HTTP/1.1\r\nHost: 127.0.0.1\r\nUpgrade: websocket\r\nConnection: Upgrade\r\n"
       "Sec-WebSocket-Key: dGhlIHNhbXBsZSBub25jZQ==\r\nSec-WebSocket-Version: 13\r\n\r\n";
