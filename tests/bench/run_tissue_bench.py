@@ -30,14 +30,16 @@ CASES = [
 SETTINGS = [("real-time", 1e-3, 10), ("strict", 1e-6, 10000)]
 
 
-def run(bench, mesh, bou, dt, material, tolerance, iterations, steps, solver="pcg"):
-    command = [str(bench), "--mesh", str(mesh), "--steps", str(steps), "--dt", str(dt), "--solver", solver,
+def run(bench, mesh, bou, dt, material, tolerance, iterations, steps, solver="pcg", extra=(), prefix=(), env=None):
+    """One tissue-bench run; its JSON. `extra`: more options; `prefix`: e.g. a taskset command."""
+    command = list(prefix) + [str(bench), "--mesh", str(mesh), "--steps", str(steps), "--dt", str(dt), "--solver", solver,
                "--tolerance", str(tolerance), "--max-iterations", str(iterations),
                "--young", str(material["young"]), "--poisson", str(material["poisson"]),
                "--density", str(material["density"])]
     if bou is not None:
         command += ["--fixed", str(bou)]
-    output = subprocess.run(command, check=True, capture_output=True, text=True).stdout
+    command += list(extra)
+    output = subprocess.run(command, check=True, capture_output=True, text=True, env=env).stdout
     return json.loads(output)
 
 

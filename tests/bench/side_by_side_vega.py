@@ -15,7 +15,6 @@ Usage: tests/bench/side_by_side_vega.py [--vega PATH] [--bench PATH] [--rounds 5
 Uses only the Python standard library.
 """
 import argparse
-import json
 import os
 import pathlib
 import platform
@@ -25,15 +24,15 @@ import statistics
 import subprocess
 import sys
 
-ROOT = pathlib.Path(__file__).resolve().parents[2]
-VEGA_MESHES = ROOT.parent / "shared" / "meshes" / "vega"
+from run_tissue_bench import BRIDGE, DISSERTATION, ROOT, VEGA as VEGA_MESHES, run as run_tissue_bench
+
 PEERS = pathlib.Path(os.environ.get("PEERS", ROOT.parent / "peers"))
 
-# name, mesh, fixed .bou (None: minimum x), dt [s], E [Pa], nu, rho [kg/m^3] (issue 12's table)
+# name, mesh, fixed .bou (None: minimum x), dt [s], material (issue 12's table)
 CASES = [
     ("simpleBridge (Vega), 12.8k tets", VEGA_MESHES / "simpleBridge" / "simpleBridge-ic_128_0.15_.1.veg",
-     VEGA_MESHES / "simpleBridge" / "simpleBridge.bou", 0.07, 1e5, 0.33, 100.0),
-    ("frog (ours), 2450 tets", ROOT / "meshes" / "frog.veg", None, 0.01, 1e5, 0.4, 1000.0),
+     VEGA_MESHES / "simpleBridge" / "simpleBridge.bou", 0.07, BRIDGE),
+    ("frog (ours), 2450 tets", ROOT / "meshes" / "frog.veg", None, 0.01, DISSERTATION),
 ]
 SETTING = (1e-3, 10)  # the real-time setting: eps, iteration cap
 
@@ -48,11 +47,11 @@ def pinned(command):
 
 
 def run_vega(vega, case, steps):
-    name, mesh, bou, dt, young, poisson, density = case
+    name, mesh, bou, dt, material = case
     eps, cap = SETTING
-    command = [str(vega), "--mesh", str(mesh), "--E", str(young), "--nu", str(poisson), "--rho", str(density),
-               "--dt", str(dt), "--steps", str(steps), "--cg-eps", str(eps), "--cg-max", str(cap),
-               "--alpha", "0", "--beta", "0"]
+    command = [str(vega), "--mesh", str(mesh), "--E", str(material["young"]), "--nu", str(material["poisson"]),
+               "--rho", str(material["density"]), "--dt", str(dt), "--steps", str(steps), "--cg-eps", str(eps),
+               "--cg-max", str(cap), "--alpha", "0", "--beta", "0"]
     if bou is not None:
         command += ["--fix-bou", str(bou)]
     out = subprocess.run(pinned(command), check=True, capture_output=True, text=True, env=environment()).stdout
@@ -63,17 +62,11 @@ def run_vega(vega, case, steps):
 
 
 def run_ours(bench, case, steps, protection):
-    name, mesh, bou, dt, young, poisson, density = case
+    name, mesh, bou, dt, material = case
     eps, cap = SETTING
-    command = [str(bench), "--mesh", str(mesh), "--steps", str(steps), "--dt", str(dt), "--solver", "pcg",
-               "--tolerance", str(eps), "--max-iterations", str(cap), "--young", str(young), "--poisson",
-               str(poisson), "--density", str(density), "--mass-damping", "0", "--stiffness-damping", "0"]
-    if bou is not None:
-        command += ["--fixed", str(bou)]
-    if not protection:
-        command.append("--no-large-turn-protection")
-    out = subprocess.run(pinned(command), check=True, capture_output=True, text=True, env=environment()).stdout
-    result = json.loads(out)
+    extra = ["--mass-damping", "0", "--stiffness-damping", "0"] + ([] if protection else ["--no-large-turn-protection"])
+    result = run_tissue_bench(bench, mesh, bou, dt, material, eps, cap, steps, extra=extra, prefix=pinned([]),
+                              env=environment())
     return result["ms_per_step"]["median"], result
 
 
