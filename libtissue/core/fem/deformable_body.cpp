@@ -132,9 +132,9 @@ double turn_angle_rad(const TetRest& rest, const Eigen::Matrix3d& rotation, cons
 
 }  // namespace
 
-bool DeformableBody::turns_further_than(const Eigen::VectorXd& increment_m, double angle_rad) const {
+double DeformableBody::largest_turn_rad(const Eigen::VectorXd& increment_m, double resolution_rad) const {
   if (increment_m.size() != dof_count()) {
-    throw std::invalid_argument("turns_further_than: the increment has " + std::to_string(increment_m.size()) +
+    throw std::invalid_argument("largest_turn_rad: the increment has " + std::to_string(increment_m.size()) +
                                 " entries, the body " + std::to_string(dof_count()) + " unknowns");
   }
   double largest_block_m = 0.0;
@@ -143,17 +143,19 @@ bool DeformableBody::turns_further_than(const Eigen::VectorXd& increment_m, doub
   }
   // G = sum_{i>0} (dp_i - dp_0) grad(phi_i)^T with |dp_i - dp_0| <= 4 max|block| (a part's vertex
   // moves by du + Psi da), so the angle is at most |G| <= 12 max|block| max|grad(phi)|.
-  if (12.0 * largest_block_m * m_largest_shape_gradient_per_m <= angle_rad) return false;
+  const double bound_rad = 12.0 * largest_block_m * m_largest_shape_gradient_per_m;
+  if (bound_rad <= resolution_rad) return bound_rad;
   const auto vertex_increment = [&](int vertex) -> Eigen::Vector3d {
     const int row = vertex_block_row(vertex);
     return row < 0 ? Eigen::Vector3d::Zero() : Eigen::Vector3d(increment_m.segment<3>(3 * row));
   };
+  double largest_rad = 0.0;
   TetPositions increment;
   for (int t = 0; t < m_mesh.tet_count(); ++t) {
     if (m_cut_index[static_cast<size_t>(t)] >= 0) continue;
     const Tet& tet = m_mesh.tets[static_cast<size_t>(t)];
     for (size_t j = 0; j < 4; ++j) increment[j] = vertex_increment(tet[j]);
-    if (turn_angle_rad(m_elasticity.rest(t), m_elasticity.rotation(t), increment) > angle_rad) return true;
+    largest_rad = std::max(largest_rad, turn_angle_rad(m_elasticity.rest(t), m_elasticity.rotation(t), increment));
   }
   for (int k = 0; k < m_xfem.cut_tet_count(); ++k) {
     const CutTet& cut_tet = m_xfem.cut_tets()[static_cast<size_t>(k)];
@@ -163,10 +165,10 @@ bool DeformableBody::turns_further_than(const Eigen::VectorXd& increment_m, doub
                        cut_tet.shift(static_cast<int>(j), part) *
                            Eigen::Vector3d(increment_m.segment<3>(3 * cut_tet.enriched_row[j]));
       }
-      if (turn_angle_rad(m_xfem.rest(k), m_xfem.rotation(k, part), increment) > angle_rad) return true;
+      largest_rad = std::max(largest_rad, turn_angle_rad(m_xfem.rest(k), m_xfem.rotation(k, part), increment));
     }
   }
-  return false;
+  return largest_rad;
 }
 
 double DeformableBody::total_mass_kg() const {

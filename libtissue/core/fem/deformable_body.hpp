@@ -78,9 +78,9 @@ class DeformableBody final : public DynamicsModel {
   void evaluate(const Eigen::VectorXd& displacement_m, Eigen::VectorXd& internal_force_n, bool update_tangent) override;
   [[nodiscard]] const BlockSparseMatrix& tangent() const override { return m_tangent; }
   /// First a bound, O(unknowns): no element (or cut part) turns further than 12 max|block of the
-  /// increment| max|grad(phi)|; past it, each tet and part: |axial(skew(R^T G))| with G the
-  /// gradient of the increment and R its rotation at the last evaluate().
-  [[nodiscard]] bool turns_further_than(const Eigen::VectorXd& increment_m, double angle_rad) const override;
+  /// increment| max|grad(phi)|; past `resolution_rad`, each tet and part: |axial(skew(R^T G))| with
+  /// G the gradient of the increment and R its rotation at the last evaluate().
+  [[nodiscard]] double largest_turn_rad(const Eigen::VectorXd& increment_m, double resolution_rad) const override;
   /// elastic_energy_j + the point spring's k |x_p - target|^2 / 2 - f_ext . u. [J]
   [[nodiscard]] double potential_energy_j(const Eigen::VectorXd& displacement_m) override;
 

@@ -56,6 +56,15 @@ BackwardEuler::BackwardEuler(std::unique_ptr<LinearSolver> solver, Settings sett
   validate(m_settings.newton);
 }
 
+// (1 + h alpha) M + (h beta + h^2) K at the model's current tangent: the matrix of the step and of
+// its Newton corrections.
+ShiftedSystem BackwardEuler::step_system(const DynamicsModel& model, double h) {
+  const RayleighDamping& damping = model.damping();
+  m_system_diagonal.resize(model.dof_count());
+  m_system_diagonal.noalias() = (1.0 + h * damping.mass_damping_per_s) * model.mass_kg();
+  return ShiftedSystem{&model.tangent(), h * damping.stiffness_damping_s + h * h, &m_system_diagonal};
+}
+
 StepReport BackwardEuler::step(DynamicsModel& model, DynamicState& state, double step_size_s) {
   if (!(step_size_s > 0.0) || !std::isfinite(step_size_s)) {
     throw IntegrationError("step size must be finite and > 0 s, got " + std::to_string(step_size_s));
@@ -80,9 +89,7 @@ StepReport BackwardEuler::step(DynamicsModel& model, DynamicState& state, double
   m_rhs.noalias() = h * (model.external_force_n() - m_internal_force_n -
                          damping.mass_damping_per_s * mass.cwiseProduct(state.velocity_m_per_s) -
                          (damping.stiffness_damping_s + h) * m_stiffness_times_velocity);
-  m_system_diagonal.resize(n);
-  m_system_diagonal.noalias() = (1.0 + h * damping.mass_damping_per_s) * mass;
-  const ShiftedSystem system{&stiffness, h * damping.stiffness_damping_s + h * h, &m_system_diagonal};
+  const ShiftedSystem system = step_system(model, h);
   report.assembly_s = seconds_since(assembly_start);
 
   const auto solve_start = std::chrono::steady_clock::now();
@@ -104,12 +111,17 @@ StepReport BackwardEuler::step(DynamicsModel& model, DynamicState& state, double
   }
   m_end_velocity.noalias() = state.velocity_m_per_s + m_velocity_change;
   m_end_displacement.noalias() = h * m_end_velocity;  // the step's increment
-  if (model.turns_further_than(m_end_displacement, m_settings.newton.trigger_angle_rad)) {
+  // One pass answers both thresholds; a corrected step is measured again for the guard.
+  const NewtonCorrections& newton = m_settings.newton;
+  double turn_rad =
+      model.largest_turn_rad(m_end_displacement, std::min(newton.trigger_angle_rad, newton.energy_guard_angle_rad));
+  if (turn_rad > newton.trigger_angle_rad) {
     correct(model, state, h, report);
     m_velocity_change.noalias() = m_end_velocity - state.velocity_m_per_s;
     m_end_displacement.noalias() = h * m_end_velocity;
+    turn_rad = model.largest_turn_rad(m_end_displacement, newton.energy_guard_angle_rad);
   }
-  const bool guard = model.turns_further_than(m_end_displacement, m_settings.newton.energy_guard_angle_rad);
+  const bool guard = turn_rad > newton.energy_guard_angle_rad;
   state.displacement_m += h * m_end_velocity;
   if (guard) report.energy_guarded = guard_energy(model, state, h);
   state.velocity_m_per_s = m_end_velocity;
@@ -169,8 +181,7 @@ void BackwardEuler::correct(DynamicsModel& model, const DynamicState& state, dou
                            damping.mass_damping_per_s * mass.cwiseProduct(m_end_velocity) -
                            damping.stiffness_damping_s * m_stiffness_times_velocity) -
                       mass.cwiseProduct(m_end_velocity - state.velocity_m_per_s);
-    m_system_diagonal.noalias() = (1.0 + h * damping.mass_damping_per_s) * mass;
-    const ShiftedSystem system{&stiffness, h * damping.stiffness_damping_s + h * h, &m_system_diagonal};
+    const ShiftedSystem system = step_system(model, h);
     report.assembly_s += seconds_since(assembly_start);
 
     const auto solve_start = std::chrono::steady_clock::now();
@@ -186,7 +197,8 @@ void BackwardEuler::correct(DynamicsModel& model, const DynamicState& state, dou
     m_end_velocity += m_correction;
     ++report.newton_iterations;
     m_end_displacement.noalias() = h * m_correction;
-    if (!model.turns_further_than(m_end_displacement, 0.01 * m_settings.newton.trigger_angle_rad)) break;
+    const double converged_rad = 0.01 * m_settings.newton.trigger_angle_rad;
+    if (model.largest_turn_rad(m_end_displacement, converged_rad) <= converged_rad) break;
   }
 }
 

@@ -26,7 +26,7 @@ class BackwardEuler final : public Integrator {
   /// Newton corrections of a step that turns elements far.
   struct NewtonCorrections {
     /// Corrected when the linearized step turns some element further than this [rad]
-    /// (DynamicsModel::turns_further_than); infinity: never (the dissertation's step).
+    /// (DynamicsModel::largest_turn_rad); infinity: never (the dissertation's step).
     double trigger_angle_rad = 0.05;
     /// Iterations at most; they stop once a correction turns no element further than 1% of the trigger.
     int max_iterations = 5;
@@ -62,6 +62,7 @@ class BackwardEuler final : public Integrator {
 
  private:
   void correct(DynamicsModel& model, const DynamicState& state, double h, StepReport& report);
+  ShiftedSystem step_system(const DynamicsModel& model, double h);
   // Scales v1 (m_end_velocity) so that the step's energy does not rise; true if it did.
   bool guard_energy(DynamicsModel& model, const DynamicState& state, double h);
 

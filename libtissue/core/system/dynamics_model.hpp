@@ -31,12 +31,14 @@ class DynamicsModel {
                         bool update_tangent) = 0;
   /// The tangent stiffness of the last evaluate() with update_tangent [N/m].
   [[nodiscard]] virtual const BlockSparseMatrix& tangent() const = 0;
-  /// True when the displacement increment `increment_m` (from the state of the last evaluate())
-  /// turns some element further than `angle_rad`: a step linearized there strays from the
-  /// nonlinear model by about the square of that angle. Conservative (it may answer true for a
-  /// large stretch too). A model with nothing to turn answers false.
-  [[nodiscard]] virtual bool turns_further_than(const Eigen::VectorXd& /*increment_m*/, double /*angle_rad*/) const {
-    return false;
+  /// The largest angle [rad] the displacement increment `increment_m` (from the state of the last
+  /// evaluate()) turns an element: a step linearized there strays from the nonlinear model by about
+  /// its square. Where a cheap bound shows every element below `resolution_rad`, that bound may be
+  /// returned instead (so compare it with thresholds >= resolution_rad). 0 for a model with nothing
+  /// to turn.
+  [[nodiscard]] virtual double largest_turn_rad(const Eigen::VectorXd& /*increment_m*/,
+                                                double /*resolution_rad*/) const {
+    return 0.0;
   }
   /// The potential of the model's forces at u: elastic energy plus that of any spring to a fixed
   /// target, minus f_ext . u [J]; NaN for a model that cannot say (its steps are not energy-guarded).
