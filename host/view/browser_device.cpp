@@ -14,13 +14,7 @@ DevicePose BrowserDevice::read(double /*time_s*/) {
 }
 
 std::array<double, 3> BrowserDevice::write_force(double /*time_s*/, const std::array<double, 3>& force_n) {
-  for (std::size_t k = 0; k < 3; ++k) m_force[k].store(force_n[k], std::memory_order_relaxed);
   return force_n;
-}
-
-std::array<double, 3> BrowserDevice::last_force() const {
-  return {m_force[0].load(std::memory_order_relaxed), m_force[1].load(std::memory_order_relaxed),
-          m_force[2].load(std::memory_order_relaxed)};
 }
 
 DeviceCounters BrowserDevice::counters() const {

@@ -2,10 +2,11 @@
 // messages from the live view's pages become the hand's pose, read by the haptic thread through a
 // LatestValue (no lock, no allocation), the same Device interface as the UDP bridge. A page that
 // disconnects, or goes silent for 0.5 s while holding a tool, withdraws the tool (mode none, the
-// pose kept). The force written is kept for the view to show; there is no hand to push.
+// pose kept). There is no hand to push: the force written is returned as sent (the view shows the
+// haptic thread's force from its own figures, live_view.hpp).
 //
 // Threads: handle_message(), connection_closed() and tick() belong to the view server's thread;
-// read() and write_force() to the haptic thread; counters() and last_force() to any.
+// read() and write_force() to the haptic thread; counters() to any.
 #pragma once
 
 #include "device/device.hpp"
@@ -41,9 +42,6 @@ class BrowserDevice final : public Device {
   /// The silence watchdog (about every 100 ms).
   void tick();
 
-  /// The last force written by the haptic thread (for the view's frames).
-  [[nodiscard]] std::array<double, 3> last_force() const;
-
  private:
   void publish(const DevicePose& pose);
 
@@ -56,7 +54,6 @@ class BrowserDevice final : public Device {
   std::map<std::uint64_t, std::uint64_t> m_last_seq;  // per connection
   // Any thread.
   std::atomic<std::uint64_t> m_received{0}, m_accepted{0}, m_malformed{0}, m_out_of_order{0}, m_withdrawals{0};
-  std::array<std::atomic<double>, 3> m_force{};
 };
 
 }  // namespace tissue::host

@@ -138,12 +138,11 @@ void LiveView::run() {
         ++revision;
       }
       ViewOverlay overlay;
-      overlay.device_force_n = m_device != nullptr ? m_device->last_force() : m_last_haptic.device_force_n;
+      overlay.device_force_n = m_last_haptic.device_force_n;
       overlay.device_max_force_n = m_settings.device_max_force_n;
       overlay.topology_revision = revision;
       try {
-        encode_view_frame(frame, overlay, false, plain);
-        encode_view_frame(frame, overlay, true, with_triangles);
+        encode_view_frames(frame, overlay, plain, with_triangles);
         m_server.publish_frame(std::make_shared<const std::string>(plain),
                                std::make_shared<const std::string>(with_triangles), revision);
         ++m_frames_encoded;

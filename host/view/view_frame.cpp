@@ -20,13 +20,12 @@ void put_vector(std::string& out, const std::array<double, 3>& v) {
   for (const double x : v) put(out, static_cast<float>(x));
 }
 
-}  // namespace
-
-void encode_view_frame(const SurfaceFrame& frame, const ViewOverlay& overlay, bool with_triangles, std::string& out) {
+// The header and the positions, with the triangles flag clear.
+void encode_plain(const SurfaceFrame& frame, const ViewOverlay& overlay, std::string& out) {
   validate_surface_frame(frame, "view frame");
   out.clear();
   put(out, VIEW_FRAME_MAGIC);
-  put(out, static_cast<std::uint32_t>(with_triangles ? 1 : 0));
+  put(out, std::uint32_t{0});  // flags: no triangles
   put(out, static_cast<std::uint32_t>(frame.vertex_count()));
   put(out, static_cast<std::uint32_t>(frame.triangle_count()));
   put(out, static_cast<std::uint32_t>(frame.mesh_triangle_count));
@@ -43,9 +42,17 @@ void encode_view_frame(const SurfaceFrame& frame, const ViewOverlay& overlay, bo
   put(out, static_cast<float>(overlay.device_max_force_n));
   put(out, std::uint32_t{0});
   for (const double x : frame.positions_m) put(out, static_cast<float>(x));
-  if (with_triangles) {
-    for (const std::uint32_t index : frame.triangles) put(out, index);
-  }
+}
+
+}  // namespace
+
+void encode_view_frames(const SurfaceFrame& frame, const ViewOverlay& overlay, std::string& plain,
+                        std::string& with_triangles) {
+  encode_plain(frame, overlay, plain);
+  with_triangles = plain;
+  const std::uint32_t flags = 1;  // triangles included
+  std::memcpy(with_triangles.data() + 4, &flags, sizeof(flags));
+  for (const std::uint32_t index : frame.triangles) put(with_triangles, index);
 }
 
 }  // namespace tissue::host

@@ -20,8 +20,10 @@ struct ViewOverlay {
   std::uint32_t topology_revision = 0;  ///< changes when the triangles change
 };
 
-/// Encodes `frame` (validate_surface_frame() first: throws OutputError for an inconsistent one)
-/// into `out` (replaced; its capacity is kept), with the triangles when `with_triangles`.
-void encode_view_frame(const SurfaceFrame& frame, const ViewOverlay& overlay, bool with_triangles, std::string& out);
+/// One frame in both forms: `plain` without the triangles, `with_triangles` the same bytes with the
+/// flag set and the triangles appended (both replaced; their capacity is kept). Checks `frame`
+/// first (validate_surface_frame(): throws OutputError for an inconsistent one).
+void encode_view_frames(const SurfaceFrame& frame, const ViewOverlay& overlay, std::string& plain,
+                        std::string& with_triangles);
 
 }  // namespace tissue::host

@@ -73,8 +73,7 @@ TEST(ViewFrame, HeaderPositionsAndTrianglesAsDocumented) {
   frame.contact_point_m = {0.5, 0.5, 0.5};
   ViewOverlay overlay{{1.0, -2.0, 3.0}, 3.3, 4};
   std::string plain, full;
-  encode_view_frame(frame, overlay, false, plain);
-  encode_view_frame(frame, overlay, true, full);
+  encode_view_frames(frame, overlay, plain, full);
   EXPECT_EQ(plain.size(), VIEW_FRAME_HEADER_BYTES + 4 * 12);
   EXPECT_EQ(full.size(), VIEW_FRAME_HEADER_BYTES + 4 * 12 + 4 * 6);
   const auto u32 = [&full](std::size_t offset) {
@@ -106,7 +105,7 @@ TEST(ViewFrame, HeaderPositionsAndTrianglesAsDocumented) {
   EXPECT_EQ(u32(96 + 4 * 12 + 4 * 5), 3u);                 // the last index
   EXPECT_EQ(std::memcmp(&plain[4], "\0\0\0\0", 4), 0);     // no triangles flag
   frame.positions_m[4] = std::nan("");
-  EXPECT_THROW(encode_view_frame(frame, overlay, false, plain), OutputError);
+  EXPECT_THROW(encode_view_frames(frame, overlay, plain, full), OutputError);
 }
 
 DevicePose away() {
