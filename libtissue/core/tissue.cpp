@@ -63,6 +63,8 @@ std::uint64_t model_fingerprint_of(const TetMesh& mesh, const TissueSettings& se
   f.add_all(body.fixed_vertices);
   f.add(body.reserve.extra_row_fraction);  // field by field: a struct's padding bytes are not values
   f.add(body.reserve.row_capacity_factor);
+  f.add(body.rotation.max_iterations);
+  f.add(body.rotation.max_error_rad);
   f.add(settings.integrator.kind);
   const IdaSettings& ida = settings.integrator.ida;
   f.add(ida.relative_tolerance);

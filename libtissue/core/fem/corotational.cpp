@@ -21,8 +21,11 @@ TetPositions gather(const Eigen::VectorXd& positions_m, const Tet& tet) {
 
 }  // namespace
 
-CorotationalElasticity::CorotationalElasticity(const TetMesh& mesh, const Material& material)
-    : m_tets(mesh.tets), m_lame((validate(material), lame_parameters(material))) {
+CorotationalElasticity::CorotationalElasticity(const TetMesh& mesh, const Material& material,
+                                               const RotationSettings& rotation)
+    : m_tets(mesh.tets),
+      m_lame((validate(material), lame_parameters(material))),
+      m_rotation_settings((validate(rotation), rotation)) {
   m_rest.reserve(m_tets.size());
   for (const Tet& tet : m_tets) {
     TetPositions rest_positions;
@@ -63,28 +66,50 @@ void CorotationalElasticity::reset_rotations() {
 void CorotationalElasticity::evaluate(const Eigen::VectorXd& positions_m, Eigen::VectorXd& internal_forces_n,
                                       BlockSparseMatrix* tangent, const std::vector<TetSlots>* slots) {
   assert(tangent == nullptr || (slots != nullptr && slots->size() == m_tets.size()));
-  for (size_t t = 0; t < m_tets.size(); ++t) {
-    if (m_excluded[t] != 0) continue;
-    const Tet& tet = m_tets[t];
-    const TetRest& rest = m_rest[t];
-    const Eigen::Matrix3d f = deformation_gradient(rest, gather(positions_m, tet));
-    const Eigen::Matrix3d& r = m_rotations[t] = extract_rotation(f, m_warm_starts[t]);
+  // Tets go in batches of ROTATION_BATCH: their rotations are extracted side by side (SIMD lanes),
+  // then each tet's force and tangent blocks are added in turn.
+  std::array<size_t, ROTATION_BATCH> batch{};
+  std::array<Eigen::Matrix3d, ROTATION_BATCH> gradients;
+  std::array<Eigen::Quaterniond*, ROTATION_BATCH> warm_starts{};
+  std::array<Eigen::Matrix3d*, ROTATION_BATCH> rotations{};
+  size_t next = 0;
+  while (next < m_tets.size()) {
+    int count = 0;
+    for (; next < m_tets.size() && count < ROTATION_BATCH; ++next) {
+      if (m_excluded[next] != 0) continue;
+      const auto lane = static_cast<size_t>(count++);
+      batch[lane] = next;
+      gradients[lane] = deformation_gradient(m_rest[next], gather(positions_m, m_tets[next]));
+      warm_starts[lane] = &m_warm_starts[next];
+      rotations[lane] = &m_rotations[next];
+    }
+    extract_rotations(count, gradients.data(), warm_starts.data(), rotations.data(), m_rotation_settings);
+    for (int lane = 0; lane < count; ++lane) {
+      add_tet(batch[static_cast<size_t>(lane)], gradients[static_cast<size_t>(lane)], internal_forces_n, tangent, slots);
+    }
+  }
+}
 
-    // f_i = V R sigma g_i (equal to R K_e (R^T x - X), see DESIGN section 4).
-    const Eigen::Matrix<double, 3, 4> forces = corotated_forces(rest, r, f, m_lame);
-    for (int i = 0; i < 4; ++i) internal_forces_n.segment<3>(3 * tet[static_cast<size_t>(i)]) += forces.col(i);
+void CorotationalElasticity::add_tet(size_t t, const Eigen::Matrix3d& f, Eigen::VectorXd& internal_forces_n,
+                                     BlockSparseMatrix* tangent, const std::vector<TetSlots>* slots) const {
+  const Tet& tet = m_tets[t];
+  const TetRest& rest = m_rest[t];
+  const Eigen::Matrix3d& r = m_rotations[t];
 
-    if (tangent == nullptr) continue;
-    const Eigen::Matrix<double, 3, 4> c = r * rest.shape_gradients_per_m;  // rotated shape gradients
-    const TetSlots& tet_slots = (*slots)[t];
-    for (int i = 0; i < 4; ++i) {
-      for (int j = i; j < 4; ++j) {
-        const int slot_ij = tet_slots[static_cast<size_t>(4 * i + j)];
-        if (slot_ij < 0) continue;
-        const Eigen::Matrix3d block = rotated_stiffness_block(rest, m_lame, c, i, j);
-        tangent->block(slot_ij) += block;
-        if (i != j) tangent->block(tet_slots[static_cast<size_t>(4 * j + i)]) += block.transpose();
-      }
+  // f_i = V R sigma g_i (equal to R K_e (R^T x - X), see DESIGN section 4).
+  const Eigen::Matrix<double, 3, 4> forces = corotated_forces(rest, r, f, m_lame);
+  for (int i = 0; i < 4; ++i) internal_forces_n.segment<3>(3 * tet[static_cast<size_t>(i)]) += forces.col(i);
+
+  if (tangent == nullptr) return;
+  const Eigen::Matrix<double, 3, 4> c = r * rest.shape_gradients_per_m;  // rotated shape gradients
+  const TetSlots& tet_slots = (*slots)[t];
+  for (int i = 0; i < 4; ++i) {
+    for (int j = i; j < 4; ++j) {
+      const int slot_ij = tet_slots[static_cast<size_t>(4 * i + j)];
+      if (slot_ij < 0) continue;
+      const Eigen::Matrix3d block = rotated_stiffness_block(rest, m_lame, c, i, j);
+      tangent->block(slot_ij) += block;
+      if (i != j) tangent->block(tet_slots[static_cast<size_t>(4 * j + i)]) += block.transpose();
     }
   }
 }
@@ -95,7 +120,7 @@ double CorotationalElasticity::elastic_energy_j(const Eigen::VectorXd& positions
     if (m_excluded[t] != 0) continue;
     const Eigen::Matrix3d f = deformation_gradient(m_rest[t], gather(positions_m, m_tets[t]));
     Eigen::Quaterniond warm_start = m_warm_starts[t];  // a copy: reporting must not change the dynamics
-    energy += corotated_energy_j(m_rest[t], extract_rotation(f, warm_start), f, m_lame);
+    energy += corotated_energy_j(m_rest[t], extract_rotation(f, warm_start, m_rotation_settings), f, m_lame);
   }
   return energy;
 }

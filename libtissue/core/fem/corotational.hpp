@@ -19,8 +19,9 @@ namespace tissue {
 
 class CorotationalElasticity {
  public:
-  /// Precomputes shape gradients and volumes. Throws ParameterError for an invalid material.
-  CorotationalElasticity(const TetMesh& mesh, const Material& material);
+  /// Precomputes shape gradients and volumes. Throws ParameterError for an invalid material or
+  /// rotation setting.
+  CorotationalElasticity(const TetMesh& mesh, const Material& material, const RotationSettings& rotation = {});
 
   [[nodiscard]] int tet_count() const { return static_cast<int>(m_tets.size()); }
   [[nodiscard]] const LameParameters& lame() const { return m_lame; }
@@ -54,12 +55,17 @@ class CorotationalElasticity {
                          const std::vector<Eigen::Quaterniond>& warm_starts);
 
  private:
+  /// Adds tet t's force and (with `tangent`) its blocks, with F = f and the rotation already extracted.
+  void add_tet(size_t t, const Eigen::Matrix3d& f, Eigen::VectorXd& internal_forces_n, BlockSparseMatrix* tangent,
+               const std::vector<TetSlots>* slots) const;
+
   std::vector<Tet> m_tets;
   std::vector<TetRest> m_rest;
   std::vector<Eigen::Matrix3d> m_rotations;
   std::vector<Eigen::Quaterniond> m_warm_starts;
   std::vector<char> m_excluded;  // 1 = modelled elsewhere (cut)
   LameParameters m_lame;
+  RotationSettings m_rotation_settings;
 };
 
 /// Lumped mass (eq. 4.15): each tet gives rho V / 4 to each of its vertices. [kg], one per vertex.

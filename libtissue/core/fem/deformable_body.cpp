@@ -28,6 +28,7 @@ namespace {
 BodySettings checked(BodySettings settings, int vertex_count) {
   validate(settings.material);
   validate(settings.damping);
+  validate(settings.rotation);
   if (!settings.gravity_m_per_s2.allFinite()) throw ParameterError("gravity must be finite");
   for (int v : settings.fixed_vertices) {
     if (v < 0 || v >= vertex_count) {
@@ -91,11 +92,11 @@ DeformableBody::DeformableBody(TetMesh mesh, BodySettings settings)
     : m_mesh(std::move(mesh)),
       m_settings(checked(std::move(settings), m_mesh.vertex_count())),
       m_dofs(make_dof_map(m_mesh.vertex_count(), m_settings.fixed_vertices)),
-      m_elasticity(m_mesh, m_settings.material),
+      m_elasticity(m_mesh, m_settings.material, m_settings.rotation),
       m_vertex_mass_kg(lumped_vertex_masses(m_mesh, m_settings.material.density_kg_per_m3)),
       m_tangent(stiffness_pattern(m_mesh, m_dofs), m_settings.reserve, u_row_capacities(m_mesh, m_dofs)),
       m_slots(make_tet_slots(m_mesh, m_dofs, m_tangent)),
-      m_xfem(m_elasticity.lame()),
+      m_xfem(m_elasticity.lame(), m_settings.rotation),
       m_enriched_row_capacity(enriched_row_capacities(m_mesh, m_dofs)),
       m_first_enriched_dof(static_cast<size_t>(m_mesh.vertex_count()), -1),
       m_cut_index(static_cast<size_t>(m_mesh.tet_count()), -1) {

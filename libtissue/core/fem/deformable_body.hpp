@@ -33,6 +33,7 @@ struct BodySettings {
   Eigen::Vector3d gravity_m_per_s2{0.0, -9.81, 0.0};
   std::vector<int> fixed_vertices;  ///< 0-based; they keep their rest positions
   BlockSparseMatrix::Reserve reserve;
+  RotationSettings rotation;  ///< when the per-tet rotation extraction stops (accuracy)
 };
 
 /// A spring of stiffness k from a material point x_p = sum_i w_i x_i of the body (a point of a

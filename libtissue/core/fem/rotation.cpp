@@ -1,9 +1,13 @@
 // Rotation extraction for co-rotational FEM (see rotation.hpp for the method and references).
 #include "core/fem/rotation.hpp"
 
+#include "core/parameter_error.hpp"
+
 #include <Eigen/SVD>
 
 #include <cmath>
+#include <stdexcept>
+#include <string>
 
 namespace tissue {
 namespace {
@@ -48,6 +52,16 @@ NewtonStep rotation_step(const Eigen::Matrix3d& s, double scale) {
 
 }  // namespace
 
+void validate(const RotationSettings& settings) {
+  if (settings.max_iterations < 1 || settings.max_iterations > 100) {
+    throw ParameterError("rotation extraction: 1 to 100 iterations, got " + std::to_string(settings.max_iterations));
+  }
+  if (!(settings.max_error_rad > 0.0) || !std::isfinite(settings.max_error_rad)) {
+    throw ParameterError("rotation extraction: the accepted error must be finite and > 0 rad, got " +
+                         std::to_string(settings.max_error_rad));
+  }
+}
+
 Eigen::Matrix3d rotation_by_svd(const Eigen::Matrix3d& deformation_gradient) {
   const Eigen::JacobiSVD<Eigen::Matrix3d> svd(deformation_gradient, Eigen::ComputeFullU | Eigen::ComputeFullV);
   Eigen::Matrix3d u = svd.matrixU();
@@ -76,8 +90,8 @@ Eigen::Matrix3d extract_rotation(const Eigen::Matrix3d& f, Eigen::Quaterniond& w
       q = (q * Eigen::Quaterniond(1.0, half.x(), half.y(), half.z())).normalized();
       r = q.toRotationMatrix();
     }
-    if (step.newton && angle < settings.angle_tolerance_rad) {
-      converged = true;  // Newton: the remaining error is O(angle^2), ~1e-12 at the default tolerance
+    if (step.newton && RotationSettings::NEWTON_ERROR_BOUND * angle * angle * angle <= settings.max_error_rad) {
+      converged = true;  // Newton: the remaining error is below ~0.55 angle^3 (rotation.hpp)
       break;
     }
   }
@@ -87,6 +101,144 @@ Eigen::Matrix3d extract_rotation(const Eigen::Matrix3d& f, Eigen::Quaterniond& w
   }
   warm_start = q;
   return r;
+}
+
+
+// --- The batched version: the same Newton iteration in SIMD lanes (GCC vector extensions; four
+// lanes, two SSE2 registers each on a baseline x86-64). Every step below is extract_rotation()'s,
+// written lane-wise; a lane that has converged is frozen by selects while the others go on.
+// The lane helpers below pass vectors by value between functions of this file only (internal
+// linkage, inlined), so GCC's note that such an ABI differs with AVX does not concern them.
+#pragma GCC diagnostic ignored "-Wpsabi"
+
+namespace {
+
+using Lanes = double __attribute__((vector_size(8 * ROTATION_BATCH)));
+using LaneMask = long long __attribute__((vector_size(8 * ROTATION_BATCH)));
+
+struct LaneQuaternion {
+  Lanes w, x, y, z;
+};
+
+// R(q) for a unit quaternion, as Eigen's toRotationMatrix (r[i + 3 j] = R(i, j)).
+void lane_rotation_matrix(const LaneQuaternion& q, Lanes* r) {
+  const Lanes tx = 2.0 * q.x, ty = 2.0 * q.y, tz = 2.0 * q.z;
+  const Lanes twx = tx * q.w, twy = ty * q.w, twz = tz * q.w;
+  const Lanes txx = tx * q.x, txy = ty * q.x, txz = tz * q.x;
+  const Lanes tyy = ty * q.y, tyz = tz * q.y, tzz = tz * q.z;
+  r[0] = 1.0 - (tyy + tzz);
+  r[3] = txy - twz;
+  r[6] = txz + twy;
+  r[1] = txy + twz;
+  r[4] = 1.0 - (txx + tzz);
+  r[7] = tyz - twx;
+  r[2] = txz - twy;
+  r[5] = tyz + twx;
+  r[8] = 1.0 - (txx + tyy);
+}
+
+Lanes lane_select(LaneMask mask, Lanes yes, Lanes no) { return mask ? yes : no; }
+
+Lanes lane_sqrt(Lanes v) {
+  Lanes out;
+  for (int l = 0; l < ROTATION_BATCH; ++l) out[l] = std::sqrt(v[l]);  // vectorised (sqrtpd) at -O2 and up
+  return out;
+}
+
+bool any(LaneMask mask) {
+  for (int l = 0; l < ROTATION_BATCH; ++l) {
+    if (mask[l] != 0) return true;
+  }
+  return false;
+}
+
+}  // namespace
+
+void extract_rotations(int count, const Eigen::Matrix3d* f_in, Eigen::Quaterniond* const* warm_starts,
+                       Eigen::Matrix3d* const* rotations, const RotationSettings& settings) {
+  if (count <= 0) return;
+  if (count > ROTATION_BATCH) {
+    throw std::invalid_argument("extract_rotations: at most " + std::to_string(ROTATION_BATCH) + " at once");
+  }
+  // Lanes beyond count repeat the first gradient (their results are dropped).
+  Lanes f[9];
+  LaneQuaternion q{};
+  for (int l = 0; l < ROTATION_BATCH; ++l) {
+    const int k = l < count ? l : 0;
+    for (int e = 0; e < 9; ++e) f[e][l] = f_in[k](e);
+    const Eigen::Quaterniond& warm = *warm_starts[k];
+    q.w[l] = warm.w();
+    q.x[l] = warm.x();
+    q.y[l] = warm.y();
+    q.z[l] = warm.z();
+  }
+  Lanes scale = {};
+  for (int l = 0; l < ROTATION_BATCH; ++l) scale[l] = f_in[l < count ? l : 0].cwiseAbs().maxCoeff();
+  Lanes r[9];
+  lane_rotation_matrix(q, r);
+  // Lanes with F = 0 or not finite keep the warm start, as extract_rotation() does.
+  LaneMask usable = {};
+  for (int l = 0; l < ROTATION_BATCH; ++l) usable[l] = (scale[l] > 0.0 && std::isfinite(scale[l])) ? -1 : 0;
+  LaneMask active = usable;
+  LaneMask converged = {};
+  const Lanes tol = 1e-10 * scale;
+  for (int iteration = 0; iteration < settings.max_iterations && any(active); ++iteration) {
+    Lanes s[9];  // S = R^T F
+    for (int i = 0; i < 3; ++i) {
+      for (int j = 0; j < 3; ++j) s[i + 3 * j] = r[3 * i] * f[3 * j] + r[3 * i + 1] * f[3 * j + 1] + r[3 * i + 2] * f[3 * j + 2];
+    }
+    const Lanes g0 = s[5] - s[7], g1 = s[6] - s[2], g2 = s[1] - s[3];  // (S21 - S12, S02 - S20, S10 - S01)
+    const Lanes trace = s[0] + s[4] + s[8];
+    // H = tr(S) I - sym(S)
+    const Lanes h00 = trace - s[0], h11 = trace - s[4], h22 = trace - s[8];
+    const Lanes h01 = -0.5 * (s[3] + s[1]), h02 = -0.5 * (s[6] + s[2]), h12 = -0.5 * (s[7] + s[5]);
+    const Lanes minor2 = h00 * h11 - h01 * h01;
+    const Lanes a00 = h11 * h22 - h12 * h12, a01 = h02 * h12 - h01 * h22, a02 = h01 * h12 - h02 * h11;
+    const Lanes a11 = h00 * h22 - h02 * h02, a12 = h02 * h01 - h00 * h12;
+    const Lanes det = h00 * a00 + h01 * a01 + h02 * a02;
+    const LaneMask newton = (h00 > tol) & (minor2 > tol * scale) & (det > tol * scale * scale);
+    const Lanes inverse_det = 1.0 / lane_select(newton, det, Lanes{} + 1.0);
+    const Lanes abs_trace = lane_select(trace < 0.0, -trace, trace);
+    const Lanes fallback = 1.0 / (abs_trace + 1e-9 * scale);
+    const Lanes t0 = lane_select(newton, (a00 * g0 + a01 * g1 + a02 * g2) * inverse_det, g0 * fallback);
+    const Lanes t1 = lane_select(newton, (a01 * g0 + a11 * g1 + a12 * g2) * inverse_det, g1 * fallback);
+    const Lanes t2 = lane_select(newton, (a02 * g0 + a12 * g1 + minor2 * g2) * inverse_det, g2 * fallback);
+    const Lanes angle = lane_sqrt(t0 * t0 + t1 * t1 + t2 * t2);
+    // |theta| <= 1 rad per step; the quaternion (1, theta/2) normalised stands in for exp([theta]x).
+    const Lanes inverse_angle = 1.0 / angle;
+    const Lanes limit = 0.5 * lane_select(inverse_angle < 1.0, inverse_angle, Lanes{} + 1.0);
+    const Lanes hx = limit * t0, hy = limit * t1, hz = limit * t2;
+    LaneQuaternion p;
+    p.w = q.w - q.x * hx - q.y * hy - q.z * hz;
+    p.x = q.w * hx + q.x + q.y * hz - q.z * hy;
+    p.y = q.w * hy - q.x * hz + q.y + q.z * hx;
+    p.z = q.w * hz + q.x * hy - q.y * hx + q.z;
+    const Lanes inverse_norm = 1.0 / lane_sqrt(p.w * p.w + p.x * p.x + p.y * p.y + p.z * p.z);
+    const LaneMask update = active & (angle > 0.0);
+    q.w = lane_select(update, p.w * inverse_norm, q.w);
+    q.x = lane_select(update, p.x * inverse_norm, q.x);
+    q.y = lane_select(update, p.y * inverse_norm, q.y);
+    q.z = lane_select(update, p.z * inverse_norm, q.z);
+    lane_rotation_matrix(q, r);
+    const LaneMask done = active & newton & (RotationSettings::NEWTON_ERROR_BOUND * angle * angle * angle <=
+                                            settings.max_error_rad);
+    converged |= done;
+    active &= ~done;
+  }
+  for (int l = 0; l < count; ++l) {
+    Eigen::Matrix3d& rotation = *rotations[l];
+    if (usable[l] == 0) {  // F = 0 or not finite: the warm start's rotation, warm start kept
+      rotation = warm_starts[l]->toRotationMatrix();
+      continue;
+    }
+    if (converged[l] == 0) {  // no convergence: the SVD decides, as in extract_rotation()
+      rotation = rotation_by_svd(f_in[l]);
+      *warm_starts[l] = Eigen::Quaterniond(rotation);
+      continue;
+    }
+    for (int e = 0; e < 9; ++e) rotation(e) = r[e][l];
+    *warm_starts[l] = Eigen::Quaterniond(q.w[l], q.x[l], q.y[l], q.z[l]);
+  }
 }
 
 }  // namespace tissue

@@ -86,7 +86,7 @@ void XfemElasticity::evaluate(const Eigen::VectorXd& positions_m, const Eigen::V
     std::array<Eigen::Matrix<double, 3, 4>, 2> part_forces;
     for (size_t p = 0; p < 2; ++p) {
       const Eigen::Matrix3d f = deformation_gradient(rest, cut_part_positions(cut_tet, PARTS[p], real_m, enrichment_m));
-      const Eigen::Matrix3d& r = m_rotations[k][p] = extract_rotation(f, m_warm_starts[k][p]);
+      const Eigen::Matrix3d& r = m_rotations[k][p] = extract_rotation(f, m_warm_starts[k][p], m_rotation_settings);
       part_forces[p] = corotated_forces(rest, r, f, m_lame);
     }
 
@@ -158,7 +158,7 @@ double XfemElasticity::elastic_energy_j(const Eigen::VectorXd& positions_m,
           deformation_gradient(m_rest[k], cut_part_positions(m_cut_tets[k], PARTS[p], real_m, enrichment_m));
       Eigen::Quaterniond warm_start = m_warm_starts[k][p];  // a copy: reporting must not change the dynamics
       energy +=
-          m_cut_tets[k].weight(PARTS[p]) * corotated_energy_j(m_rest[k], extract_rotation(f, warm_start), f, m_lame);
+          m_cut_tets[k].weight(PARTS[p]) * corotated_energy_j(m_rest[k], extract_rotation(f, warm_start, m_rotation_settings), f, m_lame);
     }
   }
   return energy;

@@ -71,7 +71,9 @@ TetPositions cut_part_positions(const CutTet& cut_tet, CutPart part, const TetPo
 
 class XfemElasticity {
  public:
-  explicit XfemElasticity(const LameParameters& lame) : m_lame(lame) {}
+  /// `rotation`: when the parts' rotation extraction stops (validated by the caller's body settings).
+  XfemElasticity(const LameParameters& lame, const RotationSettings& rotation)
+      : m_lame(lame), m_rotation_settings(rotation) {}
 
   /// Room for this many cut tets without reallocation.
   void reserve(int cut_tets);
@@ -118,6 +120,7 @@ class XfemElasticity {
               TetPositions& enrichment_m) const;
 
   LameParameters m_lame;
+  RotationSettings m_rotation_settings;
   std::vector<CutTet> m_cut_tets;
   std::vector<TetRest> m_rest;
   std::vector<CutTetSlots> m_slots;
