@@ -43,9 +43,20 @@ void add_scene_options(CLI::App& app, SceneOptions& options) {
       ->capture_default_str();
   app.add_option("--steps", options.steps, "Number of time steps")->capture_default_str();
   app.add_option("--dt", options.step_size_s, "Time step [s]")->capture_default_str();
-  app.add_option("--solver", options.solver, "Linear solver: pcg or cholmod")->capture_default_str();
-  app.add_option("--tolerance", options.tolerance, "PCG relative residual tolerance")->capture_default_str();
-  app.add_option("--max-iterations", options.max_iterations, "PCG iteration cap")->capture_default_str();
+  app.add_option("--solver", options.solver, "Linear solver: " + std::string(linear_solver_names()))
+      ->capture_default_str();
+  app.add_option("--tolerance", options.tolerance, "PCG (and pcg-cholesky) relative residual tolerance")
+      ->capture_default_str();
+  app.add_option("--max-iterations", options.max_iterations, "PCG (and pcg-cholesky) iteration cap")
+      ->capture_default_str();
+  app.add_option("--refresh-iterations", options.refresh.refresh_iterations,
+                 "pcg-cholesky: a solve needing more iterations starts a refactorization")
+      ->capture_default_str();
+  app.add_option("--pickup-setups", options.refresh.pickup_setups,
+                 "pcg-cholesky: a refactorization is used this many solver setups after it started")
+      ->capture_default_str();
+  app.add_flag("!--no-background-refactor", options.refresh.background_refactor,
+               "pcg-cholesky: refactorize at pick-up in the stepping thread instead of a worker thread");
   app.add_flag("--warm-start", options.warm_start, "PCG starts from the previous step's velocity change");
   app.add_option("--young", options.material.young_modulus_pa, "Young's modulus [Pa]")->capture_default_str();
   app.add_option("--poisson", options.material.poisson_ratio, "Poisson's ratio")->capture_default_str();
@@ -56,6 +67,8 @@ void add_scene_options(CLI::App& app, SceneOptions& options) {
   app.add_option("--gravity", options.gravity, "Gravity GX,GY,GZ [m/s^2]")->capture_default_str();
   app.add_flag("!--no-large-turn-protection", options.large_turn_protection,
                "Backward Euler without Newton corrections and energy guard (the linearized step alone, as Vega's)");
+  app.add_option("--threads", options.threads, "Threads per step, 1 or 2 (a team made and joined by each step)")
+      ->capture_default_str();
 }
 
 Scene make_scene(const SceneOptions& options) {
@@ -67,6 +80,7 @@ Scene make_scene(const SceneOptions& options) {
   settings.step_size_s = options.step_size_s;
   settings.solver.kind = parse_linear_solver_kind(options.solver);
   settings.solver.pcg = PcgSolver::Settings{options.tolerance, options.max_iterations};
+  settings.solver.refresh = options.refresh;
   settings.solver.warm_start = options.warm_start;
   settings.body.material = options.material;
   settings.body.damping = options.damping;
@@ -74,6 +88,7 @@ Scene make_scene(const SceneOptions& options) {
     settings.integrator.newton.trigger_angle_rad = std::numeric_limits<double>::infinity();
     settings.integrator.newton.energy_guard_angle_rad = std::numeric_limits<double>::infinity();
   }
+  settings.integrator.threads = options.threads;
   settings.body.gravity_m_per_s2 = parse_vector(options.gravity, "--gravity");
   settings.body.fixed_vertices = options.fixed_bou.empty() ? vertices_at_minimum(scene.mesh, 0, options.fixed_fraction)
                                                            : read_bou(options.fixed_bou, scene.mesh.vertex_count());

@@ -19,6 +19,7 @@ struct SceneOptions {
   std::string solver = "pcg";
   double tolerance = 1e-6;
   int max_iterations = 10000;
+  CholeskyPcgSolver::Refresh refresh;  ///< pcg-cholesky's refresh rules
   bool warm_start = false;
   Material material{1.0e5, 0.4, 1000.0};
   RayleighDamping damping{0.0, 0.0};
@@ -26,6 +27,7 @@ struct SceneOptions {
   /// Backward Euler's large-turn protections (BackwardEuler::NewtonCorrections); "off" = the
   /// dissertation's (and Vega's) linearized step alone.
   bool large_turn_protection = true;
+  int threads = 1;  ///< IntegratorSettings::threads
 };
 
 /// Registers the options on `app` (values are written into `options` when parsed).

@@ -17,6 +17,20 @@ void print_summary(const char* name, const Summary& s, bool last = false) {
               last ? "" : ",");
 }
 
+// pcg-cholesky's counters (how often its lagged factor was rebuilt), when that is the solver.
+void print_lagged_factor(const tissue::Tissue& tissue) {
+  const auto* integrator = dynamic_cast<const tissue::BackwardEuler*>(&tissue.integrator());
+  const auto* solver =
+      integrator != nullptr ? dynamic_cast<const tissue::CholeskyPcgSolver*>(&integrator->solver()) : nullptr;
+  if (solver == nullptr) return;
+  const tissue::CholeskyPcgSolver::Counters& c = solver->counters();
+  std::printf(
+      "  \"lagged_factor\": {\"setups\": %ld, \"factorizations\": %ld, \"refreshes_started\": %ld, "
+      "\"refreshes_picked_up\": %ld, \"refresh_failures\": %ld, \"pickups_waited\": %ld, \"iterations\": %ld},\n",
+      c.setups, c.factorizations, c.refreshes_started, c.refreshes_picked_up, c.refresh_failures, c.pickups_waited,
+      c.iterations);
+}
+
 int run(const tissue::apps::SceneOptions& options) {
   tissue::apps::Scene scene = tissue::apps::make_scene(options);
   const int vertices = scene.mesh.vertex_count();
@@ -54,7 +68,9 @@ int run(const tissue::apps::SceneOptions& options) {
   std::printf("  \"solve_ms\": %.6g,\n", tissue::apps::summarize(solve_ms).median);
   std::printf("  \"cg_iterations\": {\"mean\": %.4g, \"max\": %.0f},\n", iteration_summary.mean, iteration_summary.max);
   std::printf("  \"large_turn_protection\": %s,\n", options.large_turn_protection ? "true" : "false");
+  std::printf("  \"threads\": %d,\n", options.threads);
   std::printf("  \"newton_iterations\": %ld,\n  \"energy_guarded_steps\": %ld,\n", newton_iterations, guarded_steps);
+  print_lagged_factor(tissue);
   std::printf("  \"final_kinetic_energy_J\": %.6g\n", tissue.kinetic_energy_j());
   std::printf("}\n");
   return 0;

@@ -31,7 +31,14 @@ struct TissueState final : fmi3::ModelState {
 };
 
 LinearSolverKind linear_solver(std::int64_t item) {
-  return item == 1 ? LinearSolverKind::pcg : LinearSolverKind::cholmod;
+  switch (item) {
+    case 1:
+      return LinearSolverKind::pcg;
+    case 3:
+      return LinearSolverKind::pcg_cholesky;
+    default:
+      return LinearSolverKind::cholmod;
+  }
 }
 
 IntegratorKind integrator_kind(std::int64_t item) {
@@ -73,6 +80,9 @@ TissueSettings tissue_settings(const ValueStore& values, const TetMesh* mesh) {
   s.solver.kind = linear_solver(values.int64(vr(Vr::linear_solver)));
   s.solver.pcg = PcgSolver::Settings{values.float64(vr(Vr::pcg_tolerance)), values.int32(vr(Vr::pcg_max_iterations))};
   s.solver.warm_start = values.boolean(vr(Vr::warm_start));
+  // No FMI switch says an importer allows threads: pcgCholesky refactorizes at pick-up in the
+  // calling thread (the same results as with the worker, DESIGN "Linear solvers").
+  s.solver.refresh.background_refactor = false;
   s.step_size_s = values.float64(vr(Vr::step_size));
   InteractionSettings& i = s.interaction;
   i.contact_enabled = values.boolean(vr(Vr::contact_enabled));

@@ -255,6 +255,8 @@ constexpr auto LINEAR_SOLVER_ITEMS = std::to_array<EnumerationItem>({
     {"pcg", 1,
      "Jacobi-preconditioned conjugate gradients (iterative; integrator.pcgTolerance, integrator.pcgMaxIterations)"},
     {"cholmod", 2, "Sparse Cholesky factorization (CHOLMOD, direct, exact)"},
+    {"pcgCholesky", 3,
+     "CG preconditioned by a lagged CHOLMOD factor, refactorized when the iterations grow or a cut changes the pattern; in the FMU without a worker thread (integrator.pcgTolerance, integrator.pcgMaxIterations)"},
 });
 constexpr auto INTEGRATOR_ITEMS = std::to_array<EnumerationItem>({
     {"backwardEuler", 1, "Semi-implicit backward Euler, one linear solve per internal step (integrator.linearSolver)"},

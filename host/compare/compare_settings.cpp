@@ -368,7 +368,7 @@ SettingDescription describe_setting(const std::vector<ParameterSetting>& paramet
     d.tolerance = value_number(parameters, "integrator.idaRelativeTolerance", tissue);
   } else {
     d.linear_solver = value_text(parameters, "integrator.linearSolver", tissue).value_or("pcg");
-    if (d.linear_solver == "pcg") {
+    if (d.linear_solver == "pcg" || d.linear_solver == "pcgCholesky") {
       d.tolerance = value_number(parameters, "integrator.pcgTolerance", tissue);
       if (const std::optional<double> cap = value_number(parameters, "integrator.pcgMaxIterations", tissue)) {
         d.iteration_cap = static_cast<std::int64_t>(*cap);

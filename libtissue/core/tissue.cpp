@@ -80,6 +80,10 @@ std::uint64_t model_fingerprint_of(const TetMesh& mesh, const TissueSettings& se
   f.add(settings.solver.pcg.tolerance);
   f.add(settings.solver.pcg.max_iterations);
   f.add(settings.solver.warm_start);
+  if (settings.solver.kind == LinearSolverKind::pcg_cholesky) {  // so that older fingerprints stay as they were
+    f.add(settings.solver.refresh.refresh_iterations);          // background_refactor changes no result
+    f.add(settings.solver.refresh.pickup_setups);
+  }
   const InteractionSettings& interaction = settings.interaction;
   f.add(interaction.contact_enabled);
   f.add(interaction.cutting_enabled);

@@ -6,7 +6,10 @@
 
 #include "core/fem/corotational_kernel.hpp"
 
+#include <algorithm>
 #include <cassert>
+#include <limits>
+#include <numeric>
 #include <stdexcept>
 #include <string>
 
@@ -34,9 +37,70 @@ CorotationalElasticity::CorotationalElasticity(const TetMesh& mesh, const Materi
     }
     m_rest.push_back(precompute_tet(rest_positions));
   }
+  partition(mesh);
   m_rotations.assign(m_tets.size(), Eigen::Matrix3d::Identity());
   m_warm_starts.assign(m_tets.size(), Eigen::Quaterniond::Identity());
   m_excluded.assign(m_tets.size(), 0);
+}
+
+namespace {
+
+constexpr int ASSEMBLY_LEVELS = 3;  // the mesh, its separator, that one's: leaves ~3% of the frog alone
+
+// Splits `tets` in two at the median of their centroids along the longest axis of their extent;
+// tets that share a vertex with the other half go to `separator`.
+void split(const TetMesh& mesh, const std::vector<int>& tets, CorotationalElasticity::AssemblyPhase& halves,
+           std::vector<int>& separator, std::vector<unsigned char>& vertex_halves) {
+  std::vector<Eigen::Vector3d> centroids(tets.size());
+  Eigen::Vector3d low = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());
+  Eigen::Vector3d high = -low;
+  for (size_t k = 0; k < tets.size(); ++k) {
+    centroids[k].setZero();
+    for (const int v : mesh.tets[static_cast<size_t>(tets[k])]) {
+      centroids[k] += 0.25 * mesh.rest_positions_m[static_cast<size_t>(v)];
+    }
+    low = low.cwiseMin(centroids[k]);
+    high = high.cwiseMax(centroids[k]);
+  }
+  Eigen::Index axis = 0;
+  if (!tets.empty()) (high - low).maxCoeff(&axis);
+  std::vector<size_t> by_position(tets.size());
+  std::iota(by_position.begin(), by_position.end(), size_t{0});
+  const auto middle = by_position.begin() + static_cast<std::ptrdiff_t>(tets.size() / 2);
+  std::nth_element(by_position.begin(), middle, by_position.end(), [&](size_t a, size_t b) {
+    return centroids[a][axis] < centroids[b][axis] || (centroids[a][axis] == centroids[b][axis] && a < b);
+  });
+  std::vector<int> half(tets.size(), 0);
+  for (auto it = middle; it != by_position.end(); ++it) half[*it] = 1;
+  std::fill(vertex_halves.begin(), vertex_halves.end(), 0);  // bit h: touched by half h
+  for (size_t k = 0; k < tets.size(); ++k) {
+    for (const int v : mesh.tets[static_cast<size_t>(tets[k])]) {
+      vertex_halves[static_cast<size_t>(v)] |= static_cast<unsigned char>(1 << half[k]);
+    }
+  }
+  for (auto& list : halves) list.clear();
+  separator.clear();
+  for (size_t k = 0; k < tets.size(); ++k) {
+    bool shared = false;
+    for (const int v : mesh.tets[static_cast<size_t>(tets[k])]) shared = shared || vertex_halves[static_cast<size_t>(v)] == 3;
+    (shared ? separator : halves[static_cast<size_t>(half[k])]).push_back(tets[k]);
+  }
+}
+
+}  // namespace
+
+void CorotationalElasticity::partition(const TetMesh& mesh) {
+  static_assert(ASSEMBLY_PARTS == 2, "split() halves");
+  std::vector<int> remaining(m_tets.size());
+  std::iota(remaining.begin(), remaining.end(), 0);
+  std::vector<unsigned char> vertex_halves(static_cast<size_t>(mesh.vertex_count()));
+  m_phases.assign(ASSEMBLY_LEVELS, AssemblyPhase{});
+  std::vector<int> separator;
+  for (AssemblyPhase& phase : m_phases) {
+    split(mesh, remaining, phase, separator, vertex_halves);
+    remaining.swap(separator);
+  }
+  m_serial_tets = std::move(remaining);
 }
 
 void CorotationalElasticity::exclude(int tet) {
@@ -64,8 +128,26 @@ void CorotationalElasticity::reset_rotations() {
 }
 
 void CorotationalElasticity::evaluate(const Eigen::VectorXd& positions_m, Eigen::VectorXd& internal_forces_n,
-                                      BlockSparseMatrix* tangent, const std::vector<TetSlots>* slots) {
+                                      BlockSparseMatrix* tangent, const std::vector<TetSlots>* slots, WorkTeam* team) {
   assert(tangent == nullptr || (slots != nullptr && slots->size() == m_tets.size()));
+  for (const AssemblyPhase& phase : m_phases) {
+    if (team != nullptr && team->size() > 1) {
+      auto halves = [&](int member) {
+        for (int part = member; part < ASSEMBLY_PARTS; part += team->size()) {
+          add_tets(phase[static_cast<size_t>(part)], positions_m, internal_forces_n, tangent, slots);
+        }
+      };
+      team->run(halves);
+    } else {
+      for (const std::vector<int>& part : phase) add_tets(part, positions_m, internal_forces_n, tangent, slots);
+    }
+  }
+  add_tets(m_serial_tets, positions_m, internal_forces_n, tangent, slots);
+}
+
+void CorotationalElasticity::add_tets(const std::vector<int>& tets, const Eigen::VectorXd& positions_m,
+                                      Eigen::VectorXd& internal_forces_n, BlockSparseMatrix* tangent,
+                                      const std::vector<TetSlots>* slots) {
   // Tets go in batches of ROTATION_BATCH: their rotations are extracted side by side (SIMD lanes),
   // then each tet's force and tangent blocks are added in turn.
   std::array<size_t, ROTATION_BATCH> batch{};
@@ -73,15 +155,16 @@ void CorotationalElasticity::evaluate(const Eigen::VectorXd& positions_m, Eigen:
   std::array<Eigen::Quaterniond*, ROTATION_BATCH> warm_starts{};
   std::array<Eigen::Matrix3d*, ROTATION_BATCH> rotations{};
   size_t next = 0;
-  while (next < m_tets.size()) {
+  while (next < tets.size()) {
     int count = 0;
-    for (; next < m_tets.size() && count < ROTATION_BATCH; ++next) {
-      if (m_excluded[next] != 0) continue;
+    for (; next < tets.size() && count < ROTATION_BATCH; ++next) {
+      const auto t = static_cast<size_t>(tets[next]);
+      if (m_excluded[t] != 0) continue;
       const auto lane = static_cast<size_t>(count++);
-      batch[lane] = next;
-      gradients[lane] = deformation_gradient(m_rest[next], gather(positions_m, m_tets[next]));
-      warm_starts[lane] = &m_warm_starts[next];
-      rotations[lane] = &m_rotations[next];
+      batch[lane] = t;
+      gradients[lane] = deformation_gradient(m_rest[t], gather(positions_m, m_tets[t]));
+      warm_starts[lane] = &m_warm_starts[t];
+      rotations[lane] = &m_rotations[t];
     }
     extract_rotations(count, gradients.data(), warm_starts.data(), rotations.data(), m_rotation_settings);
     for (int lane = 0; lane < count; ++lane) {

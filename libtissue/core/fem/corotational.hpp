@@ -9,10 +9,12 @@
 #include "core/mesh/tet_mesh.hpp"
 #include "core/system/assembly.hpp"
 #include "core/system/block_sparse_matrix.hpp"
+#include "core/system/work_team.hpp"
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 
+#include <array>
 #include <vector>
 
 namespace tissue {
@@ -38,8 +40,22 @@ class CorotationalElasticity {
   /// (the restoring force in M a + D v + f_int = f_ext, [N], 3 per vertex) into `internal_forces_n`,
   /// and, when `tangent` is given, adds R_e K_e R_e^T into it through `slots` (blocks whose slot is -1,
   /// i.e. that touch a fixed vertex, are skipped). The caller zeroes both outputs.
+  ///
+  /// The tets go in a fixed order of phases: the two halves of the mesh (split at the median along
+  /// its longest axis) without the tets that share a vertex with the other half; then the two halves
+  /// of those (the separator, split the same way), and once more; then what separates these. With a team
+  /// of two the halves of a phase run side by side: they write disjoint entries, and every entry
+  /// receives its terms in the same order as with one thread, so the result is bitwise the same.
   void evaluate(const Eigen::VectorXd& positions_m, Eigen::VectorXd& internal_forces_n, BlockSparseMatrix* tangent,
-                const std::vector<TetSlots>* slots);
+                const std::vector<TetSlots>* slots, WorkTeam* team = nullptr);
+
+  /// How many parts the assembly runs side by side (a team's members beyond this wait).
+  static constexpr int ASSEMBLY_PARTS = MAX_STEP_THREADS;
+  /// One phase of the assembly: parts that share no vertex (each list ascending).
+  using AssemblyPhase = std::array<std::vector<int>, ASSEMBLY_PARTS>;
+  [[nodiscard]] const std::vector<AssemblyPhase>& assembly_phases() const { return m_phases; }
+  /// The tets assembled alone, after the phases.
+  [[nodiscard]] const std::vector<int>& serial_tets() const { return m_serial_tets; }
 
   /// Elastic energy sum_e V_e (mu eps:eps + lambda/2 tr(eps)^2), eps = sym(R_e^T F_e) - I, with the
   /// rotations of these positions (the stored warm starts are not changed). [J]
@@ -59,7 +75,16 @@ class CorotationalElasticity {
   void add_tet(size_t t, const Eigen::Matrix3d& f, Eigen::VectorXd& internal_forces_n, BlockSparseMatrix* tangent,
                const std::vector<TetSlots>* slots) const;
 
+  /// Adds the forces and blocks of `tets` (skipping excluded ones), rotations in batches.
+  void add_tets(const std::vector<int>& tets, const Eigen::VectorXd& positions_m, Eigen::VectorXd& internal_forces_n,
+                BlockSparseMatrix* tangent, const std::vector<TetSlots>* slots);
+
+  /// Splits the tets into the parts and the separator (see evaluate()).
+  void partition(const TetMesh& mesh);
+
   std::vector<Tet> m_tets;
+  std::vector<AssemblyPhase> m_phases;
+  std::vector<int> m_serial_tets;
   std::vector<TetRest> m_rest;
   std::vector<Eigen::Matrix3d> m_rotations;
   std::vector<Eigen::Quaterniond> m_warm_starts;

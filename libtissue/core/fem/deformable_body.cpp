@@ -202,7 +202,7 @@ void DeformableBody::evaluate(const Eigen::VectorXd& displacement_m, Eigen::Vect
   m_vertex_forces_n.setZero();
   if (update_tangent) m_tangent.set_zero();
   BlockSparseMatrix* tangent = update_tangent ? &m_tangent : nullptr;
-  m_elasticity.evaluate(m_positions_m, m_vertex_forces_n, tangent, &m_slots);
+  m_elasticity.evaluate(m_positions_m, m_vertex_forces_n, tangent, &m_slots, m_team);
   internal_force_n.resize(dof_count());
   const int u_rows = m_dofs.free_vertex_count();
   internal_force_n.tail(3 * enriched_dof_count()).setZero();

@@ -77,6 +77,8 @@ class DeformableBody final : public DynamicsModel {
   [[nodiscard]] const RayleighDamping& damping() const override { return m_settings.damping; }
   [[nodiscard]] const Eigen::VectorXd& external_force_n() const override { return m_external_force_n; }
   void evaluate(const Eigen::VectorXd& displacement_m, Eigen::VectorXd& internal_force_n, bool update_tangent) override;
+  /// The uncut tets' forces and blocks are then assembled by the team (bitwise the same result).
+  void lend_work_team(WorkTeam* team) override { m_team = team; }
   [[nodiscard]] const BlockSparseMatrix& tangent() const override { return m_tangent; }
   /// First a bound, O(unknowns): no element (or cut part) turns further than 12 max|block of the
   /// increment| max|grad(phi)|; past `resolution_rad`, each tet and part: |axial(skew(R^T G))| with
@@ -205,6 +207,7 @@ class DeformableBody final : public DynamicsModel {
   std::optional<PointSpring> m_point_spring;
   std::array<int, 9> m_point_spring_slots{};  // [3 i + j]: block (row of vertex i, row of vertex j), -1 if fixed
   Eigen::Vector3d m_point_spring_force_n = Eigen::Vector3d::Zero();
+  WorkTeam* m_team = nullptr;  // lent for a step (lend_work_team)
 };
 
 }  // namespace tissue

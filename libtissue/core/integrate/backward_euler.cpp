@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <optional>
 #include <string>
 
 namespace tissue {
@@ -12,6 +13,18 @@ namespace {
 double seconds_since(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
+
+// Lends a step's team to the model and takes it back when the step ends, however it ends.
+class TeamLoan {
+ public:
+  TeamLoan(DynamicsModel& model, WorkTeam* team) : m_model(model) { m_model.lend_work_team(team); }
+  ~TeamLoan() { m_model.lend_work_team(nullptr); }
+  TeamLoan(const TeamLoan&) = delete;
+  TeamLoan& operator=(const TeamLoan&) = delete;
+
+ private:
+  DynamicsModel& m_model;
+};
 
 }  // namespace
 
@@ -54,6 +67,7 @@ BackwardEuler::BackwardEuler(std::unique_ptr<LinearSolver> solver, Settings sett
     : m_solver(std::move(solver)), m_settings(settings) {
   if (!m_solver) throw std::invalid_argument("BackwardEuler needs a linear solver");
   validate(m_settings.newton);
+  validate_step_threads(m_settings.threads);
 }
 
 // (1 + h alpha) M + (h beta + h^2) K at the model's current tangent: the matrix of the step and of
@@ -76,6 +90,10 @@ StepReport BackwardEuler::step(DynamicsModel& model, DynamicState& state, double
                            std::to_string(n));
   }
   StepReport report;
+  // The opt-in team lives for this step only: joined (and taken back from the model) on every exit.
+  std::optional<WorkTeam> team;
+  if (m_settings.threads > 1) team.emplace(m_settings.threads);
+  const TeamLoan loan(model, team ? &*team : nullptr);
   const auto assembly_start = std::chrono::steady_clock::now();
   model.evaluate(state.displacement_m, m_internal_force_n, /*update_tangent=*/true);
   const BlockSparseMatrix& stiffness = model.tangent();

@@ -39,6 +39,8 @@ class BackwardEuler final : public Integrator {
     /// Start each solve from the previous step's dv instead of zero (matters for iterative solvers).
     bool warm_start = false;
     NewtonCorrections newton;
+    /// Threads of a step (1 or 2; see IntegratorSettings::threads): a WorkTeam made and joined by each step.
+    int threads = 1;
   };
   explicit BackwardEuler(std::unique_ptr<LinearSolver> solver) : BackwardEuler(std::move(solver), Settings{}) {}
   BackwardEuler(std::unique_ptr<LinearSolver> solver, Settings settings);

@@ -3,18 +3,40 @@
 
 #include "core/integrate/backward_euler.hpp"
 
+#include <array>
 #include <cmath>
 #include <string>
 
 namespace tissue {
 
+namespace {
+
+constexpr std::array LINEAR_SOLVER_KINDS{LinearSolverKind::pcg, LinearSolverKind::cholmod,
+                                         LinearSolverKind::pcg_cholesky};
+
+}  // namespace
+
 LinearSolverKind parse_linear_solver_kind(std::string_view name) {
-  if (name == "pcg") return LinearSolverKind::pcg;
-  if (name == "cholmod") return LinearSolverKind::cholmod;
-  throw ParameterError("unknown linear solver '" + std::string(name) + "' (expected pcg or cholmod)");
+  for (const LinearSolverKind kind : LINEAR_SOLVER_KINDS) {
+    if (name == to_string(kind)) return kind;
+  }
+  throw ParameterError("unknown linear solver '" + std::string(name) + "' (expected " +
+                       std::string(linear_solver_names()) + ")");
 }
 
-std::string_view to_string(LinearSolverKind kind) { return kind == LinearSolverKind::pcg ? "pcg" : "cholmod"; }
+std::string_view to_string(LinearSolverKind kind) {
+  switch (kind) {
+    case LinearSolverKind::pcg:
+      return "pcg";
+    case LinearSolverKind::cholmod:
+      return "cholmod";
+    case LinearSolverKind::pcg_cholesky:
+      return "pcg-cholesky";
+  }
+  return "unknown";
+}
+
+std::string_view linear_solver_names() { return "pcg, cholmod or pcg-cholesky"; }
 
 void validate(const SolverSettings& settings) {
   if (!(settings.pcg.tolerance > 0.0) || !std::isfinite(settings.pcg.tolerance)) {
@@ -22,6 +44,14 @@ void validate(const SolverSettings& settings) {
   }
   if (settings.pcg.max_iterations < 1) {
     throw ParameterError("PCG max iterations must be >= 1, got " + std::to_string(settings.pcg.max_iterations));
+  }
+  if (settings.refresh.refresh_iterations < 0) {
+    throw ParameterError("pcg-cholesky refresh iterations must be >= 0, got " +
+                         std::to_string(settings.refresh.refresh_iterations));
+  }
+  if (settings.refresh.pickup_setups < 1) {
+    throw ParameterError("pcg-cholesky pick-up setups must be >= 1, got " +
+                         std::to_string(settings.refresh.pickup_setups));
   }
 }
 
@@ -32,6 +62,8 @@ std::unique_ptr<LinearSolver> make_linear_solver(const SolverSettings& settings)
       return std::make_unique<PcgSolver>(settings.pcg);
     case LinearSolverKind::cholmod:
       return std::make_unique<CholmodSolver>();
+    case LinearSolverKind::pcg_cholesky:
+      return std::make_unique<CholeskyPcgSolver>(settings.pcg, settings.refresh);
   }
   throw ParameterError("unknown linear solver kind");
 }
@@ -52,12 +84,14 @@ void validate(const IntegratorSettings& settings) {
   }
   validate(settings.ida);
   validate(settings.newton);
+  validate_step_threads(settings.threads);
 }
 
 std::unique_ptr<Integrator> make_integrator(const IntegratorSettings& settings, const SolverSettings& solver) {
   validate(settings);
   if (settings.kind == IntegratorKind::ida) return std::make_unique<IdaIntegrator>(settings.ida);
-  return std::make_unique<BackwardEuler>(make_linear_solver(solver), BackwardEuler::Settings{solver.warm_start, settings.newton});
+  return std::make_unique<BackwardEuler>(make_linear_solver(solver),
+                                         BackwardEuler::Settings{solver.warm_start, settings.newton, settings.threads});
 }
 
 }  // namespace tissue

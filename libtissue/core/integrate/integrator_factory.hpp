@@ -12,20 +12,24 @@
 
 namespace tissue {
 
-enum class LinearSolverKind { pcg, cholmod };
+enum class LinearSolverKind { pcg, cholmod, pcg_cholesky };
 
-/// Parses "pcg" / "cholmod"; throws ParameterError otherwise.
+/// Parses "pcg" / "cholmod" / "pcg-cholesky" (linear_solver_names()); throws ParameterError otherwise.
 LinearSolverKind parse_linear_solver_kind(std::string_view name);
 [[nodiscard]] std::string_view to_string(LinearSolverKind kind);
+/// The accepted names, for help texts: "pcg, cholmod or pcg-cholesky".
+[[nodiscard]] std::string_view linear_solver_names();
 
 /// Backward Euler's linear solver.
 struct SolverSettings {
   LinearSolverKind kind = LinearSolverKind::pcg;
-  PcgSolver::Settings pcg;
+  PcgSolver::Settings pcg;  ///< tolerance and iteration cap of pcg and pcg-cholesky
+  CholeskyPcgSolver::Refresh refresh;  ///< pcg-cholesky: when its lagged factor is rebuilt, and where
   bool warm_start = false;  ///< PCG starts from the previous step's velocity change (see BackwardEuler)
 };
 
-/// Throws ParameterError unless tolerance > 0 (finite) and max_iterations >= 1.
+/// Throws ParameterError unless tolerance > 0 (finite), max_iterations >= 1, refresh_iterations >= 0
+/// and pickup_setups >= 1.
 void validate(const SolverSettings& settings);
 std::unique_ptr<LinearSolver> make_linear_solver(const SolverSettings& settings);
 
@@ -39,6 +43,9 @@ struct IntegratorSettings {
   IntegratorKind kind = IntegratorKind::backward_euler;
   IdaSettings ida;  ///< used when kind is ida
   BackwardEuler::NewtonCorrections newton;  ///< used when kind is backward_euler
+  /// Backward Euler: threads per step, 1 or 2 (opt-in; a team made and joined by each step, never
+  /// one that outlives it). Changes no result: the assembly is bitwise the same with either.
+  int threads = 1;
 };
 
 /// Throws ParameterError for an invalid setting (IDA's are checked whatever the kind).

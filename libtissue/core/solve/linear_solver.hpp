@@ -65,6 +65,19 @@ class LinearSolver {
   [[nodiscard]] virtual std::string_view name() const = 0;
 };
 
+/// Conjugate gradients' vectors, kept between solves so that a solve of an unchanged size does not allocate.
+struct PcgWorkspace {
+  Eigen::VectorXd residual, direction, preconditioned, product;
+
+  void resize(long n) {
+    if (residual.size() == n) return;
+    residual.resize(n);
+    direction.resize(n);
+    preconditioned.resize(n);
+    product.resize(n);
+  }
+};
+
 /// Jacobi-preconditioned conjugate gradients. Stops when ||r|| <= tolerance * ||b|| or after
 /// max_iterations (then converged = false; x is the last iterate, which a real-time loop accepts).
 class PcgSolver final : public LinearSolver {
@@ -84,7 +97,74 @@ class PcgSolver final : public LinearSolver {
  private:
   Settings m_settings;
   ShiftedSystem m_system{nullptr, 1.0, nullptr};  // of the last setup()
-  Eigen::VectorXd m_residual, m_direction, m_preconditioned, m_product, m_inverse_diagonal;
+  PcgWorkspace m_work;
+  Eigen::VectorXd m_inverse_diagonal;
+};
+
+/// Conjugate gradients preconditioned by the Cholesky factor of an earlier A (a lagged factor).
+/// On the frog a factorization costs as much as ~60 solves with the factor, and A changes little
+/// from one step to the next, so the factor is kept while it works and rebuilt off the critical path:
+/// * A setup without a usable factor (the first; A smaller than the factor, or another matrix)
+///   factorizes A at once and throws SolverError if A is not positive definite.
+/// * A refresh (a factor of the A of the setup that starts it, values copied then) starts when K's
+///   size or block pattern differs from the factor's (a cut), or when the last solve needed more than
+///   `refresh_iterations` iterations or did not converge. It is factorized in a worker thread
+///   (`background_refactor`) or, without one, at pick-up; either way the setup `pickup_setups` setups
+///   after the start installs it (waiting for the worker if need be), so the results are bitwise the
+///   same whatever the machine's speed and with or without the thread. One refresh at a time.
+/// * While the factor covers fewer rows than A (a cut appended rows at the end), the preconditioner
+///   is block diagonal: the factor on the first rows, Jacobi (1 / diag A) on the appended ones.
+/// * A refresh that fails (not positive definite) is counted and the old factor kept.
+/// A setup or solve that does not start or install a refresh allocates nothing. Stopping rule and
+/// reported residual as PcgSolver's.
+class CholeskyPcgSolver final : public LinearSolver {
+ public:
+  struct Refresh {
+    /// A solve needing more iterations than this asks for a new factor. A fixed count, not a multiple
+    /// of the first solve's: that one is 1-2 iterations with a fresh factor, and a fixed count bounds
+    /// the step's cost (frog: an iteration ~0.12 ms, 10 of them a quarter of a factorization).
+    int refresh_iterations = 10;
+    /// A refresh is installed by the setup this many setups after the one that started it (>= 1).
+    /// 2 leaves the worker a whole step (on another core) for a ~4.5 ms frog factorization; the
+    /// swinging frog's A changes so fast that a factor 4 steps old already needs 60+ iterations.
+    int pickup_setups = 2;
+    /// Factorize in a std::thread (joined at pick-up and in the destructor); false: at pick-up, in
+    /// the caller's thread (same results, for hosts that forbid threads).
+    bool background_refactor = true;
+  };
+  /// What the solver did, for benchmarks and tests. All but `pickups_waited` are deterministic.
+  struct Counters {
+    long setups = 0;
+    long factorizations = 0;        ///< synchronous ones (first setup, unusable factor)
+    long refreshes_started = 0;
+    long refreshes_picked_up = 0;   ///< installed factors
+    long refresh_failures = 0;      ///< refreshes that could not be factorized (old factor kept)
+    long refreshes_discarded = 0;   ///< in flight when a synchronous factorization replaced the factor
+    long pickups_waited = 0;        ///< pick-ups that had to wait for the worker (timing-dependent)
+    long iterations = 0;            ///< CG iterations of all solves
+    long factor_rows = 0;           ///< rows the factor in use covers (the rest: Jacobi)
+  };
+
+  CholeskyPcgSolver(PcgSolver::Settings pcg, Refresh refresh);
+  /// Waits for a refresh in flight.
+  ~CholeskyPcgSolver() override;
+  CholeskyPcgSolver(const CholeskyPcgSolver&) = delete;
+  CholeskyPcgSolver& operator=(const CholeskyPcgSolver&) = delete;
+  using LinearSolver::solve;
+  void setup(const ShiftedSystem& system) override;
+  SolveReport solve(const Eigen::VectorXd& b, Eigen::VectorXd& x) override;
+  [[nodiscard]] bool is_set_up() const override;
+  [[nodiscard]] std::string_view name() const override { return "pcg-cholesky"; }
+
+  [[nodiscard]] const Counters& counters() const;
+  /// Why the last refresh failed ("" if none did).
+  [[nodiscard]] const std::string& last_refresh_failure() const;
+  /// Symbolic analyses so far, over both factors (the one in use and the one being refreshed).
+  [[nodiscard]] int symbolic_analysis_count() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> m_impl;
 };
 
 /// Sparse Cholesky (SuiteSparse CHOLMOD, supernodal). The symbolic analysis (ordering, pattern of L)

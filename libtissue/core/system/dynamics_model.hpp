@@ -5,6 +5,7 @@
 
 #include "core/system/block_sparse_matrix.hpp"
 #include "core/system/rayleigh_damping.hpp"
+#include "core/system/work_team.hpp"
 
 #include <Eigen/Core>
 
@@ -29,6 +30,10 @@ class DynamicsModel {
   /// `update_tangent`, refreshes tangent() = d f_int / d u (the co-rotational R K R^T).
   virtual void evaluate(const Eigen::VectorXd& displacement_m, Eigen::VectorXd& internal_force_n,
                         bool update_tangent) = 0;
+  /// Lends the model a team of threads for its evaluate() calls, until lent nullptr (an integrator
+  /// lends one for the length of a step, see IntegratorSettings::threads). A model may ignore it;
+  /// results must not depend on it.
+  virtual void lend_work_team(WorkTeam* /*team*/) {}
   /// The tangent stiffness of the last evaluate() with update_tangent [N/m].
   [[nodiscard]] virtual const BlockSparseMatrix& tangent() const = 0;
   /// The largest angle [rad] the displacement increment `increment_m` (from the state of the last

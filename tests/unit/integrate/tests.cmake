@@ -2,3 +2,4 @@ tissue_add_test(test_integrate LABELS unit SOURCES integrate/test_backward_euler
 # Counts operator new across steps; its own executable because it replaces the global allocator.
 tissue_add_test(test_step_allocations LABELS unit SOURCES integrate/test_step_allocations.cpp)
 tissue_add_test(test_backward_euler_large_turns LABELS unit SOURCES integrate/test_backward_euler_large_turns.cpp)
+tissue_add_test(test_step_threads LABELS unit SOURCES integrate/test_step_threads.cpp)

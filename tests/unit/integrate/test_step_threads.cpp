@@ -1,0 +1,95 @@
+// The opt-in second thread of a step (IntegratorSettings::threads): the work team itself, the
+// assembly's split of the mesh, and that two threads give bitwise the steps of one.
+#include "core/fixed_region.hpp"
+#include "core/mesh/mesh_io.hpp"
+#include "core/system/work_team.hpp"
+#include "core/tissue.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cstdio>
+#include <string>
+#include <thread>
+#include <vector>
+
+namespace tissue {
+namespace {
+
+TEST(WorkTeam, RunsEveryMemberOncePerJobOnItsOwnThread) {
+  WorkTeam team(2);
+  for (int job = 0; job < 1000; ++job) {
+    std::vector<int> runs(2, 0);
+    std::vector<std::thread::id> ids(2);
+    auto count = [&](int member) {
+      ++runs[static_cast<size_t>(member)];
+      ids[static_cast<size_t>(member)] = std::this_thread::get_id();
+    };
+    team.run(count);
+    ASSERT_EQ(runs, std::vector<int>({1, 1})) << "job " << job;
+    ASSERT_EQ(ids[0], std::this_thread::get_id());
+    ASSERT_NE(ids[1], std::this_thread::get_id());
+  }
+}
+
+TEST(WorkTeam, ThreadSettingsOutsideOneToTwoAreRefused) {
+  EXPECT_THROW(WorkTeam{0}, ParameterError);
+  EXPECT_THROW(WorkTeam{MAX_STEP_THREADS + 1}, ParameterError);
+  TissueSettings settings;
+  settings.integrator.threads = 3;
+  EXPECT_THROW(validate(settings), ParameterError);
+  settings.integrator.threads = 0;
+  EXPECT_THROW(validate(settings), ParameterError);
+}
+
+TetMesh frog() { return read_mesh(std::string(TISSUE_MESH_DIR) + "/frog.veg"); }
+
+TEST(AssemblySplit, EveryTetOnceAndTheHalvesOfAPhaseShareNoVertex) {
+  const TetMesh mesh = frog();
+  const CorotationalElasticity elasticity(mesh, Material{1.0e5, 0.4, 1000.0});
+  std::vector<int> seen(static_cast<size_t>(mesh.tet_count()), 0);
+  for (const CorotationalElasticity::AssemblyPhase& phase : elasticity.assembly_phases()) {
+    std::vector<int> vertex_part(static_cast<size_t>(mesh.vertex_count()), -1);
+    for (int part = 0; part < CorotationalElasticity::ASSEMBLY_PARTS; ++part) {
+      for (const int t : phase[static_cast<size_t>(part)]) {
+        ++seen[static_cast<size_t>(t)];
+        for (const int v : mesh.tets[static_cast<size_t>(t)]) {
+          int& owner = vertex_part[static_cast<size_t>(v)];
+          EXPECT_TRUE(owner == -1 || owner == part) << "vertex " << v << " in both halves of a phase";
+          owner = part;
+        }
+      }
+    }
+    std::printf("frog: a phase of %zu + %zu tets\n", phase[0].size(), phase[1].size());
+  }
+  for (const int t : elasticity.serial_tets()) ++seen[static_cast<size_t>(t)];
+  EXPECT_EQ(seen, std::vector<int>(seen.size(), 1));
+  // The split is worth having: few tets are left to one thread.
+  EXPECT_LT(elasticity.serial_tets().size(), static_cast<size_t>(mesh.tet_count()) / 20);
+  std::printf("frog: %zu tets alone\n", elasticity.serial_tets().size());
+}
+
+// The frog swinging under gravity at the real-time setting, with the large-turn protections (so the
+// Newton corrections and the energy guard run with the team too), with one and with two threads.
+DynamicState run(int threads) {
+  TetMesh mesh = frog();
+  TissueSettings settings;
+  settings.body.material = {1.0e5, 0.4, 1000.0};
+  settings.body.fixed_vertices = vertices_at_minimum(mesh, 0, 0.01);
+  settings.solver.pcg = {1e-3, 10};
+  settings.step_size_s = 0.01;
+  settings.integrator.threads = threads;
+  Tissue tissue(std::move(mesh), settings);
+  for (int step = 0; step < 60; ++step) tissue.step();
+  return tissue.state();
+}
+
+TEST(StepThreads, TwoThreadsGiveBitwiseTheStepsOfOne) {
+  const DynamicState one = run(1);
+  const DynamicState two = run(2);
+  ASSERT_GT(one.displacement_m.cwiseAbs().maxCoeff(), 1e-3);
+  EXPECT_TRUE(one.displacement_m == two.displacement_m);
+  EXPECT_TRUE(one.velocity_m_per_s == two.velocity_m_per_s);
+}
+
+}  // namespace
+}  // namespace tissue
