@@ -20,6 +20,7 @@
 
 #include "core/integrate/integrator.hpp"
 #include "core/tissue.hpp"
+#include "support/under_sanitizer.hpp"
 
 #include <Eigen/Core>
 #include <gtest/gtest.h>
@@ -36,11 +37,7 @@
 namespace tissue::extremes {
 
 /// True in the sanitizer builds (CI's asan preset): cases shrink there, never silently.
-#if defined(__SANITIZE_ADDRESS__)
-inline constexpr bool UNDER_SANITIZER = true;
-#else
-inline constexpr bool UNDER_SANITIZER = false;
-#endif
+using test::UNDER_SANITIZER;
 
 /// The integrators every case runs with.
 enum class Method { euler_pcg, euler_cholmod, ida_klu, ida_krylov };

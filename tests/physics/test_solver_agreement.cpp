@@ -4,6 +4,7 @@
 #include "core/mesh/box_mesh.hpp"
 #include "core/mesh/mesh_io.hpp"
 #include "core/tissue.hpp"
+#include "support/under_sanitizer.hpp"
 
 #include <string>
 
@@ -35,11 +36,7 @@ TEST(SolverAgreement, CholmodAndStrictPcgAgree) {
   EXPECT_LT((direct - iterative).cwiseAbs().maxCoeff(), 1e-6 * direct.cwiseAbs().maxCoeff());
 }
 
-#if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
-constexpr int FROG_STEPS = 40;  // 200 take minutes under a sanitizer; the release run does all
-#else
-constexpr int FROG_STEPS = 200;
-#endif
+constexpr int FROG_STEPS = test::UNDER_SANITIZER ? 40 : 200;  // 200 take minutes under a sanitizer
 
 // The frog as tissue-bench runs it (tail held, gravity along -y, dt = 10 ms, large-turn
 // protection on): 200 steps of a large swing, with many lagged-factor refreshes.

@@ -9,6 +9,7 @@
 #include "core/fixed_region.hpp"
 #include "core/mesh/mesh_io.hpp"
 #include "core/tissue.hpp"
+#include "support/under_sanitizer.hpp"
 
 #include <gtest/gtest.h>
 
@@ -49,15 +50,9 @@ Eigen::VectorXd displacement_after(const Scene& scene, const RotationSettings& r
 
 class SpeedAccuracy : public ::testing::TestWithParam<Scene> {};
 
-#if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
-constexpr bool UNDER_SANITIZER = true;
-#else
-constexpr bool UNDER_SANITIZER = false;
-#endif
-
 TEST_P(SpeedAccuracy, FastRotationsEndWhereTheReferenceEnds) {
   const Scene& scene = GetParam();
-  if (UNDER_SANITIZER && scene.pcg_max_iterations > 10) {
+  if (test::UNDER_SANITIZER && scene.pcg_max_iterations > 10) {
     GTEST_SKIP() << "strict solves take minutes under a sanitizer; the release run checks them";
   }
   RotationSettings reference;

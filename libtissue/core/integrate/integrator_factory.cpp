@@ -36,7 +36,18 @@ std::string_view to_string(LinearSolverKind kind) {
   return "unknown";
 }
 
-std::string_view linear_solver_names() { return "pcg, cholmod or pcg-cholesky"; }
+std::string_view linear_solver_names() {
+  // "a, b or c", from the list above.
+  static const std::string names = [] {
+    std::string text;
+    for (size_t k = 0; k < LINEAR_SOLVER_KINDS.size(); ++k) {
+      if (k > 0) text += k + 1 == LINEAR_SOLVER_KINDS.size() ? " or " : ", ";
+      text += to_string(LINEAR_SOLVER_KINDS[k]);
+    }
+    return text;
+  }();
+  return names;
+}
 
 void validate(const SolverSettings& settings) {
   if (!(settings.pcg.tolerance > 0.0) || !std::isfinite(settings.pcg.tolerance)) {
@@ -45,14 +56,7 @@ void validate(const SolverSettings& settings) {
   if (settings.pcg.max_iterations < 1) {
     throw ParameterError("PCG max iterations must be >= 1, got " + std::to_string(settings.pcg.max_iterations));
   }
-  if (settings.refresh.refresh_iterations < 0) {
-    throw ParameterError("pcg-cholesky refresh iterations must be >= 0, got " +
-                         std::to_string(settings.refresh.refresh_iterations));
-  }
-  if (settings.refresh.pickup_setups < 1) {
-    throw ParameterError("pcg-cholesky pick-up setups must be >= 1, got " +
-                         std::to_string(settings.refresh.pickup_setups));
-  }
+  if (const std::string problem = settings.refresh.problem(); !problem.empty()) throw ParameterError(problem);
 }
 
 std::unique_ptr<LinearSolver> make_linear_solver(const SolverSettings& settings) {

@@ -118,10 +118,15 @@ struct CholeskyPcgSolver::Impl {
   }
 };
 
+std::string CholeskyPcgSolver::Refresh::problem() const {
+  if (refresh_iterations < 0) return "pcg-cholesky refresh iterations must be >= 0, got " + std::to_string(refresh_iterations);
+  if (pickup_setups < 1) return "pcg-cholesky pick-up setups must be >= 1, got " + std::to_string(pickup_setups);
+  return "";
+}
+
 CholeskyPcgSolver::CholeskyPcgSolver(PcgSolver::Settings pcg, Refresh refresh) {
   validate_pcg_settings(pcg, WHO);
-  if (refresh.refresh_iterations < 0) throw SolverError("CholeskyPcgSolver: refresh_iterations must be >= 0");
-  if (refresh.pickup_setups < 1) throw SolverError("CholeskyPcgSolver: pickup_setups must be >= 1");
+  if (const std::string problem = refresh.problem(); !problem.empty()) throw SolverError(std::string(WHO) + ": " + problem);
   m_impl = std::make_unique<Impl>(pcg, refresh);
 }
 

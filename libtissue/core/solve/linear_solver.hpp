@@ -131,6 +131,10 @@ class CholeskyPcgSolver final : public LinearSolver {
     /// Factorize in a std::thread (joined at pick-up and in the destructor); false: at pick-up, in
     /// the caller's thread (same results, for hosts that forbid threads).
     bool background_refactor = true;
+
+    /// The one range rule of these settings: "" when refresh_iterations >= 0 and pickup_setups >= 1,
+    /// else what is wrong (each caller throws it as its own error type).
+    [[nodiscard]] std::string problem() const;
   };
   /// What the solver did, for benchmarks and tests. All but `pickups_waited` are deterministic.
   struct Counters {

@@ -105,20 +105,6 @@ TEST(CholeskyPcg, KeepsTheLaggedFactorAndInstallsARefreshAtThePickUp) { check_la
 
 TEST(CholeskyPcg, SynchronousRefreshFollowsTheSameSchedule) { check_lagged_reuse_and_pickup(false); }
 
-// Appends a block row coupled to `neighbour`, as the XFEM enrichment does (rows at the end).
-void grow(test::TestSystem& system, int neighbour, std::mt19937& rng) {
-  const int row = system.stiffness.append_block_row();
-  system.stiffness.insert_block(row, neighbour);
-  system.stiffness.insert_block(neighbour, row);
-  const long n = system.stiffness.rows();
-  Eigen::MatrixXd grown = Eigen::MatrixXd::Zero(n, n);
-  grown.topLeftCorner(n - 3, n - 3) = system.dense_stiffness;
-  system.dense_stiffness = grown;
-  system.diagonal.conservativeResize(n);
-  system.diagonal.tail<3>().setConstant(0.07);
-  system.add_edge(row, neighbour, test::random_spd_block(rng));
-}
-
 TEST(CholeskyPcg, GrownSystemUsesJacobiOnAppendedRowsUntilTheRefreshLands) {
   test::TestSystem system = test::make_grid_system(5, 4, 4, 45);
   std::mt19937 rng(46);
@@ -138,8 +124,8 @@ TEST(CholeskyPcg, GrownSystemUsesJacobiOnAppendedRowsUntilTheRefreshLands) {
   };
   const long rows_before = system.stiffness.rows();
   check_solve();
-  grow(system, 13, rng);
-  grow(system, 40, rng);
+  test::append_coupled_row(system, 13, rng);
+  test::append_coupled_row(system, 40, rng);
   const long rows_after = system.stiffness.rows();
   ASSERT_EQ(rows_after, rows_before + 6);
 

@@ -82,16 +82,7 @@ TEST(Cholmod, FollowsRelayoutAndAppendedRows) {
   EXPECT_EQ(solver.symbolic_analysis_count(), 2);
 
   // An enriched DOF: a new block row coupled to row 13.
-  const int row = system.stiffness.append_block_row();
-  system.stiffness.insert_block(row, 13);
-  system.stiffness.insert_block(13, row);
-  const long n = system.stiffness.rows();
-  Eigen::MatrixXd grown = Eigen::MatrixXd::Zero(n, n);
-  grown.topLeftCorner(n - 3, n - 3) = system.dense_stiffness;
-  system.dense_stiffness = grown;
-  system.diagonal.conservativeResize(n);
-  system.diagonal.tail<3>().setConstant(0.07);
-  system.add_edge(row, 13, test::random_spd_block(rng));
+  test::append_coupled_row(system, 13, rng);
   expect_matches_dense(solver, system, 1.0, rng);
   EXPECT_EQ(solver.symbolic_analysis_count(), 3);
 }

@@ -55,6 +55,21 @@ inline Eigen::VectorXd random_vector(long n, std::mt19937& rng) {
   return v;
 }
 
+/// Appends a block row coupled to `neighbour` by a random SPD edge, as the XFEM enrichment grows the
+/// system (rows at the end); the appended row's d is 0.07.
+inline void append_coupled_row(TestSystem& system, int neighbour, std::mt19937& rng) {
+  const int row = system.stiffness.append_block_row();
+  system.stiffness.insert_block(row, neighbour);
+  system.stiffness.insert_block(neighbour, row);
+  const long n = system.stiffness.rows();
+  Eigen::MatrixXd grown = Eigen::MatrixXd::Zero(n, n);
+  grown.topLeftCorner(n - 3, n - 3) = system.dense_stiffness;
+  system.dense_stiffness = grown;
+  system.diagonal.conservativeResize(n);
+  system.diagonal.tail<3>().setConstant(0.07);
+  system.add_edge(row, neighbour, random_spd_block(rng));
+}
+
 /// Grid of nx*ny*nz block rows, edges to the +x, +y, +z and +x+y neighbours; d in [0.5, 1.5] * mass.
 /// `with_dense` = false leaves dense_stiffness empty (for systems too large for a dense reference).
 inline TestSystem make_grid_system(int nx, int ny, int nz, unsigned seed, double mass = 0.05,
