@@ -5,6 +5,7 @@
 #include "core/fem/corotational.hpp"
 
 #include "core/fem/corotational_kernel.hpp"
+#include "core/system/hot_kernel.hpp"
 
 #include <algorithm>
 #include <cassert>
@@ -145,7 +146,7 @@ void CorotationalElasticity::evaluate(const Eigen::VectorXd& positions_m, Eigen:
   add_tets(m_serial_tets, positions_m, internal_forces_n, tangent, slots);
 }
 
-void CorotationalElasticity::add_tets(const std::vector<int>& tets, const Eigen::VectorXd& positions_m,
+TISSUE_HOT_KERNEL void CorotationalElasticity::add_tets(const std::vector<int>& tets, const Eigen::VectorXd& positions_m,
                                       Eigen::VectorXd& internal_forces_n, BlockSparseMatrix* tangent,
                                       const std::vector<TetSlots>* slots) {
   // Tets go in batches of ROTATION_BATCH: their rotations are extracted side by side (SIMD lanes),
@@ -173,7 +174,7 @@ void CorotationalElasticity::add_tets(const std::vector<int>& tets, const Eigen:
   }
 }
 
-void CorotationalElasticity::add_tet(size_t t, const Eigen::Matrix3d& f, Eigen::VectorXd& internal_forces_n,
+TISSUE_HOT_KERNEL void CorotationalElasticity::add_tet(size_t t, const Eigen::Matrix3d& f, Eigen::VectorXd& internal_forces_n,
                                      BlockSparseMatrix* tangent, const std::vector<TetSlots>* slots) const {
   const Tet& tet = m_tets[t];
   const TetRest& rest = m_rest[t];

@@ -2,6 +2,7 @@
 #include "core/fem/rotation.hpp"
 
 #include "core/parameter_error.hpp"
+#include "core/system/hot_kernel.hpp"
 
 #include <Eigen/SVD>
 
@@ -154,7 +155,7 @@ bool any(LaneMask mask) {
 
 }  // namespace
 
-void extract_rotations(int count, const Eigen::Matrix3d* f_in, Eigen::Quaterniond* const* warm_starts,
+TISSUE_HOT_KERNEL void extract_rotations(int count, const Eigen::Matrix3d* f_in, Eigen::Quaterniond* const* warm_starts,
                        Eigen::Matrix3d* const* rotations, const RotationSettings& settings) {
   if (count <= 0) return;
   if (count > ROTATION_BATCH) {

@@ -8,6 +8,8 @@
 // slots hold column -1 and zero values, so a newly used slot is a zero block.
 #include "core/system/block_sparse_matrix.hpp"
 
+#include "core/system/hot_kernel.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
@@ -115,7 +117,7 @@ void BlockSparseMatrix::set_zero() {
   }
 }
 
-void BlockSparseMatrix::multiply(const Eigen::VectorXd& x, Eigen::VectorXd& y) const {
+TISSUE_HOT_KERNEL void BlockSparseMatrix::multiply(const Eigen::VectorXd& x, Eigen::VectorXd& y) const {
   const int n = block_rows();
   if (x.size() != rows()) {
     throw std::invalid_argument("BlockSparseMatrix::multiply: x has length " + std::to_string(x.size()) +
