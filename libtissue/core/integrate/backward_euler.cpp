@@ -14,16 +14,24 @@ double seconds_since(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 
-// Lends a step's team to the model and takes it back when the step ends, however it ends.
+// Lends a step's team to the model and the solver and takes it back when the step ends, however
+// it ends.
 class TeamLoan {
  public:
-  TeamLoan(DynamicsModel& model, WorkTeam* team) : m_model(model) { m_model.lend_work_team(team); }
-  ~TeamLoan() { m_model.lend_work_team(nullptr); }
+  TeamLoan(DynamicsModel& model, LinearSolver& solver, WorkTeam* team) : m_model(model), m_solver(solver) {
+    m_model.lend_work_team(team);
+    m_solver.lend_work_team(team);
+  }
+  ~TeamLoan() {
+    m_model.lend_work_team(nullptr);
+    m_solver.lend_work_team(nullptr);
+  }
   TeamLoan(const TeamLoan&) = delete;
   TeamLoan& operator=(const TeamLoan&) = delete;
 
  private:
   DynamicsModel& m_model;
+  LinearSolver& m_solver;
 };
 
 }  // namespace
@@ -93,7 +101,7 @@ StepReport BackwardEuler::step(DynamicsModel& model, DynamicState& state, double
   // The opt-in team lives for this step only: joined (and taken back from the model) on every exit.
   std::optional<WorkTeam> team;
   if (m_settings.threads > 1) team.emplace(m_settings.threads);
-  const TeamLoan loan(model, team ? &*team : nullptr);
+  const TeamLoan loan(model, *m_solver, team ? &*team : nullptr);
   const auto assembly_start = std::chrono::steady_clock::now();
   model.evaluate(state.displacement_m, m_internal_force_n, /*update_tangent=*/true);
   const BlockSparseMatrix& stiffness = model.tangent();

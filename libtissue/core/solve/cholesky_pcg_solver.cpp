@@ -31,8 +31,9 @@ constexpr const char* WHO = "CholeskyPcgSolver";
 struct CholeskyPcgSolver::Impl {
   PcgSolver::Settings pcg;
   Refresh refresh;
-  std::unique_ptr<CholmodFactor> active = std::make_unique<CholmodFactor>();  // the preconditioner
-  std::unique_ptr<CholmodFactor> spare = std::make_unique<CholmodFactor>();   // the refresh's, worker-owned in flight
+  // Solves without BLAS: a refresh's factorization (BLAS) may run beside them (cholmod_factor.hpp).
+  std::unique_ptr<CholmodFactor> active = std::make_unique<CholmodFactor>(CholmodFactor::Solves::without_blas);
+  std::unique_ptr<CholmodFactor> spare = std::make_unique<CholmodFactor>(CholmodFactor::Solves::without_blas);
   std::thread worker;
   std::atomic<bool> worker_done{false};
   bool in_flight = false;
@@ -44,6 +45,7 @@ struct CholeskyPcgSolver::Impl {
   Eigen::VectorXd inverse_diagonal;  // 1 / diag(A): the rows the factor does not cover
   Counters counters;
   std::string last_failure;
+  WorkTeam* team = nullptr;  // lent for a step: CG's products and updates (the factor solve stays on one thread)
 
   Impl(PcgSolver::Settings p, Refresh r) : pcg(p), refresh(r) {}
   ~Impl() { join(); }
@@ -132,6 +134,8 @@ CholeskyPcgSolver::CholeskyPcgSolver(PcgSolver::Settings pcg, Refresh refresh) {
 
 CholeskyPcgSolver::~CholeskyPcgSolver() = default;
 
+void CholeskyPcgSolver::lend_work_team(WorkTeam* team) { m_impl->team = team; }
+
 bool CholeskyPcgSolver::is_set_up() const { return m_impl->system.stiffness != nullptr; }
 
 const CholeskyPcgSolver::Counters& CholeskyPcgSolver::counters() const { return m_impl->counters; }
@@ -174,8 +178,10 @@ SolveReport CholeskyPcgSolver::solve(const Eigen::VectorXd& b, Eigen::VectorXd& 
   if (!is_set_up()) throw SolverError("CholeskyPcgSolver: solve() without a setup()");
   impl.system.check_sizes(b, x);
   const SolveReport report =
-      preconditioned_cg(impl.system, b, x, impl.pcg.tolerance, impl.pcg.max_iterations, impl.work,
-                        [&impl](const Eigen::VectorXd& r, Eigen::VectorXd& z) { impl.precondition(r, z); });
+      preconditioned_cg</*ROW_WISE=*/false>(impl.system, b, x, impl.pcg.tolerance, impl.pcg.max_iterations, impl.work,
+                                            impl.team, [&impl](const Eigen::VectorXd& r, Eigen::VectorXd& z, long, long) {
+                                              impl.precondition(r, z);
+                                            });
   impl.counters.iterations += report.iterations;
   if (!report.converged || report.iterations > impl.refresh.refresh_iterations) impl.refresh_wanted = true;
   return report;

@@ -17,11 +17,23 @@
 #include "core/solve/cholmod_factor.hpp"
 
 #include <algorithm>
+#include <mutex>
 #include <utility>
 
 namespace tissue {
+namespace {
 
-CholmodFactor::CholmodFactor() {
+// The CHOLMOD calls that reach BLAS (a supernodal factorization, a solve with a supernodal factor)
+// take turns across the process: Debian's serial OpenBLAS hands concurrent callers the same work
+// buffers (Cholmod.TwoSolversOnTwoThreadsGiveBitwiseTheirSerialResults).
+std::mutex& blas_turn() {
+  static std::mutex turn;
+  return turn;
+}
+
+}  // namespace
+
+CholmodFactor::CholmodFactor(Solves solves) : m_solves(solves) {
   cholmod_start(&m_common);
   m_common.print = 0;
   m_common.nmethods = 1;
@@ -41,6 +53,7 @@ CholmodFactor::~CholmodFactor() {
 
 void CholmodFactor::free_pattern() {
   m_status = Status::none;
+  cholmod_free_factor(&m_simplicial, &m_common);
   cholmod_free_factor(&m_factor, &m_common);
   cholmod_free_sparse(&m_matrix, &m_common);
   m_source = nullptr;
@@ -130,6 +143,7 @@ CholmodFactor::Status CholmodFactor::factorize() noexcept {
   m_status = Status::failed;
   m_cholmod_status = 0;
   m_minor = 0;
+  cholmod_free_factor(&m_simplicial, &m_common);
   if (m_matrix == nullptr) {
     m_failed_step = "factorization without a loaded matrix";
     return m_status;
@@ -145,7 +159,12 @@ CholmodFactor::Status CholmodFactor::factorize() noexcept {
     }
     m_analysis_pending = false;
   }
-  cholmod_factorize(m_matrix, m_factor, &m_common);
+  {
+    // The lock is held whether or not this factor turns out supernodal: only BLAS is guarded, and
+    // a simplicial factorization costs little.
+    const std::lock_guard<std::mutex> turn(blas_turn());
+    cholmod_factorize(m_matrix, m_factor, &m_common);
+  }
   m_cholmod_status = m_common.status;
   if (m_common.status < 0) {
     m_failed_step = "numeric factorization";
@@ -155,6 +174,16 @@ CholmodFactor::Status CholmodFactor::factorize() noexcept {
     m_minor = m_factor->minor;
     m_status = Status::not_positive_definite;
     return m_status;
+  }
+  if (m_solves == Solves::without_blas) {
+    m_simplicial = cholmod_copy_factor(m_factor, &m_common);
+    if (m_simplicial == nullptr ||
+        cholmod_change_factor(CHOLMOD_REAL, /*to_ll=*/1, /*to_super=*/0, /*to_packed=*/1, /*to_monotonic=*/1,
+                              m_simplicial, &m_common) == 0) {
+      m_failed_step = "simplicial copy of the factor";
+      m_cholmod_status = m_common.status;
+      return m_status;
+    }
   }
   m_status = Status::ok;
   return m_status;
@@ -180,8 +209,12 @@ void CholmodFactor::solve(std::span<const double> b, std::span<double> x) {
     if (m_rhs == nullptr) throw SolverError("CHOLMOD: allocating b failed");
   }
   std::copy(b.begin(), b.end(), static_cast<double*>(m_rhs->x));
+  cholmod_factor* factor = m_simplicial != nullptr ? m_simplicial : m_factor;
+  std::unique_lock<std::mutex> turn(blas_turn(), std::defer_lock);
+  if (factor->is_super) turn.lock();  // a simplicial solve calls no BLAS
   const int solved =
-      cholmod_solve2(CHOLMOD_A, m_factor, m_rhs, nullptr, &m_solution, nullptr, &m_work_y, &m_work_e, &m_common);
+      cholmod_solve2(CHOLMOD_A, factor, m_rhs, nullptr, &m_solution, nullptr, &m_work_y, &m_work_e, &m_common);
+  if (turn.owns_lock()) turn.unlock();
   if (solved == 0 || m_solution == nullptr) {
     throw_if_failed("solve");
     throw SolverError("CHOLMOD: solve failed");

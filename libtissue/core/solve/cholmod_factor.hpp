@@ -5,7 +5,11 @@
 // in use and the one being refreshed, possibly in another thread).
 //
 // Each object has its own cholmod_common, so two objects may be used from two threads at once;
-// one object is not thread-safe. factorize() never throws (it may run in a worker thread): it
+// one object is not thread-safe. CHOLMOD's supernodal factorization and solves call BLAS, and the
+// serial OpenBLAS of Debian is not safe to call from two threads at once (it hands both the same
+// work buffer: a lagged-factor run whose refresh overlapped the solves differed from run to run),
+// so a factor whose solves run beside another factorization solves with a simplicial copy of
+// itself (Solves::without_blas), which CHOLMOD solves without BLAS. factorize() never throws (it may run in a worker thread): it
 // returns a status, and failure_message() says why in the caller's thread.
 #pragma once
 
@@ -23,8 +27,11 @@ namespace tissue {
 class CholmodFactor {
  public:
   enum class Status { none, ok, not_positive_definite, failed };
+  /// supernodal: solve with the factor itself (BLAS); without_blas: factorize() also makes a
+  /// simplicial copy (no BLAS in its solves), for solves that run beside another factorization.
+  enum class Solves { supernodal, without_blas };
 
-  CholmodFactor();
+  explicit CholmodFactor(Solves solves = Solves::supernodal);
   ~CholmodFactor();
   CholmodFactor(const CholmodFactor&) = delete;
   CholmodFactor& operator=(const CholmodFactor&) = delete;
@@ -64,6 +71,8 @@ class CholmodFactor {
   cholmod_common m_common{};
   cholmod_sparse* m_matrix = nullptr;    // upper triangle of A, stype = 1, sorted, packed
   cholmod_factor* m_factor = nullptr;    // symbolic analysis + numeric factor of m_matrix
+  cholmod_factor* m_simplicial = nullptr;  // Solves::without_blas: a simplicial copy, what solve() uses
+  Solves m_solves = Solves::supernodal;
   cholmod_dense* m_rhs = nullptr;        // b, n x 1
   cholmod_dense* m_solution = nullptr;   // x, n x 1 (owned by cholmod_solve2, reused)
   cholmod_dense* m_work_y = nullptr;     // cholmod_solve2 workspaces, reused between solves

@@ -6,6 +6,7 @@
 #pragma once
 
 #include "core/system/block_sparse_matrix.hpp"
+#include "core/system/work_team.hpp"
 
 #include <Eigen/Core>
 
@@ -24,6 +25,8 @@ struct ShiftedSystem {
   [[nodiscard]] int rows() const { return stiffness->rows(); }
   /// y = A x. No allocation. x and y must be different vectors.
   void multiply(const Eigen::VectorXd& x, Eigen::VectorXd& y) const;
+  /// The block rows [first_block_row, end_block_row) of y = A x (y has length rows() already).
+  void multiply_rows(const Eigen::VectorXd& x, Eigen::VectorXd& y, int first_block_row, int end_block_row) const;
   /// Throws SolverError unless K and d are set, and d, b and x all have length rows().
   void check_sizes(const Eigen::VectorXd& b, const Eigen::VectorXd& x) const;
 };
@@ -62,6 +65,10 @@ class LinearSolver {
   }
   /// Whether solve(b, x) has an A to use.
   [[nodiscard]] virtual bool is_set_up() const = 0;
+  /// Lends the solver a team of threads for its solves until lent nullptr (an integrator lends its
+  /// step's team for the step only). The CG solvers split their products and vector updates over
+  /// it, with bitwise the results of one thread; CHOLMOD ignores it.
+  virtual void lend_work_team(WorkTeam* /*team*/) {}
   [[nodiscard]] virtual std::string_view name() const = 0;
 };
 
@@ -92,6 +99,7 @@ class PcgSolver final : public LinearSolver {
   SolveReport solve(const Eigen::VectorXd& b, Eigen::VectorXd& x) override;
   [[nodiscard]] bool is_set_up() const override { return m_system.stiffness != nullptr; }
   [[nodiscard]] std::string_view name() const override { return "pcg"; }
+  void lend_work_team(WorkTeam* team) override { m_team = team; }
   [[nodiscard]] const Settings& settings() const { return m_settings; }
 
  private:
@@ -99,6 +107,7 @@ class PcgSolver final : public LinearSolver {
   ShiftedSystem m_system{nullptr, 1.0, nullptr};  // of the last setup()
   PcgWorkspace m_work;
   Eigen::VectorXd m_inverse_diagonal;
+  WorkTeam* m_team = nullptr;  // lent for a step
 };
 
 /// Conjugate gradients preconditioned by the Cholesky factor of an earlier A (a lagged factor).
@@ -159,6 +168,7 @@ class CholeskyPcgSolver final : public LinearSolver {
   SolveReport solve(const Eigen::VectorXd& b, Eigen::VectorXd& x) override;
   [[nodiscard]] bool is_set_up() const override;
   [[nodiscard]] std::string_view name() const override { return "pcg-cholesky"; }
+  void lend_work_team(WorkTeam* team) override;
 
   [[nodiscard]] const Counters& counters() const;
   /// Why the last refresh failed ("" if none did).

@@ -1,13 +1,21 @@
 // The preconditioned conjugate-gradient loop (internal to core/solve), written once for every
 // preconditioner: PcgSolver passes Jacobi, CholeskyPcgSolver a lagged Cholesky factor.
 //
+// The vectors are worked on in two parts of block rows of about equal matrix work (VectorParts);
+// with a team of two threads each member takes one part of every mat-vec and vector update, and
+// the dot products are the sum of the parts' dots in part order with one thread or two, so two
+// threads give bitwise the iterates of one. A row-wise preconditioner (Jacobi) is applied part by
+// part; another (a Cholesky factor) by the calling thread on the whole vector.
+//
 // The reported relative_residual is that of the recursively updated residual r_k, which CG
 // carries anyway; it drifts from the true b - A x_k only by rounding (relative ~1e-15 * cond),
 // far below any tolerance a real-time step uses, and checking it would cost one more product.
 #pragma once
 
 #include "core/solve/linear_solver.hpp"
+#include "core/system/work_team.hpp"
 
+#include <array>
 #include <cmath>
 
 namespace tissue {
@@ -19,15 +27,66 @@ void check_system(const ShiftedSystem& system, const char* who);
 /// 1 / diag(A), length rows() (resized if needed); throws SolverError for an entry <= 0 or not finite.
 void jacobi_inverse_diagonal(const ShiftedSystem& system, Eigen::VectorXd& inverse_diagonal, const char* who);
 
+/// The rows of a system's vectors in PARTS consecutive parts (boundaries on block rows, balanced by
+/// the matrix blocks of each part), and the team (or none) that works on them side by side.
+class VectorParts {
+ public:
+  static constexpr int PARTS = MAX_STEP_THREADS;  // one per member of the largest team
+
+  VectorParts(const BlockSparseMatrix& matrix, WorkTeam* team) : m_team(team) {
+    for (int part = 0; part < PARTS; ++part) {
+      m_first_block_row[static_cast<size_t>(part)] = matrix.balanced_row_split(part, PARTS);
+    }
+    m_first_block_row[PARTS] = matrix.block_rows();
+  }
+  [[nodiscard]] int first_block_row(int part) const { return m_first_block_row[static_cast<size_t>(part)]; }
+  [[nodiscard]] int end_block_row(int part) const { return m_first_block_row[static_cast<size_t>(part) + 1]; }
+  [[nodiscard]] long first(int part) const { return 3L * first_block_row(part); }
+  [[nodiscard]] long count(int part) const { return 3L * (end_block_row(part) - first_block_row(part)); }
+
+  /// job(part) for every part: side by side with a team of PARTS members, else in part order.
+  template <class Job>
+  void run(Job&& job) const {
+    if (m_team != nullptr && m_team->size() == PARTS) {
+      m_team->run(job);
+    } else {
+      for (int part = 0; part < PARTS; ++part) job(part);
+    }
+  }
+
+ private:
+  WorkTeam* m_team;
+  std::array<int, PARTS + 1> m_first_block_row{};
+};
+
+/// Per-part partial sums, added in part order (the same with one thread or two).
+struct PartSums {
+  std::array<double, VectorParts::PARTS> values{};
+  [[nodiscard]] double total() const {
+    double sum = 0.0;
+    for (const double value : values) sum += value;
+    return sum;
+  }
+};
+
 /// Solves A x = b from the initial guess x (a non-finite guess is replaced by zero) until
-/// ||r|| <= tolerance * ||b|| or max_iterations. `precondition(r, z)` sets z = P^-1 r for an SPD
-/// P (z has r's length and is not r). Sizes checked by the caller; `work` sized by it.
-template <class Preconditioner>
+/// ||r|| <= tolerance * ||b|| or max_iterations. `precondition(r, z, first, count)` sets
+/// z = P^-1 r for an SPD P: with ROW_WISE it is called for each part's rows (z_i depends on r_i
+/// only) and must write only those; otherwise once for all rows (first 0, count rows()). z has r's
+/// length and is not r. Sizes checked by the caller; `work` sized by it. `team`: nullptr, or two
+/// members that share the work (the results are bitwise the same).
+template <bool ROW_WISE, class Preconditioner>
 SolveReport preconditioned_cg(const ShiftedSystem& system, const Eigen::VectorXd& b, Eigen::VectorXd& x,
-                              double tolerance, int max_iterations, PcgWorkspace& work,
+                              double tolerance, int max_iterations, PcgWorkspace& work, WorkTeam* team,
                               Preconditioner&& precondition) {
   SolveReport report;
-  const double b_norm = b.norm();
+  const VectorParts parts(*system.stiffness, team);
+  const auto segment = [&parts](auto& v, int part) { return v.segment(parts.first(part), parts.count(part)); };
+  PartSums b_squared, r_squared, rz_parts, curvature_parts;
+  for (int part = 0; part < VectorParts::PARTS; ++part) {
+    b_squared.values[static_cast<size_t>(part)] = segment(b, part).squaredNorm();
+  }
+  const double b_norm = std::sqrt(b_squared.total());
   if (b_norm == 0.0) {
     x.setZero();
     report.converged = true;
@@ -35,9 +94,12 @@ SolveReport preconditioned_cg(const ShiftedSystem& system, const Eigen::VectorXd
   }
 
   // r = b - A x, warm-started from the caller's x; a non-finite guess is replaced by zero.
-  system.multiply(x, work.product);
-  work.residual = b - work.product;
-  double r_norm = work.residual.norm();
+  parts.run([&](int part) {
+    system.multiply_rows(x, work.product, parts.first_block_row(part), parts.end_block_row(part));
+    segment(work.residual, part) = segment(b, part) - segment(work.product, part);
+    r_squared.values[static_cast<size_t>(part)] = segment(work.residual, part).squaredNorm();
+  });
+  double r_norm = std::sqrt(r_squared.total());
   if (!std::isfinite(r_norm)) {
     x.setZero();
     work.residual = b;
@@ -50,19 +112,38 @@ SolveReport preconditioned_cg(const ShiftedSystem& system, const Eigen::VectorXd
     return report;
   }
 
-  precondition(work.residual, work.preconditioned);
+  // z = P^-1 r and the parts of r . z (row-wise: inside the parts' jobs).
+  auto precondition_part = [&](int part) {
+    if constexpr (ROW_WISE) precondition(work.residual, work.preconditioned, parts.first(part), parts.count(part));
+    rz_parts.values[static_cast<size_t>(part)] = segment(work.residual, part).dot(segment(work.preconditioned, part));
+  };
+  auto precondition_all = [&] {
+    if constexpr (!ROW_WISE) precondition(work.residual, work.preconditioned, 0L, work.residual.size());
+    parts.run(precondition_part);
+    return rz_parts.total();
+  };
+
+  double rz = precondition_all();
   work.direction = work.preconditioned;
-  double rz = work.residual.dot(work.preconditioned);
+  double alpha = 0.0;
+  double beta = 0.0;
   for (int k = 1; k <= max_iterations; ++k) {
-    system.multiply(work.direction, work.product);
-    const double curvature = work.direction.dot(work.product);
+    parts.run([&](int part) {
+      system.multiply_rows(work.direction, work.product, parts.first_block_row(part), parts.end_block_row(part));
+      curvature_parts.values[static_cast<size_t>(part)] = segment(work.direction, part).dot(segment(work.product, part));
+    });
+    const double curvature = curvature_parts.total();
     // Breakdown: A is not positive definite along p (or the values are not finite). Keep the
     // last iterate and say so; the caller decides whether to accept it.
     if (!(curvature > 0.0) || !std::isfinite(curvature)) break;
-    const double alpha = rz / curvature;
-    x += alpha * work.direction;
-    work.residual -= alpha * work.product;
-    r_norm = work.residual.norm();
+    alpha = rz / curvature;
+    parts.run([&](int part) {
+      segment(x, part) += alpha * segment(work.direction, part);
+      segment(work.residual, part) -= alpha * segment(work.product, part);
+      r_squared.values[static_cast<size_t>(part)] = segment(work.residual, part).squaredNorm();
+      if constexpr (ROW_WISE) precondition_part(part);
+    });
+    r_norm = std::sqrt(r_squared.total());
     report.iterations = k;
     report.relative_residual = r_norm / b_norm;
     if (r_norm <= threshold) {
@@ -70,11 +151,12 @@ SolveReport preconditioned_cg(const ShiftedSystem& system, const Eigen::VectorXd
       break;
     }
     if (!std::isfinite(r_norm)) break;
-    precondition(work.residual, work.preconditioned);
-    const double rz_next = work.residual.dot(work.preconditioned);
-    const double beta = rz_next / rz;
+    const double rz_next = ROW_WISE ? rz_parts.total() : precondition_all();
+    beta = rz_next / rz;
     rz = rz_next;
-    work.direction = work.preconditioned + beta * work.direction;
+    parts.run([&](int part) {
+      segment(work.direction, part) = segment(work.preconditioned, part) + beta * segment(work.direction, part);
+    });
   }
   return report;
 }

@@ -53,10 +53,11 @@ void PcgSolver::setup(const ShiftedSystem& system) {
 SolveReport PcgSolver::solve(const Eigen::VectorXd& b, Eigen::VectorXd& x) {
   if (!is_set_up()) throw SolverError("PcgSolver: solve() without a setup()");
   m_system.check_sizes(b, x);
-  return preconditioned_cg(m_system, b, x, m_settings.tolerance, m_settings.max_iterations, m_work,
-                           [this](const Eigen::VectorXd& r, Eigen::VectorXd& z) {
-                             z = m_inverse_diagonal.cwiseProduct(r);
-                           });
+  return preconditioned_cg</*ROW_WISE=*/true>(
+      m_system, b, x, m_settings.tolerance, m_settings.max_iterations, m_work, m_team,
+      [this](const Eigen::VectorXd& r, Eigen::VectorXd& z, long first, long count) {
+        z.segment(first, count) = m_inverse_diagonal.segment(first, count).cwiseProduct(r.segment(first, count));
+      });
 }
 
 }  // namespace tissue

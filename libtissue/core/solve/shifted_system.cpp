@@ -12,6 +12,15 @@ void ShiftedSystem::multiply(const Eigen::VectorXd& x, Eigen::VectorXd& y) const
   y.array() = stiffness_scale * y.array() + diagonal->array() * x.array();
 }
 
+void ShiftedSystem::multiply_rows(const Eigen::VectorXd& x, Eigen::VectorXd& y, int first_block_row,
+                                  int end_block_row) const {
+  stiffness->multiply_rows(x, y, first_block_row, end_block_row);
+  const long first = 3L * first_block_row;
+  const long count = 3L * (end_block_row - first_block_row);
+  y.segment(first, count).array() =
+      stiffness_scale * y.segment(first, count).array() + diagonal->segment(first, count).array() * x.segment(first, count).array();
+}
+
 void ShiftedSystem::check_sizes(const Eigen::VectorXd& b, const Eigen::VectorXd& x) const {
   if (stiffness == nullptr || diagonal == nullptr)
     throw SolverError("linear solve: the system has no stiffness or no diagonal");

@@ -117,7 +117,7 @@ void BlockSparseMatrix::set_zero() {
   }
 }
 
-TISSUE_HOT_KERNEL void BlockSparseMatrix::multiply(const Eigen::VectorXd& x, Eigen::VectorXd& y) const {
+void BlockSparseMatrix::multiply(const Eigen::VectorXd& x, Eigen::VectorXd& y) const {
   const int n = block_rows();
   if (x.size() != rows()) {
     throw std::invalid_argument("BlockSparseMatrix::multiply: x has length " + std::to_string(x.size()) +
@@ -125,7 +125,21 @@ TISSUE_HOT_KERNEL void BlockSparseMatrix::multiply(const Eigen::VectorXd& x, Eig
   }
   if (&x == &y) throw std::invalid_argument("BlockSparseMatrix::multiply: x and y must be different vectors");
   y.resize(rows());  // no-op (and no allocation) when the size is right
+  multiply_rows(x, y, 0, n);
+}
 
+int BlockSparseMatrix::balanced_row_split(int part, int parts) const {
+  if (part <= 0 || parts <= 1) return 0;
+  if (part >= parts) return block_rows();
+  const long wanted = static_cast<long>(m_nonzero_blocks) * part / parts;
+  long blocks = 0;
+  int row = 0;
+  for (; row < block_rows() && blocks < wanted; ++row) blocks += m_row_size[to_size(row)];
+  return row;
+}
+
+TISSUE_HOT_KERNEL void BlockSparseMatrix::multiply_rows(const Eigen::VectorXd& x, Eigen::VectorXd& y,
+                                                        int first_block_row, int end_block_row) const {
   // The inner kernel of PCG: plain loops over raw arrays, three accumulators per block row,
   // so that the compiler keeps them in registers and the slots are streamed once, in order.
   const double* __restrict xv = x.data();
@@ -136,7 +150,7 @@ TISSUE_HOT_KERNEL void BlockSparseMatrix::multiply(const Eigen::VectorXd& x, Eig
   const int* row_size = m_row_size.data();
   // Two blocks per turn into two sets of accumulators: the additions into y0..y2 form the loop's
   // dependency chain, and two independent chains keep the adders busy (~25% faster than one).
-  for (int r = 0; r < n; ++r) {
+  for (int r = first_block_row; r < end_block_row; ++r) {
     const int begin = row_begin[r];
     const int end = begin + row_size[r];
     double y0 = 0.0, y1 = 0.0, y2 = 0.0;

@@ -49,6 +49,12 @@ class BlockSparseMatrix {
 
   /// y = A x, both of length rows(). y is overwritten. No allocation.
   void multiply(const Eigen::VectorXd& x, Eigen::VectorXd& y) const;
+  /// The block rows [first_block_row, end_block_row) of y = A x; y must have length rows() already
+  /// (two threads may fill disjoint row ranges of one y). Sizes are the caller's to check.
+  void multiply_rows(const Eigen::VectorXd& x, Eigen::VectorXd& y, int first_block_row, int end_block_row) const;
+  /// The first block row of part `part` of `parts` consecutive row ranges holding about equal
+  /// numbers of blocks (part 0 starts at row 0).
+  [[nodiscard]] int balanced_row_split(int part, int parts) const;
 
   /// The scalar diagonal (length rows()) into `diagonal` (resized if needed).
   void diagonal(Eigen::VectorXd& diagonal) const;

@@ -12,6 +12,8 @@
 #include <limits>
 #include <random>
 #include <string>
+#include <thread>
+#include <vector>
 
 namespace tissue {
 namespace {
@@ -171,6 +173,47 @@ TEST(Cholmod, AgreesWithPcg) {
   const SolveReport report = pcg.solve(shifted, b, iterative);
   EXPECT_TRUE(report.converged);
   EXPECT_LE((direct - iterative).norm(), 1e-8 * direct.norm());
+}
+
+}  // namespace
+}  // namespace tissue
+
+namespace tissue {
+namespace {
+
+// CHOLMOD's supernodal factorization and solves call BLAS, and Debian's serial OpenBLAS is not
+// safe to call from two threads at once: two solvers on two threads (tissue-host compare --jobs 2,
+// or pcg-cholesky's refresh beside its solves) got each other's work buffers and results that
+// changed from run to run. Two solvers on two threads must give bitwise what each gives alone.
+TEST(Cholmod, TwoSolversOnTwoThreadsGiveBitwiseTheirSerialResults) {
+  // Large enough that CHOLMOD goes supernodal (BLAS); a grid of a few hundred rows stays simplicial.
+  const test::TestSystem first = test::make_grid_system(14, 12, 10, 61, 0.05, {}, false);
+  const test::TestSystem second = test::make_grid_system(12, 12, 12, 62, 0.05, {}, false);
+  std::mt19937 rng(63);
+  const Eigen::VectorXd b_first = test::random_vector(first.stiffness.rows(), rng);
+  const Eigen::VectorXd b_second = test::random_vector(second.stiffness.rows(), rng);
+  const auto solve = [](const test::TestSystem& system, const Eigen::VectorXd& b, int scale_step) {
+    CholmodSolver solver;
+    Eigen::VectorXd x;
+    solver.solve(system.shifted(1.0 + 0.01 * scale_step), b, x);
+    return x;
+  };
+  constexpr int SOLVES = 12;
+  std::vector<Eigen::VectorXd> alone_first, alone_second;
+  for (int k = 0; k < SOLVES; ++k) {
+    alone_first.push_back(solve(first, b_first, k));
+    alone_second.push_back(solve(second, b_second, k));
+  }
+  std::vector<Eigen::VectorXd> beside_first(SOLVES), beside_second(SOLVES);
+  std::thread other([&] {
+    for (int k = 0; k < SOLVES; ++k) beside_second[static_cast<size_t>(k)] = solve(second, b_second, k);
+  });
+  for (int k = 0; k < SOLVES; ++k) beside_first[static_cast<size_t>(k)] = solve(first, b_first, k);
+  other.join();
+  for (size_t k = 0; k < SOLVES; ++k) {
+    EXPECT_TRUE(beside_first[k] == alone_first[k]) << "solve " << k << " of the first system";
+    EXPECT_TRUE(beside_second[k] == alone_second[k]) << "solve " << k << " of the second system";
+  }
 }
 
 }  // namespace

@@ -7,6 +7,8 @@
 #include <Eigen/Dense>
 
 #include <algorithm>
+#include <cstdlib>
+#include <limits>
 #include <map>
 #include <random>
 #include <stdexcept>
@@ -147,6 +149,37 @@ TEST(BlockSparseMatrix, MultiplyMatchesDenseReference) {
     const BlockMap blocks = fill_random(matrix, pattern, rng);
     EXPECT_EQ(matrix.nonzero_blocks(), static_cast<int>(blocks.size()));
     expect_product_matches(matrix, blocks, rng);
+  }
+}
+
+// Two threads of CG each take one part of the rows: the parts' products together are the whole
+// product bitwise, and the split balances the blocks to within one row's.
+TEST(BlockSparseMatrix, RowPartsOfTheProductMakeTheWholeAndBalanceTheBlocks) {
+  std::mt19937 rng(12);
+  for (const int n : {1, 2, 7, 300}) {
+    const auto pattern = random_symmetric_pattern(n, 4, rng);
+    BlockSparseMatrix matrix(pattern);
+    fill_random(matrix, pattern, rng);
+    Eigen::VectorXd x(matrix.rows());
+    for (Eigen::Index i = 0; i < x.size(); ++i) x[i] = std::uniform_real_distribution<double>(-1.0, 1.0)(rng);
+    Eigen::VectorXd whole;
+    matrix.multiply(x, whole);
+    const int split = matrix.balanced_row_split(1, 2);
+    ASSERT_EQ(matrix.balanced_row_split(0, 2), 0);
+    ASSERT_EQ(matrix.balanced_row_split(2, 2), n);
+    ASSERT_GE(split, 0);
+    ASSERT_LE(split, n);
+    Eigen::VectorXd parts = Eigen::VectorXd::Constant(matrix.rows(), std::numeric_limits<double>::quiet_NaN());
+    matrix.multiply_rows(x, parts, split, n);
+    matrix.multiply_rows(x, parts, 0, split);
+    EXPECT_TRUE(parts == whole) << n << " block rows, split at " << split;
+    int blocks_before = 0;
+    int widest_row = 0;
+    for (int r = 0; r < n; ++r) {
+      if (r < split) blocks_before += matrix.row_size(r);
+      widest_row = std::max(widest_row, matrix.row_size(r));
+    }
+    EXPECT_LE(std::abs(2 * blocks_before - matrix.nonzero_blocks()), 2 * widest_row) << n << " block rows";
   }
 }
 
