@@ -3,27 +3,52 @@
 
 #include "core/parameter_error.hpp"
 
+#include <pthread.h>
+#include <sched.h>
+
+#include <chrono>
 #include <string>
 
 namespace tissue {
 namespace {
 
-// Polls before a waiting member blocks: ~10-20 us, several times a job's hand-over on a free core.
-constexpr int SPIN_POLLS = 2000;
+// How long a waiting member spins before it blocks: longer than the gaps between a step's jobs
+// (the serial work between two CG phases, a few microseconds), because waking a blocked thread
+// costs tens of microseconds on a virtual machine (its core halts and needs an interrupt), and
+// short enough that members sharing a core lose little.
+constexpr std::chrono::microseconds SPIN_TIME{100};
+constexpr int POLLS_PER_CLOCK_READ = 64;
 
-// Waits until `value` differs from `old`: spins (pause between polls), then blocks on the atomic
-// (a futex), so that a member whose partner shares its core (a busy or oversubscribed machine, a
-// new thread placed on its parent's core) gives the core up instead of spinning to the end of its
-// time slice: spinning with yield() alone made 40 hand-overs take 4-40 ms there.
+// Waits until `value` differs from `old`: spins (pause between polls) for up to SPIN_TIME, then
+// blocks on the atomic (a futex), so that a member whose partner shares its core (a busy machine,
+// a new thread placed on its parent's core) gives the core up instead of spinning to the end of
+// its time slice: spinning with yield() alone made 40 hand-overs take 4-40 ms there.
 template <class T>
 void wait_while_equal(const std::atomic<T>& value, T old) {
-  for (int polls = 0; polls < SPIN_POLLS; ++polls) {
+  const auto give_up = std::chrono::steady_clock::now() + SPIN_TIME;
+  for (int polls = 1;; ++polls) {
     if (value.load(std::memory_order_acquire) != old) return;
 #if defined(__x86_64__) || defined(__i386__)
     __builtin_ia32_pause();
 #endif
+    if (polls % POLLS_PER_CLOCK_READ == 0 && std::chrono::steady_clock::now() > give_up) break;
   }
   while (value.load(std::memory_order_acquire) == old) value.wait(old, std::memory_order_acquire);
+}
+
+// Keeps a new worker off the caller's current core when the caller may run on others. Left to
+// itself, Linux often started the worker next to its parent on this machine (a 2-core VM) and kept
+// it there, step after step, while the other core idled: the members then took turns on one core
+// (the frog's two-thread step 7.8 ms instead of 0.38 in about one run of three). Best effort: the
+// caller's own affinity is left alone, and a failure only loses the hint.
+void keep_off_callers_core(std::thread& worker) {
+  cpu_set_t allowed;
+  CPU_ZERO(&allowed);
+  if (sched_getaffinity(0, sizeof allowed, &allowed) != 0) return;
+  const int current = sched_getcpu();
+  if (current < 0 || current >= CPU_SETSIZE || !CPU_ISSET(current, &allowed) || CPU_COUNT(&allowed) < 2) return;
+  CPU_CLR(current, &allowed);
+  pthread_setaffinity_np(worker.native_handle(), sizeof allowed, &allowed);
 }
 
 }  // namespace
@@ -38,7 +63,10 @@ void validate_step_threads(int threads) {
 WorkTeam::WorkTeam(int threads) : m_size(threads) {
   validate_step_threads(threads);
   m_workers.reserve(static_cast<size_t>(threads - 1));
-  for (int member = 1; member < threads; ++member) m_workers.emplace_back([this, member] { work(member); });
+  for (int member = 1; member < threads; ++member) {
+    m_workers.emplace_back([this, member] { work(member); });
+    keep_off_callers_core(m_workers.back());
+  }
 }
 
 WorkTeam::~WorkTeam() {

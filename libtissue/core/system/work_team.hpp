@@ -1,9 +1,9 @@
 // WorkTeam: the opt-in second (third, ...) thread of one step. A team is made at the start of a
 // step and joined at its end (it never outlives the step that made it: no pool lingers between
 // steps, inside an FMU or anywhere else); within the step its members run jobs side by side and
-// wait for each other by spinning for a few microseconds (a hand-over then costs ~1 us instead of
-// a futex wake-up's several), then by blocking, so that members sharing a core never spin away
-// each other's time slice.
+// wait for each other by spinning for up to 100 us (a hand-over then costs ~1 us instead of a
+// blocked thread's wake-up, tens of us on a virtual machine), then by blocking, so that members
+// sharing a core never spin away each other's time slice.
 #pragma once
 
 #include <atomic>
