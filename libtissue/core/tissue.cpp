@@ -83,6 +83,7 @@ std::uint64_t model_fingerprint_of(const TetMesh& mesh, const TissueSettings& se
   if (settings.solver.kind == LinearSolverKind::pcg_cholesky) {  // so that older fingerprints stay as they were
     f.add(settings.solver.refresh.refresh_iterations);          // background_refactor changes no result
     f.add(settings.solver.refresh.pickup_setups);
+    f.add(settings.solver.refresh.follow_rotations);
   }
   const InteractionSettings& interaction = settings.interaction;
   f.add(interaction.contact_enabled);

@@ -133,6 +133,39 @@ double turn_angle_rad(const TetRest& rest, const Eigen::Matrix3d& rotation, cons
 
 }  // namespace
 
+const std::vector<Eigen::Matrix3d>* DeformableBody::block_frames() const {
+  // A vertex's frame: the rotation nearest the sum of its uncut tets' rotations (their mean turn),
+  // found from the first one's, so it depends on the rotations alone (no history).
+  const size_t vertices = static_cast<size_t>(m_mesh.vertex_count());
+  m_vertex_frames.assign(vertices, Eigen::Matrix3d::Zero());
+  m_vertex_first_tet.assign(vertices, -1);
+  for (int t = 0; t < m_elasticity.tet_count(); ++t) {
+    if (m_elasticity.is_excluded(t)) continue;
+    for (const int v : m_mesh.tets[static_cast<size_t>(t)]) {
+      m_vertex_frames[static_cast<size_t>(v)] += m_elasticity.rotation(t);
+      if (m_vertex_first_tet[static_cast<size_t>(v)] < 0) m_vertex_first_tet[static_cast<size_t>(v)] = t;
+    }
+  }
+  for (size_t v = 0; v < vertices; ++v) {
+    const int first = m_vertex_first_tet[v];
+    if (first < 0) {
+      m_vertex_frames[v].setIdentity();
+      continue;
+    }
+    Eigen::Quaterniond start(m_elasticity.rotation(first));
+    m_vertex_frames[v] = extract_rotation(m_vertex_frames[v], start, m_settings.rotation);
+  }
+  m_block_frames.resize(static_cast<size_t>(m_tangent.block_rows()));
+  for (int row = 0; row < m_dofs.free_vertex_count(); ++row) {
+    m_block_frames[static_cast<size_t>(row)] = m_vertex_frames[static_cast<size_t>(m_dofs.row_vertex[static_cast<size_t>(row)])];
+  }
+  // An enriched unknown moves the part of a cut tet beyond its vertex; it takes the vertex's frame.
+  for (const EnrichedDof& dof : m_enriched_dofs) {
+    m_block_frames[static_cast<size_t>(dof.row)] = m_vertex_frames[static_cast<size_t>(dof.vertex)];
+  }
+  return &m_block_frames;
+}
+
 double DeformableBody::largest_turn_rad(const Eigen::VectorXd& increment_m, double resolution_rad) const {
   if (increment_m.size() != dof_count()) {
     throw std::invalid_argument("largest_turn_rad: the increment has " + std::to_string(increment_m.size()) +

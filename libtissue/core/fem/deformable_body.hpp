@@ -80,6 +80,9 @@ class DeformableBody final : public DynamicsModel {
   /// The uncut tets' forces and blocks are then assembled by the team (bitwise the same result).
   void lend_work_team(WorkTeam* team) override { m_team = team; }
   [[nodiscard]] const BlockSparseMatrix& tangent() const override { return m_tangent; }
+  /// A vertex's frame is the rotation nearest the sum of the rotations of its tets not modelled by
+  /// XFEM (identity if it has none); an enriched unknown takes its vertex's. O(tets), on request.
+  [[nodiscard]] const std::vector<Eigen::Matrix3d>* block_frames() const override;
   /// First a bound, O(unknowns): no element (or cut part) turns further than 12 max|block of the
   /// increment| max|grad(phi)|; past `resolution_rad`, each tet and part: |axial(skew(R^T G))| with
   /// G the gradient of the increment and R its rotation at the last evaluate().
@@ -208,6 +211,9 @@ class DeformableBody final : public DynamicsModel {
   std::array<int, 9> m_point_spring_slots{};  // [3 i + j]: block (row of vertex i, row of vertex j), -1 if fixed
   Eigen::Vector3d m_point_spring_force_n = Eigen::Vector3d::Zero();
   WorkTeam* m_team = nullptr;  // lent for a step (lend_work_team)
+  mutable std::vector<Eigen::Matrix3d> m_block_frames;  // block_frames(): made on request
+  mutable std::vector<Eigen::Matrix3d> m_vertex_frames;
+  mutable std::vector<int> m_vertex_first_tet;
 };
 
 }  // namespace tissue

@@ -84,7 +84,8 @@ ShiftedSystem BackwardEuler::step_system(const DynamicsModel& model, double h) {
   const RayleighDamping& damping = model.damping();
   m_system_diagonal.resize(model.dof_count());
   m_system_diagonal.noalias() = (1.0 + h * damping.mass_damping_per_s) * model.mass_kg();
-  return ShiftedSystem{&model.tangent(), h * damping.stiffness_damping_s + h * h, &m_system_diagonal};
+  return ShiftedSystem{&model.tangent(), h * damping.stiffness_damping_s + h * h, &m_system_diagonal,
+                       m_solver->follows_block_frames() ? model.block_frames() : nullptr};
 }
 
 StepReport BackwardEuler::step(DynamicsModel& model, DynamicState& state, double step_size_s) {

@@ -21,6 +21,9 @@ struct ShiftedSystem {
   const BlockSparseMatrix* stiffness = nullptr;  ///< K (rows() x rows())
   double stiffness_scale = 1.0;
   const Eigen::VectorXd* diagonal = nullptr;  ///< d, length stiffness->rows()
+  /// Optional (nullptr: none): per block row, the rotation K's rows have turned through since the
+  /// rest state (DynamicsModel::block_frames); given to solvers that follow_block_frames().
+  const std::vector<Eigen::Matrix3d>* block_frames = nullptr;
 
   [[nodiscard]] int rows() const { return stiffness->rows(); }
   /// y = A x. No allocation. x and y must be different vectors.
@@ -69,6 +72,9 @@ class LinearSolver {
   /// step's team for the step only). The CG solvers split their products and vector updates over
   /// it, with bitwise the results of one thread; CHOLMOD ignores it.
   virtual void lend_work_team(WorkTeam* /*team*/) {}
+  /// Whether the solver uses ShiftedSystem::block_frames (an integrator asks the model for them
+  /// only then: they cost a pass over the mesh).
+  [[nodiscard]] virtual bool follows_block_frames() const { return false; }
   [[nodiscard]] virtual std::string_view name() const = 0;
 };
 
@@ -140,6 +146,12 @@ class CholeskyPcgSolver final : public LinearSolver {
     /// Factorize in a std::thread (joined at pick-up and in the destructor); false: at pick-up, in
     /// the caller's thread (same results, for hosts that forbid threads).
     bool background_refactor = true;
+    /// Turn the factor with the rows' rotations since it was made: P^-1 = Q (L L^T)^-1 Q^T with Q
+    /// the block-diagonal turn of each row's frame (ShiftedSystem::block_frames), since
+    /// K_now = Q K_then Q^T for a part that turned rigidly. Pays for a body that swings (the
+    /// tail-held frog: 3.4 -> 1.3 ms per step), costs where parts vibrate after a cut (the cut
+    /// frog: 28 -> 41 iterations per step); docs/BENCHMARKS.md, issue 12.
+    bool follow_rotations = false;
 
     /// The one range rule of these settings: "" when refresh_iterations >= 0 and pickup_setups >= 1,
     /// else what is wrong (each caller throws it as its own error type).
@@ -169,6 +181,8 @@ class CholeskyPcgSolver final : public LinearSolver {
   [[nodiscard]] bool is_set_up() const override;
   [[nodiscard]] std::string_view name() const override { return "pcg-cholesky"; }
   void lend_work_team(WorkTeam* team) override;
+  /// Refresh::follow_rotations.
+  [[nodiscard]] bool follows_block_frames() const override;
 
   [[nodiscard]] const Counters& counters() const;
   /// Why the last refresh failed ("" if none did).

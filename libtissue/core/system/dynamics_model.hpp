@@ -36,6 +36,11 @@ class DynamicsModel {
   virtual void lend_work_team(WorkTeam* /*team*/) {}
   /// The tangent stiffness of the last evaluate() with update_tangent [N/m].
   [[nodiscard]] virtual const BlockSparseMatrix& tangent() const = 0;
+  /// Per block row of tangent(), the rotation its unknowns have turned through since the rest state
+  /// (a vertex's co-rotational frame at the last evaluate()), or nullptr for a model without one.
+  /// A lagged preconditioner turns with it (CholeskyPcgSolver). Valid until the next evaluate() or
+  /// growth of the model.
+  [[nodiscard]] virtual const std::vector<Eigen::Matrix3d>* block_frames() const { return nullptr; }
   /// The largest angle [rad] the displacement increment `increment_m` (from the state of the last
   /// evaluate()) turns an element: a step linearized there strays from the nonlinear model by about
   /// its square. Where a cheap bound shows every element below `resolution_rad`, that bound may be

@@ -13,6 +13,7 @@
 
 #include <Eigen/Dense>
 #include <Eigen/Eigenvalues>
+#include <Eigen/Geometry>
 
 #include <memory>
 #include <random>
@@ -102,6 +103,51 @@ void check_lagged_reuse_and_pickup(bool background) {
 }
 
 TEST(CholeskyPcg, KeepsTheLaggedFactorAndInstallsARefreshAtThePickUp) { check_lagged_reuse_and_pickup(true); }
+
+// follow_rotations: a factor of A turns with the rows' frames. If every block row turns by its own
+// rotation Q_i (K_ij -> Q_i K_ij Q_j^T, d the same for the three unknowns of a row), the new A is
+// Q A Q^T exactly, so the turned factor is exact and CG stops after one iteration; the unturned
+// factor of the old A needs many.
+int iterations_after_turning(bool follow_rotations) {
+  test::TestSystem system = test::make_grid_system(6, 5, 5, 45, 0.05, {}, false);
+  system.diagonal.setConstant(0.05);
+  std::mt19937 rng(46);
+  Refresh refresh = refresh_rule(1000, 1, false);  // keeps the first factor
+  refresh.follow_rotations = follow_rotations;
+  CholeskyPcgSolver solver({1e-10, 500}, refresh);
+  const int rows = system.stiffness.block_rows();
+  std::vector<Eigen::Matrix3d> frames(static_cast<size_t>(rows), Eigen::Matrix3d::Identity());
+  ShiftedSystem a = system.shifted(1.0);
+  a.block_frames = &frames;
+  const Eigen::VectorXd b = test::random_vector(system.stiffness.rows(), rng);
+  Eigen::VectorXd x = Eigen::VectorXd::Zero(b.size());
+  EXPECT_LE(solver.solve(a, b, x).iterations, 1);
+
+  for (Eigen::Matrix3d& frame : frames) {
+    const Eigen::Vector3d axis = Eigen::Vector3d::Random().normalized();
+    frame = Eigen::AngleAxisd(std::uniform_real_distribution<double>(0.2, 2.5)(rng), axis).toRotationMatrix();
+  }
+  for (int i = 0; i < rows; ++i) {
+    for (int slot = system.stiffness.row_begin(i); slot < system.stiffness.row_begin(i) + system.stiffness.row_size(i);
+         ++slot) {
+      const int j = system.stiffness.slot_column(slot);
+      const Eigen::Matrix3d turned = frames[static_cast<size_t>(i)] * system.stiffness.block(slot) *
+                                     frames[static_cast<size_t>(j)].transpose();
+      system.stiffness.block(slot) = turned;
+    }
+  }
+  x.setZero();
+  const SolveReport report = solver.solve(a, b, x);
+  EXPECT_TRUE(report.converged);
+  EXPECT_EQ(solver.counters().factorizations, 1);  // the same factor, turned or not
+  EXPECT_EQ(solver.counters().refreshes_started, 0);
+  return report.iterations;
+}
+
+TEST(CholeskyPcg, FollowingRotationsTurnsTheFactorWithTheRows) {
+  EXPECT_LE(iterations_after_turning(true), 1);
+  EXPECT_GT(iterations_after_turning(false), 10);
+}
 
 TEST(CholeskyPcg, SynchronousRefreshFollowsTheSameSchedule) { check_lagged_reuse_and_pickup(false); }
 
