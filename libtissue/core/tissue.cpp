@@ -84,6 +84,7 @@ std::uint64_t model_fingerprint_of(const TetMesh& mesh, const TissueSettings& se
     f.add(settings.solver.refresh.refresh_iterations);          // background_refactor changes no result
     f.add(settings.solver.refresh.pickup_setups);
     f.add(settings.solver.refresh.follow_rotations);
+    f.add(settings.solver.refresh.refactor_on_growth);
   }
   const InteractionSettings& interaction = settings.interaction;
   f.add(interaction.contact_enabled);

@@ -201,7 +201,7 @@ void CholeskyPcgSolver::setup(const ShiftedSystem& system) {
   if (impl.in_flight && ++impl.setups_since_start >= impl.refresh.pickup_setups) impl.pick_up(n);
 
   jacobi_inverse_diagonal(system, impl.inverse_diagonal, WHO);  // also refuses a diagonal <= 0
-  if (!impl.usable(*system.stiffness)) {
+  if (!impl.usable(*system.stiffness) || (impl.refresh.refactor_on_growth && impl.stale(*system.stiffness))) {
     impl.discard_refresh();  // older than what we factorize now
     impl.active->load(system);
     Impl::copy_frames(system, impl.active_frames);

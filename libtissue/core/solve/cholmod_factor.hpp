@@ -30,8 +30,11 @@ class CholmodFactor {
   /// supernodal: solve with the factor itself (BLAS); without_blas: factorize() also makes a
   /// simplicial copy (no BLAS in its solves), for solves that run beside another factorization.
   enum class Solves { supernodal, without_blas };
+  /// automatic: supernodal (BLAS) only for dense factors, where it pays (cholmod_factor.cpp);
+  /// supernodal: always (tests of the BLAS paths).
+  enum class Layout { automatic, supernodal };
 
-  explicit CholmodFactor(Solves solves = Solves::supernodal);
+  explicit CholmodFactor(Solves solves = Solves::supernodal, Layout layout = Layout::automatic);
   ~CholmodFactor();
   CholmodFactor(const CholmodFactor&) = delete;
   CholmodFactor& operator=(const CholmodFactor&) = delete;

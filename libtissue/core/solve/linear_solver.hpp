@@ -122,13 +122,16 @@ class PcgSolver final : public LinearSolver {
 /// * A setup without a usable factor (the first; A smaller than the factor, or another matrix)
 ///   factorizes A at once and throws SolverError if A is not positive definite.
 /// * A refresh (a factor of the A of the setup that starts it, values copied then) starts when K's
-///   size or block pattern differs from the factor's (a cut), or when the last solve needed more than
+///   size or block pattern differs from the factor's (a cut, without `refactor_on_growth`), or when
+///   the last solve needed more than
 ///   `refresh_iterations` iterations or did not converge. It is factorized in a worker thread
 ///   (`background_refactor`) or, without one, at pick-up; either way the setup `pickup_setups` setups
 ///   after the start installs it (waiting for the worker if need be), so the results are bitwise the
 ///   same whatever the machine's speed and with or without the thread. One refresh at a time.
-/// * While the factor covers fewer rows than A (a cut appended rows at the end), the preconditioner
-///   is block diagonal: the factor on the first rows, Jacobi (1 / diag A) on the appended ones.
+/// * With `refactor_on_growth` (the default) a setup whose K changed its pattern or size factorizes A
+///   at once. Without it, while the factor covers fewer rows than A (a cut appended rows at the end),
+///   the preconditioner is block diagonal: the factor on the first rows, Jacobi (1 / diag A) on the
+///   appended ones, until the refresh lands.
 /// * A refresh that fails (not positive definite) is counted and the old factor kept.
 /// A setup or solve that does not start or install a refresh allocates nothing. Stopping rule and
 /// reported residual as PcgSolver's.
@@ -152,6 +155,12 @@ class CholeskyPcgSolver final : public LinearSolver {
     /// tail-held frog: 3.4 -> 1.3 ms per step), costs where parts vibrate after a cut (the cut
     /// frog: 28 -> 41 iterations per step); docs/BENCHMARKS.md, issue 12.
     bool follow_rotations = false;
+    /// When K's pattern or size changed (a cut), factorize the new A at once in the step; false: the
+    /// old factor on the old rows and Jacobi on the new ones until a refresh lands. Measured on test
+    /// 5's cuts (docs/BENCHMARKS.md, issue 12): a cut step then costs one factorization instead of up
+    /// to max_iterations iterations with a factor that no longer fits (worst 18 -> 11 ms, median
+    /// during the cuts 3.0 -> 1.7 ms).
+    bool refactor_on_growth = true;
 
     /// The one range rule of these settings: "" when refresh_iterations >= 0 and pickup_setups >= 1,
     /// else what is wrong (each caller throws it as its own error type).

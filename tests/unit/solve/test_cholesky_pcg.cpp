@@ -156,7 +156,9 @@ TEST(CholeskyPcg, GrownSystemUsesJacobiOnAppendedRowsUntilTheRefreshLands) {
   std::mt19937 rng(46);
   const int pickup = 2;
   const double tolerance = 1e-10;
-  CholeskyPcgSolver solver({tolerance, 500}, refresh_rule(50, pickup, true));
+  Refresh refresh = refresh_rule(50, pickup, true);
+  refresh.refactor_on_growth = false;
+  CholeskyPcgSolver solver({tolerance, 500}, refresh);
   const auto check_solve = [&]() {
     const ShiftedSystem shifted = system.shifted(1.0);
     const Eigen::VectorXd b = test::random_vector(shifted.rows(), rng);
@@ -190,6 +192,29 @@ TEST(CholeskyPcg, GrownSystemUsesJacobiOnAppendedRowsUntilTheRefreshLands) {
   EXPECT_EQ(solver.counters().refreshes_started, 1);  // the factor matches the pattern: no more
   check_solve();
   EXPECT_EQ(solver.counters().refreshes_started, 1);
+}
+
+// refactor_on_growth (the default): a setup whose K grew factorizes the grown A at once, so the
+// first solve after the growth needs no more iterations than one with a fresh factor.
+TEST(CholeskyPcg, GrownSystemIsFactorizedAtOnceByDefault) {
+  test::TestSystem system = test::make_grid_system(5, 4, 4, 45);
+  std::mt19937 rng(46);
+  CholeskyPcgSolver solver({1e-10, 500}, refresh_rule(50, 2, true));
+  const auto solve = [&]() {
+    const ShiftedSystem shifted = system.shifted(1.0);
+    const Eigen::VectorXd b = test::random_vector(shifted.rows(), rng);
+    Eigen::VectorXd x = Eigen::VectorXd::Zero(shifted.rows());
+    const SolveReport report = solver.solve(shifted, b, x);
+    EXPECT_TRUE(report.converged);
+    return report.iterations;
+  };
+  EXPECT_LE(solve(), 2);
+  test::append_coupled_row(system, 13, rng);
+  test::append_coupled_row(system, 40, rng);
+  EXPECT_LE(solve(), 2);
+  EXPECT_EQ(solver.counters().factor_rows, system.stiffness.rows());
+  EXPECT_EQ(solver.counters().factorizations, 2);
+  EXPECT_EQ(solver.counters().refreshes_started, 0);
 }
 
 // A sequence like a simulation's: values drift every setup, rows are appended twice, the
