@@ -59,8 +59,9 @@ void add_scene_options(CLI::App& app, SceneOptions& options) {
                "pcg-cholesky: refactorize at pick-up in the stepping thread instead of a worker thread");
   app.add_flag("--follow-rotations", options.refresh.follow_rotations,
                "pcg-cholesky: turn the lagged factor with the vertices' rotations since it was made");
-  app.add_flag("--refactor-on-growth", options.refresh.refactor_on_growth,
-               "pcg-cholesky: factorize at once when a cut grows the system (instead of Jacobi on the new rows)");
+  app.add_flag("!--no-refactor-on-growth", options.refresh.refactor_on_growth,
+               "pcg-cholesky: when a cut grows the system, Jacobi on the new rows until a refresh lands "
+               "(default: factorize at once)");
   app.add_flag("--warm-start", options.warm_start, "PCG starts from the previous step's velocity change");
   app.add_option("--young", options.material.young_modulus_pa, "Young's modulus [Pa]")->capture_default_str();
   app.add_option("--poisson", options.material.poisson_ratio, "Poisson's ratio")->capture_default_str();

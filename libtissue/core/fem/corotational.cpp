@@ -198,13 +198,34 @@ TISSUE_HOT_KERNEL void CorotationalElasticity::add_tet(size_t t, const Eigen::Ma
   }
 }
 
-double CorotationalElasticity::elastic_energy_j(const Eigen::VectorXd& positions_m) const {
+TISSUE_HOT_KERNEL double CorotationalElasticity::elastic_energy_j(const Eigen::VectorXd& positions_m) const {
+  // Rotations in batches of ROTATION_BATCH lanes, as in add_tets (the energy guard evaluates this
+  // twice on a step that turns elements far); the terms are added in tet order.
+  std::array<size_t, ROTATION_BATCH> batch{};
+  std::array<Eigen::Matrix3d, ROTATION_BATCH> gradients;
+  std::array<Eigen::Matrix3d, ROTATION_BATCH> rotations;
+  std::array<Eigen::Quaterniond, ROTATION_BATCH> warm_starts;  // copies: reporting must not change the dynamics
+  std::array<Eigen::Quaterniond*, ROTATION_BATCH> warm_start_lanes{};
+  std::array<Eigen::Matrix3d*, ROTATION_BATCH> rotation_lanes{};
+  for (size_t lane = 0; lane < ROTATION_BATCH; ++lane) {
+    warm_start_lanes[lane] = &warm_starts[lane];
+    rotation_lanes[lane] = &rotations[lane];
+  }
   double energy = 0.0;
-  for (size_t t = 0; t < m_tets.size(); ++t) {
-    if (m_excluded[t] != 0) continue;
-    const Eigen::Matrix3d f = deformation_gradient(m_rest[t], gather(positions_m, m_tets[t]));
-    Eigen::Quaterniond warm_start = m_warm_starts[t];  // a copy: reporting must not change the dynamics
-    energy += corotated_energy_j(m_rest[t], extract_rotation(f, warm_start, m_rotation_settings), f, m_lame);
+  size_t next = 0;
+  while (next < m_tets.size()) {
+    int count = 0;
+    for (; next < m_tets.size() && count < ROTATION_BATCH; ++next) {
+      if (m_excluded[next] != 0) continue;
+      const auto lane = static_cast<size_t>(count++);
+      batch[lane] = next;
+      gradients[lane] = deformation_gradient(m_rest[next], gather(positions_m, m_tets[next]));
+      warm_starts[lane] = m_warm_starts[next];
+    }
+    extract_rotations(count, gradients.data(), warm_start_lanes.data(), rotation_lanes.data(), m_rotation_settings);
+    for (size_t lane = 0; lane < static_cast<size_t>(count); ++lane) {
+      energy += corotated_energy_j(m_rest[batch[lane]], rotations[lane], gradients[lane], m_lame);
+    }
   }
   return energy;
 }

@@ -17,6 +17,8 @@
 // so it carries an extra inertia 2 sum M^aa over those vertices (quantified in tests/unit/xfem).
 #include "core/fem/deformable_body.hpp"
 
+#include "core/system/hot_kernel.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
@@ -166,7 +168,8 @@ const std::vector<Eigen::Matrix3d>* DeformableBody::block_frames() const {
   return &m_block_frames;
 }
 
-double DeformableBody::largest_turn_rad(const Eigen::VectorXd& increment_m, double resolution_rad) const {
+TISSUE_HOT_KERNEL double DeformableBody::largest_turn_rad(const Eigen::VectorXd& increment_m,
+                                                          double resolution_rad) const {
   if (increment_m.size() != dof_count()) {
     throw std::invalid_argument("largest_turn_rad: the increment has " + std::to_string(increment_m.size()) +
                                 " entries, the body " + std::to_string(dof_count()) + " unknowns");

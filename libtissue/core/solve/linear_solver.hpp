@@ -152,7 +152,7 @@ class CholeskyPcgSolver final : public LinearSolver {
     /// Turn the factor with the rows' rotations since it was made: P^-1 = Q (L L^T)^-1 Q^T with Q
     /// the block-diagonal turn of each row's frame (ShiftedSystem::block_frames), since
     /// K_now = Q K_then Q^T for a part that turned rigidly. Pays for a body that swings (the
-    /// tail-held frog: 3.4 -> 1.3 ms per step), costs where parts vibrate after a cut (the cut
+    /// tail-held frog: 2.3 -> 1.3 ms per step), costs where parts vibrate after a cut (the cut
     /// frog: 28 -> 41 iterations per step); docs/BENCHMARKS.md, issue 12.
     bool follow_rotations = false;
     /// When K's pattern or size changed (a cut), factorize the new A at once in the step; false: the
