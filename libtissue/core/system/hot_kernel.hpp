@@ -1,5 +1,6 @@
 // TISSUE_HOT_KERNEL: marks the few functions a step spends most of its time in (the rotation
-// lanes, the tet kernel, the block mat-vec) to be compiled twice, for baseline x86-64 and for
+// lanes, the tet kernel, the block mat-vec, the energy and turn checks of the large-turn
+// protections) to be compiled twice, for baseline x86-64 and for
 // x86-64-v3 (AVX2 and FMA: x86 CPUs since about 2015), the version picked once at load time from
 // the CPU (GCC's target_clones, an ifunc). The library and the FMUs stay portable, and a CPU with
 // AVX2 gets ~20% faster steps (docs/BENCHMARKS.md, issue 12). `flatten` inlines everything the
