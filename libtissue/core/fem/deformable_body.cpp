@@ -168,8 +168,7 @@ const std::vector<Eigen::Matrix3d>* DeformableBody::block_frames() const {
   return &m_block_frames;
 }
 
-TISSUE_HOT_KERNEL double DeformableBody::largest_turn_rad(const Eigen::VectorXd& increment_m,
-                                                          double resolution_rad) const {
+double DeformableBody::largest_turn_rad(const Eigen::VectorXd& increment_m, double resolution_rad) const {
   if (increment_m.size() != dof_count()) {
     throw std::invalid_argument("largest_turn_rad: the increment has " + std::to_string(increment_m.size()) +
                                 " entries, the body " + std::to_string(dof_count()) + " unknowns");
@@ -182,6 +181,11 @@ TISSUE_HOT_KERNEL double DeformableBody::largest_turn_rad(const Eigen::VectorXd&
   // moves by du + Psi da), so the angle is at most |G| <= 12 max|block| max|grad(phi)|.
   const double bound_rad = 12.0 * largest_block_m * m_largest_shape_gradient_per_m;
   if (bound_rad <= resolution_rad) return bound_rad;
+  return largest_element_turn_rad(increment_m);
+}
+
+// (A hot kernel: GCC cannot clone the virtual largest_turn_rad itself.)
+TISSUE_HOT_KERNEL double DeformableBody::largest_element_turn_rad(const Eigen::VectorXd& increment_m) const {
   const auto vertex_increment = [&](int vertex) -> Eigen::Vector3d {
     const int row = vertex_block_row(vertex);
     return row < 0 ? Eigen::Vector3d::Zero() : Eigen::Vector3d(increment_m.segment<3>(3 * row));

@@ -197,6 +197,8 @@ class DeformableBody final : public DynamicsModel {
   void check_unknowns(const Eigen::VectorXd& displacement_m) const;
   // Adds the spring's force to m_vertex_forces_n (and its stiffness to `tangent`), from m_positions_m.
   void add_point_spring(BlockSparseMatrix* tangent);
+  // largest_turn_rad past its bound: every uncut tet and cut part.
+  [[nodiscard]] double largest_element_turn_rad(const Eigen::VectorXd& increment_m) const;
   [[nodiscard]] int vertex_block_row(int vertex) const { return m_dofs.vertex_row[static_cast<size_t>(vertex)]; }
 
   XfemElasticity m_xfem;
