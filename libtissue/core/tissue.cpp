@@ -252,7 +252,7 @@ void Tissue::interact_with_scalpel(const ToolPose& previous, const ToolPose& cur
       to.orientation = previous.orientation.slerp(fraction, current.orientation).normalized();
     }
     const auto cut_start = std::chrono::steady_clock::now();
-    const CutStepReport cut = m_cutter->step(blade(from), blade(to), m_positions_m, m_bvh);
+    const CutStepReport cut = m_cutter->step(blade(from), blade(to), m_positions_m, fitted_bvh());
     const int newly_cut = report.cut.newly_cut_tets + cut.newly_cut_tets;
     report.cut = cut;
     report.cut.newly_cut_tets = newly_cut;
@@ -389,12 +389,12 @@ void Tissue::restore(const TissueSnapshot& snapshot) {
   m_contact_output = snapshot.contact_output;
   m_steps_since_stiffness = snapshot.steps_since_stiffness;
   update_positions();
-  m_bvh.refit(m_positions_m);
+  m_bvh_stale = true;  // refitted by the first query (fitted_bvh)
 }
 
 void Tissue::interact_with_probe(const ToolPose& previous, const ToolPose& current) {
   const bool was_in_contact = m_contact.in_contact();
-  m_contact.update(previous.tip_position_m, current.tip_position_m, m_positions_m, m_bvh);
+  m_contact.update(previous.tip_position_m, current.tip_position_m, m_positions_m, fitted_bvh());
   // The probe touches the mesh's surface only: a cut face's corners are not vertices the spring can
   // act on (they move with the enriched unknowns), so a probe reaching into a crack feels nothing.
   if (m_contact.in_contact() && m_contact.proxy().triangle >= static_cast<int>(m_surface.triangles.size())) {
@@ -412,9 +412,10 @@ void Tissue::update_contact_output() {
     return;
   }
   out.active = true;
-  out.point_m = surface_point_position_m(m_contact.proxy(), m_bvh.triangles(), m_positions_m);
+  const SurfaceBvh& bvh = fitted_bvh();
+  out.point_m = surface_point_position_m(m_contact.proxy(), bvh.triangles(), m_positions_m);
   out.normal = m_contact.normal();
-  out.force_on_tool_n = m_contact.force_on_tool_n(m_bvh, m_positions_m);
+  out.force_on_tool_n = m_contact.force_on_tool_n(bvh, m_positions_m);
   out.penetration_depth_m = (m_previous_tool.tip_position_m - out.point_m).norm();
 
   const int triangle = m_contact.proxy().triangle;
@@ -522,7 +523,7 @@ TissueStepReport Tissue::step() {
 
   const auto refit_start = std::chrono::steady_clock::now();
   update_positions();
-  m_bvh.refit(m_positions_m);
+  m_bvh_stale = true;  // refitted by the first query that needs it (fitted_bvh)
   report.refit_s = seconds_since(refit_start);
 
   const auto output_start = std::chrono::steady_clock::now();

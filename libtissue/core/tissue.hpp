@@ -167,7 +167,8 @@ class Tissue {
 
   [[nodiscard]] const SurfaceMesh& surface() const { return m_surface; }
   /// Over the surface and the cut faces; empty (no tree) when neither contact nor cutting is on.
-  [[nodiscard]] const SurfaceBvh& surface_bvh() const { return m_bvh; }
+  /// Fitted to the current positions (a step leaves the refit to the first query after it).
+  [[nodiscard]] const SurfaceBvh& surface_bvh() const { return fitted_bvh(); }
   /// Throws std::logic_error when cutting is off (no cutter is built then).
   [[nodiscard]] const VolumeCutter& cutter() const;
   [[nodiscard]] bool has_cutter() const { return m_cutter.has_value(); }
@@ -220,7 +221,17 @@ class Tissue {
   Eigen::VectorXd m_vertex_positions_m;
   Eigen::VectorXd m_positions_m;
   CutSurface m_cut_surface;
-  SurfaceBvh m_bvh;
+  // The tree's boxes are refitted when a query needs them, not after every step: a step with no
+  // tool near the tissue leaves them stale (the bridge: ~0.15 ms of a 2.8 ms step).
+  [[nodiscard]] const SurfaceBvh& fitted_bvh() const {
+    if (m_bvh_stale) {
+      m_bvh.refit(m_positions_m);
+      m_bvh_stale = false;
+    }
+    return m_bvh;
+  }
+  mutable SurfaceBvh m_bvh;
+  mutable bool m_bvh_stale = false;
   std::optional<VolumeCutter> m_cutter;  // only with cutting enabled
   PointContact m_contact;
   double m_contact_stiffness_scale_n_per_m = 0.0;  ///< contact_stiffness_scale_n_per_m of the body

@@ -93,12 +93,18 @@ SolveReport preconditioned_cg(const ShiftedSystem& system, const Eigen::VectorXd
     return report;
   }
 
-  // r = b - A x, warm-started from the caller's x; a non-finite guess is replaced by zero.
-  parts.run([&](int part) {
-    system.multiply_rows(x, work.product, parts.first_block_row(part), parts.end_block_row(part));
-    segment(work.residual, part) = segment(b, part) - segment(work.product, part);
-    r_squared.values[static_cast<size_t>(part)] = segment(work.residual, part).squaredNorm();
-  });
+  // r = b - A x, warm-started from the caller's x; a non-finite guess is replaced by zero. A zero
+  // guess (the default step's) gives r = b without a product: one of a real-time step's eleven.
+  if ((x.array() == 0.0).all()) {
+    work.residual = b;
+    r_squared = b_squared;
+  } else {
+    parts.run([&](int part) {
+      system.multiply_rows(x, work.product, parts.first_block_row(part), parts.end_block_row(part));
+      segment(work.residual, part) = segment(b, part) - segment(work.product, part);
+      r_squared.values[static_cast<size_t>(part)] = segment(work.residual, part).squaredNorm();
+    });
+  }
   double r_norm = std::sqrt(r_squared.total());
   if (!std::isfinite(r_norm)) {
     x.setZero();
