@@ -101,7 +101,7 @@ struct TissueStepReport {
   double cut_s = 0.0;           ///< volume cutter
   double enrich_s = 0.0;        ///< enrichment and in-place growth
   double contact_s = 0.0;       ///< god-object update and contact outputs
-  double refit_s = 0.0;         ///< surface BVH refit
+  double positions_s = 0.0;     ///< positions after the step (the BVH refit waits for the next query)
   double total_s = 0.0;
 };
 

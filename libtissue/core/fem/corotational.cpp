@@ -146,32 +146,49 @@ void CorotationalElasticity::evaluate(const Eigen::VectorXd& positions_m, Eigen:
   add_tets(m_serial_tets, positions_m, internal_forces_n, tangent, slots);
 }
 
-TISSUE_HOT_KERNEL void CorotationalElasticity::add_tets(const std::vector<int>& tets, const Eigen::VectorXd& positions_m,
-                                      Eigen::VectorXd& internal_forces_n, BlockSparseMatrix* tangent,
-                                      const std::vector<TetSlots>* slots) {
-  // Tets go in batches of ROTATION_BATCH: their rotations are extracted side by side (SIMD lanes),
-  // then each tet's force and tangent blocks are added in turn.
+template <class TetAt, class Visit>
+void CorotationalElasticity::in_rotation_batches(size_t count, TetAt tet_at, const Eigen::VectorXd& positions_m,
+                                                 std::vector<Eigen::Quaterniond>* warm_starts,
+                                                 std::vector<Eigen::Matrix3d>* rotations, Visit visit) const {
   std::array<size_t, ROTATION_BATCH> batch{};
   std::array<Eigen::Matrix3d, ROTATION_BATCH> gradients;
-  std::array<Eigen::Quaterniond*, ROTATION_BATCH> warm_starts{};
-  std::array<Eigen::Matrix3d*, ROTATION_BATCH> rotations{};
+  std::array<Eigen::Quaterniond, ROTATION_BATCH> warm_start_copies;
+  std::array<Eigen::Matrix3d, ROTATION_BATCH> rotation_copies;
+  std::array<Eigen::Quaterniond*, ROTATION_BATCH> lane_warm_starts{};
+  std::array<Eigen::Matrix3d*, ROTATION_BATCH> lane_rotations{};
   size_t next = 0;
-  while (next < tets.size()) {
-    int count = 0;
-    for (; next < tets.size() && count < ROTATION_BATCH; ++next) {
-      const auto t = static_cast<size_t>(tets[next]);
+  while (next < count) {
+    int lanes = 0;
+    for (; next < count && lanes < ROTATION_BATCH; ++next) {
+      const auto t = static_cast<size_t>(tet_at(next));
       if (m_excluded[t] != 0) continue;
-      const auto lane = static_cast<size_t>(count++);
+      const auto lane = static_cast<size_t>(lanes++);
       batch[lane] = t;
       gradients[lane] = deformation_gradient(m_rest[t], gather(positions_m, m_tets[t]));
-      warm_starts[lane] = &m_warm_starts[t];
-      rotations[lane] = &m_rotations[t];
+      if (warm_starts != nullptr) {
+        lane_warm_starts[lane] = &(*warm_starts)[t];
+        lane_rotations[lane] = &(*rotations)[t];
+      } else {
+        warm_start_copies[lane] = m_warm_starts[t];
+        lane_warm_starts[lane] = &warm_start_copies[lane];
+        lane_rotations[lane] = &rotation_copies[lane];
+      }
     }
-    extract_rotations(count, gradients.data(), warm_starts.data(), rotations.data(), m_rotation_settings);
-    for (int lane = 0; lane < count; ++lane) {
-      add_tet(batch[static_cast<size_t>(lane)], gradients[static_cast<size_t>(lane)], internal_forces_n, tangent, slots);
+    extract_rotations(lanes, gradients.data(), lane_warm_starts.data(), lane_rotations.data(), m_rotation_settings);
+    for (size_t lane = 0; lane < static_cast<size_t>(lanes); ++lane) {
+      visit(batch[lane], gradients[lane], *lane_rotations[lane]);
     }
   }
+}
+
+TISSUE_HOT_KERNEL void CorotationalElasticity::add_tets(const std::vector<int>& tets, const Eigen::VectorXd& positions_m,
+                                                        Eigen::VectorXd& internal_forces_n, BlockSparseMatrix* tangent,
+                                                        const std::vector<TetSlots>* slots) {
+  in_rotation_batches(
+      tets.size(), [&tets](size_t k) { return tets[k]; }, positions_m, &m_warm_starts, &m_rotations,
+      [&](size_t t, const Eigen::Matrix3d& f, const Eigen::Matrix3d& /*rotation: m_rotations[t]*/) {
+        add_tet(t, f, internal_forces_n, tangent, slots);
+      });
 }
 
 TISSUE_HOT_KERNEL void CorotationalElasticity::add_tet(size_t t, const Eigen::Matrix3d& f, Eigen::VectorXd& internal_forces_n,
@@ -199,34 +216,14 @@ TISSUE_HOT_KERNEL void CorotationalElasticity::add_tet(size_t t, const Eigen::Ma
 }
 
 TISSUE_HOT_KERNEL double CorotationalElasticity::elastic_energy_j(const Eigen::VectorXd& positions_m) const {
-  // Rotations in batches of ROTATION_BATCH lanes, as in add_tets (the energy guard evaluates this
-  // twice on a step that turns elements far); the terms are added in tet order.
-  std::array<size_t, ROTATION_BATCH> batch{};
-  std::array<Eigen::Matrix3d, ROTATION_BATCH> gradients;
-  std::array<Eigen::Matrix3d, ROTATION_BATCH> rotations;
-  std::array<Eigen::Quaterniond, ROTATION_BATCH> warm_starts;  // copies: reporting must not change the dynamics
-  std::array<Eigen::Quaterniond*, ROTATION_BATCH> warm_start_lanes{};
-  std::array<Eigen::Matrix3d*, ROTATION_BATCH> rotation_lanes{};
-  for (size_t lane = 0; lane < ROTATION_BATCH; ++lane) {
-    warm_start_lanes[lane] = &warm_starts[lane];
-    rotation_lanes[lane] = &rotations[lane];
-  }
+  // Rotations in SIMD lanes as in a step (the energy guard evaluates this twice on a step that
+  // turns elements far), from copies of the warm starts; the terms are added in tet order.
   double energy = 0.0;
-  size_t next = 0;
-  while (next < m_tets.size()) {
-    int count = 0;
-    for (; next < m_tets.size() && count < ROTATION_BATCH; ++next) {
-      if (m_excluded[next] != 0) continue;
-      const auto lane = static_cast<size_t>(count++);
-      batch[lane] = next;
-      gradients[lane] = deformation_gradient(m_rest[next], gather(positions_m, m_tets[next]));
-      warm_starts[lane] = m_warm_starts[next];
-    }
-    extract_rotations(count, gradients.data(), warm_start_lanes.data(), rotation_lanes.data(), m_rotation_settings);
-    for (size_t lane = 0; lane < static_cast<size_t>(count); ++lane) {
-      energy += corotated_energy_j(m_rest[batch[lane]], rotations[lane], gradients[lane], m_lame);
-    }
-  }
+  in_rotation_batches(
+      m_tets.size(), [](size_t k) { return k; }, positions_m, nullptr, nullptr,
+      [&](size_t t, const Eigen::Matrix3d& f, const Eigen::Matrix3d& rotation) {
+        energy += corotated_energy_j(m_rest[t], rotation, f, m_lame);
+      });
   return energy;
 }
 

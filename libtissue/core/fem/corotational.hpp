@@ -75,6 +75,16 @@ class CorotationalElasticity {
   void add_tet(size_t t, const Eigen::Matrix3d& f, Eigen::VectorXd& internal_forces_n, BlockSparseMatrix* tangent,
                const std::vector<TetSlots>* slots) const;
 
+  /// visit(t, F, R) for the tets tet_at(0) .. tet_at(count - 1) that are not excluded, in order, their
+  /// rotations extracted ROTATION_BATCH at a time side by side (SIMD lanes). From and into the tets'
+  /// own warm starts and rotations when given (a step); else from copies of the warm starts, the
+  /// rotations kept in the batch (reporting must not change the dynamics). Defined in the .cpp, for
+  /// the hot kernels there.
+  template <class TetAt, class Visit>
+  void in_rotation_batches(size_t count, TetAt tet_at, const Eigen::VectorXd& positions_m,
+                           std::vector<Eigen::Quaterniond>* warm_starts, std::vector<Eigen::Matrix3d>* rotations,
+                           Visit visit) const;
+
   /// Adds the forces and blocks of `tets` (skipping excluded ones), rotations in batches.
   void add_tets(const std::vector<int>& tets, const Eigen::VectorXd& positions_m, Eigen::VectorXd& internal_forces_n,
                 BlockSparseMatrix* tangent, const std::vector<TetSlots>* slots);

@@ -129,7 +129,8 @@ struct CholeskyPcgSolver::Impl {
   // both that copy and `a` have frames.
   void update_turns(const ShiftedSystem& a) {
     const auto block_rows = static_cast<size_t>(active->rows() / 3);
-    if (!refresh.follow_rotations || a.block_frames == nullptr || active_frames.size() < block_rows || a.block_frames->size() < block_rows) {
+    if (!refresh.follow_rotations || a.block_frames == nullptr || active_frames.size() < block_rows ||
+        a.block_frames->size() < block_rows) {
       turns.clear();
       return;
     }

@@ -27,14 +27,15 @@ namespace tissue {
 class CholmodFactor {
  public:
   enum class Status { none, ok, not_positive_definite, failed };
-  /// supernodal: solve with the factor itself (BLAS); without_blas: factorize() also makes a
-  /// simplicial copy (no BLAS in its solves), for solves that run beside another factorization.
-  enum class Solves { supernodal, without_blas };
+  /// with_factor: solve with the factor itself (BLAS if it is supernodal); without_blas: factorize()
+  /// also makes a simplicial copy of a supernodal factor (no BLAS in its solves), for solves that
+  /// run beside another factorization.
+  enum class Solves { with_factor, without_blas };
   /// automatic: supernodal (BLAS) only for dense factors, where it pays (cholmod_factor.cpp);
   /// supernodal: always (tests of the BLAS paths).
   enum class Layout { automatic, supernodal };
 
-  explicit CholmodFactor(Solves solves = Solves::supernodal, Layout layout = Layout::automatic);
+  explicit CholmodFactor(Solves solves = Solves::with_factor, Layout layout = Layout::automatic);
   ~CholmodFactor();
   CholmodFactor(const CholmodFactor&) = delete;
   CholmodFactor& operator=(const CholmodFactor&) = delete;
@@ -74,8 +75,8 @@ class CholmodFactor {
   cholmod_common m_common{};
   cholmod_sparse* m_matrix = nullptr;    // upper triangle of A, stype = 1, sorted, packed
   cholmod_factor* m_factor = nullptr;    // symbolic analysis + numeric factor of m_matrix
-  cholmod_factor* m_simplicial = nullptr;  // Solves::without_blas: a simplicial copy, what solve() uses
-  Solves m_solves = Solves::supernodal;
+  cholmod_factor* m_simplicial = nullptr;  // Solves::without_blas, supernodal m_factor: what solve() uses
+  Solves m_solves = Solves::with_factor;
   cholmod_dense* m_rhs = nullptr;        // b, n x 1
   cholmod_dense* m_solution = nullptr;   // x, n x 1 (owned by cholmod_solve2, reused)
   cholmod_dense* m_work_y = nullptr;     // cholmod_solve2 workspaces, reused between solves

@@ -204,7 +204,7 @@ class CholeskyPcgSolver final : public LinearSolver {
   std::unique_ptr<Impl> m_impl;
 };
 
-/// Sparse Cholesky (SuiteSparse CHOLMOD, supernodal). The symbolic analysis (ordering, pattern of L)
+/// Sparse Cholesky (SuiteSparse CHOLMOD; simplicial unless the factor is dense, cholmod_factor.cpp). The symbolic analysis (ordering, pattern of L)
 /// is computed once and reused while K.pattern_revision() and the size are unchanged; each setup()
 /// refactorizes numerically (throws SolverError if A is not positive definite), and any number of
 /// solves use that factor (the contact stiffness needs three with one A).

@@ -5,20 +5,29 @@
 #include <string>
 
 namespace tissue {
+namespace {
+
+// y = s y + d x on the block rows [first_block_row, end_block_row), y holding K x there.
+// Coefficient-wise and in place: Eigen evaluates this without a temporary.
+void shift_rows(const ShiftedSystem& a, const Eigen::VectorXd& x, Eigen::VectorXd& y, int first_block_row,
+                int end_block_row) {
+  const long first = 3L * first_block_row;
+  const long count = 3L * (end_block_row - first_block_row);
+  y.segment(first, count).array() = a.stiffness_scale * y.segment(first, count).array() +
+                                    a.diagonal->segment(first, count).array() * x.segment(first, count).array();
+}
+
+}  // namespace
 
 void ShiftedSystem::multiply(const Eigen::VectorXd& x, Eigen::VectorXd& y) const {
-  stiffness->multiply(x, y);
-  // Coefficient-wise and in place: Eigen evaluates this without a temporary.
-  y.array() = stiffness_scale * y.array() + diagonal->array() * x.array();
+  stiffness->multiply(x, y);  // checks x and sizes y
+  shift_rows(*this, x, y, 0, stiffness->block_rows());
 }
 
 void ShiftedSystem::multiply_rows(const Eigen::VectorXd& x, Eigen::VectorXd& y, int first_block_row,
                                   int end_block_row) const {
   stiffness->multiply_rows(x, y, first_block_row, end_block_row);
-  const long first = 3L * first_block_row;
-  const long count = 3L * (end_block_row - first_block_row);
-  y.segment(first, count).array() =
-      stiffness_scale * y.segment(first, count).array() + diagonal->segment(first, count).array() * x.segment(first, count).array();
+  shift_rows(*this, x, y, first_block_row, end_block_row);
 }
 
 void ShiftedSystem::check_sizes(const Eigen::VectorXd& b, const Eigen::VectorXd& x) const {

@@ -195,7 +195,7 @@ TEST(Cholmod, TwoSupernodalFactorsOnTwoThreadsGiveBitwiseTheirSerialResults) {
   const Eigen::VectorXd b_first = test::random_vector(first.stiffness.rows(), rng);
   const Eigen::VectorXd b_second = test::random_vector(second.stiffness.rows(), rng);
   const auto solve = [](const test::TestSystem& system, const Eigen::VectorXd& b, int scale_step) {
-    CholmodFactor factor(CholmodFactor::Solves::supernodal, CholmodFactor::Layout::supernodal);
+    CholmodFactor factor(CholmodFactor::Solves::with_factor, CholmodFactor::Layout::supernodal);
     factor.load(system.shifted(1.0 + 0.01 * scale_step));
     EXPECT_EQ(factor.factorize(), CholmodFactor::Status::ok);
     Eigen::VectorXd x(b.size());
