@@ -1,11 +1,12 @@
 // The FMI 3.0 layer's description of a model: its identity and its variable table (name, type,
-// causality, variability, unit, start, range, dimensions, description) and enumeration types, as
-// the model's modelDescription XML declares them. The XML is the contract importers read; each FMU
-// writes its table once (fmu_src/<fmu>/variables.cpp) and tests/fmu/test_model_description.cpp
-// keeps the two equal. The layer drives everything from this table: which calls may set a
-// variable, the start values, array sizes and typed get/set. Plain C++, no FMI headers.
+// causality, variability, unit, start, range, dimensions, description), enumeration types, log
+// categories and default experiment. This is each FMU's port schema, written once
+// (fmu_src/<fmu>/variables.cpp): the layer drives everything from it (which calls may set a
+// variable, the start values, array sizes and typed get/set), and the build writes the FMU's
+// modelDescription.xml from it (model_description_xml.hpp). Plain C++, no FMI headers.
 #pragma once
 
+#include <algorithm>
 #include <array>
 #include <cstdint>
 #include <span>
@@ -62,12 +63,26 @@ struct EnumerationType {
   std::span<const EnumerationItem> items;
 };
 
+struct LogCategory {
+  std::string_view name;
+  std::string_view description;
+};
+
+struct DefaultExperiment {
+  double start_time_s = 0.0;
+  double stop_time_s = 1.0;
+  double step_size_s = 0.01;
+};
+
 /// Everything the layer knows of one FMU model.
 struct ModelDescription {
   std::string_view model_identifier;
   std::string_view instantiation_token;
   std::span<const VariableInfo> variables;  ///< in strictly increasing value-reference order
   std::span<const EnumerationType> enumerations;
+  std::string_view description;               ///< the model's description attribute
+  std::span<const LogCategory> log_categories;  ///< the categories the layer logs to, with what each carries
+  DefaultExperiment default_experiment;
 
   /// nullptr if no variable has this value reference / name.
   [[nodiscard]] const VariableInfo* find(ValueReference vr) const;
@@ -191,6 +206,18 @@ constexpr bool strictly_ordered(std::span<const VariableInfo> variables) {
     if (variables[k - 1].vr >= variables[k].vr) return false;
   }
   return true;
+}
+
+/// `a` and `b` as one table in value-reference order (a schema written in parts, such as an FMU's own
+/// variables and the tissue sample's, ports/tissue_sample.hpp).
+template <std::size_t N, std::size_t M>
+constexpr std::array<VariableInfo, N + M> merged(const std::array<VariableInfo, N>& a,
+                                                 const std::array<VariableInfo, M>& b) {
+  std::array<VariableInfo, N + M> all{};
+  std::copy(a.begin(), a.end(), all.begin());
+  std::copy(b.begin(), b.end(), all.begin() + static_cast<std::ptrdiff_t>(N));
+  std::sort(all.begin(), all.end(), [](const VariableInfo& l, const VariableInfo& r) { return l.vr < r.vr; });
+  return all;
 }
 
 /// The FMI spelling: "Float64", "structuralParameter", "continuous", ...

@@ -119,7 +119,7 @@ fmi3::StepOutcome HapticModel::do_step(double current_time_s, double step_s) {
   const long ticks = fmi3::whole_internal_steps(m_time_s, current_time_s, step_s, tick_s);
   const std::uint64_t refused_before = m_samples_refused;
   take_tissue_sample();
-  const auto mode = static_cast<haptic::ToolMode>(m_values.int64(vr(Vr::device_tool_mode)));
+  const auto mode = static_cast<ToolMode>(m_values.int64(vr(Vr::device_tool_mode)));
   const Eigen::Vector3d position_m = tool_position();
   for (long n = 0; n < ticks; ++n) m_renderer.tick(position_m, mode, tick_s);
   // Whole ticks from the communication point: no drift from adding step_s.

@@ -28,6 +28,7 @@ struct TissueState final : fmi3::ModelState {
   TissueSnapshot tissue;
   std::uint64_t surface_revision = 0;
   std::uint64_t integrator_iterations = 0;
+  Eigen::Vector3d stepped_tool_position_m = Eigen::Vector3d::Zero();
 };
 
 LinearSolverKind linear_solver(std::int64_t item) {
@@ -97,11 +98,15 @@ TissueSettings tissue_settings(const ValueStore& values, const TetMesh* mesh) {
   return s;
 }
 
+Eigen::Vector3d input_tool_position_m(const ValueStore& values) {
+  const std::span<const double> p = values.float64_array(vr(Vr::tool_position));
+  return {p[0], p[1], p[2]};
+}
+
 ToolPose tool_pose(const ValueStore& values) {
   ToolPose pose;
-  const std::span<const double> p = values.float64_array(vr(Vr::tool_position));
   const std::span<const double> q = values.float64_array(vr(Vr::tool_orientation));
-  pose.tip_position_m = Eigen::Vector3d(p[0], p[1], p[2]);
+  pose.tip_position_m = input_tool_position_m(values);
   pose.orientation = Eigen::Quaterniond(q[0], q[1], q[2], q[3]);
   pose.mode = static_cast<ToolMode>(values.int64(vr(Vr::tool_mode)));
   validate(pose);
@@ -109,7 +114,7 @@ ToolPose tool_pose(const ValueStore& values) {
   // A ball-ended probe touches with the pole of its ball along the tool axis (toward the tip).
   const double radius_m = values.float64(vr(Vr::probe_radius));
   if (pose.mode == ToolMode::probe && radius_m > 0.0) {
-    pose.tip_position_m -= radius_m * (pose.orientation * Eigen::Vector3d::UnitZ());
+    pose.tip_position_m -= radius_m * tool_axis(pose.orientation);
   }
   return pose;
 }
@@ -159,6 +164,7 @@ void TissueModel::build() {
   m_mesh = std::move(mesh);
   m_tissue = std::move(tissue);
   m_tissue->set_tool(tool_pose(m_values));
+  m_stepped_tool_position_m = input_tool_position_m(m_values);
   m_dirty = false;
   m_surface_revision = 0;
   m_integrator_iterations = 0;
@@ -205,6 +211,7 @@ fmi3::StepOutcome TissueModel::do_step(double current_time_s, double step_s) {
   const double now = m_start_time_s + tissue.time_s();
   const long count = fmi3::whole_internal_steps(now, current_time_s, step_s, m_values.float64(vr(Vr::step_size)));
   tissue.set_tool(tool_pose(m_values));
+  m_stepped_tool_position_m = input_tool_position_m(m_values);
   const std::size_t cuts_before = tissue.body().cut_tets().size();
   const bool contact_before = tissue.contact().active;
   const auto log_events = [&] {
@@ -254,13 +261,28 @@ double TissueModel::blade_depth_m() {
   // The edge runs from the tip along the tool axis; from the handle end (outside while a cut
   // starts), the first crossing of the mesh's own surface is where the blade enters the tissue.
   const double length_m = tissue.settings().interaction.blade_length_m;
-  const Eigen::Vector3d handle_m = tool.tip_position_m + length_m * (tool.orientation * Eigen::Vector3d::UnitZ());
+  const Eigen::Vector3d handle_m = tool.tip_position_m + length_m * tool_axis(tool.orientation);
   tissue.surface_bvh().intersect_segment(handle_m, tool.tip_position_m, tissue.current_positions_m(), m_blade_hits);
   const auto mesh_triangles = static_cast<int>(tissue.surface().triangles.size());
   for (const SurfaceBvh::SegmentHit& hit : m_blade_hits) {
     if (hit.triangle < mesh_triangles) return (1.0 - hit.segment_parameter) * length_m;
   }
   return length_m;  // no crossing while cutting: the whole edge is inside
+}
+
+Eigen::Vector3d TissueModel::applied_tool_position_m() const {
+  const ToolPose& requested = m_tissue->tool();
+  const ToolPose& applied = m_tissue->applied_tool();
+  // Only a tool that keeps its mode and does something is ever held back (reachable_pose); then the
+  // applied pose differs from the requested one, else it is the requested one as set.
+  const bool held_back = requested.mode != ToolMode::none && applied.mode == requested.mode &&
+                         (applied.tip_position_m != requested.tip_position_m ||
+                          applied.orientation.coeffs() != requested.orientation.coeffs());
+  if (!held_back) return m_stepped_tool_position_m;
+  Eigen::Vector3d position_m = applied.tip_position_m;
+  const double radius_m = m_values.float64(vr(Vr::probe_radius));
+  if (applied.mode == ToolMode::probe && radius_m > 0.0) position_m += radius_m * tool_axis(applied.orientation);
+  return position_m;
 }
 
 void TissueModel::get_float64(const VariableInfo& info, std::span<double> out) {
@@ -299,6 +321,9 @@ void TissueModel::get_float64(const VariableInfo& info, std::span<double> out) {
       return;
     case Vr::blade_depth:
       out[0] = blade_depth_m();
+      return;
+    case Vr::tool_applied_position:
+      put3(applied_tool_position_m());
       return;
     case Vr::vertex_positions: {
       std::fill(out.begin(), out.end(), 0.0);
@@ -389,6 +414,7 @@ std::unique_ptr<fmi3::ModelState> TissueModel::save() const {
   m_tissue->save(state->tissue);
   state->surface_revision = m_surface_revision;
   state->integrator_iterations = m_integrator_iterations;
+  state->stepped_tool_position_m = m_stepped_tool_position_m;
   return state;
 }
 
@@ -410,6 +436,7 @@ void TissueModel::restore(const fmi3::ModelState& model_state) {
   }
   m_surface_revision = state->surface_revision;
   m_integrator_iterations = state->integrator_iterations;
+  m_stepped_tool_position_m = state->stepped_tool_position_m;
   m_surface_triangles = surface_triangle_count();
 }
 
@@ -418,6 +445,7 @@ void TissueModel::serialize(const fmi3::ModelState& model_state, serial::ByteWri
   writer.put_bytes(serialize_snapshot(state.tissue));
   writer.put(state.surface_revision);
   writer.put(state.integrator_iterations);
+  for (int a = 0; a < 3; ++a) writer.put(state.stepped_tool_position_m(a));
 }
 
 std::unique_ptr<fmi3::ModelState> TissueModel::deserialize(serial::ByteReader& reader) const {
@@ -425,6 +453,7 @@ std::unique_ptr<fmi3::ModelState> TissueModel::deserialize(serial::ByteReader& r
   state->tissue = deserialize_snapshot(reader.get_bytes());
   reader.get(state->surface_revision);
   reader.get(state->integrator_iterations);
+  for (int a = 0; a < 3; ++a) reader.get(state->stepped_tool_position_m(a));
   return state;
 }
 

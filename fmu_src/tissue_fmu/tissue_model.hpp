@@ -21,6 +21,8 @@ namespace tissue::tissue_fmu {
 TissueSettings tissue_settings(const fmi3::ValueStore& values, const TetMesh* mesh);
 /// The tool pose for the core from the tool inputs (a ball probe touches with its pole).
 ToolPose tool_pose(const fmi3::ValueStore& values);
+/// The tool.position input.
+Eigen::Vector3d input_tool_position_m(const fmi3::ValueStore& values);
 
 class TissueModel final : public fmi3::Model {
  public:
@@ -54,6 +56,8 @@ class TissueModel final : public fmi3::Model {
   [[nodiscard]] std::size_t surface_triangle_count() const;
   /// Length of the blade inside the tissue while the scalpel cuts (0 otherwise).
   [[nodiscard]] double blade_depth_m();
+  /// tool.appliedPosition: the tool position the last step applied, in tool.position's terms.
+  [[nodiscard]] Eigen::Vector3d applied_tool_position_m() const;
 
   fmi3::ModelContext m_context;
   const fmi3::ValueStore& m_values;
@@ -66,6 +70,7 @@ class TissueModel final : public fmi3::Model {
   std::uint64_t m_surface_triangles = 0;  // at the last revision check
   bool m_capacity_warned = false;
   std::vector<SurfaceBvh::SegmentHit> m_blade_hits;  // scratch of blade_depth_m()
+  Eigen::Vector3d m_stepped_tool_position_m = Eigen::Vector3d::Zero();  // tool.position the last step took
 };
 
 }  // namespace tissue::tissue_fmu

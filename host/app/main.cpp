@@ -9,7 +9,7 @@
 #include "importer/fmu3_instance.hpp"
 #include "importer/fmu_error.hpp"
 #include "scenario/scenario.hpp"
-#include "session/fmu_links.hpp"
+#include "links/fmu_links.hpp"
 #include "session/session.hpp"
 #include "view/live_view.hpp"
 
@@ -105,7 +105,6 @@ int bench_command(const std::filesystem::path& fmu_dir, int steps, double tissue
   TissueLink tissue(tissue_fmu, {ParameterSetting{"stepSize", tissue_step_s}});
   HapticLink haptic(haptic_fmu, {});
   std::vector<double> tissue_ms, haptic_us;
-  TissueOutputs outputs;
   ToolCommand away;
   away.position_m = {0.0, 0.0, 1.0};
   tissue.set_tool(away);
@@ -113,7 +112,6 @@ int bench_command(const std::filesystem::path& fmu_dir, int steps, double tissue
     const auto start = std::chrono::steady_clock::now();
     (void)tissue.step(k * tissue_step_s, tissue_step_s);
     tissue_ms.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count());
-    tissue.read(outputs);
   }
   DevicePose pose;
   HapticOutputs out;

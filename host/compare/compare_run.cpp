@@ -1,7 +1,7 @@
 // run_measured (see compare_run.hpp): a session observer that times, records and compares.
 #include "compare/compare_run.hpp"
 
-#include "session/fmu_links.hpp"
+#include "links/fmu_links.hpp"
 #include "session/session.hpp"
 
 #include <array>
@@ -52,7 +52,7 @@ class MeasuringObserver final : public TissueStepObserver {
       m_outcome.iterations = iterations[0];
     }
     const std::span<const double> original(m_buffer.data(), 3 * m_vertex_count);
-    const std::array<double, 3>& force = step.outputs->contact_force_n;
+    const std::array<double, 3>& force = step.contact_force_n;
     if (m_compare) m_compare->add(step.reached_s, original, force, energy[0] + energy[1]);
     if (m_record != nullptr) m_record->add(step.reached_s, original, force, energy[0] + energy[1]);
   }

@@ -7,14 +7,13 @@
 // about FMI or the tissue core: the host maps a DevicePose onto the FMU inputs.
 #pragma once
 
+#include "ports/tool.hpp"
+
 #include <array>
 #include <cstdint>
 #include <string_view>
 
 namespace tissue::host {
-
-/// The instrument in the hand; the values match the Tissue FMU's tool mode enumeration.
-enum class ToolMode : std::int64_t { none = 0, probe = 1, scalpel = 2 };
 
 /// What the hand does at one instant: tool tip position [m] and orientation (unit quaternion,
 /// scalar first) in the scene frame, and the instrument selected.

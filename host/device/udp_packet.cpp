@@ -3,6 +3,7 @@
 
 #include <bit>
 #include <cmath>
+#include <optional>
 
 namespace tissue::host::udp {
 namespace {
@@ -177,8 +178,9 @@ DecodeError decode_pose(std::span<const std::uint8_t> datagram, PosePacket& out)
   if (!std::isfinite(norm_squared)) return DecodeError::non_finite;
   if (norm_squared < MIN_QUATERNION_NORM_SQUARED) return DecodeError::zero_quaternion;
   const std::uint32_t mode = load_le<std::uint32_t>(datagram, OFFSET_TOOL_MODE);
-  if (mode > static_cast<std::uint32_t>(ToolMode::scalpel)) return DecodeError::unknown_tool_mode;
-  p.pose.mode = static_cast<ToolMode>(mode);
+  const std::optional<ToolMode> known = tool_mode_of(mode);
+  if (!known) return DecodeError::unknown_tool_mode;
+  p.pose.mode = *known;
   out = p;
   return DecodeError::none;
 }

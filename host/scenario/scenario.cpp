@@ -65,9 +65,7 @@ class Reader {
 
 ToolMode tool_mode(const Reader& r, const toml::node& node, const std::string& key) {
   const std::string name = r.string(node, key);
-  if (name == "none") return ToolMode::none;
-  if (name == "probe") return ToolMode::probe;
-  if (name == "scalpel") return ToolMode::scalpel;
+  if (const auto mode = tool_mode_named(name)) return *mode;
   r.fail(key, "must be \"none\", \"probe\" or \"scalpel\", got \"" + name + "\"");
 }
 

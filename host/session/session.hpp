@@ -7,9 +7,11 @@
 #pragma once
 
 #include "device/device.hpp"
+#include "output/session_summary.hpp"
 #include "importer/fmu3_instance.hpp"
 #include "scenario/scenario.hpp"
 
+#include <array>
 #include <atomic>
 #include <cstdint>
 #include <filesystem>
@@ -21,8 +23,6 @@
 
 namespace tissue::host {
 
-struct TissueOutputs;
-
 /// One Tissue doStep as an observer sees it (offline and real time, on the dynamics thread).
 struct TissueStepInfo {
   std::uint64_t index = 0;                 ///< 0 for the first step
@@ -30,7 +30,7 @@ struct TissueStepInfo {
   double reached_s = 0.0;                  ///< tissue time reached (the last good time after a discard)
   double cpu_s = 0.0;                      ///< CPU time of the doStep call (CLOCK_THREAD_CPUTIME_ID)
   DoStepResult result;                     ///< what doStep answered
-  const TissueOutputs* outputs = nullptr;  ///< what the session read after the step
+  std::array<double, 3> contact_force_n{};  ///< the tissue's contact.force after the step
 };
 
 /// Watches the Tissue FMU of a session step by step (tissue-host compare records and measures
@@ -76,42 +76,6 @@ struct SessionOptions {
   const std::atomic<bool>* stop = nullptr;
 };
 
-struct Percentiles {
-  double p50 = 0.0, p99 = 0.0, max = 0.0;
-};
-
-struct SessionSummary {
-  std::string scenario;
-  bool offline = false;
-  double sim_time_s = 0.0, wall_time_s = 0.0, realtime_factor = 0.0;
-  double haptic_rate_hz = 0.0;
-  Percentiles haptic_period_us;
-  double haptic_period_max_at_s = 0.0;     ///< session time of the longest period (where to look)
-  double haptic_first_tick_late_us = 0.0;  ///< how late the first tick woke
-  std::uint64_t haptic_ticks = 0, deadline_misses = 0;
-  Percentiles tissue_step_ms, tissue_step_before_cut_ms, tissue_step_during_cut_ms;
-  double tissue_step_s = 0.0;
-  std::uint64_t tissue_steps = 0, tissue_overruns = 0, skipped_slots = 0, catch_up_slots = 0;
-  std::uint64_t tissue_discards = 0, tissue_errors = 0, haptic_errors = 0, samples_not_finite = 0;
-  std::uint64_t cut_tets = 0, enriched_vertices = 0;
-  bool contact_seen = false;
-  double max_device_force_n = 0.0, device_max_force_n = 0.0;
-  double passivity_dissipated_j = 0.0, passivity_observed_j = 0.0;
-  bool nan_detected = false;
-  std::string device_name;
-  DeviceCounters device;
-  std::uint64_t frames_written = 0, frames_dropped = 0;
-  bool view = false;
-  std::uint64_t view_connections = 0, view_frames_sent = 0, view_frames_skipped = 0, view_messages = 0,
-                view_malformed = 0, view_oversized = 0, view_flood = 0, view_out_of_order = 0, view_withdrawals = 0;
-  bool realtime_priority = false;
-  std::string realtime_priority_note;
-  std::string first_error;
-  std::string overrun_policy;
-
-  [[nodiscard]] std::string to_json() const;
-};
-
 /// Runs the scenario; writes summary.json, log.csv, frames/*.vtu with surface.pvd and final.png into
 /// options.output_dir. Throws ScenarioError / FmuError / std::runtime_error when it cannot start;
 /// failures during the run are counted in the summary.
@@ -124,8 +88,5 @@ std::vector<ParameterSetting> with_overrides(std::vector<ParameterSetting> param
 /// Limits the FMUs' solver libraries (OpenMP, OpenBLAS) to the calling thread, before the FMUs load;
 /// once per process (setenv is not safe while other threads run: call it before starting any).
 void keep_solver_libraries_on_the_calling_thread();
-
-/// The summary in a few lines, and where the outputs are.
-void print_summary(std::ostream& out, const SessionSummary& summary, const std::filesystem::path& output_dir);
 
 }  // namespace tissue::host

@@ -10,7 +10,7 @@
 #pragma once
 
 #include "device/device.hpp"
-#include "session/latest_value.hpp"
+#include "sync/latest_value.hpp"
 
 #include <array>
 #include <atomic>

@@ -6,7 +6,7 @@
 #pragma once
 
 #include "output/surface_frame.hpp"
-#include "session/latest_value.hpp"
+#include "sync/latest_value.hpp"
 #include "view/browser_device.hpp"
 #include "view/view_server.hpp"
 

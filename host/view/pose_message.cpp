@@ -4,6 +4,7 @@
 #include <nlohmann/json.hpp>
 
 #include <cmath>
+#include <optional>
 
 namespace tissue::host {
 namespace {
@@ -55,15 +56,9 @@ std::optional<PoseMessage> parse_pose_message(std::string_view text, std::string
   const auto mode = message.find("mode");
   if (mode == message.end() || !mode->is_string()) return refuse(why, "mode is not a string");
   const std::string name = mode->get<std::string>();
-  if (name == "none") {
-    result.pose.mode = ToolMode::none;
-  } else if (name == "probe") {
-    result.pose.mode = ToolMode::probe;
-  } else if (name == "scalpel") {
-    result.pose.mode = ToolMode::scalpel;
-  } else {
-    return refuse(why, "mode is not none, probe or scalpel");
-  }
+  const std::optional<ToolMode> named = tool_mode_named(name);
+  if (!named) return refuse(why, "mode is not none, probe or scalpel");
+  result.pose.mode = *named;
   return result;
 }
 

@@ -23,7 +23,7 @@ add_library(tissue::host_view ALIAS tissue_host_view)
 target_include_directories(tissue_host_view PUBLIC ${PROJECT_SOURCE_DIR}/host)
 target_compile_features(tissue_host_view PUBLIC cxx_std_20)
 target_link_libraries(tissue_host_view
-  PUBLIC tissue_host_view_server tissue::host_device tissue::host_output Threads::Threads
+  PUBLIC tissue_host_view_server tissue::host_device tissue::host_output tissue::host_sync Threads::Threads
   PRIVATE nlohmann_json::nlohmann_json tissue::warnings)
 
 # The page and three.js (npm, ./scripts/setup) are served from the build, never from the network.

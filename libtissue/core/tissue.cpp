@@ -130,9 +130,7 @@ PointContactSettings contact_settings(const TissueSettings& settings, const Defo
 }  // namespace
 
 ToolMode parse_tool_mode(std::string_view name) {
-  if (name == "none") return ToolMode::none;
-  if (name == "probe") return ToolMode::probe;
-  if (name == "scalpel") return ToolMode::scalpel;
+  if (const auto mode = tool_mode_named(name)) return *mode;
   throw ParameterError("unknown tool mode '" + std::string(name) + "' (expected none, probe or scalpel)");
 }
 
@@ -213,8 +211,7 @@ void Tissue::set_tool(const ToolPose& pose) {
 }
 
 Blade Tissue::blade(const ToolPose& pose) const {
-  return Blade{pose.tip_position_m, pose.tip_position_m + m_settings.interaction.blade_length_m *
-                                                              (pose.orientation * Eigen::Vector3d::UnitZ())};
+  return Blade{pose.tip_position_m, pose.tip_position_m + m_settings.interaction.blade_length_m * tool_axis(pose.orientation)};
 }
 
 ToolPose reachable_pose(const ToolPose& previous, const ToolPose& target, double blade_length_m, double max_step_m) {

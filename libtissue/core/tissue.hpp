@@ -15,6 +15,7 @@
 #include "core/integrate/integrator_factory.hpp"
 #include "core/mesh/topology.hpp"
 #include "core/solve/linear_solver.hpp"
+#include "ports/tool.hpp"
 
 #include <Eigen/Geometry>
 
@@ -27,8 +28,6 @@
 #include <vector>
 
 namespace tissue {
-
-enum class ToolMode { none, probe, scalpel };
 
 /// Parses "none" / "probe" / "scalpel"; throws ParameterError otherwise.
 ToolMode parse_tool_mode(std::string_view name);
@@ -43,6 +42,12 @@ struct ToolPose {
 
 /// Throws ParameterError for a non-finite position or a non-finite or zero quaternion.
 void validate(const ToolPose& pose);
+
+/// The tool axis (local +z, from the tip toward the handle) of a unit quaternion (ports/tool.hpp).
+inline Eigen::Vector3d tool_axis(const Eigen::Quaterniond& orientation) {
+  const auto axis = tissue::tool_axis(orientation.w(), orientation.x(), orientation.y(), orientation.z());
+  return {axis[0], axis[1], axis[2]};
+}
 
 /// The pose a tool reaches from `previous` toward `target` when no point of its blade (blade_length_m
 /// along the axis from the tip) may travel more than max_step_m: `target` itself when it is within

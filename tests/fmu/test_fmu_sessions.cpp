@@ -204,6 +204,37 @@ TEST(TissueFmu, ProbePushesBackAndScalpelCuts) {
   EXPECT_TRUE(contact_logged);
 }
 
+// tool.appliedPosition is the x0 the haptic loop renders about (ports/tissue_sample.hpp): the tool
+// position the tissue applied. Unheld, it is tool.position as set, to the bit. A probe teleported
+// 0.5 m is held to the hand's top speed (tool.maxSpeed, 5 m/s by default): after one communication
+// step of 10 internal steps it is 10 x 5 mm along the straight line, not where it was put (the host
+// used to pass on its own copy of the requested pose as x0).
+TEST(TissueFmu, AppliedToolPositionIsWhereTheTissueHeldTheTool) {
+  const FrogGeometry g = rest_geometry();
+  Session s;
+  s.start();
+  const std::array<double, 3> start{g.top[0], g.top[1], g.top[2] + 0.01};
+  s.tool(start, 1);
+  s.step();
+  std::vector<double> applied;
+  ASSERT_EQ(s.fmu().get_float64("tool.appliedPosition", applied), fmi3OK);
+  EXPECT_EQ(applied, std::vector<double>(start.begin(), start.end()));
+
+  const std::array<double, 3> far{start[0] + 0.5, start[1], start[2]};
+  s.tool(far, 1);
+  s.step();
+  ASSERT_EQ(s.fmu().get_float64("tool.appliedPosition", applied), fmi3OK);
+  const double reach_m = 5.0 * STEP_S;  // tool.maxSpeed x the communication step
+  EXPECT_NEAR(applied[0], start[0] + reach_m, 1e-12);
+  EXPECT_NEAR(applied[1], start[1], 1e-12);
+  EXPECT_NEAR(applied[2], start[2], 1e-12);
+
+  // It catches up within ceil(0.5 m / 50 mm) = 10 steps, and then is the input again.
+  for (int k = 0; k < 10; ++k) s.step();
+  ASSERT_EQ(s.fmu().get_float64("tool.appliedPosition", applied), fmi3OK);
+  EXPECT_EQ(applied, std::vector<double>(far.begin(), far.end()));
+}
+
 TEST(TissueFmu, SceneSwitchesTurnOffWhatTheyName) {
   const FrogGeometry g = rest_geometry();
   Session s("switched");

@@ -18,15 +18,16 @@ set(TISSUE_HOST_CMAKE_PACKED_FMU ${CMAKE_CURRENT_BINARY_DIR}/cmake_packed.fmu)
 add_custom_command(OUTPUT ${TISSUE_HOST_CMAKE_PACKED_FMU}
   COMMAND ${CMAKE_COMMAND} -E rm -rf cmake_packed ${TISSUE_HOST_CMAKE_PACKED_FMU}
   COMMAND ${CMAKE_COMMAND} -E make_directory cmake_packed/resources cmake_packed/binaries/x86_64-linux
-  COMMAND ${CMAKE_COMMAND} -E copy ${PROJECT_SOURCE_DIR}/modelDescription/Tissue.xml cmake_packed/modelDescription.xml
+  COMMAND ${CMAKE_COMMAND} -E copy ${TISSUE_TISSUE_XML_PATH} cmake_packed/modelDescription.xml
   COMMAND ${CMAKE_COMMAND} -E copy ${PROJECT_SOURCE_DIR}/modelDescription/README.md cmake_packed/resources/README.md
   COMMAND ${CMAKE_COMMAND} -E chdir cmake_packed
           ${CMAKE_COMMAND} -E tar cf ${TISSUE_HOST_CMAKE_PACKED_FMU} --format=zip modelDescription.xml resources binaries
-  DEPENDS ${PROJECT_SOURCE_DIR}/modelDescription/Tissue.xml ${PROJECT_SOURCE_DIR}/modelDescription/README.md
+  DEPENDS ${TISSUE_TISSUE_XML_PATH} ${PROJECT_SOURCE_DIR}/modelDescription/README.md
   WORKING_DIRECTORY ${CMAKE_CURRENT_BINARY_DIR}
   COMMENT "Packing cmake_packed.fmu for the host tests"
   VERBATIM)
 add_custom_target(tissue_host_cmake_packed_fmu DEPENDS ${TISSUE_HOST_CMAKE_PACKED_FMU})
+add_dependencies(tissue_host_cmake_packed_fmu tissue_fmu_package)
 
 add_executable(test_host_importer
   ${CMAKE_CURRENT_LIST_DIR}/test_model_description.cpp
@@ -38,6 +39,7 @@ target_link_libraries(test_host_importer PRIVATE tissue::fmi_importer PkgConfig:
                                                  GTest::gtest GTest::gtest_main tissue::warnings)
 target_compile_definitions(test_host_importer PRIVATE
   TISSUE_SOURCE_DIR="${PROJECT_SOURCE_DIR}"
+  TISSUE_TISSUE_XML="${TISSUE_TISSUE_XML_PATH}"
   TISSUE_PARTIAL_FMI3_BINARY="$<TARGET_FILE:tissue_host_partial_fmi3>"
   TISSUE_HOST_CMAKE_PACKED_FMU="${TISSUE_HOST_CMAKE_PACKED_FMU}")
 add_dependencies(test_host_importer tissue_host_partial_fmi3 tissue_host_cmake_packed_fmu)

@@ -114,7 +114,7 @@ TEST_F(FmuArchiveTest, ReadsAnArchivePackedByCmakeTar) {
   // (ZIP_CHECKCONS) rejects such archives, so this guards the way FmuArchive opens them.
   const FmuArchive archive(TISSUE_HOST_CMAKE_PACKED_FMU);
   EXPECT_EQ(test::read_file(archive.model_description_path()),
-            test::read_file(TISSUE_SOURCE_DIR "/modelDescription/Tissue.xml"));
+            test::read_file(TISSUE_TISSUE_XML));
   EXPECT_EQ(test::read_file(archive.resources_directory() / "README.md"),
             test::read_file(TISSUE_SOURCE_DIR "/modelDescription/README.md"));
   EXPECT_TRUE(std::filesystem::is_directory(archive.directory() / "binaries" / "x86_64-linux"));

@@ -158,7 +158,7 @@ TEST(ModelDescription, ReadsEnumerationsAndStringStarts) {
 }
 
 TEST(ModelDescription, ReadsTheTissueFmuDescription) {
-  const ModelDescription md = load_model_description(TISSUE_SOURCE_DIR "/modelDescription/Tissue.xml");
+  const ModelDescription md = load_model_description(TISSUE_TISSUE_XML);
   EXPECT_EQ(md.model_name(), "Tissue");
   EXPECT_EQ(md.co_simulation().model_identifier, "Tissue");
   EXPECT_TRUE(md.co_simulation().can_get_and_set_fmu_state);

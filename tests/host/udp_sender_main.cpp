@@ -26,7 +26,7 @@
 namespace {
 
 using tissue::host::DevicePose;
-using tissue::host::ToolMode;
+using tissue::ToolMode;
 namespace udp = tissue::host::udp;
 
 volatile std::sig_atomic_t g_stop = 0;

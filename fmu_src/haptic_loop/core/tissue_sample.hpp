@@ -10,12 +10,11 @@
 // stiffness of the force the tool exerts on the tissue.)
 #pragma once
 
+#include "ports/tool.hpp"
+
 #include <Eigen/Core>
 
 namespace tissue::haptic {
-
-/// The tool the user holds (DESIGN section 5). `none`: the tool is put away, no force.
-enum class ToolMode { none, probe, scalpel };
 
 /// One tissue update. A sample with contact_active == false renders no contact force (its contact
 /// fields may then be zero); blade_depth_m is used in scalpel mode whether in contact or not.

@@ -1,10 +1,9 @@
 // TissueLink, HapticLink and apply_parameters (see fmu_links.hpp).
-#include "session/fmu_links.hpp"
+#include "links/fmu_links.hpp"
 
 #include "importer/fmu_error.hpp"
 
 #include <algorithm>
-#include <cmath>
 #include <limits>
 
 namespace tissue::host {
@@ -17,10 +16,6 @@ fmi3ValueReference vr(const Fmu3Instance& instance, std::string_view name) {
 void expect_ok(fmi3Status status, Fmu3Instance& instance, const std::string& what) {
   if (status == fmi3OK || status == fmi3Warning) return;
   throw FmuError(what + " failed (" + status_name(status) + "): " + instance.log_text());
-}
-
-bool all_finite(std::span<const double> values) {
-  return std::all_of(values.begin(), values.end(), [](double v) { return std::isfinite(v); });
 }
 
 }  // namespace
@@ -97,10 +92,6 @@ TissueLink::TissueLink(const Fmu3& fmu, const std::vector<ParameterSetting>& par
       m_tool_position(vr(m_instance, "tool.position")),
       m_tool_orientation(vr(m_instance, "tool.orientation")),
       m_tool_mode(vr(m_instance, "tool.mode")),
-      m_float_outputs{vr(m_instance, "contact.point"), vr(m_instance, "contact.normal"),
-                      vr(m_instance, "contact.force"), vr(m_instance, "contact.stiffness"),
-                      vr(m_instance, "cut.bladeDepth")},
-      m_contact_active(vr(m_instance, "contact.active")),
       m_vertex_count(vr(m_instance, "surface.vertexCount")),
       m_triangle_count(vr(m_instance, "surface.triangleCount")),
       m_positions(vr(m_instance, "surface.vertexPositions")),
@@ -120,7 +111,6 @@ TissueLink::TissueLink(const Fmu3& fmu, const std::vector<ParameterSetting>& par
   std::vector<double> blade;
   expect_ok(m_instance.get_float64("tool.bladeLength", blade), m_instance, "Tissue: blade length");
   m_blade_length_m = blade.at(0);
-  m_float_buffer.resize(3 + 3 + 3 + 9 + 1);
   SurfaceFrame rest;
   read_surface(rest);
   const std::size_t vertices = rest.vertex_count();
@@ -138,7 +128,6 @@ TissueLink::TissueLink(const Fmu3& fmu, const std::vector<ParameterSetting>& par
 }
 
 void TissueLink::set_tool(const ToolCommand& tool) {
-  m_last_tool = tool;
   const std::array<fmi3ValueReference, 2> vrs{m_tool_position, m_tool_orientation};
   std::array<double, 7> values{};
   std::copy(tool.position_m.begin(), tool.position_m.end(), values.begin());
@@ -150,24 +139,12 @@ void TissueLink::set_tool(const ToolCommand& tool) {
 
 DoStepResult TissueLink::step(double time_s, double step_s) { return m_instance.do_step(time_s, step_s); }
 
-void TissueLink::read(TissueOutputs& out) {
-  (void)m_instance.get_float64(m_float_outputs, m_float_buffer);
-  const double* f = m_float_buffer.data();
-  std::copy(f, f + 3, out.contact_point_m.begin());
-  std::copy(f + 3, f + 6, out.contact_normal.begin());
-  std::copy(f + 6, f + 9, out.contact_force_n.begin());
-  std::copy(f + 9, f + 18, out.contact_stiffness_n_per_m.begin());
-  out.blade_depth_m = f[18];
-  out.finite = all_finite(m_float_buffer);
-  std::array<fmi3Boolean, 1> active{};
-  (void)m_instance.get_boolean(std::span<const fmi3ValueReference>(&m_contact_active, 1), active);
-  out.contact_active = active[0];
+void TissueLink::read_counters(TissueSample& sample) {
   std::array<fmi3UInt64, 2> counters{};
   const std::array<fmi3ValueReference, 2> counter_vrs{m_cut_tets, m_enriched};
   (void)m_instance.get_uint64(counter_vrs, counters);
-  out.cut_tets = counters[0];
-  out.enriched_vertices = counters[1];
-  out.tool_position_m = m_last_tool.position_m;
+  sample.cut_tets = counters[0];
+  sample.enriched_vertices = counters[1];
 }
 
 void TissueLink::reserve(SurfaceFrame& frame) const {
@@ -195,14 +172,6 @@ HapticLink::HapticLink(const Fmu3& fmu, const std::vector<ParameterSetting>& par
     : m_instance(fmu, "haptic", false),
       m_device_float{vr(m_instance, "device.position"), vr(m_instance, "device.orientation")},
       m_device_mode(vr(m_instance, "device.toolMode")),
-      m_tissue_float{vr(m_instance, "tissue.time"),
-                     vr(m_instance, "tissue.contactPoint"),
-                     vr(m_instance, "tissue.contactNormal"),
-                     vr(m_instance, "tissue.contactForce"),
-                     vr(m_instance, "tissue.contactStiffness"),
-                     vr(m_instance, "tissue.toolPosition"),
-                     vr(m_instance, "tissue.bladeDepth")},
-      m_tissue_active(vr(m_instance, "tissue.contactActive")),
       m_out_float{vr(m_instance, "tool.position"), vr(m_instance, "tool.orientation"), vr(m_instance, "device.force")},
       m_out_energy{vr(m_instance, "passivity.observedEnergy"), vr(m_instance, "passivity.dissipatedEnergy")},
       m_out_mode(vr(m_instance, "tool.mode")),
@@ -224,21 +193,6 @@ void HapticLink::set_device(const DevicePose& pose) {
   (void)m_instance.set_float64(m_device_float, values);
   const std::array<fmi3Int64, 1> mode{static_cast<fmi3Int64>(pose.mode)};
   (void)m_instance.set_int64(std::span<const fmi3ValueReference>(&m_device_mode, 1), mode);
-}
-
-void HapticLink::set_tissue(const TissueOutputs& t) {
-  std::array<double, 1 + 3 + 3 + 3 + 9 + 3 + 1> values{};
-  auto* p = values.data();
-  *p++ = t.time_s;
-  p = std::copy(t.contact_point_m.begin(), t.contact_point_m.end(), p);
-  p = std::copy(t.contact_normal.begin(), t.contact_normal.end(), p);
-  p = std::copy(t.contact_force_n.begin(), t.contact_force_n.end(), p);
-  p = std::copy(t.contact_stiffness_n_per_m.begin(), t.contact_stiffness_n_per_m.end(), p);
-  p = std::copy(t.tool_position_m.begin(), t.tool_position_m.end(), p);
-  *p = t.blade_depth_m;
-  (void)m_instance.set_float64(m_tissue_float, values);
-  const std::array<fmi3Boolean, 1> active{t.contact_active};
-  (void)m_instance.set_boolean(std::span<const fmi3ValueReference>(&m_tissue_active, 1), active);
 }
 
 DoStepResult HapticLink::step(double time_s, double step_s) { return m_instance.do_step(time_s, step_s); }

@@ -1,13 +1,15 @@
-// The host's two FMU instances as the session uses them: the Tissue FMU (tool pose in; contact,
-// counters and surface out) and the HapticLoop FMU (device and tissue sample in; tool pose and
-// device force out). Value references are looked up once by name; the calls of a step or a tick
-// are the importer's thin calls on preallocated buffers (no allocation, no exception). Scenario
-// parameters are applied by name, converted to each variable's type, and refused with the key.
+// The host's two FMU instances as the session uses them: the Tissue FMU (tool pose in; the tissue
+// sample, counters and surface out) and the HapticLoop FMU (device and tissue sample in; tool pose
+// and device force out), and the relay of the tissue sample between them (sample_relay.hpp). Value
+// references are looked up once by name; the calls of a step or a tick are the importer's thin calls
+// on preallocated buffers (no allocation, no exception). Scenario parameters are applied by name,
+// converted to each variable's type, and refused with the key.
 #pragma once
 
 #include "device/device.hpp"
 #include "importer/fmu3.hpp"
 #include "importer/fmu3_instance.hpp"
+#include "links/sample_relay.hpp"
 #include "output/surface_frame.hpp"
 #include "scenario/scenario.hpp"
 
@@ -24,18 +26,6 @@ struct ToolCommand {
   std::array<double, 3> position_m{};
   std::array<double, 4> orientation_wxyz{1.0, 0.0, 0.0, 0.0};
   std::int64_t mode = 0;
-};
-
-/// Dynamics side -> haptic side: the tissue's outputs after a step, and the time they are for.
-struct TissueOutputs {
-  double time_s = 0.0;
-  bool contact_active = false;
-  std::array<double, 3> contact_point_m{}, contact_normal{}, contact_force_n{};
-  std::array<double, 9> contact_stiffness_n_per_m{};
-  std::array<double, 3> tool_position_m{};
-  double blade_depth_m = 0.0;
-  std::uint64_t cut_tets = 0, enriched_vertices = 0;
-  bool finite = true;  ///< every number above is finite
 };
 
 /// What the haptic loop outputs after a tick.
@@ -58,7 +48,8 @@ class TissueLink {
 
   void set_tool(const ToolCommand& tool);
   DoStepResult step(double time_s, double step_s);
-  void read(TissueOutputs& outputs);
+  /// The cut counters into `sample` (the relay reads the sample's fields).
+  void read_counters(TissueSample& sample);
   /// The surface into `frame` (its vectors keep their capacity: no allocation after the first).
   void read_surface(SurfaceFrame& frame);
   /// Gives `frame` the capacity read_surface() needs, so that reading into it allocates nothing.
@@ -72,14 +63,11 @@ class TissueLink {
  private:
   Fmu3Instance m_instance;
   fmi3ValueReference m_tool_position, m_tool_orientation, m_tool_mode;
-  std::array<fmi3ValueReference, 5> m_float_outputs{};  // point, normal, force, stiffness, blade depth
-  fmi3ValueReference m_contact_active, m_vertex_count, m_triangle_count, m_positions, m_triangles, m_cut_tets,
-      m_enriched, m_cut_triangles;
+  fmi3ValueReference m_vertex_count, m_triangle_count, m_positions, m_triangles, m_cut_tets, m_enriched,
+      m_cut_triangles;
   std::size_t m_vertex_capacity = 0, m_triangle_capacity = 0;
-  std::vector<double> m_float_buffer;
   std::array<double, 3> m_rest_lower{}, m_rest_upper{};
   double m_blade_length_m = 0.0;
-  ToolCommand m_last_tool;
 };
 
 class HapticLink {
@@ -87,8 +75,6 @@ class HapticLink {
   HapticLink(const Fmu3& fmu, const std::vector<ParameterSetting>& parameters);
 
   void set_device(const DevicePose& pose);
-  /// A new tissue sample (only finite outputs are passed on; the caller checks `finite`).
-  void set_tissue(const TissueOutputs& tissue);
   DoStepResult step(double time_s, double step_s);
   void read(HapticOutputs& outputs);
   [[nodiscard]] double max_force_n() const { return m_max_force_n; }
@@ -98,8 +84,6 @@ class HapticLink {
   Fmu3Instance m_instance;
   std::array<fmi3ValueReference, 2> m_device_float{};  // position, orientation
   fmi3ValueReference m_device_mode;
-  std::array<fmi3ValueReference, 7> m_tissue_float{};  // time, point, normal, force, stiffness, tool position, depth
-  fmi3ValueReference m_tissue_active;
   std::array<fmi3ValueReference, 3> m_out_float{};  // tool position, tool orientation, device force
   std::array<fmi3ValueReference, 2> m_out_energy{};
   fmi3ValueReference m_out_mode;

@@ -1,0 +1,57 @@
+// The session's device (see session_device.hpp).
+#include "session/session_device.hpp"
+
+#include "device/replay_device.hpp"
+#include "device/scripted_device.hpp"
+#include "device/udp_device.hpp"
+#include "view/browser_device.hpp"
+
+#include <vector>
+
+namespace tissue::host {
+
+std::unique_ptr<Device> make_device(const DeviceConfig& config, const TissueLink& tissue) {
+  switch (config.kind) {
+    case DeviceKind::scripted: {
+      std::vector<DeviceWaypoint> waypoints;
+      for (const Waypoint& w : config.waypoints) {
+        DeviceWaypoint d;
+        d.time_s = w.time_s;
+        for (std::size_t a = 0; a < 3; ++a) {
+          d.pose.position_m[a] = w.box_relative ? tissue.rest_lower()[a] +
+                                                      w.position[a] * (tissue.rest_upper()[a] - tissue.rest_lower()[a])
+                                                : w.position[a];
+        }
+        d.pose.orientation_wxyz = w.orientation_wxyz;
+        d.pose.mode = w.mode;
+        waypoints.push_back(d);
+      }
+      return std::make_unique<ScriptedDevice>(std::move(waypoints));
+    }
+    case DeviceKind::replay:
+      return std::make_unique<ReplayDevice>(config.replay_file);
+    case DeviceKind::browser: {
+      // Start put away, 2 cm above the middle of the body's top.
+      DevicePose pose;
+      for (std::size_t a = 0; a < 2; ++a) pose.position_m[a] = 0.5 * (tissue.rest_lower()[a] + tissue.rest_upper()[a]);
+      pose.position_m[2] = tissue.rest_upper()[2] + 0.02;
+      return std::make_unique<BrowserDevice>(pose);
+    }
+    case DeviceKind::udp: {
+      UdpDeviceSettings settings;
+      settings.bind_address = config.udp_address;
+      settings.port = config.udp_port;
+      settings.allow_remote = config.udp_allow_remote;
+      return std::make_unique<UdpDevice>(settings);
+    }
+  }
+  throw ScenarioError("device: unknown kind");
+}
+
+DeviceConfig browser_config() {
+  DeviceConfig config;
+  config.kind = DeviceKind::browser;
+  return config;
+}
+
+}  // namespace tissue::host
