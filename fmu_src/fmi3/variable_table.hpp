@@ -68,6 +68,16 @@ struct LogCategory {
   std::string_view description;
 };
 
+/// The log categories the layer logs to (instance.cpp), with the model's words for what its warnings
+/// and its events carry; the rest are the layer's own.
+constexpr std::array<LogCategory, 5> layer_log_categories(std::string_view warnings, std::string_view events) {
+  return {{{"logStatusWarning", warnings},
+           {"logStatusError", "Calls that returned fmi3Error or fmi3Discard, with the reason"},
+           {"logStatusFatal", "Calls that returned fmi3Fatal"},
+           {"logCalls", "Every FMI function call with its arguments"},
+           {"logEvents", events}}};
+}
+
 struct DefaultExperiment {
   double start_time_s = 0.0;
   double stop_time_s = 1.0;

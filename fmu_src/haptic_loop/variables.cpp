@@ -18,14 +18,9 @@ const auto ENUMERATIONS = std::to_array<EnumerationType>({
     {"ToolMode", ports::TOOL_MODE_DESCRIPTION, TOOL_MODE_ITEMS},
 });
 
-constexpr auto LOG_CATEGORIES = std::to_array<fmi3::LogCategory>({
-    {"logStatusWarning",
-     "Calls that returned fmi3Warning, and recoverable problems such as a refused tissue sample"},
-    {"logStatusError", "Calls that returned fmi3Error or fmi3Discard, with the reason"},
-    {"logStatusFatal", "Calls that returned fmi3Fatal"},
-    {"logCalls", "Every FMI function call"},
-    {"logEvents", "Events of the haptic loop"},
-});
+constexpr auto LOG_CATEGORIES = fmi3::layer_log_categories(
+    "Calls that returned fmi3Warning, and recoverable problems such as a refused tissue sample",
+    "Events of the haptic loop");
 
 }  // namespace
 

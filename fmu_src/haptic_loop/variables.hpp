@@ -193,7 +193,7 @@ constexpr auto own_variables() {
 /// a field) as its tissue.* inputs, in value-reference order.
 template <std::size_t N>
 constexpr auto haptic_loop_variables(const std::array<ports::SampleField, N>& sample) {
-  return fmi3::merged(variables_detail::own_variables(), ports::haptic_inputs(sample));
+  return fmi3::merged(variables_detail::own_variables(), ports::entries(sample, ports::haptic_input));
 }
 
 /// The HapticLoop FMU's description: identity, variables, enumeration types, log categories.

@@ -42,18 +42,13 @@ constexpr fmi3::VariableInfo haptic_input(const SampleField& field) {
   return shaped(entry, field);
 }
 
+/// One entry per field, made by `entry` (tissue_output or haptic_input).
 template <std::size_t N>
-constexpr std::array<fmi3::VariableInfo, N> tissue_outputs(const std::array<SampleField, N>& fields) {
-  std::array<fmi3::VariableInfo, N> entries{};
-  for (std::size_t k = 0; k < N; ++k) entries[k] = tissue_output(fields[k]);
-  return entries;
-}
-
-template <std::size_t N>
-constexpr std::array<fmi3::VariableInfo, N> haptic_inputs(const std::array<SampleField, N>& fields) {
-  std::array<fmi3::VariableInfo, N> entries{};
-  for (std::size_t k = 0; k < N; ++k) entries[k] = haptic_input(fields[k]);
-  return entries;
+constexpr std::array<fmi3::VariableInfo, N> entries(const std::array<SampleField, N>& fields,
+                                                    fmi3::VariableInfo (*entry)(const SampleField&)) {
+  std::array<fmi3::VariableInfo, N> made{};
+  for (std::size_t k = 0; k < N; ++k) made[k] = entry(fields[k]);
+  return made;
 }
 
 inline constexpr std::string_view TOOL_MODE_DESCRIPTION = "What the tool does";

@@ -42,14 +42,9 @@ const auto ENUMERATIONS = std::to_array<EnumerationType>({
     {"ToolMode", ports::TOOL_MODE_DESCRIPTION, TOOL_MODE_ITEMS},
 });
 
-constexpr auto LOG_CATEGORIES = std::to_array<fmi3::LogCategory>({
-    {"logStatusWarning",
-     "Calls that returned fmi3Warning, and recoverable problems such as a surface that outgrew its capacity"},
-    {"logStatusError", "Calls that returned fmi3Error or fmi3Discard, with the reason"},
-    {"logStatusFatal", "Calls that returned fmi3Fatal"},
-    {"logCalls", "Every FMI function call with its arguments"},
-    {"logEvents", "Cuts made and contacts started/ended"},
-});
+constexpr auto LOG_CATEGORIES = fmi3::layer_log_categories(
+    "Calls that returned fmi3Warning, and recoverable problems such as a surface that outgrew its capacity",
+    "Cuts made and contacts started/ended");
 
 }  // namespace
 

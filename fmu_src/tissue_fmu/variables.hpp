@@ -297,7 +297,7 @@ constexpr auto own_variables() {
 /// field), in value-reference order.
 template <std::size_t N>
 constexpr auto tissue_variables(const std::array<ports::SampleField, N>& sample) {
-  return fmi3::merged(variables_detail::own_variables(), ports::tissue_outputs(sample));
+  return fmi3::merged(variables_detail::own_variables(), ports::entries(sample, ports::tissue_output));
 }
 
 /// The Tissue FMU's description: identity, variables, enumeration types, log categories.

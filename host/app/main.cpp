@@ -91,12 +91,6 @@ int info_command(const std::string& fmu_file) {
   return 0;
 }
 
-double percentile(std::vector<double> values, double q) {
-  std::sort(values.begin(), values.end());
-  const auto index = static_cast<std::size_t>(std::ceil(q * static_cast<double>(values.size()))) - 1;
-  return values[std::min(values.size() - 1, index)];
-}
-
 int bench_command(const std::filesystem::path& fmu_dir, int steps, double tissue_step_s) {
   // The two FMUs' step costs through the importer, as the session calls them (offline, one thread).
   const Fmu3 tissue_fmu(fmu_dir / "Tissue.fmu");
@@ -122,10 +116,11 @@ int bench_command(const std::filesystem::path& fmu_dir, int steps, double tissue
     haptic.read(out);
     haptic_us.push_back(std::chrono::duration<double, std::micro>(std::chrono::steady_clock::now() - start).count());
   }
+  const Percentiles tissue_cost = percentiles(tissue_ms, 1.0), haptic_cost = percentiles(haptic_us, 1.0);
   std::cout << "Tissue doStep (" << tissue_step_s * 1e3 << " ms, one internal step, tool away), " << steps
-            << " steps: p50 " << percentile(tissue_ms, 0.5) << " ms, p99 " << percentile(tissue_ms, 0.99) << " ms\n";
+            << " steps: p50 " << tissue_cost.p50 << " ms, p99 " << tissue_cost.p99 << " ms\n";
   std::cout << "HapticLoop tick (set device, doStep 1 ms, get outputs), " << 10 * steps << " ticks: p50 "
-            << percentile(haptic_us, 0.5) << " us, p99 " << percentile(haptic_us, 0.99) << " us\n";
+            << haptic_cost.p50 << " us, p99 " << haptic_cost.p99 << " us\n";
   return 0;
 }
 
