@@ -34,7 +34,7 @@ Instance::Instance(const ModelDescription& description, std::string name, std::s
     }
   };
   m_model = make_model(context, m_values);
-  m_model->validate(m_values);  // the start values must run: a table that says otherwise is a bug
+  m_model->validate_parameters(m_values);  // the start values must run: a table that says otherwise is a bug
 }
 
 // Takes C strings so that a call with logging off costs no allocation (the haptic loop calls at 1 kHz).
@@ -202,7 +202,7 @@ void Instance::set(std::span<const ValueReference> vrs, std::span<const T> value
                         " were passed");
   }
   try {
-    m_model->validate(m_candidate);
+    if (parameter_set) m_model->validate_parameters(m_candidate);
   } catch (const std::exception& error) {
     // The model's checks speak of its settings; say which variables were being set.
     std::string names;
@@ -278,7 +278,7 @@ std::unique_ptr<InstanceState> Instance::deserialize(std::span<const std::uint8_
     }
     auto saved = std::make_unique<InstanceState>(InstanceState{mode, ValueStore(m_description), nullptr});
     saved->values.deserialize(reader);
-    m_model->validate(saved->values);
+    m_model->validate_parameters(saved->values);
     saved->model = m_model->deserialize(reader);
     reader.finish();
     return saved;

@@ -52,11 +52,12 @@ class Model {
  public:
   virtual ~Model() = default;
 
-  /// Refuses (throws, with a message naming the variable) a set of values the model cannot run
-  /// with: called on every fmi3Set* with the values as they would be after it. Delegates to the
-  /// core's own validate(); the layer has already checked types, sizes, finiteness and
-  /// enumeration items.
-  virtual void validate(const ValueStore& values) const = 0;
+  /// Refuses (throws, with a message naming the variable) parameters the model cannot run with:
+  /// called on an fmi3Set* that sets a parameter, with the values as they would be after it (and on
+  /// instantiation and a deserialized state). Delegates to the core's own validate(). A set of
+  /// inputs alone is not: the layer checks what the schema says of them (type, size, finiteness,
+  /// enumeration items, min_norm), the model checks them once per step where it uses them.
+  virtual void validate_parameters(const ValueStore& values) const = 0;
   /// Parameters were set (values committed); the model rebuilds from them when it next needs to.
   virtual void parameters_changed() {}
 

@@ -229,6 +229,19 @@ void ValueStore::write(const VariableInfo& info, std::span<const T> values) {
       m_integer[s.offset + e] = static_cast<std::int64_t>(values[e]);
     }
   }
+  check_rules(info);
+}
+
+void ValueStore::check_rules(const VariableInfo& info) const {
+  const Slot& s = slot(info, info.type);
+  if (info.min_norm > 0.0) {
+    double squared = 0.0;
+    for (std::size_t e = 0; e < s.count; ++e) squared += m_float64[s.offset + e] * m_float64[s.offset + e];
+    if (!(std::sqrt(squared) > info.min_norm)) {
+      throw VariableError(std::string(info.name) + " must have a norm above " + std::to_string(info.min_norm) +
+                          " (a quaternion the model normalizes), got " + std::to_string(std::sqrt(squared)));
+    }
+  }
   if (info.type == VariableType::enumeration) {
     const EnumerationType* type = m_model->find_enumeration(info.declared_type);
     for (std::size_t e = 0; type != nullptr && e < s.count; ++e) {
@@ -314,10 +327,16 @@ void ValueStore::deserialize(serial::ByteReader& reader) {
   for (std::uint64_t& v : uint64) reader.get(v);
   expect(strings.size(), sizeof(std::uint64_t));
   for (std::string& v : strings) v = reader.get_string();
-  m_float64 = std::move(float64);
-  m_integer = std::move(integer);
-  m_uint64 = std::move(uint64);
-  m_string = std::move(strings);
+  // Check the schema's rules on a copy before taking the values: a refused state changes nothing.
+  ValueStore candidate(*m_model);
+  candidate.m_float64 = std::move(float64);
+  candidate.m_integer = std::move(integer);
+  candidate.m_uint64 = std::move(uint64);
+  candidate.m_string = std::move(strings);
+  for (const VariableInfo& info : m_model->variables) {
+    if (info.is_stored()) candidate.check_rules(info);
+  }
+  *this = std::move(candidate);
 }
 
 }  // namespace tissue::fmi3

@@ -69,6 +69,9 @@ class ValueStore {
     std::size_t count = 0;
   };
   [[nodiscard]] const Slot& slot(const VariableInfo& info, VariableType type) const;
+  /// Throws VariableError unless the stored values of `info` keep the schema's rules beyond their
+  /// type and finiteness: enumeration items, min_norm.
+  void check_rules(const VariableInfo& info) const;
   [[nodiscard]] const Slot& slot(ValueReference vr, VariableType type) const;
 
   const ModelDescription* m_model;

@@ -43,6 +43,9 @@ struct VariableInfo {
   std::array<Dimension, 2> dimensions;
   int rank = 0;  ///< 0 = scalar
   std::string_view description;
+  /// A Float64 array whose Euclidean norm a set must keep above this (0: no such rule): a quaternion
+  /// the model normalizes where it uses it. The layer refuses the set (ValueStore::write).
+  double min_norm = 0.0;
 
   /// Parameters, structural parameters and inputs hold a value the importer sets (ValueStore).
   [[nodiscard]] constexpr bool is_stored() const {
@@ -106,7 +109,7 @@ class Entry {
  public:
   constexpr Entry(ValueReference vr, std::string_view name, VariableType type, Causality causality,
                   Variability variability)
-      : m_info{vr, name, type, causality, variability, {}, {}, {}, {}, {}, {}, 0, {}} {}
+      : m_info{vr, name, type, causality, variability, {}, {}, {}, {}, {}, {}, 0, {}, 0.0} {}
 
   constexpr Entry& unit(std::string_view unit) {
     m_info.unit = unit;
@@ -136,6 +139,10 @@ class Entry {
   constexpr Entry& shape(Dimension rows, Dimension columns) {
     m_info.dimensions = {rows, columns};
     m_info.rank = 2;
+    return *this;
+  }
+  constexpr Entry& min_norm(double norm) {
+    m_info.min_norm = norm;
     return *this;
   }
   constexpr Entry& describe(std::string_view description) {

@@ -60,17 +60,15 @@ haptic::RendererSettings renderer_settings(const ValueStore& values) {
 HapticModel::HapticModel(const fmi3::ModelContext& context, const ValueStore& values)
     : m_context(context), m_values(values), m_renderer(renderer_settings(values)) {}
 
-void HapticModel::validate(const ValueStore& values) const {
+// The inputs are not checked here: the schema's rules hold at every set (device.orientation's
+// min_norm), and the tissue sample is checked where it is used (take_tissue_sample: a bad one is
+// refused and counted, the hand's loop goes on).
+void HapticModel::validate_parameters(const ValueStore& values) const {
   (void)renderer_settings(values);
   const double step_s = values.float64(vr(Vr::step_size));
   if (!(step_s > 0.0)) throw VariableError("stepSize must be > 0 s, got " + std::to_string(step_s));
   const double scale = values.float64(vr(Vr::workspace_scale));
   if (!(scale > 0.0)) throw VariableError("workspace.scale must be > 0, got " + std::to_string(scale));
-  const std::span<const double> q = values.float64_array(vr(Vr::device_orientation));
-  if (!(std::sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]) > 1e-12)) {
-    throw VariableError("device.orientation must be a non-zero quaternion");
-  }
-  if (values.float64(vr(Vr::tissue_blade_depth)) < 0.0) throw VariableError("tissue.bladeDepth must be >= 0 m");
 }
 
 void HapticModel::parameters_changed() { m_renderer = haptic::HapticRenderer(renderer_settings(m_values)); }

@@ -24,7 +24,7 @@ class HapticModel final : public fmi3::Model {
  public:
   HapticModel(const fmi3::ModelContext& context, const fmi3::ValueStore& values);
 
-  void validate(const fmi3::ValueStore& values) const override;
+  void validate_parameters(const fmi3::ValueStore& values) const override;
   void parameters_changed() override;
   void enter_initialization_mode(double start_time_s) override;
   void exit_initialization_mode() override;

@@ -7,6 +7,7 @@
 #include "fmi3/variable_table.hpp"
 #include "ports/sample_entries.hpp"
 #include "ports/tissue_sample.hpp"
+#include "ports/tool.hpp"
 
 #include <array>
 #include <span>
@@ -63,14 +64,14 @@ enum class Vr : std::uint32_t {
 };
 
 namespace variables_detail {
-constexpr auto own_variables() {
+// The table in parts, one kind of variable each, in value-reference order within each; own_variables()
+// merges them (fmi3::merged: by value reference).
+
+/// The step, the device's limits, passivity, the velocity filter, cutting, the workspace (1-10).
+constexpr auto parameters() {
   using namespace fmi3;  // NOLINT(google-build-using-namespace): the table reads as the XML
   using enum VariableType;
-  using enum Variability;
   return std::to_array<VariableInfo>({
-    fmi3::independent_time(Vr::time),
-
-    // Parameters.
     parameter(Vr::step_size, "stepSize", float64)
         .unit("s")
         .start("0.001")
@@ -117,8 +118,16 @@ constexpr auto own_variables() {
         .start("0 0 0")
         .shape(fixed_size(3))
         .describe("Where the device's origin lies in the tissue's frame"),
+});
+}
 
-    // Inputs: the device.
+/// The device's pose and buttons (20-22) and the tissue sample's time (23; the sample's fields
+/// come from ports/tissue_sample.hpp).
+constexpr auto inputs() {
+  using namespace fmi3;  // NOLINT(google-build-using-namespace): the table reads as the XML
+  using enum VariableType;
+  using enum Variability;
+  return std::to_array<VariableInfo>({
     input(Vr::device_position, "device.position", float64, continuous)
         .unit("m")
         .start("0 0 0")
@@ -128,6 +137,7 @@ constexpr auto own_variables() {
         .unit("1")
         .start("1 0 0 0")
         .shape(fixed_size(4))
+        .min_norm(MIN_ORIENTATION_NORM)
         .describe("Orientation of the device's stylus as a quaternion (w x y z); the tool axis is its local +z"),
     input(Vr::device_tool_mode, "device.toolMode", enumeration, discrete)
         .declared_type("ToolMode")
@@ -139,7 +149,15 @@ constexpr auto own_variables() {
         .unit("s")
         .start("0")
         .describe("Tissue time the tissue inputs are for; a new value marks a new tissue sample"),
-    // Outputs.
+});
+}
+
+/// The tool command, the force and its parts, passivity, the limits acting, the samples (40-53).
+constexpr auto outputs() {
+  using namespace fmi3;  // NOLINT(google-build-using-namespace): the table reads as the XML
+  using enum VariableType;
+  using enum Variability;
+  return std::to_array<VariableInfo>({
     output(Vr::tool_position, "tool.position", float64, continuous)
         .unit("m")
         .shape(fixed_size(3))
@@ -186,6 +204,13 @@ constexpr auto own_variables() {
     output(Vr::samples_refused, "tissue.samplesRefused", uint64, discrete)
         .describe("Tissue samples refused (non-finite, a non-unit normal): the previous one is kept"),
 });
+}
+
+/// The HapticLoop FMU's own variables: the independent time and the parts above.
+constexpr auto own_variables() {
+  using fmi3::merged;
+  const auto independent = std::to_array<fmi3::VariableInfo>({fmi3::independent_time(Vr::time)});
+  return merged(merged(merged(independent, parameters()), inputs()), outputs());
 }
 }  // namespace variables_detail
 

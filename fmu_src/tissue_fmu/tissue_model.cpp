@@ -28,7 +28,6 @@ struct TissueState final : fmi3::ModelState {
   TissueSnapshot tissue;
   std::uint64_t surface_revision = 0;
   std::uint64_t integrator_iterations = 0;
-  Eigen::Vector3d stepped_tool_position_m = Eigen::Vector3d::Zero();
 };
 
 LinearSolverKind linear_solver(std::int64_t item) {
@@ -81,9 +80,8 @@ TissueSettings tissue_settings(const ValueStore& values, const TetMesh* mesh) {
   s.solver.kind = linear_solver(values.int64(vr(Vr::linear_solver)));
   s.solver.pcg = PcgSolver::Settings{values.float64(vr(Vr::pcg_tolerance)), values.int32(vr(Vr::pcg_max_iterations))};
   s.solver.warm_start = values.boolean(vr(Vr::warm_start));
-  // No FMI switch says an importer allows threads: pcgCholesky refactorizes at pick-up in the
-  // calling thread (the same results as with the worker, DESIGN "Linear solvers").
-  s.solver.refresh.background_refactor = false;
+  // No FMI switch says an importer allows threads: the core's default, no worker thread (pcgCholesky
+  // refactorizes at pick-up in the calling thread, the same results; DESIGN "Threads").
   s.step_size_s = values.float64(vr(Vr::step_size));
   InteractionSettings& i = s.interaction;
   i.contact_enabled = values.boolean(vr(Vr::contact_enabled));
@@ -94,40 +92,26 @@ TissueSettings tissue_settings(const ValueStore& values, const TetMesh* mesh) {
   i.contact_stiffness_model = stiffness_model(values.int64(vr(Vr::contact_stiffness_model)));
   i.contact_stiffness_refresh_steps = values.int32(vr(Vr::contact_stiffness_refresh_steps));
   i.max_tool_speed_m_per_s = values.float64(vr(Vr::tool_max_speed));
+  i.probe_radius_m = values.float64(vr(Vr::probe_radius));
   validate(s);
   return s;
 }
 
-Eigen::Vector3d input_tool_position_m(const ValueStore& values) {
-  const std::span<const double> p = values.float64_array(vr(Vr::tool_position));
-  return {p[0], p[1], p[2]};
-}
-
 ToolPose tool_pose(const ValueStore& values) {
   ToolPose pose;
+  const std::span<const double> p = values.float64_array(vr(Vr::tool_position));
   const std::span<const double> q = values.float64_array(vr(Vr::tool_orientation));
-  pose.tip_position_m = input_tool_position_m(values);
+  pose.tip_position_m = Eigen::Vector3d(p[0], p[1], p[2]);
   pose.orientation = Eigen::Quaterniond(q[0], q[1], q[2], q[3]);
   pose.mode = static_cast<ToolMode>(values.int64(vr(Vr::tool_mode)));
-  validate(pose);
-  pose.orientation.normalize();
-  // A ball-ended probe touches with the pole of its ball along the tool axis (toward the tip).
-  const double radius_m = values.float64(vr(Vr::probe_radius));
-  if (pose.mode == ToolMode::probe && radius_m > 0.0) {
-    pose.tip_position_m -= radius_m * tool_axis(pose.orientation);
-  }
   return pose;
 }
 
 TissueModel::TissueModel(const fmi3::ModelContext& context, const ValueStore& values)
     : m_context(context), m_values(values) {}
 
-void TissueModel::validate(const ValueStore& values) const {
+void TissueModel::validate_parameters(const ValueStore& values) const {
   (void)tissue_settings(values, nullptr);
-  if (!(values.float64(vr(Vr::probe_radius)) >= 0.0)) {
-    throw ParameterError("tool.probeRadius must be >= 0 m, got " +
-                         std::to_string(values.float64(vr(Vr::probe_radius))));
-  }
   for (const Vr capacity : {Vr::vertex_capacity, Vr::triangle_capacity}) {
     const std::uint64_t rows = values.uint64(vr(capacity));
     if (rows < 1 || rows > MAX_CAPACITY) {
@@ -135,7 +119,6 @@ void TissueModel::validate(const ValueStore& values) const {
                           " must be in [1, 2^26], got " + std::to_string(rows));
     }
   }
-  (void)tool_pose(values);
 }
 
 // --- the model ---
@@ -160,15 +143,13 @@ void TissueModel::build() {
       throw VariableError("mesh '" + name + "' cannot be loaded: " + error.what());
     }
   }
-  auto tissue = std::make_unique<Tissue>(mesh, tissue_settings(m_values, &mesh));
-  m_mesh = std::move(mesh);
-  m_tissue = std::move(tissue);
+  TissueSettings settings = tissue_settings(m_values, &mesh);
+  m_tissue = std::make_unique<Tissue>(std::move(mesh), std::move(settings));
   m_tissue->set_tool(tool_pose(m_values));
-  m_stepped_tool_position_m = input_tool_position_m(m_values);
   m_dirty = false;
   m_surface_revision = 0;
   m_integrator_iterations = 0;
-  m_surface_triangles = surface_triangle_count();
+  m_surface_triangles = m_tissue->drawn_triangle_count();
   m_capacity_warned = false;
 }
 
@@ -176,14 +157,8 @@ void TissueModel::ensure_built() {
   if (m_dirty || !m_tissue) build();
 }
 
-std::size_t TissueModel::surface_triangle_count() const {
-  const CutSurface& cuts = m_tissue->cut_surface();
-  return m_tissue->surface().triangles.size() - cuts.replaced_triangles().size() + cuts.skin_triangles().size() +
-         cuts.triangles().size();
-}
-
 void TissueModel::update_surface_counters() {
-  const std::size_t triangles = surface_triangle_count();
+  const std::size_t triangles = m_tissue->drawn_triangle_count();
   if (triangles != m_surface_triangles) {
     ++m_surface_revision;
     m_surface_triangles = triangles;
@@ -210,8 +185,7 @@ fmi3::StepOutcome TissueModel::do_step(double current_time_s, double step_s) {
   Tissue& tissue = *m_tissue;
   const double now = m_start_time_s + tissue.time_s();
   const long count = fmi3::whole_internal_steps(now, current_time_s, step_s, m_values.float64(vr(Vr::step_size)));
-  tissue.set_tool(tool_pose(m_values));
-  m_stepped_tool_position_m = input_tool_position_m(m_values);
+  tissue.set_tool(tool_pose(m_values));  // the inputs' one check (Tissue::set_tool), where they are used
   const std::size_t cuts_before = tissue.body().cut_tets().size();
   const bool contact_before = tissue.contact().active;
   const auto log_events = [&] {
@@ -254,37 +228,6 @@ void TissueModel::reset() {
 
 // --- outputs ---
 
-double TissueModel::blade_depth_m() {
-  const Tissue& tissue = *m_tissue;
-  const ToolPose& tool = tissue.tool();
-  if (tool.mode != ToolMode::scalpel || !tissue.has_cutter() || !tissue.cutter().cutting()) return 0.0;
-  // The edge runs from the tip along the tool axis; from the handle end (outside while a cut
-  // starts), the first crossing of the mesh's own surface is where the blade enters the tissue.
-  const double length_m = tissue.settings().interaction.blade_length_m;
-  const Eigen::Vector3d handle_m = tool.tip_position_m + length_m * tool_axis(tool.orientation);
-  tissue.surface_bvh().intersect_segment(handle_m, tool.tip_position_m, tissue.current_positions_m(), m_blade_hits);
-  const auto mesh_triangles = static_cast<int>(tissue.surface().triangles.size());
-  for (const SurfaceBvh::SegmentHit& hit : m_blade_hits) {
-    if (hit.triangle < mesh_triangles) return (1.0 - hit.segment_parameter) * length_m;
-  }
-  return length_m;  // no crossing while cutting: the whole edge is inside
-}
-
-Eigen::Vector3d TissueModel::applied_tool_position_m() const {
-  const ToolPose& requested = m_tissue->tool();
-  const ToolPose& applied = m_tissue->applied_tool();
-  // Only a tool that keeps its mode and does something is ever held back (reachable_pose); then the
-  // applied pose differs from the requested one, else it is the requested one as set.
-  const bool held_back = requested.mode != ToolMode::none && applied.mode == requested.mode &&
-                         (applied.tip_position_m != requested.tip_position_m ||
-                          applied.orientation.coeffs() != requested.orientation.coeffs());
-  if (!held_back) return m_stepped_tool_position_m;
-  Eigen::Vector3d position_m = applied.tip_position_m;
-  const double radius_m = m_values.float64(vr(Vr::probe_radius));
-  if (applied.mode == ToolMode::probe && radius_m > 0.0) position_m += radius_m * tool_axis(applied.orientation);
-  return position_m;
-}
-
 void TissueModel::get_float64(const VariableInfo& info, std::span<double> out) {
   ensure_built();
   Tissue& tissue = *m_tissue;
@@ -320,10 +263,10 @@ void TissueModel::get_float64(const VariableInfo& info, std::span<double> out) {
       out[0] = tissue.elastic_energy_j();
       return;
     case Vr::blade_depth:
-      out[0] = blade_depth_m();
+      out[0] = tissue.blade_depth_m();
       return;
     case Vr::tool_applied_position:
-      put3(applied_tool_position_m());
+      put3(tissue.applied_tool_position_m());
       return;
     case Vr::vertex_positions: {
       std::fill(out.begin(), out.end(), 0.0);
@@ -343,32 +286,18 @@ void TissueModel::get_uint32(const VariableInfo& info, std::span<std::uint32_t> 
   ensure_built();
   std::fill(out.begin(), out.end(), 0U);
   if (!m_values.boolean(vr(Vr::mesh_output_enabled))) return;
-  // The mesh's surface without the triangles of cut tets, their pieces either side of the cut (the
-  // skin), then the cut faces: corners beyond the mesh vertices follow the parts (cut_surface.hpp).
   std::size_t at = 0;
-  const auto put = [&](const std::array<int, 3>& triangle) {
+  m_tissue->for_each_drawn_triangle([&](const std::array<int, 3>& triangle) {
     if (at + 3 > out.size()) return;
     for (const int v : triangle) out[at++] = static_cast<std::uint32_t>(v);
-  };
-  const CutSurface& cuts = m_tissue->cut_surface();
-  const auto& mesh_triangles = m_tissue->surface().triangles;
-  auto replaced = cuts.replaced_triangles().begin();
-  for (std::size_t t = 0; t < mesh_triangles.size(); ++t) {
-    if (replaced != cuts.replaced_triangles().end() && *replaced == static_cast<int>(t)) {
-      ++replaced;
-      continue;
-    }
-    put(mesh_triangles[t]);
-  }
-  for (const auto& triangle : cuts.skin_triangles()) put(triangle);
-  for (const auto& triangle : cuts.triangles()) put(triangle);
+  });
 }
 
 void TissueModel::get_uint64(const VariableInfo& info, std::span<std::uint64_t> out) {
   ensure_built();
   const Tissue& tissue = *m_tissue;
   const auto vertices = static_cast<std::uint64_t>(tissue.current_positions_m().size() / 3);
-  const auto triangles = static_cast<std::uint64_t>(surface_triangle_count());
+  const auto triangles = static_cast<std::uint64_t>(m_tissue->drawn_triangle_count());
   const bool mesh_out = m_values.boolean(vr(Vr::mesh_output_enabled));
   switch (static_cast<Vr>(info.vr)) {
     case Vr::vertex_count:
@@ -414,7 +343,6 @@ std::unique_ptr<fmi3::ModelState> TissueModel::save() const {
   m_tissue->save(state->tissue);
   state->surface_revision = m_surface_revision;
   state->integrator_iterations = m_integrator_iterations;
-  state->stepped_tool_position_m = m_stepped_tool_position_m;
   return state;
 }
 
@@ -423,21 +351,13 @@ void TissueModel::restore(const fmi3::ModelState& model_state) {
   if (state == nullptr) throw VariableError("set FMU state: not a Tissue FMU state");
   ensure_built();
   try {
-    if (m_tissue->can_restore(state->tissue)) {
-      m_tissue->restore(state->tissue);
-    } else {
-      // Cuts cannot be undone in place: a fresh Tissue replays the snapshot's.
-      auto fresh = std::make_unique<Tissue>(m_mesh, tissue_settings(m_values, &m_mesh));
-      fresh->restore(state->tissue);
-      m_tissue = std::move(fresh);
-    }
+    restore_or_replay(m_tissue, state->tissue);
   } catch (const StateError& error) {
     throw VariableError(std::string("set FMU state: ") + error.what());
   }
   m_surface_revision = state->surface_revision;
   m_integrator_iterations = state->integrator_iterations;
-  m_stepped_tool_position_m = state->stepped_tool_position_m;
-  m_surface_triangles = surface_triangle_count();
+  m_surface_triangles = m_tissue->drawn_triangle_count();
 }
 
 void TissueModel::serialize(const fmi3::ModelState& model_state, serial::ByteWriter& writer) const {
@@ -445,7 +365,6 @@ void TissueModel::serialize(const fmi3::ModelState& model_state, serial::ByteWri
   writer.put_bytes(serialize_snapshot(state.tissue));
   writer.put(state.surface_revision);
   writer.put(state.integrator_iterations);
-  for (int a = 0; a < 3; ++a) writer.put(state.stepped_tool_position_m(a));
 }
 
 std::unique_ptr<fmi3::ModelState> TissueModel::deserialize(serial::ByteReader& reader) const {
@@ -453,7 +372,6 @@ std::unique_ptr<fmi3::ModelState> TissueModel::deserialize(serial::ByteReader& r
   state->tissue = deserialize_snapshot(reader.get_bytes());
   reader.get(state->surface_revision);
   reader.get(state->integrator_iterations);
-  for (int a = 0; a < 3; ++a) reader.get(state->stepped_tool_position_m(a));
   return state;
 }
 

@@ -19,16 +19,14 @@ namespace tissue::tissue_fmu {
 /// The core's settings from the FMU's parameters; fixed vertices only if `mesh` is given. Throws
 /// ParameterError for values the core refuses.
 TissueSettings tissue_settings(const fmi3::ValueStore& values, const TetMesh* mesh);
-/// The tool pose for the core from the tool inputs (a ball probe touches with its pole).
+/// The tool pose from the tool inputs, as set (the core checks and normalizes it, Tissue::set_tool).
 ToolPose tool_pose(const fmi3::ValueStore& values);
-/// The tool.position input.
-Eigen::Vector3d input_tool_position_m(const fmi3::ValueStore& values);
 
 class TissueModel final : public fmi3::Model {
  public:
   TissueModel(const fmi3::ModelContext& context, const fmi3::ValueStore& values);
 
-  void validate(const fmi3::ValueStore& values) const override;
+  void validate_parameters(const fmi3::ValueStore& values) const override;
   void parameters_changed() override { m_dirty = true; }
   void enter_initialization_mode(double start_time_s) override;
   void exit_initialization_mode() override;
@@ -52,25 +50,16 @@ class TissueModel final : public fmi3::Model {
   void build();
   void ensure_built();
   void update_surface_counters();
-  /// Triangles of the surface output: the mesh's surface and the cut faces.
-  [[nodiscard]] std::size_t surface_triangle_count() const;
-  /// Length of the blade inside the tissue while the scalpel cuts (0 otherwise).
-  [[nodiscard]] double blade_depth_m();
-  /// tool.appliedPosition: the tool position the last step applied, in tool.position's terms.
-  [[nodiscard]] Eigen::Vector3d applied_tool_position_m() const;
 
   fmi3::ModelContext m_context;
   const fmi3::ValueStore& m_values;
   double m_start_time_s = 0.0;
   bool m_dirty = true;  // a parameter changed since the Tissue was built
-  TetMesh m_mesh;       // as loaded: a fresh Tissue for a restored state with other cuts
   std::unique_ptr<Tissue> m_tissue;
   std::uint64_t m_surface_revision = 0;
   std::uint64_t m_integrator_iterations = 0;  ///< integrator.iterations
   std::uint64_t m_surface_triangles = 0;  // at the last revision check
   bool m_capacity_warned = false;
-  std::vector<SurfaceBvh::SegmentHit> m_blade_hits;  // scratch of blade_depth_m()
-  Eigen::Vector3d m_stepped_tool_position_m = Eigen::Vector3d::Zero();  // tool.position the last step took
 };
 
 }  // namespace tissue::tissue_fmu

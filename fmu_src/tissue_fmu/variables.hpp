@@ -8,6 +8,7 @@
 #include "fmi3/variable_table.hpp"
 #include "ports/sample_entries.hpp"
 #include "ports/tissue_sample.hpp"
+#include "ports/tool.hpp"
 
 #include <array>
 #include <span>
@@ -84,14 +85,14 @@ enum class Vr : std::uint32_t {
 };
 
 namespace variables_detail {
-constexpr auto own_variables() {
+// The table in parts, one kind of variable each, in value-reference order within each; own_variables()
+// merges them (fmi3::merged: by value reference).
+
+/// The body: mesh, material, damping, gravity, the fixed region (value references 1-9).
+constexpr auto body_parameters() {
   using namespace fmi3;  // NOLINT(google-build-using-namespace): the table reads as the XML
   using enum VariableType;
-  using enum Variability;
   return std::to_array<VariableInfo>({
-    fmi3::independent_time(Vr::time),
-
-    // Parameters.
     parameter(Vr::mesh, "mesh", string)
         .start("frog")
         .describe("Tetrahedral mesh of the specimen: \"frog\" for the embedded default frog (also shipped as "
@@ -137,6 +138,14 @@ constexpr auto own_variables() {
         .min("0")
         .max("1")
         .describe("Thickness of the fixed slab as a fraction of the mesh's extent along fixedRegion.axis"),
+});
+}
+
+/// The backward-Euler step: its linear solver, PCG's settings, the internal step (10-14).
+constexpr auto solver_parameters() {
+  using namespace fmi3;  // NOLINT(google-build-using-namespace): the table reads as the XML
+  using enum VariableType;
+  return std::to_array<VariableInfo>({
     parameter(Vr::linear_solver, "integrator.linearSolver", enumeration)
         .declared_type("LinearSolver")
         .start("1")
@@ -156,6 +165,14 @@ constexpr auto own_variables() {
         .unit("s")
         .start("0.001")
         .describe("Internal backward-Euler step; must be > 0. A communication step must be a whole multiple of it"),
+});
+}
+
+/// What the scene builds, the tool, the contact and the cutter (15-23).
+constexpr auto scene_parameters() {
+  using namespace fmi3;  // NOLINT(google-build-using-namespace): the table reads as the XML
+  using enum VariableType;
+  return std::to_array<VariableInfo>({
     parameter(Vr::contact_enabled, "scene.contact", boolean)
         .start("true")
         .describe("Probe contact on; when false the contact structures are not built and the probe does not touch "
@@ -195,8 +212,14 @@ constexpr auto own_variables() {
         .start("0.001")
         .describe("Smallest volume fraction either side of a cut tetrahedron is given (keeps slivers stiff and "
                   "massive enough); in [1e-12, 0.5)"),
+});
+}
 
-    // Structural parameters.
+/// The surface output's capacities (24-25).
+constexpr auto structural_parameters() {
+  using namespace fmi3;  // NOLINT(google-build-using-namespace): the table reads as the XML
+  using enum VariableType;
+  return std::to_array<VariableInfo>({
     structural_parameter(Vr::vertex_capacity, "surface.vertexCapacity", uint64)
         .start("8192")
         .min("1")
@@ -205,8 +228,15 @@ constexpr auto own_variables() {
         .start("8192")
         .min("1")
         .describe("Rows of surface.triangles: the most surface triangles that can be output"),
+});
+}
 
-    // Inputs.
+/// The tool pose and mode (30-32).
+constexpr auto inputs() {
+  using namespace fmi3;  // NOLINT(google-build-using-namespace): the table reads as the XML
+  using enum VariableType;
+  using enum Variability;
+  return std::to_array<VariableInfo>({
     input(Vr::tool_position, "tool.position", float64, continuous)
         .unit("m")
         .start("0 0 0")
@@ -216,14 +246,23 @@ constexpr auto own_variables() {
         .unit("1")
         .start("1 0 0 0")
         .shape(fixed_size(4))
+        .min_norm(MIN_ORIENTATION_NORM)
         .describe("Orientation of the tool as a unit quaternion (w x y z), local to world; the tool axis is the "
                   "local +z axis, from the tip toward the handle"),
     input(Vr::tool_mode, "tool.mode", enumeration, discrete)
         .declared_type("ToolMode")
         .start("0")
         .describe("What the tool does: none, probe or scalpel"),
+});
+}
 
-    // Outputs.
+/// The contact depth, the surface, the cut counters, the energies, the iterations (45-66; the
+/// outputs the tissue sample carries come from ports/tissue_sample.hpp).
+constexpr auto outputs() {
+  using namespace fmi3;  // NOLINT(google-build-using-namespace): the table reads as the XML
+  using enum VariableType;
+  using enum Variability;
+  return std::to_array<VariableInfo>({
     output(Vr::contact_depth, "contact.depth", float64, continuous)
         .unit("m")
         .describe("Penetration depth: distance from the tool tip to contact.point"),
@@ -257,7 +296,14 @@ constexpr auto own_variables() {
     output(Vr::integrator_iterations, "integrator.iterations", uint64, discrete)
         .describe("Iterations of the integrator so far: PCG iterations (backward Euler with PCG), IDA's Newton "
                   "iterations plus its GMRES iterations (IDA); a direct solve counts none"),
+});
+}
 
+/// The integrator choice and IDA's settings, the hand's speed limit (issue 10; 70-76).
+constexpr auto integrator_parameters() {
+  using namespace fmi3;  // NOLINT(google-build-using-namespace): the table reads as the XML
+  using enum VariableType;
+  return std::to_array<VariableInfo>({
     parameter(Vr::integrator_method, "integrator.method", enumeration)
         .declared_type("Integrator")
         .start("1")
@@ -290,6 +336,15 @@ constexpr auto own_variables() {
         .describe("Fastest a hand moves the tool; a pose farther than this times the internal step from the last is "
                   "approached at this speed (the tool is clamped, a scalpel sweeps the path in sub-steps); must be > 0"),
 });
+}
+
+/// The Tissue FMU's own variables: the independent time and the parts above.
+constexpr auto own_variables() {
+  using fmi3::merged;
+  const auto independent = std::to_array<fmi3::VariableInfo>({fmi3::independent_time(Vr::time)});
+  const auto parameters =
+      merged(merged(merged(body_parameters(), solver_parameters()), scene_parameters()), integrator_parameters());
+  return merged(merged(merged(merged(independent, parameters), structural_parameters()), inputs()), outputs());
 }
 }  // namespace variables_detail
 

@@ -168,123 +168,160 @@ std::string random_token() {
   return out.str();
 }
 
+// `run`'s arguments, as the command line sets them.
+struct RunArguments {
+  std::string scenario_file;
+  SessionOptions options;
+  std::string output_dir = "session";
+  std::string record_file;
+  bool no_priority = false;
+  bool view = false, mouse = false;
+  int view_port = 8080;
+  std::string view_listen = "127.0.0.1";
+  double duration_s = 0.0;
+};
+
+// `compare`'s arguments, as the command line sets them.
+struct CompareArguments {
+  CompareOptions options;
+  std::string scenario, settings_file;
+  std::string output = "compare";
+  double duration_s = 0.0;
+};
+
+// `fmu_dir` and `quiet` are shared with the other commands.
+CLI::App* add_run_command(CLI::App& app, RunArguments& a, std::string& fmu_dir, bool& quiet) {
+  CLI::App* run = app.add_subcommand("run", "Run a scenario (host/scenarios/*.toml) in real time or offline");
+  run->add_option("scenario", a.scenario_file, "Scenario file (TOML)")->required()->check(CLI::ExistingFile);
+  run->add_flag("--offline", a.options.offline, "Same schedule without sleeping; bitwise reproducible");
+  run->add_option("--output,-o", a.output_dir, "Folder for summary.json, log.csv, frames, final.png")
+      ->capture_default_str();
+  run->add_option("--record", a.record_file, "Also write the device poses as a CSV a replay device plays back");
+  run->add_option("--fmu-dir", fmu_dir, "Where Tissue.fmu and HapticLoop.fmu are (default: the build's fmus/)");
+  run->add_flag("--no-rt-priority", a.no_priority, "Do not ask for SCHED_FIFO");
+  run->add_flag("--quiet,-q", quiet, "Only the summary");
+  run->add_flag("--view", a.view, "Serve a live 3D view of the session in the browser (http://127.0.0.1:PORT/)");
+  run->add_option("--port", a.view_port, "The live view's port (0: any free port)")
+      ->check(CLI::Range(0, 65535))
+      ->capture_default_str();
+  run->add_option("--view-listen", a.view_listen,
+                  "The address the view listens on; any but loopback needs the access token printed at start")
+      ->capture_default_str();
+  run->add_flag("--mouse", a.mouse, "The view's mouse and keyboard drive the tool (implies --view)");
+  run->add_option("--duration", a.duration_s, "Run for this many seconds instead of the scenario's duration")
+      ->check(CLI::PositiveNumber);
+  return run;
+}
+
+CLI::App* add_bench_command(CLI::App& app, int& steps, double& step_s, std::string& fmu_dir) {
+  CLI::App* bench = app.add_subcommand("bench", "Time the two FMUs' steps through the importer");
+  bench->add_option("--steps", steps, "Tissue steps")->check(CLI::Range(1, 1000000))->capture_default_str();
+  bench->add_option("--step", step_s, "Tissue communication step [s]")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  bench->add_option("--fmu-dir", fmu_dir, "Where Tissue.fmu and HapticLoop.fmu are");
+  return bench;
+}
+
+CLI::App* add_compare_command(CLI::App& app, CompareArguments& a, std::string& fmu_dir, bool& quiet) {
+  CLI::App* compare =
+      app.add_subcommand("compare",
+                         "Run a scenario offline under several integrator settings against a reference: "
+                         "compare.csv, compare.png, recommendation.txt (also under mpirun)");
+  compare->add_option("scenario", a.scenario, "Scenario file (TOML)")->required()->check(CLI::ExistingFile);
+  compare
+      ->add_option("--settings", a.settings_file,
+                   "TOML file with a [compare] table (default: the scenario's, else built-in)")
+      ->check(CLI::ExistingFile);
+  compare->add_option("--output,-o", a.output, "Folder for the outputs")->capture_default_str();
+  compare->add_option("--jobs,-j", a.options.jobs, "Runs at once in this process (threads), >= 1")
+      ->capture_default_str();
+  compare->add_option("--steps", a.options.steps_s, "Internal steps [s] for every setting, e.g. 0.001,0.01")
+      ->delimiter(',');
+  compare->add_option("--duration", a.duration_s, "Run the scenario for DURATION seconds instead (e.g. shorter)");
+  compare->add_option("--fmu-dir", fmu_dir, "Where Tissue.fmu and HapticLoop.fmu are");
+  compare->add_flag("--quiet,-q", quiet, "No progress line");
+  return compare;
+}
+
+// The live view's settings from `run`'s arguments; a token (printed) when it listens beyond loopback.
+SessionOptions::View view_options(const RunArguments& a) {
+  SessionOptions::View v;
+  v.address = a.view_listen;
+  v.port = static_cast<std::uint16_t>(a.view_port);
+  v.static_dir = TISSUE_VIEW_DIR;
+  if (!is_loopback_address(a.view_listen)) {
+    v.token = random_token();
+    std::cerr << "tissue-host: WARNING: the live view listens on " << a.view_listen
+              << ", not on loopback: anyone who can reach it and has the token can watch";
+    if (a.mouse) std::cerr << " and move the tool";
+    std::cerr << ". Token: " << v.token << "\n";
+  }
+  return v;
+}
+
+// The session `run` asks for; a real-time run ends early on Ctrl-C.
+SessionOptions session_options(const RunArguments& a, const std::filesystem::path& fmus) {
+  SessionOptions options = a.options;
+  options.output_dir = a.output_dir;
+  options.fmu_dir = fmus;
+  options.realtime_priority = !a.no_priority;
+  if (!a.record_file.empty()) options.record = a.record_file;
+  if (!options.offline) {
+    options.stop = &g_stop_requested;
+    struct sigaction action {};
+    action.sa_handler = on_interrupt;
+    sigemptyset(&action.sa_mask);
+    sigaction(SIGINT, &action, nullptr);
+  }
+  if (a.view || a.mouse) {
+    const SessionOptions::View v = view_options(a);
+    options.view = v;
+    options.browser_device = a.mouse;
+    options.view_started = [address = v.address, token = v.token](std::uint16_t port) {
+      std::cout << "live view: http://" << (address == "0.0.0.0" ? "127.0.0.1" : address) << ":" << port << "/"
+                << (token.empty() ? "" : "?token=" + token) << std::endl;
+    };
+  }
+  return options;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
   CLI::App app{"tissue-host: the real-time haptic host of the tissue FMUs"};
   app.require_subcommand(1);
+  std::string fmu_dir;  // run, bench and compare
+  bool quiet = false;   // run and compare
 
-  std::string scenario_file;
-  SessionOptions options;
-  std::string output_dir = "session";
-  std::string record_file;
-  std::string fmu_dir;
-  bool no_priority = false;
-  bool quiet = false;
-  CLI::App* run = app.add_subcommand("run", "Run a scenario (host/scenarios/*.toml) in real time or offline");
-  run->add_option("scenario", scenario_file, "Scenario file (TOML)")->required()->check(CLI::ExistingFile);
-  run->add_flag("--offline", options.offline, "Same schedule without sleeping; bitwise reproducible");
-  run->add_option("--output,-o", output_dir, "Folder for summary.json, log.csv, frames, final.png")
-      ->capture_default_str();
-  run->add_option("--record", record_file, "Also write the device poses as a CSV a replay device plays back");
-  run->add_option("--fmu-dir", fmu_dir, "Where Tissue.fmu and HapticLoop.fmu are (default: the build's fmus/)");
-  run->add_flag("--no-rt-priority", no_priority, "Do not ask for SCHED_FIFO");
-  run->add_flag("--quiet,-q", quiet, "Only the summary");
-  bool view = false, mouse = false;
-  int view_port = 8080;
-  std::string view_listen = "127.0.0.1";
-  run->add_flag("--view", view, "Serve a live 3D view of the session in the browser (http://127.0.0.1:PORT/)");
-  run->add_option("--port", view_port, "The live view's port (0: any free port)")
-      ->check(CLI::Range(0, 65535))
-      ->capture_default_str();
-  run->add_option("--view-listen", view_listen,
-                  "The address the view listens on; any but loopback needs the access token printed at start")
-      ->capture_default_str();
-  run->add_flag("--mouse", mouse, "The view's mouse and keyboard drive the tool (implies --view)");
-  double run_duration_s = 0.0;
-  run->add_option("--duration", run_duration_s, "Run for this many seconds instead of the scenario's duration")
-      ->check(CLI::PositiveNumber);
-
+  RunArguments run_arguments;
+  CLI::App* run = add_run_command(app, run_arguments, fmu_dir, quiet);
   std::string fmu_file;
   CLI::App* info = app.add_subcommand("info", "Describe an FMU (variables, capabilities)");
   info->add_option("fmu", fmu_file, "FMU file")->required()->check(CLI::ExistingFile);
-
   int bench_steps = 200;
   double bench_step_s = 0.01;
-  CLI::App* bench = app.add_subcommand("bench", "Time the two FMUs' steps through the importer");
-  bench->add_option("--steps", bench_steps, "Tissue steps")->check(CLI::Range(1, 1000000))->capture_default_str();
-  bench->add_option("--step", bench_step_s, "Tissue communication step [s]")
-      ->check(CLI::PositiveNumber)
-      ->capture_default_str();
-  bench->add_option("--fmu-dir", fmu_dir, "Where Tissue.fmu and HapticLoop.fmu are");
-
-  CompareOptions compare_options;
-  std::string compare_scenario, settings_file;
-  std::string compare_output = "compare";
-  double duration_s = 0.0;
-  CLI::App* compare =
-      app.add_subcommand("compare",
-                         "Run a scenario offline under several integrator settings against a reference: "
-                         "compare.csv, compare.png, recommendation.txt (also under mpirun)");
-  compare->add_option("scenario", compare_scenario, "Scenario file (TOML)")->required()->check(CLI::ExistingFile);
-  compare
-      ->add_option("--settings", settings_file,
-                   "TOML file with a [compare] table (default: the scenario's, else built-in)")
-      ->check(CLI::ExistingFile);
-  compare->add_option("--output,-o", compare_output, "Folder for the outputs")->capture_default_str();
-  compare->add_option("--jobs,-j", compare_options.jobs, "Runs at once in this process (threads), >= 1")
-      ->capture_default_str();
-  compare->add_option("--steps", compare_options.steps_s, "Internal steps [s] for every setting, e.g. 0.001,0.01")
-      ->delimiter(',');
-  compare->add_option("--duration", duration_s, "Run the scenario for DURATION seconds instead (e.g. shorter)");
-  compare->add_option("--fmu-dir", fmu_dir, "Where Tissue.fmu and HapticLoop.fmu are");
-  compare->add_flag("--quiet,-q", quiet, "No progress line");
+  CLI::App* bench = add_bench_command(app, bench_steps, bench_step_s, fmu_dir);
+  CompareArguments compare_arguments;
+  CLI::App* compare = add_compare_command(app, compare_arguments, fmu_dir, quiet);
 
   CLI11_PARSE(app, argc, argv);
   try {
     const std::filesystem::path fmus = fmu_dir.empty() ? default_fmu_dir() : std::filesystem::path(fmu_dir);
     if (run->parsed()) {
-      options.output_dir = output_dir;
-      options.fmu_dir = fmus;
-      options.realtime_priority = !no_priority;
-      if (!record_file.empty()) options.record = record_file;
-      if (!options.offline) {
-        options.stop = &g_stop_requested;
-        struct sigaction action {};
-        action.sa_handler = on_interrupt;
-        sigemptyset(&action.sa_mask);
-        sigaction(SIGINT, &action, nullptr);
-      }
-      if (view || mouse) {
-        SessionOptions::View v;
-        v.address = view_listen;
-        v.port = static_cast<std::uint16_t>(view_port);
-        v.static_dir = TISSUE_VIEW_DIR;
-        if (!is_loopback_address(view_listen)) {
-          v.token = random_token();
-          std::cerr << "tissue-host: WARNING: the live view listens on " << view_listen
-                    << ", not on loopback: anyone who can reach it and has the token can watch";
-          if (mouse) std::cerr << " and move the tool";
-          std::cerr << ". Token: " << v.token << "\n";
-        }
-        options.view = v;
-        options.browser_device = mouse;
-        options.view_started = [address = v.address, token = v.token](std::uint16_t port) {
-          std::cout << "live view: http://" << (address == "0.0.0.0" ? "127.0.0.1" : address) << ":" << port << "/"
-                    << (token.empty() ? "" : "?token=" + token) << std::endl;
-        };
-      }
-      return run_command(scenario_file, options, quiet, run_duration_s);
+      return run_command(run_arguments.scenario_file, session_options(run_arguments, fmus), quiet,
+                         run_arguments.duration_s);
     }
     if (info->parsed()) return info_command(fmu_file);
     if (bench->parsed()) return bench_command(fmus, bench_steps, bench_step_s);
     if (compare->parsed()) {
-      compare_options.scenario_file = compare_scenario;
-      if (!settings_file.empty()) compare_options.settings_file = settings_file;
-      compare_options.output_dir = compare_output;
-      compare_options.fmu_dir = fmus;
-      if (compare->count("--duration") > 0) compare_options.duration_s = duration_s;
-      return compare_command(compare_options, quiet, argc, argv);
+      CompareOptions& options = compare_arguments.options;
+      options.scenario_file = compare_arguments.scenario;
+      if (!compare_arguments.settings_file.empty()) options.settings_file = compare_arguments.settings_file;
+      options.output_dir = compare_arguments.output;
+      options.fmu_dir = fmus;
+      if (compare->count("--duration") > 0) options.duration_s = compare_arguments.duration_s;
+      return compare_command(options, quiet, argc, argv);
     }
   } catch (const std::exception& error) {
     std::cerr << "tissue-host: " << error.what() << "\n";

@@ -145,10 +145,27 @@ Rgb series_colour(std::size_t k) {
   return PALETTE[k % PALETTE.size()];
 }
 
-RgbImage render_log_log_plot(const LogLogPlot& plot) {
-  if (plot.width < 320 || plot.height < 240 || plot.width > 8192 || plot.height > 8192) {
-    throw std::invalid_argument("render_log_log_plot: size must be 320 x 240 to 8192 x 8192");
+namespace {
+
+constexpr int BIG = 2;  // scale of the title, tick labels, axis titles and legend (notes: 1)
+
+// The plot area on the canvas, in pixels, and the log-log mapping into it.
+struct PlotFrame {
+  int left = 110, top = 50, right = 0, bottom = 0;
+  Decades xd, yd;
+
+  [[nodiscard]] double px(double x) const {
+    return left + (std::log10(x) - xd.from) / (xd.to - xd.from) * (right - left);
   }
+  [[nodiscard]] double py(double y) const {
+    return bottom - (std::log10(y) - yd.from) / (yd.to - yd.from) * (bottom - top);
+  }
+  [[nodiscard]] int decade_x(int e) const { return static_cast<int>(std::lround(px(std::pow(10.0, e)))); }
+  [[nodiscard]] int decade_y(int e) const { return static_cast<int>(std::lround(py(std::pow(10.0, e)))); }
+};
+
+// The decades the two axes span; refuses points that are not positive and finite, and bad indices.
+std::array<Decades, 2> axis_decades(const LogLogPlot& plot) {
   double x_lo = 0.0, x_hi = 1.0, y_lo = 0.0, y_hi = 1.0;
   for (std::size_t i = 0; i < plot.points.size(); ++i) {
     const PlotPoint& p = plot.points[i];
@@ -166,65 +183,65 @@ RgbImage render_log_log_plot(const LogLogPlot& plot) {
     if (f >= plot.points.size()) throw std::invalid_argument("render_log_log_plot: front index out of range");
   }
   // Without points the axes span one decade (1 to 10) each, so that the frame still draws.
-  const Decades xd = decades(x_lo, x_hi), yd = decades(y_lo, y_hi);
+  return {decades(x_lo, x_hi), decades(y_lo, y_hi)};
+}
 
-  Canvas canvas(plot.width, plot.height);
-  const int big = 2;
-  const int line_height = Canvas::text_height(big) + 8;
-
-  // Layout: title on top, legend on the right, tick labels and titles left and below, notes last.
-  int legend_width = Canvas::text_width(plot.front_name, big);
-  for (const std::string& name : plot.series) legend_width = std::max(legend_width, Canvas::text_width(name, big));
+// Layout: title on top, legend on the right, tick labels and titles left and below, notes last.
+PlotFrame plot_frame(const LogLogPlot& plot, int note_line) {
+  const std::array<Decades, 2> axes = axis_decades(plot);
+  int legend_width = Canvas::text_width(plot.front_name, BIG);
+  for (const std::string& name : plot.series) legend_width = std::max(legend_width, Canvas::text_width(name, BIG));
   legend_width = std::min(legend_width + 36, plot.width / 3);
-  const int note_line = Canvas::text_height(1) + 3;
   const int notes_height = static_cast<int>(plot.notes.size()) * note_line;
-  const int left = 110, top = 50;
-  const int right = plot.width - legend_width - 30;
-  const int bottom = plot.height - 78 - notes_height;
-  if (right - left < 100 || bottom - top < 100) throw std::invalid_argument("render_log_log_plot: too small");
-  const auto px = [&](double x) { return left + (std::log10(x) - xd.from) / (xd.to - xd.from) * (right - left); };
-  const auto py = [&](double y) { return bottom - (std::log10(y) - yd.from) / (yd.to - yd.from) * (bottom - top); };
-  const auto decade_x = [&](int e) { return static_cast<int>(std::lround(px(std::pow(10.0, e)))); };
-  const auto decade_y = [&](int e) { return static_cast<int>(std::lround(py(std::pow(10.0, e)))); };
+  PlotFrame frame;
+  frame.right = plot.width - legend_width - 30;
+  frame.bottom = plot.height - 78 - notes_height;
+  if (frame.right - frame.left < 100 || frame.bottom - frame.top < 100) {
+    throw std::invalid_argument("render_log_log_plot: too small");
+  }
+  frame.xd = axes[0];
+  frame.yd = axes[1];
+  return frame;
+}
 
-  canvas.fill_rect(0, 0, plot.width - 1, plot.height - 1, WHITE);
-  canvas.text((plot.width - Canvas::text_width(plot.title, big)) / 2, 14, plot.title, big, TEXT);
-
-  // Grid, ticks and their labels; labels thinned to about ten per axis.
-  const int x_every = std::max(1, (xd.last - xd.first + 9) / 10);
-  const int y_every = std::max(1, (yd.last - yd.first + 9) / 10);
-  for (int e = xd.first; e <= xd.last; ++e) {
-    const int x = decade_x(e);
-    canvas.vline(x, top, bottom, GRID);
-    canvas.vline(x, bottom - 6, bottom, BLACK);
-    if ((e - xd.first) % x_every == 0) {
+// Grid, ticks and their labels (thinned to about ten per axis), the frame and the axis titles.
+void draw_axes(Canvas& canvas, const PlotFrame& f, const LogLogPlot& plot) {
+  const int x_every = std::max(1, (f.xd.last - f.xd.first + 9) / 10);
+  const int y_every = std::max(1, (f.yd.last - f.yd.first + 9) / 10);
+  for (int e = f.xd.first; e <= f.xd.last; ++e) {
+    const int x = f.decade_x(e);
+    canvas.vline(x, f.top, f.bottom, GRID);
+    canvas.vline(x, f.bottom - 6, f.bottom, BLACK);
+    if ((e - f.xd.first) % x_every == 0) {
       const std::string label = decade_label(e);
-      canvas.text(x - Canvas::text_width(label, big) / 2, bottom + 8, label, big, TEXT);
+      canvas.text(x - Canvas::text_width(label, BIG) / 2, f.bottom + 8, label, BIG, TEXT);
     }
-    for (int m = 2; m <= 9 && e < xd.last && xd.last - xd.first <= 8; ++m) {
-      canvas.vline(static_cast<int>(std::lround(px(m * std::pow(10.0, e)))), bottom - 3, bottom, BLACK);
+    for (int m = 2; m <= 9 && e < f.xd.last && f.xd.last - f.xd.first <= 8; ++m) {
+      canvas.vline(static_cast<int>(std::lround(f.px(m * std::pow(10.0, e)))), f.bottom - 3, f.bottom, BLACK);
     }
   }
-  for (int e = yd.first; e <= yd.last; ++e) {
-    const int y = decade_y(e);
-    canvas.hline(left, right, y, GRID);
-    canvas.hline(left, left + 6, y, BLACK);
-    if ((e - yd.first) % y_every == 0) {
+  for (int e = f.yd.first; e <= f.yd.last; ++e) {
+    const int y = f.decade_y(e);
+    canvas.hline(f.left, f.right, y, GRID);
+    canvas.hline(f.left, f.left + 6, y, BLACK);
+    if ((e - f.yd.first) % y_every == 0) {
       const std::string label = decade_label(e);
-      canvas.text(left - 8 - Canvas::text_width(label, big), y - Canvas::cap_height(big) / 2, label, big, TEXT);
+      canvas.text(f.left - 8 - Canvas::text_width(label, BIG), y - Canvas::cap_height(BIG) / 2, label, BIG, TEXT);
     }
-    for (int m = 2; m <= 9 && e < yd.last && yd.last - yd.first <= 8; ++m) {
-      canvas.hline(left, left + 3, static_cast<int>(std::lround(py(m * std::pow(10.0, e)))), BLACK);
+    for (int m = 2; m <= 9 && e < f.yd.last && f.yd.last - f.yd.first <= 8; ++m) {
+      canvas.hline(f.left, f.left + 3, static_cast<int>(std::lround(f.py(m * std::pow(10.0, e)))), BLACK);
     }
   }
-  canvas.hline(left, right, top, BLACK);
-  canvas.hline(left, right, bottom, BLACK);
-  canvas.vline(left, top, bottom, BLACK);
-  canvas.vline(right, top, bottom, BLACK);
-  canvas.text((left + right - Canvas::text_width(plot.x_title, big)) / 2, bottom + 36, plot.x_title, big, TEXT);
-  canvas.text_up(16, (top + bottom + Canvas::text_width(plot.y_title, big)) / 2, plot.y_title, big, TEXT);
+  canvas.hline(f.left, f.right, f.top, BLACK);
+  canvas.hline(f.left, f.right, f.bottom, BLACK);
+  canvas.vline(f.left, f.top, f.bottom, BLACK);
+  canvas.vline(f.right, f.top, f.bottom, BLACK);
+  canvas.text((f.left + f.right - Canvas::text_width(plot.x_title, BIG)) / 2, f.bottom + 36, plot.x_title, BIG, TEXT);
+  canvas.text_up(16, (f.top + f.bottom + Canvas::text_width(plot.y_title, BIG)) / 2, plot.y_title, BIG, TEXT);
+}
 
-  // The front behind the points, then the points, then the rings.
+// The front behind the points, then the points, then the rings.
+void draw_points(Canvas& canvas, const PlotFrame& f, const LogLogPlot& plot) {
   std::vector<std::size_t> front = plot.front;
   std::sort(front.begin(), front.end(), [&](std::size_t a, std::size_t b) {
     return plot.points[a].x < plot.points[b].x ||
@@ -233,26 +250,44 @@ RgbImage render_log_log_plot(const LogLogPlot& plot) {
   for (std::size_t k = 1; k < front.size(); ++k) {
     const PlotPoint& a = plot.points[front[k - 1]];
     const PlotPoint& b = plot.points[front[k]];
-    canvas.line(px(a.x), py(a.y), px(b.x), py(b.y), 2.0, BLACK);
+    canvas.line(f.px(a.x), f.py(a.y), f.px(b.x), f.py(b.y), 2.0, BLACK);
   }
-  for (const PlotPoint& p : plot.points) canvas.disc(px(p.x), py(p.y), 5.5, series_colour(p.series));
-  for (const std::size_t f : front) canvas.disc(px(plot.points[f].x), py(plot.points[f].y), 10.0, BLACK, 7.5);
+  for (const PlotPoint& p : plot.points) canvas.disc(f.px(p.x), f.py(p.y), 5.5, series_colour(p.series));
+  for (const std::size_t k : front) canvas.disc(f.px(plot.points[k].x), f.py(plot.points[k].y), 10.0, BLACK, 7.5);
+}
 
-  // Legend.
-  const int legend_x = right + 20;
-  int legend_y = top + 4;
+// One line per series, then the front's, right of the plot area.
+void draw_legend(Canvas& canvas, const PlotFrame& f, const LogLogPlot& plot) {
+  const int line_height = Canvas::text_height(BIG) + 8;
+  const int legend_x = f.right + 20;
+  int legend_y = f.top + 4;
   for (std::size_t k = 0; k < plot.series.size(); ++k, legend_y += line_height) {
-    canvas.disc(legend_x + 10, legend_y + Canvas::cap_height(big) / 2, 5.5, series_colour(k));
-    canvas.text(legend_x + 26, legend_y, plot.series[k], big, TEXT);
+    canvas.disc(legend_x + 10, legend_y + Canvas::cap_height(BIG) / 2, 5.5, series_colour(k));
+    canvas.text(legend_x + 26, legend_y, plot.series[k], BIG, TEXT);
   }
   if (!plot.front.empty()) {
-    const int middle = legend_y + Canvas::cap_height(big) / 2;
+    const int middle = legend_y + Canvas::cap_height(BIG) / 2;
     canvas.line(legend_x, middle, legend_x + 20, middle, 2.0, BLACK);
     canvas.disc(legend_x + 10, middle, 10.0, BLACK, 7.5);
-    canvas.text(legend_x + 26, legend_y, plot.front_name, big, TEXT);
+    canvas.text(legend_x + 26, legend_y, plot.front_name, BIG, TEXT);
   }
+}
 
-  int note_y = bottom + 62;
+}  // namespace
+
+RgbImage render_log_log_plot(const LogLogPlot& plot) {
+  if (plot.width < 320 || plot.height < 240 || plot.width > 8192 || plot.height > 8192) {
+    throw std::invalid_argument("render_log_log_plot: size must be 320 x 240 to 8192 x 8192");
+  }
+  const int note_line = Canvas::text_height(1) + 3;
+  const PlotFrame frame = plot_frame(plot, note_line);
+  Canvas canvas(plot.width, plot.height);
+  canvas.fill_rect(0, 0, plot.width - 1, plot.height - 1, WHITE);
+  canvas.text((plot.width - Canvas::text_width(plot.title, BIG)) / 2, 14, plot.title, BIG, TEXT);
+  draw_axes(canvas, frame, plot);
+  draw_points(canvas, frame, plot);
+  draw_legend(canvas, frame, plot);
+  int note_y = frame.bottom + 62;
   for (const std::string& note : plot.notes) {
     canvas.text(12, note_y, note, 1, TEXT);
     note_y += note_line;

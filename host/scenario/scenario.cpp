@@ -140,33 +140,24 @@ Waypoint waypoint(const Reader& r, const toml::node& node, const std::string& ke
   return w;
 }
 
-}  // namespace
-
-std::vector<ParameterSetting> read_parameter_table(const toml::table& table, const std::string& where,
-                                                   const std::string& origin) {
-  return parameters(Reader(origin), &table, where);
-}
-
-Scenario parse_scenario(const std::string& text, const std::filesystem::path& origin) {
-  const Reader r(origin.string());
-  toml::table root;
+toml::table parse_toml(const std::string& text, const std::filesystem::path& origin) {
   try {
-    root = toml::parse(text, origin.string());
+    return toml::parse(text, origin.string());
   } catch (const toml::parse_error& error) {
     std::ostringstream message;
     message << origin.string() << ":" << error.source().begin.line << ": " << error.description();
     throw ScenarioError(message.str());
   }
-  // [compare] belongs to tissue-host compare (host/compare/compare_settings.*), which reads it itself.
-  r.only(root, "", {"scenario", "tissue", "haptic", "device", "realtime", "output", "expect", "compare"});
-  Scenario s;
-  s.file = origin;
-  const std::filesystem::path base = origin.has_parent_path() ? origin.parent_path() : std::filesystem::path(".");
-  const auto relative_to_file = [&](const std::string& path) {
-    const std::filesystem::path p(path);
-    return p.is_absolute() ? p : base / p;
-  };
+}
 
+// A path the scenario gives: absolute, or relative to the scenario file's folder `base`.
+std::filesystem::path relative_to(const std::filesystem::path& base, const std::string& path) {
+  const std::filesystem::path p(path);
+  return p.is_absolute() ? p : base / p;
+}
+
+// [scenario]: name (the file's stem unless given), description, duration.
+void read_scenario_table(const Reader& r, const toml::table& root, const std::filesystem::path& origin, Scenario& s) {
   const toml::table* scenario = root["scenario"].as_table();
   if (scenario == nullptr) r.fail("scenario", "the [scenario] table is missing");
   r.only(*scenario, "scenario", {"name", "description", "duration"});
@@ -177,17 +168,20 @@ Scenario parse_scenario(const std::string& text, const std::filesystem::path& or
   if (duration == nullptr) r.fail("scenario.duration", "is missing (seconds)");
   s.duration_s = r.positive(*duration, "scenario.duration");
   if (s.duration_s > 24.0 * 3600.0) r.fail("scenario.duration", "longer than a day");
+}
 
+// [tissue] (optional): the FMU, the communication step, the parameters and a mesh file.
+void read_tissue(const Reader& r, const toml::table& root, const std::filesystem::path& base, Scenario& s) {
   if (const toml::table* tissue = root["tissue"].as_table()) {
     r.only(*tissue, "tissue", {"fmu", "communication_step", "mesh", "parameters"});
-    if (const toml::node* n = tissue->get("fmu")) s.tissue_fmu = relative_to_file(r.string(*n, "tissue.fmu"));
+    if (const toml::node* n = tissue->get("fmu")) s.tissue_fmu = relative_to(base, r.string(*n, "tissue.fmu"));
     if (const toml::node* n = tissue->get("communication_step")) {
       s.tissue_step_s = r.positive(*n, "tissue.communication_step");
     }
     s.tissue_parameters = parameters(r, tissue->get_as<toml::table>("parameters"), "tissue.parameters");
     if (const toml::node* n = tissue->get("mesh")) {
       // A mesh file next to the scenario: the FMU is given its absolute path.
-      const std::filesystem::path mesh = relative_to_file(r.string(*n, "tissue.mesh"));
+      const std::filesystem::path mesh = relative_to(base, r.string(*n, "tissue.mesh"));
       if (!std::filesystem::exists(mesh)) r.fail("tissue.mesh", "no file " + mesh.string());
       s.tissue_parameters.insert(s.tissue_parameters.begin(),
                                  ParameterSetting{"mesh", std::filesystem::absolute(mesh).lexically_normal().string()});
@@ -199,9 +193,13 @@ Scenario parse_scenario(const std::string& text, const std::filesystem::path& or
                    [](const ParameterSetting& p) { return p.name == "stepSize"; })) {
     s.tissue_parameters.push_back(ParameterSetting{"stepSize", s.tissue_step_s});
   }
+}
+
+// [haptic] (optional): the FMU, the period, the parameters; the tissue step a whole number of periods.
+void read_haptic(const Reader& r, const toml::table& root, const std::filesystem::path& base, Scenario& s) {
   if (const toml::table* haptic = root["haptic"].as_table()) {
     r.only(*haptic, "haptic", {"fmu", "period", "parameters"});
-    if (const toml::node* n = haptic->get("fmu")) s.haptic_fmu = relative_to_file(r.string(*n, "haptic.fmu"));
+    if (const toml::node* n = haptic->get("fmu")) s.haptic_fmu = relative_to(base, r.string(*n, "haptic.fmu"));
     if (const toml::node* n = haptic->get("period")) s.haptic_period_s = r.positive(*n, "haptic.period");
     s.haptic_parameters = parameters(r, haptic->get_as<toml::table>("parameters"), "haptic.parameters");
   }
@@ -211,85 +209,128 @@ Scenario parse_scenario(const std::string& text, const std::filesystem::path& or
     r.fail("tissue.communication_step",
            "must be a whole multiple of haptic.period (" + std::to_string(s.haptic_period_s) + " s)");
   }
+}
 
+// The waypoints of a scripted device, in increasing time.
+std::vector<Waypoint> waypoints(const Reader& r, const toml::table& device) {
+  const toml::array* list = device.get_as<toml::array>("waypoints");
+  if (list == nullptr || list->empty()) r.fail("device.waypoints", "a scripted device needs waypoints");
+  std::vector<Waypoint> result;
+  for (std::size_t k = 0; k < list->size(); ++k) {
+    result.push_back(waypoint(r, *list->get(k), "device.waypoints[" + std::to_string(k) + "]"));
+  }
+  for (std::size_t k = 1; k < result.size(); ++k) {
+    if (!(result[k].time_s > result[k - 1].time_s)) {
+      r.fail("device.waypoints[" + std::to_string(k) + "].t", "waypoint times must increase");
+    }
+  }
+  return result;
+}
+
+// [device]: scripted (waypoints), replay (a --record file), udp (address, port) or browser.
+DeviceConfig read_device(const Reader& r, const toml::table& root, const std::filesystem::path& base) {
   const toml::table* device = root["device"].as_table();
   if (device == nullptr) r.fail("device", "the [device] table is missing");
   r.only(*device, "device", {"kind", "waypoints", "file", "address", "port", "allow_remote"});
   const toml::node* kind = device->get("kind");
   const std::string kind_name = kind != nullptr ? r.string(*kind, "device.kind") : "scripted";
+  DeviceConfig config;
   if (kind_name == "scripted") {
-    s.device.kind = DeviceKind::scripted;
-    const toml::array* waypoints = device->get_as<toml::array>("waypoints");
-    if (waypoints == nullptr || waypoints->empty()) r.fail("device.waypoints", "a scripted device needs waypoints");
-    for (std::size_t k = 0; k < waypoints->size(); ++k) {
-      s.device.waypoints.push_back(waypoint(r, *waypoints->get(k), "device.waypoints[" + std::to_string(k) + "]"));
-    }
-    for (std::size_t k = 1; k < s.device.waypoints.size(); ++k) {
-      if (!(s.device.waypoints[k].time_s > s.device.waypoints[k - 1].time_s)) {
-        r.fail("device.waypoints[" + std::to_string(k) + "].t", "waypoint times must increase");
-      }
-    }
+    config.kind = DeviceKind::scripted;
+    config.waypoints = waypoints(r, *device);
   } else if (kind_name == "replay") {
-    s.device.kind = DeviceKind::replay;
+    config.kind = DeviceKind::replay;
     const toml::node* file = device->get("file");
     if (file == nullptr) r.fail("device.file", "a replay device needs the CSV file --record wrote");
-    s.device.replay_file = relative_to_file(r.string(*file, "device.file"));
+    config.replay_file = relative_to(base, r.string(*file, "device.file"));
   } else if (kind_name == "udp") {
-    s.device.kind = DeviceKind::udp;
-    if (const toml::node* n = device->get("address")) s.device.udp_address = r.string(*n, "device.address");
+    config.kind = DeviceKind::udp;
+    if (const toml::node* n = device->get("address")) config.udp_address = r.string(*n, "device.address");
     if (const toml::node* n = device->get("port")) {
       const double port = r.number(*n, "device.port");
       if (port < 1 || port > 65535 || port != std::floor(port)) r.fail("device.port", "must be in 1..65535");
-      s.device.udp_port = static_cast<std::uint16_t>(port);
+      config.udp_port = static_cast<std::uint16_t>(port);
     }
     if (const toml::node* n = device->get("allow_remote"))
-      s.device.udp_allow_remote = r.boolean(*n, "device.allow_remote");
+      config.udp_allow_remote = r.boolean(*n, "device.allow_remote");
   } else if (kind_name == "browser") {
-    s.device.kind = DeviceKind::browser;  // the live view's mouse and keyboard (--view)
+    config.kind = DeviceKind::browser;  // the live view's mouse and keyboard (--view)
   } else {
     r.fail("device.kind", "must be \"scripted\", \"replay\", \"udp\" or \"browser\", got \"" + kind_name + "\"");
   }
+  return config;
+}
 
-  if (const toml::table* realtime = root["realtime"].as_table()) {
-    r.only(*realtime, "realtime", {"overrun_policy", "max_catch_up_slots"});
-    if (const toml::node* n = realtime->get("overrun_policy")) {
-      const std::string policy = r.string(*n, "realtime.overrun_policy");
-      if (policy == "catch_up") {
-        s.overrun_policy = OverrunPolicy::catch_up;
-      } else if (policy == "skip") {
-        s.overrun_policy = OverrunPolicy::skip;
-      } else {
-        r.fail("realtime.overrun_policy", "must be \"catch_up\" or \"skip\"");
-      }
-    }
-    if (const toml::node* n = realtime->get("max_catch_up_slots")) {
-      const double slots = r.number(*n, "realtime.max_catch_up_slots");
-      if (slots < 1 || slots > 100 || slots != std::floor(slots))
-        r.fail("realtime.max_catch_up_slots", "must be in 1..100");
-      s.max_catch_up_slots = static_cast<int>(slots);
+// [realtime] (optional): the overrun policy and how many slots a step may catch up.
+void read_realtime(const Reader& r, const toml::table& realtime, Scenario& s) {
+  r.only(realtime, "realtime", {"overrun_policy", "max_catch_up_slots"});
+  if (const toml::node* n = realtime.get("overrun_policy")) {
+    const std::string policy = r.string(*n, "realtime.overrun_policy");
+    if (policy == "catch_up") {
+      s.overrun_policy = OverrunPolicy::catch_up;
+    } else if (policy == "skip") {
+      s.overrun_policy = OverrunPolicy::skip;
+    } else {
+      r.fail("realtime.overrun_policy", "must be \"catch_up\" or \"skip\"");
     }
   }
-  if (const toml::table* output = root["output"].as_table()) {
-    r.only(*output, "output", {"frame_rate", "png"});
-    if (const toml::node* n = output->get("frame_rate")) {
-      s.frame_rate_hz = r.number(*n, "output.frame_rate");
-      if (s.frame_rate_hz < 0.0 || s.frame_rate_hz > 1000.0) r.fail("output.frame_rate", "must be in [0, 1000] Hz");
-    }
-    if (const toml::node* n = output->get("png")) s.write_png = r.boolean(*n, "output.png");
+  if (const toml::node* n = realtime.get("max_catch_up_slots")) {
+    const double slots = r.number(*n, "realtime.max_catch_up_slots");
+    if (slots < 1 || slots > 100 || slots != std::floor(slots))
+      r.fail("realtime.max_catch_up_slots", "must be in 1..100");
+    s.max_catch_up_slots = static_cast<int>(slots);
   }
-  if (const toml::table* expect = root["expect"].as_table()) {
-    r.only(*expect, "expect", {"min_cut_tets", "max_cut_tets", "contact"});
-    const auto count = [&](const char* key) -> std::optional<std::uint64_t> {
-      const toml::node* n = expect->get(key);
-      if (n == nullptr) return std::nullopt;
-      const double value = r.number(*n, std::string("expect.") + key);
-      if (value < 0 || value != std::floor(value)) r.fail(std::string("expect.") + key, "must be a count");
-      return static_cast<std::uint64_t>(value);
-    };
-    s.expect.min_cut_tets = count("min_cut_tets");
-    s.expect.max_cut_tets = count("max_cut_tets");
-    if (const toml::node* n = expect->get("contact")) s.expect.contact = r.boolean(*n, "expect.contact");
+}
+
+// [output] (optional): the frame rate of the VTU frames and whether to render final.png.
+void read_output(const Reader& r, const toml::table& output, Scenario& s) {
+  r.only(output, "output", {"frame_rate", "png"});
+  if (const toml::node* n = output.get("frame_rate")) {
+    s.frame_rate_hz = r.number(*n, "output.frame_rate");
+    if (s.frame_rate_hz < 0.0 || s.frame_rate_hz > 1000.0) r.fail("output.frame_rate", "must be in [0, 1000] Hz");
   }
+  if (const toml::node* n = output.get("png")) s.write_png = r.boolean(*n, "output.png");
+}
+
+// [expect] (optional): what the tests check.
+Expectations read_expect(const Reader& r, const toml::table& expect) {
+  r.only(expect, "expect", {"min_cut_tets", "max_cut_tets", "contact"});
+  const auto count = [&](const char* key) -> std::optional<std::uint64_t> {
+    const toml::node* n = expect.get(key);
+    if (n == nullptr) return std::nullopt;
+    const double value = r.number(*n, std::string("expect.") + key);
+    if (value < 0 || value != std::floor(value)) r.fail(std::string("expect.") + key, "must be a count");
+    return static_cast<std::uint64_t>(value);
+  };
+  Expectations expectations;
+  expectations.min_cut_tets = count("min_cut_tets");
+  expectations.max_cut_tets = count("max_cut_tets");
+  if (const toml::node* n = expect.get("contact")) expectations.contact = r.boolean(*n, "expect.contact");
+  return expectations;
+}
+
+}  // namespace
+
+std::vector<ParameterSetting> read_parameter_table(const toml::table& table, const std::string& where,
+                                                   const std::string& origin) {
+  return parameters(Reader(origin), &table, where);
+}
+
+Scenario parse_scenario(const std::string& text, const std::filesystem::path& origin) {
+  const Reader r(origin.string());
+  const toml::table root = parse_toml(text, origin);
+  // [compare] belongs to tissue-host compare (host/compare/compare_settings.*), which reads it itself.
+  r.only(root, "", {"scenario", "tissue", "haptic", "device", "realtime", "output", "expect", "compare"});
+  Scenario s;
+  s.file = origin;
+  const std::filesystem::path base = origin.has_parent_path() ? origin.parent_path() : std::filesystem::path(".");
+  read_scenario_table(r, root, origin, s);
+  read_tissue(r, root, base, s);
+  read_haptic(r, root, base, s);
+  s.device = read_device(r, root, base);
+  if (const toml::table* realtime = root["realtime"].as_table()) read_realtime(r, *realtime, s);
+  if (const toml::table* output = root["output"].as_table()) read_output(r, *output, s);
+  if (const toml::table* expect = root["expect"].as_table()) s.expect = read_expect(r, *expect);
   return s;
 }
 

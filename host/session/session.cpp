@@ -1,4 +1,6 @@
-// run_session (see session.hpp).
+// run_session (see session.hpp): the Session builds the parts (the two FMU links and the sample's
+// relay, the device, the recording, the live view), says what a tick, a step and a frame do
+// (schedule/session_steps.hpp), and hands itself to a scheduler (schedule/): offline or real time.
 #include "session/session.hpp"
 
 #include "importer/fmu3.hpp"
@@ -7,14 +9,15 @@
 #include "output/frame_writer.hpp"
 #include "output/png_renderer.hpp"
 #include "output/session_log.hpp"
+#include "schedule/offline_schedule.hpp"
+#include "schedule/realtime_schedule.hpp"
+#include "schedule/schedule.hpp"
+#include "schedule/session_steps.hpp"
 #include "session/session_device.hpp"
-#include "sync/frame_pipe.hpp"
 #include "sync/latest_value.hpp"
 #include "sync/realtime_clock.hpp"
 #include "view/browser_device.hpp"
 #include "view/live_view.hpp"
-
-#include <sys/mman.h>
 
 #include <algorithm>
 #include <atomic>
@@ -24,8 +27,6 @@
 #include <memory>
 #include <mutex>
 #include <optional>
-#include <ostream>
-#include <thread>
 #include <vector>
 
 namespace tissue::host {
@@ -43,9 +44,18 @@ std::filesystem::path fmu_path(const std::filesystem::path& configured, const st
   return fmu_dir / name;
 }
 
+RealtimeOptions realtime_options(const SessionOptions& options) {
+  RealtimeOptions realtime;
+  realtime.realtime_priority = options.realtime_priority;
+  realtime.haptic_thread_started = options.haptic_thread_started;
+  realtime.stop = options.stop;
+  realtime.progress = options.progress;
+  return realtime;
+}
+
 // --- the session ---
 
-class Session {
+class Session final : public SessionSteps {
  public:
   Session(const Scenario& scenario, const SessionOptions& options)
       : m_scenario(scenario),
@@ -59,8 +69,10 @@ class Session {
         m_point_slot(m_relay.layout().slot("contact.point")),
         m_force_slot(m_relay.layout().slot("contact.force")),
         m_blade_depth_slot(m_relay.layout().slot("cut.bladeDepth")),
+        m_step_sample(m_relay.make_sample()),
         m_last_outputs(m_relay.make_sample()),
-        m_device(make_device(options.browser_device ? browser_config() : scenario.device, m_tissue)) {
+        m_device(make_device(options.browser_device ? browser_config() : scenario.device, m_tissue)),
+        m_schedule(make_schedule(scenario)) {
     if (options.view && options.offline) throw ScenarioError("--view: the live view needs a real-time run, not --offline");
     if (!options.view && dynamic_cast<BrowserDevice*>(m_device.get()) != nullptr) {
       throw ScenarioError("device: the browser device needs the live view (run with --view or --mouse)");
@@ -82,17 +94,12 @@ class Session {
       settings.blade_length_m = m_tissue.blade_length_m();
       m_view = std::make_unique<LiveView>(settings, dynamic_cast<BrowserDevice*>(m_device.get()));
     }
-    m_period_s = scenario.haptic_period_s;
-    m_slot_s = scenario.tissue_step_s;
-    m_ticks_per_slot = static_cast<std::uint64_t>(std::llround(m_slot_s / m_period_s));
-    m_ticks = static_cast<std::uint64_t>(std::llround(std::ceil(scenario.duration_s / m_slot_s))) * m_ticks_per_slot;
-    m_rows.resize(m_ticks);
-    m_periods_s.reserve(m_ticks);
-    m_step_s.reserve(m_ticks / m_ticks_per_slot + 8);
-    m_step_cutting.reserve(m_ticks / m_ticks_per_slot + 8);
+    m_rows.resize(m_schedule.ticks);
+    m_step_s.reserve(m_schedule.slots() + 8);
+    m_step_cutting.reserve(m_schedule.slots() + 8);
     m_summary.scenario = scenario.name;
     m_summary.offline = options.offline;
-    m_summary.tissue_step_s = m_slot_s;
+    m_summary.tissue_step_s = m_schedule.slot_s;
     m_summary.device_name = std::string(m_device->name());
     m_summary.device_max_force_n = m_haptic.max_force_n();
     m_summary.overrun_policy = scenario.overrun_policy == OverrunPolicy::catch_up ? "catch_up" : "skip";
@@ -107,21 +114,27 @@ class Session {
 
   SessionSummary run() {
     if (m_options.tissue_observer != nullptr) m_options.tissue_observer->started(m_tissue.instance());
-    const Nanoseconds wall_start = now_ns();
+    start_view();
+    std::optional<FrameWriter> writer;
+    if (m_options.write_outputs) writer.emplace(m_options.output_dir);
+    FrameWriter* const frames = writer ? &*writer : nullptr;
     if (m_options.offline) {
-      run_offline();
-      m_summary.wall_time_s = static_cast<double>(now_ns() - wall_start) * 1e-9;
+      run_offline(*this, m_schedule, frames, m_options.progress, m_summary);
     } else {
-      run_realtime();  // measures the session's wall time itself, from its first deadline
+      run_realtime(*this, m_schedule, realtime_options(m_options), frames, m_summary);
     }
+    m_rows.resize(m_summary.haptic_ticks);  // fewer when a real-time run was stopped early
+    stop_view();
     finish();
     return m_summary;
   }
 
  private:
+  // --- SessionSteps: what the scheduler drives ---
+
   // One haptic tick n (session time n * period). Haptic thread: no allocation, no lock.
-  void haptic_tick(std::uint64_t n) {
-    const double t = static_cast<double>(n) * m_period_s;
+  void haptic_tick(std::uint64_t n) override {
+    const double t = static_cast<double>(n) * m_schedule.haptic_period_s;
     const DevicePose pose = m_device->read(t);
     if (m_tissue_sample.update()) {
       const TissueSample& sample = m_tissue_sample.read_buffer();
@@ -134,7 +147,7 @@ class Session {
       }
     }
     m_haptic.set_device(pose);
-    const DoStepResult result = m_haptic.step(t, m_period_s);
+    const DoStepResult result = m_haptic.step(t, m_schedule.haptic_period_s);
     if (result.status != fmi3OK && result.status != fmi3Warning) ++m_summary.haptic_errors;
     m_haptic.read(m_haptic_out);
     std::array<double, 3> force = m_haptic_out.device_force_n;
@@ -146,7 +159,7 @@ class Session {
     m_summary.max_device_force_n = std::max(m_summary.max_device_force_n, norm3(sent));
     ToolCommand& command = m_tool_command.write_buffer();
     command = m_haptic_out.tool;
-    command.time_s = t + m_period_s;
+    command.time_s = t + m_schedule.haptic_period_s;
     m_tool_command.publish();
     LogRow& row = m_rows[n];
     row.time_s = t;
@@ -159,12 +172,19 @@ class Session {
     row.observed_energy_j = m_haptic_out.observed_energy_j;
   }
 
-  // One tissue step from tissue time `time_s` over `slots` slots; returns the outputs to publish.
-  void tissue_step(double time_s, int slots, TissueSample& out) {
+  void haptic_tick_timed(std::uint64_t n, double period_s, std::uint64_t deadline_misses) override {
+    if (m_view) m_view->record_tick(period_s, deadline_misses, m_rows[n].force_n);
+  }
+
+  bool tissue_failed() const override { return m_tissue_failed; }
+
+  // One tissue step from tissue time `time_s` over `slots` slots, into m_step_sample. Dynamics thread.
+  double tissue_step(double time_s, int slots) override {
+    TissueSample& out = m_step_sample;
     m_tool_command.update();
     m_tissue.set_tool(m_tool_command.read_buffer());
     const bool scalpel = m_tool_command.read_buffer().mode == static_cast<std::int64_t>(ToolMode::scalpel);
-    const double step_s = slots * m_slot_s;
+    const double step_s = slots * m_schedule.slot_s;
     TissueStepObserver* const observer = m_options.tissue_observer;
     const Nanoseconds cpu_start = observer != nullptr ? thread_cpu_ns() : 0;
     const Nanoseconds start = now_ns();
@@ -202,15 +222,34 @@ class Session {
     m_cut_tets.store(out.cut_tets, std::memory_order_relaxed);
     m_summary.cut_tets = out.cut_tets;
     m_summary.enriched_vertices = out.enriched_vertices;
+    m_last_outputs = out;
+    return out.time_s;
   }
 
-  bool frame_due(double time_s) const {
+  void publish_tissue_sample() override {
+    m_tissue_sample.write_buffer() = m_step_sample;
+    m_tissue_sample.publish();
+  }
+
+  void tissue_sample_published(double time_s) override {
+    if (!m_view) return;
+    m_view->publish_tissue(TissueLive{time_s, m_step_s.empty() ? 0.0 : m_step_s.back(), m_step_sample.cut_tets});
+    if (m_view->frame_due()) {
+      fill_frame(m_view->frame_buffer(), time_s);
+      m_view->publish_frame();
+    }
+  }
+
+  bool frame_due(double time_s) const override {
     return m_options.write_outputs && m_scenario.frame_rate_hz > 0.0 && time_s + 1e-9 >= m_next_frame_s;
   }
-  void capture_frame(SurfaceFrame& frame, double time_s) {
+  void capture_frame(SurfaceFrame& frame, double time_s) override {
     fill_frame(frame, time_s);
     m_next_frame_s += 1.0 / m_scenario.frame_rate_hz;
   }
+  void frame_dropped() override { m_next_frame_s += 1.0 / m_scenario.frame_rate_hz; }
+  void reserve_frame(SurfaceFrame& frame) override { m_tissue.reserve(frame); }
+  // The surface, the tool and the contact at `time_s` (the recording's frames and the live view's).
   void fill_frame(SurfaceFrame& frame, double time_s) {
     m_tissue.read_surface(frame);
     frame.time_s = time_s;
@@ -228,252 +267,38 @@ class Session {
     while (m_next_frame_s <= time_s + 1e-9) m_next_frame_s += 1.0 / m_scenario.frame_rate_hz;
   }
 
-  void run_offline() {
-    std::optional<FrameWriter> writer;
-    if (m_options.write_outputs) writer.emplace(m_options.output_dir);
-    SurfaceFrame frame;
-    bool pending = false;
-    TissueSample result = m_relay.make_sample();
-    double tissue_time_s = 0.0;
-    std::uint64_t next_progress = 0;
-    for (std::uint64_t n = 0; n < m_ticks; ++n) {
-      if (n % m_ticks_per_slot == 0) {
-        // The result of the previous step arrives at the start of this slot, then the next starts.
-        if (pending) {
-          m_tissue_sample.write_buffer() = result;
-          m_tissue_sample.publish();
-          pending = false;
-        }
-        if (!m_tissue_failed) {
-          tissue_step(tissue_time_s, 1, result);
-          m_last_outputs = result;
-          tissue_time_s = result.time_s;
-          pending = true;
-          if (frame_due(tissue_time_s)) {
-            capture_frame(frame, tissue_time_s);
-            writer->write(frame);
-          }
-        }
-      }
-      haptic_tick(n);
-      if (m_options.progress != nullptr && n >= next_progress) {
-        *m_options.progress << "offline: t = " << static_cast<double>(n) * m_period_s << " / " << m_scenario.duration_s
-                            << " s, cut tets " << m_summary.cut_tets << "\n";
-        next_progress += m_ticks / 10 + 1;
-      }
-    }
-    m_summary.haptic_ticks = m_ticks;
-    m_summary.tissue_steps = m_step_s.size();
-    m_summary.sim_time_s = static_cast<double>(m_ticks) * m_period_s;
-    if (writer) {
-      m_summary.frames_written = writer->count();
-      writer->finish();
-    }
+  std::uint64_t cut_tets() const override { return m_cut_tets.load(std::memory_order_relaxed); }
+
+  // --- around the run ---
+
+  // The live view listens before the run and stops after it; its counters go into the summary.
+  void start_view() {
+    if (!m_view) return;
+    m_view->start();
+    if (m_options.view_started) m_options.view_started(m_view->port());
   }
-
-  void run_realtime() {
-    if (m_view) {
-      m_view->start();
-      if (m_options.view_started) m_options.view_started(m_view->port());
-    }
-    run_realtime_threads();
-    if (m_view) {
-      m_view->stop();
-      const LiveViewCounters c = m_view->counters();
-      m_summary.view = true;
-      m_summary.view_connections = c.server.connections;
-      m_summary.view_frames_sent = c.server.frames_sent;
-      m_summary.view_frames_skipped = c.server.frames_skipped;
-      m_summary.view_messages = c.server.messages;
-      m_summary.view_malformed = c.device.malformed + c.server.binary;
-      m_summary.view_oversized = c.server.oversized;
-      m_summary.view_flood = c.server.flood;
-      m_summary.view_out_of_order = c.device.out_of_order;
-      m_summary.view_withdrawals = c.device.watchdog_trips;
-    }
-  }
-
-  // What the two real-time threads and the main thread share during a run.
-  struct RealtimeRun {
-    std::atomic<int> ready{0};
-    std::atomic<bool> go{false};
-    std::atomic<bool> haptic_done{false};
-    std::atomic<std::uint64_t> ticks_done{0};
-    Nanoseconds start = 0;       // the first deadline (set before `go`)
-    Nanoseconds haptic_end = 0;  // haptic thread's, read after the join
-    Priority haptic_priority, dynamics_priority;
-    std::optional<std::uint64_t> stopped_at;  // haptic thread's, read after the join
-  };
-
-  // The haptic thread: ticks on absolute deadlines of the haptic period, measuring the periods.
-  void haptic_thread(RealtimeRun& run) {
-    if (m_options.realtime_priority) run.haptic_priority = try_fifo_priority(80);
-    run.ready.fetch_add(1);
-    while (!run.go.load(std::memory_order_acquire)) std::this_thread::yield();
-    const Nanoseconds period = to_ns(m_period_s);
-    Nanoseconds previous_wake = 0;
-    if (m_options.haptic_thread_started) m_options.haptic_thread_started();
-    for (std::uint64_t n = 0; n < m_ticks; ++n) {
-      if (m_options.stop != nullptr && m_options.stop->load(std::memory_order_relaxed)) {
-        run.stopped_at = n;  // asked to end early (Ctrl-C): the summary covers the ticks run
-        break;
-      }
-      const Nanoseconds deadline = run.start + static_cast<Nanoseconds>(n) * period;
-      sleep_until_ns(deadline);
-      const Nanoseconds woke = now_ns();
-      if (n == 0) m_summary.haptic_first_tick_late_us = static_cast<double>(woke - deadline) * 1e-3;
-      if (n > 0) {
-        const double period_s = static_cast<double>(woke - previous_wake) * 1e-9;
-        m_periods_s.push_back(period_s);
-        if (period_s > m_longest_period_s) {
-          m_longest_period_s = period_s;
-          m_summary.haptic_period_max_at_s = static_cast<double>(n) * m_period_s;
-        }
-      }
-      previous_wake = woke;
-      haptic_tick(n);
-      if (now_ns() > deadline + period) ++m_summary.deadline_misses;  // the next tick starts late
-      if (m_view) {
-        m_view->record_tick(m_periods_s.empty() ? 0.0 : m_periods_s.back(), m_summary.deadline_misses,
-                            m_rows[n].force_n);
-      }
-      run.ticks_done.store(n + 1, std::memory_order_relaxed);
-    }
-    run.haptic_end = now_ns();
-    run.haptic_done.store(true, std::memory_order_release);
-  }
-
-  // The dynamics thread: a tissue step per slot, the overrun policy when one takes longer.
-  void dynamics_thread(RealtimeRun& run, FramePipe& pipe) {
-    if (m_options.realtime_priority) run.dynamics_priority = try_fifo_priority(70);
-    run.ready.fetch_add(1);
-    while (!run.go.load(std::memory_order_acquire)) std::this_thread::yield();
-    const Nanoseconds slot = to_ns(m_slot_s);
-    const std::uint64_t slots_total = m_ticks / m_ticks_per_slot;
-    std::uint64_t k = 0;  // the slot this step starts in
-    int slots = 1;        // slots this step covers
-    double tissue_time_s = 0.0;
-    TissueSample result = m_relay.make_sample();
-    while (k < slots_total && !run.haptic_done.load(std::memory_order_acquire) && !m_tissue_failed) {
-      sleep_until_ns(run.start + static_cast<Nanoseconds>(k) * slot);
-      slots = static_cast<int>(std::min<std::uint64_t>(static_cast<std::uint64_t>(slots), slots_total - k));
-      tissue_step(tissue_time_s, slots, result);
-      tissue_time_s = result.time_s;
-      m_last_outputs = result;
-      TissueSample& out = m_tissue_sample.write_buffer();
-      out = result;
-      m_tissue_sample.publish();
-      if (m_view) {
-        m_view->publish_tissue(TissueLive{tissue_time_s, m_step_s.empty() ? 0.0 : m_step_s.back(), result.cut_tets});
-        if (m_view->frame_due()) {
-          fill_frame(m_view->frame_buffer(), tissue_time_s);
-          m_view->publish_frame();
-        }
-      }
-      if (frame_due(tissue_time_s)) {
-        if (auto frame = pipe.take_free()) {
-          capture_frame(*frame, tissue_time_s);
-          pipe.push_filled(std::move(frame));
-        } else {
-          ++m_summary.frames_dropped;
-          m_next_frame_s += 1.0 / m_scenario.frame_rate_hz;
-        }
-      }
-      k += static_cast<std::uint64_t>(slots);
-      slots = 1;
-      const Nanoseconds finished = now_ns();
-      const Nanoseconds slot_end = run.start + static_cast<Nanoseconds>(k) * slot;
-      if (finished > slot_end) {
-        // Overrun: the step took longer than its slot(s). Never silent: counted, and handled by
-        // the scenario's policy.
-        ++m_summary.tissue_overruns;
-        const auto missed = static_cast<std::uint64_t>((finished - slot_end) / slot) + 1;
-        if (m_scenario.overrun_policy == OverrunPolicy::catch_up) {
-          // The next step starts now (its slot began already) and covers the slots up to the
-          // one the wall clock is in, at most max_catch_up_slots more than its own; tissue time
-          // stays on wall time, with a longer (still whole-internal-step) communication step.
-          const std::uint64_t cover =
-              std::min<std::uint64_t>(missed, static_cast<std::uint64_t>(m_scenario.max_catch_up_slots) + 1);
-          slots = static_cast<int>(cover);
-          m_summary.catch_up_slots += cover - 1;
-          if (missed > cover) {
-            m_summary.skipped_slots += missed - cover;
-            k += missed - cover;
-          }
-        } else {
-          // The missed slots are skipped: the next step waits for the next slot boundary.
-          m_summary.skipped_slots += missed;
-          k += missed;
-        }
-      }
-    }
-    m_summary.sim_time_s = tissue_time_s;
-  }
-
-  void run_realtime_threads() {
-    FramePipe pipe(8);
-    pipe.prepare([&](SurfaceFrame& frame) { m_tissue.reserve(frame); });
-    RealtimeRun run;
-    std::thread haptic([&] { haptic_thread(run); });
-    std::thread dynamics([&] { dynamics_thread(run, pipe); });
-
-    while (run.ready.load() < 2) std::this_thread::yield();
-    if (m_options.realtime_priority) {
-      // Everything mapped now, the two threads' stacks and the frames included, is locked in
-      // memory: no page fault in the loops. Not future mappings (MCL_FUTURE): then each large
-      // allocation of the dynamics thread populated and locked its pages under the address-space
-      // lock and stalled the haptic thread. May be refused like the priority.
-      (void)mlockall(MCL_CURRENT);
-    }
-    run.start = now_ns() + 20'000'000;  // 20 ms from now: both threads are waiting
-    run.go.store(true, std::memory_order_release);
-
-    std::optional<FrameWriter> writer;
-    if (m_options.write_outputs) writer.emplace(m_options.output_dir);
-    Nanoseconds next_progress = run.start + 1'000'000'000;
-    const auto drain = [&](std::chrono::milliseconds timeout) {
-      while (auto frame = pipe.wait_filled(timeout)) {
-        writer->write(*frame);
-        pipe.give_back(std::move(frame));
-        timeout = std::chrono::milliseconds(0);
-      }
-    };
-    while (!run.haptic_done.load(std::memory_order_acquire)) {
-      drain(std::chrono::milliseconds(50));
-      if (m_options.progress != nullptr && now_ns() >= next_progress) {
-        const double t = static_cast<double>(run.ticks_done.load(std::memory_order_relaxed)) * m_period_s;
-        *m_options.progress << "real time: t = " << t << " / " << m_scenario.duration_s << " s, cut tets "
-                            << m_cut_tets.load(std::memory_order_relaxed) << "\n";
-        next_progress += 1'000'000'000;
-      }
-    }
-    haptic.join();
-    dynamics.join();
-    if (run.stopped_at) {
-      m_ticks = *run.stopped_at;
-      m_rows.resize(m_ticks);
-    }
-    m_summary.wall_time_s = static_cast<double>(run.haptic_end - run.start) * 1e-9;
-    drain(std::chrono::milliseconds(0));
-    if (writer) {
-      m_summary.frames_written = writer->count();
-      writer->finish();
-    }
-    m_summary.haptic_ticks = m_ticks;
-    m_summary.tissue_steps = m_step_s.size();
-    m_summary.realtime_priority = run.haptic_priority.granted && run.dynamics_priority.granted;
-    m_summary.realtime_priority_note =
-        m_options.realtime_priority
-            ? (m_summary.realtime_priority ? "SCHED_FIFO (haptic 80, dynamics 70)" : run.haptic_priority.note)
-            : "not asked for";
+  void stop_view() {
+    if (!m_view) return;
+    m_view->stop();
+    const LiveViewCounters c = m_view->counters();
+    m_summary.view = true;
+    m_summary.view_connections = c.server.connections;
+    m_summary.view_frames_sent = c.server.frames_sent;
+    m_summary.view_frames_skipped = c.server.frames_skipped;
+    m_summary.view_messages = c.server.messages;
+    m_summary.view_malformed = c.device.malformed + c.server.binary;
+    m_summary.view_oversized = c.server.oversized;
+    m_summary.view_flood = c.server.flood;
+    m_summary.view_out_of_order = c.device.out_of_order;
+    m_summary.view_withdrawals = c.device.watchdog_trips;
   }
 
   void finish() {
     const double wall = m_summary.wall_time_s;
-    if (m_options.offline) m_summary.sim_time_s = static_cast<double>(m_ticks) * m_period_s;
     m_summary.realtime_factor = wall > 0.0 ? m_summary.sim_time_s / wall : 0.0;
-    m_summary.haptic_rate_hz = wall > 0.0 && !m_options.offline ? static_cast<double>(m_ticks) / wall : 0.0;
-    m_summary.haptic_period_us = percentiles(m_periods_s, 1e6);
+    m_summary.haptic_rate_hz =
+        wall > 0.0 && !m_options.offline ? static_cast<double>(m_summary.haptic_ticks) / wall : 0.0;
+    m_summary.tissue_steps = m_step_s.size();
     m_summary.tissue_step_ms = percentiles(m_step_s, 1e3);
     std::vector<double> before, during;
     for (std::size_t k = 0; k < m_step_s.size(); ++k) (m_step_cutting[k] ? during : before).push_back(m_step_s[k]);
@@ -507,22 +332,20 @@ class Session {
   HapticLink m_haptic;
   SampleRelay m_relay;  // the tissue sample from m_tissue to m_haptic, and its fields' slots
   SampleSlot m_contact_slot, m_point_slot, m_force_slot, m_blade_depth_slot;
+  TissueSample m_step_sample;   // dynamics thread's: the step's sample, until published
   TissueSample m_last_outputs;  // dynamics thread's: the last step's sample
   std::unique_ptr<Device> m_device;
   std::unique_ptr<LiveView> m_view;          // --view
-  double m_period_s = 0.001, m_slot_s = 0.01;
-  std::uint64_t m_ticks_per_slot = 10, m_ticks = 0;
+  Schedule m_schedule;
   // Exchanged between the threads (dissertation 5.1.3).
   LatestValue<ToolCommand> m_tool_command;
   LatestValue<TissueSample> m_tissue_sample;
   // Haptic thread's own.
   HapticOutputs m_haptic_out;
   std::vector<LogRow> m_rows;
-  std::vector<double> m_periods_s;
   double m_last_tissue_time_s = 0.0;
   bool m_contact = false;
   bool m_haptic_nan = false;
-  double m_longest_period_s = 0.0;
   // Dynamics thread's own.
   std::vector<double> m_step_s;
   std::vector<std::uint8_t> m_step_cutting;

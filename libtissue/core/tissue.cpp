@@ -96,6 +96,7 @@ std::uint64_t model_fingerprint_of(const TetMesh& mesh, const TissueSettings& se
   f.add(interaction.contact_stiffness_model);
   f.add(interaction.contact_stiffness_refresh_steps);
   f.add(interaction.max_tool_speed_m_per_s);
+  if (interaction.probe_radius_m != 0.0) f.add(interaction.probe_radius_m);  // older fingerprints unchanged
   f.add(settings.step_size_s);
   return f.value();
 }
@@ -123,7 +124,7 @@ PointContactSettings contact_settings(const TissueSettings& settings, const Defo
   contact.passed_over_depth_m = 0.5 * mean_surface_edge_m(body, surface);
   // The spring stands for the rigid tool: the step must not damp it (issue 9).
   contact.spring_tangent_fraction =
-      integrator.undamped_spring_fraction(settings.step_size_s, settings.body.damping.stiffness_damping_s);
+      integrator.undamped_tangent_share(settings.step_size_s, settings.body.damping.stiffness_damping_s);
   return contact;
 }
 
@@ -159,6 +160,9 @@ void validate(const InteractionSettings& settings) {
     throw ParameterError("tool speed limit must be finite and > 0 m/s, got " +
                          std::to_string(settings.max_tool_speed_m_per_s));
   }
+  if (!(settings.probe_radius_m >= 0.0) || !std::isfinite(settings.probe_radius_m)) {
+    throw ParameterError("probe radius must be finite and >= 0 m, got " + std::to_string(settings.probe_radius_m));
+  }
   if (settings.contact_stiffness_refresh_steps < 1) {
     throw ParameterError("contact stiffness refresh must be >= 1 step, got " +
                          std::to_string(settings.contact_stiffness_refresh_steps));
@@ -186,6 +190,7 @@ Tissue::Tissue(TetMesh mesh, TissueSettings settings)
       m_model_fingerprint(model_fingerprint_of(m_body.mesh(), m_settings)) {
   m_state.displacement_m.setZero(m_body.dof_count());
   m_state.velocity_m_per_s.setZero(m_body.dof_count());
+  m_body.attach(m_contact_spring);
   if (m_settings.interaction.cutting_enabled) {
     m_cutter.emplace(m_body.mesh(), m_adjacency, m_surface, m_settings.interaction.cutter);
   }
@@ -199,7 +204,7 @@ const VolumeCutter& Tissue::cutter() const {
 void validate(const ToolPose& pose) {
   if (!pose.tip_position_m.allFinite()) throw ParameterError("tool position must be finite");
   const double norm = pose.orientation.coeffs().norm();
-  if (!std::isfinite(norm) || !(norm > 1e-12)) {
+  if (!std::isfinite(norm) || !(norm > MIN_ORIENTATION_NORM)) {
     throw ParameterError("tool orientation must be a finite, non-zero quaternion");
   }
 }
@@ -208,6 +213,30 @@ void Tissue::set_tool(const ToolPose& pose) {
   validate(pose);
   m_tool = pose;
   m_tool.orientation.normalize();
+  if (!m_stepped) m_applied_tool_position_m = m_tool.tip_position_m;  // nothing held it back yet
+}
+
+ToolPose Tissue::touching_pose() const {
+  ToolPose touching = m_tool;
+  const double radius_m = m_settings.interaction.probe_radius_m;
+  if (touching.mode == ToolMode::probe && radius_m > 0.0) {
+    touching.tip_position_m -= radius_m * tool_axis(touching.orientation);
+  }
+  return touching;
+}
+
+double Tissue::blade_depth_m() const {
+  if (m_tool.mode != ToolMode::scalpel || !m_cutter || !m_cutter->cutting()) return 0.0;
+  // The edge runs from the tip along the tool axis; from the handle end (outside while a cut
+  // starts), the first crossing of the mesh's own surface is where the blade enters the tissue.
+  const double length_m = m_settings.interaction.blade_length_m;
+  const Eigen::Vector3d handle_m = m_tool.tip_position_m + length_m * tool_axis(m_tool.orientation);
+  fitted_bvh().intersect_segment(handle_m, m_tool.tip_position_m, m_positions_m, m_blade_hits);
+  const auto mesh_triangles = static_cast<int>(m_surface.triangles.size());
+  for (const SurfaceBvh::SegmentHit& hit : m_blade_hits) {
+    if (hit.triangle < mesh_triangles) return (1.0 - hit.segment_parameter) * length_m;
+  }
+  return length_m;  // no crossing while cutting: the whole edge is inside
 }
 
 Blade Tissue::blade(const ToolPose& pose) const {
@@ -296,9 +325,10 @@ void Tissue::save(TissueSnapshot& snapshot) const {
   snapshot.integrator_state = m_integrator->internal_state();
   if (m_cutter) m_cutter->save(snapshot.cutter);
   snapshot.contact = m_contact.state();
-  snapshot.point_spring = m_body.point_spring();
+  snapshot.point_spring = m_contact_spring.spring();
   snapshot.tool = m_tool;
   snapshot.previous_tool = m_previous_tool;
+  snapshot.applied_tool_position_m = m_applied_tool_position_m;
   snapshot.contact_output = m_contact_output;
   snapshot.steps_since_stiffness = m_steps_since_stiffness;
 }
@@ -357,6 +387,7 @@ void Tissue::restore(const TissueSnapshot& snapshot) {
       !std::isfinite(dynamics.time_s)) {
     throw StateError("the state holds a non-finite displacement, velocity or time");
   }
+  if (!snapshot.applied_tool_position_m.allFinite()) throw StateError("the state's applied tool position is not finite");
   const DeformableBody::Rotations& rotations = snapshot.rotations;
   const size_t tets = static_cast<size_t>(m_body.mesh().tet_count());
   if (rotations.tets.size() != tets || rotations.tet_warm_starts.size() != tets ||
@@ -368,12 +399,12 @@ void Tissue::restore(const TissueSnapshot& snapshot) {
   if (contact.in_contact && (contact.proxy.triangle < 0 || contact.proxy.triangle >= m_bvh.triangle_count())) {
     throw StateError("the state's contact is on a triangle the surface does not have");
   }
-  const std::optional<PointSpring> old_spring = m_body.point_spring();
+  const std::optional<PointSpring> old_spring = m_contact_spring.spring();
   try {
-    m_body.set_point_spring(snapshot.point_spring);
+    m_contact_spring.set(snapshot.point_spring, m_body.term_layout());
     if (m_cutter) m_cutter->restore(snapshot.cutter);
   } catch (const std::invalid_argument& error) {
-    m_body.set_point_spring(old_spring);
+    m_contact_spring.set(old_spring, m_body.term_layout());
     throw StateError(std::string("the state is inconsistent: ") + error.what());
   }
   m_body.restore_rotations(rotations);
@@ -383,6 +414,8 @@ void Tissue::restore(const TissueSnapshot& snapshot) {
   m_contact.restore(contact);
   m_tool = snapshot.tool;
   m_previous_tool = snapshot.previous_tool;
+  m_applied_tool_position_m = snapshot.applied_tool_position_m;
+  m_stepped = true;  // the snapshot's applied position stands until the next step
   m_contact_output = snapshot.contact_output;
   m_steps_since_stiffness = snapshot.steps_since_stiffness;
   update_positions();
@@ -397,7 +430,7 @@ void Tissue::interact_with_probe(const ToolPose& previous, const ToolPose& curre
   if (m_contact.in_contact() && m_contact.proxy().triangle >= static_cast<int>(m_surface.triangles.size())) {
     m_contact.release();
   }
-  m_contact.apply(m_bvh, m_body);
+  m_contact.apply(m_bvh, m_contact_spring, m_body.term_layout());
   if (m_contact.in_contact() && !was_in_contact) m_steps_since_stiffness = -1;  // a new contact: refresh K_c
   if (m_contact.in_contact() != was_in_contact) m_integrator->restart(Restart::contact_changed);
 }
@@ -438,30 +471,11 @@ void Tissue::update_contact_output() {
 Eigen::Matrix3d Tissue::effective_contact_stiffness(int triangle) {
   const std::array<int, 3>& vertices = m_bvh.triangle(triangle);
   const ContactInterpolation point = contact_interpolation(m_body.dofs(), vertices, m_contact.proxy().barycentric);
-  const std::optional<PointSpring>& spring = m_body.point_spring();
-  // K_c of a factorized matrix; the tangent of this step holds the contact spring: take it out
-  // exactly (Sherman-Morrison). Nothing when the factor fails or K_c is not finite or its smallest
-  // eigenvalue is not above `floor_n_per_m`.
-  const auto condensed = [&](const ShiftedSystem& system, double floor_n_per_m) -> std::optional<Eigen::Matrix3d> {
-    try {
-      m_effective_stiffness.factorize(system);
-      std::optional<Eigen::Matrix3d> stiffness;
-      if (spring) {
-        // What the factorized matrix holds of the spring: its share of the tangent, times the scale.
-        const double in_matrix = system.stiffness_scale * spring->tangent_fraction * spring->stiffness_n_per_m;
-        stiffness = m_effective_stiffness.stiffness_n_per_m(
-            point, contact_interpolation(m_body.dofs(), spring->vertices, spring->weights), in_matrix);
-      } else {
-        stiffness = m_effective_stiffness.stiffness_n_per_m(point);
-      }
-      // A point on fixed vertices only is a rigid support: report the spring alone.
-      if (!stiffness) return Eigen::Matrix3d::Identity() * contact_spring_stiffness_n_per_m();
-      const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eigen(*stiffness, Eigen::EigenvaluesOnly);
-      if (!stiffness->allFinite() || !(eigen.eigenvalues().minCoeff() > floor_n_per_m)) return std::nullopt;
-      return stiffness;
-    } catch (const SolverError&) {
-      return std::nullopt;
-    }
+  // K_c of a factorized matrix, the contact spring taken out (contact_stiffness.hpp); a point on
+  // fixed vertices only is a rigid support: the spring alone.
+  const auto condensed = [&](const ShiftedSystem& system, double floor_n_per_m) {
+    return condensed_contact_stiffness(m_effective_stiffness, system, m_body.dofs(), point, m_contact_spring.spring(),
+                                       contact_spring_stiffness_n_per_m(), floor_n_per_m);
   };
   // DESIGN section 4: the static K where the body is held; the step's Newton matrix, asked of the
   // integrator, where nothing holds it, or where the static K fails because a cut set the
@@ -493,7 +507,8 @@ TissueStepReport Tissue::step() {
   const InteractionSettings& interaction = m_settings.interaction;
   // DESIGN section 7: a pose farther than a hand can move in one step is approached at the hand's
   // top speed; the tool catches up with it over the next steps.
-  const ToolPose current = reachable_pose(previous, m_tool, interaction.blade_length_m,
+  const ToolPose target = touching_pose();
+  const ToolPose current = reachable_pose(previous, target, interaction.blade_length_m,
                                           interaction.max_tool_speed_m_per_s * m_settings.step_size_s);
 
   // Collide and cut (DESIGN section 3): the blade's sweep since the last step.
@@ -508,15 +523,29 @@ TissueStepReport Tissue::step() {
   const bool probe = current.mode == ToolMode::probe && interaction.contact_enabled;
   if (probe) {
     interact_with_probe(previous.mode == ToolMode::probe ? previous : current, current);
-  } else if (m_contact.in_contact() || m_body.point_spring()) {
+  } else if (m_contact.in_contact() || m_contact_spring.spring()) {
     m_contact.release();
-    m_body.set_point_spring(std::nullopt);
+    m_contact_spring.set(std::nullopt, m_body.term_layout());
     m_integrator->restart(Restart::contact_changed);
   }
   report.contact_s = seconds_since(contact_start);
 
   report.dynamics = m_integrator->step(m_body, m_state, m_settings.step_size_s);
   m_previous_tool = current;
+  m_stepped = true;
+  // Only a tool that keeps its mode and does something is ever held back (reachable_pose); then the
+  // applied pose differs from the target, else the position is the one set, bitwise.
+  const bool held_back = target.mode != ToolMode::none && current.mode == target.mode &&
+                         (current.tip_position_m != target.tip_position_m ||
+                          current.orientation.coeffs() != target.orientation.coeffs());
+  m_applied_tool_position_m = m_tool.tip_position_m;
+  if (held_back) {
+    m_applied_tool_position_m = current.tip_position_m;
+    const double radius_m = interaction.probe_radius_m;
+    if (current.mode == ToolMode::probe && radius_m > 0.0) {
+      m_applied_tool_position_m += radius_m * tool_axis(current.orientation);
+    }
+  }
 
   const auto positions_start = std::chrono::steady_clock::now();
   update_positions();
@@ -528,6 +557,17 @@ TissueStepReport Tissue::step() {
   report.contact_s += seconds_since(output_start);
   report.total_s = seconds_since(start);
   return report;
+}
+
+void restore_or_replay(std::unique_ptr<Tissue>& tissue, const TissueSnapshot& snapshot) {
+  if (tissue->can_restore(snapshot)) {
+    tissue->restore(snapshot);
+    return;
+  }
+  // Cuts cannot be undone in place: a fresh Tissue replays the snapshot's.
+  auto fresh = std::make_unique<Tissue>(tissue->body().mesh(), tissue->settings());
+  fresh->restore(snapshot);
+  tissue = std::move(fresh);
 }
 
 }  // namespace tissue

@@ -8,6 +8,7 @@
 #include "core/collide/surface_bvh.hpp"
 #include "core/contact/contact_stiffness.hpp"
 #include "core/contact/point_contact.hpp"
+#include "core/contact/point_spring.hpp"
 #include "core/cut/cut_surface.hpp"
 #include "core/cut/volume_cutter.hpp"
 #include "core/fem/deformable_body.hpp"
@@ -34,6 +35,8 @@ ToolMode parse_tool_mode(std::string_view name);
 
 /// The tool as the host drives it. The tool axis is the local +z axis, from the tip toward the
 /// handle; the scalpel's cutting edge is the segment from the tip along that axis.
+/// A ball-ended probe (InteractionSettings::probe_radius_m > 0) is posed by its ball's centre and
+/// touches the tissue with the ball's pole along the axis, toward the tip (Tissue::touching_pose).
 struct ToolPose {
   Eigen::Vector3d tip_position_m = Eigen::Vector3d::Zero();
   Eigen::Quaterniond orientation = Eigen::Quaterniond::Identity();
@@ -71,6 +74,9 @@ struct InteractionSettings {
   /// The fastest a hand moves the tool (tip or blade end) [m/s]: a pose farther than this times the
   /// step from the last pose the tissue applied is approached at this speed (DESIGN section 7).
   double max_tool_speed_m_per_s = 5.0;
+  /// Radius of a ball-ended probe [m], >= 0: the probe's pose is its ball's centre, and it touches
+  /// with the ball's pole (0: a point tip, the pose is the touching point).
+  double probe_radius_m = 0.0;
 };
 
 /// Throws ParameterError for an invalid setting.
@@ -132,6 +138,7 @@ struct TissueSnapshot {
   std::optional<PointSpring> point_spring;
   ToolPose tool;
   ToolPose previous_tool;
+  Eigen::Vector3d applied_tool_position_m = Eigen::Vector3d::Zero();
   ContactOutput contact_output;
   int steps_since_stiffness = 0;
 };
@@ -144,13 +151,23 @@ class Tissue {
   Tissue(const Tissue&) = delete;
   Tissue& operator=(const Tissue&) = delete;
 
-  /// The tool pose for the next step. Throws ParameterError (pose kept) for a non-finite position
-  /// or a non-finite or zero quaternion (it is normalized).
+  /// The tool pose for the next step, as the hand gives it (a ball probe by its centre): the one
+  /// check of a pose (validate) and its one normalization. Throws ParameterError (pose kept) for a
+  /// non-finite position or a non-finite or zero quaternion.
   void set_tool(const ToolPose& pose);
+  /// The pose as set (normalized).
   [[nodiscard]] const ToolPose& tool() const { return m_tool; }
-  /// The pose the last step applied: tool() or, after an impossible jump, the pose on the way to it
-  /// that the hand's top speed reaches (InteractionSettings::max_tool_speed_m_per_s).
+  /// The pose that touches the tissue: tool(), with a ball probe's pole for its centre.
+  [[nodiscard]] ToolPose touching_pose() const;
+  /// The touching pose the last step applied: touching_pose() or, after an impossible jump, the pose
+  /// on the way to it that the hand's top speed reaches (InteractionSettings::max_tool_speed_m_per_s).
   [[nodiscard]] const ToolPose& applied_tool() const { return m_previous_tool; }
+  /// The tool position the last step applied, in set_tool's terms (a ball probe's centre): the
+  /// position set, bitwise, unless the hand's top speed held the tool back.
+  [[nodiscard]] const Eigen::Vector3d& applied_tool_position_m() const { return m_applied_tool_position_m; }
+  /// Length of the blade inside the tissue while the scalpel cuts [m] (0 otherwise): from the
+  /// handle end of the edge, the first crossing of the mesh's own surface is where it enters.
+  [[nodiscard]] double blade_depth_m() const;
 
   /// One step of step_size_s: tool interaction (cut or contact), backward Euler, BVH refit,
   /// contact outputs. Throws IntegrationError (state unchanged) when the dynamics step fails.
@@ -169,6 +186,15 @@ class Tissue {
   [[nodiscard]] const Eigen::VectorXd& current_positions_m() const { return m_positions_m; }
   /// The faces the cuts opened; they are in the surface BVH after the mesh's surface triangles.
   [[nodiscard]] const CutSurface& cut_surface() const { return m_cut_surface; }
+  /// The surface to draw, with corners indexing current_positions_m(): the mesh's surface without
+  /// the triangles of cut tets, their pieces either side of the cut (the skin), then the cut faces.
+  template <class Visit>
+  void for_each_drawn_triangle(Visit&& visit) const;
+  /// How many triangles for_each_drawn_triangle() visits.
+  [[nodiscard]] std::size_t drawn_triangle_count() const {
+    return m_surface.triangles.size() - m_cut_surface.replaced_triangles().size() +
+           m_cut_surface.skin_triangles().size() + m_cut_surface.triangles().size();
+  }
 
   [[nodiscard]] const SurfaceMesh& surface() const { return m_surface; }
   /// Over the surface and the cut faces; empty (no tree) when neither contact nor cutting is on.
@@ -178,6 +204,8 @@ class Tissue {
   [[nodiscard]] const VolumeCutter& cutter() const;
   [[nodiscard]] bool has_cutter() const { return m_cutter.has_value(); }
   [[nodiscard]] const PointContact& point_contact() const { return m_contact; }
+  /// The contact's spring, a force term of the body while the probe touches.
+  [[nodiscard]] const PointSpringTerm& contact_spring() const { return m_contact_spring; }
   [[nodiscard]] const ContactOutput& contact() const { return m_contact_output; }
   /// A hash of the mesh and every setting: a snapshot restores only into a Tissue of the same value.
   [[nodiscard]] std::uint64_t model_fingerprint() const { return m_model_fingerprint; }
@@ -218,6 +246,7 @@ class Tissue {
   [[nodiscard]] Blade blade(const ToolPose& pose) const;
 
   TissueSettings m_settings;
+  PointSpringTerm m_contact_spring;  // attached to m_body for its lifetime
   DeformableBody m_body;
   std::unique_ptr<Integrator> m_integrator;
   DynamicState m_state;
@@ -247,9 +276,32 @@ class Tissue {
   ContactOutput m_contact_output;
   ToolPose m_tool;
   ToolPose m_previous_tool;
+  Eigen::Vector3d m_applied_tool_position_m = Eigen::Vector3d::Zero();
+  bool m_stepped = false;  // a step (or a restore) has set m_applied_tool_position_m
+  mutable std::vector<SurfaceBvh::SegmentHit> m_blade_hits;  // scratch of blade_depth_m()
   std::uint64_t m_model_fingerprint = 0;
   std::vector<TetCut> m_cut_history;
   std::vector<int> m_cut_batch_ends;
 };
+
+/// Restores `snapshot` into `tissue`: in place when it can (Tissue::can_restore), else into a fresh
+/// Tissue of the same mesh and settings that replays the snapshot's cuts (cuts are not undone in
+/// place), which replaces `tissue` once it holds the snapshot. Throws StateError, `tissue` unchanged.
+void restore_or_replay(std::unique_ptr<Tissue>& tissue, const TissueSnapshot& snapshot);
+
+template <class Visit>
+void Tissue::for_each_drawn_triangle(Visit&& visit) const {
+  const std::vector<int>& replaced = m_cut_surface.replaced_triangles();  // ascending
+  auto next_replaced = replaced.begin();
+  for (std::size_t t = 0; t < m_surface.triangles.size(); ++t) {
+    if (next_replaced != replaced.end() && *next_replaced == static_cast<int>(t)) {
+      ++next_replaced;
+      continue;
+    }
+    visit(m_surface.triangles[t]);
+  }
+  for (const auto& triangle : m_cut_surface.skin_triangles()) visit(triangle);
+  for (const auto& triangle : m_cut_surface.triangles()) visit(triangle);
+}
 
 }  // namespace tissue

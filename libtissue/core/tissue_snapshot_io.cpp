@@ -10,7 +10,8 @@ namespace tissue {
 namespace {
 
 constexpr std::uint64_t MAGIC = 0x31305353'49535354ULL;  // "TSSISS01" read as little-endian bytes
-constexpr std::uint32_t VERSION = 3;  // 2: PointSpring::tangent_fraction; 3: the cuts' enrichment offsets
+// 2: PointSpring::tangent_fraction; 3: the cuts' enrichment offsets; 4: the applied tool position
+constexpr std::uint32_t VERSION = 4;
 
 // The core's Eigen types and cut records on top of the shared byte stream.
 class Writer : public serial::ByteWriter {
@@ -148,6 +149,7 @@ std::vector<std::uint8_t> serialize_snapshot(const TissueSnapshot& s) {
   }
   put_tool(w, s.tool);
   put_tool(w, s.previous_tool);
+  w.put(s.applied_tool_position_m);
   const ContactOutput& o = s.contact_output;
   w.put(static_cast<std::uint8_t>(o.active));
   w.put(o.point_m);
@@ -207,6 +209,7 @@ TissueSnapshot read_snapshot(std::span<const std::uint8_t> bytes) {
   }
   s.tool = get_tool(r);
   s.previous_tool = get_tool(r);
+  r.get(s.applied_tool_position_m);
   ContactOutput& o = s.contact_output;
   o.active = r.get_bool();
   r.get(o.point_m);

@@ -42,6 +42,10 @@ constexpr std::optional<ToolMode> tool_mode_of(std::int64_t value) {
   return std::nullopt;
 }
 
+/// The smallest norm an orientation quaternion (w, x, y, z) may have before it is normalized: the
+/// core's pose check and the FMUs' orientation inputs (min_norm) refuse one at or below it.
+inline constexpr double MIN_ORIENTATION_NORM = 1e-12;
+
 /// The tool axis in world coordinates: the image of the tool's local +z axis (from the tip toward
 /// the handle; the scalpel's edge runs along it) under the unit quaternion (w, x, y, z). The same
 /// arithmetic as Eigen's q * Vector3d::UnitZ(), term by term, so both give the same bits.

@@ -356,7 +356,7 @@ bool Run::step() {
     return false;
   }
   // The contact spring's work on the body in this step (file comment of the header).
-  if (const std::optional<PointSpring>& spring = tissue.body().point_spring()) {
+  if (const std::optional<PointSpring>& spring = tissue.contact_spring().spring()) {
     const Eigen::VectorXd& after = tissue.current_positions_m();
     Eigen::Vector3d x0 = Eigen::Vector3d::Zero(), x1 = Eigen::Vector3d::Zero();
     for (int i = 0; i < 3; ++i) {

@@ -28,3 +28,8 @@ add_executable(test_port_schema ${CMAKE_CURRENT_LIST_DIR}/test_port_schema.cpp)
 target_link_libraries(test_port_schema PRIVATE tissue::tissue_fmu_variables tissue::haptic_loop_variables
                                                tissue::host_links GTest::gtest GTest::gtest_main tissue::warnings)
 gtest_discover_tests(test_port_schema PROPERTIES LABELS "fmu" DISCOVERY_TIMEOUT 60)
+
+# test_fmi3_checks: where the layer checks a set value (a counting model stands in for the FMUs').
+add_executable(test_fmi3_checks ${CMAKE_CURRENT_LIST_DIR}/test_fmi3_checks.cpp)
+target_link_libraries(test_fmi3_checks PRIVATE tissue::fmi3 GTest::gtest GTest::gtest_main tissue::warnings)
+gtest_discover_tests(test_fmi3_checks PROPERTIES LABELS "fmu" DISCOVERY_TIMEOUT 60)

@@ -5,6 +5,7 @@
 #include "core/fem/tet_element.hpp"
 
 #include <Eigen/Dense>
+#include <Eigen/Eigenvalues>
 
 #include <algorithm>
 #include <cmath>
@@ -184,6 +185,31 @@ double mean_surface_edge_m(const DeformableBody& body, const SurfaceMesh& surfac
 double contact_stiffness_scale_n_per_m(const DeformableBody& body, const SurfaceMesh& surface) {
   const LameParameters& lame = body.elasticity().lame();
   return (lame.lambda_pa + 2.0 * lame.mu_pa) * mean_surface_edge_m(body, surface);
+}
+
+std::optional<Eigen::Matrix3d> condensed_contact_stiffness(EffectiveContactStiffness& effective,
+                                                          const ShiftedSystem& system, const DofMap& dofs,
+                                                          const ContactInterpolation& point,
+                                                          const std::optional<PointSpring>& spring,
+                                                          double rigid_support_n_per_m, double floor_n_per_m) {
+  try {
+    effective.factorize(system);
+    std::optional<Eigen::Matrix3d> stiffness;
+    if (spring) {
+      // What the factorized matrix holds of the spring: its share of the tangent, times the scale.
+      const double in_matrix = system.stiffness_scale * spring->tangent_fraction * spring->stiffness_n_per_m;
+      stiffness =
+          effective.stiffness_n_per_m(point, contact_interpolation(dofs, spring->vertices, spring->weights), in_matrix);
+    } else {
+      stiffness = effective.stiffness_n_per_m(point);
+    }
+    if (!stiffness) return Eigen::Matrix3d::Identity() * rigid_support_n_per_m;
+    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eigen(*stiffness, Eigen::EigenvaluesOnly);
+    if (!stiffness->allFinite() || !(eigen.eigenvalues().minCoeff() > floor_n_per_m)) return std::nullopt;
+    return stiffness;
+  } catch (const SolverError&) {
+    return std::nullopt;
+  }
 }
 
 }  // namespace tissue

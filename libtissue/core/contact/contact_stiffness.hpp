@@ -20,6 +20,7 @@
 #pragma once
 
 #include "core/fem/corotational.hpp"
+#include "core/contact/point_spring.hpp"
 #include "core/fem/deformable_body.hpp"
 #include "core/mesh/topology.hpp"
 #include "core/solve/linear_solver.hpp"
@@ -98,6 +99,16 @@ class EffectiveContactStiffness {
   ResponseMatrix m_response;
   ResponseMatrix m_spring_response;
 };
+
+/// K_c of the tissue alone at `point` from `system`, factorized into `effective`: the contact spring,
+/// if set, is in the matrix as its tangent share times the system's scale and is taken out exactly.
+/// A point on fixed vertices only is a rigid support: `rigid_support_n_per_m` I. Nothing when the
+/// factor fails, or when K_c is not finite or its smallest eigenvalue is not above `floor_n_per_m`.
+std::optional<Eigen::Matrix3d> condensed_contact_stiffness(EffectiveContactStiffness& effective,
+                                                          const ShiftedSystem& system, const DofMap& dofs,
+                                                          const ContactInterpolation& point,
+                                                          const std::optional<PointSpring>& spring,
+                                                          double rigid_support_n_per_m, double floor_n_per_m);
 
 /// The element-local model (header): R K_oo R^T of tet `tet` with `opposite_local_vertex` (0..3) the
 /// vertex not on the contacted face, at the rotation of the last evaluate(). [N/m], SPD.

@@ -109,8 +109,8 @@ std::optional<PointSpring> PointContact::spring(const SurfaceBvh& surface) const
                      m_settings.spring_stiffness_n_per_m, m_settings.spring_tangent_fraction};
 }
 
-void PointContact::apply(const SurfaceBvh& surface, DeformableBody& body) const {
-  body.set_point_spring(spring(surface));
+void PointContact::apply(const SurfaceBvh& surface, PointSpringTerm& term, const TermLayout& layout) const {
+  term.set(spring(surface), layout);
 }
 
 Eigen::Vector3d PointContact::force_on_tool_n(const SurfaceBvh& surface, const Eigen::VectorXd& positions_m) const {

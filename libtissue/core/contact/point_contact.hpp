@@ -23,7 +23,7 @@
 // (K_n the contact's normal stiffness; tests/physics/test_contact_press.cpp). The force on the
 // tool is the spring's at the end of the step, k (x_p - HIP), the reaction of the body.
 //
-// The spring is isotropic (DeformableBody::PointSpring), so within a step it also holds the
+// The spring is isotropic (PointSpring), so within a step it also holds the
 // material point tangentially; the re-projection then releases only the tangential stretch
 // |f_t| / k per step, and a tangential load relaxes by a factor (1 - k_t / k) per step (k_t the
 // tangential contact stiffness): with k = 100 k_t, ~100 steps per e-fold, felt as a viscous
@@ -33,6 +33,7 @@
 #pragma once
 
 #include "core/collide/surface_bvh.hpp"
+#include "core/contact/point_spring.hpp"
 #include "core/contact/surface_point.hpp"
 #include "core/fem/deformable_body.hpp"
 
@@ -95,7 +96,7 @@ class PointContact {
   [[nodiscard]] double penetration_depth_m() const { return m_in_contact ? m_depth_m : 0.0; }
   [[nodiscard]] const PointContactSettings& settings() const { return m_settings; }
 
-  /// The spring from the proxy's material point to the HIP, for DeformableBody::set_point_spring;
+  /// The spring from the proxy's material point to the HIP, for the body's PointSpringTerm;
   /// nothing when not in contact.
   [[nodiscard]] std::optional<PointSpring> spring(const SurfaceBvh& surface) const;
 
@@ -119,8 +120,8 @@ class PointContact {
     m_hip_m = state.hip_m;
     m_depth_m = state.depth_m;
   }
-  /// body.set_point_spring(spring(surface)).
-  void apply(const SurfaceBvh& surface, DeformableBody& body) const;
+  /// term.set(spring(surface), layout): `term` attached to the body whose term_layout() is `layout`.
+  void apply(const SurfaceBvh& surface, PointSpringTerm& term, const TermLayout& layout) const;
   /// The force on the tool k (x_p - HIP) with the proxy's material point at `positions_m` (e.g.
   /// after the step), i.e. minus the spring's force on the body; zero when not in contact. [N]
   [[nodiscard]] Eigen::Vector3d force_on_tool_n(const SurfaceBvh& surface, const Eigen::VectorXd& positions_m) const;

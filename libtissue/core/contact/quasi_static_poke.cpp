@@ -99,19 +99,22 @@ Eigen::Matrix<double, 3, 2> tangent_basis(const Eigen::Vector3d& n) {
   return basis;
 }
 
-// Clears the body's point spring for the lifetime of the guard, then puts it back.
-class PointSpringCleared {
+// Detaches the body's force terms (the contact spring) for the lifetime of the guard, then
+// attaches them again.
+class ForceTermsDetached {
  public:
-  explicit PointSpringCleared(DeformableBody& body) : m_body(body), m_saved(body.point_spring()) {
-    m_body.set_point_spring(std::nullopt);
+  explicit ForceTermsDetached(DeformableBody& body) : m_body(body), m_saved(body.force_terms()) {
+    for (ForceTerm* term : m_saved) m_body.detach(*term);
   }
-  ~PointSpringCleared() { m_body.set_point_spring(m_saved); }
-  PointSpringCleared(const PointSpringCleared&) = delete;
-  PointSpringCleared& operator=(const PointSpringCleared&) = delete;
+  ~ForceTermsDetached() {
+    for (ForceTerm* term : m_saved) m_body.attach(*term);
+  }
+  ForceTermsDetached(const ForceTermsDetached&) = delete;
+  ForceTermsDetached& operator=(const ForceTermsDetached&) = delete;
 
  private:
   DeformableBody& m_body;
-  std::optional<PointSpring> m_saved;
+  std::vector<ForceTerm*> m_saved;
 };
 
 }  // namespace
@@ -133,7 +136,7 @@ QuasiStaticPoke quasi_static_poke(DeformableBody& body, const SurfaceTriangles& 
                                 std::to_string(initial_displacement_m.size()) + " values, the body has " +
                                 std::to_string(n) + " unknowns");
   }
-  const PointSpringCleared spring_cleared(body);
+  const ForceTermsDetached terms_detached(body);
 
   VertexTriangles adjacency;
   adjacency.build(triangles, body.mesh().vertex_count());

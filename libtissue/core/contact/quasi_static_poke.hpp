@@ -59,8 +59,8 @@ struct QuasiStaticPoke {
 
 /// Pushes the material point `start` (a triangle of `triangles`, the body's outward surface) to
 /// `target_m` and solves for static equilibrium from `initial_displacement_m` (zero if empty).
-/// Uses body.evaluate(), so it changes the body's rotation warm starts; the body's point spring is
-/// cleared for the solve and restored. Throws std::invalid_argument for a body with nothing fixed
+/// Uses body.evaluate(), so it changes the body's rotation warm starts; the body's force terms (the
+/// contact spring) are detached for the solve and attached again. Throws std::invalid_argument for a body with nothing fixed
 /// (no static equilibrium), a non-finite target or a start off the surface; returns converged =
 /// false when Newton or the slide runs out of iterations (or the tangent stops being positive definite).
 QuasiStaticPoke quasi_static_poke(DeformableBody& body, const SurfaceTriangles& triangles, const SurfacePoint& start,

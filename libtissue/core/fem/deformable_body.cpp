@@ -248,7 +248,10 @@ void DeformableBody::evaluate(const Eigen::VectorXd& displacement_m, Eigen::Vect
   internal_force_n.tail(3 * enriched_dof_count()).setZero();
   m_xfem.evaluate(m_positions_m, displacement_m, m_vertex_forces_n, internal_force_n, tangent);
 
-  add_point_spring(tangent);
+  for (ForceTerm* term : m_force_terms) {
+    term->add_force(m_positions_m, m_vertex_forces_n);
+    if (tangent != nullptr) term->add_tangent(*tangent);
+  }
 
   for (int row = 0; row < u_rows; ++row) {
     internal_force_n.segment<3>(3 * row) =
@@ -264,14 +267,7 @@ double DeformableBody::elastic_energy_j(const Eigen::VectorXd& displacement_m) {
 
 double DeformableBody::potential_energy_j(const Eigen::VectorXd& displacement_m) {
   double energy = elastic_energy_j(displacement_m) - m_external_force_n.dot(displacement_m);  // positions set
-  if (m_point_spring) {
-    Eigen::Vector3d point_m = Eigen::Vector3d::Zero();
-    for (size_t i = 0; i < 3; ++i) {
-      point_m += m_point_spring->weights[static_cast<Eigen::Index>(i)] *
-                 m_positions_m.segment<3>(3 * m_point_spring->vertices[i]);
-    }
-    energy += 0.5 * m_point_spring->stiffness_n_per_m * (point_m - m_point_spring->target_m).squaredNorm();
-  }
+  for (const ForceTerm* term : m_force_terms) energy += term->energy_j(m_positions_m);
   return energy;
 }
 
@@ -489,22 +485,10 @@ void DeformableBody::refresh_cut_tet_slots(int cut_tet_index) {
   }
 }
 
-void DeformableBody::refresh_point_spring_slots() {
-  m_point_spring_slots.fill(-1);
-  if (!m_point_spring) return;
-  for (size_t i = 0; i < 3; ++i) {
-    for (size_t j = 0; j < 3; ++j) {
-      const int row = vertex_block_row(m_point_spring->vertices[i]);
-      const int col = vertex_block_row(m_point_spring->vertices[j]);
-      if (row >= 0 && col >= 0) m_point_spring_slots[3 * i + j] = m_tangent.find_slot(row, col);
-    }
-  }
-}
-
 void DeformableBody::refresh_all_slots() {
   m_slots = make_tet_slots(m_mesh, m_dofs, m_tangent);
   for (int k = 0; k < m_xfem.cut_tet_count(); ++k) refresh_cut_tet_slots(k);
-  refresh_point_spring_slots();
+  for (ForceTerm* term : m_force_terms) term->locate(term_layout());
 }
 
 void DeformableBody::grow_state(DynamicState& state) const {
@@ -541,70 +525,15 @@ double DeformableBody::part_mass_kg(int cut_tet_index, CutPart part) const {
          m_xfem.rest(cut_tet_index).volume_m3;
 }
 
-// --- Point spring ---
+// --- Force terms ---
 
-void DeformableBody::add_point_spring(BlockSparseMatrix* tangent) {
-  m_point_spring_force_n.setZero();
-  if (!m_point_spring) return;
-  const PointSpring& spring = *m_point_spring;
-  Eigen::Vector3d point_m = Eigen::Vector3d::Zero();
-  for (size_t i = 0; i < 3; ++i) {
-    point_m += spring.weights[static_cast<Eigen::Index>(i)] * m_positions_m.segment<3>(3 * spring.vertices[i]);
+void DeformableBody::attach(ForceTerm& term) {
+  if (std::find(m_force_terms.begin(), m_force_terms.end(), &term) == m_force_terms.end()) {
+    m_force_terms.push_back(&term);
   }
-  // f_int gains k (x_p - target) w_i on vertex i; the body feels the opposite, k (target - x_p).
-  const Eigen::Vector3d stretch_force_n = spring.stiffness_n_per_m * (point_m - spring.target_m);
-  m_point_spring_force_n = -stretch_force_n;
-  for (size_t i = 0; i < 3; ++i) {
-    m_vertex_forces_n.segment<3>(3 * spring.vertices[i]) +=
-        spring.weights[static_cast<Eigen::Index>(i)] * stretch_force_n;
-  }
-  if (tangent == nullptr) return;
-  for (size_t i = 0; i < 3; ++i) {
-    for (size_t j = 0; j < 3; ++j) {
-      const int slot = m_point_spring_slots[3 * i + j];
-      if (slot < 0) continue;  // a fixed vertex
-      tangent->block(slot).diagonal().array() += spring.tangent_fraction * spring.stiffness_n_per_m *
-                                                 spring.weights[static_cast<Eigen::Index>(i)] *
-                                                 spring.weights[static_cast<Eigen::Index>(j)];
-    }
-  }
+  term.locate(term_layout());
 }
 
-void DeformableBody::set_point_spring(std::optional<PointSpring> spring) {
-  if (spring) {
-    const PointSpring& s = *spring;
-    for (const int v : s.vertices) {
-      if (v < 0 || v >= m_mesh.vertex_count()) {
-        throw ParameterError("point spring: vertex " + std::to_string(v) + " outside [0, " +
-                             std::to_string(m_mesh.vertex_count()) + ")");
-      }
-    }
-    if (!s.weights.allFinite() || std::abs(s.weights.sum() - 1.0) > 1e-6) {
-      throw ParameterError("point spring: weights must be finite and sum to 1");
-    }
-    if (!s.target_m.allFinite()) throw ParameterError("point spring: target must be finite");
-    if (!std::isfinite(s.stiffness_n_per_m) || s.stiffness_n_per_m < 0.0) {
-      throw ParameterError("point spring: stiffness must be finite and >= 0, got " +
-                           std::to_string(s.stiffness_n_per_m));
-    }
-    if (!(s.tangent_fraction > 0.0 && s.tangent_fraction <= 1.0)) {
-      throw ParameterError("point spring: the tangent fraction must be in (0, 1], got " +
-                           std::to_string(s.tangent_fraction));
-    }
-    for (const int a : s.vertices) {
-      for (const int b : s.vertices) {
-        const int row = vertex_block_row(a);
-        const int col = vertex_block_row(b);
-        if (row >= 0 && col >= 0 && m_tangent.find_slot(row, col) < 0) {
-          throw ParameterError("point spring: vertices " + std::to_string(a) + " and " + std::to_string(b) +
-                               " share no tet");
-        }
-      }
-    }
-  }
-  m_point_spring = std::move(spring);
-  m_point_spring_force_n.setZero();
-  refresh_point_spring_slots();
-}
+void DeformableBody::detach(ForceTerm& term) { std::erase(m_force_terms, &term); }
 
 }  // namespace tissue

@@ -1,6 +1,7 @@
 // DeformableBody: a tet mesh made into a DynamicsModel: co-rotational elasticity, lumped mass,
 // Rayleigh damping, gravity and fixed vertices (removed from the unknowns); XFEM cuts that grow the
-// system in place (issue 3); and the point spring through which god-object contact pulls the body.
+// system in place; and the force terms attached to it (system/force_term.hpp: the god-object
+// contact's spring).
 //
 // Unknowns (3 each): block rows [0, free_vertex_count()) are the displacements u of the free
 // vertices, in vertex order; then come the enriched unknowns a, one per (vertex, cut id, side),
@@ -16,6 +17,7 @@
 #include "core/system/assembly.hpp"
 #include "core/system/block_sparse_matrix.hpp"
 #include "core/system/dynamics_model.hpp"
+#include "core/system/force_term.hpp"
 
 #include <Eigen/Core>
 
@@ -34,20 +36,6 @@ struct BodySettings {
   std::vector<int> fixed_vertices;  ///< 0-based; they keep their rest positions
   BlockSparseMatrix::Reserve reserve;
   RotationSettings rotation;  ///< when the per-tet rotation extraction stops (accuracy)
-};
-
-/// A spring of stiffness k from a material point x_p = sum_i w_i x_i of the body (a point of a
-/// surface triangle) to a target: the body feels k (target - x_p), shared out with the weights.
-struct PointSpring {
-  std::array<int, 3> vertices{};  ///< mesh vertices (the 3 vertices of a surface triangle)
-  Eigen::Vector3d weights = Eigen::Vector3d::Constant(1.0 / 3.0);  ///< w_i, summing to 1
-  Eigen::Vector3d target_m = Eigen::Vector3d::Zero();
-  double stiffness_n_per_m = 0.0;
-  /// The share of k entered in tangent(), in (0, 1]. 1 makes tangent() = d f_int / du; but the
-  /// integrators damp the tangent (D = alpha M + beta K), which damps the spring like tissue,
-  /// beta k against a fixed frame. undamped_tangent_fraction() (backward_euler.hpp) takes the
-  /// damping out of a backward-Euler step. The force is k (x_p - target) whatever the share.
-  double tangent_fraction = 1.0;
 };
 
 /// One enriched unknown a (3 components, one block row): listed once per (vertex, cut id, side),
@@ -87,7 +75,7 @@ class DeformableBody final : public DynamicsModel {
   /// increment| max|grad(phi)|; past `resolution_rad`, each tet and part: |axial(skew(R^T G))| with
   /// G the gradient of the increment and R its rotation at the last evaluate().
   [[nodiscard]] double largest_turn_rad(const Eigen::VectorXd& increment_m, double resolution_rad) const override;
-  /// elastic_energy_j + the point spring's k |x_p - target|^2 / 2 - f_ext . u. [J]
+  /// elastic_energy_j + the attached terms' energies - f_ext . u. [J]
   [[nodiscard]] double potential_energy_j(const Eigen::VectorXd& displacement_m) override;
 
   [[nodiscard]] const TetMesh& mesh() const { return m_mesh; }
@@ -146,17 +134,18 @@ class DeformableBody final : public DynamicsModel {
   /// Rest mass of a part, rho w_p V. [kg]
   [[nodiscard]] double part_mass_kg(int cut_tet_index, CutPart part) const;
 
-  // --- Point spring (god-object contact) ---
+  // --- Force terms beside elasticity (the god-object contact's spring) ---
 
-  /// While set, evaluate() adds the spring's force k w_i (x_p - target) to f_int of each free
-  /// vertex i and c k w_i w_j I to the tangent (c its tangent_fraction). Throws ParameterError
-  /// (spring unchanged) unless the vertices are in range, every pair of free ones shares a tet,
-  /// weights and target are finite with |sum w - 1| <= 1e-6, 0 <= k < inf and 0 < c <= 1.
-  void set_point_spring(std::optional<PointSpring> spring);
-  [[nodiscard]] const std::optional<PointSpring>& point_spring() const { return m_point_spring; }
-  /// k (target - x_p) at the last evaluate(): the force the spring applies to the body (zero without
-  /// a spring). [N]
-  [[nodiscard]] Eigen::Vector3d point_spring_force_on_body_n() const { return m_point_spring_force_n; }
+  /// evaluate() adds `term`'s force and stiffness from now on; the caller keeps it alive until
+  /// detach(). Locates it in the tangent (ForceTerm::locate), and again after every re-layout.
+  void attach(ForceTerm& term);
+  /// Stops adding `term` (nothing if it is not attached).
+  void detach(ForceTerm& term);
+  [[nodiscard]] const std::vector<ForceTerm*>& force_terms() const { return m_force_terms; }
+  /// Where the mesh vertices sit in the tangent, for a term's checks and slots.
+  [[nodiscard]] TermLayout term_layout() const {
+    return {m_mesh.vertex_count(), m_dofs.vertex_row, &m_tangent};
+  }
 
   /// Forgets the rotation warm starts of all tets and parts (e.g. after a state was restored).
   void reset_rotations();
@@ -189,14 +178,11 @@ class DeformableBody final : public DynamicsModel {
   Eigen::VectorXd m_positions_m;      // all vertices
   Eigen::VectorXd m_vertex_forces_n;  // all vertices
 
-  // Looks up every slot held (uncut tets, cut tets, point spring) again: after a relayout.
+  // Looks up every slot held (uncut tets, cut tets, force terms) again: after a relayout.
   void refresh_all_slots();
   void refresh_cut_tet_slots(int cut_tet_index);
-  void refresh_point_spring_slots();
   void check_cuts(std::span<const TetCut> cuts) const;
   void check_unknowns(const Eigen::VectorXd& displacement_m) const;
-  // Adds the spring's force to m_vertex_forces_n (and its stiffness to `tangent`), from m_positions_m.
-  void add_point_spring(BlockSparseMatrix* tangent);
   // largest_turn_rad past its bound: every uncut tet and cut part.
   [[nodiscard]] double largest_element_turn_rad(const Eigen::VectorXd& increment_m) const;
   [[nodiscard]] int vertex_block_row(int vertex) const { return m_dofs.vertex_row[static_cast<size_t>(vertex)]; }
@@ -209,9 +195,7 @@ class DeformableBody final : public DynamicsModel {
   std::vector<int> m_next_enriched_dof;   // per enriched unknown: next one of the same vertex, or -1
   std::vector<int> m_cut_index;           // per tet: index into cut_tets(), or -1
 
-  std::optional<PointSpring> m_point_spring;
-  std::array<int, 9> m_point_spring_slots{};  // [3 i + j]: block (row of vertex i, row of vertex j), -1 if fixed
-  Eigen::Vector3d m_point_spring_force_n = Eigen::Vector3d::Zero();
+  std::vector<ForceTerm*> m_force_terms;  // attached, not owned
   WorkTeam* m_team = nullptr;  // lent for a step (lend_work_team)
   mutable std::vector<Eigen::Matrix3d> m_block_frames;  // block_frames(): made on request
   mutable std::vector<Eigen::Matrix3d> m_vertex_frames;

@@ -58,7 +58,7 @@ class BackwardEuler final : public Integrator {
   /// (1/h^2) times this step's matrix: newton_stiffness_system with c = 1/h.
   [[nodiscard]] ShiftedSystem newton_stiffness(const DynamicsModel& model, double step_size_s,
                                                Eigen::VectorXd& diagonal) const override;
-  [[nodiscard]] double undamped_spring_fraction(double step_size_s, double stiffness_damping_s) const override {
+  [[nodiscard]] double undamped_tangent_share(double step_size_s, double stiffness_damping_s) const override {
     return undamped_tangent_fraction(step_size_s, stiffness_damping_s);
   }
 

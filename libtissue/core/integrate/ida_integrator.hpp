@@ -64,7 +64,7 @@ class IdaIntegrator final : public Integrator {
   [[nodiscard]] ShiftedSystem newton_stiffness(const DynamicsModel& model, double step_size_s,
                                                Eigen::VectorXd& diagonal) const override;
   /// 1: the spring enters the tangent whole (IDA's residual damps it by beta k; see DESIGN).
-  [[nodiscard]] double undamped_spring_fraction(double /*step_size_s*/, double /*stiffness_damping_s*/) const override {
+  [[nodiscard]] double undamped_tangent_share(double /*step_size_s*/, double /*stiffness_damping_s*/) const override {
     return 1.0;
   }
   [[nodiscard]] const IdaSettings& settings() const { return m_settings; }

@@ -62,10 +62,10 @@ class Integrator {
   /// a step size that is not finite and > 0.
   [[nodiscard]] virtual ShiftedSystem newton_stiffness(const DynamicsModel& model, double step_size_s,
                                                        Eigen::VectorXd& diagonal) const = 0;
-  /// The share of a stiffness the point spring of the contact (the rigid tool) puts in the tangent,
-  /// so that the step does not damp it (backward Euler: h / (h + beta)); 1 where it cannot be kept
-  /// undamped that way.
-  [[nodiscard]] virtual double undamped_spring_fraction(double step_size_s, double stiffness_damping_s) const = 0;
+  /// The share of its stiffness a force term that stands for something rigid, not tissue (the
+  /// contact's spring: system/force_term.hpp), puts in the tangent so that the step does not damp
+  /// it (backward Euler: h / (h + beta)); 1 where it cannot be kept undamped that way.
+  [[nodiscard]] virtual double undamped_tangent_share(double step_size_s, double stiffness_damping_s) const = 0;
 };
 
 /// The Newton matrix of the residual M a + D v + f_int(u) - f_ext in u, when the method ties

@@ -37,6 +37,8 @@ SettledPress press_and_hold(DeformableBody& body, const SurfaceMesh& surface, do
   const double step_size_s = 1e-2;
   PointContact contact(
       PointContactSettings{spring_n_per_m, undamped_tangent_fraction(step_size_s, body.damping().stiffness_damping_s)});
+  PointSpringTerm spring_term;
+  body.attach(spring_term);
   Eigen::Vector3d hip_previous = hip_outside;
   SettledPress press;
   int quiet_steps = 0;
@@ -46,7 +48,7 @@ SettledPress press_and_hold(DeformableBody& body, const SurfaceMesh& surface, do
     bvh.refit(x);
     EXPECT_TRUE(contact.update(hip_previous, hip, x, bvh));
     hip_previous = hip;
-    contact.apply(bvh, body);
+    contact.apply(bvh, spring_term, body.term_layout());
     integrator.step(body, state, step_size_s);
     body.positions(state.displacement_m, x);
     press.force_on_tool_n = contact.force_on_tool_n(bvh, x);
@@ -57,7 +59,7 @@ SettledPress press_and_hold(DeformableBody& body, const SurfaceMesh& surface, do
     previous_force = press.force_on_tool_n;
   }
   press.settled = quiet_steps >= 10;
-  body.set_point_spring(std::nullopt);
+  body.detach(spring_term);
   return press;
 }
 

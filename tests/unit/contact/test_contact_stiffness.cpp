@@ -104,10 +104,13 @@ TEST(EffectiveContactStiffness, TakesTheContactSpringOutOfTheMatrix) {
   const Eigen::Matrix3d k_c = *frog.effective.stiffness_n_per_m(frog.interpolation(point));
   const EffectiveContactStiffness::ResponseMatrix response = frog.effective.unit_force_response();
   const double k = 100.0 * contact_stiffness_scale_n_per_m(frog.body, frog.surface);
+  PointSpringTerm spring_term;
+  frog.body.attach(spring_term);
   for (const SurfacePoint& spring_at :
        {point, SurfacePoint{point.triangle, Eigen::Vector3d(0.6, 0.3, 0.1)}, points[1]}) {
-    frog.body.set_point_spring(PointSpring{frog.surface.triangles[static_cast<size_t>(spring_at.triangle)],
-                                           spring_at.barycentric, frog.position(spring_at), k});
+    spring_term.set(PointSpring{frog.surface.triangles[static_cast<size_t>(spring_at.triangle)], spring_at.barycentric,
+                                frog.position(spring_at), k},
+                    frog.body.term_layout());
     Eigen::VectorXd force, diagonal;
     frog.body.evaluate(Eigen::VectorXd::Zero(frog.body.dof_count()), force, true);
     EffectiveContactStiffness with_spring;
@@ -126,7 +129,7 @@ TEST(EffectiveContactStiffness, TakesTheContactSpringOutOfTheMatrix) {
     EXPECT_THROW((void)with_spring.stiffness_n_per_m(frog.interpolation(point), frog.interpolation(spring_at), -1.0),
                  std::invalid_argument);
   }
-  frog.body.set_point_spring(std::nullopt);
+  frog.body.detach(spring_term);
 }
 
 TEST(EffectiveContactStiffness, APointOnFixedVerticesOnlyIsRigid) {

@@ -147,12 +147,15 @@ TEST(QuasiStaticPoke, LeavesTheBodysContactSpringAsItWas) {
   const SurfacePoint point = back_points(frog.surface, frog.rest)[0];
   const PointSpring spring{frog.surface.triangles[static_cast<size_t>(point.triangle)], point.barycentric,
                            frog.position(point), 123.0};
-  frog.body.set_point_spring(spring);
+  PointSpringTerm spring_term;
+  frog.body.attach(spring_term);
+  spring_term.set(spring, frog.body.term_layout());
   const QuasiStaticPoke poke = frog.poke(point, frog.position(point) - 1e-4 * frog.normal(point), PokeFriction::bonded);
   EXPECT_TRUE(poke.converged);
-  ASSERT_TRUE(frog.body.point_spring().has_value());
-  EXPECT_EQ(frog.body.point_spring()->stiffness_n_per_m, 123.0);
-  EXPECT_EQ(frog.body.point_spring()->vertices, spring.vertices);
+  ASSERT_EQ(frog.body.force_terms(), std::vector<ForceTerm*>{&spring_term}) << "the spring is attached again";
+  ASSERT_TRUE(spring_term.spring().has_value());
+  EXPECT_EQ(spring_term.spring()->stiffness_n_per_m, 123.0);
+  EXPECT_EQ(spring_term.spring()->vertices, spring.vertices);
 }
 
 }  // namespace

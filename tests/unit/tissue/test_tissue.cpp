@@ -107,7 +107,41 @@ TEST(Tissue, ProbeTouchesPushesBackAndLetsGo) {
   tissue.set_tool({above, Eigen::Quaterniond::Identity(), ToolMode::probe});
   tissue.step();
   EXPECT_FALSE(tissue.contact().active);
-  EXPECT_EQ(tissue.body().point_spring(), std::nullopt);
+  EXPECT_EQ(tissue.contact_spring().spring(), std::nullopt);
+}
+
+// A ball probe of radius r posed by its centre touches as a point probe posed at its pole, r along the
+// tool axis toward the tip: the two tissues step bitwise alike, and each reports as applied the
+// position it was given. A refused radius is refused when given.
+TEST(Tissue, ABallProbeTouchesWithItsPole) {
+  const TetMesh mesh = make_box_mesh(4, 4, 2, 0.01);
+  TissueSettings settings;
+  settings.body.fixed_vertices = vertices_at_minimum(mesh, 2, 0.0);
+  settings.body.gravity_m_per_s2.setZero();
+  settings.solver.kind = LinearSolverKind::cholmod;
+  settings.step_size_s = 0.01;
+  Tissue point_probe(mesh, settings);
+  settings.interaction.probe_radius_m = 0.002;
+  Tissue ball_probe(mesh, settings);
+  const Eigen::Quaterniond tilted = Eigen::Quaterniond(Eigen::AngleAxisd(0.3, Eigen::Vector3d(1, 1, 0).normalized()));
+  for (const double depth_m : {-0.001, 1e-4, 2e-4}) {
+    const Eigen::Vector3d pole(0.0213, 0.0187, 0.02 - depth_m);
+    const Eigen::Vector3d centre = pole + 0.002 * tool_axis(tilted);
+    point_probe.set_tool({pole, tilted, ToolMode::probe});
+    ball_probe.set_tool({centre, tilted, ToolMode::probe});
+    for (int n = 0; n < 20; ++n) {
+      point_probe.step();
+      ball_probe.step();
+    }
+    EXPECT_EQ(ball_probe.applied_tool().tip_position_m, point_probe.applied_tool().tip_position_m);
+    EXPECT_EQ(ball_probe.applied_tool_position_m(), centre);
+    EXPECT_EQ(point_probe.applied_tool_position_m(), pole);
+    EXPECT_EQ(ball_probe.contact().active, depth_m > 0.0);
+    EXPECT_EQ(ball_probe.contact().force_on_tool_n, point_probe.contact().force_on_tool_n);
+    EXPECT_EQ(ball_probe.state().displacement_m, point_probe.state().displacement_m);
+  }
+  settings.interaction.probe_radius_m = -1e-3;
+  EXPECT_THROW(Tissue(mesh, settings), ParameterError);
 }
 
 // A body with nothing fixed condenses its contact stiffness from the step matrix

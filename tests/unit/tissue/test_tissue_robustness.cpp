@@ -76,7 +76,7 @@ TEST(TissueRobustness, ProbingAPieceNothingHoldsRendersTheStepStiffness) {
       try {
         static_stiffness.factorize(static_contact_system(tissue.body().tangent(), zero));
         const SurfacePoint& proxy = tissue.point_contact().proxy();
-        const PointSpring& spring = *tissue.body().point_spring();
+        const PointSpring& spring = *tissue.contact_spring().spring();
         const auto k_static = static_stiffness.stiffness_n_per_m(
             contact_interpolation(tissue.body().dofs(), tissue.surface_bvh().triangle(proxy.triangle),
                                   proxy.barycentric),

@@ -1,6 +1,7 @@
 // Tests of the point spring through which god-object contact pulls the body: its force and tangent
 // against the definition and finite differences, the static pull of a clamped bar against two
 // springs in series (the spring and the bar's compliance at the point, P^T K^-1 P), and the checks.
+#include "core/contact/point_spring.hpp"
 #include "core/fem/deformable_body.hpp"
 #include "core/mesh/box_mesh.hpp"
 #include "xfem/xfem_test_helpers.hpp"
@@ -23,9 +24,15 @@ using xfem_test::dense;
 struct Bar {
   TetMesh mesh;
   DeformableBody body;
+  PointSpringTerm spring_term;  // attached to body
 
   Bar(int cubes, double young_modulus_pa)
-      : mesh(make_box_mesh(cubes, 2, 2, 0.01)), body(mesh, settings(mesh, young_modulus_pa)) {}
+      : mesh(make_box_mesh(cubes, 2, 2, 0.01)), body(mesh, settings(mesh, young_modulus_pa)) {
+    body.attach(spring_term);
+  }
+  Bar(const Bar&) = delete;
+  Bar& operator=(const Bar&) = delete;
+  void set_point_spring(std::optional<PointSpring> s) { spring_term.set(std::move(s), body.term_layout()); }
 
   static BodySettings settings(const TetMesh& mesh, double young_modulus_pa) {
     BodySettings s;
@@ -80,10 +87,10 @@ TEST(PointSpring, ForceAndTangentMatchTheDefinitionAndFiniteDifferences) {
     for (Eigen::Index k = 0; k < u.size(); ++k) u(k) = 3e-4 * std::sin(1.3 * static_cast<double>(k));
 
     Eigen::VectorXd f_without;
-    bar.body.set_point_spring(std::nullopt);
+    bar.set_point_spring(std::nullopt);
     bar.body.evaluate(u, f_without, true);
     const Eigen::MatrixXd k_without = dense(bar.body.tangent());
-    bar.body.set_point_spring(spring);
+    bar.set_point_spring(spring);
     Eigen::VectorXd f_with;
     bar.body.evaluate(u, f_with, true);
     const Eigen::MatrixXd k_spring = dense(bar.body.tangent()) - k_without;
@@ -99,7 +106,7 @@ TEST(PointSpring, ForceAndTangentMatchTheDefinitionAndFiniteDifferences) {
     }
     // Sums of a few products: round-off only, relative to the elastic forces they were added to.
     EXPECT_LT((f_spring - expected).norm(), 1e-12 * f_with.norm());
-    EXPECT_LT((bar.body.point_spring_force_on_body_n() + spring.stiffness_n_per_m * stretch).norm(),
+    EXPECT_LT((bar.spring_term.force_on_body_n() + spring.stiffness_n_per_m * stretch).norm(),
               1e-12 * stretch.norm() * spring.stiffness_n_per_m);
 
     // The spring is linear in u: central differences are exact up to round-off of f_int (~1e-16 |f|
@@ -115,12 +122,12 @@ TEST(PointSpring, ForceAndTangentMatchTheDefinitionAndFiniteDifferences) {
       Eigen::VectorXd f_minus;
       bar.body.evaluate(plus, f_plus, false);
       bar.body.evaluate(minus, f_minus, false);
-      bar.body.set_point_spring(std::nullopt);
+      bar.set_point_spring(std::nullopt);
       Eigen::VectorXd e_plus;
       Eigen::VectorXd e_minus;
       bar.body.evaluate(plus, e_plus, false);
       bar.body.evaluate(minus, e_minus, false);
-      bar.body.set_point_spring(spring);
+      bar.set_point_spring(spring);
       numeric.col(k) = ((f_plus - e_plus) - (f_minus - e_minus)) / (2.0 * step_m);
     }
     EXPECT_LT((numeric - k_spring).norm(), 1e-6 * k_spring.norm());
@@ -129,7 +136,7 @@ TEST(PointSpring, ForceAndTangentMatchTheDefinitionAndFiniteDifferences) {
     // A tangent fraction c scales the spring's tangent only (the undamped contact spring).
     PointSpring shared = spring;
     shared.tangent_fraction = 0.25;
-    bar.body.set_point_spring(shared);
+    bar.set_point_spring(shared);
     Eigen::VectorXd f_shared;
     bar.body.evaluate(u, f_shared, true);
     EXPECT_LT((f_shared - f_with).norm(), 1e-12 * f_with.norm());
@@ -162,11 +169,11 @@ TEST(PointSpring, PullOnAClampedBarIsTwoSpringsInSeries) {
     bar.body.positions(Eigen::VectorXd::Zero(bar.body.dof_count()), positions);
     const PointSpring spring{triangle, weights, bar.point(PointSpring{triangle, weights, {}, 0.0}, positions) + pull,
                              spring_n_per_m};
-    bar.body.set_point_spring(spring);
+    bar.set_point_spring(spring);
     Eigen::VectorXd u = Eigen::VectorXd::Zero(bar.body.dof_count());
     xfem_test::solve_static(bar.body, u);
     bar.body.evaluate(u, force, false);
-    const Eigen::Vector3d f = bar.body.point_spring_force_on_body_n();
+    const Eigen::Vector3d f = bar.spring_term.force_on_body_n();
     const Eigen::Vector3d expected = (compliance + Eigen::Matrix3d::Identity() / spring_n_per_m).inverse() * pull;
     EXPECT_LT((f - expected).norm(), 1e-3 * expected.norm());
     const int axis = pull.x() != 0.0 ? 0 : 2;
@@ -181,11 +188,11 @@ TEST(PointSpring, RefusesBadSpringsAndKeepsTheOldOne) {
   Bar bar(3, 1e5);
   const std::array<int, 3> triangle = bar.face_at(0.03);
   const PointSpring good{triangle, Eigen::Vector3d(0.2, 0.3, 0.5), Eigen::Vector3d(0.03, 0.0, 0.0), 10.0};
-  bar.body.set_point_spring(good);
+  bar.set_point_spring(good);
   const auto refused = [&](PointSpring bad) {
-    EXPECT_THROW(bar.body.set_point_spring(bad), ParameterError);
-    ASSERT_TRUE(bar.body.point_spring().has_value());
-    EXPECT_EQ(bar.body.point_spring()->vertices, good.vertices);
+    EXPECT_THROW(bar.set_point_spring(bad), ParameterError);
+    ASSERT_TRUE(bar.spring_term.spring().has_value());
+    EXPECT_EQ(bar.spring_term.spring()->vertices, good.vertices);
   };
   PointSpring bad = good;
   bad.vertices[1] = bar.mesh.vertex_count();
@@ -216,9 +223,9 @@ TEST(PointSpring, RefusesBadSpringsAndKeepsTheOldOne) {
 
   Eigen::VectorXd f;
   bar.body.evaluate(Eigen::VectorXd::Zero(bar.body.dof_count()), f, false);
-  EXPECT_GT(bar.body.point_spring_force_on_body_n().norm(), 0.0);
-  bar.body.set_point_spring(std::nullopt);
-  EXPECT_EQ(bar.body.point_spring_force_on_body_n().norm(), 0.0);
+  EXPECT_GT(bar.spring_term.force_on_body_n().norm(), 0.0);
+  bar.set_point_spring(std::nullopt);
+  EXPECT_EQ(bar.spring_term.force_on_body_n().norm(), 0.0);
   bar.body.evaluate(Eigen::VectorXd::Zero(bar.body.dof_count()), f, false);
   EXPECT_LT(f.norm(), 1e-12);  // at rest, no gravity, no spring: only round-off of the rest shape
 }

@@ -1,6 +1,7 @@
 // Real-time discipline (STYLE.md principle 6) with cuts and contact: once a body has been cut and
 // the point spring set, a backward-Euler step with PCG allocates nothing after the first. Counts
 // every global operator new in this executable.
+#include "core/contact/point_spring.hpp"
 #include "core/fem/deformable_body.hpp"
 #include "core/integrate/backward_euler.hpp"
 #include "core/mesh/box_mesh.hpp"
@@ -24,8 +25,11 @@ TEST(XfemAllocations, StepOfACutBodyWithAPointSpringAllocatesNothing) {
   }
   DeformableBody body(mesh, settings);
   const Tet& tet = mesh.tets.back();
-  body.set_point_spring(PointSpring{
-      {tet[0], tet[1], tet[2]}, Eigen::Vector3d::Constant(1.0 / 3.0), Eigen::Vector3d(0.13, 0.02, 0.02), 100.0});
+  PointSpringTerm spring;
+  body.attach(spring);
+  spring.set(PointSpring{{tet[0], tet[1], tet[2]}, Eigen::Vector3d::Constant(1.0 / 3.0), Eigen::Vector3d(0.13, 0.02, 0.02),
+                         100.0},
+             body.term_layout());
   DynamicState state{Eigen::VectorXd::Zero(body.dof_count()), Eigen::VectorXd::Zero(body.dof_count())};
   BackwardEuler integrator(std::make_unique<PcgSolver>(PcgSolver::Settings{1e-3, 10}));
   integrator.step(body, state, 0.01);

@@ -3,6 +3,7 @@
 // storage layout with the default reserve, and CHOLMOD and PCG both solve the grown system. With
 // no reserve the storage is re-laid out and every slot map is looked up again: the result equals
 // the in-place growth.
+#include "core/contact/point_spring.hpp"
 #include "core/fem/deformable_body.hpp"
 #include "core/fixed_region.hpp"
 #include "core/integrate/backward_euler.hpp"
@@ -122,8 +123,12 @@ TEST(XfemGrowth, RelayoutRecomputesEverySlotMap) {
   const Tet& tet = mesh.tets[37];
   const PointSpring spring{
       {tet[0], tet[1], tet[3]}, Eigen::Vector3d(0.2, 0.3, 0.5), Eigen::Vector3d(0.05, 0.01, 0.03), 50.0};
-  roomy.set_point_spring(spring);
-  tight.set_point_spring(spring);
+  PointSpringTerm roomy_spring;
+  PointSpringTerm tight_spring;
+  roomy.attach(roomy_spring);
+  tight.attach(tight_spring);
+  roomy_spring.set(spring, roomy.term_layout());
+  tight_spring.set(spring, tight.term_layout());
 
   const auto cuts = xfem_test::plane_cuts(mesh, Plane{Eigen::Vector3d(1, 0.1, 0.2).normalized(), 0.045});
   EXPECT_FALSE(roomy.enrich(cuts).matrix_relayout);

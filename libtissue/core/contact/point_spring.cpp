@@ -1,0 +1,98 @@
+// PointSpringTerm (see point_spring.hpp).
+#include "core/contact/point_spring.hpp"
+
+#include "core/parameter_error.hpp"
+
+#include <cmath>
+#include <string>
+
+namespace tissue {
+
+Eigen::Vector3d PointSpringTerm::material_point_m(const Eigen::VectorXd& positions_m) const {
+  Eigen::Vector3d point_m = Eigen::Vector3d::Zero();
+  for (size_t i = 0; i < 3; ++i) {
+    point_m += m_spring->weights[static_cast<Eigen::Index>(i)] * positions_m.segment<3>(3 * m_spring->vertices[i]);
+  }
+  return point_m;
+}
+
+void PointSpringTerm::add_force(const Eigen::VectorXd& positions_m, Eigen::VectorXd& vertex_forces_n) {
+  m_force_on_body_n.setZero();
+  if (!m_spring) return;
+  // f_int gains k (x_p - target) w_i on vertex i; the body feels the opposite, k (target - x_p).
+  const Eigen::Vector3d stretch_force_n = m_spring->stiffness_n_per_m * (material_point_m(positions_m) - m_spring->target_m);
+  m_force_on_body_n = -stretch_force_n;
+  for (size_t i = 0; i < 3; ++i) {
+    vertex_forces_n.segment<3>(3 * m_spring->vertices[i]) += m_spring->weights[static_cast<Eigen::Index>(i)] * stretch_force_n;
+  }
+}
+
+void PointSpringTerm::add_tangent(BlockSparseMatrix& tangent) const {
+  if (!m_spring) return;
+  const PointSpring& spring = *m_spring;
+  for (size_t i = 0; i < 3; ++i) {
+    for (size_t j = 0; j < 3; ++j) {
+      const int slot = m_slots[3 * i + j];
+      if (slot < 0) continue;  // a fixed vertex
+      tangent.block(slot).diagonal().array() += spring.tangent_fraction * spring.stiffness_n_per_m *
+                                                spring.weights[static_cast<Eigen::Index>(i)] *
+                                                spring.weights[static_cast<Eigen::Index>(j)];
+    }
+  }
+}
+
+double PointSpringTerm::energy_j(const Eigen::VectorXd& positions_m) const {
+  if (!m_spring) return 0.0;
+  return 0.5 * m_spring->stiffness_n_per_m * (material_point_m(positions_m) - m_spring->target_m).squaredNorm();
+}
+
+void PointSpringTerm::locate(const TermLayout& layout) {
+  m_slots.fill(-1);
+  if (!m_spring) return;
+  for (size_t i = 0; i < 3; ++i) {
+    for (size_t j = 0; j < 3; ++j) {
+      const int row = layout.vertex_row[static_cast<size_t>(m_spring->vertices[i])];
+      const int col = layout.vertex_row[static_cast<size_t>(m_spring->vertices[j])];
+      if (row >= 0 && col >= 0) m_slots[3 * i + j] = layout.tangent->find_slot(row, col);
+    }
+  }
+}
+
+void PointSpringTerm::set(std::optional<PointSpring> spring, const TermLayout& layout) {
+  if (spring) {
+    const PointSpring& s = *spring;
+    for (const int v : s.vertices) {
+      if (v < 0 || v >= layout.vertex_count) {
+        throw ParameterError("point spring: vertex " + std::to_string(v) + " outside [0, " +
+                             std::to_string(layout.vertex_count) + ")");
+      }
+    }
+    if (!s.weights.allFinite() || std::abs(s.weights.sum() - 1.0) > 1e-6) {
+      throw ParameterError("point spring: weights must be finite and sum to 1");
+    }
+    if (!s.target_m.allFinite()) throw ParameterError("point spring: target must be finite");
+    if (!std::isfinite(s.stiffness_n_per_m) || s.stiffness_n_per_m < 0.0) {
+      throw ParameterError("point spring: stiffness must be finite and >= 0, got " +
+                           std::to_string(s.stiffness_n_per_m));
+    }
+    if (!(s.tangent_fraction > 0.0 && s.tangent_fraction <= 1.0)) {
+      throw ParameterError("point spring: the tangent fraction must be in (0, 1], got " +
+                           std::to_string(s.tangent_fraction));
+    }
+    for (const int a : s.vertices) {
+      for (const int b : s.vertices) {
+        const int row = layout.vertex_row[static_cast<size_t>(a)];
+        const int col = layout.vertex_row[static_cast<size_t>(b)];
+        if (row >= 0 && col >= 0 && layout.tangent->find_slot(row, col) < 0) {
+          throw ParameterError("point spring: vertices " + std::to_string(a) + " and " + std::to_string(b) +
+                               " share no tet");
+        }
+      }
+    }
+  }
+  m_spring = std::move(spring);
+  m_force_on_body_n.setZero();
+  locate(layout);
+}
+
+}  // namespace tissue

@@ -1,0 +1,57 @@
+// The god-object contact's spring as a force term of the body: from a material point of the body
+// (a point of a surface triangle) to the tool's interaction point (point_contact.hpp says why a
+// spring, and why its tangent share is below 1).
+#pragma once
+
+#include "core/system/force_term.hpp"
+
+#include <Eigen/Core>
+
+#include <array>
+#include <optional>
+
+namespace tissue {
+
+/// A spring of stiffness k from a material point x_p = sum_i w_i x_i of the body (a point of a
+/// surface triangle) to a target: the body feels k (target - x_p), shared out with the weights.
+struct PointSpring {
+  std::array<int, 3> vertices{};  ///< mesh vertices (the 3 vertices of a surface triangle)
+  Eigen::Vector3d weights = Eigen::Vector3d::Constant(1.0 / 3.0);  ///< w_i, summing to 1
+  Eigen::Vector3d target_m = Eigen::Vector3d::Zero();
+  double stiffness_n_per_m = 0.0;
+  /// The share of k entered in the tangent, in (0, 1]. 1 makes the tangent d f_int / du; but the
+  /// integrators damp the tangent (D = alpha M + beta K), which damps the spring like tissue,
+  /// beta k against a fixed frame. Integrator::undamped_tangent_share() takes the damping out of
+  /// the step. The force is k (x_p - target) whatever the share.
+  double tangent_fraction = 1.0;
+};
+
+/// The body's point spring, or none. Attach it to the body (DeformableBody::attach) once; set() it
+/// as the contact starts, moves and ends.
+class PointSpringTerm final : public ForceTerm {
+ public:
+  /// Sets (or clears) the spring: f_int gains k w_i (x_p - target) on each vertex i, the tangent
+  /// c k w_i w_j I between free vertices (c its tangent_fraction). Throws ParameterError (spring
+  /// unchanged) unless the vertices are in range, every pair of free ones shares a tet, weights and
+  /// target are finite with |sum w - 1| <= 1e-6, 0 <= k < inf and 0 < c <= 1. `layout` is the
+  /// body's (DeformableBody::term_layout).
+  void set(std::optional<PointSpring> spring, const TermLayout& layout);
+  [[nodiscard]] const std::optional<PointSpring>& spring() const { return m_spring; }
+  /// k (target - x_p) at the last add_force(): the force the spring applies to the body (zero
+  /// without a spring) [N].
+  [[nodiscard]] const Eigen::Vector3d& force_on_body_n() const { return m_force_on_body_n; }
+
+  void add_force(const Eigen::VectorXd& positions_m, Eigen::VectorXd& vertex_forces_n) override;
+  void add_tangent(BlockSparseMatrix& tangent) const override;
+  [[nodiscard]] double energy_j(const Eigen::VectorXd& positions_m) const override;
+  void locate(const TermLayout& layout) override;
+
+ private:
+  [[nodiscard]] Eigen::Vector3d material_point_m(const Eigen::VectorXd& positions_m) const;
+
+  std::optional<PointSpring> m_spring;
+  std::array<int, 9> m_slots{};  // [3 i + j]: block (row of vertex i, row of vertex j), -1 if fixed
+  Eigen::Vector3d m_force_on_body_n = Eigen::Vector3d::Zero();
+};
+
+}  // namespace tissue
