@@ -1,7 +1,10 @@
 // A JSON string literal of a text (summary.json, compare.json): quotes and backslashes escaped,
-// control characters replaced by spaces. The one place the host writes JSON strings.
+// control characters replaced by spaces. The one place the host writes JSON strings (and numbers that
+// may not be finite).
 #pragma once
 
+#include <cmath>
+#include <sstream>
 #include <string>
 
 namespace tissue::host {
@@ -19,6 +22,16 @@ inline std::string json_string(const std::string& text) {
     }
   }
   return quoted + "\"";
+}
+
+/// A JSON number at 9 significant digits (as the summary writes them), or null for a value JSON
+/// cannot hold (NaN, infinity: e.g. a hand that never settled).
+inline std::string json_number(double value) {
+  if (!std::isfinite(value)) return "null";
+  std::ostringstream out;
+  out.precision(9);
+  out << value;
+  return out.str();
 }
 
 }  // namespace tissue::host

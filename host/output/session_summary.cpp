@@ -71,6 +71,19 @@ std::string SessionSummary::to_json() const {
       << ", \"accepted\": " << device.accepted << ", \"malformed\": " << device.malformed
       << ", \"out_of_order\": " << device.out_of_order << ", \"duplicate\": " << device.duplicate
       << ", \"stale\": " << device.stale << ", \"watchdog_trips\": " << device.watchdog_trips << "},\n";
+  if (hand) {
+    const auto number = [](double x) { return json_number(x); };
+    out << "  \"hand\": {\"settle_time_s\": " << number(hand->settle_time_s)
+        << ", \"settle_speed_m_per_s\": " << number(hand->settle_speed_m_per_s)
+        << ", \"residual_speed_m_per_s\": " << number(hand->residual_speed_m_per_s)
+        << ", \"device_work_J\": " << number(hand->device_work_j)
+        << ", \"chatter_frequency_Hz\": " << number(hand->chatter_frequency_hz)
+        << ", \"chatter_amplitude_m\": " << number(hand->chatter_amplitude_m) << ", \"mean_force_N\": ["
+        << number(hand->mean_force_n[0]) << ", " << number(hand->mean_force_n[1]) << ", "
+        << number(hand->mean_force_n[2]) << "], \"mean_position_m\": [" << number(hand->mean_position_m[0]) << ", "
+        << number(hand->mean_position_m[1]) << ", " << number(hand->mean_position_m[2])
+        << "], \"window_s\": " << number(hand->window_s) << "},\n";
+  }
   out << "  \"frames_written\": " << frames_written << ",\n";
   out << "  \"frames_dropped\": " << frames_dropped << ",\n";
   if (view) {
@@ -101,6 +114,13 @@ void print_summary(std::ostream& out, const SessionSummary& s, const std::filesy
   out << "  cut tets " << s.cut_tets << ", enriched vertices " << s.enriched_vertices << ", max device force "
       << s.max_device_force_n << " N (device maximum " << s.device_max_force_n << " N), passivity dissipated "
       << s.passivity_dissipated_j << " J, NaN " << (s.nan_detected ? "DETECTED" : "none") << "\n";
+  if (s.hand) {
+    out << "  hand: " << (std::isnan(s.hand->settle_time_s) ? std::string("never settled")
+                                                             : "settled at " + std::to_string(s.hand->settle_time_s) + " s")
+        << ", residual speed " << s.hand->residual_speed_m_per_s * 1e3 << " mm/s, chatter "
+        << s.hand->chatter_frequency_hz << " Hz x " << s.hand->chatter_amplitude_m * 1e3
+        << " mm, device work on the hand " << s.hand->device_work_j << " J\n";
+  }
   if (!s.first_error.empty()) out << "  first error: " << s.first_error << "\n";
   out << "  outputs in " << output_dir.string() << ": summary.json, log.csv, ";
   if (s.frames_written > 0) {

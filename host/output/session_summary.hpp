@@ -4,6 +4,7 @@
 #pragma once
 
 #include "device/device.hpp"
+#include "device/hand_device.hpp"
 
 #include <cstdint>
 #include <filesystem>
@@ -37,6 +38,7 @@ struct SessionSummary {
   bool nan_detected = false;
   std::string device_name;
   DeviceCounters device;
+  std::optional<HandFigures> hand;  ///< a simulated hand's motion (device kind "hand")
   std::uint64_t frames_written = 0, frames_dropped = 0;
   bool view = false;
   std::uint64_t view_connections = 0, view_frames_sent = 0, view_frames_skipped = 0, view_messages = 0,

@@ -227,17 +227,56 @@ std::vector<Waypoint> waypoints(const Reader& r, const toml::table& device) {
   return result;
 }
 
-// [device]: scripted (waypoints), replay (a --record file), udp (address, port) or browser.
+// A hand device's mass, damping, grip and push, each refused outside its range (HandLimits).
+HandSettings read_hand(const Reader& r, const toml::table& device) {
+  HandSettings hand;
+  const auto in_range = [&](const char* key, double low, double high, const char* unit, double& value) {
+    const toml::node* n = device.get(key);
+    if (n == nullptr) return;
+    const std::string name = std::string("device.") + key;
+    value = r.number(*n, name);
+    if (!(value >= low && value <= high)) {
+      r.fail(name, "must be in [" + std::to_string(low) + ", " + std::to_string(high) + "] " + unit + ", got " +
+                       std::to_string(value));
+    }
+  };
+  in_range("mass", HandLimits::min_mass_kg, HandLimits::max_mass_kg, "kg", hand.mass_kg);
+  in_range("damping", 0.0, HandLimits::max_damping_n_s_per_m, "N s/m", hand.damping_n_s_per_m);
+  in_range("grip_stiffness", 0.0, HandLimits::max_grip_stiffness_n_per_m, "N/m", hand.grip_stiffness_n_per_m);
+  if (const toml::node* n = device.get("push")) {
+    hand.push_n = r.numbers<3>(*n, "device.push");
+    for (const double p : hand.push_n) {
+      if (!(std::abs(p) <= HandLimits::max_push_n)) {
+        r.fail("device.push", "each component must be in [-" + std::to_string(HandLimits::max_push_n) + ", " +
+                                  std::to_string(HandLimits::max_push_n) + "] N, got " + std::to_string(p));
+      }
+    }
+  }
+  return hand;
+}
+
+// [device]: scripted (waypoints), hand (waypoints held by a simulated hand), replay (a --record
+// file), udp (address, port) or browser.
 DeviceConfig read_device(const Reader& r, const toml::table& root, const std::filesystem::path& base) {
   const toml::table* device = root["device"].as_table();
   if (device == nullptr) r.fail("device", "the [device] table is missing");
-  r.only(*device, "device", {"kind", "waypoints", "file", "address", "port", "allow_remote"});
+  r.only(*device, "device",
+         {"kind", "waypoints", "file", "address", "port", "allow_remote", "mass", "damping", "grip_stiffness", "push"});
   const toml::node* kind = device->get("kind");
   const std::string kind_name = kind != nullptr ? r.string(*kind, "device.kind") : "scripted";
   DeviceConfig config;
+  if (kind_name != "hand") {
+    for (const char* key : {"mass", "damping", "grip_stiffness", "push"}) {
+      if (device->contains(key)) r.fail(std::string("device.") + key, "is for kind = \"hand\" only");
+    }
+  }
   if (kind_name == "scripted") {
     config.kind = DeviceKind::scripted;
     config.waypoints = waypoints(r, *device);
+  } else if (kind_name == "hand") {
+    config.kind = DeviceKind::hand;
+    config.waypoints = waypoints(r, *device);
+    config.hand = read_hand(r, *device);
   } else if (kind_name == "replay") {
     config.kind = DeviceKind::replay;
     const toml::node* file = device->get("file");
@@ -256,7 +295,8 @@ DeviceConfig read_device(const Reader& r, const toml::table& root, const std::fi
   } else if (kind_name == "browser") {
     config.kind = DeviceKind::browser;  // the live view's mouse and keyboard (--view)
   } else {
-    r.fail("device.kind", "must be \"scripted\", \"replay\", \"udp\" or \"browser\", got \"" + kind_name + "\"");
+    r.fail("device.kind",
+           "must be \"scripted\", \"hand\", \"replay\", \"udp\" or \"browser\", got \"" + kind_name + "\"");
   }
   return config;
 }

@@ -7,6 +7,7 @@
 #pragma once
 
 #include "device/device.hpp"
+#include "device/simulated_hand.hpp"
 
 #include <array>
 #include <cstdint>
@@ -41,11 +42,12 @@ struct Waypoint {
   ToolMode mode = ToolMode::none;
 };
 
-enum class DeviceKind { scripted, replay, udp, browser };
+enum class DeviceKind { scripted, hand, replay, udp, browser };
 
 struct DeviceConfig {
   DeviceKind kind = DeviceKind::scripted;
-  std::vector<Waypoint> waypoints;    ///< scripted
+  std::vector<Waypoint> waypoints;    ///< scripted, hand (the path its grip follows)
+  HandSettings hand;                  ///< hand: mass, damping, grip, push
   std::filesystem::path replay_file;  ///< replay (relative to the scenario file)
   std::string udp_address = "127.0.0.1";
   std::uint16_t udp_port = 47001;

@@ -3,6 +3,7 @@
 // (schedule/session_steps.hpp), and hands itself to a scheduler (schedule/): offline or real time.
 #include "session/session.hpp"
 
+#include "device/hand_device.hpp"
 #include "importer/fmu3.hpp"
 #include "links/fmu_links.hpp"
 #include "links/sample_relay.hpp"
@@ -71,7 +72,8 @@ class Session final : public SessionSteps {
         m_blade_depth_slot(m_relay.layout().slot("cut.bladeDepth")),
         m_step_sample(m_relay.make_sample()),
         m_last_outputs(m_relay.make_sample()),
-        m_device(make_device(options.browser_device ? browser_config() : scenario.device, m_tissue)),
+        m_device(make_device(options.browser_device ? browser_config() : scenario.device, m_tissue,
+                             scenario.haptic_period_s)),
         m_schedule(make_schedule(scenario)) {
     if (options.view && options.offline) throw ScenarioError("--view: the live view needs a real-time run, not --offline");
     if (!options.view && dynamic_cast<BrowserDevice*>(m_device.get()) != nullptr) {
@@ -309,6 +311,7 @@ class Session final : public SessionSteps {
     m_summary.passivity_dissipated_j = last.dissipated_energy_j;
     m_summary.passivity_observed_j = last.observed_energy_j;
     m_summary.device = m_device->counters();
+    if (const auto* hand = dynamic_cast<const HandDevice*>(m_device.get())) m_summary.hand = hand->figures();
     m_summary.nan_detected = m_haptic_nan || m_tissue_nan || !std::isfinite(m_summary.max_device_force_n);
     if (!m_options.write_outputs) return;
 

@@ -1,6 +1,7 @@
 // The session's device (see session_device.hpp).
 #include "session/session_device.hpp"
 
+#include "device/hand_device.hpp"
 #include "device/replay_device.hpp"
 #include "device/scripted_device.hpp"
 #include "device/udp_device.hpp"
@@ -10,24 +11,34 @@
 
 namespace tissue::host {
 
-std::unique_ptr<Device> make_device(const DeviceConfig& config, const TissueLink& tissue) {
-  switch (config.kind) {
-    case DeviceKind::scripted: {
-      std::vector<DeviceWaypoint> waypoints;
-      for (const Waypoint& w : config.waypoints) {
-        DeviceWaypoint d;
-        d.time_s = w.time_s;
-        for (std::size_t a = 0; a < 3; ++a) {
-          d.pose.position_m[a] = w.box_relative ? tissue.rest_lower()[a] +
-                                                      w.position[a] * (tissue.rest_upper()[a] - tissue.rest_lower()[a])
-                                                : w.position[a];
-        }
-        d.pose.orientation_wxyz = w.orientation_wxyz;
-        d.pose.mode = w.mode;
-        waypoints.push_back(d);
-      }
-      return std::make_unique<ScriptedDevice>(std::move(waypoints));
+namespace {
+
+// The scenario's waypoints in the scene frame (box-relative ones placed by the tissue's rest box).
+std::vector<DeviceWaypoint> device_waypoints(const DeviceConfig& config, const TissueLink& tissue) {
+  std::vector<DeviceWaypoint> waypoints;
+  for (const Waypoint& w : config.waypoints) {
+    DeviceWaypoint d;
+    d.time_s = w.time_s;
+    for (std::size_t a = 0; a < 3; ++a) {
+      d.pose.position_m[a] = w.box_relative ? tissue.rest_lower()[a] +
+                                                  w.position[a] * (tissue.rest_upper()[a] - tissue.rest_lower()[a])
+                                            : w.position[a];
     }
+    d.pose.orientation_wxyz = w.orientation_wxyz;
+    d.pose.mode = w.mode;
+    waypoints.push_back(d);
+  }
+  return waypoints;
+}
+
+}  // namespace
+
+std::unique_ptr<Device> make_device(const DeviceConfig& config, const TissueLink& tissue, double haptic_period_s) {
+  switch (config.kind) {
+    case DeviceKind::scripted:
+      return std::make_unique<ScriptedDevice>(device_waypoints(config, tissue));
+    case DeviceKind::hand:
+      return std::make_unique<HandDevice>(device_waypoints(config, tissue), config.hand, haptic_period_s);
     case DeviceKind::replay:
       return std::make_unique<ReplayDevice>(config.replay_file);
     case DeviceKind::browser: {

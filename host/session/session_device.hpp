@@ -10,8 +10,9 @@
 
 namespace tissue::host {
 
-/// The device `config` describes, placed by `tissue`'s rest box. Throws ScenarioError / std::runtime_error.
-std::unique_ptr<Device> make_device(const DeviceConfig& config, const TissueLink& tissue);
+/// The device `config` describes, placed by `tissue`'s rest box; a hand is advanced in ticks of
+/// `haptic_period_s`. Throws ScenarioError / std::runtime_error.
+std::unique_ptr<Device> make_device(const DeviceConfig& config, const TissueLink& tissue, double haptic_period_s);
 /// The browser device's configuration (--mouse).
 DeviceConfig browser_config();
 

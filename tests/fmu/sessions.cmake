@@ -35,3 +35,16 @@ target_include_directories(test_haptic_loop_allocations PRIVATE ${PROJECT_SOURCE
 target_compile_definitions(test_haptic_loop_allocations PRIVATE HAPTIC_LOOP_FMU_PATH="${TISSUE_HAPTICLOOP_FMU_PATH}")
 add_dependencies(test_haptic_loop_allocations hapticloop_fmu_package)
 gtest_discover_tests(test_haptic_loop_allocations PROPERTIES LABELS "fmu" DISCOVERY_TIMEOUT 60)
+
+# The closed-loop harness of issue 20: a simulated hand on HapticLoop.fmu, synthetic tissues sampled
+# at 100 Hz one step late; its tests, and hand_on_walls, the table it measures (docs/BENCHMARKS.md).
+add_library(tissue_hand_on_tissue STATIC ${CMAKE_CURRENT_LIST_DIR}/hand_on_tissue.cpp)
+target_include_directories(tissue_hand_on_tissue PUBLIC ${CMAKE_CURRENT_LIST_DIR})
+target_link_libraries(tissue_hand_on_tissue PUBLIC tissue::host_device tissue::fmi_importer PRIVATE tissue::warnings)
+target_compile_definitions(tissue_hand_on_tissue PRIVATE HAPTIC_LOOP_FMU_PATH="${TISSUE_HAPTICLOOP_FMU_PATH}")
+add_dependencies(tissue_hand_on_tissue hapticloop_fmu_package)
+add_executable(test_haptic_loop_hand ${CMAKE_CURRENT_LIST_DIR}/test_haptic_loop_hand.cpp)
+target_link_libraries(test_haptic_loop_hand PRIVATE tissue_hand_on_tissue GTest::gtest GTest::gtest_main tissue::warnings)
+gtest_discover_tests(test_haptic_loop_hand PROPERTIES LABELS "fmu" DISCOVERY_TIMEOUT 60)
+add_executable(hand_on_walls ${CMAKE_CURRENT_LIST_DIR}/hand_on_walls.cpp)
+target_link_libraries(hand_on_walls PRIVATE tissue_hand_on_tissue tissue::warnings)

@@ -115,7 +115,22 @@ TEST_P(EveryScenario, RunsOfflineAsExpectedAndReproducibly) {
 
 INSTANTIATE_TEST_SUITE_P(HostScenarios, EveryScenario,
                          ::testing::Values("poke_frog", "cut_frog_complete", "cut_frog_partial", "beam_two_cuts",
-                                           "careless_hand", "cantilever_release"));
+                                           "careless_hand", "cantilever_release", "hand_press_frog"));
+
+// The hand's figures reach the summary (device kind "hand"): a hand pressing the frog was in contact,
+// and the device's force did work on it.
+TEST(HandDevice, TheSummarySaysHowTheHandMoved) {
+  const Scenario scenario = load_scenario(SCENARIOS / "hand_press_frog.toml");
+  EXPECT_EQ(scenario.device.kind, DeviceKind::hand);
+  EXPECT_EQ(scenario.device.hand.grip_stiffness_n_per_m, 300.0);
+  const std::filesystem::path dir = fresh_dir("hand_press");
+  const SessionSummary s = run_offline(scenario, dir);
+  ASSERT_TRUE(s.hand.has_value());
+  EXPECT_TRUE(s.contact_seen);
+  EXPECT_NE(s.hand->device_work_j, 0.0);
+  EXPECT_NEAR(s.hand->window_s, 1.0, 1e-9);
+  EXPECT_NE(contents(dir / "summary.json").find("\"hand\": {\"settle_time_s\": "), std::string::npos);
+}
 
 TEST(Replay, ARecordedSessionReplayedIsTheSameSession) {
   const Scenario scripted = load_scenario(SCENARIOS / "cut_frog_partial.toml");
@@ -210,6 +225,17 @@ TEST(ScenarioFile, MistakesAreRefusedNamingTheKey) {
   refused("[scenario]\nduration = 1.0\n[device]\nkind = \"joystick\"\n", "device.kind");
   refused("[scenario\nduration = 1.0\n", "test.toml:1");
   refused("[scenario]\nduration = 1.0\n[device]\nkind = \"udp\"\nport = 70000\n", "device.port");
+  // A simulated hand's settings: refused with the key and the allowed range; only for a hand.
+  const std::string hand = "[scenario]\nduration = 1.0\n[device]\nkind = \"hand\"\n"
+                           "waypoints = [ { t = 0.0, position = [0, 0, 0] } ]\n";
+  refused(hand + "mass = 0.0\n", "test.toml: device.mass: must be in [0.010000, 10.000000] kg, got 0");
+  refused(hand + "mass = nan\n", "device.mass: must be finite");
+  refused(hand + "damping = -1\n", "device.damping: must be in [0.000000, 100.000000] N s/m");
+  refused(hand + "grip_stiffness = 1e12\n", "device.grip_stiffness: must be in");
+  refused(hand + "push = [0, 0, 1e3]\n", "device.push: each component must be in [-50.000000, 50.000000] N");
+  refused(hand + "push = [0, 1]\n", "device.push: must be an array of 3 numbers");
+  refused("[scenario]\nduration = 1.0\n[device]\nwaypoints = [ { t = 0.0, position = [0, 0, 0] } ]\nmass = 0.2\n",
+          "device.mass: is for kind = \"hand\" only");
 }
 
 TEST(ScenarioFile, AParameterTheFmuRefusesStopsTheSessionBeforeItStarts) {
