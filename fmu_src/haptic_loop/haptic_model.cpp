@@ -49,6 +49,7 @@ haptic::RendererSettings renderer_settings(const ValueStore& values) {
   s.max_force_n = values.float64(vr(Vr::max_force));
   s.max_force_rate_n_per_s = values.float64(vr(Vr::max_force_rate));
   s.passivity_control = values.boolean(vr(Vr::passivity_control));
+  s.passivity_min_hand_mass_kg = values.float64(vr(Vr::passivity_min_hand_mass));
   s.velocity_filter_cutoff_hz = values.float64(vr(Vr::velocity_cutoff));
   s.cutting.fracture_toughness_j_per_m2 = values.float64(vr(Vr::fracture_toughness));
   s.cutting.blade_friction_n_per_m = values.float64(vr(Vr::blade_friction));

@@ -33,6 +33,7 @@ enum class Vr : std::uint32_t {
   cutting_smoothing_speed = 8,
   workspace_scale = 9,
   workspace_offset = 10,
+  passivity_min_hand_mass = 11,
   // inputs: the device
   device_position = 20,
   device_orientation = 21,
@@ -128,6 +129,11 @@ constexpr auto inputs() {
   using enum VariableType;
   using enum Variability;
   return std::to_array<VariableInfo>({
+    parameter(Vr::passivity_min_hand_mass, "passivity.minHandMass", float64)
+        .unit("kg")
+        .start("0.05")
+        .describe("The lightest hand the passivity controller must not throw back: its damping is at most this over "
+                  "twice the tick, so that it never reverses the hand's motion within a tick; must be > 0"),
     input(Vr::device_position, "device.position", float64, continuous)
         .unit("m")
         .start("0 0 0")

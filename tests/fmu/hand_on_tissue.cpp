@@ -142,6 +142,7 @@ LoopResult run_hand_on(SyntheticTissue& tissue, const LoopSettings& settings) {
   fmi3Status status = fmu.set_float64("device.maxForce", {settings.max_force_n});
   if (status == fmi3OK) status = fmu.set_float64("device.maxForceRate", {settings.max_force_rate_n_per_s});
   if (status == fmi3OK) status = fmu.set_boolean("passivity.control", {settings.passivity_control});
+  if (status == fmi3OK) status = fmu.set_float64("passivity.minHandMass", {settings.min_hand_mass_kg});
   if (status == fmi3OK) status = fmu.set_float64("device.position", {0.0, 0.0, settings.start_height_m});
   if (status == fmi3OK) status = fmu.enter_initialization_mode(std::nullopt, 0.0, std::nullopt);
   if (status == fmi3OK) status = fmu.exit_initialization_mode();

@@ -93,6 +93,7 @@ struct LoopSettings {
   double max_force_n = 3.3;          ///< device.maxForce
   double max_force_rate_n_per_s = 300.0;  ///< device.maxForceRate (the FMU's start value)
   bool passivity_control = true;
+  double min_hand_mass_kg = 0.05;  ///< passivity.minHandMass (the FMU's start value)
   int sample_ticks = 10;   ///< 100 Hz samples
   double duration_s = 3.0;
 };

@@ -4,6 +4,7 @@
 #include "haptic_loop/core/force_limits.hpp"
 #include "haptic_loop/core/velocity_filter.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 #include <string>
@@ -30,6 +31,9 @@ bool all_finite(const std::array<double, 3>& a) {
 /// Relative slack on |f| <= max_force_n for a restored command: the clamp scales by max / |f|,
 /// which can land an ulp or two above max.
 constexpr double FORCE_BOUND_SLACK = 1e-12;
+/// Below this motion along the normal between two samples the force's secant is noise: keep the
+/// last stiffness estimate (1 um, about a desktop device's position resolution).
+constexpr double MIN_SECANT_MOTION_M = 1e-6;
 
 }  // namespace
 
@@ -38,6 +42,10 @@ void validate(const RendererSettings& settings) {
           "finite and > 0");
   require(settings.max_force_rate_n_per_s > 0.0, "max_force_rate_n_per_s", settings.max_force_rate_n_per_s,
           "> 0 (+infinity: no limit)");
+  require(std::isfinite(settings.passivity_min_hand_mass_kg) && settings.passivity_min_hand_mass_kg > 0.0,
+          "passivity_min_hand_mass_kg", settings.passivity_min_hand_mass_kg, "finite and > 0");
+  require(std::isfinite(settings.max_estimated_stiffness_n_per_m) && settings.max_estimated_stiffness_n_per_m >= 0.0,
+          "max_estimated_stiffness_n_per_m", settings.max_estimated_stiffness_n_per_m, "finite and >= 0");
   require(std::isfinite(settings.velocity_filter_cutoff_hz) && settings.velocity_filter_cutoff_hz > 0.0,
           "velocity_filter_cutoff_hz", settings.velocity_filter_cutoff_hz, "finite and > 0");
   validate(settings.cutting);
@@ -48,9 +56,24 @@ HapticRenderer::HapticRenderer(RendererSettings settings) : m_settings(settings)
 void HapticRenderer::set_sample(const TissueSample& sample) {
   TissueSample prepared = sample;
   const SampleRepair repair = prepare_sample(prepared);  // throws before anything changes
+  if (prepared.contact_active && prepared.contact_stiffness_n_per_m.isZero(0.0)) {
+    prepared.contact_stiffness_n_per_m = estimated_stiffness(prepared);
+  }
   m_sample = prepared;
   m_has_sample = true;
   m_last_sample_repaired = repair.stiffness_repaired;
+}
+
+Eigen::Matrix3d HapticRenderer::estimated_stiffness(const TissueSample& sample) const {
+  const Eigen::Vector3d& n = sample.contact_normal;
+  if (!m_has_sample || !m_sample.contact_active) return Eigen::Matrix3d::Zero();
+  double k_n_per_m = n.dot(m_sample.contact_stiffness_n_per_m * n);  // the last estimate, along n
+  const double moved_m = (sample.tool_position_m - m_sample.tool_position_m).dot(n);
+  if (std::abs(moved_m) > MIN_SECANT_MOTION_M) {
+    const double secant = -(sample.force_on_tool_n - m_sample.force_on_tool_n).dot(n) / moved_m;
+    if (std::isfinite(secant)) k_n_per_m = std::clamp(secant, 0.0, m_settings.max_estimated_stiffness_n_per_m);
+  }
+  return k_n_per_m * (n * n.transpose()).eval();  // n n^T first: exactly symmetric
 }
 
 Eigen::Vector3d HapticRenderer::tick(const Eigen::Vector3d& device_position_m, ToolMode mode, double dt_s) {
@@ -108,7 +131,9 @@ Eigen::Vector3d HapticRenderer::tick(const Eigen::Vector3d& device_position_m, T
   Eigen::Vector3d command_n = limited.force_n;
   Eigen::Vector3d damping_n = Eigen::Vector3d::Zero();
   if (m_settings.passivity_control) {
-    const PassivityAction action = passivity_damping(m_observer.energy_j(), command_n, motion_m_per_s, dt_s);
+    const double max_damping_n_s_per_m = m_settings.passivity_min_hand_mass_kg / (2.0 * dt_s);
+    const PassivityAction action =
+        passivity_damping(m_observer.energy_j(), command_n, motion_m_per_s, dt_s, max_damping_n_s_per_m);
     if (action.damping_n_s_per_m > 0.0) {
       clamped = clamp_magnitude(command_n + action.damping_force_n, m_settings.max_force_n);
       limited = limit_rate(m_commanded_force_n, clamped.force_n, max_change_n);

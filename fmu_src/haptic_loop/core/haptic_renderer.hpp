@@ -43,6 +43,16 @@ struct RendererSettings {
   double max_force_rate_n_per_s = 300.0;
   /// Time-domain passivity controller on (passivity.hpp). The observer always runs.
   bool passivity_control = true;
+  /// The lightest hand the controller must not throw back [kg], finite and > 0: its damping is
+  /// bounded by min_hand_mass / (2 dt), so that over one tick it slows such a hand by at most half
+  /// and never reverses it (passivity.hpp). 0.05 kg: a light grip on a stylus.
+  double passivity_min_hand_mass_kg = 0.05;
+  /// A sample without stiffness (K_c = 0: a tissue that reports its force only) is given the
+  /// stiffness its force changed by along the normal since the last sample in contact, per metre the
+  /// tool moved (the secant; HapticRenderer::set_sample), at most this [N/m], finite and >= 0 (0:
+  /// no estimate, the force is held). 5000 N/m: above what a desktop device renders (a 3D Systems
+  /// Touch ~1-2.3 N/mm).
+  double max_estimated_stiffness_n_per_m = 5000.0;
   /// Cut-off of the velocity low-pass [Hz], finite and > 0 (velocity_filter.hpp). 30 Hz: above the
   /// bandwidth of voluntary hand motion (below about 10 Hz), with a lag of 5.3 ms.
   double velocity_filter_cutoff_hz = 30.0;
@@ -102,6 +112,10 @@ class HapticRenderer {
   /// A new tissue sample arrived; it replaces the previous one (zero-order hold until the next).
   /// Throws std::invalid_argument (naming the field; the renderer unchanged) for a sample that
   /// prepare_sample() refuses: non-finite numbers, negative blade depth, a non-unit normal.
+  /// A sample in contact without stiffness (K_c = 0) gets k n n^T, k the secant of its normal force
+  /// over the tool's normal motion since the previous sample in contact (clamped to [0,
+  /// max_estimated_stiffness_n_per_m]; the previous k while the tool moved less than 1 um): held
+  /// force alone renders a delayed, active spring (issue 20, docs/DESIGN.md).
   void set_sample(const TissueSample& sample);
 
   /// One haptic tick: the device (hand) position now, the tool mode, the tick length. Returns the
@@ -133,6 +147,8 @@ class HapticRenderer {
   double dissipated_energy_j() const { return m_observer.dissipated_j(); }
 
  private:
+  /// k n n^T for a sample without stiffness (set_sample).
+  [[nodiscard]] Eigen::Matrix3d estimated_stiffness(const TissueSample& sample) const;
   RendererSettings m_settings;
   TissueSample m_sample;
   bool m_has_sample = false;

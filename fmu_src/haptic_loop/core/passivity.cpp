@@ -18,12 +18,13 @@ void PassivityObserver::book(const Eigen::Vector3d& held_force_n, const Eigen::V
 void PassivityObserver::drop_credit() { m_energy_j = std::min(m_energy_j, 0.0); }
 
 PassivityAction passivity_damping(double energy_j, const Eigen::Vector3d& force_n,
-                                  const Eigen::Vector3d& velocity_m_per_s, double dt_s) {
+                                  const Eigen::Vector3d& velocity_m_per_s, double dt_s,
+                                  double max_damping_n_s_per_m) {
   PassivityAction action;
   action.predicted_energy_j = energy_j - force_n.dot(velocity_m_per_s) * dt_s;
   const double speed_squared = velocity_m_per_s.squaredNorm();
   if (action.predicted_energy_j >= 0.0 || speed_squared < REST_SPEED_M_PER_S * REST_SPEED_M_PER_S) return action;
-  action.damping_n_s_per_m = -action.predicted_energy_j / (dt_s * speed_squared);
+  action.damping_n_s_per_m = std::min(-action.predicted_energy_j / (dt_s * speed_squared), max_damping_n_s_per_m);
   action.damping_force_n = -action.damping_n_s_per_m * velocity_m_per_s;
   return action;
 }

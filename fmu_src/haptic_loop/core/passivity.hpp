@@ -22,6 +22,17 @@
 // prediction error, |f| |a| dt^2 (a the hand's acceleration); where they hold it back (a deficit
 // larger than max_force_n or the rate limit can dissipate in one tick), the deficit stays booked
 // and is dissipated over the next ticks.
+//
+// The damping is bounded (issue 20): -alpha v held over a tick slows a hand of mass m by about
+// alpha dt / m of its speed, and past 1 it reverses the hand within the tick, so that the "damping"
+// pushes it back the way it came: the controller then gives energy, the observer books a larger
+// deficit and the next alpha is larger still (a 0.2 kg hand on a 2000 N/m wall with maxForce
+// 100 N gained 2 J). alpha <= m_min / (2 dt) slows the lightest hand allowed by at most half per
+// tick, so the damping force opposes the motion over the whole tick and only dissipates; a deficit
+// it cannot take in one tick stays booked and is taken over the next ones. Bounding the
+// controller's dissipation per tick is the idea of Ryu, Kim and Hannaford 2004 ("Sampled- and
+// continuous-time passivity and stability of virtual environments", IEEE Trans. Robotics 20(4)) and
+// of energy-bounding schemes (Kim and Ryu 2004).
 #pragma once
 
 #include <Eigen/Core>
@@ -63,9 +74,11 @@ struct PassivityAction {
 };
 
 /// The controller's step (see the file comment) for the observed energy `energy_j`, the force about
-/// to be commanded and the backward-difference velocity. No action (alpha = 0) when E_pred >= 0 or
-/// the device is at rest (|v| < 1e-9 m/s: no energy can flow, and alpha would overflow).
+/// to be commanded and the backward-difference velocity, alpha at most `max_damping_n_s_per_m`. No
+/// action (alpha = 0) when E_pred >= 0 or the device is at rest (|v| < 1e-9 m/s: no energy can flow,
+/// and alpha would overflow).
 PassivityAction passivity_damping(double energy_j, const Eigen::Vector3d& force_n,
-                                  const Eigen::Vector3d& velocity_m_per_s, double dt_s);
+                                  const Eigen::Vector3d& velocity_m_per_s, double dt_s,
+                                  double max_damping_n_s_per_m);
 
 }  // namespace tissue::haptic

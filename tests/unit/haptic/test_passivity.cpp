@@ -9,6 +9,8 @@
 
 #include <gtest/gtest.h>
 
+#include <limits>
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -16,6 +18,8 @@
 
 namespace tissue::haptic {
 namespace {
+
+constexpr double UNBOUNDED = std::numeric_limits<double>::infinity();  // the controller's damping, unbounded
 
 constexpr double PI = std::numbers::pi;
 constexpr double LATERAL_FREQUENCY_HZ = 0.37;
@@ -116,8 +120,15 @@ void print(const char* name, const WallRun& run) {
       name, run.hand_energy_j, run.hand_pushed_j, run.max_force_n, run.controller_ticks, run.dissipated_j);
 }
 
+// The hand here is driven by position: it goes where the script says whatever the force, a hand of
+// unbounded mass, so the controller's damping need not be bounded (passivity.hpp) and these tests
+// keep its full authority; the bound is tested with hands that answer the force
+// (tests/fmu/test_haptic_loop_hand.cpp).
+constexpr double KINEMATIC_HAND_KG = 1e300;
+
 RendererSettings controller(bool on) {
   RendererSettings settings;
+  settings.passivity_min_hand_mass_kg = KINEMATIC_HAND_KG;
   settings.passivity_control = on;
   return settings;
 }
@@ -156,11 +167,32 @@ TEST(Passivity, WallSampledAt30HzGivesTheHandNoEnergyWithTheControllerOn) {
 TEST(Passivity, WithoutStiffnessTheHeldForceActsAsNegativeDamping) {
   WallScenario s;
   s.reported_stiffness_n_per_m = 0.0;
-  const WallRun off = run_renderer(s, controller(false));
+  RendererSettings held = controller(false);
+  held.max_estimated_stiffness_n_per_m = 0.0;  // the force held, no stiffness estimated
+  const WallRun off = run_renderer(s, held);
   const double predicted_j =
       s.wall_stiffness_n_per_m * (1.0 / s.sample_rate_hz) / 2.0 * contact_speed_squared_integral(s);
   std::printf("  energy to the hand %.3e J, negative-damping prediction %.3e J\n", off.hand_energy_j, predicted_j);
   EXPECT_NEAR(off.hand_energy_j, predicted_j, 0.15 * predicted_j);
+}
+
+// Issue 20: the renderer estimates the missing stiffness from successive samples (the secant of the
+// force along the normal over the tool's motion), so the same force-only wall is rendered as a
+// spring at 1 kHz again, except over the first sample period of each contact (no secant yet, the
+// force held): the hand gains under a quarter of what the held force gives it (measured 0.19), the
+// rest of the way to the reported K_c's hold leak being those first periods.
+TEST(Passivity, AnEstimatedStiffnessRestoresTheSpring) {
+  WallScenario s;
+  s.reported_stiffness_n_per_m = 0.0;
+  const WallRun estimated = run_renderer(s, controller(false));
+  WallScenario exact = s;
+  exact.reported_stiffness_n_per_m = s.wall_stiffness_n_per_m;
+  const WallRun reported = run_renderer(exact, controller(false));
+  const double held_j = s.wall_stiffness_n_per_m * (1.0 / s.sample_rate_hz) / 2.0 * contact_speed_squared_integral(s);
+  std::printf("  energy to the hand: estimated K %.3e J, reported K_c %.3e J, held force (predicted) %.3e J\n",
+              estimated.hand_energy_j, reported.hand_energy_j, held_j);
+  EXPECT_LT(estimated.hand_energy_j, 0.25 * held_j);
+  EXPECT_GT(estimated.hand_energy_j, reported.hand_energy_j);
 }
 
 // Why the observer books f_{k-1} . (x_k - x_{k-1}) and not, as printed, f_k . v_k dt: the same
@@ -186,7 +218,7 @@ TEST(Passivity, PairingEachForceWithTheVelocityOfItsOwnTickLetsTheHoldLeakThroug
     if (held.contact_active) f = unilateral_force(intermediate_force(held, x), held, x);
     const double max_change_n = settings.max_force_rate_n_per_s * s.dt_s;
     f = limit_rate(previous_f, clamp_magnitude(f, settings.max_force_n).force_n, max_change_n).force_n;
-    const PassivityAction action = passivity_damping(energy_j, f, v, s.dt_s);
+    const PassivityAction action = passivity_damping(energy_j, f, v, s.dt_s, UNBOUNDED);
     if (action.damping_n_s_per_m > 0.0) {
       f = limit_rate(previous_f, clamp_magnitude(f + action.damping_force_n, settings.max_force_n).force_n,
                      max_change_n)
@@ -224,7 +256,7 @@ TEST(Passivity, ControllerDampingDissipatesExactlyThePredictedDeficit) {
   const Eigen::Vector3d v(0.02, 0.01, 0.05);
   const double dt = 1e-3;
   const double energy_j = 1e-6;
-  const PassivityAction action = passivity_damping(energy_j, f, v, dt);
+  const PassivityAction action = passivity_damping(energy_j, f, v, dt, UNBOUNDED);
   const double predicted = energy_j - f.dot(v) * dt;  // 1e-6 - 1.0e-4 < 0
   ASSERT_LT(predicted, 0.0);
   EXPECT_DOUBLE_EQ(action.predicted_energy_j, predicted);
@@ -232,8 +264,12 @@ TEST(Passivity, ControllerDampingDissipatesExactlyThePredictedDeficit) {
   // With the damping the predicted balance is exactly zero.
   EXPECT_NEAR(energy_j - (f + action.damping_force_n).dot(v) * dt, 0.0, 1e-18);
   // No deficit, or no motion: no action.
-  EXPECT_EQ(passivity_damping(1.0, f, v, dt).damping_n_s_per_m, 0.0);
-  EXPECT_EQ(passivity_damping(-1.0, f, Eigen::Vector3d::Zero(), dt).damping_n_s_per_m, 0.0);
+  EXPECT_EQ(passivity_damping(1.0, f, v, dt, UNBOUNDED).damping_n_s_per_m, 0.0);
+  EXPECT_EQ(passivity_damping(-1.0, f, Eigen::Vector3d::Zero(), dt, UNBOUNDED).damping_n_s_per_m, 0.0);
+  // Bounded (issue 20): at most the bound, the rest of the deficit left for the next ticks.
+  const PassivityAction bounded = passivity_damping(energy_j, f, v, dt, 10.0);
+  EXPECT_EQ(bounded.damping_n_s_per_m, 10.0);
+  EXPECT_LT(energy_j - (f + bounded.damping_force_n).dot(v) * dt, 0.0);
 }
 
 }  // namespace
