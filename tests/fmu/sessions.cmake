@@ -48,3 +48,8 @@ target_link_libraries(test_haptic_loop_hand PRIVATE tissue_hand_on_tissue GTest:
 gtest_discover_tests(test_haptic_loop_hand PROPERTIES LABELS "fmu" DISCOVERY_TIMEOUT 60)
 add_executable(hand_on_walls ${CMAKE_CURRENT_LIST_DIR}/hand_on_walls.cpp)
 target_link_libraries(hand_on_walls PRIVATE tissue_hand_on_tissue tissue::warnings)
+
+# z_width: the Z-width chart (docs/z_width.png): the stiffest wall each hand settles on, for an ideal
+# 1 kHz wall and through HapticLoop.fmu with and without K_c (a tool, not a test).
+add_executable(z_width ${CMAKE_CURRENT_LIST_DIR}/z_width.cpp)
+target_link_libraries(z_width PRIVATE tissue_hand_on_tissue tissue::host_compare tissue::host_output tissue::warnings)
