@@ -1,12 +1,13 @@
 // z_width: the Z-width chart of issue 20 (docs/z_width.png, docs/BENCHMARKS.md "Haptic loop"). For
 // hands of 0.05, 0.2 and 0.5 kg with damping 0.5, 2 and 5 N s/m, the stiffest wall on which the hand
 // settles (dropped from 1 cm pushing 1 N: below 1 mm/s over the last second of 20 s, no chatter
-// above 10 um; 20 s is ten decay times of the slowest hand, 2 m / b = 2 s), found by bisection in log K over [30, 1e5] N/m, for
+// above 10 um; 20 s is ten decay times of the slowest hand, 2 m / b = 2 s), up to which every wall of
+// a log grid over [30, 1e5] N/m settles, for
 //   (a) an ideal wall rendered directly at 1 kHz (f = -K z held over each tick),
 //   (b) HapticLoop.fmu with 100 Hz samples one step late, carrying K_c,
 //   (c) the same with force-only samples;
 // with Colgate and Schenkel's passivity bound b > K T / 2 (K = 2 b / T) drawn for reference.
-//   z_width [out.png]
+//   z_width [out.png [device.maxForceRate N/s]]
 #include "hand_on_tissue.hpp"
 
 #include "compare/plot_png.hpp"
@@ -14,6 +15,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <functional>
 #include <string>
 #include <vector>
@@ -26,6 +28,7 @@ namespace {
 constexpr double LOWEST_N_PER_M = 30.0, HIGHEST_N_PER_M = 1e5;
 constexpr double SETTLED_SPEED_M_PER_S = 1e-3, CHATTER_M = 10e-6;
 constexpr double RUN_S = 20.0;
+double g_max_force_rate_n_per_s = 300.0;  // device.maxForceRate (the FMU's start value unless given)
 
 bool settled(const HandFigures& f) {
   return f.residual_speed_m_per_s < SETTLED_SPEED_M_PER_S && f.chatter_amplitude_m < CHATTER_M;
@@ -57,28 +60,31 @@ bool settles_through_the_loop(const HandSettings& hand, double stiffness_n_per_m
   LoopSettings settings;
   settings.hand = hand;
   settings.duration_s = RUN_S;
+  settings.max_force_rate_n_per_s = g_max_force_rate_n_per_s;
   Wall wall(stiffness_n_per_m, reports_stiffness);
   const LoopResult r = run_hand_on(wall, settings);
   return r.completed && settled(r.hand);
 }
 
-// The stiffest K in [LOWEST, HIGHEST] that settles, by bisection in log K (assuming that a wall
-// that settles stays settled when softer); LOWEST if none does.
+// The stiffest K of a log grid over [LOWEST, HIGHEST] (24 values, 1.42x apart) below which every
+// wall of the grid settles: stability need not be monotonic in K (the controller, the rate limit),
+// so a bisection could jump over an unstable band; LOWEST / 1.42 if even LOWEST does not settle.
 double z_width(const std::function<bool(double)>& settles) {
-  if (settles(HIGHEST_N_PER_M)) return HIGHEST_N_PER_M;
-  if (!settles(LOWEST_N_PER_M)) return LOWEST_N_PER_M;
-  double low = std::log(LOWEST_N_PER_M), high = std::log(HIGHEST_N_PER_M);
-  for (int k = 0; k < 16; ++k) {
-    const double middle = 0.5 * (low + high);
-    (settles(std::exp(middle)) ? low : high) = middle;
+  constexpr int STEPS = 24;
+  double stable = LOWEST_N_PER_M / std::pow(HIGHEST_N_PER_M / LOWEST_N_PER_M, 1.0 / (STEPS - 1));
+  for (int i = 0; i < STEPS; ++i) {
+    const double k = LOWEST_N_PER_M * std::pow(HIGHEST_N_PER_M / LOWEST_N_PER_M, static_cast<double>(i) / (STEPS - 1));
+    if (!settles(k)) break;
+    stable = k;
   }
-  return std::exp(low);
+  return stable;
 }
 
 }  // namespace
 
 int main(int argc, char** argv) {
   const std::string out = argc > 1 ? argv[1] : "z_width.png";
+  if (argc > 2) g_max_force_rate_n_per_s = std::atof(argv[2]);
   LogLogPlot plot;
   plot.width = 1100;
   plot.height = 700;
