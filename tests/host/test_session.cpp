@@ -115,10 +115,23 @@ TEST_P(EveryScenario, RunsOfflineAsExpectedAndReproducibly) {
 
 INSTANTIATE_TEST_SUITE_P(HostScenarios, EveryScenario,
                          ::testing::Values("poke_frog", "cut_frog_complete", "cut_frog_partial", "beam_two_cuts",
-                                           "careless_hand", "cantilever_release", "hand_press_frog"));
+                                           "careless_hand", "cantilever_release", "hand_press_frog",
+                                           "hand_cut_frog"));
 
 // The hand's figures reach the summary (device kind "hand"): a hand pressing the frog was in contact,
 // and the device's force did work on it.
+// A scalpel drawn by a hand through the frog (E = 1 MPa): the stroke cuts through although the
+// cutting force holds the blade back, and that force only resists: it takes work from the hand
+// (the device's work on the hand is negative), never gives it.
+TEST(HandDevice, AHandDrawnScalpelCutsThroughAndTheBladeTakesWorkFromTheHand) {
+  const Scenario scenario = load_scenario(SCENARIOS / "hand_cut_frog.toml");
+  const SessionSummary s = run_offline(scenario, fresh_dir("hand_cut"));
+  ASSERT_TRUE(s.hand.has_value());
+  EXPECT_GE(s.cut_tets, 50u);
+  EXPECT_LT(s.hand->device_work_j, 0.0);
+  EXPECT_FALSE(s.nan_detected);
+}
+
 TEST(HandDevice, TheSummarySaysHowTheHandMoved) {
   const Scenario scenario = load_scenario(SCENARIOS / "hand_press_frog.toml");
   EXPECT_EQ(scenario.device.kind, DeviceKind::hand);
