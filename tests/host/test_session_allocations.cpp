@@ -34,6 +34,27 @@ void operator delete(void* p, std::size_t) noexcept { std::free(p); }
 namespace tissue::host {
 namespace {
 
+// One real-time session of `scenario_file` (1 s), counting the haptic thread's allocations.
+long haptic_thread_allocations(const char* scenario_file, const char* output) {
+  Scenario scenario = load_scenario(std::filesystem::path(TISSUE_SCENARIO_DIR) / scenario_file);
+  scenario.duration_s = 1.0;  // the probe reaches the back at 0.3 s: contact samples are taken
+  scenario.write_png = false;
+  SessionOptions options;
+  options.output_dir = std::filesystem::temp_directory_path() / output;
+  options.fmu_dir = TISSUE_FMU_DIR;
+  options.realtime_priority = false;
+  options.haptic_thread_started = [] { t_counted = true; };
+  g_counted_allocations = 0;
+  const SessionSummary summary = run_session(scenario, options);
+  // Contact samples reach the haptic thread when the tissue keeps pace (a sanitizer build's tissue
+  // steps overrun their slots many times over, and the probe may never reach the back).
+  if (summary.sim_time_s > 0.9 * scenario.duration_s) {
+    EXPECT_TRUE(summary.contact_seen) << scenario_file;
+  }
+  EXPECT_EQ(summary.haptic_ticks, 1000u) << scenario_file;
+  return g_counted_allocations.load();
+}
+
 TEST(HapticThread, AllocatesNothingAfterStart) {
   // The counter works: an allocation on a counted thread is seen.
   t_counted = true;
@@ -42,22 +63,9 @@ TEST(HapticThread, AllocatesNothingAfterStart) {
   ::operator delete(probe);
   ASSERT_EQ(g_counted_allocations.exchange(0), 1);
 
-  Scenario scenario = load_scenario(std::filesystem::path(TISSUE_SCENARIO_DIR) / "poke_frog.toml");
-  scenario.duration_s = 1.0;  // the probe reaches the back at 0.3 s: contact samples are taken
-  scenario.write_png = false;
-  SessionOptions options;
-  options.output_dir = std::filesystem::temp_directory_path() / "tissue_host_test_allocations";
-  options.fmu_dir = TISSUE_FMU_DIR;
-  options.realtime_priority = false;
-  options.haptic_thread_started = [] { t_counted = true; };
-  const SessionSummary summary = run_session(scenario, options);
-  // Contact samples reach the haptic thread when the tissue keeps pace (a sanitizer build's tissue
-  // steps overrun their slots many times over, and the probe may never reach the back).
-  if (summary.sim_time_s > 0.9 * scenario.duration_s) {
-    EXPECT_TRUE(summary.contact_seen);
-  }
-  EXPECT_EQ(summary.haptic_ticks, 1000u);
-  EXPECT_EQ(g_counted_allocations.load(), 0);
+  EXPECT_EQ(haptic_thread_allocations("poke_frog.toml", "tissue_host_test_allocations"), 0);
+  // A simulated hand as the device (issue 20): its tick and its window of figures allocate nothing.
+  EXPECT_EQ(haptic_thread_allocations("hand_press_frog.toml", "tissue_host_test_allocations_hand"), 0);
 }
 
 }  // namespace
