@@ -35,6 +35,24 @@ std::string status_text(const char* call, fmi3Status status, Fmu3Instance& fmu) 
   return std::string(call) + ": " + status_name(status) + "\n" + fmu.log_text();
 }
 
+bool finite(const Sample& s) {
+  bool all = std::isfinite(s.time_s) && std::isfinite(s.blade_depth_m);
+  for (const Vec3* v : {&s.point_m, &s.normal, &s.force_n, &s.tool_position_m}) {
+    for (const double x : *v) all = all && std::isfinite(x);
+  }
+  for (const double x : s.stiffness_n_per_m) all = all && std::isfinite(x);
+  return all;
+}
+
+Vec3 get3(Fmu3Instance& fmu, fmi3ValueReference ref) {
+  Vec3 v{};
+  const std::array<fmi3ValueReference, 1> vrs{ref};
+  if (fmu.get_float64(vrs, v) != fmi3OK) v.fill(std::numeric_limits<double>::quiet_NaN());
+  return v;
+}
+
+}  // namespace
+
 fmi3Status deliver(Fmu3Instance& fmu, const Sample& s) {
   const Refs& r = refs();
   const std::array<fmi3ValueReference, 7> float_vrs{r.tissue_time,   r.contact_point,     r.contact_normal,
@@ -55,24 +73,6 @@ fmi3Status deliver(Fmu3Instance& fmu, const Sample& s) {
   if (status != fmi3OK) return status;
   return fmu.set_float64(float_vrs, values);
 }
-
-bool finite(const Sample& s) {
-  bool all = std::isfinite(s.time_s) && std::isfinite(s.blade_depth_m);
-  for (const Vec3* v : {&s.point_m, &s.normal, &s.force_n, &s.tool_position_m}) {
-    for (const double x : *v) all = all && std::isfinite(x);
-  }
-  for (const double x : s.stiffness_n_per_m) all = all && std::isfinite(x);
-  return all;
-}
-
-Vec3 get3(Fmu3Instance& fmu, fmi3ValueReference ref) {
-  Vec3 v{};
-  const std::array<fmi3ValueReference, 1> vrs{ref};
-  if (fmu.get_float64(vrs, v) != fmi3OK) v.fill(std::numeric_limits<double>::quiet_NaN());
-  return v;
-}
-
-}  // namespace
 
 const Fmu3& haptic_loop_fmu() {
   static const Fmu3 fmu(HAPTIC_LOOP_FMU_PATH);

@@ -112,6 +112,10 @@ struct LoopResult {
 
 const Fmu3& haptic_loop_fmu();
 
+/// Sets `sample` as the HapticLoop's tissue.* inputs (with tissue.time), as the host's relay does:
+/// one set per type, the booleans first.
+fmi3Status deliver(Fmu3Instance& fmu, const Sample& sample);
+
 /// The hand dropped onto `tissue`, run for `settings.duration_s`.
 LoopResult run_hand_on(SyntheticTissue& tissue, const LoopSettings& settings);
 

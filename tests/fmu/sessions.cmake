@@ -20,9 +20,9 @@ tissue_add_range_test(test_haptic_loop_fmu_ranges FMU ${TISSUE_HAPTICLOOP_FMU_PA
 
 # Sessions on the built HapticLoop.fmu, driven as the real-time host drives it.
 add_executable(test_haptic_loop_sessions ${CMAKE_CURRENT_LIST_DIR}/test_haptic_loop_sessions.cpp)
-target_link_libraries(test_haptic_loop_sessions PRIVATE tissue::fmi_importer tissue::warnings GTest::gtest
-                                                        GTest::gtest_main)
-target_compile_definitions(test_haptic_loop_sessions PRIVATE HAPTIC_LOOP_FMU_PATH="${TISSUE_HAPTICLOOP_FMU_PATH}")
+# The tissue sample and its delivery are the closed-loop harness's (hand_on_tissue.hpp, below).
+target_link_libraries(test_haptic_loop_sessions PRIVATE tissue_hand_on_tissue tissue::fmi_importer tissue::warnings
+                                                        GTest::gtest GTest::gtest_main)
 add_dependencies(test_haptic_loop_sessions hapticloop_fmu_package)
 gtest_discover_tests(test_haptic_loop_sessions PROPERTIES LABELS "fmu" DISCOVERY_TIMEOUT 60)
 

@@ -11,6 +11,7 @@
 // * bad input: refused with fmi3Error (then only a saved state or a reset leads on), except a bad
 //   tissue sample, which is counted and skipped so that the hand's loop keeps running.
 // The tissue is played by the test (a flat wall), so the numbers physics predicts are known exactly.
+#include "hand_on_tissue.hpp"
 #include "importer/fmu3.hpp"
 #include "importer/fmu3_instance.hpp"
 
@@ -39,10 +40,7 @@ constexpr double PI = std::numbers::pi;
 constexpr double TICK_S = 1e-3;                                          // the haptic tick (stepSize's start value)
 constexpr std::int64_t TOOL_NONE = 0, TOOL_PROBE = 1, TOOL_SCALPEL = 2;  // enumeration ToolMode
 
-const Fmu3& haptic_fmu() {
-  static const Fmu3 fmu(HAPTIC_LOOP_FMU_PATH);
-  return fmu;
-}
+const Fmu3& haptic_fmu() { return hand_test::haptic_loop_fmu(); }
 
 double dot(const Vec3& a, const Vec3& b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
 double norm(const Vec3& a) { return std::sqrt(dot(a, a)); }
@@ -76,18 +74,8 @@ const Refs& refs() {
   return r;
 }
 
-/// One tissue output as the host forwards it to the haptic loop (the Tissue FMU's contact.* and
-/// cut.bladeDepth, with the tool position and the time they are for).
-struct TissueOutputs {
-  double time_s = 0.0;
-  bool contact_active = false;
-  Vec3 point_m{};
-  Vec3 normal{0.0, 0.0, 1.0};
-  Vec3 force_n{};
-  std::array<double, 9> stiffness_n_per_m{};  // row-major
-  Vec3 tool_position_m{};
-  double blade_depth_m = 0.0;
-};
+/// One tissue output as the host forwards it to the haptic loop: the harness's sample (hand_on_tissue.hpp).
+using TissueOutputs = hand_test::Sample;
 
 /// What one haptic tick reports (the booleans of the same tick).
 struct TickFlags {
@@ -111,26 +99,7 @@ class HapticSession {
     ASSERT_EQ(m_fmu.exit_initialization_mode(), fmi3OK) << m_fmu.log_text();
   }
 
-  fmi3Status deliver(const TissueOutputs& o) {
-    const Refs& r = refs();
-    const std::array<fmi3ValueReference, 7> float_vrs{r.tissue_time,   r.contact_point,     r.contact_normal,
-                                                      r.contact_force, r.contact_stiffness, r.tool_position_in,
-                                                      r.blade_depth};
-    std::array<double, 23> values{};
-    std::size_t at = 0;
-    values[at++] = o.time_s;
-    for (const double v : o.point_m) values[at++] = v;
-    for (const double v : o.normal) values[at++] = v;
-    for (const double v : o.force_n) values[at++] = v;
-    for (const double v : o.stiffness_n_per_m) values[at++] = v;
-    for (const double v : o.tool_position_m) values[at++] = v;
-    values[at++] = o.blade_depth_m;
-    const std::array<fmi3ValueReference, 1> bool_vrs{r.contact_active};
-    const std::array<fmi3Boolean, 1> active{o.contact_active};
-    const fmi3Status status = m_fmu.set_boolean(bool_vrs, active);
-    if (status != fmi3OK) return status;
-    return m_fmu.set_float64(float_vrs, values);
-  }
+  fmi3Status deliver(const TissueOutputs& o) { return hand_test::deliver(m_fmu, o); }
 
   fmi3Status set_device(const Vec3& position_m, std::int64_t mode) {
     const std::array<fmi3ValueReference, 2> float_vrs{refs().device_position, refs().device_orientation};
