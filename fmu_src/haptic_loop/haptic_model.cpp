@@ -50,6 +50,7 @@ haptic::RendererSettings renderer_settings(const ValueStore& values) {
   s.max_force_rate_n_per_s = values.float64(vr(Vr::max_force_rate));
   s.passivity_control = values.boolean(vr(Vr::passivity_control));
   s.passivity_min_hand_mass_kg = values.float64(vr(Vr::passivity_min_hand_mass));
+  s.contact_damping_n_s_per_m = values.float64(vr(Vr::contact_damping));
   s.velocity_filter_cutoff_hz = values.float64(vr(Vr::velocity_cutoff));
   s.cutting.fracture_toughness_j_per_m2 = values.float64(vr(Vr::fracture_toughness));
   s.cutting.blade_friction_n_per_m = values.float64(vr(Vr::blade_friction));
@@ -91,6 +92,7 @@ void HapticModel::take_tissue_sample() {
   haptic::TissueSample sample;
   sample.time_s = time_s;
   sample.contact_active = m_values.boolean(vr(Vr::tissue_contact_active));
+  sample.surface_near = m_values.boolean(vr(Vr::tissue_contact_near));
   sample.contact_point_m = vector3(m_values, Vr::tissue_contact_point);
   sample.contact_normal = vector3(m_values, Vr::tissue_contact_normal);
   sample.force_on_tool_n = vector3(m_values, Vr::tissue_contact_force);
@@ -242,6 +244,7 @@ void HapticModel::serialize(const fmi3::ModelState& model_state, serial::ByteWri
   const haptic::RendererState& r = state.renderer;
   w.put_bool(r.has_sample);
   w.put_bool(r.contact_active);
+  w.put_bool(r.surface_near);
   w.put(r.sample_time_s);
   put_array(w, r.contact_point_m);
   put_array(w, r.contact_normal);
@@ -268,6 +271,7 @@ std::unique_ptr<fmi3::ModelState> HapticModel::deserialize(serial::ByteReader& r
   haptic::RendererState& s = state->renderer;
   s.has_sample = r.get_bool();
   s.contact_active = r.get_bool();
+  s.surface_near = r.get_bool();
   r.get(s.sample_time_s);
   get_array(r, s.contact_point_m);
   get_array(r, s.contact_normal);

@@ -34,6 +34,7 @@ enum class Vr : std::uint32_t {
   workspace_scale = 9,
   workspace_offset = 10,
   passivity_min_hand_mass = 11,
+  contact_damping = 12,
   // inputs: the device
   device_position = 20,
   device_orientation = 21,
@@ -41,6 +42,7 @@ enum class Vr : std::uint32_t {
   // inputs: the tissue's latest outputs
   tissue_time = 23,
   tissue_contact_active = ports::sample_field("contact.active").haptic_vr,
+  tissue_contact_near = ports::sample_field("contact.near").haptic_vr,
   tissue_contact_point = ports::sample_field("contact.point").haptic_vr,
   tissue_contact_normal = ports::sample_field("contact.normal").haptic_vr,
   tissue_contact_force = ports::sample_field("contact.force").haptic_vr,
@@ -84,7 +86,7 @@ constexpr auto parameters() {
         .describe("Largest force magnitude ever commanded (3.3 N: peak force of a 3D Systems Touch); must be > 0"),
     parameter(Vr::max_force_rate, "device.maxForceRate", float64)
         .unit("N/s")
-        .start("300")
+        .start("1000")
         .describe("Largest change of the commanded force per second, so that a cut releasing tension or a new "
                   "contact never kicks the hand; must be > 0"),
     parameter(Vr::passivity_control, "passivity.control", boolean)
@@ -134,6 +136,13 @@ constexpr auto inputs() {
         .start("0.05")
         .describe("The lightest hand the passivity controller must not throw back: its damping is at most this over "
                   "twice the tick, so that it never reverses the hand's motion within a tick; must be > 0"),
+    parameter(Vr::contact_damping, "contact.damping", float64)
+        .unit("N.s/m")
+        .start("2")
+        .min("0")
+        .describe("Viscous damping of a contact along its normal, so that a light, loosely held hand does not ring on "
+                  "a stiff contact: the loop is stable while contact stiffness x stepSize / 2 < hand damping + this "
+                  "(Gil et al. 2004)"),
     input(Vr::device_position, "device.position", float64, continuous)
         .unit("m")
         .start("0 0 0")

@@ -119,6 +119,13 @@ void TissueModel::validate_parameters(const ValueStore& values) const {
                           " must be in [1, 2^26], got " + std::to_string(rows));
     }
   }
+  if (!(values.float64(vr(Vr::contact_near_margin)) >= 0.0)) {
+    throw VariableError("contact.nearMargin must be >= 0 m, got " + std::to_string(values.float64(vr(Vr::contact_near_margin))));
+  }
+}
+
+void TissueModel::update_near_surface() {
+  m_near = near_surface(*m_tissue, m_values.float64(vr(Vr::contact_near_margin)), m_near_hits);
 }
 
 // --- the model ---
@@ -151,6 +158,7 @@ void TissueModel::build() {
   m_integrator_iterations = 0;
   m_surface_triangles = m_tissue->drawn_triangle_count();
   m_capacity_warned = false;
+  update_near_surface();
 }
 
 void TissueModel::ensure_built() {
@@ -209,12 +217,14 @@ fmi3::StepOutcome TissueModel::do_step(double current_time_s, double step_s) {
                                  static_cast<std::uint64_t>(report.dynamics.linear_iterations);
     } catch (const std::exception& error) {
       update_surface_counters();
+      update_near_surface();
       log_events();
       m_context.log(fmi3::LogLevel::warning, std::string("doStep: an internal step failed: ") + error.what());
       return {false, m_start_time_s + tissue.time_s()};
     }
   }
   update_surface_counters();
+  update_near_surface();
   log_events();
   return {true, m_start_time_s + tissue.time_s()};
 }
@@ -222,6 +232,7 @@ fmi3::StepOutcome TissueModel::do_step(double current_time_s, double step_s) {
 void TissueModel::reset() {
   m_start_time_s = 0.0;
   m_tissue.reset();
+  m_near.reset();
   m_dirty = true;
   m_surface_revision = 0;
 }
@@ -240,19 +251,21 @@ void TissueModel::get_float64(const VariableInfo& info, std::span<double> out) {
       out[0] = m_start_time_s + tissue.time_s();
       return;
     case Vr::contact_point:
-      put3(contact.point_m);
+      put3(!contact.active && m_near ? m_near->point_m : contact.point_m);
       return;
     case Vr::contact_normal:
-      put3(contact.normal);
+      put3(!contact.active && m_near ? m_near->normal : contact.normal);
       return;
     case Vr::contact_force:
       put3(contact.force_on_tool_n);
       return;
-    case Vr::contact_stiffness:
+    case Vr::contact_stiffness: {
+      const Eigen::Matrix3d& k = !contact.active && m_near ? m_near->stiffness_n_per_m : contact.stiffness_n_per_m;
       for (int r = 0; r < 3; ++r) {
-        for (int c = 0; c < 3; ++c) out[static_cast<std::size_t>(3 * r + c)] = contact.stiffness_n_per_m(r, c);
+        for (int c = 0; c < 3; ++c) out[static_cast<std::size_t>(3 * r + c)] = k(r, c);
       }
       return;
+    }
     case Vr::contact_depth:
       out[0] = contact.penetration_depth_m;
       return;
@@ -330,9 +343,10 @@ void TissueModel::get_uint64(const VariableInfo& info, std::span<std::uint64_t> 
 }
 
 void TissueModel::get_boolean(const VariableInfo& info, std::span<bool> out) {
-  if (static_cast<Vr>(info.vr) != Vr::contact_active) Model::get_boolean(info, out);
+  const auto which = static_cast<Vr>(info.vr);
+  if (which != Vr::contact_active && which != Vr::contact_near) Model::get_boolean(info, out);
   ensure_built();
-  out[0] = m_tissue->contact().active;
+  out[0] = which == Vr::contact_active ? m_tissue->contact().active : m_near.has_value();
 }
 
 // --- FMU states ---
@@ -358,6 +372,7 @@ void TissueModel::restore(const fmi3::ModelState& model_state) {
   m_surface_revision = state->surface_revision;
   m_integrator_iterations = state->integrator_iterations;
   m_surface_triangles = m_tissue->drawn_triangle_count();
+  update_near_surface();
 }
 
 void TissueModel::serialize(const fmi3::ModelState& model_state, serial::ByteWriter& writer) const {

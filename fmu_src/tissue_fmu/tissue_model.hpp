@@ -4,6 +4,7 @@
 #pragma once
 
 #include "core/mesh/tet_mesh.hpp"
+#include "core/contact/surface_near.hpp"
 #include "core/tissue.hpp"
 #include "fmi3/model.hpp"
 #include "tissue_fmu/variables.hpp"
@@ -50,6 +51,8 @@ class TissueModel final : public fmi3::Model {
   void build();
   void ensure_built();
   void update_surface_counters();
+  /// contact.near and the surface it reports, after a build, a step or a restore.
+  void update_near_surface();
 
   fmi3::ModelContext m_context;
   const fmi3::ValueStore& m_values;
@@ -60,6 +63,8 @@ class TissueModel final : public fmi3::Model {
   std::uint64_t m_integrator_iterations = 0;  ///< integrator.iterations
   std::uint64_t m_surface_triangles = 0;  // at the last revision check
   bool m_capacity_warned = false;
+  std::optional<NearSurface> m_near;                  ///< contact.near's surface, if near
+  std::vector<SurfaceBvh::SphereHit> m_near_hits;     // scratch of update_near_surface()
 };
 
 }  // namespace tissue::tissue_fmu

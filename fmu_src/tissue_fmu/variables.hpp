@@ -55,6 +55,7 @@ enum class Vr : std::uint32_t {
   tool_mode = 32,
   // outputs
   contact_active = ports::sample_field("contact.active").tissue_vr,
+  contact_near = ports::sample_field("contact.near").tissue_vr,
   contact_point = ports::sample_field("contact.point").tissue_vr,
   contact_normal = ports::sample_field("contact.normal").tissue_vr,
   contact_force = ports::sample_field("contact.force").tissue_vr,
@@ -81,6 +82,7 @@ enum class Vr : std::uint32_t {
   ida_max_step = 74,
   ida_linear_solver = 75,
   tool_max_speed = 76,
+  contact_near_margin = 77,  // issue 20
   tool_applied_position = ports::sample_field("tool.appliedPosition").tissue_vr
 };
 
@@ -335,6 +337,13 @@ constexpr auto integrator_parameters() {
         .start("5")
         .describe("Fastest a hand moves the tool; a pose farther than this times the internal step from the last is "
                   "approached at this speed (the tool is clamped, a scalpel sweeps the path in sub-steps); must be > 0"),
+    parameter(Vr::contact_near_margin, "contact.nearMargin", float64)
+        .unit("m")
+        .start("0.01")
+        .min("0")
+        .describe("A probe not in contact but this close to the surface reports it (contact.near): the nearest surface "
+                  "point, its normal and stiffness, so that a haptic loop feels the surface from the tick the tool "
+                  "crosses it; 0: never"),
 });
 }
 

@@ -184,6 +184,8 @@ HapticLink::HapticLink(const Fmu3& fmu, const std::vector<ParameterSetting>& par
   std::vector<double> max_force;
   expect_ok(m_instance.get_float64("device.maxForce", max_force), m_instance, "HapticLoop: max force");
   m_max_force_n = max_force.at(0);
+  expect_ok(m_instance.get_float64("device.maxForceRate", max_force), m_instance, "HapticLoop: max force rate");
+  m_max_force_rate_n_per_s = max_force.at(0);
 }
 
 void HapticLink::set_device(const DevicePose& pose) {

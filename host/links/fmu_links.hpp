@@ -78,6 +78,7 @@ class HapticLink {
   DoStepResult step(double time_s, double step_s);
   void read(HapticOutputs& outputs);
   [[nodiscard]] double max_force_n() const { return m_max_force_n; }
+  [[nodiscard]] double max_force_rate_n_per_s() const { return m_max_force_rate_n_per_s; }
   [[nodiscard]] Fmu3Instance& instance() { return m_instance; }
 
  private:
@@ -88,7 +89,7 @@ class HapticLink {
   std::array<fmi3ValueReference, 2> m_out_energy{};
   fmi3ValueReference m_out_mode;
   std::array<fmi3ValueReference, 3> m_out_flags{};
-  double m_max_force_n = 0.0;
+  double m_max_force_n = 0.0, m_max_force_rate_n_per_s = 0.0;
 };
 
 }  // namespace tissue::host

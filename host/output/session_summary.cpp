@@ -64,6 +64,7 @@ std::string SessionSummary::to_json() const {
   out << "  \"contact_seen\": " << (contact_seen ? "true" : "false") << ",\n";
   out << "  \"max_device_force_N\": " << max_device_force_n << ",\n";
   out << "  \"device_max_force_N\": " << device_max_force_n << ",\n";
+  out << "  \"device_max_force_rate_N_per_s\": " << device_max_force_rate_n_per_s << ",\n";
   out << "  \"passivity_dissipated_J\": " << passivity_dissipated_j << ",\n";
   out << "  \"passivity_observed_J\": " << passivity_observed_j << ",\n";
   out << "  \"nan_detected\": " << (nan_detected ? "true" : "false") << ",\n";

@@ -33,7 +33,7 @@ struct SessionSummary {
   std::uint64_t tissue_discards = 0, tissue_errors = 0, haptic_errors = 0, samples_not_finite = 0;
   std::uint64_t cut_tets = 0, enriched_vertices = 0;
   bool contact_seen = false;
-  double max_device_force_n = 0.0, device_max_force_n = 0.0;
+  double max_device_force_n = 0.0, device_max_force_n = 0.0, device_max_force_rate_n_per_s = 0.0;
   double passivity_dissipated_j = 0.0, passivity_observed_j = 0.0;
   bool nan_detected = false;
   std::string device_name;

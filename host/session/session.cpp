@@ -104,6 +104,7 @@ class Session final : public SessionSteps {
     m_summary.tissue_step_s = m_schedule.slot_s;
     m_summary.device_name = std::string(m_device->name());
     m_summary.device_max_force_n = m_haptic.max_force_n();
+    m_summary.device_max_force_rate_n_per_s = m_haptic.max_force_rate_n_per_s();
     m_summary.overrun_policy = scenario.overrun_policy == OverrunPolicy::catch_up ? "catch_up" : "skip";
     if (options.write_outputs) std::filesystem::create_directories(options.output_dir);
     // The first tool command: the haptic loop's output before any tick (the device at t = 0).

@@ -39,17 +39,25 @@ inline constexpr std::string_view SAMPLE_TIME_INPUT = "tissue.time";
 inline constexpr auto TISSUE_SAMPLE = std::to_array<SampleField>({
     {"contact.active", "tissue.contactActive", 40, 24, SampleType::boolean, 1, 1, "", "false", "",
      "The probe is in contact with the tissue", "The tissue's contact.active"},
+    {"contact.near", "tissue.contactNear", 69, 32, SampleType::boolean, 1, 1, "", "false", "",
+     "The probe is not in contact but within contact.nearMargin of the surface: contact.point, contact.normal and "
+     "contact.stiffness describe the nearest surface point, so that a haptic loop renders the surface from the "
+     "tick the tool crosses it",
+     "The tissue's contact.near: render the plane through tissue.contactPoint with normal tissue.contactNormal "
+     "and stiffness n^T K_c n from the tick the tool crosses it"},
     {"contact.point", "tissue.contactPoint", 41, 25, SampleType::float64, 3, 1, "m", "0 0 0", "",
-     "Contact point on the deformed surface (the god-object position); meaningful while contact.active",
+     "Contact point on the deformed surface (the god-object position) while contact.active; the nearest surface "
+     "point while contact.near",
      "The tissue's contact.point (god-object on the deformed surface)"},
     {"contact.normal", "tissue.contactNormal", 42, 26, SampleType::float64, 3, 1, "1", "0 0 1", "",
-     "Unit outward surface normal at contact.point; meaningful while contact.active",
+     "Unit outward surface normal at contact.point; meaningful while contact.active or contact.near",
      "The tissue's contact.normal (unit outward normal)"},
     {"contact.force", "tissue.contactForce", 43, 27, SampleType::float64, 3, 1, "N", "0 0 0", "",
      "Force of the tissue on the tool",
      "The tissue's contact.force: f0, the force on the tool at tissue.toolPosition"},
     {"contact.stiffness", "tissue.contactStiffness", 44, 28, SampleType::float64, 3, 3, "N/m", "0 0 0 0 0 0 0 0 0", "",
-     "Contact stiffness K_c (row-major 3x3) for rendering f = f0 + K_c (x - x0) between tissue updates",
+     "Contact stiffness K_c (row-major 3x3) for rendering f = f0 + K_c (x - x0) between tissue updates (while "
+     "contact.near: the element-local model at contact.point)",
      "The tissue's contact.stiffness K_c (row-major 3x3): the force on the tool is rendered as f0 - K_c (x - x0) "
      "against the contact plane"},
     {"tool.appliedPosition", "tissue.toolPosition", 67, 29, SampleType::float64, 3, 1, "m", "0 0 0", "",

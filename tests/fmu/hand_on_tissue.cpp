@@ -19,6 +19,7 @@ fmi3ValueReference vr(std::string_view name) {
 struct Refs {
   fmi3ValueReference device_position = vr("device.position"), device_tool_mode = vr("device.toolMode"),
                      tissue_time = vr("tissue.time"), contact_active = vr("tissue.contactActive"),
+                     contact_near = vr("tissue.contactNear"),
                      contact_point = vr("tissue.contactPoint"), contact_normal = vr("tissue.contactNormal"),
                      contact_force = vr("tissue.contactForce"), contact_stiffness = vr("tissue.contactStiffness"),
                      tool_position_in = vr("tissue.toolPosition"), blade_depth = vr("tissue.bladeDepth"),
@@ -67,9 +68,9 @@ fmi3Status deliver(Fmu3Instance& fmu, const Sample& s) {
   for (const double v : s.stiffness_n_per_m) values[at++] = v;
   for (const double v : s.tool_position_m) values[at++] = v;
   values[at++] = s.blade_depth_m;
-  const std::array<fmi3ValueReference, 1> bool_vrs{r.contact_active};
-  const std::array<fmi3Boolean, 1> active{s.contact_active};
-  const fmi3Status status = fmu.set_boolean(bool_vrs, active);
+  const std::array<fmi3ValueReference, 2> bool_vrs{r.contact_active, r.contact_near};
+  const std::array<fmi3Boolean, 2> flags{s.contact_active, s.contact_near};
+  const fmi3Status status = fmu.set_boolean(bool_vrs, flags);
   if (status != fmi3OK) return status;
   return fmu.set_float64(float_vrs, values);
 }
@@ -83,6 +84,7 @@ Sample Wall::sample(const Vec3& tool_m, double time_s) {
   Sample s;
   s.time_s = time_s;
   s.contact_active = tool_m[2] < 0.0;
+  s.contact_near = m_reports_near && !s.contact_active && tool_m[2] < NEAR_MARGIN_M;
   s.point_m = {tool_m[0], tool_m[1], 0.0};
   if (s.contact_active) s.force_n = {0.0, 0.0, -m_stiffness_n_per_m * tool_m[2]};
   if (m_reports_stiffness) s.stiffness_n_per_m[8] = m_stiffness_n_per_m;
@@ -92,7 +94,7 @@ Sample Wall::sample(const Vec3& tool_m, double time_s) {
 
 std::string Wall::name() const {
   return std::to_string(static_cast<int>(m_stiffness_n_per_m)) + " N/m wall, " +
-         (m_reports_stiffness ? "with K_c" : "force only");
+         (m_reports_stiffness ? "with K_c" : "force only") + (m_reports_near ? "" : ", contact only");
 }
 
 Sample ViscoelasticWall::sample(const Vec3& tool_m, double time_s) {
@@ -103,6 +105,7 @@ Sample ViscoelasticWall::sample(const Vec3& tool_m, double time_s) {
   if (m_last && time_s > m_last->first) rate_m_per_s = (depth_m - m_last->second) / (time_s - m_last->first);
   m_last = {time_s, depth_m};
   s.contact_active = depth_m > 0.0;
+  s.contact_near = !s.contact_active && tool_m[2] < NEAR_MARGIN_M;
   s.point_m = {tool_m[0], tool_m[1], 0.0};
   if (s.contact_active) {
     s.force_n = {0.0, 0.0, std::max(0.0, m_stiffness_n_per_m * depth_m + m_damping_n_s_per_m * rate_m_per_s)};
@@ -123,7 +126,7 @@ Sample CorruptedSamples::sample(const Vec3& tool_m, double time_s) {
   if (m_count % m_period == 0) s.force_n[2] = std::numeric_limits<double>::quiet_NaN();
   if (m_count % m_period == m_period / 2) {
     s.normal = {0.0, 0.0, 2.0};
-    if (s.contact_active) ++m_long_normals_in_contact;
+    if (s.contact_active || s.contact_near) ++m_long_normals_used;
   }
   return s;
 }
@@ -143,6 +146,7 @@ LoopResult run_hand_on(SyntheticTissue& tissue, const LoopSettings& settings) {
   if (status == fmi3OK) status = fmu.set_float64("device.maxForceRate", {settings.max_force_rate_n_per_s});
   if (status == fmi3OK) status = fmu.set_boolean("passivity.control", {settings.passivity_control});
   if (status == fmi3OK) status = fmu.set_float64("passivity.minHandMass", {settings.min_hand_mass_kg});
+  if (status == fmi3OK) status = fmu.set_float64("contact.damping", {settings.contact_damping_n_s_per_m});
   if (status == fmi3OK) status = fmu.set_float64("device.position", {0.0, 0.0, settings.start_height_m});
   if (status == fmi3OK) status = fmu.enter_initialization_mode(std::nullopt, 0.0, std::nullopt);
   if (status == fmi3OK) status = fmu.exit_initialization_mode();
@@ -174,6 +178,9 @@ LoopResult run_hand_on(SyntheticTissue& tissue, const LoopSettings& settings) {
     const DoStepResult stepped = fmu.do_step(t, TICK_S);
     if (stepped.status != fmi3OK && stepped.status != fmi3Warning) return fail("doStep", stepped.status);
     hand.write_force(t, get3(fmu, r.device_force));
+    if (settings.trace != nullptr) {
+      settings.trace->push_back({hand.hand().position_m()[2], hand.hand().velocity_m_per_s()[2]});
+    }
     most_work_j = std::max(most_work_j, hand.hand().device_work_j());
   }
   const std::array<fmi3ValueReference, 1> refused_vrs{r.samples_refused};

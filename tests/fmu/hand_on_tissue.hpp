@@ -22,11 +22,14 @@ namespace tissue::host::hand_test {
 
 using Vec3 = std::array<double, 3>;
 constexpr double TICK_S = 1e-3;
+/// A tool this close above a wall is told the wall is near (the Tissue FMU's contact.nearMargin).
+constexpr double NEAR_MARGIN_M = 0.01;
 
 /// One sample as the host forwards it (the Tissue FMU's sample fields).
 struct Sample {
   double time_s = 0.0;
   bool contact_active = false;
+  bool contact_near = false;  ///< not in contact, the wall within NEAR_MARGIN_M of the tool
   Vec3 point_m{};
   Vec3 normal{0.0, 0.0, 1.0};
   Vec3 force_n{};
@@ -44,17 +47,19 @@ class SyntheticTissue {
 };
 
 /// A wall z < 0 of stiffness K: force K (-z) e_z; K_c = K e_z e_z^T, or 0 (force-only, a tissue that
-/// reports no stiffness).
+/// reports no stiffness). A tool less than NEAR_MARGIN_M above it is told the wall is near, unless
+/// `reports_near` is false (a tissue that reports contact only).
 class Wall final : public SyntheticTissue {
  public:
-  Wall(double stiffness_n_per_m, bool reports_stiffness)
-      : m_stiffness_n_per_m(stiffness_n_per_m), m_reports_stiffness(reports_stiffness) {}
+  Wall(double stiffness_n_per_m, bool reports_stiffness, bool reports_near = true)
+      : m_stiffness_n_per_m(stiffness_n_per_m), m_reports_stiffness(reports_stiffness), m_reports_near(reports_near) {}
   Sample sample(const Vec3& tool_m, double time_s) override;
   [[nodiscard]] std::string name() const override;
 
  private:
   double m_stiffness_n_per_m;
   bool m_reports_stiffness;
+  bool m_reports_near;
 };
 
 /// A Kelvin-Voigt wall whose force lags its depth: K d + c dd/dt (dd/dt from the last two samples),
@@ -77,25 +82,29 @@ class CorruptedSamples final : public SyntheticTissue {
   CorruptedSamples(std::unique_ptr<SyntheticTissue> tissue, int period) : m_tissue(std::move(tissue)), m_period(period) {}
   Sample sample(const Vec3& tool_m, double time_s) override;
   [[nodiscard]] std::string name() const override { return m_tissue->name() + ", corrupted samples"; }
-  /// How many of the samples given a normal of length 2 were in contact (the loop refuses those).
-  [[nodiscard]] long long_normals_in_contact() const { return m_long_normals_in_contact; }
+  /// How many of the samples given a normal of length 2 were in contact or near the surface (the loop
+  /// refuses those: their normal is used).
+  [[nodiscard]] long long_normals_used() const { return m_long_normals_used; }
 
  private:
   std::unique_ptr<SyntheticTissue> m_tissue;
   int m_period;
   long m_count = 0;
-  long m_long_normals_in_contact = 0;
+  long m_long_normals_used = 0;
 };
 
 struct LoopSettings {
   HandSettings hand;                 ///< default: 0.2 kg, 2 N s/m; the harness pushes with push_n
   double start_height_m = 0.01;      ///< the hand starts at rest this far above the wall
   double max_force_n = 3.3;          ///< device.maxForce
-  double max_force_rate_n_per_s = 300.0;  ///< device.maxForceRate (the FMU's start value)
+  double max_force_rate_n_per_s = 1000.0;  ///< device.maxForceRate (the FMU's start value)
   bool passivity_control = true;
   double min_hand_mass_kg = 0.05;  ///< passivity.minHandMass (the FMU's start value)
+  double contact_damping_n_s_per_m = 2.0;  ///< contact.damping (the FMU's start value)
   int sample_ticks = 10;   ///< 100 Hz samples
   double duration_s = 3.0;
+  /// If set, the hand's (z, dz/dt) after every tick.
+  std::vector<std::array<double, 2>>* trace = nullptr;
 };
 
 struct LoopResult {

@@ -329,6 +329,7 @@ TEST(ModelDescription, UnitsAreDefinedWithTheirSiBaseUnits) {
       {"1", {0, 0, 0}},      {"m", {0, 1, 0}},     {"s", {0, 0, 1}},    {"kg", {1, 0, 0}},   {"N", {1, 1, -2}},
       {"Pa", {1, -1, -2}},   {"J", {1, 2, -2}},    {"N/m", {1, 0, -2}}, {"N/s", {1, 1, -3}}, {"J/m2", {1, 0, -2}},
       {"kg/m3", {1, -3, 0}}, {"m/s2", {0, 1, -2}}, {"m/s", {0, 1, -1}}, {"1/s", {0, 0, -1}}, {"Hz", {0, 0, -1}},
+      {"N.s/m", {1, 0, -1}},
   };
   std::map<std::string, std::array<int, 3>> expected;
   for (const pugi::xml_node unit : root().child("UnitDefinitions").children("Unit")) {

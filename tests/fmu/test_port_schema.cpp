@@ -59,7 +59,7 @@ TEST(PortSchema, EverySampleFieldIsATissueOutputAndAHapticInputInTheWrittenXml) 
   }
   const host::SampleLayout layout(ports::TISSUE_SAMPLE, tissue, haptic);
   EXPECT_EQ(layout.number_count(), 3U + 3U + 3U + 9U + 3U + 1U);  // point, normal, force, K_c, x0, blade depth
-  EXPECT_EQ(layout.flag_count(), 1U);                             // contact.active
+  EXPECT_EQ(layout.flag_count(), 2U);                             // contact.active, contact.near
 }
 
 TEST(PortSchema, AFieldAddedToTheSampleAloneAppearsInBothXmlsAndTheHostsRelay) {

@@ -28,7 +28,7 @@ namespace {
 constexpr double LOWEST_N_PER_M = 30.0, HIGHEST_N_PER_M = 1e5;
 constexpr double SETTLED_SPEED_M_PER_S = 1e-3, CHATTER_M = 10e-6;
 constexpr double RUN_S = 20.0;
-double g_max_force_rate_n_per_s = 300.0;  // device.maxForceRate (the FMU's start value unless given)
+double g_max_force_rate_n_per_s = 1000.0;  // device.maxForceRate (the FMU's start value unless given)
 
 bool settled(const HandFigures& f) {
   return f.residual_speed_m_per_s < SETTLED_SPEED_M_PER_S && f.chatter_amplitude_m < CHATTER_M;

@@ -14,4 +14,16 @@ Eigen::Vector3d unilateral_force(const Eigen::Vector3d& force_n, const TissueSam
   return force_n;
 }
 
+Eigen::Vector3d near_surface_force(const TissueSample& sample, const Eigen::Vector3d& tool_position_m) {
+  const Eigen::Vector3d& n = sample.contact_normal;
+  const double depth_m = (sample.contact_point_m - tool_position_m).dot(n);
+  return (n.dot(sample.contact_stiffness_n_per_m * n) * depth_m) * n;
+}
+
+Eigen::Vector3d contact_damping_force(const TissueSample& sample, const Eigen::Vector3d& velocity_m_per_s,
+                                      double damping_n_s_per_m) {
+  const Eigen::Vector3d& n = sample.contact_normal;
+  return (-damping_n_s_per_m * velocity_m_per_s.dot(n)) * n;
+}
+
 }  // namespace tissue::haptic

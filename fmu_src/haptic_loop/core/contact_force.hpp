@@ -27,4 +27,21 @@ Eigen::Vector3d intermediate_force(const TissueSample& sample, const Eigen::Vect
 Eigen::Vector3d unilateral_force(const Eigen::Vector3d& force_n, const TissueSample& sample,
                                  const Eigen::Vector3d& tool_position_m);
 
+/// The surface next to a tool that was not in contact at the sample (TissueSample::surface_near):
+/// the plane through contact_point_m with normal n pushes a tool that crossed it out along n with
+/// (n^T K_c n) times the depth. So a contact starts at the tick the tool crosses the surface, not a
+/// tissue step and a sample period later (issue 20), and the tissue's own contact
+/// (intermediate_force) takes over with the next sample. Ignores the plane's side (unilateral_force()
+/// applies it).
+Eigen::Vector3d near_surface_force(const TissueSample& sample, const Eigen::Vector3d& tool_position_m);
+
+/// Viscous damping of the contact along its normal, -B (v . n) n: what keeps a light, lightly damped
+/// hand from ringing on a stiff contact rendered at a finite rate. A zero-order-hold spring K at tick T
+/// loses damping K T / 2 (Colgate and Schenkel 1997); with a virtual damper B the rendered wall is
+/// stable for a hand of damping b while K T / 2 < b + B (Gil, Avello, Rubio and Florez 2004, "Stability
+/// analysis of a 1 DOF haptic interface using the Routh-Hurwitz criterion", IEEE Trans. Control
+/// Systems Technology 12(4)). Ignores the plane's side (unilateral_force() applies it).
+Eigen::Vector3d contact_damping_force(const TissueSample& sample, const Eigen::Vector3d& velocity_m_per_s,
+                                      double damping_n_s_per_m);
+
 }  // namespace tissue::haptic

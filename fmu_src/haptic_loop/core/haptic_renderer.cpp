@@ -46,6 +46,8 @@ void validate(const RendererSettings& settings) {
           "passivity_min_hand_mass_kg", settings.passivity_min_hand_mass_kg, "finite and > 0");
   require(std::isfinite(settings.max_estimated_stiffness_n_per_m) && settings.max_estimated_stiffness_n_per_m >= 0.0,
           "max_estimated_stiffness_n_per_m", settings.max_estimated_stiffness_n_per_m, "finite and >= 0");
+  require(std::isfinite(settings.contact_damping_n_s_per_m) && settings.contact_damping_n_s_per_m >= 0.0,
+          "contact_damping_n_s_per_m", settings.contact_damping_n_s_per_m, "finite and >= 0");
   require(std::isfinite(settings.velocity_filter_cutoff_hz) && settings.velocity_filter_cutoff_hz > 0.0,
           "velocity_filter_cutoff_hz", settings.velocity_filter_cutoff_hz, "finite and > 0");
   validate(settings.cutting);
@@ -113,9 +115,13 @@ Eigen::Vector3d HapticRenderer::tick(const Eigen::Vector3d& device_position_m, T
 
   // The environment: contact (probe or scalpel, as the sample says) and cutting (scalpel).
   if (m_has_sample && mode != ToolMode::none) {
-    if (m_sample.contact_active) {
-      report.contact_force_n =
-          unilateral_force(intermediate_force(m_sample, device_position_m), m_sample, device_position_m);
+    const bool near_plane = !m_sample.contact_active && m_sample.surface_near && mode == ToolMode::probe;
+    if (m_sample.contact_active || near_plane) {
+      const Eigen::Vector3d spring_n = m_sample.contact_active ? intermediate_force(m_sample, device_position_m)
+                                                               : near_surface_force(m_sample, device_position_m);
+      const Eigen::Vector3d damping_n =
+          contact_damping_force(m_sample, motion_m_per_s, m_settings.contact_damping_n_s_per_m);
+      report.contact_force_n = unilateral_force(spring_n + damping_n, m_sample, device_position_m);
     }
     if (mode == ToolMode::scalpel) {
       report.cutting_force_n =
@@ -163,6 +169,7 @@ RendererState HapticRenderer::save_state() const {
   RendererState state;
   state.has_sample = m_has_sample;
   state.contact_active = m_sample.contact_active;
+  state.surface_near = m_sample.surface_near;
   state.sample_time_s = m_sample.time_s;
   state.contact_point_m = to_array(m_sample.contact_point_m);
   state.contact_normal = to_array(m_sample.contact_normal);
@@ -184,6 +191,7 @@ void HapticRenderer::restore_state(const RendererState& state) {
   TissueSample sample;
   sample.time_s = state.sample_time_s;
   sample.contact_active = state.contact_active;
+  sample.surface_near = state.surface_near;
   sample.contact_point_m = to_vector(state.contact_point_m);
   sample.contact_normal = to_vector(state.contact_normal);
   sample.force_on_tool_n = to_vector(state.force_on_tool_n);

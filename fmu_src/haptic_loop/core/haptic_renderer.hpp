@@ -35,12 +35,12 @@ struct RendererSettings {
   /// (its continuous force is 0.88 N; holding more for long is the device driver's concern).
   double max_force_n = 3.3;
   /// Largest change of the commanded force per second [N/s], > 0; +infinity turns the limiter off.
-  /// 300 N/s: above what a legitimate contact needs (a 2000 N/m contact, about the stiffest a
-  /// desktop device renders, met at a brisk 0.1 m/s asks for 200 N/s, so contacts are not softened),
-  /// while a full-scale step (3.3 N, a cut releasing tension, a contact appearing under a resting
-  /// tool) is spread over 11 ms, i.e. 11 ticks instead of one. An engineering choice, not a
-  /// published figure.
-  double max_force_rate_n_per_s = 300.0;
+  /// 1000 N/s: a 2000 N/m contact (about the stiffest a desktop device renders) met at 0.5 m/s asks
+  /// for this much, so contacts are not softened, while a full-scale step (3.3 N: a cut releasing
+  /// tension) is spread over 3.3 ticks. 300 N/s (the value before issue 20) lagged the contact at the
+  /// 10-20 Hz a hand rings at: it narrowed the Z-width of the lightest hands (0.05 kg, 0.5 N s/m: 717
+  /// against 24396 N/m with K_c; docs/BENCHMARKS.md). An engineering choice, not a published figure.
+  double max_force_rate_n_per_s = 1000.0;
   /// Time-domain passivity controller on (passivity.hpp). The observer always runs.
   bool passivity_control = true;
   /// The lightest hand the controller must not throw back [kg], finite and > 0: its damping is
@@ -53,6 +53,11 @@ struct RendererSettings {
   /// no estimate, the force is held). 5000 N/m: above what a desktop device renders (a 3D Systems
   /// Touch ~1-2.3 N/mm).
   double max_estimated_stiffness_n_per_m = 5000.0;
+  /// Viscous damping of a contact along its normal [N s/m], finite and >= 0 (contact_force.hpp,
+  /// contact_damping_force). 2 N s/m: a 0.5 N s/m hand (a loose grip) then stays stable on contacts up
+  /// to 2 (0.5 + 2) / T = 5000 N/m at T = 1 ms (Gil et al. 2004), above what a desktop device renders;
+  /// at the 0.1 m/s of a brisk poke it adds 0.2 N.
+  double contact_damping_n_s_per_m = 2.0;
   /// Cut-off of the velocity low-pass [Hz], finite and > 0 (velocity_filter.hpp). 30 Hz: above the
   /// bandwidth of voluntary hand motion (below about 10 Hz), with a lag of 5.3 ms.
   double velocity_filter_cutoff_hz = 30.0;
@@ -83,6 +88,7 @@ struct RendererState {
   // The current tissue sample (after prepare_sample), matrices column-major.
   bool has_sample = false;
   bool contact_active = false;
+  bool surface_near = false;
   double sample_time_s = 0.0;
   std::array<double, 3> contact_point_m{};
   std::array<double, 3> contact_normal{};

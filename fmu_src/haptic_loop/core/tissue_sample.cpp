@@ -30,13 +30,14 @@ SampleRepair prepare_sample(TissueSample& sample) {
   require_finite(std::isfinite(sample.blade_depth_m), "blade_depth_m");
   if (sample.blade_depth_m < 0.0) throw std::invalid_argument("TissueSample: blade_depth_m is negative");
   const double normal_length = sample.contact_normal.norm();
-  if (sample.contact_active && !(std::abs(normal_length - 1.0) <= NORMAL_LENGTH_TOLERANCE)) {
+  const bool plane = sample.contact_active || sample.surface_near;
+  if (plane && !(std::abs(normal_length - 1.0) <= NORMAL_LENGTH_TOLERANCE)) {
     throw std::invalid_argument("TissueSample: contact_normal is not a unit vector (length " +
                                 std::to_string(normal_length) + ")");
   }
 
   // Everything checked: from here on the sample is only repaired.
-  if (sample.contact_active) sample.contact_normal /= normal_length;
+  if (plane) sample.contact_normal /= normal_length;
   SampleRepair repair;
   const Eigen::Matrix3d symmetric =
       0.5 * (sample.contact_stiffness_n_per_m + sample.contact_stiffness_n_per_m.transpose());

@@ -17,10 +17,13 @@
 namespace tissue::haptic {
 
 /// One tissue update. A sample with contact_active == false renders no contact force (its contact
-/// fields may then be zero); blade_depth_m is used in scalpel mode whether in contact or not.
+/// fields may then be zero), unless surface_near: then the contact point, normal and K_c describe the
+/// surface next to the tool, rendered as a plane from the tick the tool crosses it (issue 20);
+/// blade_depth_m is used in scalpel mode whether in contact or not.
 struct TissueSample {
   double time_s = 0.0;  ///< tissue time at which it was computed (kept for logging only)
   bool contact_active = false;
+  bool surface_near = false;  ///< not in contact, the surface within the tissue's margin of the tool
   Eigen::Vector3d contact_point_m = Eigen::Vector3d::Zero();  ///< god-object on the deformed surface
   Eigen::Vector3d contact_normal = Eigen::Vector3d::Zero();   ///< unit outward surface normal there
   Eigen::Vector3d force_on_tool_n = Eigen::Vector3d::Zero();  ///< f0: the tissue's force on the tool at x0
@@ -37,7 +40,7 @@ struct SampleRepair {
 
 /// Checks a sample and brings it to the form the renderer relies on, in place:
 /// * refuses (std::invalid_argument naming the field, sample unchanged) any non-finite number, a
-///   negative blade depth, and, when contact is active, a normal whose length differs from 1 by
+///   negative blade depth, and, when contact is active or the surface near, a normal whose length differs from 1 by
 ///   more than 1e-6;
 /// * renormalizes the normal to unit length;
 /// * replaces K_c by the nearest (Frobenius) symmetric PSD matrix: the symmetric part with its

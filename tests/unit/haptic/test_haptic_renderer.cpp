@@ -189,7 +189,9 @@ TEST(HapticRenderer, ATickLengthThatIsNotPositiveAndFiniteIsRefusedStateUnchange
 }
 
 TEST(HapticRenderer, TheToolPutAwayFeelsNothingAfterTheRamp) {
-  HapticRenderer renderer;
+  RendererSettings settings;
+  settings.max_force_rate_n_per_s = 300.0;  // not the default: seven ticks to watch
+  HapticRenderer renderer(settings);
   renderer.set_sample(pressing_contact());
   const Eigen::Vector3d x(0.0, 0.0, -1e-3);
   for (int i = 0; i < 30; ++i) renderer.tick(x, ToolMode::probe, DT_S);
