@@ -11,8 +11,9 @@ namespace {
 // FMU states serialized by the layer: a tag, a version, the model identifier, then the mode, the
 // stored values and the model's own section.
 constexpr std::uint64_t STATE_MAGIC = 0x45544154'53334946ULL;  // "FI3STATE" as little-endian bytes
-// 2: the Tissue FMU saves its iteration count; 3: the HapticLoop's sample says whether the surface is near
-constexpr std::uint32_t STATE_VERSION = 3;
+// 2: the Tissue FMU saves its iteration count; 3: the HapticLoop's sample says whether the surface is
+// near; 4: and carries the contact's damping and the tool's velocity over the tissue's step
+constexpr std::uint32_t STATE_VERSION = 4;
 
 }  // namespace
 

@@ -51,6 +51,7 @@ haptic::RendererSettings renderer_settings(const ValueStore& values) {
   s.passivity_control = values.boolean(vr(Vr::passivity_control));
   s.passivity_min_hand_mass_kg = values.float64(vr(Vr::passivity_min_hand_mass));
   s.contact_damping_n_s_per_m = values.float64(vr(Vr::contact_damping));
+  s.hold_damping = values.boolean(vr(Vr::contact_hold_damping));
   s.velocity_filter_cutoff_hz = values.float64(vr(Vr::velocity_cutoff));
   s.cutting.fracture_toughness_j_per_m2 = values.float64(vr(Vr::fracture_toughness));
   s.cutting.blade_friction_n_per_m = values.float64(vr(Vr::blade_friction));
@@ -97,8 +98,12 @@ void HapticModel::take_tissue_sample() {
   sample.contact_normal = vector3(m_values, Vr::tissue_contact_normal);
   sample.force_on_tool_n = vector3(m_values, Vr::tissue_contact_force);
   const std::span<const double> k = m_values.float64_array(vr(Vr::tissue_contact_stiffness));
+  const std::span<const double> d = m_values.float64_array(vr(Vr::tissue_contact_damping));
   for (int r = 0; r < 3; ++r) {
-    for (int c = 0; c < 3; ++c) sample.contact_stiffness_n_per_m(r, c) = k[static_cast<std::size_t>(3 * r + c)];
+    for (int c = 0; c < 3; ++c) {
+      sample.contact_stiffness_n_per_m(r, c) = k[static_cast<std::size_t>(3 * r + c)];
+      sample.contact_damping_n_s_per_m(r, c) = d[static_cast<std::size_t>(3 * r + c)];
+    }
   }
   sample.tool_position_m = vector3(m_values, Vr::tissue_tool_position);
   sample.blade_depth_m = m_values.float64(vr(Vr::tissue_blade_depth));
@@ -250,6 +255,8 @@ void HapticModel::serialize(const fmi3::ModelState& model_state, serial::ByteWri
   put_array(w, r.contact_normal);
   put_array(w, r.force_on_tool_n);
   put_array(w, r.contact_stiffness_n_per_m);
+  put_array(w, r.contact_damping_n_s_per_m);
+  put_array(w, r.sample_tool_velocity_m_per_s);
   put_array(w, r.tool_position_m);
   w.put(r.blade_depth_m);
   w.put_bool(r.has_previous_position);
@@ -277,6 +284,8 @@ std::unique_ptr<fmi3::ModelState> HapticModel::deserialize(serial::ByteReader& r
   get_array(r, s.contact_normal);
   get_array(r, s.force_on_tool_n);
   get_array(r, s.contact_stiffness_n_per_m);
+  get_array(r, s.contact_damping_n_s_per_m);
+  get_array(r, s.sample_tool_velocity_m_per_s);
   get_array(r, s.tool_position_m);
   r.get(s.blade_depth_m);
   s.has_previous_position = r.get_bool();

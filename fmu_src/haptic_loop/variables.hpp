@@ -35,6 +35,7 @@ enum class Vr : std::uint32_t {
   workspace_offset = 10,
   passivity_min_hand_mass = 11,
   contact_damping = 12,
+  contact_hold_damping = 13,
   // inputs: the device
   device_position = 20,
   device_orientation = 21,
@@ -47,6 +48,7 @@ enum class Vr : std::uint32_t {
   tissue_contact_normal = ports::sample_field("contact.normal").haptic_vr,
   tissue_contact_force = ports::sample_field("contact.force").haptic_vr,
   tissue_contact_stiffness = ports::sample_field("contact.stiffness").haptic_vr,
+  tissue_contact_damping = ports::sample_field("contact.damping").haptic_vr,
   tissue_tool_position = ports::sample_field("tool.appliedPosition").haptic_vr,
   tissue_blade_depth = ports::sample_field("cut.bladeDepth").haptic_vr,
   // outputs
@@ -140,9 +142,13 @@ constexpr auto inputs() {
         .unit("N.s/m")
         .start("2")
         .min("0")
-        .describe("Viscous damping of a contact along its normal, so that a light, loosely held hand does not ring on "
-                  "a stiff contact: the loop is stable while contact stiffness x stepSize / 2 < hand damping + this "
-                  "(Gil et al. 2004)"),
+        .describe("Viscous damping of a contact along its normal on top of the tissue's own (tissue.contactDamping): "
+                  "a floor for a tissue that reports its force only"),
+    parameter(Vr::contact_hold_damping, "contact.holdDamping", boolean)
+        .start("true")
+        .describe("Damp a contact by stepSize times its stiffness: twice what holding the contact's spring over a "
+                  "tick gives the hand (Colgate and Schenkel 1997), so that any hand is stable on any contact (Gil "
+                  "et al. 2004); off only to measure what it does"),
     input(Vr::device_position, "device.position", float64, continuous)
         .unit("m")
         .start("0 0 0")

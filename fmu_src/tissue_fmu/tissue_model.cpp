@@ -259,10 +259,16 @@ void TissueModel::get_float64(const VariableInfo& info, std::span<double> out) {
     case Vr::contact_force:
       put3(contact.force_on_tool_n);
       return;
-    case Vr::contact_stiffness: {
+    case Vr::contact_stiffness:
+    case Vr::contact_damping: {
       const Eigen::Matrix3d& k = !contact.active && m_near ? m_near->stiffness_n_per_m : contact.stiffness_n_per_m;
+      // D_c = beta K_c: pressed at a speed v, the tool feels the quasi-static force plus beta K_n v
+      // (point_contact.hpp; tests/physics/test_contact_press.cpp).
+      const double scale = static_cast<Vr>(info.vr) == Vr::contact_damping
+                               ? tissue.settings().body.damping.stiffness_damping_s
+                               : 1.0;
       for (int r = 0; r < 3; ++r) {
-        for (int c = 0; c < 3; ++c) out[static_cast<std::size_t>(3 * r + c)] = k(r, c);
+        for (int c = 0; c < 3; ++c) out[static_cast<std::size_t>(3 * r + c)] = scale * k(r, c);
       }
       return;
     }

@@ -60,6 +60,7 @@ enum class Vr : std::uint32_t {
   contact_normal = ports::sample_field("contact.normal").tissue_vr,
   contact_force = ports::sample_field("contact.force").tissue_vr,
   contact_stiffness = ports::sample_field("contact.stiffness").tissue_vr,
+  contact_damping = ports::sample_field("contact.damping").tissue_vr,
   contact_depth = 45,
   vertex_count = 50,
   triangle_count = 51,

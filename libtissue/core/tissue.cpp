@@ -424,7 +424,14 @@ void Tissue::restore(const TissueSnapshot& snapshot) {
 
 void Tissue::interact_with_probe(const ToolPose& previous, const ToolPose& current) {
   const bool was_in_contact = m_contact.in_contact();
-  m_contact.update(previous.tip_position_m, current.tip_position_m, m_positions_m, fitted_bvh());
+  // How far the pressed surface rises to a tool drawn back (PointContact::update): the last step's
+  // normal force over its normal contact stiffness.
+  const ContactOutput& last = m_contact_output;
+  const double pressed_n = last.active ? last.force_on_tool_n.dot(last.normal) : 0.0;
+  const double normal_stiffness_n_per_m = last.normal.dot(last.stiffness_n_per_m * last.normal);
+  const double follow_distance_m =
+      pressed_n > 0.0 && normal_stiffness_n_per_m > 0.0 ? pressed_n / normal_stiffness_n_per_m : 0.0;
+  m_contact.update(previous.tip_position_m, current.tip_position_m, m_positions_m, fitted_bvh(), follow_distance_m);
   // The probe touches the mesh's surface only: a cut face's corners are not vertices the spring can
   // act on (they move with the enriched unknowns), so a probe reaching into a crack feels nothing.
   if (m_contact.in_contact() && m_contact.proxy().triangle >= static_cast<int>(m_surface.triangles.size())) {

@@ -60,6 +60,12 @@ inline constexpr auto TISSUE_SAMPLE = std::to_array<SampleField>({
      "contact.near: the element-local model at contact.point)",
      "The tissue's contact.stiffness K_c (row-major 3x3): the force on the tool is rendered as f0 - K_c (x - x0) "
      "against the contact plane"},
+    {"contact.damping", "tissue.contactDamping", 46, 33, SampleType::float64, 3, 3, "N.s/m", "0 0 0 0 0 0 0 0 0", "",
+     "Contact damping D_c (row-major 3x3): the tissue's viscous resistance to the tool's motion at the contact, "
+     "damping.beta times contact.stiffness (the Rayleigh stiffness-proportional part), so that a haptic loop "
+     "renders f = f0 - K_c (x - x0) - D_c (v - v0) between tissue updates (v0: the tool's velocity over the step)",
+     "The tissue's contact.damping D_c (row-major 3x3): the part of f0 that is viscous is rendered at the hand's "
+     "velocity now, -D_c (v - v0), not held at the velocity of a step ago"},
     {"tool.appliedPosition", "tissue.toolPosition", 67, 29, SampleType::float64, 3, 1, "m", "0 0 0", "",
      "The tool position the last step applied, in tool.position's terms: tool.position, unless the hand's top "
      "speed (tool.maxSpeed) held the tool back on its way there",

@@ -22,6 +22,7 @@ struct Refs {
                      contact_near = vr("tissue.contactNear"),
                      contact_point = vr("tissue.contactPoint"), contact_normal = vr("tissue.contactNormal"),
                      contact_force = vr("tissue.contactForce"), contact_stiffness = vr("tissue.contactStiffness"),
+                     contact_damping = vr("tissue.contactDamping"),
                      tool_position_in = vr("tissue.toolPosition"), blade_depth = vr("tissue.bladeDepth"),
                      tool_position = vr("tool.position"), device_force = vr("device.force"),
                      samples_refused = vr("tissue.samplesRefused");
@@ -42,6 +43,7 @@ bool finite(const Sample& s) {
     for (const double x : *v) all = all && std::isfinite(x);
   }
   for (const double x : s.stiffness_n_per_m) all = all && std::isfinite(x);
+  for (const double x : s.damping_n_s_per_m) all = all && std::isfinite(x);
   return all;
 }
 
@@ -56,16 +58,17 @@ Vec3 get3(Fmu3Instance& fmu, fmi3ValueReference ref) {
 
 fmi3Status deliver(Fmu3Instance& fmu, const Sample& s) {
   const Refs& r = refs();
-  const std::array<fmi3ValueReference, 7> float_vrs{r.tissue_time,   r.contact_point,     r.contact_normal,
-                                                    r.contact_force, r.contact_stiffness, r.tool_position_in,
-                                                    r.blade_depth};
-  std::array<double, 23> values{};
+  const std::array<fmi3ValueReference, 8> float_vrs{r.tissue_time,       r.contact_point,   r.contact_normal,
+                                                    r.contact_force,     r.contact_stiffness, r.contact_damping,
+                                                    r.tool_position_in,  r.blade_depth};
+  std::array<double, 32> values{};
   std::size_t at = 0;
   values[at++] = s.time_s;
   for (const double v : s.point_m) values[at++] = v;
   for (const double v : s.normal) values[at++] = v;
   for (const double v : s.force_n) values[at++] = v;
   for (const double v : s.stiffness_n_per_m) values[at++] = v;
+  for (const double v : s.damping_n_s_per_m) values[at++] = v;
   for (const double v : s.tool_position_m) values[at++] = v;
   values[at++] = s.blade_depth_m;
   const std::array<fmi3ValueReference, 2> bool_vrs{r.contact_active, r.contact_near};
@@ -111,13 +114,15 @@ Sample ViscoelasticWall::sample(const Vec3& tool_m, double time_s) {
     s.force_n = {0.0, 0.0, std::max(0.0, m_stiffness_n_per_m * depth_m + m_damping_n_s_per_m * rate_m_per_s)};
   }
   s.stiffness_n_per_m[8] = m_stiffness_n_per_m;
+  if (m_reports_damping) s.damping_n_s_per_m[8] = m_damping_n_s_per_m;
   s.tool_position_m = tool_m;
   return s;
 }
 
 std::string ViscoelasticWall::name() const {
   return std::to_string(static_cast<int>(m_stiffness_n_per_m)) + " N/m viscoelastic wall (" +
-         std::to_string(static_cast<int>(m_damping_n_s_per_m)) + " N s/m)";
+         std::to_string(static_cast<int>(m_damping_n_s_per_m)) + " N s/m" + (m_reports_damping ? "" : ", not reported") +
+         ")";
 }
 
 Sample CorruptedSamples::sample(const Vec3& tool_m, double time_s) {
@@ -147,6 +152,7 @@ LoopResult run_hand_on(SyntheticTissue& tissue, const LoopSettings& settings) {
   if (status == fmi3OK) status = fmu.set_boolean("passivity.control", {settings.passivity_control});
   if (status == fmi3OK) status = fmu.set_float64("passivity.minHandMass", {settings.min_hand_mass_kg});
   if (status == fmi3OK) status = fmu.set_float64("contact.damping", {settings.contact_damping_n_s_per_m});
+  if (status == fmi3OK) status = fmu.set_boolean("contact.holdDamping", {settings.hold_damping});
   if (status == fmi3OK) status = fmu.set_float64("device.position", {0.0, 0.0, settings.start_height_m});
   if (status == fmi3OK) status = fmu.enter_initialization_mode(std::nullopt, 0.0, std::nullopt);
   if (status == fmi3OK) status = fmu.exit_initialization_mode();

@@ -34,6 +34,7 @@ struct Sample {
   Vec3 normal{0.0, 0.0, 1.0};
   Vec3 force_n{};
   std::array<double, 9> stiffness_n_per_m{};  // row-major
+  std::array<double, 9> damping_n_s_per_m{};  // row-major
   Vec3 tool_position_m{};
   double blade_depth_m = 0.0;
 };
@@ -63,16 +64,18 @@ class Wall final : public SyntheticTissue {
 };
 
 /// A Kelvin-Voigt wall whose force lags its depth: K d + c dd/dt (dd/dt from the last two samples),
-/// K_c = K e_z e_z^T.
+/// K_c = K e_z e_z^T, D_c = c e_z e_z^T (or 0: a tissue that does not report its damping).
 class ViscoelasticWall final : public SyntheticTissue {
  public:
-  ViscoelasticWall(double stiffness_n_per_m, double damping_n_s_per_m)
-      : m_stiffness_n_per_m(stiffness_n_per_m), m_damping_n_s_per_m(damping_n_s_per_m) {}
+  ViscoelasticWall(double stiffness_n_per_m, double damping_n_s_per_m, bool reports_damping = true)
+      : m_stiffness_n_per_m(stiffness_n_per_m), m_damping_n_s_per_m(damping_n_s_per_m),
+        m_reports_damping(reports_damping) {}
   Sample sample(const Vec3& tool_m, double time_s) override;
   [[nodiscard]] std::string name() const override;
 
  private:
   double m_stiffness_n_per_m, m_damping_n_s_per_m;
+  bool m_reports_damping;
   std::optional<std::pair<double, double>> m_last;  // (time, depth)
 };
 
@@ -101,6 +104,7 @@ struct LoopSettings {
   bool passivity_control = true;
   double min_hand_mass_kg = 0.05;  ///< passivity.minHandMass (the FMU's start value)
   double contact_damping_n_s_per_m = 2.0;  ///< contact.damping (the FMU's start value)
+  bool hold_damping = true;                ///< contact.holdDamping (the FMU's start value)
   int sample_ticks = 10;   ///< 100 Hz samples
   double duration_s = 3.0;
   /// If set, the hand's (z, dz/dt) after every tick.

@@ -20,6 +20,7 @@
 #include <limits>
 #include <memory>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace tissue::host {
@@ -233,6 +234,65 @@ TEST(TissueFmu, AppliedToolPositionIsWhereTheTissueHeldTheTool) {
   for (int k = 0; k < 10; ++k) s.step();
   ASSERT_EQ(s.fmu().get_float64("tool.appliedPosition", applied), fmi3OK);
   EXPECT_EQ(applied, std::vector<double>(far.begin(), far.end()));
+}
+
+// contact.near (issue 20): a probe within contact.nearMargin (10 mm) of the surface, not touching it,
+// is told where the surface is, so that the haptic loop feels it from the tick it crosses: a point
+// below the probe, the outward normal there (up, on the top of the back) and a positive normal
+// stiffness. Farther, or with the margin 0, nothing; in contact, contact.active instead. The damping
+// the sample carries is damping.beta (1 ms by default) times the stiffness, to the bit.
+TEST(TissueFmu, ReportsTheSurfaceNearAProbeAndTheContactsDamping) {
+  const FrogGeometry g = rest_geometry();
+  const auto flags = [](Session& s) {
+    std::vector<bool> active, near;
+    EXPECT_EQ(s.fmu().get_boolean("contact.active", active), fmi3OK);
+    EXPECT_EQ(s.fmu().get_boolean("contact.near", near), fmi3OK);
+    return std::pair<bool, bool>{active.at(0), near.at(0)};
+  };
+  const auto damping_is_beta_times_stiffness = [](Session& s) {
+    std::vector<double> stiffness, damping;
+    ASSERT_EQ(s.fmu().get_float64("contact.stiffness", stiffness), fmi3OK);
+    ASSERT_EQ(s.fmu().get_float64("contact.damping", damping), fmi3OK);
+    for (std::size_t k = 0; k < 9; ++k) EXPECT_EQ(damping[k], 1e-3 * stiffness[k]) << k;
+  };
+  Session s;
+  s.start();
+  s.tool({g.top[0], g.top[1], g.top[2] + 0.005}, 1);
+  s.step();
+  EXPECT_EQ(flags(s), std::pair(false, true));
+  std::vector<double> point, normal, stiffness;
+  ASSERT_EQ(s.fmu().get_float64("contact.point", point), fmi3OK);
+  ASSERT_EQ(s.fmu().get_float64("contact.normal", normal), fmi3OK);
+  ASSERT_EQ(s.fmu().get_float64("contact.stiffness", stiffness), fmi3OK);
+  EXPECT_LT(point[2], g.top[2] + 0.005);
+  EXPECT_GT(point[2], g.top[2] - 0.01);  // it sagged a little under gravity
+  EXPECT_GT(normal[2], 0.7);
+  EXPECT_NEAR(std::hypot(normal[0], normal[1], normal[2]), 1.0, 1e-12);
+  double normal_stiffness = 0.0;
+  for (std::size_t r = 0; r < 3; ++r) {
+    for (std::size_t c = 0; c < 3; ++c) normal_stiffness += normal[r] * stiffness[3 * r + c] * normal[c];
+  }
+  EXPECT_GT(normal_stiffness, 0.0);
+  damping_is_beta_times_stiffness(s);
+
+  s.tool({g.top[0], g.top[1], g.top[2] + 0.02}, 1);
+  s.step();
+  EXPECT_EQ(flags(s), std::pair(false, false));
+
+  s.tool({g.top[0], g.top[1], g.top[2] - 0.002}, 1);
+  for (int k = 0; k < 5; ++k) s.step();
+  EXPECT_EQ(flags(s), std::pair(true, false));
+  damping_is_beta_times_stiffness(s);
+
+  Session no_margin("no margin");
+  ASSERT_EQ(no_margin.fmu().set_float64("contact.nearMargin", {0.0}), fmi3OK);
+  no_margin.start();
+  no_margin.tool({g.top[0], g.top[1], g.top[2] + 0.005}, 1);
+  no_margin.step();
+  EXPECT_EQ(flags(no_margin), std::pair(false, false));
+  Session negative("negative margin");
+  EXPECT_EQ(negative.fmu().set_float64("contact.nearMargin", {-1e-3}), fmi3Error);
+  EXPECT_NE(negative.fmu().log_text().find("contact.nearMargin"), std::string::npos) << negative.fmu().log_text();
 }
 
 TEST(TissueFmu, SceneSwitchesTurnOffWhatTheyName) {

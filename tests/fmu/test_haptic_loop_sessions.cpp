@@ -734,8 +734,9 @@ TEST_F(HapticBadUse, ABadTissueSampleIsCountedAndSkippedWhileTheLoopRunsOn) {
     }
   }
   EXPECT_TRUE(got == expected) << "the refused samples changed the rendered force";
-  // The last good sample, and contact.damping (2 N s/m, the start value) on the hand's 1 mm/s inward.
-  EXPECT_NEAR(got[149][2], 2.5 + 2000.0 * (1e-3 + 1e-6 * 149 - 1e-3) + 2.0 * 1e-6 / TICK_S, 1e-9);
+  // The last good sample, and the contact's damping on the hand's 1 mm/s inward: contact.damping
+  // (2 N s/m, the start value) and the hold damping, stepSize K_c (contact_force.hpp).
+  EXPECT_NEAR(got[149][2], 2.5 + 2000.0 * (1e-3 + 1e-6 * 149 - 1e-3) + (2.0 + 2000.0 * TICK_S) * 1e-6 / TICK_S, 1e-9);
   EXPECT_EQ(m_session.counter(refs().samples_received), reference.counter(refs().samples_received));
   int warnings = 0;
   for (const LogRecord& record : m_session.fmu().log()) {

@@ -58,7 +58,7 @@ TEST(PortSchema, EverySampleFieldIsATissueOutputAndAHapticInputInTheWrittenXml) 
     EXPECT_EQ(out->unit, field.unit) << field.tissue_output;
   }
   const host::SampleLayout layout(ports::TISSUE_SAMPLE, tissue, haptic);
-  EXPECT_EQ(layout.number_count(), 3U + 3U + 3U + 9U + 3U + 1U);  // point, normal, force, K_c, x0, blade depth
+  EXPECT_EQ(layout.number_count(), 3U + 3U + 3U + 9U + 9U + 3U + 1U);  // point, normal, force, K_c, D_c, x0, blade depth
   EXPECT_EQ(layout.flag_count(), 2U);                             // contact.active, contact.near
 }
 

@@ -12,6 +12,7 @@
 #include <gtest/gtest.h>
 
 #include <array>
+#include <cstdio>
 #include <atomic>
 #include <chrono>
 #include <cmath>
@@ -144,6 +145,80 @@ TEST(HandDevice, TheSummarySaysHowTheHandMoved) {
   EXPECT_NE(s.hand->device_work_j, 0.0);
   EXPECT_NEAR(s.hand->window_s, 1.0, 1e-9);
   EXPECT_NE(contents(dir / "summary.json").find("\"hand\": {\"settle_time_s\": "), std::string::npos);
+}
+
+// The mean device force over the last `window_s` of log.csv [N].
+std::array<double, 3> mean_force_n(const std::filesystem::path& log_file, double window_s) {
+  std::ifstream log(log_file);
+  std::string line;
+  std::getline(log, line);  // header
+  std::vector<std::array<double, 4>> rows;  // time, force
+  while (std::getline(log, line)) {
+    std::vector<double> fields;
+    std::stringstream row(line);
+    for (std::string field; std::getline(row, field, ',');) fields.push_back(std::stod(field));
+    rows.push_back({fields.at(0), fields.at(8), fields.at(9), fields.at(10)});
+  }
+  std::array<double, 3> sum{};
+  int count = 0;
+  for (const auto& r : rows) {
+    if (r[0] < rows.back()[0] - window_s) continue;
+    for (std::size_t a = 0; a < 3; ++a) sum[a] += r[a + 1];
+    ++count;
+  }
+  for (double& x : sum) x /= count;
+  return sum;
+}
+
+// Issue 20: a hand (0.2 kg, 2 N s/m, gripping its path at 300 N/m) presses the frog's back 5 mm and
+// holds, on the frog as shipped (E = 100 kPa) and ten times stiffer and more viscous (1 MPa,
+// damping.beta 10 ms: the contact ~10x stiffer, its viscous force ~100x larger). It settles within
+// 0.5 s of the end of its path, and the force it rests on (the last of 4 s) is the tissue's
+// quasi-static force there: a scripted tool taken to where the hand rests and held for 8 s feels the
+// same force, to the tolerance of the contact tests for the default contact spring, 1.5 k_n / k <=
+// 1.5 x 2.2 / 100 = 3.3% (ContactDynamics, test_contact_dynamics.cpp, which also shows that the
+// settled dynamic contact is the full model's frictionless quasi-static poke). Measured 0.07% and
+// 0.9%; the held tool needs the 8 s at 1 MPa because a tangential load relaxes slowly under the
+// isotropic contact spring (point_contact.hpp).
+TEST(HandDevice, AHandPressingTheFrogSettlesOnTheQuasiStaticForce) {
+  for (const bool stiff : {false, true}) {
+    Scenario scenario = load_scenario(SCENARIOS / "hand_press_frog.toml");
+    scenario.duration_s = 4.0;
+    if (stiff) {
+      scenario.tissue_parameters.push_back({"material.youngModulus", 1e6});
+      scenario.tissue_parameters.push_back({"damping.beta", 0.01});
+    }
+    const std::filesystem::path dir = fresh_dir(stiff ? "hand_press_stiff" : "hand_press_soft");
+    const SessionSummary s = run_offline(scenario, dir);
+    ASSERT_TRUE(s.hand.has_value());
+    const double path_end_s = scenario.device.waypoints.back().time_s;
+    EXPECT_LE(s.hand->settle_time_s - path_end_s, 0.5) << (stiff ? "1 MPa" : "100 kPa");
+    EXPECT_LT(s.hand->residual_speed_m_per_s, 1e-3);
+
+    Scenario held = scenario;
+    held.device.kind = DeviceKind::scripted;
+    held.duration_s = 8.0;
+    const std::array<double, 3> rest = s.hand->mean_position_m;
+    Waypoint above;
+    above.position = {rest[0], rest[1], rest[2] + 0.01};
+    above.mode = ToolMode::probe;
+    Waypoint there = above;
+    there.time_s = 0.5;
+    there.position = rest;
+    Waypoint hold = there;
+    hold.time_s = held.duration_s;
+    held.device.waypoints = {above, there, hold};
+    const std::filesystem::path held_dir = fresh_dir(stiff ? "held_stiff" : "held_soft");
+    (void)run_offline(held, held_dir);
+    const std::array<double, 3> quasi_static = mean_force_n(held_dir / "log.csv", 0.5);
+    const std::array<double, 3>& hand = s.hand->mean_force_n;
+    const double difference = std::hypot(hand[0] - quasi_static[0], hand[1] - quasi_static[1], hand[2] - quasi_static[2]);
+    const double magnitude = std::hypot(quasi_static[0], quasi_static[1], quasi_static[2]);
+    std::printf("  %s: settled %.3f s after the path, residual %.3g mm/s; hand %.4f N, held %.4f N: %.2f%%\n",
+                stiff ? "1 MPa" : "100 kPa", s.hand->settle_time_s - path_end_s, 1e3 * s.hand->residual_speed_m_per_s,
+                std::hypot(hand[0], hand[1], hand[2]), magnitude, 100.0 * difference / magnitude);
+    EXPECT_LE(difference, 0.033 * magnitude);
+  }
 }
 
 TEST(Replay, ARecordedSessionReplayedIsTheSameSession) {

@@ -61,9 +61,15 @@ void HapticRenderer::set_sample(const TissueSample& sample) {
   if (prepared.contact_active && prepared.contact_stiffness_n_per_m.isZero(0.0)) {
     prepared.contact_stiffness_n_per_m = estimated_stiffness(prepared);
   }
+  const bool touching = prepared.contact_active || prepared.surface_near;
+  const bool followed = m_has_sample && (m_sample.contact_active || m_sample.surface_near);
+  const double interval_s = prepared.time_s - m_sample.time_s;
+  m_sample_tool_velocity_m_per_s = touching && followed && interval_s > 0.0
+                                       ? ((prepared.tool_position_m - m_sample.tool_position_m) / interval_s).eval()
+                                       : Eigen::Vector3d::Zero();
   m_sample = prepared;
   m_has_sample = true;
-  m_last_sample_repaired = repair.stiffness_repaired;
+  m_last_sample_repaired = repair.stiffness_repaired || repair.damping_repaired;
 }
 
 Eigen::Matrix3d HapticRenderer::estimated_stiffness(const TissueSample& sample) const {
@@ -120,7 +126,8 @@ Eigen::Vector3d HapticRenderer::tick(const Eigen::Vector3d& device_position_m, T
       const Eigen::Vector3d spring_n = m_sample.contact_active ? intermediate_force(m_sample, device_position_m)
                                                                : near_surface_force(m_sample, device_position_m);
       const Eigen::Vector3d damping_n =
-          contact_damping_force(m_sample, motion_m_per_s, m_settings.contact_damping_n_s_per_m);
+          contact_damping_force(m_sample, motion_m_per_s, m_sample_tool_velocity_m_per_s,
+                                m_settings.contact_damping_n_s_per_m, m_settings.hold_damping ? dt_s : 0.0);
       report.contact_force_n = unilateral_force(spring_n + damping_n, m_sample, device_position_m);
     }
     if (mode == ToolMode::scalpel) {
@@ -175,6 +182,8 @@ RendererState HapticRenderer::save_state() const {
   state.contact_normal = to_array(m_sample.contact_normal);
   state.force_on_tool_n = to_array(m_sample.force_on_tool_n);
   Eigen::Map<Eigen::Matrix3d>(state.contact_stiffness_n_per_m.data()) = m_sample.contact_stiffness_n_per_m;
+  Eigen::Map<Eigen::Matrix3d>(state.contact_damping_n_s_per_m.data()) = m_sample.contact_damping_n_s_per_m;
+  state.sample_tool_velocity_m_per_s = to_array(m_sample_tool_velocity_m_per_s);
   state.tool_position_m = to_array(m_sample.tool_position_m);
   state.blade_depth_m = m_sample.blade_depth_m;
   state.has_previous_position = m_has_previous_position;
@@ -196,15 +205,18 @@ void HapticRenderer::restore_state(const RendererState& state) {
   sample.contact_normal = to_vector(state.contact_normal);
   sample.force_on_tool_n = to_vector(state.force_on_tool_n);
   sample.contact_stiffness_n_per_m = Eigen::Map<const Eigen::Matrix3d>(state.contact_stiffness_n_per_m.data());
+  sample.contact_damping_n_s_per_m = Eigen::Map<const Eigen::Matrix3d>(state.contact_damping_n_s_per_m.data());
   sample.tool_position_m = to_vector(state.tool_position_m);
   sample.blade_depth_m = state.blade_depth_m;
   // The saved sample was prepared already: check it the same way, but keep its exact numbers so
   // that a restored renderer continues bitwise as the saved one.
   TissueSample check = sample;
-  if (prepare_sample(check).stiffness_repaired) {
-    throw std::invalid_argument("RendererState: contact_stiffness_n_per_m is not symmetric positive semi-definite");
+  const SampleRepair repair = prepare_sample(check);
+  if (repair.stiffness_repaired || repair.damping_repaired) {
+    throw std::invalid_argument("RendererState: the contact stiffness or damping is not symmetric positive semi-definite");
   }
-  const bool motion_finite = all_finite(state.previous_position_m) && all_finite(state.filtered_velocity_m_per_s);
+  const bool motion_finite = all_finite(state.previous_position_m) && all_finite(state.filtered_velocity_m_per_s) &&
+                             all_finite(state.sample_tool_velocity_m_per_s);
   const bool command_finite = all_finite(state.commanded_force_n) && all_finite(state.commanded_damping_n);
   if (!motion_finite || !command_finite || !std::isfinite(state.observed_energy_j) ||
       !std::isfinite(state.dissipated_energy_j)) {
@@ -215,6 +227,7 @@ void HapticRenderer::restore_state(const RendererState& state) {
   }
 
   m_sample = sample;
+  m_sample_tool_velocity_m_per_s = to_vector(state.sample_tool_velocity_m_per_s);
   m_has_sample = state.has_sample;
   m_last_sample_repaired = false;
   m_has_previous_position = state.has_previous_position;

@@ -53,11 +53,16 @@ struct RendererSettings {
   /// no estimate, the force is held). 5000 N/m: above what a desktop device renders (a 3D Systems
   /// Touch ~1-2.3 N/mm).
   double max_estimated_stiffness_n_per_m = 5000.0;
-  /// Viscous damping of a contact along its normal [N s/m], finite and >= 0 (contact_force.hpp,
-  /// contact_damping_force). 2 N s/m: a 0.5 N s/m hand (a loose grip) then stays stable on contacts up
-  /// to 2 (0.5 + 2) / T = 5000 N/m at T = 1 ms (Gil et al. 2004), above what a desktop device renders;
-  /// at the 0.1 m/s of a brisk poke it adds 0.2 N.
+  /// Viscous damping of a contact along its normal [N s/m], finite and >= 0, on top of the tissue's
+  /// own (contact_force.hpp, contact_damping_force). 2 N s/m: a floor for a tissue that reports its
+  /// force only (no K_c, no D_c): its contacts start a sample late and the stiffness is estimated, and
+  /// 2 N s/m keeps what the one-port gives the hands of issue 20 to 2.9 mJ (11 mJ without); at the
+  /// 0.1 m/s of a brisk poke it adds 0.2 N.
   double contact_damping_n_s_per_m = 2.0;
+  /// Damp a contact by T K_c (T the tick): gives back twice what holding the contact's spring over a
+  /// tick gives the hand, so that any hand is stable on any contact (contact_damping_force). Off only
+  /// to measure what it does.
+  bool hold_damping = true;
   /// Cut-off of the velocity low-pass [Hz], finite and > 0 (velocity_filter.hpp). 30 Hz: above the
   /// bandwidth of voluntary hand motion (below about 10 Hz), with a lag of 5.3 ms.
   double velocity_filter_cutoff_hz = 30.0;
@@ -94,6 +99,8 @@ struct RendererState {
   std::array<double, 3> contact_normal{};
   std::array<double, 3> force_on_tool_n{};
   std::array<double, 9> contact_stiffness_n_per_m{};
+  std::array<double, 9> contact_damping_n_s_per_m{};
+  std::array<double, 3> sample_tool_velocity_m_per_s{};  ///< v0 (HapticRenderer::sample_tool_velocity_m_per_s)
   std::array<double, 3> tool_position_m{};
   double blade_depth_m = 0.0;
   // Motion.
@@ -118,6 +125,7 @@ class HapticRenderer {
   /// A new tissue sample arrived; it replaces the previous one (zero-order hold until the next).
   /// Throws std::invalid_argument (naming the field; the renderer unchanged) for a sample that
   /// prepare_sample() refuses: non-finite numbers, negative blade depth, a non-unit normal.
+  /// The tool's velocity over the tissue step (sample_tool_velocity_m_per_s) is estimated here.
   /// A sample in contact without stiffness (K_c = 0) gets k n n^T, k the secant of its normal force
   /// over the tool's normal motion since the previous sample in contact (clamped to [0,
   /// max_estimated_stiffness_n_per_m]; the previous k while the tool moved less than 1 um): held
@@ -145,6 +153,10 @@ class HapticRenderer {
   bool has_sample() const { return m_has_sample; }
   /// The sample being rendered, as prepare_sample() left it.
   const TissueSample& sample() const { return m_sample; }
+  /// v0: the tool's velocity over the tissue step the sample ends, (x0 - x0_previous) / (t - t_previous)
+  /// from the last two samples (both in contact or near the surface, in increasing time); 0 otherwise.
+  /// The viscous part of f0 is D_c v0; the renderer replaces it by D_c v, the hand's velocity now.
+  const Eigen::Vector3d& sample_tool_velocity_m_per_s() const { return m_sample_tool_velocity_m_per_s; }
   /// Whether prepare_sample() had to project the last sample's K_c to symmetric PSD.
   bool last_sample_repaired() const { return m_last_sample_repaired; }
   /// Energy the renderer (the one-port behind the device) has absorbed [J]; see passivity.hpp.
@@ -157,6 +169,7 @@ class HapticRenderer {
   [[nodiscard]] Eigen::Matrix3d estimated_stiffness(const TissueSample& sample) const;
   RendererSettings m_settings;
   TissueSample m_sample;
+  Eigen::Vector3d m_sample_tool_velocity_m_per_s = Eigen::Vector3d::Zero();
   bool m_has_sample = false;
   bool m_last_sample_repaired = false;
   bool m_has_previous_position = false;

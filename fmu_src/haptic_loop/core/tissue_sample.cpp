@@ -11,8 +11,23 @@ namespace tissue::haptic {
 namespace {
 
 constexpr double NORMAL_LENGTH_TOLERANCE = 1e-6;
-/// K_c differing from its PSD projection by less than this (relative, Frobenius) is rounding.
+/// K_c or D_c differing from its PSD projection by less than this (relative, Frobenius) is rounding.
 constexpr double STIFFNESS_ROUNDING = 1e-12;
+
+/// `matrix` replaced by its nearest symmetric PSD matrix; whether that changed it beyond rounding.
+bool project_to_symmetric_psd(Eigen::Matrix3d& matrix) {
+  const Eigen::Matrix3d symmetric = 0.5 * (matrix + matrix.transpose());
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eigen(symmetric);
+  Eigen::Vector3d eigenvalues = eigen.eigenvalues();
+  Eigen::Matrix3d projected = symmetric;
+  if (eigenvalues.minCoeff() < 0.0) {
+    eigenvalues = eigenvalues.cwiseMax(0.0);
+    projected = eigen.eigenvectors() * eigenvalues.asDiagonal() * eigen.eigenvectors().transpose();
+  }
+  const bool repaired = (projected - matrix).norm() > STIFFNESS_ROUNDING * matrix.norm();
+  matrix = projected;
+  return repaired;
+}
 
 void require_finite(bool finite, const char* field) {
   if (!finite) throw std::invalid_argument(std::string("TissueSample: ") + field + " is not finite");
@@ -26,6 +41,7 @@ SampleRepair prepare_sample(TissueSample& sample) {
   require_finite(sample.contact_normal.allFinite(), "contact_normal");
   require_finite(sample.force_on_tool_n.allFinite(), "force_on_tool_n");
   require_finite(sample.contact_stiffness_n_per_m.allFinite(), "contact_stiffness_n_per_m");
+  require_finite(sample.contact_damping_n_s_per_m.allFinite(), "contact_damping_n_s_per_m");
   require_finite(sample.tool_position_m.allFinite(), "tool_position_m");
   require_finite(std::isfinite(sample.blade_depth_m), "blade_depth_m");
   if (sample.blade_depth_m < 0.0) throw std::invalid_argument("TissueSample: blade_depth_m is negative");
@@ -39,18 +55,8 @@ SampleRepair prepare_sample(TissueSample& sample) {
   // Everything checked: from here on the sample is only repaired.
   if (plane) sample.contact_normal /= normal_length;
   SampleRepair repair;
-  const Eigen::Matrix3d symmetric =
-      0.5 * (sample.contact_stiffness_n_per_m + sample.contact_stiffness_n_per_m.transpose());
-  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eigen(symmetric);
-  Eigen::Vector3d eigenvalues = eigen.eigenvalues();
-  Eigen::Matrix3d projected = symmetric;
-  if (eigenvalues.minCoeff() < 0.0) {
-    eigenvalues = eigenvalues.cwiseMax(0.0);
-    projected = eigen.eigenvectors() * eigenvalues.asDiagonal() * eigen.eigenvectors().transpose();
-  }
-  const double change = (projected - sample.contact_stiffness_n_per_m).norm();
-  repair.stiffness_repaired = change > STIFFNESS_ROUNDING * sample.contact_stiffness_n_per_m.norm();
-  sample.contact_stiffness_n_per_m = projected;
+  repair.stiffness_repaired = project_to_symmetric_psd(sample.contact_stiffness_n_per_m);
+  repair.damping_repaired = project_to_symmetric_psd(sample.contact_damping_n_s_per_m);
   return repair;
 }
 

@@ -29,6 +29,9 @@ struct TissueSample {
   Eigen::Vector3d force_on_tool_n = Eigen::Vector3d::Zero();  ///< f0: the tissue's force on the tool at x0
   /// K_c [N/m], 3x3, symmetric positive semi-definite: d(force on tool) = -K_c d(tool position).
   Eigen::Matrix3d contact_stiffness_n_per_m = Eigen::Matrix3d::Zero();
+  /// D_c [N s/m], 3x3, symmetric positive semi-definite: d(force on tool) = -D_c d(tool velocity); the
+  /// viscous part of f0 is D_c times the tool's velocity over the tissue's step.
+  Eigen::Matrix3d contact_damping_n_s_per_m = Eigen::Matrix3d::Zero();
   Eigen::Vector3d tool_position_m = Eigen::Vector3d::Zero();  ///< x0: the tool position f0 is for
   double blade_depth_m = 0.0;  ///< length of the scalpel's edge inside the tissue (0: not cutting)
 };
@@ -36,6 +39,7 @@ struct TissueSample {
 /// What prepare_sample() had to repair.
 struct SampleRepair {
   bool stiffness_repaired = false;  ///< K_c was not symmetric PSD beyond rounding and was projected
+  bool damping_repaired = false;    ///< D_c, the same
 };
 
 /// Checks a sample and brings it to the form the renderer relies on, in place:
@@ -43,7 +47,7 @@ struct SampleRepair {
 ///   negative blade depth, and, when contact is active or the surface near, a normal whose length differs from 1 by
 ///   more than 1e-6;
 /// * renormalizes the normal to unit length;
-/// * replaces K_c by the nearest (Frobenius) symmetric PSD matrix: the symmetric part with its
+/// * replaces K_c and D_c each by the nearest (Frobenius) symmetric PSD matrix: the symmetric part with its
 ///   negative eigenvalues set to 0. An antisymmetric part (a curl force field) or a negative
 ///   eigenvalue would make the rendered contact an energy source on a closed path; removing them
 ///   only removes that. No allocation (fixed-size 3x3 eigen-solver).

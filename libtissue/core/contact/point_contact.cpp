@@ -43,7 +43,7 @@ bool PointContact::inside_by_parity(const Eigen::Vector3d& point_m, const Eigen:
 PointContact::PointContact(PointContactSettings settings) : m_settings(settings) { validate(m_settings); }
 
 bool PointContact::update(const Eigen::Vector3d& hip_previous_m, const Eigen::Vector3d& hip_m,
-                          const Eigen::VectorXd& positions_m, const SurfaceBvh& surface) {
+                          const Eigen::VectorXd& positions_m, const SurfaceBvh& surface, double follow_distance_m) {
   if (!hip_m.allFinite() || !hip_previous_m.allFinite()) {
     throw std::invalid_argument("point contact: the tool tip position is not finite");
   }
@@ -59,6 +59,7 @@ bool PointContact::update(const Eigen::Vector3d& hip_previous_m, const Eigen::Ve
 
   m_hip_m = hip_m;
   SurfacePoint start = m_proxy;
+  const bool was_in_contact = m_in_contact;
   if (!m_in_contact) {
     surface.intersect_segment(hip_previous_m, hip_m, positions_m, m_segment_hits);
     const Eigen::Vector3d motion = hip_m - hip_previous_m;
@@ -91,7 +92,9 @@ bool PointContact::update(const Eigen::Vector3d& hip_previous_m, const Eigen::Ve
 
   const SurfaceProjection projection =
       slide_to_closest_point(hip_m, start, surface.triangles(), m_adjacency, positions_m);
-  if ((hip_m - projection.position_m).dot(projection.normal) >= 0.0) {  // the HIP is outside: separation
+  const double outside_m = (hip_m - projection.position_m).dot(projection.normal);
+  const double follows_m = was_in_contact && std::isfinite(follow_distance_m) ? follow_distance_m : 0.0;
+  if (outside_m >= follows_m) {  // the HIP is outside, farther than the surface follows: separation
     m_in_contact = false;
     return false;
   }

@@ -75,11 +75,17 @@ class PointContact {
   ///   at most that deep: a tool switched on deep inside the body does not snap to its surface.
   /// * In contact (or just started): the proxy slides over the current surface to the locally
   ///   closest point to the HIP (slide_to_closest_point; frictionless); contact ends when the HIP
-  ///   is on the outer side of the surface there (pseudo-normal test).
+  ///   is on the outer side of the surface there (pseudo-normal test) by `follow_distance_m` or more.
+  ///   A pressed surface follows a tool drawn back by less than its quasi-static rebound, f_n / k_n
+  ///   (the caller's estimate from the last step's force and contact stiffness; 0: it follows
+  ///   nothing): the surface here is the last step's, still pressed, and would rise to the tool within
+  ///   the step. Ending the contact instead lets the released surface spring up through the tool
+  ///   unresisted for a whole step, and the next step finds the tool deep inside (issue 20: a hand
+  ///   easing off a 1 N press by 10 um, under 1 mm/s, got 13 N back and chattered).
   /// Returns in_contact(). Throws std::invalid_argument (state unchanged) for a non-finite HIP or
   /// positions that do not cover the surface's vertices.
   bool update(const Eigen::Vector3d& hip_previous_m, const Eigen::Vector3d& hip_m, const Eigen::VectorXd& positions_m,
-              const SurfaceBvh& surface);
+              const SurfaceBvh& surface, double follow_distance_m = 0.0);
   /// Ends a contact (e.g. the tool mode changed).
   void release() { m_in_contact = false; }
 

@@ -1,11 +1,14 @@
 // The intermediate representation and the unilateral constraint (contact_force.hpp): the rendered
-// force is f0 - K_c (x - x0) inside the contact plane, nothing outside, and never a pull inward.
+// force is f0 - K_c (x - x0) inside the contact plane and as far out as the pressed surface rebounds,
+// nothing beyond, and never a pull inward.
 #include "haptic_loop/core/contact_force.hpp"
 #include "haptic_loop/core/haptic_renderer.hpp"
 
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
+
+#include <limits>
 
 namespace tissue::haptic {
 namespace {
@@ -66,15 +69,40 @@ TEST(ContactForce, PushingDeeperIncreasesTheOutwardForceByTheNormalStiffness) {
   EXPECT_NEAR(gain_n, d * normal_stiffness, 1e-12);
 }
 
-TEST(ContactForce, OutsideTheContactPlaneThereIsNoForce) {
+/// How far the pressed surface of `s` follows the tool back: f_n / k_n.
+double rebound_m(const TissueSample& s) {
+  const Eigen::Vector3d& n = s.contact_normal;
+  return s.force_on_tool_n.dot(n) / n.dot(s.contact_stiffness_n_per_m * n);
+}
+
+TEST(ContactForce, BeyondThePressedSurfacesReboundThereIsNoForce) {
   const TissueSample s = tilted_contact();
   const Eigen::Vector3d tangent = s.contact_normal.unitOrthogonal();
-  for (double height_m : {1e-9, 1e-4, 1e-2}) {
-    const Eigen::Vector3d x = s.contact_point_m + height_m * s.contact_normal + 3e-3 * tangent;
+  for (double beyond : {1e-9, 0.1, 10.0}) {
+    const Eigen::Vector3d x = s.contact_point_m + (1.0 + beyond) * rebound_m(s) * s.contact_normal + 3e-3 * tangent;
     // The linear model would still push (it extrapolates beyond the surface)...
     ASSERT_GT(intermediate_force(s, x).norm(), 0.0);
     // ...the constraint does not.
-    EXPECT_EQ(unilateral_force(intermediate_force(s, x), s, x), Eigen::Vector3d::Zero()) << height_m;
+    EXPECT_EQ(unilateral_force(intermediate_force(s, x), s, x), Eigen::Vector3d::Zero()) << beyond;
+  }
+}
+
+// The sample's contact point is the surface pressed down to within microns of the tool (the Tissue's
+// contact spring), so a tool drawn back by more than that is outside the plane through it; the
+// pressed surface follows it back (its rebound f_n / k_n, 1 mm here), and the force is the linear
+// model's, not nothing (issue 20: the hand easing off a press lost the whole force and chattered).
+TEST(ContactForce, APressedSurfaceFollowsTheToolBackByItsRebound) {
+  TissueSample s = tilted_contact();
+  const Eigen::Vector3d& n = s.contact_normal;
+  s.tool_position_m = s.contact_point_m - 1e-6 * n;  // the spring's gap
+  s.force_on_tool_n = 1.0 * n;
+  ASSERT_GT(rebound_m(s), 1e-4);
+  for (double back_m : {1e-5, 1e-4, 0.9 * rebound_m(s)}) {
+    const Eigen::Vector3d x = s.contact_point_m + back_m * n;
+    ASSERT_GT((x - s.contact_point_m).dot(n), 0.0);  // outside the plane through the contact point
+    const Eigen::Vector3d f = unilateral_force(intermediate_force(s, x), s, x);
+    EXPECT_LT((f - expected_force(s, x)).norm(), 1e-12) << back_m;
+    EXPECT_GT(f.dot(n), 0.0) << back_m;
   }
 }
 
@@ -131,6 +159,53 @@ TEST(ContactForce, TheRendererHoldsTheContactForceOnAStillTool) {
   renderer.set_sample(released);
   for (int i = 0; i < 50; ++i) f = renderer.tick(x, ToolMode::probe, 1e-3);
   EXPECT_EQ(f, Eigen::Vector3d::Zero());
+}
+
+}  // namespace
+}  // namespace tissue::haptic
+
+namespace tissue::haptic {
+namespace {
+
+// The tissue's viscosity (D_c): f0 holds D_c v0, v0 the tool's velocity over the tissue's step, which
+// the renderer takes from the last two samples' tool positions and times; it renders f0 - K_c (x -
+// x0) - D_c (v - v0) with v the hand's velocity now (backward difference). A hand moving on as the
+// tool did feels f0 at x0; a hand stopping feels the viscous part gone. Limits, controller and the
+// loop's own damping off so that the formula is all there is. Tolerance 1e-9 N: velocities are
+// differences of positions ~1e-2 m over 1e-3 s (rounding ~1e-13 m/s) times D_c ~ 10 N s/m.
+TEST(ContactForce, TheTissuesViscosityIsRenderedAtTheVelocityNow) {
+  RendererSettings settings;
+  settings.max_force_n = 100.0;
+  settings.max_force_rate_n_per_s = std::numeric_limits<double>::infinity();
+  settings.passivity_control = false;
+  settings.contact_damping_n_s_per_m = 0.0;
+  settings.hold_damping = false;
+  HapticRenderer renderer(settings);
+  TissueSample s = tilted_contact();
+  const Eigen::Vector3d& n = s.contact_normal;
+  s.contact_damping_n_s_per_m = 10.0 * (n * n.transpose()).eval() + 2.0 * Eigen::Matrix3d::Identity();
+  const Eigen::Vector3d v0 = -0.05 * n + 0.01 * n.unitOrthogonal();  // pressing in, sliding a little
+  const double dt = 1e-3, period = 1e-2;
+  TissueSample first = s;
+  first.time_s = 1.0;
+  first.tool_position_m = s.tool_position_m - period * v0;
+  renderer.set_sample(first);
+  s.time_s = first.time_s + period;
+  renderer.set_sample(s);
+  EXPECT_LT((renderer.sample_tool_velocity_m_per_s() - v0).norm(), 1e-12);
+  for (const Eigen::Vector3d& v : {v0, Eigen::Vector3d::Zero().eval(), (2.0 * v0).eval()}) {
+    renderer.tick(s.tool_position_m - dt * v, ToolMode::probe, dt);
+    const Eigen::Vector3d f = renderer.tick(s.tool_position_m, ToolMode::probe, dt);
+    const Eigen::Vector3d expected = s.force_on_tool_n - s.contact_damping_n_s_per_m * (v - v0);
+    EXPECT_LT((f - expected).norm(), 1e-9) << "v = " << v.transpose();
+  }
+  // A sample after one out of contact has no v0: the tool's motion before is not the tissue's.
+  TissueSample away = s;
+  away.contact_active = false;
+  renderer.set_sample(away);
+  s.time_s += period;
+  renderer.set_sample(s);
+  EXPECT_EQ(renderer.sample_tool_velocity_m_per_s(), Eigen::Vector3d::Zero());
 }
 
 }  // namespace

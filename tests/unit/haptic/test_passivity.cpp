@@ -130,6 +130,7 @@ RendererSettings controller(bool on) {
   RendererSettings settings;
   settings.passivity_min_hand_mass_kg = KINEMATIC_HAND_KG;
   settings.contact_damping_n_s_per_m = 0.0;  // the leak asserted below is the undamped spring's
+  settings.hold_damping = false;
   settings.passivity_control = on;
   return settings;
 }

@@ -110,6 +110,44 @@ TEST(Tissue, ProbeTouchesPushesBackAndLetsGo) {
   EXPECT_EQ(tissue.contact_spring().spring(), std::nullopt);
 }
 
+// The same press, then the tip drawn back by a quarter of the depth: far more than the microns the
+// contact spring leaves between the pressed surface and the tip, so the tip is outside the surface
+// as the last step left it, but well within the pressed block's rebound f_n / k_n. The surface rises
+// with the tip: the contact holds at every step (it used to end at the first, and the block then
+// sprang up through the tip unresisted: issue 20's chattering hand) and settles at the force of the
+// shallower press, springs in series as above.
+TEST(Tissue, APressedSurfaceFollowsATipDrawnBackALittle) {
+  const TetMesh mesh = make_box_mesh(4, 4, 2, 0.01);
+  TissueSettings settings;
+  settings.body.fixed_vertices = vertices_at_minimum(mesh, 2, 0.0);
+  settings.body.gravity_m_per_s2.setZero();
+  settings.body.damping = RayleighDamping{20.0, 0.0};
+  settings.solver.kind = LinearSolverKind::cholmod;
+  settings.step_size_s = 0.01;
+  Tissue tissue(mesh, settings);
+  const Eigen::Vector3d above(0.0213, 0.0187, 0.025);
+  tissue.set_tool({above, Eigen::Quaterniond::Identity(), ToolMode::probe});
+  tissue.step();
+  constexpr double DEPTH_M = 1e-4;
+  const auto press = [&](double depth_m) {
+    tissue.set_tool(
+        {Eigen::Vector3d(above.x(), above.y(), 0.02 - depth_m), Eigen::Quaterniond::Identity(), ToolMode::probe});
+  };
+  press(DEPTH_M);
+  for (int n = 0; n < 300; ++n) tissue.step();
+  ASSERT_TRUE(tissue.contact().active);
+  const double gap_m = tissue.contact().force_on_tool_n.norm() / tissue.contact_spring_stiffness_n_per_m();
+  ASSERT_LT(gap_m, 0.05 * DEPTH_M);  // the tip is drawn back by 5x more than the spring's gap
+  press(0.75 * DEPTH_M);
+  for (int n = 0; n < 300; ++n) {
+    tissue.step();
+    ASSERT_TRUE(tissue.contact().active) << "lost at step " << n;
+  }
+  const double k_n = 1.0 / tissue.contact().stiffness_n_per_m.inverse()(2, 2);
+  const double expected = 0.75 * DEPTH_M / (1.0 / k_n + 1.0 / tissue.contact_spring_stiffness_n_per_m());
+  EXPECT_NEAR(tissue.contact().force_on_tool_n.z(), expected, 0.02 * expected);
+}
+
 // A ball probe of radius r posed by its centre touches as a point probe posed at its pole, r along the
 // tool axis toward the tip: the two tissues step bitwise alike, and each reports as applied the
 // position it was given. A refused radius is refused when given.
