@@ -250,9 +250,13 @@ void TissueModel::get_float64(const VariableInfo& info, std::span<double> out) {
     case Vr::time:
       out[0] = m_start_time_s + tissue.time_s();
       return;
-    case Vr::contact_point:
-      put3(!contact.active && m_near ? m_near->point_m : contact.point_m);
+    case Vr::contact_point: {
+      // In the tool position's terms, as x0 (tool.appliedPosition): a ball probe touches with its pole
+      // and is posed by its centre, so the point is offset from the surface by the same centre - pole.
+      const Eigen::Vector3d ball_offset_m = tissue.applied_tool_position_m() - tissue.applied_tool().tip_position_m;
+      put3((!contact.active && m_near ? m_near->point_m : contact.point_m) + ball_offset_m);
       return;
+    }
     case Vr::contact_normal:
       put3(!contact.active && m_near ? m_near->normal : contact.normal);
       return;

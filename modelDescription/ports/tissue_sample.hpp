@@ -47,7 +47,7 @@ inline constexpr auto TISSUE_SAMPLE = std::to_array<SampleField>({
      "and stiffness n^T K_c n from the tick the tool crosses it"},
     {"contact.point", "tissue.contactPoint", 41, 25, SampleType::float64, 3, 1, "m", "0 0 0", "",
      "Contact point on the deformed surface (the god-object position) while contact.active; the nearest surface "
-     "point while contact.near",
+     "point while contact.near; in tool.position's terms: a ball probe's centre where its pole touches",
      "The tissue's contact.point (god-object on the deformed surface)"},
     {"contact.normal", "tissue.contactNormal", 42, 26, SampleType::float64, 3, 1, "1", "0 0 1", "",
      "Unit outward surface normal at contact.point; meaningful while contact.active or contact.near",

@@ -295,6 +295,37 @@ TEST(TissueFmu, ReportsTheSurfaceNearAProbeAndTheContactsDamping) {
   EXPECT_NE(negative.fmu().log_text().find("contact.nearMargin"), std::string::npos) << negative.fmu().log_text();
 }
 
+// A ball probe (tool.probeRadius 3 mm) is posed by its centre and touches with its pole, so its
+// contact point is given in the same terms as x0: where the centre is when the pole touches. A haptic
+// loop's plane test, (x0 - point) . n, then says "inside" by the pole's depth (it said "outside" by
+// the radius, and the loop rendered nothing), near the surface as in contact.
+TEST(TissueFmu, ABallProbesContactPointIsInTheTermsOfItsCentre) {
+  const FrogGeometry g = rest_geometry();
+  constexpr double RADIUS_M = 0.003;
+  Session s("ball");
+  ASSERT_EQ(s.fmu().set_float64("tool.probeRadius", {RADIUS_M}), fmi3OK);
+  s.start();
+  const auto signed_depth = [&s] {
+    std::vector<double> applied, point, normal;
+    EXPECT_EQ(s.fmu().get_float64("tool.appliedPosition", applied), fmi3OK);
+    EXPECT_EQ(s.fmu().get_float64("contact.point", point), fmi3OK);
+    EXPECT_EQ(s.fmu().get_float64("contact.normal", normal), fmi3OK);
+    double depth = 0.0;
+    for (std::size_t a = 0; a < 3; ++a) depth += (point[a] - applied[a]) * normal[a];
+    return depth;
+  };
+  s.tool({g.top[0], g.top[1], g.top[2] + RADIUS_M + 0.004}, 1);  // the pole 4 mm above: near
+  s.step();
+  EXPECT_NEAR(signed_depth(), -0.004, 0.002);  // the frog sags a little meanwhile
+  s.tool({g.top[0], g.top[1], g.top[2] + RADIUS_M - 0.002}, 1);  // the pole 2 mm in
+  for (int k = 0; k < 5; ++k) s.step();
+  std::vector<bool> active;
+  ASSERT_EQ(s.fmu().get_boolean("contact.active", active), fmi3OK);
+  ASSERT_TRUE(active[0]);
+  EXPECT_GT(signed_depth(), 0.0);
+  EXPECT_LT(signed_depth(), 0.002);
+}
+
 TEST(TissueFmu, SceneSwitchesTurnOffWhatTheyName) {
   const FrogGeometry g = rest_geometry();
   Session s("switched");
