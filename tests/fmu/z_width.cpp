@@ -118,8 +118,9 @@ int main(int argc, char** argv) {
     plot.points.push_back({b, 2.0 * b / TICK_S, 3 * masses.size()});
   }
   plot.front_name = "Colgate-Schenkel bound";
-  plot.notes.push_back("(a) f = -K z held over each 1 ms tick; (b), (c) HapticLoop.fmu, samples at 100 Hz one step late;");
-  plot.notes.push_back("settled: under 1 mm/s over the last second of 20 s, chatter under 10 um; 30 N/m: none settles.");
+  plot.notes.push_back("(a) f = -K z held over each 1 ms tick, no damping; (b), (c) HapticLoop.fmu, samples at 100 Hz one");
+  plot.notes.push_back("step late, its contact damped by 2 N s/m + T K_c; settled: under 1 mm/s over the last second of 20 s,");
+  plot.notes.push_back("chatter under 10 um; the grid spans 30 N/m (none settles) to 1e5 N/m (all up to it settle).");
   write_png(out, render_log_log_plot(plot));
   std::printf("wrote %s\n", out.c_str());
   return 0;
