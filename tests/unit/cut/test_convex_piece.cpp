@@ -1,0 +1,178 @@
+// Convex pieces of a tet between cut planes (convex_piece.hpp, issue 21): volumes against closed forms
+// and against the single-cut part volumes (cut_geometry.hpp), the arrangement's cells against the
+// tet's volume and against a count of grid points, and the degenerate planes (through a vertex,
+// along a face).
+#include "core/cut/convex_piece.hpp"
+#include "core/cut/cut_geometry.hpp"
+#include "core/mesh/topology.hpp"
+
+#include <gtest/gtest.h>
+
+#include <Eigen/Geometry>
+
+#include <cmath>
+#include <random>
+#include <vector>
+
+namespace tissue {
+namespace {
+
+using Corners = std::array<Eigen::Vector3d, 4>;
+
+const Corners UNIT_TET{Eigen::Vector3d(0.0, 0.0, 0.0), Eigen::Vector3d(1.0, 0.0, 0.0), Eigen::Vector3d(0.0, 1.0, 0.0),
+                       Eigen::Vector3d(0.0, 0.0, 1.0)};
+constexpr double TOLERANCE_M = 1e-12;
+
+double tet_volume(const Corners& x) { return std::abs((x[1] - x[0]).dot((x[2] - x[0]).cross(x[3] - x[0]))) / 6.0; }
+
+TEST(ConvexPiece, TheWholeTetHasItsVolumeAndCentroidInEitherOrientation) {
+  Corners flipped = UNIT_TET;
+  std::swap(flipped[1], flipped[2]);
+  for (const Corners& x : {UNIT_TET, flipped}) {
+    const ConvexPiece piece = ConvexPiece::tet(x);
+    EXPECT_NEAR(piece.volume_m3(), 1.0 / 6.0, 1e-15);
+    EXPECT_LT((piece.centroid_m() - Eigen::Vector3d::Constant(0.25)).norm(), 1e-15);
+  }
+}
+
+// The unit tet x, y, z >= 0, x + y + z <= 1 cut by x = a and y = b (a + b < 1): the corner x > a,
+// y > b is the tet x' + y' + z <= 1 - a - b, volume (1 - a - b)^3 / 6, and x > a alone leaves
+// (1 - a)^3 / 6. The four cells of the X add up to 1/6. Exact planes: to 1e-15.
+TEST(ConvexPiece, TwoCrossingPlanesCutTheCellsTheClosedFormsGive) {
+  const double a = 0.2, b = 0.3;
+  const std::array<CutPlane, 2> planes{CutPlane{Eigen::Vector3d::UnitX(), a}, CutPlane{Eigen::Vector3d::UnitY(), b}};
+  std::vector<PieceCell> cells, scratch;
+  arrangement_cells(UNIT_TET, planes, TOLERANCE_M, cells, scratch);
+  ASSERT_EQ(cells.size(), 4u);
+  const auto volume_of = [&](std::uint32_t above) {
+    for (const PieceCell& cell : cells) {
+      if (cell.above == above) return cell.piece.volume_m3();
+    }
+    return -1.0;
+  };
+  const double both = std::pow(1.0 - a - b, 3) / 6.0;
+  const double x_only = std::pow(1.0 - a, 3) / 6.0 - both;
+  const double y_only = std::pow(1.0 - b, 3) / 6.0 - both;
+  EXPECT_NEAR(volume_of(0b11u), both, 1e-15);
+  EXPECT_NEAR(volume_of(0b01u), x_only, 1e-15);
+  EXPECT_NEAR(volume_of(0b10u), y_only, 1e-15);
+  EXPECT_NEAR(volume_of(0b00u), 1.0 / 6.0 - both - x_only - y_only, 1e-15);
+  // A plane that misses the corner cell x > a, y > b (x + y = 0.4 < a + b) splits only the others.
+  const std::array<CutPlane, 3> three{planes[0], planes[1], CutPlane{Eigen::Vector3d(1.0, 1.0, 0.0), 0.4}};
+  arrangement_cells(UNIT_TET, three, TOLERANCE_M, cells, scratch);
+  double sum = 0.0;
+  for (const PieceCell& cell : cells) sum += cell.piece.volume_m3();
+  EXPECT_NEAR(sum, 1.0 / 6.0, 1e-15);
+  EXPECT_EQ(cells.size(), 7u);  // the 0b11 cell whole (x + y > 0.5 there), the three others split in two
+}
+
+// One plane: the two pieces are the single-cut parts of cut_geometry (part_volume through the
+// plane's edge crossings), for 1-3 and 2-2 splits of a skewed tet.
+TEST(ConvexPiece, OnePlaneGivesTheSingleCutsPartVolumes) {
+  const Corners x{Eigen::Vector3d(0.01, -0.02, 0.0), Eigen::Vector3d(1.1, 0.05, 0.1), Eigen::Vector3d(0.2, 0.9, -0.1),
+                  Eigen::Vector3d(0.3, 0.25, 1.2)};
+  const std::array<CutPlane, 3> planes{CutPlane{Eigen::Vector3d(0.3, 0.2, 1.0), 0.8},     // 1-3: vertex 3 above
+                                       CutPlane{Eigen::Vector3d(1.0, 0.1, -0.2), 0.45},   // 2-2
+                                       CutPlane{Eigen::Vector3d(-0.4, 1.0, 0.3), 0.3}};  // 2-2
+  for (const CutPlane& plane : planes) {
+    unsigned group = 0;
+    std::array<Eigen::Vector3d, 6> cut_points{};
+    for (int i = 0; i < 4; ++i) {
+      if (plane.signed_distance(x[static_cast<std::size_t>(i)]) > 0.0) group |= 1u << static_cast<unsigned>(i);
+    }
+    ASSERT_NE(group, 0u);
+    ASSERT_NE(group, 15u);
+    for (std::size_t k = 0; k < 6; ++k) {
+      const Eigen::Vector3d& p = x[static_cast<std::size_t>(TET_EDGES[k][0])];
+      const Eigen::Vector3d& q = x[static_cast<std::size_t>(TET_EDGES[k][1])];
+      const double dp = plane.signed_distance(p), dq = plane.signed_distance(q);
+      if (dp * dq < 0.0) cut_points[k] = p + (q - p) * (dp / (dp - dq));
+    }
+    const double expected = std::abs(part_volume(x, group, cut_points));
+    const ConvexPiece above = ConvexPiece::tet(x).clipped(plane, true, TOLERANCE_M);
+    const ConvexPiece below = ConvexPiece::tet(x).clipped(plane, false, TOLERANCE_M);
+    EXPECT_NEAR(above.volume_m3(), expected, 1e-14) << "group " << group;
+    EXPECT_NEAR(above.volume_m3() + below.volume_m3(), tet_volume(x), 1e-14);
+    EXPECT_GT(plane.signed_distance(above.centroid_m()), 0.0);
+    EXPECT_LT(plane.signed_distance(below.centroid_m()), 0.0);
+  }
+}
+
+// Random planes through a random tet: the cells add up to the tet, and each holds the share of a
+// fine grid of the tet's barycentric points that lies on its sides of the planes (a count: 1/n^3
+// of the volume per point, so to a few 1e-3 relative).
+TEST(ConvexPiece, RandomArrangementsAddUpAndHoldTheirPoints) {
+  std::mt19937 rng(20261126);
+  std::uniform_real_distribution<double> unit(-1.0, 1.0);
+  std::vector<PieceCell> cells, scratch;
+  for (int trial = 0; trial < 20; ++trial) {
+    Corners x{};
+    for (Eigen::Vector3d& corner : x) corner = Eigen::Vector3d(unit(rng), unit(rng), unit(rng));
+    if (tet_volume(x) < 0.05) continue;
+    std::vector<CutPlane> planes;
+    const Eigen::Vector3d centre = 0.25 * (x[0] + x[1] + x[2] + x[3]);
+    for (int c = 0; c < 4; ++c) {
+      const Eigen::Vector3d n = Eigen::Vector3d(unit(rng), unit(rng), unit(rng)).normalized();
+      planes.push_back(CutPlane{n, n.dot(centre) + 0.2 * unit(rng)});
+    }
+    arrangement_cells(x, planes, TOLERANCE_M, cells, scratch);
+    double sum = 0.0;
+    for (const PieceCell& cell : cells) sum += cell.piece.volume_m3();
+    EXPECT_NEAR(sum, tet_volume(x), 1e-13 * tet_volume(x)) << "trial " << trial;
+    constexpr int N = 60;
+    std::vector<int> counts(cells.size(), 0);
+    int total = 0;
+    for (int i = 0; i < N; ++i) {
+      for (int j = 0; i + j < N; ++j) {
+        for (int k = 0; i + j + k < N; ++k) {
+          const double l1 = (i + 0.25) / N, l2 = (j + 0.25) / N, l3 = (k + 0.25) / N;
+          const Eigen::Vector3d p = x[0] + l1 * (x[1] - x[0]) + l2 * (x[2] - x[0]) + l3 * (x[3] - x[0]);
+          std::uint32_t above = 0;
+          for (std::size_t c = 0; c < planes.size(); ++c) {
+            if (planes[c].signed_distance(p) > 0.0) above |= 1u << static_cast<unsigned>(c);
+          }
+          ++total;
+          for (std::size_t c = 0; c < cells.size(); ++c) {
+            if (cells[c].above == above) ++counts[c];
+          }
+        }
+      }
+    }
+    for (std::size_t c = 0; c < cells.size(); ++c) {
+      const double share = cells[c].piece.volume_m3() / tet_volume(x);
+      EXPECT_NEAR(static_cast<double>(counts[c]) / total, share, 0.01 + 0.05 * share) << "trial " << trial << " cell " << c;
+    }
+  }
+}
+
+// A plane through a vertex, one along a face, one that misses: no empty or sliver cells, the
+// volume kept whole on the right side.
+TEST(ConvexPiece, DegeneratePlanesLeaveNoSlivers) {
+  std::vector<PieceCell> cells, scratch;
+  // Through vertex 0 and the midpoint of the opposite edge: two halves.
+  const std::array<CutPlane, 1> through_vertex{CutPlane{Eigen::Vector3d(1.0, -1.0, 0.0), 0.0}};
+  arrangement_cells(UNIT_TET, through_vertex, TOLERANCE_M, cells, scratch);
+  ASSERT_EQ(cells.size(), 2u);
+  EXPECT_NEAR(cells[0].piece.volume_m3(), 1.0 / 12.0, 1e-15);
+  EXPECT_NEAR(cells[1].piece.volume_m3(), 1.0 / 12.0, 1e-15);
+  // The plane z = 0 of the tet's own face: one cell, above it.
+  const std::array<CutPlane, 1> along_face{CutPlane{Eigen::Vector3d::UnitZ(), 0.0}};
+  arrangement_cells(UNIT_TET, along_face, TOLERANCE_M, cells, scratch);
+  ASSERT_EQ(cells.size(), 1u);
+  EXPECT_EQ(cells[0].above, 1u);
+  EXPECT_NEAR(cells[0].piece.volume_m3(), 1.0 / 6.0, 1e-15);
+  // A plane beyond the tet.
+  const std::array<CutPlane, 1> beyond{CutPlane{Eigen::Vector3d::UnitZ(), 2.0}};
+  arrangement_cells(UNIT_TET, beyond, TOLERANCE_M, cells, scratch);
+  ASSERT_EQ(cells.size(), 1u);
+  EXPECT_EQ(cells[0].above, 0u);
+}
+
+TEST(ConvexPiece, MoreThanTheCapacityOfPlanesIsRefused) {
+  std::vector<CutPlane> planes(MAX_PIECE_CUTS + 1, CutPlane{Eigen::Vector3d::UnitX(), 0.1});
+  std::vector<PieceCell> cells, scratch;
+  EXPECT_THROW(arrangement_cells(UNIT_TET, planes, TOLERANCE_M, cells, scratch), std::length_error);
+}
+
+}  // namespace
+}  // namespace tissue
