@@ -45,6 +45,7 @@ target_compile_definitions(tissue_hand_on_tissue PRIVATE HAPTIC_LOOP_FMU_PATH="$
 add_dependencies(tissue_hand_on_tissue hapticloop_fmu_package)
 add_executable(test_haptic_loop_hand ${CMAKE_CURRENT_LIST_DIR}/test_haptic_loop_hand.cpp)
 target_link_libraries(test_haptic_loop_hand PRIVATE tissue_hand_on_tissue GTest::gtest GTest::gtest_main tissue::warnings)
+target_include_directories(test_haptic_loop_hand PRIVATE ${PROJECT_SOURCE_DIR}/tests)
 gtest_discover_tests(test_haptic_loop_hand PROPERTIES LABELS "fmu" DISCOVERY_TIMEOUT 60)
 add_executable(hand_on_walls ${CMAKE_CURRENT_LIST_DIR}/hand_on_walls.cpp)
 target_link_libraries(hand_on_walls PRIVATE tissue_hand_on_tissue tissue::warnings)

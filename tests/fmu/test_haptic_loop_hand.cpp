@@ -4,6 +4,7 @@
 // f / K; bad samples are refused and counted while the hand's loop goes on. (The loop's failures on stiff walls are
 // measured by hand_on_walls, docs/BENCHMARKS.md "Haptic loop".)
 #include "hand_on_tissue.hpp"
+#include "support/oscillation_envelope.hpp"
 
 #include <gtest/gtest.h>
 
@@ -113,13 +114,7 @@ TEST(HandOnTissue, TheContactsDampingDampsTheHandAsPredicted) {
     const LoopResult r = run_hand_on(wall, settings);
     ASSERT_TRUE(r.completed) << r.failure;
     const double m = 0.2, b = 1.0, k = 2000.0, omega = std::sqrt(k / m), z_eq = -1.0 / k;
-    const auto envelope = [&](double t) {
-      const auto first = static_cast<std::size_t>(std::lround(t / TICK_S));
-      const auto period = static_cast<std::size_t>(std::lround(2.0 * std::numbers::pi / omega / TICK_S));
-      double sum = 0.0;
-      for (std::size_t n = first; n < first + period; ++n) sum += std::hypot(states[n][0] - z_eq, states[n][1] / omega);
-      return sum / static_cast<double>(period);
-    };
+    const auto envelope = [&](double t) { return test_support::oscillation_envelope(states, t, TICK_S, omega, z_eq); };
     const double rate_per_s = std::log(envelope(1.0) / envelope(2.0));
     const double hold_n_s_per_m = c.hold_damping ? k * TICK_S : 0.0;
     const double predicted_per_s = (b + c.contact_damping_n_s_per_m + hold_n_s_per_m - k * TICK_S / 2.0) / (2.0 * m);

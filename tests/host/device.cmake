@@ -21,4 +21,5 @@ gtest_discover_tests(test_view PROPERTIES LABELS "host" DISCOVERY_TIMEOUT 60)
 # The simulated hand and its device (closed forms of the tick, the figures).
 add_executable(test_simulated_hand ${CMAKE_CURRENT_LIST_DIR}/test_simulated_hand.cpp)
 target_link_libraries(test_simulated_hand PRIVATE tissue::host_device GTest::gtest GTest::gtest_main tissue::warnings)
+target_include_directories(test_simulated_hand PRIVATE ${PROJECT_SOURCE_DIR}/tests)
 gtest_discover_tests(test_simulated_hand PROPERTIES LABELS "host" DISCOVERY_TIMEOUT 60)

@@ -5,6 +5,7 @@
 // frequency and amplitude of an oscillation).
 #include "device/hand_device.hpp"
 #include "device/simulated_hand.hpp"
+#include "support/oscillation_envelope.hpp"
 
 #include <gtest/gtest.h>
 
@@ -148,13 +149,7 @@ TEST(HandDevice, OnASampledWallTheHandDecaysAtTheRateColgateAndSchenkelPredict) 
   std::vector<std::array<double, 2>> states;
   (void)wall_drop(2.1, 1.0, &states);
   const double m = 0.2, b = 2.0, k = 2000.0, omega = std::sqrt(k / m), z_eq = -1.0 / k;
-  const auto envelope = [&](double t) {
-    const auto first = static_cast<std::size_t>(std::lround(t / TICK_S));
-    const auto period = static_cast<std::size_t>(std::lround(2.0 * std::numbers::pi / omega / TICK_S));
-    double sum = 0.0;
-    for (std::size_t n = first; n < first + period; ++n) sum += std::hypot(states[n][0] - z_eq, states[n][1] / omega);
-    return sum / static_cast<double>(period);
-  };
+  const auto envelope = [&](double t) { return test_support::oscillation_envelope(states, t, TICK_S, omega, z_eq); };
   const double rate_per_s = std::log(envelope(1.0) / envelope(2.0));
   EXPECT_NEAR(rate_per_s, (b - k * TICK_S / 2.0) / (2.0 * m), 0.01 * 2.5);
 }

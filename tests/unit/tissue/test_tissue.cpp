@@ -73,15 +73,20 @@ TEST(Tissue, RefusesABadToolPoseAndKeepsTheLastOne) {
 // the surface, the tool is pushed back out (force along +z), the contact stiffness is SPD and, in
 // the linear regime, the settled force is K_c d to the spring's share of the compliance; lifting
 // the tip ends the contact.
-TEST(Tissue, ProbeTouchesPushesBackAndLetsGo) {
-  const TetMesh mesh = make_box_mesh(4, 4, 2, 0.01);  // 0.04 x 0.04 x 0.02 m
+/// A 0.04 x 0.04 x 0.02 m block clamped at its bottom, no gravity, CHOLMOD, 10 ms steps.
+Tissue clamped_block() {
+  const TetMesh mesh = make_box_mesh(4, 4, 2, 0.01);
   TissueSettings settings;
   settings.body.fixed_vertices = vertices_at_minimum(mesh, 2, 0.0);
   settings.body.gravity_m_per_s2.setZero();
   settings.body.damping = RayleighDamping{20.0, 0.0};
   settings.solver.kind = LinearSolverKind::cholmod;
   settings.step_size_s = 0.01;
-  Tissue tissue(mesh, settings);
+  return Tissue(mesh, settings);
+}
+
+TEST(Tissue, ProbeTouchesPushesBackAndLetsGo) {
+  Tissue tissue = clamped_block();
   const Eigen::Vector3d above(0.0213, 0.0187, 0.025);
   tissue.set_tool({above, Eigen::Quaterniond::Identity(), ToolMode::probe});
   tissue.step();
@@ -117,14 +122,7 @@ TEST(Tissue, ProbeTouchesPushesBackAndLetsGo) {
 // sprang up through the tip unresisted: issue 20's chattering hand) and settles at the force of the
 // shallower press, springs in series as above.
 TEST(Tissue, APressedSurfaceFollowsATipDrawnBackALittle) {
-  const TetMesh mesh = make_box_mesh(4, 4, 2, 0.01);
-  TissueSettings settings;
-  settings.body.fixed_vertices = vertices_at_minimum(mesh, 2, 0.0);
-  settings.body.gravity_m_per_s2.setZero();
-  settings.body.damping = RayleighDamping{20.0, 0.0};
-  settings.solver.kind = LinearSolverKind::cholmod;
-  settings.step_size_s = 0.01;
-  Tissue tissue(mesh, settings);
+  Tissue tissue = clamped_block();
   const Eigen::Vector3d above(0.0213, 0.0187, 0.025);
   tissue.set_tool({above, Eigen::Quaterniond::Identity(), ToolMode::probe});
   tissue.step();
