@@ -465,22 +465,21 @@ EnrichmentResult DeformableBody::enrich(std::span<const TetCut> cuts, std::span<
 
 void DeformableBody::refresh_cut_tet_slots(int cut_tet_index) {
   const CutTet& cut_tet = m_xfem.cut_tets()[static_cast<size_t>(cut_tet_index)];
-  std::array<int, 8> rows{};
-  for (size_t i = 0; i < 4; ++i) {
-    rows[i] = vertex_block_row(cut_tet.vertices[i]);
-    rows[i + 4] = cut_tet.enriched_row[i];
-  }
+  const int dofs = m_xfem.dof_count(cut_tet_index);
+  const std::vector<int>& ghosts = m_xfem.ghost_rows(cut_tet_index);
+  const auto row_of = [&](int dof) {
+    return dof < 4 ? vertex_block_row(cut_tet.vertices[static_cast<size_t>(dof)]) : ghosts[static_cast<size_t>(dof - 4)];
+  };
   CutTetSlots& slots = m_xfem.slots(cut_tet_index);
-  for (size_t r = 0; r < 8; ++r) {
-    for (size_t col = 0; col < 8; ++col) {
+  for (int r = 0; r < dofs; ++r) {
+    for (int col = 0; col < dofs; ++col) {
       int slot = -1;
-      const bool zero_block = r >= 4 && col >= 4 && cut_tet.cut.side[r - 4] != cut_tet.cut.side[col - 4];
-      if (!zero_block && rows[r] >= 0 && rows[col] >= 0) {
-        slot = m_tangent.find_slot(rows[r], rows[col]);
+      if (m_xfem.couples(cut_tet_index, r, col) && row_of(r) >= 0 && row_of(col) >= 0) {
+        slot = m_tangent.find_slot(row_of(r), row_of(col));
         if (slot < 0)
           throw std::logic_error("enrich: a block of cut tet " + std::to_string(cut_tet.cut.tet) + " is missing");
       }
-      slots[8 * r + col] = slot;
+      slots[static_cast<size_t>(dofs * r + col)] = slot;
     }
   }
 }

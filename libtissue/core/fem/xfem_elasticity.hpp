@@ -8,6 +8,13 @@
 //   Fp_i  = V R_p sigma(sym(R_p^T F_p) - I) g_i  (= [R_p K_e (R_p^T p_p - p0)]_i),
 // with the tangent blocks of eq. 4.3-4.6, w_p s_p(I) s_p(J) R_p K_ij R_p^T, where s_p = 1 for a
 // u unknown and Psi_pi for an enriched one.
+//
+// Internally a cut tet is a list of pieces (issue 21, the virtual-node algorithm): piece p is a
+// full-shape copy weighted by w_p whose local vertex j is the real x_j, or a ghost x_j + s (a_g -
+// offset) with its own enriched row g and sign s. A single cut is the two pieces above; the forces
+// and blocks below are then exactly eq. 3.31-3.32 and 4.3-4.6. For N pieces: u_j gets
+// sum_p w_p Fp_j, a ghost row w_p s Fp_j, and block (I, J) sum_p w_p s_p(I) s_p(J) R_p K_ij R_p^T
+// over the DOFs each piece uses (its 4 u rows and its ghost rows).
 #pragma once
 
 #include "core/fem/tet_cut.hpp"
@@ -21,6 +28,7 @@
 #include <Eigen/Geometry>
 
 #include <array>
+#include <span>
 #include <vector>
 
 namespace tissue {
@@ -58,10 +66,25 @@ struct CutTet {
   }
 };
 
-/// Slots of the 8x8 blocks of a cut tet, index 8 I + J: I < 4 is u of local vertex I, I >= 4 the
-/// enriched a of local vertex I - 4. -1 where there is no block: the u of a fixed vertex, and the
-/// a-a blocks of two vertices on opposite sides (Psi_pi Psi_pj = 0 in both parts, eq. 4.6).
-using CutTetSlots = std::array<int, 64>;
+/// A piece of a cut tet as an element copy: its rest volume fraction and, per local vertex, the
+/// enriched row of its ghost there (-1: the real vertex), the ghost's sign and offset:
+/// p_j = x_j + sign_j (a_{row_j} - offset_j).
+struct CutPiece {
+  double weight = 0.0;
+  std::array<int, 4> ghost_row{-1, -1, -1, -1};
+  std::array<double, 4> ghost_sign{};
+  TetPositions offset_m{Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero(),
+                        Eigen::Vector3d::Zero()};
+};
+
+/// The two pieces of a single cut (above, below) from its CutTet.
+std::array<CutPiece, 2> pieces_of(const CutTet& cut_tet);
+
+/// Slots of the blocks of a cut tet over its local DOFs (XfemElasticity::dof_count): index D I + J
+/// for D DOFs; DOF I < 4 is u of local vertex I, I >= 4 the ghost row ghost_rows(k)[I - 4]. -1
+/// where there is no block: the u of a fixed vertex, and two DOFs no piece uses together (for a
+/// single cut: the a-a blocks of two vertices on opposite sides, eq. 4.6).
+using CutTetSlots = std::vector<int>;
 
 /// Positions p_pj = x_j + Psi_pj (a_j - offset_j) of the 4 vertices of part p (eq. 3.26-3.27, with
 /// CutTet::enrichment_offset_m), from the real positions x and the enriched displacements a of the
@@ -82,15 +105,31 @@ class XfemElasticity {
   /// rotation before the cut: with a = 0 both parts coincide with the tet). Slots start at -1 (set
   /// them with slots() before the first evaluate with a tangent).
   void add(const CutTet& cut_tet, const TetRest& rest, const Eigen::Matrix3d& rotation);
+  /// The same for a tet cut into any number of pieces (>= 2; `cut_tet` keeps its vertices and its
+  /// first cut, its two-part fields are not used). Throws std::invalid_argument for fewer than two
+  /// pieces, weights that are not positive or do not add up to 1 (to 1e-12), or a ghost sign other
+  /// than +-1.
+  void add(const CutTet& cut_tet, std::span<const CutPiece> pieces, const TetRest& rest,
+           const Eigen::Matrix3d& rotation);
 
   [[nodiscard]] int cut_tet_count() const { return static_cast<int>(m_cut_tets.size()); }
   [[nodiscard]] const std::vector<CutTet>& cut_tets() const { return m_cut_tets; }
   [[nodiscard]] const TetRest& rest(int k) const { return m_rest[static_cast<size_t>(k)]; }
+  [[nodiscard]] const std::vector<CutPiece>& pieces(int k) const { return m_pieces[static_cast<size_t>(k)]; }
+  /// The distinct ghost rows of cut tet k, in first use order: its local DOFs 4, 5, ...
+  [[nodiscard]] const std::vector<int>& ghost_rows(int k) const { return m_ghost_rows[static_cast<size_t>(k)]; }
+  /// 4 + ghost_rows(k).size().
+  [[nodiscard]] int dof_count(int k) const { return 4 + static_cast<int>(ghost_rows(k).size()); }
+  /// Whether some piece of cut tet k uses both local DOFs (so that their block exists).
+  [[nodiscard]] bool couples(int k, int dof_i, int dof_j) const;
   [[nodiscard]] CutTetSlots& slots(int k) { return m_slots[static_cast<size_t>(k)]; }
   [[nodiscard]] const CutTetSlots& slots(int k) const { return m_slots[static_cast<size_t>(k)]; }
-  /// R_p of cut tet k at the last evaluate().
+  /// R_p of cut tet k at the last evaluate() (a single cut: piece 0 above, 1 below).
   [[nodiscard]] const Eigen::Matrix3d& rotation(int k, CutPart part) const {
     return m_rotations[static_cast<size_t>(k)][part == CutPart::above ? 0 : 1];
+  }
+  [[nodiscard]] const Eigen::Matrix3d& piece_rotation(int k, int piece) const {
+    return m_rotations[static_cast<size_t>(k)][static_cast<size_t>(piece)];
   }
 
   /// One pass over the cut tets. `positions_m`: real positions of all vertices (3 per vertex);
@@ -107,25 +146,31 @@ class XfemElasticity {
 
   /// Forgets the warm starts (rotations back to identity).
   void reset_rotations();
-  /// The parts' rotations and warm starts per cut tet ([above, below]).
-  [[nodiscard]] const std::vector<std::array<Eigen::Matrix3d, 2>>& rotations() const { return m_rotations; }
-  [[nodiscard]] const std::vector<std::array<Eigen::Quaterniond, 2>>& warm_starts() const { return m_warm_starts; }
-  /// Sets both; throws std::invalid_argument (nothing changed) unless there is one of each per cut tet.
+  /// The parts' rotations and warm starts per cut tet ([above, below]; the first two pieces of a tet
+  /// cut into more, which a state cannot hold yet).
+  [[nodiscard]] std::vector<std::array<Eigen::Matrix3d, 2>> rotations() const;
+  [[nodiscard]] std::vector<std::array<Eigen::Quaterniond, 2>> warm_starts() const;
+  /// Sets both; throws std::invalid_argument (nothing changed) unless there is one of each per cut
+  /// tet, all of two pieces.
   void restore_rotations(const std::vector<std::array<Eigen::Matrix3d, 2>>& rotations,
                          const std::vector<std::array<Eigen::Quaterniond, 2>>& warm_starts);
 
  private:
-  // Real positions and enriched displacements of the local vertices of cut tet k.
-  void gather(size_t k, const Eigen::VectorXd& positions_m, const Eigen::VectorXd& displacement_m, TetPositions& real_m,
-              TetPositions& enrichment_m) const;
+  // Real positions of the local vertices of cut tet k.
+  void gather(size_t k, const Eigen::VectorXd& positions_m, TetPositions& real_m) const;
+  // Positions of piece p's vertices.
+  static TetPositions piece_positions(const CutPiece& piece, const TetPositions& real_m,
+                                      const Eigen::VectorXd& displacement_m);
 
   LameParameters m_lame;
   RotationSettings m_rotation_settings;
   std::vector<CutTet> m_cut_tets;
   std::vector<TetRest> m_rest;
+  std::vector<std::vector<CutPiece>> m_pieces;
+  std::vector<std::vector<int>> m_ghost_rows;
   std::vector<CutTetSlots> m_slots;
-  std::vector<std::array<Eigen::Matrix3d, 2>> m_rotations;       // [above, below]
-  std::vector<std::array<Eigen::Quaterniond, 2>> m_warm_starts;  // [above, below]
+  std::vector<std::vector<Eigen::Matrix3d>> m_rotations;       // per piece (a single cut: above, below)
+  std::vector<std::vector<Eigen::Quaterniond>> m_warm_starts;  // per piece
 };
 
 }  // namespace tissue
