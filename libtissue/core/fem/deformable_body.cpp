@@ -466,11 +466,11 @@ EnrichmentResult DeformableBody::enrich(std::span<const TetCut> cuts, std::span<
 void DeformableBody::refresh_cut_tet_slots(int cut_tet_index) {
   const CutTet& cut_tet = m_xfem.cut_tets()[static_cast<size_t>(cut_tet_index)];
   const int dofs = m_xfem.dof_count(cut_tet_index);
-  const std::vector<int>& ghosts = m_xfem.ghost_rows(cut_tet_index);
+  const std::span<const int> ghosts = m_xfem.ghost_rows(cut_tet_index);
   const auto row_of = [&](int dof) {
     return dof < 4 ? vertex_block_row(cut_tet.vertices[static_cast<size_t>(dof)]) : ghosts[static_cast<size_t>(dof - 4)];
   };
-  CutTetSlots& slots = m_xfem.slots(cut_tet_index);
+  const CutTetSlots slots = m_xfem.slots(cut_tet_index);
   for (int r = 0; r < dofs; ++r) {
     for (int col = 0; col < dofs; ++col) {
       int slot = -1;

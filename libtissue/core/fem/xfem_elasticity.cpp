@@ -49,11 +49,15 @@ void XfemElasticity::reserve(int cut_tets) {
   const size_t n = to_size(cut_tets);
   m_cut_tets.reserve(n);
   m_rest.reserve(n);
-  m_pieces.reserve(n);
-  m_ghost_rows.reserve(n);
-  m_slots.reserve(n);
-  m_rotations.reserve(n);
-  m_warm_starts.reserve(n);
+  m_piece_begin.reserve(n + 1);
+  m_pieces.reserve(2 * n);
+  m_ghost_dofs.reserve(2 * n);
+  m_rotations.reserve(2 * n);
+  m_warm_starts.reserve(2 * n);
+  m_ghost_begin.reserve(n + 1);
+  m_ghost_rows.reserve(4 * n);
+  m_slot_begin.reserve(n + 1);
+  m_slots.reserve(64 * n);
 }
 
 void XfemElasticity::add(const CutTet& cut_tet, const TetRest& rest, const Eigen::Matrix3d& rotation) {
@@ -65,56 +69,72 @@ void XfemElasticity::add(const CutTet& cut_tet, std::span<const CutPiece> pieces
                          const Eigen::Matrix3d& rotation) {
   if (pieces.size() < 2) throw std::invalid_argument("XFEM: a cut tet needs two pieces or more");
   double total = 0.0;
-  std::vector<int> ghost_rows;
+  const std::size_t first_ghost = m_ghost_rows.size();
+  const auto ghost_rows = [&] { return std::span<const int>(m_ghost_rows).subspan(first_ghost); };
   for (const CutPiece& piece : pieces) {
     if (!(piece.weight > 0.0)) throw std::invalid_argument("XFEM: a piece's weight is not positive");
     total += piece.weight;
     for (size_t j = 0; j < 4; ++j) {
-      if (piece.ghost_row[j] < 0) continue;
-      if (std::abs(piece.ghost_sign[j]) != 1.0) throw std::invalid_argument("XFEM: a ghost's sign is not +-1");
-      if (std::find(ghost_rows.begin(), ghost_rows.end(), piece.ghost_row[j]) == ghost_rows.end()) {
-        ghost_rows.push_back(piece.ghost_row[j]);
+      if (piece.ghost_row[j] >= 0 && std::abs(piece.ghost_sign[j]) != 1.0) {
+        throw std::invalid_argument("XFEM: a ghost's sign is not +-1");
       }
     }
   }
   if (std::abs(total - 1.0) > 1e-12) {
     throw std::invalid_argument("XFEM: the pieces' weights add up to " + std::to_string(total) + ", not 1");
   }
+  for (const CutPiece& piece : pieces) {
+    for (size_t j = 0; j < 4; ++j) {
+      const int row = piece.ghost_row[j];
+      const std::span<const int> rows = ghost_rows();
+      if (row >= 0 && std::find(rows.begin(), rows.end(), row) == rows.end()) m_ghost_rows.push_back(row);
+    }
+  }
+  m_ghost_begin.push_back(static_cast<int>(m_ghost_rows.size()));
+  for (const CutPiece& piece : pieces) {
+    std::array<int, 4> dofs{};
+    const std::span<const int> rows = ghost_rows();
+    for (size_t j = 0; j < 4; ++j) {
+      const int row = piece.ghost_row[j];
+      dofs[j] = row < 0 ? -1 : 4 + static_cast<int>(std::find(rows.begin(), rows.end(), row) - rows.begin());
+    }
+    m_pieces.push_back(piece);
+    m_ghost_dofs.push_back(dofs);
+    m_rotations.push_back(rotation);
+    m_warm_starts.emplace_back(rotation);
+  }
+  m_piece_begin.push_back(static_cast<int>(m_pieces.size()));
+  const std::size_t dofs = 4 + ghost_rows().size();
+  m_slots.insert(m_slots.end(), dofs * dofs, -1);
+  m_slot_begin.push_back(m_slots.size());
   m_cut_tets.push_back(cut_tet);
   m_rest.push_back(rest);
-  m_pieces.emplace_back(pieces.begin(), pieces.end());
-  const size_t dofs = 4 + ghost_rows.size();
-  m_ghost_rows.push_back(std::move(ghost_rows));
-  m_slots.emplace_back(dofs * dofs, -1);
-  m_rotations.emplace_back(pieces.size(), rotation);
-  m_warm_starts.emplace_back(pieces.size(), Eigen::Quaterniond(rotation));
 }
 
 bool XfemElasticity::couples(int k, int dof_i, int dof_j) const {
   if (dof_i < 4 && dof_j < 4) return true;
-  const std::vector<int>& ghosts = m_ghost_rows[to_size(k)];
-  const auto uses = [&](const CutPiece& piece, int dof) {
-    if (dof < 4) return true;
-    const int row = ghosts[to_size(dof - 4)];
-    return std::find(piece.ghost_row.begin(), piece.ghost_row.end(), row) != piece.ghost_row.end();
-  };
-  for (const CutPiece& piece : m_pieces[to_size(k)]) {
-    if (uses(piece, dof_i) && uses(piece, dof_j)) return true;
+  const std::size_t begin = piece_begin(k);
+  for (std::size_t p = begin; p < begin + piece_count(k); ++p) {
+    const std::array<int, 4>& dofs = m_ghost_dofs[p];
+    const auto uses = [&](int dof) { return dof < 4 || std::find(dofs.begin(), dofs.end(), dof) != dofs.end(); };
+    if (uses(dof_i) && uses(dof_j)) return true;
   }
   return false;
 }
 
 std::vector<std::array<Eigen::Matrix3d, 2>> XfemElasticity::rotations() const {
   std::vector<std::array<Eigen::Matrix3d, 2>> out;
-  out.reserve(m_rotations.size());
-  for (const auto& r : m_rotations) out.push_back({r[0], r[1]});
+  out.reserve(m_cut_tets.size());
+  for (int k = 0; k < cut_tet_count(); ++k) out.push_back({m_rotations[piece_begin(k)], m_rotations[piece_begin(k) + 1]});
   return out;
 }
 
 std::vector<std::array<Eigen::Quaterniond, 2>> XfemElasticity::warm_starts() const {
   std::vector<std::array<Eigen::Quaterniond, 2>> out;
-  out.reserve(m_warm_starts.size());
-  for (const auto& q : m_warm_starts) out.push_back({q[0], q[1]});
+  out.reserve(m_cut_tets.size());
+  for (int k = 0; k < cut_tet_count(); ++k) {
+    out.push_back({m_warm_starts[piece_begin(k)], m_warm_starts[piece_begin(k) + 1]});
+  }
   return out;
 }
 
@@ -125,18 +145,20 @@ void XfemElasticity::restore_rotations(const std::vector<std::array<Eigen::Matri
                                 " cut tets, got " + std::to_string(rotations.size()) + " and " +
                                 std::to_string(warm_starts.size()));
   }
-  for (const auto& pieces : m_pieces) {
-    if (pieces.size() != 2) throw std::invalid_argument("XFEM: a state holds the rotations of two pieces per cut tet");
+  for (int k = 0; k < cut_tet_count(); ++k) {
+    if (piece_count(k) != 2) throw std::invalid_argument("XFEM: a state holds the rotations of two pieces per cut tet");
   }
-  for (size_t k = 0; k < m_cut_tets.size(); ++k) {
-    m_rotations[k] = {rotations[k][0], rotations[k][1]};
-    m_warm_starts[k] = {warm_starts[k][0], warm_starts[k][1]};
+  for (int k = 0; k < cut_tet_count(); ++k) {
+    for (std::size_t p = 0; p < 2; ++p) {
+      m_rotations[piece_begin(k) + p] = rotations[to_size(k)][p];
+      m_warm_starts[piece_begin(k) + p] = warm_starts[to_size(k)][p];
+    }
   }
 }
 
 void XfemElasticity::reset_rotations() {
-  for (auto& r : m_rotations) std::fill(r.begin(), r.end(), Eigen::Matrix3d::Identity());
-  for (auto& q : m_warm_starts) std::fill(q.begin(), q.end(), Eigen::Quaterniond::Identity());
+  std::fill(m_rotations.begin(), m_rotations.end(), Eigen::Matrix3d::Identity());
+  std::fill(m_warm_starts.begin(), m_warm_starts.end(), Eigen::Quaterniond::Identity());
 }
 
 void XfemElasticity::gather(size_t k, const Eigen::VectorXd& positions_m, TetPositions& real_m) const {
@@ -161,15 +183,16 @@ void XfemElasticity::evaluate(const Eigen::VectorXd& positions_m, const Eigen::V
   for (size_t k = 0; k < m_cut_tets.size(); ++k) {
     const CutTet& cut_tet = m_cut_tets[k];
     const TetRest& rest = m_rest[k];
-    const std::vector<CutPiece>& pieces = m_pieces[k];
+    const std::size_t first = piece_begin(static_cast<int>(k));
+    const std::size_t count = piece_count(static_cast<int>(k));
     gather(k, positions_m, real_m);
 
     // Per piece: F_p, R_p (warm-started per piece), its nodal forces Fp_i, and what it adds.
     Eigen::Matrix<double, 3, 4> vertex_sum = Eigen::Matrix<double, 3, 4>::Zero();
-    for (size_t p = 0; p < pieces.size(); ++p) {
-      const CutPiece& piece = pieces[p];
+    for (size_t p = first; p < first + count; ++p) {
+      const CutPiece& piece = m_pieces[p];
       const Eigen::Matrix3d f = deformation_gradient(rest, piece_positions(piece, real_m, displacement_m));
-      const Eigen::Matrix3d& r = m_rotations[k][p] = extract_rotation(f, m_warm_starts[k][p], m_rotation_settings);
+      const Eigen::Matrix3d& r = m_rotations[p] = extract_rotation(f, m_warm_starts[p], m_rotation_settings);
       const Eigen::Matrix<double, 3, 4> forces = corotated_forces(rest, r, f, m_lame);
       vertex_sum += piece.weight * forces;
       for (size_t i = 0; i < 4; ++i) {
@@ -180,11 +203,15 @@ void XfemElasticity::evaluate(const Eigen::VectorXd& positions_m, const Eigen::V
     for (int i = 0; i < 4; ++i) vertex_forces_n.segment<3>(3 * cut_tet.vertices[to_size(i)]) += vertex_sum.col(i);
 
     if (tangent == nullptr) continue;
-    const std::vector<int>& ghosts = m_ghost_rows[k];
-    const int dofs = 4 + static_cast<int>(ghosts.size());
-    const CutTetSlots& slots = m_slots[k];
-    for (size_t p = 0; p < pieces.size(); ++p) {
-      const CutPiece& piece = pieces[p];
+    const int dofs = dof_count(static_cast<int>(k));
+    const int* const slots = m_slots.data() + m_slot_begin[k];
+    // The u-u blocks are summed over the pieces first (every piece has them), then written once.
+    std::array<Eigen::Matrix3d, 16> uu;
+    for (int i = 0; i < 4; ++i) {
+      for (int j = i; j < 4; ++j) uu[to_size(4 * i + j)].setZero();
+    }
+    for (size_t p = first; p < first + count; ++p) {
+      const CutPiece& piece = m_pieces[p];
       // The piece's DOFs: u of each local vertex (coefficient 1), its ghosts (coefficient sign).
       std::array<int, 8> dof{};
       std::array<int, 8> vertex{};
@@ -196,30 +223,47 @@ void XfemElasticity::evaluate(const Eigen::VectorXd& positions_m, const Eigen::V
         coefficient[to_size(n++)] = 1.0;
       }
       for (int i = 0; i < 4; ++i) {
-        if (piece.ghost_row[to_size(i)] < 0) continue;
-        const auto at = std::find(ghosts.begin(), ghosts.end(), piece.ghost_row[to_size(i)]);
-        dof[to_size(n)] = 4 + static_cast<int>(at - ghosts.begin());
+        const int ghost = m_ghost_dofs[p][to_size(i)];
+        if (ghost < 0) continue;
+        dof[to_size(n)] = ghost;
         vertex[to_size(n)] = i;
         coefficient[to_size(n++)] = piece.ghost_sign[to_size(i)];
       }
-      const Eigen::Matrix<double, 3, 4> c = m_rotations[k][p] * rest.shape_gradients_per_m;
+      const Eigen::Matrix<double, 3, 4> c = m_rotations[p] * rest.shape_gradients_per_m;
       std::array<Eigen::Matrix3d, 16> blocks;
       for (int i = 0; i < 4; ++i) {
         for (int j = i; j < 4; ++j) blocks[to_size(4 * i + j)] = rotated_stiffness_block(rest, m_lame, c, i, j);
       }
+      for (int i = 0; i < 4; ++i) {
+        for (int j = i; j < 4; ++j) uu[to_size(4 * i + j)] += piece.weight * blocks[to_size(4 * i + j)];
+      }
+      // Blocks (a, b) with a ghost, a <= b, and their transposes into (b, a).
       for (int a = 0; a < n; ++a) {
-        for (int b = 0; b < n; ++b) {
-          const int slot = slots[to_size(dofs * dof[to_size(a)] + dof[to_size(b)])];
+        for (int b = std::max(a, 4); b < n; ++b) {
+          const int slot = slots[dofs * dof[to_size(a)] + dof[to_size(b)]];
           if (slot < 0) continue;
           const int i = vertex[to_size(a)];
           const int j = vertex[to_size(b)];
           const double w = piece.weight * coefficient[to_size(a)] * coefficient[to_size(b)];
+          Eigen::Matrix3d block;
           if (i <= j) {
-            tangent->block(slot) += w * blocks[to_size(4 * i + j)];
+            block.noalias() = w * blocks[to_size(4 * i + j)];
           } else {
-            tangent->block(slot) += w * blocks[to_size(4 * j + i)].transpose();
+            block.noalias() = w * blocks[to_size(4 * j + i)].transpose();
+          }
+          tangent->block(slot) += block;
+          if (dof[to_size(a)] != dof[to_size(b)]) {
+            tangent->block(slots[dofs * dof[to_size(b)] + dof[to_size(a)]]) += block.transpose();
           }
         }
+      }
+    }
+    for (int i = 0; i < 4; ++i) {
+      for (int j = i; j < 4; ++j) {
+        const int slot = slots[dofs * i + j];
+        if (slot < 0) continue;  // a fixed vertex's u
+        tangent->block(slot) += uu[to_size(4 * i + j)];
+        if (i != j) tangent->block(slots[dofs * j + i]) += uu[to_size(4 * i + j)].transpose();
       }
     }
   }
@@ -231,10 +275,11 @@ double XfemElasticity::elastic_energy_j(const Eigen::VectorXd& positions_m,
   TetPositions real_m;
   for (size_t k = 0; k < m_cut_tets.size(); ++k) {
     gather(k, positions_m, real_m);
-    for (size_t p = 0; p < m_pieces[k].size(); ++p) {
-      const CutPiece& piece = m_pieces[k][p];
+    const std::size_t first = piece_begin(static_cast<int>(k));
+    for (size_t p = first; p < first + piece_count(static_cast<int>(k)); ++p) {
+      const CutPiece& piece = m_pieces[p];
       const Eigen::Matrix3d f = deformation_gradient(m_rest[k], piece_positions(piece, real_m, displacement_m));
-      Eigen::Quaterniond warm_start = m_warm_starts[k][p];  // a copy: reporting must not change the dynamics
+      Eigen::Quaterniond warm_start = m_warm_starts[p];  // a copy: reporting must not change the dynamics
       energy += piece.weight *
                 corotated_energy_j(m_rest[k], extract_rotation(f, warm_start, m_rotation_settings), f, m_lame);
     }

@@ -84,7 +84,7 @@ std::array<CutPiece, 2> pieces_of(const CutTet& cut_tet);
 /// for D DOFs; DOF I < 4 is u of local vertex I, I >= 4 the ghost row ghost_rows(k)[I - 4]. -1
 /// where there is no block: the u of a fixed vertex, and two DOFs no piece uses together (for a
 /// single cut: the a-a blocks of two vertices on opposite sides, eq. 4.6).
-using CutTetSlots = std::vector<int>;
+using CutTetSlots = std::span<int>;
 
 /// Positions p_pj = x_j + Psi_pj (a_j - offset_j) of the 4 vertices of part p (eq. 3.26-3.27, with
 /// CutTet::enrichment_offset_m), from the real positions x and the enriched displacements a of the
@@ -115,21 +115,30 @@ class XfemElasticity {
   [[nodiscard]] int cut_tet_count() const { return static_cast<int>(m_cut_tets.size()); }
   [[nodiscard]] const std::vector<CutTet>& cut_tets() const { return m_cut_tets; }
   [[nodiscard]] const TetRest& rest(int k) const { return m_rest[static_cast<size_t>(k)]; }
-  [[nodiscard]] const std::vector<CutPiece>& pieces(int k) const { return m_pieces[static_cast<size_t>(k)]; }
+  [[nodiscard]] std::span<const CutPiece> pieces(int k) const {
+    return std::span<const CutPiece>(m_pieces).subspan(piece_begin(k), piece_count(k));
+  }
+  [[nodiscard]] std::size_t piece_count(int k) const { return piece_begin(k + 1) - piece_begin(k); }
   /// The distinct ghost rows of cut tet k, in first use order: its local DOFs 4, 5, ...
-  [[nodiscard]] const std::vector<int>& ghost_rows(int k) const { return m_ghost_rows[static_cast<size_t>(k)]; }
+  [[nodiscard]] std::span<const int> ghost_rows(int k) const {
+    const auto begin = static_cast<std::size_t>(m_ghost_begin[static_cast<std::size_t>(k)]);
+    const auto end = static_cast<std::size_t>(m_ghost_begin[static_cast<std::size_t>(k) + 1]);
+    return std::span<const int>(m_ghost_rows).subspan(begin, end - begin);
+  }
   /// 4 + ghost_rows(k).size().
   [[nodiscard]] int dof_count(int k) const { return 4 + static_cast<int>(ghost_rows(k).size()); }
   /// Whether some piece of cut tet k uses both local DOFs (so that their block exists).
   [[nodiscard]] bool couples(int k, int dof_i, int dof_j) const;
-  [[nodiscard]] CutTetSlots& slots(int k) { return m_slots[static_cast<size_t>(k)]; }
-  [[nodiscard]] const CutTetSlots& slots(int k) const { return m_slots[static_cast<size_t>(k)]; }
+  [[nodiscard]] CutTetSlots slots(int k) {
+    const auto begin = m_slot_begin[static_cast<std::size_t>(k)];
+    return std::span<int>(m_slots).subspan(begin, m_slot_begin[static_cast<std::size_t>(k) + 1] - begin);
+  }
   /// R_p of cut tet k at the last evaluate() (a single cut: piece 0 above, 1 below).
   [[nodiscard]] const Eigen::Matrix3d& rotation(int k, CutPart part) const {
-    return m_rotations[static_cast<size_t>(k)][part == CutPart::above ? 0 : 1];
+    return m_rotations[piece_begin(k) + (part == CutPart::above ? 0 : 1)];
   }
   [[nodiscard]] const Eigen::Matrix3d& piece_rotation(int k, int piece) const {
-    return m_rotations[static_cast<size_t>(k)][static_cast<size_t>(piece)];
+    return m_rotations[piece_begin(k) + static_cast<std::size_t>(piece)];
   }
 
   /// One pass over the cut tets. `positions_m`: real positions of all vertices (3 per vertex);
@@ -162,15 +171,25 @@ class XfemElasticity {
   static TetPositions piece_positions(const CutPiece& piece, const TetPositions& real_m,
                                       const Eigen::VectorXd& displacement_m);
 
+  [[nodiscard]] std::size_t piece_begin(int k) const {
+    return static_cast<std::size_t>(m_piece_begin[static_cast<std::size_t>(k)]);
+  }
+
+  // Flat, cut tet after cut tet (one pass over contiguous memory): per cut tet, per piece, ghost
+  // rows and slots with their begin offsets.
   LameParameters m_lame;
   RotationSettings m_rotation_settings;
   std::vector<CutTet> m_cut_tets;
   std::vector<TetRest> m_rest;
-  std::vector<std::vector<CutPiece>> m_pieces;
-  std::vector<std::vector<int>> m_ghost_rows;
-  std::vector<CutTetSlots> m_slots;
-  std::vector<std::vector<Eigen::Matrix3d>> m_rotations;       // per piece (a single cut: above, below)
-  std::vector<std::vector<Eigen::Quaterniond>> m_warm_starts;  // per piece
+  std::vector<int> m_piece_begin{0};
+  std::vector<CutPiece> m_pieces;
+  std::vector<std::array<int, 4>> m_ghost_dofs;  // per piece and local vertex: its local DOF, -1 real
+  std::vector<Eigen::Matrix3d> m_rotations;       // per piece (a single cut: above, below)
+  std::vector<Eigen::Quaterniond> m_warm_starts;  // per piece
+  std::vector<int> m_ghost_begin{0};
+  std::vector<int> m_ghost_rows;
+  std::vector<std::size_t> m_slot_begin{0};
+  std::vector<int> m_slots;
 };
 
 }  // namespace tissue

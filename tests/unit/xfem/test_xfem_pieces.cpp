@@ -61,7 +61,7 @@ struct FourPieces {
       for (int c = 0; c < BLOCK_ROWS; ++c) pattern[static_cast<size_t>(r)].push_back(c);
     }
     tangent = BlockSparseMatrix(pattern);
-    const std::vector<int>& ghosts = xfem.ghost_rows(0);
+    const std::span<const int> ghosts = xfem.ghost_rows(0);
     const int dofs = xfem.dof_count(0);
     const auto row_of = [&](int dof) { return dof < 4 ? dof : ghosts[static_cast<size_t>(dof - 4)]; };
     for (int a = 0; a < dofs; ++a) {
@@ -185,7 +185,7 @@ TEST(XfemPieces, TangentMatchesFiniteDifferencesWhenEveryPieceMovesRigidly) {
   EXPECT_LT((numeric - analytic).norm(), 1e-6 * analytic.norm());
   EXPECT_LT((analytic - analytic.transpose()).norm(), 1e-12 * analytic.norm());
   // Ghosts of different pieces never meet (their blocks are absent); ghosts of one piece do.
-  const std::vector<int>& ghosts = tet.xfem.ghost_rows(0);
+  const std::span<const int> ghosts = tet.xfem.ghost_rows(0);
   const auto dof_of = [&](int row) {
     return 4 + static_cast<int>(std::find(ghosts.begin(), ghosts.end(), row) - ghosts.begin());
   };
