@@ -72,7 +72,8 @@ namespace variables_detail {
 // The table in parts, one kind of variable each, in value-reference order within each; own_variables()
 // merges them (fmi3::merged: by value reference).
 
-/// The step, the device's limits, passivity, the velocity filter, cutting, the workspace (1-10).
+/// The step, the device's limits, passivity, the velocity filter, cutting, the workspace, the hand
+/// passivity assumes, the contact's damping (1-13).
 constexpr auto parameters() {
   using namespace fmi3;  // NOLINT(google-build-using-namespace): the table reads as the XML
   using enum VariableType;
@@ -123,16 +124,6 @@ constexpr auto parameters() {
         .start("0 0 0")
         .shape(fixed_size(3))
         .describe("Where the device's origin lies in the tissue's frame"),
-});
-}
-
-/// The device's pose and buttons (20-22) and the tissue sample's time (23; the sample's fields
-/// come from ports/tissue_sample.hpp).
-constexpr auto inputs() {
-  using namespace fmi3;  // NOLINT(google-build-using-namespace): the table reads as the XML
-  using enum VariableType;
-  using enum Variability;
-  return std::to_array<VariableInfo>({
     parameter(Vr::passivity_min_hand_mass, "passivity.minHandMass", float64)
         .unit("kg")
         .start("0.05")
@@ -149,6 +140,16 @@ constexpr auto inputs() {
         .describe("Damp a contact by stepSize times its stiffness: twice what holding the contact's spring over a "
                   "tick gives the hand (Colgate and Schenkel 1997), so that any hand is stable on any contact (Gil "
                   "et al. 2004); off only to measure what it does"),
+});
+}
+
+/// The device's pose and buttons (20-22) and the tissue sample's time (23; the sample's fields
+/// come from ports/tissue_sample.hpp).
+constexpr auto inputs() {
+  using namespace fmi3;  // NOLINT(google-build-using-namespace): the table reads as the XML
+  using enum VariableType;
+  using enum Variability;
+  return std::to_array<VariableInfo>({
     input(Vr::device_position, "device.position", float64, continuous)
         .unit("m")
         .start("0 0 0")

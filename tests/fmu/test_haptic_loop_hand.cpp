@@ -19,12 +19,18 @@
 namespace tissue::host::hand_test {
 namespace {
 
-TEST(HandOnTissue, RestsAtTheStaticDepthOnASoftWall) {
+/// A 5 N s/m hand pushing 0.5 N for 6 s, the controller off: where the loop is known to be stable.
+LoopSettings well_damped_on_soft_wall() {
   LoopSettings settings;
   settings.hand.damping_n_s_per_m = 5.0;
   settings.hand.push_n = {0.0, 0.0, -0.5};
   settings.passivity_control = false;
   settings.duration_s = 6.0;
+  return settings;
+}
+
+TEST(HandOnTissue, RestsAtTheStaticDepthOnASoftWall) {
+  const LoopSettings settings = well_damped_on_soft_wall();
   Wall wall(300.0, false);
   const LoopResult r = run_hand_on(wall, settings);
   ASSERT_TRUE(r.completed) << r.failure;
@@ -39,11 +45,7 @@ TEST(HandOnTissue, RestsAtTheStaticDepthOnASoftWall) {
 }
 
 TEST(HandOnTissue, BadSamplesAreRefusedAndTheHandsLoopGoesOn) {
-  LoopSettings settings;
-  settings.hand.damping_n_s_per_m = 5.0;
-  settings.hand.push_n = {0.0, 0.0, -0.5};
-  settings.passivity_control = false;
-  settings.duration_s = 6.0;
+  const LoopSettings settings = well_damped_on_soft_wall();
   CorruptedSamples tissue(std::make_unique<Wall>(300.0, false), 7);
   const LoopResult r = run_hand_on(tissue, settings);
   ASSERT_TRUE(r.completed) << r.failure;

@@ -507,15 +507,13 @@ TetPositions DeformableBody::part_positions(const Eigen::VectorXd& displacement_
                                             CutPart part) const {
   const CutTet& cut_tet = m_xfem.cut_tets().at(static_cast<size_t>(cut_tet_index));
   TetPositions real_m;
-  TetPositions enrichment_m;
   for (size_t j = 0; j < 4; ++j) {
     const int vertex = cut_tet.vertices[j];
     const int row = vertex_block_row(vertex);
     real_m[j] = m_mesh.rest_positions_m[static_cast<size_t>(vertex)];
     if (row >= 0) real_m[j] += displacement_m.segment<3>(3 * row);
-    enrichment_m[j] = displacement_m.segment<3>(3 * cut_tet.enriched_row[j]);
   }
-  return cut_part_positions(cut_tet, part, real_m, enrichment_m);
+  return piece_positions(m_xfem.piece(cut_tet_index, part == CutPart::above ? 0 : 1), real_m, displacement_m);
 }
 
 double DeformableBody::part_mass_kg(int cut_tet_index, CutPart part) const {

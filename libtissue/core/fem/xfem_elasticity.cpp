@@ -20,15 +20,6 @@ Eigen::Index to_int(size_t i) { return static_cast<Eigen::Index>(i); }
 
 }  // namespace
 
-TetPositions cut_part_positions(const CutTet& cut_tet, CutPart part, const TetPositions& real_positions_m,
-                                const TetPositions& enrichment_m) {
-  TetPositions p;
-  for (int j = 0; j < 4; ++j)
-    p[to_size(j)] = real_positions_m[to_size(j)] +
-                    cut_tet.shift(j, part) * (enrichment_m[to_size(j)] - cut_tet.enrichment_offset_m[to_size(j)]);
-  return p;
-}
-
 std::array<CutPiece, 2> pieces_of(const CutTet& cut_tet) {
   std::array<CutPiece, 2> pieces;
   for (size_t p = 0; p < 2; ++p) {
@@ -166,9 +157,9 @@ void XfemElasticity::gather(size_t k, const Eigen::VectorXd& positions_m, TetPos
   for (size_t j = 0; j < 4; ++j) real_m[j] = positions_m.segment<3>(3 * cut_tet.vertices[j]);
 }
 
-TetPositions XfemElasticity::piece_positions(const CutPiece& piece, const TetPositions& real_m,
-                                             const Eigen::VectorXd& displacement_m) {
-  TetPositions p = real_m;
+TetPositions piece_positions(const CutPiece& piece, const TetPositions& real_positions_m,
+                             const Eigen::VectorXd& displacement_m) {
+  TetPositions p = real_positions_m;
   for (size_t j = 0; j < 4; ++j) {
     if (piece.ghost_row[j] < 0) continue;
     p[j] += piece.ghost_sign[j] * (displacement_m.segment<3>(3 * piece.ghost_row[j]) - piece.offset_m[j]);

@@ -86,11 +86,11 @@ std::array<CutPiece, 2> pieces_of(const CutTet& cut_tet);
 /// single cut: the a-a blocks of two vertices on opposite sides, eq. 4.6).
 using CutTetSlots = std::span<int>;
 
-/// Positions p_pj = x_j + Psi_pj (a_j - offset_j) of the 4 vertices of part p (eq. 3.26-3.27, with
-/// CutTet::enrichment_offset_m), from the real positions x and the enriched displacements a of the
-/// tet's local vertices. [m]
-TetPositions cut_part_positions(const CutTet& cut_tet, CutPart part, const TetPositions& real_positions_m,
-                                const TetPositions& enrichment_m);
+/// Positions of the 4 vertices of `piece`: x_j, or x_j + sign_j (a_j - offset_j) for a ghost (for a
+/// single cut eq. 3.26-3.27 with Psi = sign), from the real positions x of the tet's local vertices
+/// and the unknowns (the ghosts' a are read from their rows). [m]
+TetPositions piece_positions(const CutPiece& piece, const TetPositions& real_positions_m,
+                             const Eigen::VectorXd& displacement_m);
 
 class XfemElasticity {
  public:
@@ -115,9 +115,8 @@ class XfemElasticity {
   [[nodiscard]] int cut_tet_count() const { return static_cast<int>(m_cut_tets.size()); }
   [[nodiscard]] const std::vector<CutTet>& cut_tets() const { return m_cut_tets; }
   [[nodiscard]] const TetRest& rest(int k) const { return m_rest[static_cast<size_t>(k)]; }
-  [[nodiscard]] std::span<const CutPiece> pieces(int k) const {
-    return std::span<const CutPiece>(m_pieces).subspan(piece_begin(k), piece_count(k));
-  }
+  /// Piece `piece` of cut tet k (a single cut: 0 above, 1 below).
+  [[nodiscard]] const CutPiece& piece(int k, int piece) const { return m_pieces[piece_begin(k) + static_cast<std::size_t>(piece)]; }
   [[nodiscard]] std::size_t piece_count(int k) const { return piece_begin(k + 1) - piece_begin(k); }
   /// The distinct ghost rows of cut tet k, in first use order: its local DOFs 4, 5, ...
   [[nodiscard]] std::span<const int> ghost_rows(int k) const {
@@ -136,9 +135,6 @@ class XfemElasticity {
   /// R_p of cut tet k at the last evaluate() (a single cut: piece 0 above, 1 below).
   [[nodiscard]] const Eigen::Matrix3d& rotation(int k, CutPart part) const {
     return m_rotations[piece_begin(k) + (part == CutPart::above ? 0 : 1)];
-  }
-  [[nodiscard]] const Eigen::Matrix3d& piece_rotation(int k, int piece) const {
-    return m_rotations[piece_begin(k) + static_cast<std::size_t>(piece)];
   }
 
   /// One pass over the cut tets. `positions_m`: real positions of all vertices (3 per vertex);
@@ -167,9 +163,6 @@ class XfemElasticity {
  private:
   // Real positions of the local vertices of cut tet k.
   void gather(size_t k, const Eigen::VectorXd& positions_m, TetPositions& real_m) const;
-  // Positions of piece p's vertices.
-  static TetPositions piece_positions(const CutPiece& piece, const TetPositions& real_m,
-                                      const Eigen::VectorXd& displacement_m);
 
   [[nodiscard]] std::size_t piece_begin(int k) const {
     return static_cast<std::size_t>(m_piece_begin[static_cast<std::size_t>(k)]);
