@@ -431,24 +431,23 @@ EnrichmentResult DeformableBody::enrich(std::span<const TetCut> cuts, std::span<
           cut_tet.shift(static_cast<int>(i), opposite) * quarter_mass_kg * m_settings.gravity_m_per_s2;
     }
 
-    // 3. Blocks u-a, a-u and a-a into the reserved room (u-u blocks exist already).
-    std::array<int, 8> rows{};
-    for (size_t i = 0; i < 4; ++i) {
-      rows[i] = vertex_block_row(cut_tet.vertices[i]);
-      rows[i + 4] = cut_tet.enriched_row[i];
-    }
-    for (size_t r = 0; r < 8; ++r) {
-      for (size_t col = 0; col < 8; ++col) {
+    m_elasticity.exclude(cut.tet);
+    const int k = m_xfem.cut_tet_count();
+    m_cut_index[static_cast<size_t>(cut.tet)] = k;
+    m_xfem.add(cut_tet, rest, m_elasticity.rotation(cut.tet));
+
+    // 3. The blocks its pieces couple beyond u-u (which exist already), into the reserved room.
+    const int dofs = m_xfem.dof_count(k);
+    for (int r = 0; r < dofs; ++r) {
+      for (int col = 0; col < dofs; ++col) {
         if (r < 4 && col < 4) continue;
-        if (r >= 4 && col >= 4 && cut.side[r - 4] != cut.side[col - 4]) continue;  // identically zero
-        if (rows[r] < 0 || rows[col] < 0) continue;                                // a fixed vertex's u
-        m_tangent.insert_block(rows[r], rows[col]);
+        if (!m_xfem.couples(k, r, col)) continue;  // identically zero
+        const int row = cut_tet_dof_row(k, r);
+        const int column = cut_tet_dof_row(k, col);
+        if (row < 0 || column < 0) continue;  // a fixed vertex's u
+        m_tangent.insert_block(row, column);
       }
     }
-
-    m_elasticity.exclude(cut.tet);
-    m_cut_index[static_cast<size_t>(cut.tet)] = m_xfem.cut_tet_count();
-    m_xfem.add(cut_tet, rest, m_elasticity.rotation(cut.tet));
   }
   result.new_cut_tets = static_cast<int>(cuts.size());
 
@@ -463,13 +462,17 @@ EnrichmentResult DeformableBody::enrich(std::span<const TetCut> cuts, std::span<
   return result;
 }
 
+int DeformableBody::cut_tet_dof_row(int cut_tet_index, int dof) const {
+  if (dof < 4) {
+    return vertex_block_row(m_xfem.cut_tets()[static_cast<size_t>(cut_tet_index)].vertices[static_cast<size_t>(dof)]);
+  }
+  return m_xfem.ghost_rows(cut_tet_index)[static_cast<size_t>(dof - 4)];
+}
+
 void DeformableBody::refresh_cut_tet_slots(int cut_tet_index) {
   const CutTet& cut_tet = m_xfem.cut_tets()[static_cast<size_t>(cut_tet_index)];
   const int dofs = m_xfem.dof_count(cut_tet_index);
-  const std::span<const int> ghosts = m_xfem.ghost_rows(cut_tet_index);
-  const auto row_of = [&](int dof) {
-    return dof < 4 ? vertex_block_row(cut_tet.vertices[static_cast<size_t>(dof)]) : ghosts[static_cast<size_t>(dof - 4)];
-  };
+  const auto row_of = [&](int dof) { return cut_tet_dof_row(cut_tet_index, dof); };
   const CutTetSlots slots = m_xfem.slots(cut_tet_index);
   for (int r = 0; r < dofs; ++r) {
     for (int col = 0; col < dofs; ++col) {

@@ -181,6 +181,9 @@ class DeformableBody final : public DynamicsModel {
   // Looks up every slot held (uncut tets, cut tets, force terms) again: after a relayout.
   void refresh_all_slots();
   void refresh_cut_tet_slots(int cut_tet_index);
+  /// The block row of local DOF `dof` of a cut tet (XfemElasticity::dof_count): u of a local vertex
+  /// (-1 if fixed) or a ghost row.
+  [[nodiscard]] int cut_tet_dof_row(int cut_tet_index, int dof) const;
   void check_cuts(std::span<const TetCut> cuts) const;
   void check_unknowns(const Eigen::VectorXd& displacement_m) const;
   // largest_turn_rad past its bound: every uncut tet and cut part.
