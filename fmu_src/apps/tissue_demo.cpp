@@ -55,8 +55,8 @@ class Printer {
     const tissue::ContactOutput& contact = m_tissue.contact();
     const double normal_stiffness =
         contact.active ? contact.normal.dot(contact.stiffness_n_per_m * contact.normal) : 0.0;
-    std::printf("%-8s %6d %8.3f %9zu %9d %9d %10.4f %12.4g %8.3f\n", phase, m_step, m_tissue.time_s(),
-                m_tissue.body().cut_tets().size(), m_tissue.body().enriched_dof_count(), m_tissue.body().dof_count(),
+    std::printf("%-8s %6d %8.3f %9d %9d %9d %10.4f %12.4g %8.3f\n", phase, m_step, m_tissue.time_s(),
+                m_tissue.body().cut_tet_count(), m_tissue.body().enriched_dof_count(), m_tissue.body().dof_count(),
                 contact.force_on_tool_n.norm(), normal_stiffness, 1e3 * report.total_s);
   }
   [[nodiscard]] const std::vector<double>& step_ms() const { return m_step_ms; }
@@ -120,9 +120,9 @@ int run(const DemoOptions& options) {
   }
   const tissue::apps::Summary summary = tissue::apps::summarize(print.step_ms());
   std::printf(
-      "tissue-demo: %zu steps, %.3f ms per step (median), %.3f ms (max); simulated %.3f s; %zu tets cut, "
+      "tissue-demo: %zu steps, %.3f ms per step (median), %.3f ms (max); simulated %.3f s; %d tets cut, "
       "%d enriched vertices\n",
-      print.step_ms().size(), summary.median, summary.max, tissue.time_s(), tissue.body().cut_tets().size(),
+      print.step_ms().size(), summary.median, summary.max, tissue.time_s(), tissue.body().cut_tet_count(),
       tissue.body().enriched_dof_count());
   return 0;
 }

@@ -333,10 +333,10 @@ void TissueModel::get_uint64(const VariableInfo& info, std::span<std::uint64_t> 
       out[0] = m_surface_revision;
       return;
     case Vr::cut_triangle_count:
-      out[0] = mesh_out ? std::min<std::uint64_t>(tissue.cut_surface().triangles().size(), triangles) : 0;
+      out[0] = mesh_out ? std::min<std::uint64_t>(tissue.cut_surface().drawn_triangles().size(), triangles) : 0;
       return;
     case Vr::cut_tets:
-      out[0] = tissue.body().cut_tets().size();
+      out[0] = static_cast<std::uint64_t>(tissue.body().cut_tet_count());
       return;
     case Vr::enriched_vertices:
       out[0] = static_cast<std::uint64_t>(tissue.body().enriched_dof_count());

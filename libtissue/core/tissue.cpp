@@ -110,7 +110,8 @@ constexpr double MAX_SWEEP_ANGLE_RAD = 5.0 * 3.14159265358979323846 / 180.0;
 
 bool same_cut(const TetCut& a, const TetCut& b) {
   return a.tet == b.tet && a.cut_id == b.cut_id && a.side == b.side &&
-         a.volume_fraction_above == b.volume_fraction_above && a.edge_ratio == b.edge_ratio;
+         a.volume_fraction_above == b.volume_fraction_above && a.edge_ratio == b.edge_ratio &&
+         a.min_volume_fraction == b.min_volume_fraction;
 }
 
 PointContactSettings contact_settings(const TissueSettings& settings, const DeformableBody& body,
@@ -294,7 +295,8 @@ void Tissue::interact_with_scalpel(const ToolPose& previous, const ToolPose& cur
   }
 }
 
-EnrichmentResult Tissue::apply_cuts(std::span<const TetCut> cuts, std::span<const TetPositions> recorded_offsets_m) {
+EnrichmentResult Tissue::apply_cuts(std::span<const TetCut> cuts,
+                                    std::span<const std::vector<TetPositions>> recorded_offsets_m) {
   const int first_new = static_cast<int>(m_body.cut_tets().size());
   EnrichmentResult result;
   if (recorded_offsets_m.empty()) {
@@ -318,8 +320,7 @@ void Tissue::save(TissueSnapshot& snapshot) const {
   snapshot.model_fingerprint = m_model_fingerprint;
   snapshot.cuts = m_cut_history;
   snapshot.cut_batch_ends = m_cut_batch_ends;
-  snapshot.cut_offsets.clear();
-  for (const CutTet& cut_tet : m_body.cut_tets()) snapshot.cut_offsets.push_back(cut_tet.enrichment_offset_m);
+  snapshot.cut_offsets = cut_offsets();
   snapshot.dynamics = m_state;
   m_body.save_rotations(snapshot.rotations);
   snapshot.integrator_state = m_integrator->internal_state();
@@ -333,15 +334,20 @@ void Tissue::save(TissueSnapshot& snapshot) const {
   snapshot.steps_since_stiffness = m_steps_since_stiffness;
 }
 
+std::vector<std::vector<TetPositions>> Tissue::cut_offsets() const {
+  std::vector<std::vector<TetPositions>> offsets(m_body.cut_tets().size());
+  for (size_t k = 0; k < offsets.size(); ++k) {
+    for (size_t p = 0; p < m_body.xfem().piece_count(static_cast<int>(k)); ++p) {
+      offsets[k].push_back(m_body.xfem().piece(static_cast<int>(k), static_cast<int>(p)).offset_m);
+    }
+  }
+  return offsets;
+}
+
 bool Tissue::has_cuts_of(const TissueSnapshot& snapshot) const {
-  const std::vector<CutTet>& cut_tets = m_body.cut_tets();
   return snapshot.cut_batch_ends == m_cut_batch_ends && snapshot.cuts.size() == m_cut_history.size() &&
          std::equal(snapshot.cuts.begin(), snapshot.cuts.end(), m_cut_history.begin(), same_cut) &&
-         snapshot.cut_offsets.size() == cut_tets.size() &&
-         std::equal(snapshot.cut_offsets.begin(), snapshot.cut_offsets.end(), cut_tets.begin(),
-                    [](const TetPositions& offsets, const CutTet& cut_tet) {
-                      return offsets == cut_tet.enrichment_offset_m;
-                    });
+         snapshot.cut_offsets == cut_offsets();
 }
 
 void Tissue::restore(const TissueSnapshot& snapshot) {
@@ -391,8 +397,8 @@ void Tissue::restore(const TissueSnapshot& snapshot) {
   const DeformableBody::Rotations& rotations = snapshot.rotations;
   const size_t tets = static_cast<size_t>(m_body.mesh().tet_count());
   if (rotations.tets.size() != tets || rotations.tet_warm_starts.size() != tets ||
-      rotations.parts.size() != m_body.cut_tets().size() ||
-      rotations.part_warm_starts.size() != m_body.cut_tets().size()) {
+      rotations.pieces.size() != m_body.xfem().piece_rotations().size() ||
+      rotations.piece_warm_starts.size() != m_body.xfem().piece_warm_starts().size()) {
     throw StateError("the state's rotations do not match the mesh and its cuts");
   }
   const PointContact::State& contact = snapshot.contact;

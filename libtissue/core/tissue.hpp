@@ -129,7 +129,7 @@ struct TissueSnapshot {
   std::uint64_t model_fingerprint = 0;  ///< of the mesh and settings (Tissue::model_fingerprint())
   std::vector<TetCut> cuts;             ///< every enriched cut, in order
   std::vector<int> cut_batch_ends;      ///< after enrichment k, cuts [0, cut_batch_ends[k]) were applied
-  std::vector<TetPositions> cut_offsets;  ///< per cut: CutTet::enrichment_offset_m when it was applied
+  std::vector<std::vector<TetPositions>> cut_offsets;  ///< per cut: its cut tet's pieces' CutPiece::offset_m
   DynamicState dynamics;
   DeformableBody::Rotations rotations;
   Eigen::VectorXd integrator_state;
@@ -193,7 +193,7 @@ class Tissue {
   /// How many triangles for_each_drawn_triangle() visits.
   [[nodiscard]] std::size_t drawn_triangle_count() const {
     return m_surface.triangles.size() - m_cut_surface.replaced_triangles().size() +
-           m_cut_surface.skin_triangles().size() + m_cut_surface.triangles().size();
+           m_cut_surface.skin_triangles().size() + m_cut_surface.drawn_triangles().size();
   }
 
   [[nodiscard]] const SurfaceMesh& surface() const { return m_surface; }
@@ -242,7 +242,10 @@ class Tissue {
   void update_positions();
   /// Enriches `cuts` (one batch), grows the state, adds the opened faces to the surface and the BVH.
   // Live (offsets empty: taken from the state) or replayed from a snapshot (its recorded offsets).
-  EnrichmentResult apply_cuts(std::span<const TetCut> cuts, std::span<const TetPositions> recorded_offsets_m = {});
+  EnrichmentResult apply_cuts(std::span<const TetCut> cuts,
+                              std::span<const std::vector<TetPositions>> recorded_offsets_m = {});
+  // Per cut tet, its pieces' offsets (what a replay needs besides the cuts).
+  [[nodiscard]] std::vector<std::vector<TetPositions>> cut_offsets() const;
   [[nodiscard]] Blade blade(const ToolPose& pose) const;
 
   TissueSettings m_settings;
@@ -301,7 +304,7 @@ void Tissue::for_each_drawn_triangle(Visit&& visit) const {
     visit(m_surface.triangles[t]);
   }
   for (const auto& triangle : m_cut_surface.skin_triangles()) visit(triangle);
-  for (const auto& triangle : m_cut_surface.triangles()) visit(triangle);
+  for (const auto& triangle : m_cut_surface.drawn_triangles()) visit(triangle);
 }
 
 }  // namespace tissue

@@ -10,8 +10,9 @@ namespace tissue {
 namespace {
 
 constexpr std::uint64_t MAGIC = 0x31305353'49535354ULL;  // "TSSISS01" read as little-endian bytes
-// 2: PointSpring::tangent_fraction; 3: the cuts' enrichment offsets; 4: the applied tool position
-constexpr std::uint32_t VERSION = 4;
+// 2: PointSpring::tangent_fraction; 3: the cuts' enrichment offsets; 4: the applied tool position;
+// 5: several cuts per tet (pieces' offsets and rotations, the cuts' smallest fraction, cut counts)
+constexpr std::uint32_t VERSION = 5;
 
 // The core's Eigen types and cut records on top of the shared byte stream.
 class Writer : public serial::ByteWriter {
@@ -50,6 +51,11 @@ class Writer : public serial::ByteWriter {
     put_item(cut.side);
     put(cut.volume_fraction_above);
     put_item(cut.edge_ratio);
+    put(cut.min_volume_fraction);
+  }
+  template <class T>
+  void put_item(const std::vector<T>& values) {
+    put_all(values);
   }
 };
 
@@ -81,6 +87,11 @@ class Reader : public serial::ByteReader {
     get(cut.side);
     get(cut.volume_fraction_above);
     get(cut.edge_ratio);
+    get(cut.min_volume_fraction);
+  }
+  template <class T>
+  void get(std::vector<T>& values) {
+    get_all(values, 8);
   }
   template <class T>
   void get_all(std::vector<T>& values, size_t item_bytes) {
@@ -120,14 +131,15 @@ std::vector<std::uint8_t> serialize_snapshot(const TissueSnapshot& s) {
   w.put(s.dynamics.time_s);
   w.put_all(s.rotations.tets);
   w.put_all(s.rotations.tet_warm_starts);
-  w.put_all(s.rotations.parts);
-  w.put_all(s.rotations.part_warm_starts);
+  w.put_all(s.rotations.pieces);
+  w.put_all(s.rotations.piece_warm_starts);
   w.put(s.integrator_state);
   const VolumeCutter::SessionState& c = s.cutter;
   w.put(static_cast<std::uint8_t>(c.cutting));
   w.put(c.cut_id);
   w.put_all(c.tet_cut_session);
   w.put_all(c.tet_ignored_session);
+  w.put_all(c.tet_cut_count);
   w.put_all(c.edge_session);
   w.put_all(c.edge_ratio);
   w.put_all(c.edge_upper_end);
@@ -171,22 +183,23 @@ TissueSnapshot read_snapshot(std::span<const std::uint8_t> bytes) {
   }
   TissueSnapshot s;
   r.get(s.model_fingerprint);
-  r.get_all(s.cuts, 4 + 4 + 4 + 8 + 48);
+  r.get_all(s.cuts, 4 + 4 + 4 + 8 + 48 + 8);
   r.get_all(s.cut_batch_ends, 4);
-  r.get_all(s.cut_offsets, 96);
+  r.get_all(s.cut_offsets, 8);
   r.get(s.dynamics.displacement_m);
   r.get(s.dynamics.velocity_m_per_s);
   r.get(s.dynamics.time_s);
   r.get_all(s.rotations.tets, 72);
   r.get_all(s.rotations.tet_warm_starts, 32);
-  r.get_all(s.rotations.parts, 144);
-  r.get_all(s.rotations.part_warm_starts, 64);
+  r.get_all(s.rotations.pieces, 72);
+  r.get_all(s.rotations.piece_warm_starts, 32);
   r.get(s.integrator_state);
   VolumeCutter::SessionState& c = s.cutter;
   c.cutting = r.get_bool();
   r.get(c.cut_id);
   r.get_all(c.tet_cut_session, 4);
   r.get_all(c.tet_ignored_session, 4);
+  r.get_all(c.tet_cut_count, 1);
   r.get_all(c.edge_session, 4);
   r.get_all(c.edge_ratio, 8);
   r.get_all(c.edge_upper_end, 1);

@@ -1,6 +1,7 @@
 // CutSurface (see cut_surface.hpp).
 #include "core/cut/cut_surface.hpp"
 
+#include "core/fem/tet_pieces.hpp"
 #include "core/mesh/topology.hpp"
 
 #include <Eigen/Geometry>
@@ -21,13 +22,126 @@ double ratio_from(const TetCut& cut, int a, int b) {
   return 0.5;  // unreachable for two distinct local vertices
 }
 
+// The weights of the point (1 - ratio) x_from + ratio x_to.
+std::array<double, 4> on_edge(int from, int to, double ratio) {
+  std::array<double, 4> weights{};
+  weights[static_cast<size_t>(from)] = 1.0 - ratio;
+  weights[static_cast<size_t>(to)] = ratio;
+  return weights;
+}
+
+// Barycentric weights of x in the tet `corners`.
+std::array<double, 4> barycentric(const std::array<Eigen::Vector3d, 4>& corners, const Eigen::Vector3d& x) {
+  Eigen::Matrix3d edges;
+  for (int i = 0; i < 3; ++i) edges.col(i) = corners[static_cast<size_t>(i + 1)] - corners[0];
+  const Eigen::Vector3d tail = edges.partialPivLu().solve(x - corners[0]);
+  return {1.0 - tail.sum(), tail(0), tail(1), tail(2)};
+}
+
 }  // namespace
 
+int CutSurface::add_point(int cut_tet, int piece, const std::array<double, 4>& weights) {
+  m_points.push_back(Point{cut_tet, piece, weights});
+  return m_vertex_count + static_cast<int>(m_points.size()) - 1;
+}
+
 int CutSurface::add_cut_tets(const DeformableBody& body, int first_cut_tet, const SurfaceMesh& surface) {
+  const int cut_tets = static_cast<int>(body.cut_tets().size());
+  const int triangles_before = static_cast<int>(m_triangles.size());
+  m_retired.resize(static_cast<size_t>(cut_tets), 0);
+  for (int k = first_cut_tet; k < cut_tets; ++k) {
+    if (body.cut_geometry(k).cuts.size() == 1) {
+      add_once_cut_faces(body, k, surface);
+    } else {
+      add_piece_faces(body, k, surface);
+    }
+  }
+  bool retired_any = false;
+  for (int k = 0; k < cut_tets; ++k) {
+    if (body.retired(k) && m_retired[static_cast<size_t>(k)] == 0) {
+      retire(body, k);
+      retired_any = true;
+    }
+  }
+  if (retired_any) {
+    m_drawn.clear();
+    for (size_t t = 0; t < m_triangles.size(); ++t) {
+      if (m_retired[static_cast<size_t>(m_triangle_cut_tet[t])] == 0) m_drawn.push_back(m_triangles[t]);
+    }
+  } else {
+    m_drawn.insert(m_drawn.end(), m_triangles.begin() + triangles_before, m_triangles.end());
+  }
+  m_cut_tets = cut_tets;
+  return static_cast<int>(m_triangles.size()) - triangles_before;
+}
+
+void CutSurface::retire(const DeformableBody& body, int k) {
+  m_retired[static_cast<size_t>(k)] = 1;
+  // Its corners all follow vertex 0 of the first piece of the tet's current cut tet: zero area.
+  const int current = body.cut_tet_index(body.cut_tets()[static_cast<size_t>(k)].cut.tet);
+  for (Point& point : m_points) {
+    if (point.cut_tet == k) point = Point{current, 0, {1.0, 0.0, 0.0, 0.0}};
+  }
+  size_t kept = 0;
+  for (size_t t = 0; t < m_skin.size(); ++t) {
+    if (m_skin_cut_tet[t] == k) continue;
+    m_skin[kept] = m_skin[t];
+    m_skin_cut_tet[kept++] = m_skin_cut_tet[t];
+  }
+  m_skin.resize(kept);
+  m_skin_cut_tet.resize(kept);
+}
+
+void CutSurface::replace_surface_triangles(int tet, const SurfaceMesh& surface) {
+  const auto [first, last] = std::equal_range(surface.triangle_tet.begin(), surface.triangle_tet.end(), tet);
+  for (auto it = first; it != last; ++it) {
+    const int triangle_index = static_cast<int>(it - surface.triangle_tet.begin());
+    const auto at = std::lower_bound(m_replaced.begin(), m_replaced.end(), triangle_index);
+    if (at == m_replaced.end() || *at != triangle_index) m_replaced.insert(at, triangle_index);
+  }
+}
+
+void CutSurface::add_piece_faces(const DeformableBody& body, int k, const SurfaceMesh& surface) {
+  const CutTetGeometry& geometry = body.cut_geometry(k);
+  const TetMesh& mesh = body.mesh();
+  const int tet_index = body.cut_tets()[static_cast<size_t>(k)].cut.tet;
+  const Tet& tet = mesh.tets[static_cast<size_t>(tet_index)];
+  std::array<Eigen::Vector3d, 4> rest;
+  for (size_t j = 0; j < 4; ++j) rest[j] = mesh.rest_positions_m[static_cast<size_t>(tet[j])];
+  // Which local faces of the tet are on the mesh's surface.
+  std::array<bool, 4> on_surface{};
+  const auto [first, last] = std::equal_range(surface.triangle_tet.begin(), surface.triangle_tet.end(), tet_index);
+  for (auto it = first; it != last; ++it) {
+    on_surface[static_cast<size_t>(surface.triangle_local_face[static_cast<size_t>(it - surface.triangle_tet.begin())])] = true;
+  }
+  replace_surface_triangles(tet_index, surface);
+  for (int p = 0; p < static_cast<int>(geometry.pieces.size()); ++p) {
+    const ConvexPiece piece = piece_geometry(rest, geometry.cuts, geometry.pieces[static_cast<size_t>(p)].sides);
+    for (int f = 0; f < piece.face_count(); ++f) {
+      const int tag = piece.face_tag(f);
+      const bool cap = tag >= 4;
+      if (!cap && !on_surface[static_cast<size_t>(tag)]) continue;  // inside the mesh
+      const int first_corner = add_point(k, p, barycentric(rest, piece.corner(f, 0)));
+      int previous = add_point(k, p, barycentric(rest, piece.corner(f, 1)));
+      for (int c = 2; c < piece.corner_count(f); ++c) {
+        const int next = add_point(k, p, barycentric(rest, piece.corner(f, c)));
+        if (cap) {
+          m_triangles.push_back({first_corner, previous, next});
+          m_triangle_cut_tet.push_back(k);
+        } else {
+          m_skin.push_back({first_corner, previous, next});
+          m_skin_cut_tet.push_back(k);
+        }
+        previous = next;
+      }
+    }
+  }
+}
+
+void CutSurface::add_once_cut_faces(const DeformableBody& body, int k, const SurfaceMesh& surface) {
   const auto& cut_tets = body.cut_tets();
   const TetMesh& mesh = body.mesh();
-  const int triangles_before = static_cast<int>(m_triangles.size());
-  for (int k = first_cut_tet; k < static_cast<int>(cut_tets.size()); ++k) {
+  {
     const TetCut& cut = cut_tets[static_cast<size_t>(k)].cut;
     const Tet& tet = mesh.tets[static_cast<size_t>(cut.tet)];
     // The crossed edges between the two groups, ordered around the polygon: walk from edge to edge
@@ -69,10 +183,11 @@ int CutSurface::add_cut_tets(const DeformableBody& body, int first_cut_tet, cons
     const bool polygon_faces_below = normal.dot(above_to_below) >= 0.0;
 
     for (CutPart part : {CutPart::above, CutPart::below}) {
+      const int piece = part == CutPart::above ? 0 : 1;
       const int first_point = m_vertex_count + static_cast<int>(m_points.size());
       for (int e : crossed) {
         const auto& edge = TET_EDGES[static_cast<size_t>(e)];
-        m_points.push_back(Point{k, part, edge[0], edge[1], cut.edge_ratio[static_cast<size_t>(e)]});
+        add_point(k, piece, on_edge(edge[0], edge[1], cut.edge_ratio[static_cast<size_t>(e)]));
       }
       // Outward from the part: toward below for part above, toward above for part below.
       const bool keep_order = (part == CutPart::above) == polygon_faces_below;
@@ -81,10 +196,12 @@ int CutSurface::add_cut_tets(const DeformableBody& body, int first_cut_tet, cons
         std::array<int, 3> triangle{first_point, first_point + t, first_point + t + 1};
         if (!keep_order) std::swap(triangle[1], triangle[2]);
         m_triangles.push_back(triangle);
+        m_triangle_cut_tet.push_back(k);
       }
     }
 
     // The skin: the tet's surface triangles (triangle_tet is in tet order), split along the cut.
+    replace_surface_triangles(cut.tet, surface);
     const auto [first, last] = std::equal_range(surface.triangle_tet.begin(), surface.triangle_tet.end(), cut.tet);
     for (auto it = first; it != last; ++it) {
       const int triangle_index = static_cast<int>(it - surface.triangle_tet.begin());
@@ -95,7 +212,6 @@ int CutSurface::add_cut_tets(const DeformableBody& body, int first_cut_tet, cons
           if (tet[static_cast<size_t>(i)] == triangle[static_cast<size_t>(c)]) local[static_cast<size_t>(c)] = i;
         }
       }
-      m_replaced.insert(std::upper_bound(m_replaced.begin(), m_replaced.end(), triangle_index), triangle_index);
       for (CutPart part : {CutPart::above, CutPart::below}) {
         const int side = part == CutPart::above ? 1 : -1;
         std::vector<int> polygon;  // walked in the triangle's order, so the winding stays outward
@@ -104,34 +220,37 @@ int CutSurface::add_cut_tets(const DeformableBody& body, int first_cut_tet, cons
           const int b = local[static_cast<size_t>((c + 1) % 3)];
           if (cut.side[static_cast<size_t>(a)] == side) polygon.push_back(triangle[static_cast<size_t>(c)]);
           if (cut.side[static_cast<size_t>(a)] != cut.side[static_cast<size_t>(b)]) {
-            polygon.push_back(m_vertex_count + static_cast<int>(m_points.size()));
-            m_points.push_back(Point{k, part, a, b, ratio_from(cut, a, b)});
+            polygon.push_back(add_point(k, part == CutPart::above ? 0 : 1, on_edge(a, b, ratio_from(cut, a, b))));
           }
         }
-        for (size_t t = 1; t + 1 < polygon.size(); ++t) m_skin.push_back({polygon[0], polygon[t], polygon[t + 1]});
+        for (size_t t = 1; t + 1 < polygon.size(); ++t) {
+          m_skin.push_back({polygon[0], polygon[t], polygon[t + 1]});
+          m_skin_cut_tet.push_back(k);
+        }
       }
     }
   }
-  m_cut_tets = static_cast<int>(cut_tets.size());
-  return static_cast<int>(m_triangles.size()) - triangles_before;
 }
 
 void CutSurface::update_points(const DeformableBody& body, const Eigen::VectorXd& displacement_m,
                                Eigen::VectorXd& positions_m) const {
   positions_m.conservativeResize(3 * (m_vertex_count + point_count()));
   int last_cut_tet = -1;
-  CutPart last_part = CutPart::above;
-  TetPositions part_positions;
+  int last_piece = -1;
+  TetPositions piece_positions{Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero(),
+                               Eigen::Vector3d::Zero()};
   for (size_t p = 0; p < m_points.size(); ++p) {
     const Point& point = m_points[p];
-    if (point.cut_tet != last_cut_tet || point.part != last_part) {
-      part_positions = body.part_positions(displacement_m, point.cut_tet, point.part);
+    if (point.cut_tet != last_cut_tet || point.piece != last_piece) {
+      piece_positions = body.piece_positions(displacement_m, point.cut_tet, point.piece);
       last_cut_tet = point.cut_tet;
-      last_part = point.part;
+      last_piece = point.piece;
     }
-    positions_m.segment<3>(3 * (m_vertex_count + static_cast<Eigen::Index>(p))) =
-        (1.0 - point.ratio) * part_positions[static_cast<size_t>(point.from)] +
-        point.ratio * part_positions[static_cast<size_t>(point.to)];
+    Eigen::Vector3d x = Eigen::Vector3d::Zero();
+    for (size_t j = 0; j < 4; ++j) {
+      if (point.weights[j] != 0.0) x += point.weights[j] * piece_positions[j];
+    }
+    positions_m.segment<3>(3 * (m_vertex_count + static_cast<Eigen::Index>(p))) = x;
   }
 }
 

@@ -141,6 +141,7 @@ VolumeCutter::VolumeCutter(const TetMesh& mesh, const TetAdjacency& adjacency, c
   m_candidate_stamp.assign(tets, 0);
   m_tet_cut_session.assign(tets, -1);
   m_tet_ignored_session.assign(tets, -1);
+  m_tet_cut_count.assign(tets, 0);
   m_edge_stamp.assign(edges, 0);
   m_edge_session.assign(edges, -1);
   m_edge_ratio.assign(edges, 0.0);
@@ -173,6 +174,7 @@ void VolumeCutter::save(SessionState& state) const {
   state.cut_id = m_cut_id;
   state.tet_cut_session = m_tet_cut_session;
   state.tet_ignored_session = m_tet_ignored_session;
+  state.tet_cut_count = m_tet_cut_count;
   state.edge_session = m_edge_session;
   state.edge_ratio = m_edge_ratio;
   state.edge_upper_end = m_edge_upper_end;
@@ -184,6 +186,7 @@ void VolumeCutter::restore(const SessionState& state) {
   const size_t tets = m_tet_cut_session.size();
   const size_t edges = m_edge_session.size();
   if (state.tet_cut_session.size() != tets || state.tet_ignored_session.size() != tets ||
+      state.tet_cut_count.size() != tets ||
       state.edge_session.size() != edges || state.edge_ratio.size() != edges || state.edge_upper_end.size() != edges) {
     fail("the state is of another mesh (" + std::to_string(state.tet_cut_session.size()) + " tets, " +
          std::to_string(state.edge_session.size()) + " edges; this one has " + std::to_string(tets) + " and " +
@@ -196,6 +199,10 @@ void VolumeCutter::restore(const SessionState& state) {
       !std::all_of(state.edge_session.begin(), state.edge_session.end(), session_ok)) {
     fail("a tet or edge names a session after " + std::to_string(state.cut_id));
   }
+  if (!std::all_of(state.tet_cut_count.begin(), state.tet_cut_count.end(),
+                   [](std::int8_t count) { return count >= 0 && count <= MAX_PIECE_CUTS; })) {
+    fail("a tet's cut count is outside [0, " + std::to_string(MAX_PIECE_CUTS) + "]");
+  }
   if (!std::all_of(state.active.begin(), state.active.end(),
                    [&](int tet) { return tet >= 0 && static_cast<size_t>(tet) < tets; })) {
     fail("an active tet is out of range");
@@ -205,6 +212,7 @@ void VolumeCutter::restore(const SessionState& state) {
   m_cut_id = state.cut_id;
   std::copy(state.tet_cut_session.begin(), state.tet_cut_session.end(), m_tet_cut_session.begin());
   std::copy(state.tet_ignored_session.begin(), state.tet_ignored_session.end(), m_tet_ignored_session.begin());
+  std::copy(state.tet_cut_count.begin(), state.tet_cut_count.end(), m_tet_cut_count.begin());
   std::copy(state.edge_session.begin(), state.edge_session.end(), m_edge_session.begin());
   std::copy(state.edge_ratio.begin(), state.edge_ratio.end(), m_edge_ratio.begin());
   std::copy(state.edge_upper_end.begin(), state.edge_upper_end.end(), m_edge_upper_end.begin());
@@ -417,16 +425,18 @@ void VolumeCutter::complete_touched_tets(CutStepReport& report) {
         m_mesh.rest_positions_m[at(vertices[2])], m_mesh.rest_positions_m[at(vertices[3])]};
     auto cut = classify_tet_cut(rest, crossings, m_settings.vertex_snap_fraction, m_settings.min_volume_fraction);
     if (!cut) continue;
-    if (m_tet_cut_session[at(tet)] >= 0) {  // cut in an earlier session: one cut per tet
+    if (m_tet_cut_count[at(tet)] >= MAX_PIECE_CUTS) {  // the pieces' capacity (convex_piece.hpp)
       if (m_tet_ignored_session[at(tet)] != m_cut_id) {
         m_tet_ignored_session[at(tet)] = m_cut_id;
-        ++report.ignored_second_cuts;
+        ++report.ignored_cuts;
       }
       continue;
     }
     cut->tet = tet;
     cut->cut_id = m_cut_id;
+    cut->min_volume_fraction = m_settings.min_volume_fraction;
     m_tet_cut_session[at(tet)] = m_cut_id;
+    ++m_tet_cut_count[at(tet)];
     m_new_cuts.push_back(*cut);
   }
 }

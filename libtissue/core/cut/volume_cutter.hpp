@@ -2,7 +2,8 @@
 // algorithms 1-5). The blade is the segment tip-handle; between two steps it sweeps two
 // triangles. A local neighbour search from the tets the blade touches records where the sweep
 // crosses mesh edges (once per cutting session), and every tet whose recorded crossings separate
-// its vertices is handed to the XFEM as a TetCut as soon as it is cut completely (one cut per tet).
+// its vertices is handed to the XFEM as a TetCut as soon as it is cut completely (once per session;
+// a tet may be cut by up to MAX_PIECE_CUTS sessions, issue 21).
 //
 // Additions to the dissertation's algorithms, for robustness:
 //  * A session also starts when the sweep (not only the current blade) crosses the surface, so a
@@ -17,14 +18,17 @@
 //
 // A session (one cut_id) runs from the step in which the blade or its sweep meets the surface to
 // the step after which the blade touches no tet, or to end_cut(). When a tet is complete, and how
-// its TetCut is computed, is decided by classify_tet_cut (cut_geometry.hpp). A tet cut in an earlier
-// session is never cut again; if this session's crossings would cut it, it is counted once in
-// CutStepReport::ignored_second_cuts. The search starts from the previous step's active tets: if the
+// its TetCut is computed, is decided by classify_tet_cut (cut_geometry.hpp) on this session's
+// crossings of the tet's edges: a later session that crosses a cut tet completely cuts it again (the
+// XFEM splits the pieces it passes through, split_pieces). A tet that carries MAX_PIECE_CUTS cuts
+// already is not cut again: counted once per session in CutStepReport::ignored_cuts. The search
+// starts from the previous step's active tets: if the
 // body moves so far in one step that the blade has left all of them, only the parts of the sweep
 // that reach the surface are found.
 #pragma once
 
 #include "core/collide/surface_bvh.hpp"
+#include "core/fem/convex_piece.hpp"
 #include "core/fem/tet_cut.hpp"
 #include "core/mesh/tet_mesh.hpp"
 #include "core/mesh/topology.hpp"
@@ -71,7 +75,7 @@ struct CutterSettings {
   double vertex_snap_fraction = 1e-3;
   /// V_a/V is clamped to [this, 1 - this], so that neither part of a cut tet has (almost) no
   /// stiffness and mass (eq. 3.21-3.23, 4.16). In [SMALLEST_MIN_VOLUME_FRACTION, 0.5).
-  double min_volume_fraction = 1e-3;
+  double min_volume_fraction = DEFAULT_MIN_VOLUME_FRACTION;
 };
 
 /// Throws ParameterError unless both fractions are in their ranges (the one place they are checked).
@@ -85,7 +89,7 @@ struct CutStepReport {
   int active_tets = 0;          ///< tets the blade touches after the step (algorithm 4)
   int new_edge_crossings = 0;   ///< edges crossed for the first time in this session
   int newly_cut_tets = 0;       ///< tets completed by this step (= new_cuts().size())
-  int ignored_second_cuts = 0;  ///< tets cut in an earlier session that this session cut again
+  int ignored_cuts = 0;         ///< tets this session cut that carry MAX_PIECE_CUTS cuts already (not cut again)
   double seconds = 0.0;         ///< wall time of the step
 };
 
@@ -115,6 +119,8 @@ class VolumeCutter {
   /// The tets the blade touches after the last step (the seeds of the next search).
   [[nodiscard]] const std::vector<int>& active_tets() const { return m_active; }
   [[nodiscard]] bool is_cut(int tet) const { return m_tet_cut_session[static_cast<std::size_t>(tet)] >= 0; }
+  /// How many sessions cut `tet`.
+  [[nodiscard]] int cut_count(int tet) const { return m_tet_cut_count[static_cast<std::size_t>(tet)]; }
   /// Where the current (or last) session crossed `edge` (an id of TetAdjacency::edges {v0, v1}):
   /// the ratio r of the point (1 - r) x_v0 + r x_v1, or nothing if it did not cross it.
   [[nodiscard]] std::optional<double> edge_crossing(int edge) const;
@@ -129,6 +135,7 @@ class VolumeCutter {
     int cut_id = -1;
     std::vector<int> tet_cut_session;
     std::vector<int> tet_ignored_session;
+    std::vector<std::int8_t> tet_cut_count;
     std::vector<int> edge_session;
     std::vector<double> edge_ratio;
     std::vector<std::int8_t> edge_upper_end;
@@ -166,8 +173,9 @@ class VolumeCutter {
 
   std::vector<std::int64_t> m_tet_stamp;        ///< visited (algorithms 1, 2)
   std::vector<std::int64_t> m_candidate_stamp;  ///< already queued for the completion test
-  std::vector<int> m_tet_cut_session;           ///< session that cut the tet, -1 if uncut
-  std::vector<int> m_tet_ignored_session;       ///< last session that reported a second cut
+  std::vector<int> m_tet_cut_session;           ///< last session that cut the tet, -1 if uncut
+  std::vector<std::int8_t> m_tet_cut_count;     ///< sessions that cut the tet
+  std::vector<int> m_tet_ignored_session;       ///< last session that reported an ignored cut
   std::vector<std::int64_t> m_edge_stamp;       ///< tested against the current sweep
   std::vector<int> m_edge_session;              ///< session whose crossing is recorded, -1 if none
   std::vector<double> m_edge_ratio;             ///< along {v0, v1}

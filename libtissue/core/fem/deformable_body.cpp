@@ -67,16 +67,19 @@ Neighbourhoods neighbourhoods(const TetMesh& mesh, const DofMap& dofs) {
   return counts;
 }
 
-// Room one cut can ever need, so that cutting never overflows a row (DESIGN section 3: the matrix
-// grows in place). A u row holds its free neighbours and gains one u-a block per enriched
-// neighbour, fixed ones included: free + all (twice its blocks inside the body, more next to fixed
-// vertices). An enriched row holds a-u blocks with the free neighbours and a-a blocks with all.
+// Room cuts need, so that cutting does not overflow a row (DESIGN section 3: the matrix grows in
+// place). A u row holds its free neighbours and gains a u-a block for every ghost of a neighbour,
+// fixed ones included: one per neighbour for a single cut, up to three where two cuts cross (the
+// ghosts behind the first, the second and both): free + GHOSTS_PER_NEIGHBOUR all. An enriched row
+// holds a-u blocks with the free neighbours and a-a blocks with their ghosts, as many.
+constexpr int GHOSTS_PER_NEIGHBOUR = 3;
+
 std::vector<int> u_row_capacities(const TetMesh& mesh, const DofMap& dofs) {
   const Neighbourhoods counts = neighbourhoods(mesh, dofs);
   std::vector<int> capacities(static_cast<size_t>(dofs.free_vertex_count()));
   for (size_t row = 0; row < capacities.size(); ++row) {
     const auto v = static_cast<size_t>(dofs.row_vertex[row]);
-    capacities[row] = counts.free[v] + counts.all[v];
+    capacities[row] = counts.free[v] + GHOSTS_PER_NEIGHBOUR * counts.all[v];
   }
   return capacities;
 }
@@ -84,7 +87,7 @@ std::vector<int> u_row_capacities(const TetMesh& mesh, const DofMap& dofs) {
 std::vector<int> enriched_row_capacities(const TetMesh& mesh, const DofMap& dofs) {
   const Neighbourhoods counts = neighbourhoods(mesh, dofs);
   std::vector<int> capacities(counts.all.size());
-  for (size_t v = 0; v < capacities.size(); ++v) capacities[v] = counts.free[v] + counts.all[v];
+  for (size_t v = 0; v < capacities.size(); ++v) capacities[v] = counts.free[v] + GHOSTS_PER_NEIGHBOUR * counts.all[v];
   return capacities;
 }
 
@@ -199,14 +202,17 @@ TISSUE_HOT_KERNEL double DeformableBody::largest_element_turn_rad(const Eigen::V
     largest_rad = std::max(largest_rad, turn_angle_rad(m_elasticity.rest(t), m_elasticity.rotation(t), increment));
   }
   for (int k = 0; k < m_xfem.cut_tet_count(); ++k) {
+    if (m_xfem.retired(k)) continue;
     const CutTet& cut_tet = m_xfem.cut_tets()[static_cast<size_t>(k)];
-    for (const CutPart part : {CutPart::above, CutPart::below}) {
+    for (int p = 0; p < static_cast<int>(m_xfem.piece_count(k)); ++p) {
+      const CutPiece& piece = m_xfem.piece(k, p);
       for (size_t j = 0; j < 4; ++j) {
-        increment[j] = vertex_increment(cut_tet.vertices[j]) +
-                       cut_tet.shift(static_cast<int>(j), part) *
-                           Eigen::Vector3d(increment_m.segment<3>(3 * cut_tet.enriched_row[j]));
+        increment[j] = vertex_increment(cut_tet.vertices[j]);
+        if (piece.ghost_row[j] >= 0) {
+          increment[j] += piece.ghost_sign[j] * Eigen::Vector3d(increment_m.segment<3>(3 * piece.ghost_row[j]));
+        }
       }
-      largest_rad = std::max(largest_rad, turn_angle_rad(m_xfem.rest(k), m_xfem.rotation(k, part), increment));
+      largest_rad = std::max(largest_rad, turn_angle_rad(m_xfem.rest(k), m_xfem.rotation(k, p), increment));
     }
   }
   return largest_rad;
@@ -278,18 +284,18 @@ double DeformableBody::kinetic_energy_j(const Eigen::VectorXd& velocity_m_per_s)
 void DeformableBody::save_rotations(Rotations& rotations) const {
   rotations.tets = m_elasticity.rotations();
   rotations.tet_warm_starts = m_elasticity.warm_starts();
-  rotations.parts = m_xfem.rotations();
-  rotations.part_warm_starts = m_xfem.warm_starts();
+  rotations.pieces = m_xfem.piece_rotations();
+  rotations.piece_warm_starts = m_xfem.piece_warm_starts();
 }
 
 void DeformableBody::restore_rotations(const Rotations& rotations) {
-  if (rotations.parts.size() != m_xfem.cut_tets().size() ||
-      rotations.part_warm_starts.size() != m_xfem.cut_tets().size()) {
-    throw std::invalid_argument("body: the saved rotations are of " + std::to_string(rotations.parts.size()) +
-                                " cut tets, the body has " + std::to_string(m_xfem.cut_tets().size()));
+  if (rotations.pieces.size() != m_xfem.piece_rotations().size() ||
+      rotations.piece_warm_starts.size() != m_xfem.piece_warm_starts().size()) {
+    throw std::invalid_argument("body: the saved rotations are of " + std::to_string(rotations.pieces.size()) +
+                                " cut-tet pieces, the body has " + std::to_string(m_xfem.piece_rotations().size()));
   }
   m_elasticity.restore_rotations(rotations.tets, rotations.tet_warm_starts);
-  m_xfem.restore_rotations(rotations.parts, rotations.part_warm_starts);
+  m_xfem.restore_rotations(rotations.pieces, rotations.piece_warm_starts);
 }
 
 void DeformableBody::reset_rotations() {
@@ -299,26 +305,47 @@ void DeformableBody::reset_rotations() {
 
 // --- XFEM ---
 
-int DeformableBody::find_enriched_dof(int vertex, int cut_id, int side) const {
+int DeformableBody::find_ghost(int vertex, const SeparatingCuts& cuts) const {
   if (vertex < 0 || vertex >= m_mesh.vertex_count()) return -1;
   for (int k = m_first_enriched_dof[static_cast<size_t>(vertex)]; k >= 0;
        k = m_next_enriched_dof[static_cast<size_t>(k)]) {
-    const EnrichedDof& dof = m_enriched_dofs[static_cast<size_t>(k)];
-    if (dof.cut_id == cut_id && dof.side == side) return k;
+    if (m_enriched_dofs[static_cast<size_t>(k)].separated_by == cuts) return k;
   }
   return -1;
+}
+
+int DeformableBody::find_enriched_dof(int vertex, int cut_id, int side) const {
+  SeparatingCuts cuts;
+  cuts.count = 1;
+  cuts.cut_id[0] = cut_id;
+  cuts.side[0] = static_cast<std::int8_t>(side);
+  return find_ghost(vertex, cuts);
 }
 
 void DeformableBody::check_cuts(std::span<const TetCut> cuts) const {
   std::vector<int> tets;
   tets.reserve(cuts.size());
+  const auto has_plane = [](const TetCut& cut) {
+    return std::count_if(cut.edge_ratio.begin(), cut.edge_ratio.end(), [](double r) { return r >= 0.0; }) >= 3;
+  };
   for (size_t c = 0; c < cuts.size(); ++c) {
     const TetCut& cut = cuts[c];
     const std::string where = "enrich: cut " + std::to_string(c) + " (tet " + std::to_string(cut.tet) + "): ";
     if (cut.tet < 0 || cut.tet >= m_mesh.tet_count()) {
       throw ParameterError(where + "tet outside [0, " + std::to_string(m_mesh.tet_count()) + ")");
     }
-    if (cut_tet_index(cut.tet) >= 0) throw ParameterError(where + "the tet is cut already (one cut per tet)");
+    if (const int k = cut_tet_index(cut.tet); k >= 0) {
+      const std::vector<TetCut>& earlier = m_cut_geometry[static_cast<size_t>(k)].cuts;
+      if (std::any_of(earlier.begin(), earlier.end(), [&](const TetCut& e) { return e.cut_id == cut.cut_id; })) {
+        throw ParameterError(where + "the tet is cut already by cut " + std::to_string(cut.cut_id));
+      }
+      if (earlier.size() >= static_cast<size_t>(MAX_PIECE_CUTS)) {
+        throw ParameterError(where + "the tet carries " + std::to_string(MAX_PIECE_CUTS) + " cuts already");
+      }
+      if (!has_plane(cut) || !std::all_of(earlier.begin(), earlier.end(), has_plane)) {
+        throw ParameterError(where + "cutting a cut tet needs the edge crossings of each cut");
+      }
+    }
     bool above = false;
     bool below = false;
     for (const std::int8_t side : cut.side) {
@@ -331,6 +358,10 @@ void DeformableBody::check_cuts(std::span<const TetCut> cuts) const {
         !(cut.volume_fraction_above < 1.0)) {
       throw ParameterError(where + "volume fraction " + std::to_string(cut.volume_fraction_above) +
                            " is not in (0, 1)");
+    }
+    if (!(cut.min_volume_fraction > 0.0) || !(cut.min_volume_fraction < 0.5)) {
+      throw ParameterError(where + "smallest piece fraction " + std::to_string(cut.min_volume_fraction) +
+                           " is not in (0, 0.5)");
     }
     tets.push_back(cut.tet);
   }
@@ -346,95 +377,188 @@ EnrichmentResult DeformableBody::enrich(std::span<const TetCut> cuts, DynamicSta
                                 " displacements and " + std::to_string(state.velocity_m_per_s.size()) +
                                 " velocities, the body " + std::to_string(size) + " unknowns");
   }
-  check_cuts(cuts);
-  // The offsets: the current a of each existing unknown a cut tet will join.
-  std::vector<TetPositions> offsets_m(cuts.size());
-  for (size_t c = 0; c < cuts.size(); ++c) {
-    const Tet& tet = m_mesh.tets[static_cast<size_t>(cuts[c].tet)];
-    for (size_t i = 0; i < 4; ++i) {
-      const int k = find_enriched_dof(tet[i], cuts[c].cut_id, cuts[c].side[i]);
-      offsets_m[c][i] = k < 0 ? Eigen::Vector3d::Zero()
-                              : Eigen::Vector3d(state.displacement_m.segment<3>(3 * m_enriched_dofs[static_cast<size_t>(k)].row));
-    }
-  }
   const Eigen::VectorXd mass_before_kg = m_mass_kg;
-  const EnrichmentResult result = enrich(cuts, offsets_m);
+  const EnrichmentResult result = enrich_pieces(cuts, {}, &state.displacement_m);
   grow_state(state);
-  // An existing unknown that gained mass keeps its momentum (an inelastic join of the new part).
+  // An existing unknown that gained mass keeps its momentum (an inelastic join of the new piece).
   for (Eigen::Index r = 0; r < mass_before_kg.size(); ++r) {
     if (m_mass_kg(r) > mass_before_kg(r)) state.velocity_m_per_s(r) *= mass_before_kg(r) / m_mass_kg(r);
   }
   return result;
 }
 
-EnrichmentResult DeformableBody::enrich(std::span<const TetCut> cuts, std::span<const TetPositions> offsets_m) {
-  check_cuts(cuts);
-  if (!offsets_m.empty() && offsets_m.size() != cuts.size()) {
-    throw ParameterError("enrich: " + std::to_string(offsets_m.size()) + " offsets for " +
-                         std::to_string(cuts.size()) + " cuts");
-  }
-  for (const TetPositions& offsets : offsets_m) {
-    for (const Eigen::Vector3d& offset : offsets) {
-      if (!offset.allFinite()) throw ParameterError("enrich: an enrichment offset is not finite");
+EnrichmentResult DeformableBody::enrich(std::span<const TetCut> cuts, std::span<const std::vector<TetPositions>> offsets_m) {
+  return enrich_pieces(cuts, offsets_m, nullptr);
+}
+
+std::array<Eigen::Vector3d, 4> DeformableBody::rest_corners(int tet) const {
+  const Tet& vertices = m_mesh.tets[static_cast<size_t>(tet)];
+  return {m_mesh.rest_positions_m[static_cast<size_t>(vertices[0])], m_mesh.rest_positions_m[static_cast<size_t>(vertices[1])],
+          m_mesh.rest_positions_m[static_cast<size_t>(vertices[2])], m_mesh.rest_positions_m[static_cast<size_t>(vertices[3])]};
+}
+
+void DeformableBody::add_ghost_loads(int k, double sign) {
+  const double tet_mass_kg = m_settings.material.density_kg_per_m3 * m_xfem.rest(k).volume_m3;
+  for (size_t p = 0; p < m_xfem.piece_count(k); ++p) {
+    const CutPiece& piece = m_xfem.piece(k, static_cast<int>(p));
+    const double quarter_mass_kg = 0.25 * piece.weight * tet_mass_kg;
+    for (size_t j = 0; j < 4; ++j) {
+      const int row = piece.ghost_row[j];
+      if (row < 0) continue;
+      m_mass_kg.segment<3>(3 * row).array() += sign * quarter_mass_kg;
+      m_external_force_n.segment<3>(3 * row) += sign * piece.ghost_sign[j] * quarter_mass_kg * m_settings.gravity_m_per_s2;
     }
   }
+}
+
+// Enriched lumped mass and gravity for any number of pieces: each piece p lumped as a full tet of
+// mass w_p m puts w_p m / 4 on each of its ghosts (as M^aa above), and its gravity on the ghost
+// row is sign w_p m / 4 g (the ghost sits at x_j + sign a).
+EnrichmentResult DeformableBody::enrich_pieces(std::span<const TetCut> cuts,
+                                               std::span<const std::vector<TetPositions>> offsets_m,
+                                               const Eigen::VectorXd* displacement_m) {
+  check_cuts(cuts);
+  if (!offsets_m.empty() && offsets_m.size() != cuts.size()) {
+    throw ParameterError("enrich: " + std::to_string(offsets_m.size()) + " offset lists for " +
+                         std::to_string(cuts.size()) + " cuts");
+  }
+  // Every cut's geometry first: nothing changes before all are known to be valid.
+  std::vector<CutTetGeometry> geometries(cuts.size());
+  for (size_t c = 0; c < cuts.size(); ++c) {
+    const int old = cut_tet_index(cuts[c].tet);
+    CutTetGeometry& geometry = geometries[c];
+    if (old >= 0) geometry.cuts = m_cut_geometry[static_cast<size_t>(old)].cuts;
+    geometry.cuts.push_back(cuts[c]);
+    const std::span<const TetPiece> previous =
+        old >= 0 ? std::span<const TetPiece>(m_cut_geometry[static_cast<size_t>(old)].pieces) : std::span<const TetPiece>();
+    try {
+      geometry.pieces = split_pieces(rest_corners(cuts[c].tet), geometry.cuts, previous);
+    } catch (const std::invalid_argument& error) {
+      throw ParameterError("enrich: cut " + std::to_string(c) + ": " + error.what());
+    }
+    if (geometry.pieces.size() < 2) throw ParameterError("enrich: cut " + std::to_string(c) + " leaves one piece");
+    if (!offsets_m.empty()) {
+      if (offsets_m[c].size() != geometry.pieces.size()) {
+        throw ParameterError("enrich: cut " + std::to_string(c) + " has " + std::to_string(offsets_m[c].size()) +
+                             " offset sets for " + std::to_string(geometry.pieces.size()) + " pieces");
+      }
+      for (const TetPositions& offsets : offsets_m[c]) {
+        for (const Eigen::Vector3d& offset : offsets) {
+          if (!offset.allFinite()) throw ParameterError("enrich: an enrichment offset is not finite");
+        }
+      }
+    }
+  }
+
   EnrichmentResult result;
   const std::uint64_t layout_before = m_tangent.layout_revision();
   const int u_rows = m_dofs.free_vertex_count();
   const int old_dofs = enriched_dof_count();
+  const int first_new_cut_tet = m_xfem.cut_tet_count();
+  // The current a of an unknown (new ones, and every one without a running state, are zero).
+  const auto current_a = [&](int row) -> Eigen::Vector3d {
+    if (displacement_m == nullptr || 3 * row >= displacement_m->size()) return Eigen::Vector3d::Zero();
+    return displacement_m->segment<3>(3 * row);
+  };
 
-  // 1. The enriched unknowns: one per (vertex, cut id, side), appended as block rows.
-  std::vector<std::array<int, 4>> dof_of_cut(cuts.size());
   for (size_t c = 0; c < cuts.size(); ++c) {
     const TetCut& cut = cuts[c];
+    CutTetGeometry& geometry = geometries[c];
+    const int old = cut_tet_index(cut.tet);
     const Tet& tet = m_mesh.tets[static_cast<size_t>(cut.tet)];
-    for (size_t i = 0; i < 4; ++i) {
-      int k = find_enriched_dof(tet[i], cut.cut_id, cut.side[i]);
-      if (k < 0) {
-        k = enriched_dof_count();
-        const int row = m_tangent.append_block_row(m_enriched_row_capacity[static_cast<size_t>(tet[i])]);
-        if (row != u_rows + k) throw std::logic_error("enrich: the tangent's rows and the unknowns disagree");
-        m_enriched_dofs.push_back(EnrichedDof{tet[i], cut.cut_id, cut.side[i], row});
-        m_next_enriched_dof.push_back(m_first_enriched_dof[static_cast<size_t>(tet[i])]);
-        m_first_enriched_dof[static_cast<size_t>(tet[i])] = k;
+
+    // 1. The pieces' ghosts: one enriched unknown per (vertex, separating cuts), appended as block rows.
+    std::vector<CutPiece> pieces(geometry.pieces.size());
+    std::vector<Eigen::Matrix3d> rotations(geometry.pieces.size(), m_elasticity.rotation(cut.tet));
+    for (size_t q = 0; q < pieces.size(); ++q) {
+      pieces[q].weight = geometry.pieces[q].volume_fraction;
+      if (old >= 0) rotations[q] = m_xfem.rotation(old, geometry.pieces[q].parent);
+    }
+    // Vertex by vertex (unknowns are created in local-vertex order), each piece's ghost of it.
+    for (size_t j = 0; j < 4; ++j) {
+      for (size_t q = 0; q < pieces.size(); ++q) {
+        const TetPiece& shape = geometry.pieces[q];
+        CutPiece& piece = pieces[q];
+        if (vertex_in_piece(geometry.cuts, shape.sides, static_cast<int>(j))) continue;
+        SeparatingCuts separated;
+        for (size_t k = 0; k < geometry.cuts.size(); ++k) {
+          const std::uint32_t bit = 1u << k;
+          const int vertex_side = geometry.cuts[k].side[j];
+          if ((shape.sides.bounded & bit) == 0 || (vertex_side > 0) == ((shape.sides.above & bit) != 0)) continue;
+          const auto n = static_cast<size_t>(separated.count++);
+          separated.cut_id[n] = geometry.cuts[k].cut_id;
+          separated.side[n] = static_cast<std::int8_t>(vertex_side);
+        }
+        // Sorted by cut id (insertion sort of at most MAX_PIECE_CUTS pairs).
+        for (int a = 1; a < separated.count; ++a) {
+          for (int b = a; b > 0 && separated.cut_id[static_cast<size_t>(b)] < separated.cut_id[static_cast<size_t>(b - 1)]; --b) {
+            std::swap(separated.cut_id[static_cast<size_t>(b)], separated.cut_id[static_cast<size_t>(b - 1)]);
+            std::swap(separated.side[static_cast<size_t>(b)], separated.side[static_cast<size_t>(b - 1)]);
+          }
+        }
+        int k = find_ghost(tet[j], separated);
+        if (k < 0) {
+          k = enriched_dof_count();
+          const int row = m_tangent.append_block_row(m_enriched_row_capacity[static_cast<size_t>(tet[j])]);
+          if (row != u_rows + k) throw std::logic_error("enrich: the tangent's rows and the unknowns disagree");
+          m_enriched_dofs.push_back(EnrichedDof{tet[j], separated.cut_id[0], separated.side[0], row, separated});
+          m_next_enriched_dof.push_back(m_first_enriched_dof[static_cast<size_t>(tet[j])]);
+          m_first_enriched_dof[static_cast<size_t>(tet[j])] = k;
+        }
+        const int row = m_enriched_dofs[static_cast<size_t>(k)].row;
+        // The ghost's sign is a function of its key: -H of the vertex for the first separating cut
+        // (a single cut: Psi = (H_p - H_j) / 2 = -H_j).
+        const double sign = -static_cast<double>(separated.side[0]);
+        piece.ghost_row[j] = row;
+        piece.ghost_sign[j] = sign;
+        // Where the piece starts: where its parent had the vertex (x_j + parent's ghost, or x_j).
+        if (!offsets_m.empty()) {
+          piece.offset_m[j] = offsets_m[c][q][j];
+        } else {
+          Eigen::Vector3d from_real_m = Eigen::Vector3d::Zero();
+          const CutPiece* parent = old >= 0 ? &m_xfem.piece(old, shape.parent) : nullptr;
+          if (parent != nullptr && parent->ghost_row[j] >= 0) {
+            from_real_m = parent->ghost_sign[j] * (current_a(parent->ghost_row[j]) - parent->offset_m[j]);
+          }
+          piece.offset_m[j] = current_a(row) - sign * from_real_m;
+        }
       }
-      dof_of_cut[c][i] = k;
     }
-  }
-  result.new_enriched_dofs = enriched_dof_count() - old_dofs;
 
-  // 2. Mass and external force of the new unknowns start at zero, then each cut tet adds its share.
-  m_mass_kg.conservativeResize(dof_count());
-  m_external_force_n.conservativeResize(dof_count());
-  m_mass_kg.tail(3 * result.new_enriched_dofs).setZero();
-  m_external_force_n.tail(3 * result.new_enriched_dofs).setZero();
+    // 2. Mass and external force: new rows start at zero; the retired cut tet's share leaves its
+    // ghosts, the new one's arrives.
+    const Eigen::Index old_size = m_mass_kg.size();
+    m_mass_kg.conservativeResize(dof_count());
+    m_external_force_n.conservativeResize(dof_count());
+    m_mass_kg.tail(dof_count() - old_size).setZero();
+    m_external_force_n.tail(dof_count() - old_size).setZero();
+    if (old >= 0) {
+      add_ghost_loads(old, -1.0);
+      m_xfem.retire(old);
+    } else {
+      m_elasticity.exclude(cut.tet);
+      ++m_tets_cut;
+    }
 
-  const double density = m_settings.material.density_kg_per_m3;
-  for (size_t c = 0; c < cuts.size(); ++c) {
-    const TetCut& cut = cuts[c];
     CutTet cut_tet;
-    cut_tet.cut = cut;
-    cut_tet.vertices = m_mesh.tets[static_cast<size_t>(cut.tet)];
-    cut_tet.weight_above = cut.volume_fraction_above;
-    cut_tet.weight_below = 1.0 - cut.volume_fraction_above;
-    for (size_t i = 0; i < 4; ++i) cut_tet.enriched_row[i] = m_enriched_dofs[static_cast<size_t>(dof_of_cut[c][i])].row;
-    if (!offsets_m.empty()) cut_tet.enrichment_offset_m = offsets_m[c];
-
-    const TetRest& rest = m_elasticity.rest(cut.tet);
-    for (size_t i = 0; i < 4; ++i) {
-      // The part on the other side of the cut from vertex i, and Psi of vertex i in it (= -H_i).
-      const CutPart opposite = cut.side[i] == 1 ? CutPart::below : CutPart::above;
-      const double quarter_mass_kg = 0.25 * density * cut_tet.weight(opposite) * rest.volume_m3;
-      const int row = cut_tet.enriched_row[i];
-      m_mass_kg.segment<3>(3 * row).array() += quarter_mass_kg;
-      m_external_force_n.segment<3>(3 * row) +=
-          cut_tet.shift(static_cast<int>(i), opposite) * quarter_mass_kg * m_settings.gravity_m_per_s2;
+    cut_tet.cut = geometry.cuts.front();
+    cut_tet.vertices = tet;
+    if (pieces.size() == 2 && geometry.cuts.size() == 1) {
+      cut_tet.weight_above = pieces[0].weight;
+      cut_tet.weight_below = pieces[1].weight;
+      for (size_t j = 0; j < 4; ++j) {
+        const CutPiece& ghost_piece = pieces[cut.side[j] > 0 ? 1 : 0];  // the piece across the cut
+        cut_tet.enriched_row[j] = ghost_piece.ghost_row[j];
+        cut_tet.enrichment_offset_m[j] = ghost_piece.offset_m[j];
+      }
+    } else {
+      cut_tet.enriched_row = {-1, -1, -1, -1};
     }
-
-    m_elasticity.exclude(cut.tet);
     const int k = m_xfem.cut_tet_count();
     m_cut_index[static_cast<size_t>(cut.tet)] = k;
-    m_xfem.add(cut_tet, rest, m_elasticity.rotation(cut.tet));
+    m_xfem.add(cut_tet, pieces, m_elasticity.rest(cut.tet), rotations);
+    m_cut_geometry.push_back(std::move(geometry));
+    add_ghost_loads(k, 1.0);
 
     // 3. The blocks its pieces couple beyond u-u (which exist already), into the reserved room.
     const int dofs = m_xfem.dof_count(k);
@@ -450,14 +574,14 @@ EnrichmentResult DeformableBody::enrich(std::span<const TetCut> cuts, std::span<
     }
   }
   result.new_cut_tets = static_cast<int>(cuts.size());
+  result.new_enriched_dofs = enriched_dof_count() - old_dofs;
 
   // 4. Slots: of the new cut tets only, unless the storage moved (rare: room is reserved ahead).
   result.matrix_relayout = m_tangent.layout_revision() != layout_before;
   if (result.matrix_relayout) {
     refresh_all_slots();
   } else {
-    for (int k = m_xfem.cut_tet_count() - result.new_cut_tets; k < m_xfem.cut_tet_count(); ++k)
-      refresh_cut_tet_slots(k);
+    for (int k = first_new_cut_tet; k < m_xfem.cut_tet_count(); ++k) refresh_cut_tet_slots(k);
   }
   return result;
 }
@@ -506,8 +630,7 @@ void DeformableBody::grow_state(DynamicState& state) const {
   state.velocity_m_per_s.tail(dof_count() - old_size).setZero();
 }
 
-TetPositions DeformableBody::part_positions(const Eigen::VectorXd& displacement_m, int cut_tet_index,
-                                            CutPart part) const {
+TetPositions DeformableBody::piece_positions(const Eigen::VectorXd& displacement_m, int cut_tet_index, int piece) const {
   const CutTet& cut_tet = m_xfem.cut_tets().at(static_cast<size_t>(cut_tet_index));
   TetPositions real_m;
   for (size_t j = 0; j < 4; ++j) {
@@ -516,12 +639,11 @@ TetPositions DeformableBody::part_positions(const Eigen::VectorXd& displacement_
     real_m[j] = m_mesh.rest_positions_m[static_cast<size_t>(vertex)];
     if (row >= 0) real_m[j] += displacement_m.segment<3>(3 * row);
   }
-  return piece_positions(m_xfem.piece(cut_tet_index, part == CutPart::above ? 0 : 1), real_m, displacement_m);
+  return tissue::piece_positions(m_xfem.piece(cut_tet_index, piece), real_m, displacement_m);
 }
 
-double DeformableBody::part_mass_kg(int cut_tet_index, CutPart part) const {
-  const size_t k = static_cast<size_t>(cut_tet_index);
-  return m_settings.material.density_kg_per_m3 * m_xfem.cut_tets().at(k).weight(part) *
+double DeformableBody::piece_mass_kg(int cut_tet_index, int piece) const {
+  return m_settings.material.density_kg_per_m3 * m_xfem.piece(cut_tet_index, piece).weight *
          m_xfem.rest(cut_tet_index).volume_m3;
 }
 

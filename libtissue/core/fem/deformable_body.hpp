@@ -4,11 +4,13 @@
 // contact's spring).
 //
 // Unknowns (3 each): block rows [0, free_vertex_count()) are the displacements u of the free
-// vertices, in vertex order; then come the enriched unknowns a, one per (vertex, cut id, side),
-// in creation order. A fixed vertex has no u row but gets an enriched row when cut: its ghost copy
-// on the other side of the cut must be free to move.
+// vertices, in vertex order; then come the enriched unknowns a, one per ghost key (vertex, the cuts
+// that separate the piece from it: for a single cut (vertex, cut id, side)), in creation order. A
+// fixed vertex has no u row but gets an enriched row when cut: its ghost copy on the other side of
+// the cut must be free to move.
 #pragma once
 
+#include "core/fem/tet_pieces.hpp"
 #include "core/fem/tet_cut.hpp"
 #include "core/fem/corotational.hpp"
 #include "core/fem/material.hpp"
@@ -38,13 +40,31 @@ struct BodySettings {
   RotationSettings rotation;  ///< when the per-tet rotation extraction stops (accuracy)
 };
 
-/// One enriched unknown a (3 components, one block row): listed once per (vertex, cut id, side),
-/// however many cut tets share it (dissertation figure 4.2).
+/// The cuts that separate a piece from one of its tet's vertices: (cut id, H of the vertex for
+/// that cut) pairs, sorted by cut id. With the vertex it keys the piece's ghost copy of the vertex,
+/// shared by the pieces of neighbouring tets on the same sides (issue 21).
+struct SeparatingCuts {
+  int count = 0;
+  std::array<int, MAX_PIECE_CUTS> cut_id{};
+  std::array<std::int8_t, MAX_PIECE_CUTS> side{};
+  bool operator==(const SeparatingCuts&) const = default;
+};
+
+/// One enriched unknown a (3 components, one block row): the ghost copy of a vertex, listed once per
+/// (vertex, separating cuts), however many cut tets share it (dissertation figure 4.2).
 struct EnrichedDof {
   int vertex = -1;
-  int cut_id = 0;
-  std::int8_t side = 0;  ///< H of the vertex for this cut: +1 above, -1 below
+  int cut_id = 0;        ///< the first separating cut (a single cut: the cut)
+  std::int8_t side = 0;  ///< H of the vertex for that cut: +1 above, -1 below
   int row = -1;          ///< block row in the system (unknowns 3 row .. 3 row + 2)
+  SeparatingCuts separated_by;
+};
+
+/// How one cut tet is cut: its cuts in the order applied and its pieces (piece p is
+/// XfemElasticity::piece(k, p)).
+struct CutTetGeometry {
+  std::vector<TetCut> cuts;
+  std::vector<TetPiece> pieces;
 };
 
 /// What an enrichment changed.
@@ -90,26 +110,28 @@ class DeformableBody final : public DynamicsModel {
 
   // --- XFEM cuts (dissertation 3.3, 4.2; DESIGN section 4) ---
 
-  /// Enriches completely cut tets (one cut per tet) and grows the system in place: enriched
-  /// unknowns are appended (listed once per (vertex, cut id, side)), their blocks inserted into the
-  /// tangent's reserved room (the u-u blocks and their slots are kept), mass and external force
-  /// extended. New enriched unknowns start at a = 0, da/dt = 0 (grow_state()): each part then
-  /// coincides with the deformed tet and the u forces do not change. Both parts' rotations start
-  /// from the tet's current rotation. Throws ParameterError, with nothing changed, if a cut names a
-  /// tet out of range or already cut (or twice), lacks a sign or has a sign other than +-1, or has
-  /// a volume fraction outside (0, 1) or not finite.
+  /// Enriches completely cut tets and grows the system in place: enriched unknowns are appended
+  /// (listed once per ghost key), their blocks inserted into the tangent's reserved room (the u-u
+  /// blocks and their slots are kept), mass and external force extended. A tet cut before is cut
+  /// again (issue 21): its pieces are split by the new cut (split_pieces), the old cut tet is retired
+  /// and a new one of the new pieces appended, each starting where its parent piece was. New
+  /// enriched unknowns start at a = 0, da/dt = 0 (grow_state()): each piece then coincides with the
+  /// deformed tet (or its parent) and the forces do not change. Throws ParameterError, with nothing
+  /// changed, if a cut names a tet out of range, twice in the batch, already cut by the same cut id
+  /// or by MAX_PIECE_CUTS cuts, lacks a sign or has a sign other than +-1, has a volume fraction
+  /// outside (0, 1) or not finite, or (cutting a cut tet) lacks the edge crossings of a plane.
   ///
   /// This form is for a body whose existing enriched unknowns are still at a = 0 (no step taken
-  /// since they were made, as in tests), or to replay recorded cuts: `offsets_m`, empty or one per
-  /// cut, are the CutTet::enrichment_offset_m they had when made (see cut_tets()).
-  EnrichmentResult enrich(std::span<const TetCut> cuts, std::span<const TetPositions> offsets_m = {});
+  /// since they were made, as in tests), or to replay recorded cuts: `offsets_m`, empty or one list
+  /// per cut, are the offsets of the new cut tet's pieces (CutPiece::offset_m) when it was made.
+  EnrichmentResult enrich(std::span<const TetCut> cuts, std::span<const std::vector<TetPositions>> offsets_m = {});
   EnrichmentResult enrich(const TetCut& cut) { return enrich(std::span<const TetCut>(&cut, 1)); }
 
-  /// The form for a running body (a cut completed in the middle of a simulation): a tet that joins
-  /// an enriched unknown which exists already (made by a tet completed at an earlier step of the same
-  /// stroke, and moved since) records its current value as the offset, so that its parts start as
-  /// the tet was; the join is inelastic: the unknown's velocity is scaled by old mass / new mass
-  /// (its momentum kept, kinetic energy not gained). `state` is grown as by grow_state(). Throws
+  /// The form for a running body (a cut completed in the middle of a simulation): a piece that joins
+  /// an enriched unknown which exists already (made by a tet completed at an earlier step, and moved
+  /// since) records an offset so that it starts where the tet (or its parent piece) was; the join
+  /// is inelastic: an unknown's velocity is scaled by old mass / new mass where its mass grew (its
+  /// momentum kept, kinetic energy not gained). `state` is grown as by grow_state(). Throws
   /// ParameterError for bad cuts and std::invalid_argument for a state of the wrong size, with
   /// nothing changed.
   EnrichmentResult enrich(std::span<const TetCut> cuts, DynamicState& state);
@@ -120,19 +142,35 @@ class DeformableBody final : public DynamicsModel {
 
   [[nodiscard]] int enriched_dof_count() const { return static_cast<int>(m_enriched_dofs.size()); }
   [[nodiscard]] const std::vector<EnrichedDof>& enriched_dofs() const { return m_enriched_dofs; }
-  /// Index into enriched_dofs() of the unknown of (vertex, cut id, side), or -1.
+  /// Index into enriched_dofs() of the unknown of (vertex, cut id, side) of a single cut, or -1.
   [[nodiscard]] int find_enriched_dof(int vertex, int cut_id, int side) const;
+  /// Index into enriched_dofs() of the ghost of `vertex` behind `cuts`, or -1.
+  [[nodiscard]] int find_ghost(int vertex, const SeparatingCuts& cuts) const;
+  /// Every cut tet made, retired ones included (a tet cut again is a new cut tet).
   [[nodiscard]] const std::vector<CutTet>& cut_tets() const { return m_xfem.cut_tets(); }
-  /// Index into cut_tets() of a tet, or -1 if it is not cut.
+  /// How many tets are cut.
+  [[nodiscard]] int cut_tet_count() const { return m_tets_cut; }
+  /// How cut tet k is cut (its cuts and pieces).
+  [[nodiscard]] const CutTetGeometry& cut_geometry(int k) const { return m_cut_geometry.at(static_cast<size_t>(k)); }
+  /// Whether cut tet k was replaced by a later cut of its tet (then it adds nothing).
+  [[nodiscard]] bool retired(int k) const { return m_xfem.retired(k); }
+  /// Index into cut_tets() of a tet's current cut tet, or -1 if it is not cut.
   [[nodiscard]] int cut_tet_index(int tet) const { return m_cut_index[static_cast<size_t>(tet)]; }
   [[nodiscard]] const XfemElasticity& xfem() const { return m_xfem; }
 
-  /// Positions of the 4 vertices of part `part` of cut tet `cut_tet_index` (index into cut_tets()),
-  /// p_j = x_j + Psi_j a_j: the real vertices on the part's side, the ghost copies on the other. [m]
+  /// Positions of the 4 vertices of piece `piece` of cut tet `cut_tet_index` (index into cut_tets()):
+  /// the real vertices in the piece, the ghost copies elsewhere. [m]
+  [[nodiscard]] TetPositions piece_positions(const Eigen::VectorXd& displacement_m, int cut_tet_index, int piece) const;
+  /// Rest mass of a piece, rho w_p V. [kg]
+  [[nodiscard]] double piece_mass_kg(int cut_tet_index, int piece) const;
+  /// The same for a tet cut once: part a is piece 0, part b piece 1, p_j = x_j + Psi_j a_j.
   [[nodiscard]] TetPositions part_positions(const Eigen::VectorXd& displacement_m, int cut_tet_index,
-                                            CutPart part) const;
-  /// Rest mass of a part, rho w_p V. [kg]
-  [[nodiscard]] double part_mass_kg(int cut_tet_index, CutPart part) const;
+                                            CutPart part) const {
+    return piece_positions(displacement_m, cut_tet_index, part == CutPart::above ? 0 : 1);
+  }
+  [[nodiscard]] double part_mass_kg(int cut_tet_index, CutPart part) const {
+    return piece_mass_kg(cut_tet_index, part == CutPart::above ? 0 : 1);
+  }
 
   // --- Force terms beside elasticity (the god-object contact's spring) ---
 
@@ -149,13 +187,13 @@ class DeformableBody final : public DynamicsModel {
 
   /// Forgets the rotation warm starts of all tets and parts (e.g. after a state was restored).
   void reset_rotations();
-  /// The rotations and warm starts of all tets and cut-tet parts: with u, v they make the state a
+  /// The rotations and warm starts of all tets and cut-tet pieces: with u, v they make the state a
   /// step continues from bitwise.
   struct Rotations {
     std::vector<Eigen::Matrix3d> tets;
     std::vector<Eigen::Quaterniond> tet_warm_starts;
-    std::vector<std::array<Eigen::Matrix3d, 2>> parts;  ///< per cut tet, [above, below]
-    std::vector<std::array<Eigen::Quaterniond, 2>> part_warm_starts;
+    std::vector<Eigen::Matrix3d> pieces;  ///< cut tet after cut tet, piece after piece
+    std::vector<Eigen::Quaterniond> piece_warm_starts;
   };
   void save_rotations(Rotations& rotations) const;
   /// Throws std::invalid_argument (nothing changed) when the sizes do not match the mesh and cuts.
@@ -185,14 +223,21 @@ class DeformableBody final : public DynamicsModel {
   /// (-1 if fixed) or a ghost row.
   [[nodiscard]] int cut_tet_dof_row(int cut_tet_index, int dof) const;
   void check_cuts(std::span<const TetCut> cuts) const;
+  EnrichmentResult enrich_pieces(std::span<const TetCut> cuts, std::span<const std::vector<TetPositions>> offsets_m,
+                                 const Eigen::VectorXd* displacement_m);
+  [[nodiscard]] std::array<Eigen::Vector3d, 4> rest_corners(int tet) const;
+  // Adds (sign +1) or removes (-1) what cut tet k's ghosts carry: rho w_p V / 4 of mass and gravity.
+  void add_ghost_loads(int k, double sign);
   void check_unknowns(const Eigen::VectorXd& displacement_m) const;
   // largest_turn_rad past its bound: every uncut tet and cut part.
   [[nodiscard]] double largest_element_turn_rad(const Eigen::VectorXd& increment_m) const;
   [[nodiscard]] int vertex_block_row(int vertex) const { return m_dofs.vertex_row[static_cast<size_t>(vertex)]; }
 
   XfemElasticity m_xfem;
-  std::vector<int> m_enriched_row_capacity;  // per vertex: blocks its enriched row may ever hold (one cut)
+  std::vector<int> m_enriched_row_capacity;  // per vertex: blocks its enriched row is given
   std::vector<EnrichedDof> m_enriched_dofs;
+  std::vector<CutTetGeometry> m_cut_geometry;  // per cut tet
+  int m_tets_cut = 0;
   double m_largest_shape_gradient_per_m = 0.0;  // max |grad(phi_i)| over the mesh: 1 / the lowest altitude
   std::vector<int> m_first_enriched_dof;  // per vertex: first of its enriched unknowns, or -1
   std::vector<int> m_next_enriched_dof;   // per enriched unknown: next one of the same vertex, or -1

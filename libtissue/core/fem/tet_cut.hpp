@@ -1,11 +1,14 @@
-// TetCut: how one completely cut tet is split, as the volume cutter hands it to the XFEM
-// (dissertation 3.3, 4.3.2). One cut per tet.
+// TetCut: how one cutting session cut one tet completely, as the volume cutter hands it to the XFEM
+// (dissertation 3.3, 4.3.2). A tet may be cut by several sessions, one TetCut each (issue 21).
 #pragma once
 
 #include <array>
 #include <cstdint>
 
 namespace tissue {
+
+/// The default smallest volume fraction of a cut piece (CutterSettings::min_volume_fraction).
+inline constexpr double DEFAULT_MIN_VOLUME_FRACTION = 1e-3;
 
 struct TetCut {
   int tet = -1;
@@ -20,6 +23,9 @@ struct TetCut {
   /// Where the cut crosses local edge k (TET_EDGES[k] = {i, j}): the point is
   /// (1 - r) X_i + r X_j in the rest configuration; -1 for an edge the cut does not cross.
   std::array<double, 6> edge_ratio{-1.0, -1.0, -1.0, -1.0, -1.0, -1.0};
+  /// The cutter's smallest piece (CutterSettings::min_volume_fraction): a later cut of the tet
+  /// splits a piece only if both sides keep at least this fraction of the tet (split_pieces).
+  double min_volume_fraction = DEFAULT_MIN_VOLUME_FRACTION;
 };
 
 }  // namespace tissue

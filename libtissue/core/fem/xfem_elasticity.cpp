@@ -40,6 +40,7 @@ void XfemElasticity::reserve(int cut_tets) {
   const size_t n = to_size(cut_tets);
   m_cut_tets.reserve(n);
   m_rest.reserve(n);
+  m_retired.reserve(n);
   m_piece_begin.reserve(n + 1);
   m_pieces.reserve(2 * n);
   m_ghost_dofs.reserve(2 * n);
@@ -53,12 +54,14 @@ void XfemElasticity::reserve(int cut_tets) {
 
 void XfemElasticity::add(const CutTet& cut_tet, const TetRest& rest, const Eigen::Matrix3d& rotation) {
   const std::array<CutPiece, 2> two = pieces_of(cut_tet);
-  add(cut_tet, two, rest, rotation);
+  const std::array<Eigen::Matrix3d, 2> rotations{rotation, rotation};
+  add(cut_tet, two, rest, rotations);
 }
 
 void XfemElasticity::add(const CutTet& cut_tet, std::span<const CutPiece> pieces, const TetRest& rest,
-                         const Eigen::Matrix3d& rotation) {
+                         std::span<const Eigen::Matrix3d> rotations) {
   if (pieces.size() < 2) throw std::invalid_argument("XFEM: a cut tet needs two pieces or more");
+  if (rotations.size() != pieces.size()) throw std::invalid_argument("XFEM: one start rotation per piece");
   double total = 0.0;
   const std::size_t first_ghost = m_ghost_rows.size();
   const auto ghost_rows = [&] { return std::span<const int>(m_ghost_rows).subspan(first_ghost); };
@@ -82,7 +85,8 @@ void XfemElasticity::add(const CutTet& cut_tet, std::span<const CutPiece> pieces
     }
   }
   m_ghost_begin.push_back(static_cast<int>(m_ghost_rows.size()));
-  for (const CutPiece& piece : pieces) {
+  for (std::size_t p = 0; p < pieces.size(); ++p) {
+    const CutPiece& piece = pieces[p];
     std::array<int, 4> dofs{};
     const std::span<const int> rows = ghost_rows();
     for (size_t j = 0; j < 4; ++j) {
@@ -91,8 +95,8 @@ void XfemElasticity::add(const CutTet& cut_tet, std::span<const CutPiece> pieces
     }
     m_pieces.push_back(piece);
     m_ghost_dofs.push_back(dofs);
-    m_rotations.push_back(rotation);
-    m_warm_starts.emplace_back(rotation);
+    m_rotations.push_back(rotations[p]);
+    m_warm_starts.emplace_back(rotations[p]);
   }
   m_piece_begin.push_back(static_cast<int>(m_pieces.size()));
   const std::size_t dofs = 4 + ghost_rows().size();
@@ -100,6 +104,7 @@ void XfemElasticity::add(const CutTet& cut_tet, std::span<const CutPiece> pieces
   m_slot_begin.push_back(m_slots.size());
   m_cut_tets.push_back(cut_tet);
   m_rest.push_back(rest);
+  m_retired.push_back(0);
 }
 
 bool XfemElasticity::couples(int k, int dof_i, int dof_j) const {
@@ -113,38 +118,15 @@ bool XfemElasticity::couples(int k, int dof_i, int dof_j) const {
   return false;
 }
 
-std::vector<std::array<Eigen::Matrix3d, 2>> XfemElasticity::rotations() const {
-  std::vector<std::array<Eigen::Matrix3d, 2>> out;
-  out.reserve(m_cut_tets.size());
-  for (int k = 0; k < cut_tet_count(); ++k) out.push_back({m_rotations[piece_begin(k)], m_rotations[piece_begin(k) + 1]});
-  return out;
-}
-
-std::vector<std::array<Eigen::Quaterniond, 2>> XfemElasticity::warm_starts() const {
-  std::vector<std::array<Eigen::Quaterniond, 2>> out;
-  out.reserve(m_cut_tets.size());
-  for (int k = 0; k < cut_tet_count(); ++k) {
-    out.push_back({m_warm_starts[piece_begin(k)], m_warm_starts[piece_begin(k) + 1]});
-  }
-  return out;
-}
-
-void XfemElasticity::restore_rotations(const std::vector<std::array<Eigen::Matrix3d, 2>>& rotations,
-                                       const std::vector<std::array<Eigen::Quaterniond, 2>>& warm_starts) {
-  if (rotations.size() != m_cut_tets.size() || warm_starts.size() != m_cut_tets.size()) {
-    throw std::invalid_argument("XFEM: expected the parts' rotations of " + std::to_string(m_cut_tets.size()) +
-                                " cut tets, got " + std::to_string(rotations.size()) + " and " +
+void XfemElasticity::restore_rotations(const std::vector<Eigen::Matrix3d>& rotations,
+                                       const std::vector<Eigen::Quaterniond>& warm_starts) {
+  if (rotations.size() != m_rotations.size() || warm_starts.size() != m_warm_starts.size()) {
+    throw std::invalid_argument("XFEM: expected the rotations of " + std::to_string(m_rotations.size()) +
+                                " cut-tet pieces, got " + std::to_string(rotations.size()) + " and " +
                                 std::to_string(warm_starts.size()));
   }
-  for (int k = 0; k < cut_tet_count(); ++k) {
-    if (piece_count(k) != 2) throw std::invalid_argument("XFEM: a state holds the rotations of two pieces per cut tet");
-  }
-  for (int k = 0; k < cut_tet_count(); ++k) {
-    for (std::size_t p = 0; p < 2; ++p) {
-      m_rotations[piece_begin(k) + p] = rotations[to_size(k)][p];
-      m_warm_starts[piece_begin(k) + p] = warm_starts[to_size(k)][p];
-    }
-  }
+  m_rotations = rotations;
+  m_warm_starts = warm_starts;
 }
 
 void XfemElasticity::reset_rotations() {
@@ -172,6 +154,7 @@ void XfemElasticity::evaluate(const Eigen::VectorXd& positions_m, const Eigen::V
                               BlockSparseMatrix* tangent) {
   TetPositions real_m;
   for (size_t k = 0; k < m_cut_tets.size(); ++k) {
+    if (m_retired[k] != 0) continue;
     const CutTet& cut_tet = m_cut_tets[k];
     const TetRest& rest = m_rest[k];
     const std::size_t first = piece_begin(static_cast<int>(k));
@@ -265,6 +248,7 @@ double XfemElasticity::elastic_energy_j(const Eigen::VectorXd& positions_m,
   double energy = 0.0;
   TetPositions real_m;
   for (size_t k = 0; k < m_cut_tets.size(); ++k) {
+    if (m_retired[k] != 0) continue;
     gather(k, positions_m, real_m);
     const std::size_t first = piece_begin(static_cast<int>(k));
     for (size_t p = first; p < first + piece_count(static_cast<int>(k)); ++p) {

@@ -28,6 +28,7 @@
 #include <Eigen/Geometry>
 
 #include <array>
+#include <cstdint>
 #include <span>
 #include <vector>
 
@@ -106,11 +107,15 @@ class XfemElasticity {
   /// them with slots() before the first evaluate with a tangent).
   void add(const CutTet& cut_tet, const TetRest& rest, const Eigen::Matrix3d& rotation);
   /// The same for a tet cut into any number of pieces (>= 2; `cut_tet` keeps its vertices and its
-  /// first cut, its two-part fields are not used). Throws std::invalid_argument for fewer than two
-  /// pieces, weights that are not positive or do not add up to 1 (to 1e-12), or a ghost sign other
-  /// than +-1.
+  /// first cut, its two-part fields are not used), piece p's rotation starting from rotations[p].
+  /// Throws std::invalid_argument for fewer than two pieces, weights that are not positive or do not
+  /// add up to 1 (to 1e-12), a ghost sign other than +-1, or a rotation per piece missing.
   void add(const CutTet& cut_tet, std::span<const CutPiece> pieces, const TetRest& rest,
-           const Eigen::Matrix3d& rotation);
+           std::span<const Eigen::Matrix3d> rotations);
+  /// Cut tet k no longer counts (a later cut replaced it by a new cut tet of more pieces); its blocks
+  /// and slots stay, its forces are no longer added.
+  void retire(int k) { m_retired[static_cast<std::size_t>(k)] = 1; }
+  [[nodiscard]] bool retired(int k) const { return m_retired[static_cast<std::size_t>(k)] != 0; }
 
   [[nodiscard]] int cut_tet_count() const { return static_cast<int>(m_cut_tets.size()); }
   [[nodiscard]] const std::vector<CutTet>& cut_tets() const { return m_cut_tets; }
@@ -136,6 +141,10 @@ class XfemElasticity {
   [[nodiscard]] const Eigen::Matrix3d& rotation(int k, CutPart part) const {
     return m_rotations[piece_begin(k) + (part == CutPart::above ? 0 : 1)];
   }
+  /// R_p of piece p of cut tet k at the last evaluate().
+  [[nodiscard]] const Eigen::Matrix3d& rotation(int k, int piece) const {
+    return m_rotations[piece_begin(k) + static_cast<std::size_t>(piece)];
+  }
 
   /// One pass over the cut tets. `positions_m`: real positions of all vertices (3 per vertex);
   /// `displacement_m`: the unknowns (the enriched a are read from the enriched rows). Adds f_i into
@@ -151,14 +160,12 @@ class XfemElasticity {
 
   /// Forgets the warm starts (rotations back to identity).
   void reset_rotations();
-  /// The parts' rotations and warm starts per cut tet ([above, below]; the first two pieces of a tet
-  /// cut into more, which a state cannot hold yet).
-  [[nodiscard]] std::vector<std::array<Eigen::Matrix3d, 2>> rotations() const;
-  [[nodiscard]] std::vector<std::array<Eigen::Quaterniond, 2>> warm_starts() const;
-  /// Sets both; throws std::invalid_argument (nothing changed) unless there is one of each per cut
-  /// tet, all of two pieces.
-  void restore_rotations(const std::vector<std::array<Eigen::Matrix3d, 2>>& rotations,
-                         const std::vector<std::array<Eigen::Quaterniond, 2>>& warm_starts);
+  /// The pieces' rotations and warm starts, cut tet after cut tet (retired ones included).
+  [[nodiscard]] const std::vector<Eigen::Matrix3d>& piece_rotations() const { return m_rotations; }
+  [[nodiscard]] const std::vector<Eigen::Quaterniond>& piece_warm_starts() const { return m_warm_starts; }
+  /// Sets both; throws std::invalid_argument (nothing changed) unless there is one of each per piece.
+  void restore_rotations(const std::vector<Eigen::Matrix3d>& rotations,
+                         const std::vector<Eigen::Quaterniond>& warm_starts);
 
  private:
   // Real positions of the local vertices of cut tet k.
@@ -174,6 +181,7 @@ class XfemElasticity {
   RotationSettings m_rotation_settings;
   std::vector<CutTet> m_cut_tets;
   std::vector<TetRest> m_rest;
+  std::vector<std::uint8_t> m_retired;  // per cut tet
   std::vector<int> m_piece_begin{0};
   std::vector<CutPiece> m_pieces;
   std::vector<std::array<int, 4>> m_ghost_dofs;  // per piece and local vertex: its local DOF, -1 real

@@ -148,6 +148,7 @@ class ReferenceCutter {
     m_records.assign(body.adjacency.edges.size(), -1.0);
     m_cut_session.assign(body.mesh.tets.size(), -1);
     m_ignored_session.assign(body.mesh.tets.size(), -1);
+    m_cut_count.assign(body.mesh.tets.size(), 0);
     for (const auto& ends : body.adjacency.edges) m_edge_boxes.push_back(Box{body.x(ends[0]), body.x(ends[1])});
     for (int t = 0; t < body.mesh.tet_count(); ++t) {
       const auto x = body.tet_points(t);
@@ -188,11 +189,12 @@ class ReferenceCutter {
     }
     for (int t = 0; t < m_body.mesh.tet_count(); ++t) {
       if (m_cut_session[at(t)] == m_session || !completes(t)) continue;
-      if (m_cut_session[at(t)] >= 0) {
+      if (m_cut_count[at(t)] >= MAX_PIECE_CUTS) {  // a tet takes at most this many cuts
         if (m_ignored_session[at(t)] != m_session) ++result.ignored;
         m_ignored_session[at(t)] = m_session;
         continue;
       }
+      ++m_cut_count[at(t)];
       m_cut_session[at(t)] = m_session;
       result.new_cuts.push_back(t);
     }
@@ -270,6 +272,7 @@ class ReferenceCutter {
   std::vector<double> m_records;
   std::vector<int> m_cut_session;
   std::vector<int> m_ignored_session;
+  std::vector<int> m_cut_count;
   std::vector<Box> m_edge_boxes;  ///< the body does not move while the reference runs
   std::vector<Box> m_tet_boxes;
   std::vector<Box> m_triangle_boxes;

@@ -2,7 +2,7 @@
 // and against the single-cut part volumes (cut_geometry.hpp), the arrangement's cells against the
 // tet's volume and against a count of grid points, and the degenerate planes (through a vertex,
 // along a face).
-#include "core/cut/convex_piece.hpp"
+#include "core/fem/convex_piece.hpp"
 #include "core/cut/cut_geometry.hpp"
 #include "core/mesh/topology.hpp"
 

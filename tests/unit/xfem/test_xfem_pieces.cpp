@@ -55,7 +55,7 @@ struct FourPieces {
     }
     CutTet cut_tet;
     cut_tet.vertices = Tet{0, 1, 2, 3};
-    xfem.add(cut_tet, pieces, rest, Eigen::Matrix3d::Identity());
+    xfem.add(cut_tet, pieces, rest, std::vector<Eigen::Matrix3d>(pieces.size(), Eigen::Matrix3d::Identity()));
     std::vector<std::vector<int>> pattern(BLOCK_ROWS);
     for (int r = 0; r < BLOCK_ROWS; ++r) {
       for (int c = 0; c < BLOCK_ROWS; ++c) pattern[static_cast<size_t>(r)].push_back(c);
@@ -198,17 +198,20 @@ TEST(XfemPieces, BadPiecesAreRefused) {
   FourPieces tet;
   CutTet cut_tet;
   cut_tet.vertices = Tet{0, 1, 2, 3};
+  const std::vector<Eigen::Matrix3d> identities(2, Eigen::Matrix3d::Identity());
   std::vector<CutPiece> one(1);
   one[0].weight = 1.0;
-  EXPECT_THROW(tet.xfem.add(cut_tet, one, tet.rest, Eigen::Matrix3d::Identity()), std::invalid_argument);
+  EXPECT_THROW(tet.xfem.add(cut_tet, one, tet.rest, std::span(identities).first(1)), std::invalid_argument);
   std::vector<CutPiece> two(2);
   two[0].weight = 0.5;
   two[1].weight = 0.6;
-  EXPECT_THROW(tet.xfem.add(cut_tet, two, tet.rest, Eigen::Matrix3d::Identity()), std::invalid_argument);
+  EXPECT_THROW(tet.xfem.add(cut_tet, two, tet.rest, identities), std::invalid_argument);
   two[1].weight = 0.5;
   two[1].ghost_row[0] = 7;
   two[1].ghost_sign[0] = 0.5;
-  EXPECT_THROW(tet.xfem.add(cut_tet, two, tet.rest, Eigen::Matrix3d::Identity()), std::invalid_argument);
+  EXPECT_THROW(tet.xfem.add(cut_tet, two, tet.rest, identities), std::invalid_argument);
+  two[1].ghost_sign[0] = 1.0;
+  EXPECT_THROW(tet.xfem.add(cut_tet, two, tet.rest, std::span(identities).first(1)), std::invalid_argument);
   EXPECT_EQ(tet.xfem.cut_tet_count(), 1);
 }
 

@@ -34,10 +34,10 @@ class ConvexPiece {
   static ConvexPiece tet(const std::array<Eigen::Vector3d, 4>& x);
 
   /// The part of this piece on one side of `plane` (`above`: its positive side), or an empty piece.
-  /// Corners within `tolerance_m` of the plane count as on it. A piece that would exceed
-  /// MAX_PIECE_FACES faces or MAX_FACE_CORNERS corners on a face throws std::length_error (more than
-  /// MAX_PIECE_CUTS planes).
-  [[nodiscard]] ConvexPiece clipped(const CutPlane& plane, bool above, double tolerance_m) const;
+  /// Corners within `tolerance_m` of the plane count as on it. The cap the plane leaves gets the face
+  /// tag `cap_tag`; clipped faces keep theirs. A piece that would exceed MAX_PIECE_FACES faces or
+  /// MAX_FACE_CORNERS corners on a face throws std::length_error (more than MAX_PIECE_CUTS planes).
+  [[nodiscard]] ConvexPiece clipped(const CutPlane& plane, bool above, double tolerance_m, int cap_tag = -1) const;
 
   [[nodiscard]] bool empty() const { return m_face_count == 0; }
   /// Volume by the divergence theorem [m^3]; 0 when empty.
@@ -46,16 +46,20 @@ class ConvexPiece {
   [[nodiscard]] Eigen::Vector3d centroid_m() const;
   [[nodiscard]] int face_count() const { return m_face_count; }
   [[nodiscard]] int corner_count(int face) const { return m_corner_count[static_cast<std::size_t>(face)]; }
+  /// Where face f lies: k in [0, 4) on the tet's face opposite its vertex k (TET_FACES' order), or the
+  /// cap tag of the clip that made it.
+  [[nodiscard]] int face_tag(int face) const { return m_face_tag[static_cast<std::size_t>(face)]; }
   /// Corner k of face f, counter-clockwise seen from outside.
   [[nodiscard]] const Eigen::Vector3d& corner(int face, int k) const {
     return m_corners[static_cast<std::size_t>(face)][static_cast<std::size_t>(k)];
   }
 
  private:
-  void add_face(const Eigen::Vector3d* corners, int count);
+  void add_face(const Eigen::Vector3d* corners, int count, int tag);
 
   int m_face_count = 0;
   std::array<int, MAX_PIECE_FACES> m_corner_count{};
+  std::array<int, MAX_PIECE_FACES> m_face_tag{};
   std::array<std::array<Eigen::Vector3d, MAX_FACE_CORNERS>, MAX_PIECE_FACES> m_corners{};
 };
 

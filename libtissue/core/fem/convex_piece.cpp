@@ -1,5 +1,5 @@
 // ConvexPiece (see convex_piece.hpp).
-#include "core/cut/convex_piece.hpp"
+#include "core/fem/convex_piece.hpp"
 
 #include <Eigen/Geometry>
 
@@ -27,12 +27,13 @@ double cone_volume(const Eigen::Vector3d& origin, const Eigen::Vector3d& a, cons
 
 }  // namespace
 
-void ConvexPiece::add_face(const Eigen::Vector3d* corners, int count) {
+void ConvexPiece::add_face(const Eigen::Vector3d* corners, int count, int tag) {
   if (m_face_count == MAX_PIECE_FACES || count > MAX_FACE_CORNERS) {
     throw std::length_error("ConvexPiece: more than " + std::to_string(MAX_PIECE_CUTS) + " cut planes");
   }
   const auto f = static_cast<std::size_t>(m_face_count++);
   m_corner_count[f] = count;
+  m_face_tag[f] = tag;
   for (int k = 0; k < count; ++k) m_corners[f][static_cast<std::size_t>(k)] = corners[k];
 }
 
@@ -41,16 +42,17 @@ ConvexPiece ConvexPiece::tet(const std::array<Eigen::Vector3d, 4>& x) {
   // Faces opposite each vertex, counter-clockwise from outside for a positively oriented tet.
   constexpr std::array<std::array<int, 3>, 4> FACES = {{{1, 2, 3}, {0, 3, 2}, {0, 1, 3}, {0, 2, 1}}};
   ConvexPiece piece;
-  for (const auto& face : FACES) {
+  for (int tag = 0; tag < 4; ++tag) {
+    const auto& face = FACES[static_cast<std::size_t>(tag)];
     std::array<Eigen::Vector3d, 3> corners{x[static_cast<std::size_t>(face[0])], x[static_cast<std::size_t>(face[1])],
                                            x[static_cast<std::size_t>(face[2])]};
     if (!positive) std::swap(corners[1], corners[2]);
-    piece.add_face(corners.data(), 3);
+    piece.add_face(corners.data(), 3, tag);
   }
   return piece;
 }
 
-ConvexPiece ConvexPiece::clipped(const CutPlane& plane, bool above, double tolerance_m) const {
+ConvexPiece ConvexPiece::clipped(const CutPlane& plane, bool above, double tolerance_m, int cap_tag) const {
   const double normal_length = plane.normal.norm();
   const Eigen::Vector3d unit = plane.normal / normal_length;
   const double sign = above ? 1.0 : -1.0;
@@ -101,12 +103,12 @@ ConvexPiece ConvexPiece::clipped(const CutPlane& plane, bool above, double toler
       // A face lying in the plane: it is the cap if it faces the side cut away; otherwise the piece
       // lies on that side and nothing is kept.
       if (sign * newell_normal(m_corners[static_cast<std::size_t>(f)].data(), n).dot(unit) < 0.0) {
-        out.add_face(kept.data(), k);
+        out.add_face(kept.data(), k, face_tag(f));
         cap_is_a_face = true;
       }
       continue;
     }
-    out.add_face(kept.data(), k);
+    out.add_face(kept.data(), k, face_tag(f));
   }
   if (!cap_is_a_face && cap_count >= 3 && out.m_face_count > 0) {
     // The cap's corners in order around their centroid, counter-clockwise seen from the side cut away
@@ -128,7 +130,7 @@ ConvexPiece ConvexPiece::clipped(const CutPlane& plane, bool above, double toler
       sorted[static_cast<std::size_t>(k)] = cap[static_cast<std::size_t>(order[static_cast<std::size_t>(k)].second)];
     }
     if (cap_count > MAX_FACE_CORNERS) throw std::length_error("ConvexPiece: a cap with too many corners");
-    out.add_face(sorted.data(), cap_count);
+    out.add_face(sorted.data(), cap_count, cap_tag);
   }
   if (out.m_face_count < 4 || !(out.volume_m3() > 0.0)) return ConvexPiece{};
   return out;
@@ -170,8 +172,8 @@ void arrangement_cells(const std::array<Eigen::Vector3d, 4>& x, std::span<const 
     scratch.clear();
     const std::uint32_t bit = 1u << static_cast<unsigned>(c);
     for (const PieceCell& cell : cells) {
-      ConvexPiece above = cell.piece.clipped(planes[c], true, tolerance_m);
-      ConvexPiece below = cell.piece.clipped(planes[c], false, tolerance_m);
+      ConvexPiece above = cell.piece.clipped(planes[c], true, tolerance_m, 4 + static_cast<int>(c));
+      ConvexPiece below = cell.piece.clipped(planes[c], false, tolerance_m, 4 + static_cast<int>(c));
       if (!above.empty()) scratch.push_back(PieceCell{std::move(above), cell.above | bit});
       if (!below.empty()) scratch.push_back(PieceCell{std::move(below), cell.above});
     }
