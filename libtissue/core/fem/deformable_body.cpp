@@ -380,6 +380,7 @@ EnrichmentResult DeformableBody::enrich(std::span<const TetCut> cuts, DynamicSta
   const Eigen::VectorXd mass_before_kg = m_mass_kg;
   const EnrichmentResult result = enrich_pieces(cuts, {}, &state.displacement_m);
   grow_state(state);
+  for (const int row : m_orphaned_rows) state.velocity_m_per_s.segment<3>(3 * row).setZero();
   // An existing unknown that gained mass keeps its momentum (an inelastic join of the new piece).
   for (Eigen::Index r = 0; r < mass_before_kg.size(); ++r) {
     if (m_mass_kg(r) > mass_before_kg(r)) state.velocity_m_per_s(r) *= mass_before_kg(r) / m_mass_kg(r);
@@ -398,6 +399,7 @@ std::array<Eigen::Vector3d, 4> DeformableBody::rest_corners(int tet) const {
 }
 
 void DeformableBody::add_ghost_loads(int k, double sign) {
+  const int u_rows = m_dofs.free_vertex_count();
   const double tet_mass_kg = m_settings.material.density_kg_per_m3 * m_xfem.rest(k).volume_m3;
   for (size_t p = 0; p < m_xfem.piece_count(k); ++p) {
     const CutPiece& piece = m_xfem.piece(k, static_cast<int>(p));
@@ -407,6 +409,7 @@ void DeformableBody::add_ghost_loads(int k, double sign) {
       if (row < 0) continue;
       m_mass_kg.segment<3>(3 * row).array() += sign * quarter_mass_kg;
       m_external_force_n.segment<3>(3 * row) += sign * piece.ghost_sign[j] * quarter_mass_kg * m_settings.gravity_m_per_s2;
+      m_ghost_users[static_cast<size_t>(row - u_rows)] += sign > 0.0 ? 1 : -1;
     }
   }
 }
@@ -455,6 +458,7 @@ EnrichmentResult DeformableBody::enrich_pieces(std::span<const TetCut> cuts,
   const int u_rows = m_dofs.free_vertex_count();
   const int old_dofs = enriched_dof_count();
   const int first_new_cut_tet = m_xfem.cut_tet_count();
+  m_orphaned_rows.clear();
   // The current a of an unknown (new ones, and every one without a running state, are zero).
   const auto current_a = [&](int row) -> Eigen::Vector3d {
     if (displacement_m == nullptr || 3 * row >= displacement_m->size()) return Eigen::Vector3d::Zero();
@@ -484,7 +488,7 @@ EnrichmentResult DeformableBody::enrich_pieces(std::span<const TetCut> cuts,
         for (size_t k = 0; k < geometry.cuts.size(); ++k) {
           const std::uint32_t bit = 1u << k;
           const int vertex_side = geometry.cuts[k].side[j];
-          if ((shape.sides.bounded & bit) == 0 || (vertex_side > 0) == ((shape.sides.above & bit) != 0)) continue;
+          if ((vertex_side > 0) == ((shape.sides.above & bit) != 0)) continue;
           const auto n = static_cast<size_t>(separated.count++);
           separated.cut_id[n] = geometry.cuts[k].cut_id;
           separated.side[n] = static_cast<std::int8_t>(vertex_side);
@@ -528,6 +532,7 @@ EnrichmentResult DeformableBody::enrich_pieces(std::span<const TetCut> cuts,
     // 2. Mass and external force: new rows start at zero; the retired cut tet's share leaves its
     // ghosts, the new one's arrives.
     const Eigen::Index old_size = m_mass_kg.size();
+    m_ghost_users.resize(static_cast<size_t>(enriched_dof_count()), 0);
     m_mass_kg.conservativeResize(dof_count());
     m_external_force_n.conservativeResize(dof_count());
     m_mass_kg.tail(dof_count() - old_size).setZero();
@@ -559,6 +564,17 @@ EnrichmentResult DeformableBody::enrich_pieces(std::span<const TetCut> cuts,
     m_xfem.add(cut_tet, pieces, m_elasticity.rest(cut.tet), rotations);
     m_cut_geometry.push_back(std::move(geometry));
     add_ghost_loads(k, 1.0);
+    // A ghost no piece uses any more (the pieces that used it moved to ghosts behind more cuts): it
+    // keeps a mass so the system stays regular, and loses its load; nothing moves it.
+    if (old >= 0) {
+      for (const int row : m_xfem.ghost_rows(old)) {
+        const auto dof = static_cast<size_t>(row - u_rows);
+        if (m_ghost_users[dof] != 0 || std::find(m_orphaned_rows.begin(), m_orphaned_rows.end(), row) != m_orphaned_rows.end()) continue;
+        m_mass_kg.segment<3>(3 * row).setConstant(m_vertex_mass_kg[static_cast<size_t>(m_enriched_dofs[dof].vertex)]);
+        m_external_force_n.segment<3>(3 * row).setZero();
+        m_orphaned_rows.push_back(row);
+      }
+    }
 
     // 3. The blocks its pieces couple beyond u-u (which exist already), into the reserved room.
     const int dofs = m_xfem.dof_count(k);

@@ -237,6 +237,8 @@ class DeformableBody final : public DynamicsModel {
   std::vector<int> m_enriched_row_capacity;  // per vertex: blocks its enriched row is given
   std::vector<EnrichedDof> m_enriched_dofs;
   std::vector<CutTetGeometry> m_cut_geometry;  // per cut tet
+  std::vector<int> m_ghost_users;              // per enriched unknown: pieces of live cut tets using it
+  std::vector<int> m_orphaned_rows;            // rows the last enrich() left unused
   int m_tets_cut = 0;
   double m_largest_shape_gradient_per_m = 0.0;  // max |grad(phi_i)| over the mesh: 1 / the lowest altitude
   std::vector<int> m_first_enriched_dof;  // per vertex: first of its enriched unknowns, or -1

@@ -74,7 +74,6 @@ ConvexPiece piece_geometry(const std::array<Eigen::Vector3d, 4>& rest_m, std::sp
 bool vertex_in_piece(std::span<const TetCut> cuts, const PieceSides& sides, int j) {
   for (std::size_t c = 0; c < cuts.size(); ++c) {
     const std::uint32_t bit = 1u << c;
-    if ((sides.bounded & bit) == 0) continue;
     if ((cuts[c].side[static_cast<std::size_t>(j)] > 0) != ((sides.above & bit) != 0)) return false;
   }
   return true;
@@ -105,7 +104,9 @@ std::vector<TetPiece> split_pieces(const std::array<Eigen::Vector3d, 4>& rest_m,
     const double below_m3 = std::abs(geometry.clipped(plane, false, tolerance_m).volume_m3());
     const double smallest_m3 = cut.min_volume_fraction * tet_volume_m3;
     if (above_m3 < smallest_m3 || below_m3 < smallest_m3) {
-      pieces.push_back(TetPiece{old.sides, old.volume_fraction, static_cast<int>(p)});
+      const std::uint32_t side = above_m3 >= below_m3 ? bit : 0u;
+      pieces.push_back(TetPiece{PieceSides{old.sides.bounded, old.sides.above | side}, old.volume_fraction,
+                                static_cast<int>(p)});
       continue;
     }
     const double above_fraction = old.volume_fraction * above_m3 / (above_m3 + below_m3);

@@ -19,10 +19,12 @@
 
 namespace tissue {
 
-/// Which of a tet's cuts (in the order applied, bit c for cut c) bound a piece, and on which side.
+/// Where a piece lies with respect to each of its tet's cuts (in the order applied, bit c for cut c).
 struct PieceSides {
-  std::uint32_t bounded = 0;  ///< bit c: cut c bounds the piece
-  std::uint32_t above = 0;    ///< bit c: the piece lies above cut c (only where bounded)
+  std::uint32_t bounded = 0;  ///< bit c: cut c bounds the piece (split it or its parent)
+  /// bit c: the piece lies above cut c; for a cut that does not bound it, the side of its plane that
+  /// holds the piece (all of it but less than the smallest fraction)
+  std::uint32_t above = 0;
   bool operator==(const PieceSides&) const = default;
 };
 
@@ -38,7 +40,8 @@ CutPlane cut_plane(const std::array<Eigen::Vector3d, 4>& rest_m, const TetCut& c
 
 /// The pieces after the last of `cuts` (all the tet's cuts, in order; at most MAX_PIECE_CUTS);
 /// `previous`: the pieces of the cuts before it (empty for the first cut). Pieces keep their order;
-/// a split piece becomes two, above first. Split fractions divide the piece's own fraction in the
+/// a split piece becomes two, above first; a piece not split takes the side of the new plane that
+/// holds it. Split fractions divide the piece's own fraction in the
 /// ratio of the two sides' volumes, so the fractions keep adding up to 1.
 std::vector<TetPiece> split_pieces(const std::array<Eigen::Vector3d, 4>& rest_m, std::span<const TetCut> cuts,
                                    std::span<const TetPiece> previous);
@@ -47,7 +50,7 @@ std::vector<TetPiece> split_pieces(const std::array<Eigen::Vector3d, 4>& rest_m,
 ConvexPiece piece_geometry(const std::array<Eigen::Vector3d, 4>& rest_m, std::span<const TetCut> cuts,
                            const PieceSides& sides);
 
-/// Whether local vertex j lies in the piece (on the piece's side of every cut bounding it).
+/// Whether local vertex j lies in the piece (on the piece's side of every cut of the tet).
 bool vertex_in_piece(std::span<const TetCut> cuts, const PieceSides& sides, int j);
 
 }  // namespace tissue
