@@ -29,7 +29,8 @@ TissueSettings frog_settings(const TetMesh& mesh) {
 }
 
 // The scripted session: probe pressed into the back (steps 0-19), tool away (20-21), a vertical
-// scalpel drawn across the body at mid length (22-61), tool away (62-).
+// scalpel drawn across the body at mid length (22-61), tool away (62-63), a second stroke along the
+// body at mid width that crosses the first and cuts its tets again (64-103), tool away (104-).
 class Session {
  public:
   explicit Session(const TetMesh& mesh) {
@@ -53,6 +54,11 @@ class Session {
       const double s = (step - 22) / 39.0;
       const double y = (m_lower.y() - 0.01) + s * (m_upper.y() - m_lower.y() + 0.02);
       return {Eigen::Vector3d(m_centre.x(), y, m_lower.z() - 0.01), upright, ToolMode::scalpel};
+    }
+    if (step >= 64 && step < 104) {
+      const double s = (step - 64) / 39.0;
+      const double x = m_centre.x() - 0.3 * (m_upper.x() - m_lower.x()) + s * 0.6 * (m_upper.x() - m_lower.x());
+      return {Eigen::Vector3d(x, m_centre.y() + 0.001, m_lower.z() - 0.01), upright, ToolMode::scalpel};
     }
     return {Eigen::Vector3d(m_centre.x(), m_upper.y() + 0.05, m_upper.z() + 0.05), upright, ToolMode::none};
   }
@@ -97,7 +103,7 @@ void expect_same_continuation(const Tissue& original, const Tissue& restored) {
   EXPECT_TRUE(original.contact().stiffness_n_per_m == restored.contact().stiffness_n_per_m);
 }
 
-constexpr int LAST_STEP = 80;
+constexpr int LAST_STEP = 110;
 
 class TissueState : public ::testing::TestWithParam<int> {};
 
@@ -113,11 +119,15 @@ TEST_P(TissueState, SerializedIntoAFreshInstanceContinuesBitwise) {
   const std::vector<std::uint8_t> bytes = serialize_snapshot(snapshot);
   run(original, session, saved_at, LAST_STEP);
   ASSERT_GT(original.body().cut_tets().size(), 50u) << "the stroke should cut across the body";
+  // The second stroke cut tets of the first again (their first cut tets retired).
+  EXPECT_GT(original.body().cut_tets().size(), static_cast<size_t>(original.body().cut_tet_count()));
   // The stroke completes tets over many steps: later ones join moved unknowns with offsets, which
   // the replay into a fresh instance must reproduce.
   int offsets = 0;
-  for (const CutTet& cut_tet : original.body().cut_tets()) {
-    for (const Eigen::Vector3d& offset : cut_tet.enrichment_offset_m) offsets += offset.norm() > 0.0;
+  for (int k = 0; k < static_cast<int>(original.body().cut_tets().size()); ++k) {
+    for (int p = 0; p < static_cast<int>(original.body().xfem().piece_count(k)); ++p) {
+      for (const Eigen::Vector3d& offset : original.body().xfem().piece(k, p).offset_m) offsets += offset.norm() > 0.0;
+    }
   }
   EXPECT_GT(offsets, 0);
 
@@ -128,23 +138,23 @@ TEST_P(TissueState, SerializedIntoAFreshInstanceContinuesBitwise) {
 }
 
 // Pressing (contact and its stiffness refresh), before the stroke, mid-stroke (a session open and
-// tets partly cut) and after it.
-INSTANTIATE_TEST_SUITE_P(SavedAtStep, TissueState, ::testing::Values(15, 21, 40, 70));
+// tets partly cut), between the strokes, mid-way through the second (cut tets cut again) and after.
+INSTANTIATE_TEST_SUITE_P(SavedAtStep, TissueState, ::testing::Values(15, 21, 40, 63, 85, 107));
 
 TEST(TissueState, RestoredInPlaceRepeatsTheSameSteps) {
   const TetMesh mesh = frog();
   Session session(mesh);
   Tissue tissue(mesh, frog_settings(mesh));
   session.set_top(top_of_back(tissue, session));
-  run(tissue, session, 0, 64);
+  run(tissue, session, 0, 104);
   TissueSnapshot snapshot;
   tissue.save(snapshot);
-  run(tissue, session, 64, LAST_STEP);
+  run(tissue, session, 104, LAST_STEP);
   const DynamicState first = tissue.state();
   ASSERT_TRUE(tissue.has_cuts_of(snapshot));
   tissue.restore(snapshot);
   EXPECT_TRUE(bitwise_equal(tissue.state().displacement_m, snapshot.dynamics.displacement_m));
-  run(tissue, session, 64, LAST_STEP);
+  run(tissue, session, 104, LAST_STEP);
   EXPECT_TRUE(bitwise_equal(tissue.state().displacement_m, first.displacement_m));
   EXPECT_TRUE(bitwise_equal(tissue.state().velocity_m_per_s, first.velocity_m_per_s));
 }
