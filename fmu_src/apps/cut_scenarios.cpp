@@ -15,6 +15,12 @@ std::vector<CutScenario> frog_cut_scenarios() {
   const CutStroke across_head{"across-head", {0.041, -0.04}, {0.041, 0.04}};
   const CutStroke left_shin{"left-shin", {-0.055, 0.07}, {-0.055, 0.005}};
   const CutStroke right_shin{"right-shin", {-0.055, -0.07}, {-0.055, -0.005}};
+  // Issue 21, several cuts per tet: the other diagonal (an X with `diagonal`), and a triangle of three
+  // strokes on the back that overshoot each other's ends (the corners' tets cut twice).
+  const CutStroke other_diagonal{"other-diagonal", {0.035, -0.06}, {-0.035, 0.06}};
+  const CutStroke triangle_base{"triangle-base", {-0.045, -0.03}, {0.025, -0.03}};
+  const CutStroke triangle_left{"triangle-left", {-0.045, -0.04}, {0.0, 0.035}};
+  const CutStroke triangle_right{"triangle-right", {0.025, -0.04}, {-0.01, 0.035}};
   return {
       {"test2-across-body", {across_body}},
       {"test3-along-body", {along_body}},
@@ -22,6 +28,9 @@ std::vector<CutScenario> frog_cut_scenarios() {
       {"test5-body-and-head", {across_body, across_head}},
       {"test6-two-legs", {left_shin, right_shin}},
       {"test7-body-head-leg", {across_body, across_head, left_shin}},
+      {"test8-across-and-along", {across_body, along_body}},
+      {"test9-x", {diagonal, other_diagonal}},
+      {"test10-triangle", {triangle_base, triangle_left, triangle_right}},
   };
 }
 
