@@ -3,6 +3,7 @@
 // tet's volume and against a count of grid points, and the degenerate planes (through a vertex,
 // along a face).
 #include "core/fem/convex_piece.hpp"
+#include "core/fem/tet_pieces.hpp"
 #include "core/cut/cut_geometry.hpp"
 #include "core/mesh/topology.hpp"
 
@@ -172,6 +173,92 @@ TEST(ConvexPiece, MoreThanTheCapacityOfPlanesIsRefused) {
   std::vector<CutPlane> planes(MAX_PIECE_CUTS + 1, CutPlane{Eigen::Vector3d::UnitX(), 0.1});
   std::vector<PieceCell> cells, scratch;
   EXPECT_THROW(arrangement_cells(UNIT_TET, planes, TOLERANCE_M, cells, scratch), std::length_error);
+}
+
+// --- pieces of a tet cut several times (tet_pieces.hpp) --------------------------------------------
+
+// The TetCut a plane makes in the tet x: sides by the plane's sign, crossings on the edges it crosses,
+// the fraction above from the clipped piece.
+TetCut cut_by(const std::array<Eigen::Vector3d, 4>& x, const CutPlane& plane, int cut_id) {
+  TetCut cut;
+  cut.cut_id = cut_id;
+  cut.min_volume_fraction = 1e-3;
+  std::array<double, 4> f{};
+  for (size_t i = 0; i < 4; ++i) {
+    f[i] = plane.signed_distance(x[i]);
+    cut.side[i] = f[i] > 0.0 ? 1 : -1;
+  }
+  for (size_t e = 0; e < 6; ++e) {
+    const double a = f[static_cast<size_t>(TET_EDGES[e][0])], b = f[static_cast<size_t>(TET_EDGES[e][1])];
+    if ((a > 0.0) != (b > 0.0)) cut.edge_ratio[e] = a / (a - b);
+  }
+  cut.volume_fraction_above = ConvexPiece::tet(x).clipped(plane, true, 0.0).volume_m3() / ConvexPiece::tet(x).volume_m3();
+  return cut;
+}
+
+TEST(TetPieces, ACrossingCutSplitsBothPiecesAndAFarCutOnlyTheOneItReaches) {
+  const double s = 0.01;
+  const std::array<Eigen::Vector3d, 4> x{Eigen::Vector3d(0, 0, 0), Eigen::Vector3d(s, 0, 0), Eigen::Vector3d(0, s, 0),
+                                         Eigen::Vector3d(0, 0, s)};
+  const double volume = ConvexPiece::tet(x).volume_m3();
+  const std::vector<CutPlane> planes{CutPlane{Eigen::Vector3d::UnitX(), 0.3 * s}, CutPlane{Eigen::Vector3d::UnitY(), 0.2 * s},
+                                     CutPlane{Eigen::Vector3d::UnitZ(), 0.8 * s}};
+  std::vector<TetCut> cuts;
+  for (int c = 0; c < 3; ++c) cuts.push_back(cut_by(x, planes[static_cast<size_t>(c)], c));
+
+  // Each cut's plane through its crossings is the plane that made it.
+  for (int c = 0; c < 3; ++c) {
+    const CutPlane plane = cut_plane(x, cuts[static_cast<size_t>(c)]);
+    EXPECT_NEAR(plane.normal.dot(planes[static_cast<size_t>(c)].normal), 1.0, 1e-12);
+    EXPECT_NEAR(plane.offset, planes[static_cast<size_t>(c)].offset, 1e-15);
+  }
+  const std::vector<TetPiece> one = split_pieces(x, std::span(cuts).first(1), {});
+  ASSERT_EQ(one.size(), 2u);
+  EXPECT_DOUBLE_EQ(one[0].volume_fraction, cuts[0].volume_fraction_above);
+
+  // The X: four cells, each the arrangement's, two from each parent.
+  const std::vector<TetPiece> two = split_pieces(x, std::span(cuts).first(2), one);
+  ASSERT_EQ(two.size(), 4u);
+  std::vector<PieceCell> cells, scratch;
+  arrangement_cells(x, std::span(planes).first(2), 0.0, cells, scratch);
+  ASSERT_EQ(cells.size(), 4u);
+  double total = 0.0;
+  for (const TetPiece& piece : two) {
+    EXPECT_EQ(piece.sides.bounded, 3u);
+    EXPECT_EQ(piece.parent, (piece.sides.above & 1u) != 0 ? 0 : 1);
+    total += piece.volume_fraction;
+    bool matched = false;
+    for (const PieceCell& cell : cells) {
+      if (cell.above != piece.sides.above) continue;
+      matched = true;
+      EXPECT_NEAR(piece.volume_fraction, cell.piece.volume_m3() / volume, 1e-13);
+      EXPECT_NEAR(piece_geometry(x, std::span(cuts).first(2), piece.sides).volume_m3(), cell.piece.volume_m3(), 1e-20);
+    }
+    EXPECT_TRUE(matched);
+  }
+  EXPECT_NEAR(total, 1.0, 1e-15);
+
+  // z = 0.8 s reaches only the corner cell holding vertex 3 (x < 0.3 s, y < 0.2 s): the others stay
+  // whole, below it.
+  const std::vector<TetPiece> three = split_pieces(x, cuts, two);
+  ASSERT_EQ(three.size(), 5u);
+  total = 0.0;
+  for (const TetPiece& piece : three) {
+    total += piece.volume_fraction;
+    const bool split = (piece.sides.bounded & 4u) != 0;
+    const PieceSides& parent = two[static_cast<size_t>(piece.parent)].sides;
+    EXPECT_EQ(split, parent.above == 0u) << "only the cell below both earlier cuts";
+    if (!split) {
+      EXPECT_EQ(piece.sides.above & 4u, 0u) << "a piece the cut does not reach takes the side holding it";
+    }
+  }
+  EXPECT_NEAR(total, 1.0, 1e-15);
+  // Every vertex lies in exactly one piece.
+  for (int j = 0; j < 4; ++j) {
+    int holders = 0;
+    for (const TetPiece& piece : three) holders += vertex_in_piece(cuts, piece.sides, j) ? 1 : 0;
+    EXPECT_EQ(holders, 1) << "vertex " << j;
+  }
 }
 
 }  // namespace
