@@ -362,22 +362,25 @@ void Tissue::restore(const TissueSnapshot& snapshot) {
   if (static_cast<size_t>(previous_end) != snapshot.cuts.size()) {
     throw StateError("the state's cut batches do not add up to its cuts");
   }
-  if (snapshot.cut_offsets.size() != snapshot.cuts.size()) {
-    throw StateError("the state has " + std::to_string(snapshot.cut_offsets.size()) + " enrichment offsets for " +
-                     std::to_string(snapshot.cuts.size()) + " cuts");
-  }
   if (!can_restore(snapshot)) {
     throw StateError("the state has other cuts than this instance; restore it into a fresh instance");
   }
   if (!has_cuts_of(snapshot)) {
     try {
+      // A batch makes a cut tet per cut and may remake others (their pieces' ghosts regrouped): it
+      // takes the offsets of as many cut tets as it made.
       int begin = 0;
+      size_t offsets_used = 0;
+      const std::span<const std::vector<TetPositions>> offsets(snapshot.cut_offsets);
       for (const int end : snapshot.cut_batch_ends) {
         const auto first = static_cast<size_t>(begin);
         const auto count = static_cast<size_t>(end - begin);
-        apply_cuts(std::span(snapshot.cuts).subspan(first, count), std::span(snapshot.cut_offsets).subspan(first, count));
+        if (offsets_used + count > offsets.size()) throw StateError("the state has too few enrichment offsets");
+        const EnrichmentResult made = apply_cuts(std::span(snapshot.cuts).subspan(first, count), offsets.subspan(offsets_used));
+        offsets_used += static_cast<size_t>(made.new_cut_tets);
         begin = end;
       }
+      if (offsets_used != offsets.size()) throw StateError("the state has more enrichment offsets than cut tets");
     } catch (const std::invalid_argument& error) {
       throw StateError(std::string("the state's cuts cannot be replayed: ") + error.what());
     }

@@ -129,7 +129,7 @@ struct TissueSnapshot {
   std::uint64_t model_fingerprint = 0;  ///< of the mesh and settings (Tissue::model_fingerprint())
   std::vector<TetCut> cuts;             ///< every enriched cut, in order
   std::vector<int> cut_batch_ends;      ///< after enrichment k, cuts [0, cut_batch_ends[k]) were applied
-  std::vector<std::vector<TetPositions>> cut_offsets;  ///< per cut: its cut tet's pieces' CutPiece::offset_m
+  std::vector<std::vector<TetPositions>> cut_offsets;  ///< per cut tet made: its pieces' CutPiece::offset_m
   DynamicState dynamics;
   DeformableBody::Rotations rotations;
   Eigen::VectorXd integrator_state;

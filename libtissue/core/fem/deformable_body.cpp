@@ -17,10 +17,14 @@
 // so it carries an extra inertia 2 sum M^aa over those vertices (quantified in tests/unit/xfem).
 #include "core/fem/deformable_body.hpp"
 
+#include "core/mesh/topology.hpp"
 #include "core/system/hot_kernel.hpp"
 
 #include <algorithm>
 #include <cmath>
+#include <map>
+#include <optional>
+#include <tuple>
 #include <stdexcept>
 #include <string>
 
@@ -115,6 +119,18 @@ DeformableBody::DeformableBody(TetMesh mesh, BodySettings settings)
   }
   m_positions_m.resize(3 * m_mesh.vertex_count());
   m_vertex_forces_n.resize(3 * m_mesh.vertex_count());
+  m_vertex_tet_begin.assign(static_cast<size_t>(m_mesh.vertex_count()) + 1, 0);
+  for (const Tet& tet : m_mesh.tets) {
+    for (const int v : tet) ++m_vertex_tet_begin[static_cast<size_t>(v) + 1];
+  }
+  for (size_t v = 0; v < static_cast<size_t>(m_mesh.vertex_count()); ++v) m_vertex_tet_begin[v + 1] += m_vertex_tet_begin[v];
+  m_vertex_tets.resize(static_cast<size_t>(m_vertex_tet_begin.back()));
+  {
+    std::vector<int> next(m_vertex_tet_begin.begin(), m_vertex_tet_begin.end() - 1);
+    for (int t = 0; t < m_mesh.tet_count(); ++t) {
+      for (const int v : m_mesh.tets[static_cast<size_t>(t)]) m_vertex_tets[static_cast<size_t>(next[static_cast<size_t>(v)]++)] = t;
+    }
+  }
   positions(Eigen::VectorXd::Zero(dof_count()), m_positions_m);
   // Room for the enrichments the matrix has room for (the dissertation's 150% DOFs).
   const int spare_rows = m_tangent.block_row_capacity() - m_tangent.block_rows();
@@ -414,36 +430,283 @@ void DeformableBody::add_ghost_loads(int k, double sign) {
   }
 }
 
+namespace {
+
+// The cuts of `geometry` that separate piece q from its local vertex j, as (cut id, H of the
+// vertex) sorted by cut id; none when j lies in the piece.
+SeparatingCuts separating_cuts(const CutTetGeometry& geometry, size_t q, size_t j) {
+  SeparatingCuts separated;
+  const PieceSides& sides = geometry.pieces[q].sides;
+  for (size_t k = 0; k < geometry.cuts.size(); ++k) {
+    const int vertex_side = geometry.cuts[k].side[j];
+    if ((vertex_side > 0) == ((sides.above & (1u << k)) != 0)) continue;
+    const auto n = static_cast<size_t>(separated.count++);
+    separated.cut_id[n] = geometry.cuts[k].cut_id;
+    separated.side[n] = static_cast<std::int8_t>(vertex_side);
+  }
+  for (int a = 1; a < separated.count; ++a) {  // insertion sort of at most MAX_PIECE_CUTS pairs
+    for (int b = a; b > 0 && separated.cut_id[static_cast<size_t>(b)] < separated.cut_id[static_cast<size_t>(b - 1)]; --b) {
+      std::swap(separated.cut_id[static_cast<size_t>(b)], separated.cut_id[static_cast<size_t>(b - 1)]);
+      std::swap(separated.side[static_cast<size_t>(b)], separated.side[static_cast<size_t>(b - 1)]);
+    }
+  }
+  return separated;
+}
+
+// The plane of a cut for telling which face material a piece has: a cut given without its crossings
+// (by hand, as in tests; a tet cut once needs none) crosses its edges at their middles.
+CutPlane face_cut_plane(const std::array<Eigen::Vector3d, 4>& corners, TetCut cut) {
+  for (size_t e = 0; e < 6; ++e) {
+    const bool crossed = cut.side[static_cast<size_t>(TET_EDGES[e][0])] != cut.side[static_cast<size_t>(TET_EDGES[e][1])];
+    if (crossed && cut.edge_ratio[e] < 0.0) cut.edge_ratio[e] = 0.5;
+  }
+  return cut_plane(corners, cut);
+}
+
+// Twice the area of the part of the triangle `face` (rest positions) that lies in piece q of a tet
+// (rest corners `x`) and in piece r of another (rest corners `y`): the triangle clipped by the planes
+// that bound either piece, each on its piece's side.
+double shared_face_area(const std::array<Eigen::Vector3d, 3>& face, const std::array<Eigen::Vector3d, 4>& x,
+                        const CutTetGeometry& first, size_t q, const std::array<Eigen::Vector3d, 4>& y,
+                        const CutTetGeometry& second, size_t r) {
+  std::vector<Eigen::Vector3d> polygon(face.begin(), face.end());
+  std::vector<Eigen::Vector3d> kept;
+  const auto clip = [&](const CutPlane& plane, bool above) {
+    kept.clear();
+    const double sign = above ? 1.0 : -1.0;
+    for (size_t i = 0; i < polygon.size(); ++i) {
+      const Eigen::Vector3d& a = polygon[i];
+      const Eigen::Vector3d& b = polygon[(i + 1) % polygon.size()];
+      const double da = sign * plane.signed_distance(a);
+      const double db = sign * plane.signed_distance(b);
+      if (da >= 0.0) kept.push_back(a);
+      if ((da > 0.0 && db < 0.0) || (da < 0.0 && db > 0.0)) kept.push_back(a + (b - a) * (da / (da - db)));
+    }
+    polygon.swap(kept);
+  };
+  for (const auto& [corners, geometry, piece] : {std::tuple{&x, &first, q}, std::tuple{&y, &second, r}}) {
+    const PieceSides& sides = geometry->pieces[piece].sides;
+    for (size_t k = 0; k < geometry->cuts.size() && polygon.size() >= 3; ++k) {
+      if ((sides.bounded & (1u << k)) == 0) continue;
+      clip(face_cut_plane(*corners, geometry->cuts[k]), (sides.above & (1u << k)) != 0);
+    }
+  }
+  if (polygon.size() < 3) return 0.0;
+  Eigen::Vector3d normal = Eigen::Vector3d::Zero();
+  for (size_t i = 0; i < polygon.size(); ++i) normal += polygon[i].cross(polygon[(i + 1) % polygon.size()]);
+  return normal.norm();
+}
+
+}  // namespace
+
 // Enriched lumped mass and gravity for any number of pieces: each piece p lumped as a full tet of
 // mass w_p m puts w_p m / 4 on each of its ghosts (as M^aa above), and its gravity on the ghost
 // row is sign w_p m / 4 g (the ghost sits at x_j + sign a).
+//
+// Which ghost a piece uses (the virtual-node algorithm's node copies, Molino et al. 2004): around a
+// vertex v, the pieces of the tets that hold v with the same separating cuts (separating_cuts) that
+// touch across a shared face form one copy of v; each such group (connected component) is one ghost.
+// Keying by the separating cuts alone joins pieces on either side of a stroke that ends at another
+// (a flap's corner): there the same cuts separate two pieces from v that no material joins.
 EnrichmentResult DeformableBody::enrich_pieces(std::span<const TetCut> cuts,
                                                std::span<const std::vector<TetPositions>> offsets_m,
                                                const Eigen::VectorXd* displacement_m) {
   check_cuts(cuts);
-  if (!offsets_m.empty() && offsets_m.size() != cuts.size()) {
-    throw ParameterError("enrich: " + std::to_string(offsets_m.size()) + " offset lists for " +
-                         std::to_string(cuts.size()) + " cuts");
-  }
+  // A cut tet to be made: for a cut of the batch, or to give an existing one other ghosts.
+  struct Plan {
+    int tet = -1;
+    int old = -1;  // the live cut tet it replaces, or -1
+    bool from_cut = true;
+    CutTetGeometry geometry;
+    std::vector<std::array<int, 4>> rows;  // per piece and local vertex: ghost row, -1 real, -2 - n the n-th new row
+  };
+  std::vector<Plan> plans;
+  std::vector<int> plan_of_tet(static_cast<size_t>(m_mesh.tet_count()), -1);
   // Every cut's geometry first: nothing changes before all are known to be valid.
-  std::vector<CutTetGeometry> geometries(cuts.size());
   for (size_t c = 0; c < cuts.size(); ++c) {
-    const int old = cut_tet_index(cuts[c].tet);
-    CutTetGeometry& geometry = geometries[c];
-    if (old >= 0) geometry.cuts = m_cut_geometry[static_cast<size_t>(old)].cuts;
-    geometry.cuts.push_back(cuts[c]);
-    const std::span<const TetPiece> previous =
-        old >= 0 ? std::span<const TetPiece>(m_cut_geometry[static_cast<size_t>(old)].pieces) : std::span<const TetPiece>();
+    Plan plan;
+    plan.tet = cuts[c].tet;
+    plan.old = cut_tet_index(cuts[c].tet);
+    if (plan.old >= 0) plan.geometry.cuts = m_cut_geometry[static_cast<size_t>(plan.old)].cuts;
+    plan.geometry.cuts.push_back(cuts[c]);
+    const std::span<const TetPiece> previous = plan.old >= 0
+                                                   ? std::span<const TetPiece>(m_cut_geometry[static_cast<size_t>(plan.old)].pieces)
+                                                   : std::span<const TetPiece>();
     try {
-      geometry.pieces = split_pieces(rest_corners(cuts[c].tet), geometry.cuts, previous);
+      plan.geometry.pieces = split_pieces(rest_corners(plan.tet), plan.geometry.cuts, previous);
     } catch (const std::invalid_argument& error) {
       throw ParameterError("enrich: cut " + std::to_string(c) + ": " + error.what());
     }
-    if (geometry.pieces.size() < 2) throw ParameterError("enrich: cut " + std::to_string(c) + " leaves one piece");
-    if (!offsets_m.empty()) {
-      if (offsets_m[c].size() != geometry.pieces.size()) {
-        throw ParameterError("enrich: cut " + std::to_string(c) + " has " + std::to_string(offsets_m[c].size()) +
-                             " offset sets for " + std::to_string(geometry.pieces.size()) + " pieces");
+    if (plan.geometry.pieces.size() < 2) throw ParameterError("enrich: cut " + std::to_string(c) + " leaves one piece");
+    plan.rows.assign(plan.geometry.pieces.size(), {-1, -1, -1, -1});
+    plan_of_tet[static_cast<size_t>(plan.tet)] = static_cast<int>(plans.size());
+    plans.push_back(std::move(plan));
+  }
+
+  // The ghosts, vertex by vertex around the batch's tets.
+  std::vector<SeparatingCuts> new_rows;  // keys of the rows to create
+  std::vector<int> new_row_vertex;
+  std::vector<int> vertices;
+  for (const TetCut& cut : cuts) {
+    for (const int v : m_mesh.tets[static_cast<size_t>(cut.tet)]) vertices.push_back(v);
+  }
+  std::sort(vertices.begin(), vertices.end());
+  vertices.erase(std::unique(vertices.begin(), vertices.end()), vertices.end());
+  struct Node {
+    int tet;
+    size_t piece;
+    size_t local;  // v's local index in the tet
+    SeparatingCuts key;
+    int candidate;  // the row it uses now (or its parent used), -1 none
+  };
+  std::vector<Node> nodes;
+  std::vector<int> parent_of;  // union-find over nodes
+  const auto find = [&](int i) {
+    while (parent_of[static_cast<size_t>(i)] != i) i = parent_of[static_cast<size_t>(i)] = parent_of[static_cast<size_t>(parent_of[static_cast<size_t>(i)])];
+    return i;
+  };
+  for (const int v : vertices) {
+    nodes.clear();
+    const auto star = std::span(m_vertex_tets).subspan(static_cast<size_t>(m_vertex_tet_begin[static_cast<size_t>(v)]),
+                                                        static_cast<size_t>(m_vertex_tet_begin[static_cast<size_t>(v) + 1] -
+                                                                            m_vertex_tet_begin[static_cast<size_t>(v)]));
+    for (const int t : star) {
+      const Tet& tet = m_mesh.tets[static_cast<size_t>(t)];
+      const auto local = static_cast<size_t>(std::find(tet.begin(), tet.end(), v) - tet.begin());
+      const int p = plan_of_tet[static_cast<size_t>(t)];
+      const int k = cut_tet_index(t);
+      if (p < 0 && k < 0) continue;  // uncut: v is real there
+      const CutTetGeometry& geometry = p >= 0 ? plans[static_cast<size_t>(p)].geometry : m_cut_geometry[static_cast<size_t>(k)];
+      for (size_t q = 0; q < geometry.pieces.size(); ++q) {
+        const SeparatingCuts key = separating_cuts(geometry, q, local);
+        if (key.count == 0) continue;
+        int candidate = -1;
+        if (p < 0) {
+          candidate = m_xfem.piece(k, static_cast<int>(q)).ghost_row[local];
+        } else if (const Plan& plan = plans[static_cast<size_t>(p)]; plan.from_cut && plan.old >= 0) {
+          candidate = m_xfem.piece(plan.old, geometry.pieces[q].parent).ghost_row[local];
+        } else if (!plan.from_cut) {
+          candidate = plan.rows[q][local];
+        }
+        if (candidate >= 0 && !(m_enriched_dofs[static_cast<size_t>(candidate - m_dofs.free_vertex_count())].separated_by == key)) {
+          candidate = -1;  // a ghost behind other cuts
+        }
+        nodes.push_back(Node{t, q, local, key, candidate});
+      }
+    }
+    // Components, key by key: pieces of the key and the uncut tets of the star (whose material is
+    // whole), joined where two of them share a face with material of both on it.
+    std::vector<int> connectors;  // the star's uncut tets
+    for (const int t : star) {
+      if (plan_of_tet[static_cast<size_t>(t)] < 0 && cut_tet_index(t) < 0) connectors.push_back(t);
+    }
+    const auto geometry_of = [&](int t) -> const CutTetGeometry& {
+      const int p = plan_of_tet[static_cast<size_t>(t)];
+      return p >= 0 ? plans[static_cast<size_t>(p)].geometry : m_cut_geometry[static_cast<size_t>(cut_tet_index(t))];
+    };
+    // The face two tets share (rest positions), if they share one.
+    const auto shared_face = [&](int first, int second) -> std::optional<std::array<Eigen::Vector3d, 3>> {
+      const Tet& a = m_mesh.tets[static_cast<size_t>(first)];
+      const Tet& b = m_mesh.tets[static_cast<size_t>(second)];
+      std::array<Eigen::Vector3d, 3> face;
+      size_t count = 0;
+      for (const int w : a) {
+        if (std::find(b.begin(), b.end(), w) == b.end()) continue;
+        if (count == 3) return std::nullopt;  // the same tet
+        face[count++] = m_mesh.rest_positions_m[static_cast<size_t>(w)];
+      }
+      if (count != 3) return std::nullopt;
+      return face;
+    };
+    const auto touch = [&](const std::array<Eigen::Vector3d, 3>& face, double area) {
+      return area > 1e-9 * (face[1] - face[0]).cross(face[2] - face[0]).norm();
+    };
+    static const CutTetGeometry WHOLE{{}, {TetPiece{}}};  // an uncut tet as a piece bounded by nothing
+    std::vector<bool> done(nodes.size(), false);
+    for (size_t first = 0; first < nodes.size(); ++first) {
+      if (done[first]) continue;
+      std::vector<size_t> members;  // the nodes of this key, then the connectors (offset by their count)
+      for (size_t i = first; i < nodes.size(); ++i) {
+        if (nodes[i].key == nodes[first].key) members.push_back(i);
+      }
+      for (const size_t i : members) done[i] = true;
+      const size_t n = members.size();
+      parent_of.resize(n + connectors.size());
+      for (size_t i = 0; i < parent_of.size(); ++i) parent_of[i] = static_cast<int>(i);
+      const auto tet_of = [&](size_t m) { return m < n ? nodes[members[m]].tet : connectors[m - n]; };
+      for (size_t i = 0; i < parent_of.size(); ++i) {
+        for (size_t j = i + 1; j < parent_of.size(); ++j) {
+          if (find(static_cast<int>(i)) == find(static_cast<int>(j))) continue;
+          const auto face = shared_face(tet_of(i), tet_of(j));
+          if (!face) continue;
+          const bool joined =
+              i >= n || j >= n
+                  ? touch(*face, shared_face_area(*face, rest_corners(tet_of(i)), i < n ? geometry_of(tet_of(i)) : WHOLE,
+                                                  i < n ? nodes[members[i]].piece : 0, rest_corners(tet_of(j)),
+                                                  j < n ? geometry_of(tet_of(j)) : WHOLE, j < n ? nodes[members[j]].piece : 0))
+                  : touch(*face, shared_face_area(*face, rest_corners(tet_of(i)), geometry_of(tet_of(i)), nodes[members[i]].piece,
+                                                  rest_corners(tet_of(j)), geometry_of(tet_of(j)), nodes[members[j]].piece));
+          if (joined) parent_of[static_cast<size_t>(find(static_cast<int>(j)))] = find(static_cast<int>(i));
+        }
+      }
+      // Each component keeps the row most of its nodes use (one component per row), or gets a new one.
+      std::vector<int> claimed;
+      std::vector<int> roots;
+      for (size_t m = 0; m < n; ++m) {
+        const int root = find(static_cast<int>(m));
+        if (std::find(roots.begin(), roots.end(), root) == roots.end()) roots.push_back(root);
+      }
+      for (const int root : roots) {
+        std::map<int, int> votes;
+        for (size_t m = 0; m < n; ++m) {
+          if (find(static_cast<int>(m)) == root && nodes[members[m]].candidate >= 0) ++votes[nodes[members[m]].candidate];
+        }
+        int row = -1;
+        int best = 0;
+        for (const auto& [candidate, count] : votes) {
+          if (count > best && std::find(claimed.begin(), claimed.end(), candidate) == claimed.end()) {
+            row = candidate;
+            best = count;
+          }
+        }
+        if (row < 0) {
+          row = -2 - static_cast<int>(new_rows.size());
+          new_rows.push_back(nodes[first].key);
+          new_row_vertex.push_back(v);
+        }
+        claimed.push_back(row);
+        for (size_t m = 0; m < n; ++m) {
+          if (find(static_cast<int>(m)) != root) continue;
+          const Node& node = nodes[members[m]];
+          int p = plan_of_tet[static_cast<size_t>(node.tet)];
+          if (p < 0) {
+            const int k = cut_tet_index(node.tet);
+            if (m_xfem.piece(k, static_cast<int>(node.piece)).ghost_row[node.local] == row) continue;
+            // An existing cut tet whose piece moves to another ghost: made again with its ghosts.
+            Plan plan;
+            plan.tet = node.tet;
+            plan.old = k;
+            plan.from_cut = false;
+            plan.geometry = m_cut_geometry[static_cast<size_t>(k)];
+            for (int q = 0; q < static_cast<int>(m_xfem.piece_count(k)); ++q) plan.rows.push_back(m_xfem.piece(k, q).ghost_row);
+            p = static_cast<int>(plans.size());
+            plan_of_tet[static_cast<size_t>(node.tet)] = p;
+            plans.push_back(std::move(plan));
+          }
+          plans[static_cast<size_t>(p)].rows[node.piece][node.local] = row;
+        }
+      }
+    }
+  }
+  if (!offsets_m.empty()) {
+    if (offsets_m.size() < plans.size()) {
+      throw ParameterError("enrich: " + std::to_string(offsets_m.size()) + " offset lists for " +
+                           std::to_string(plans.size()) + " cut tets");
+    }
+    for (size_t c = 0; c < plans.size(); ++c) {
+      if (offsets_m[c].size() != plans[c].geometry.pieces.size()) {
+        throw ParameterError("enrich: cut tet " + std::to_string(c) + " has " + std::to_string(offsets_m[c].size()) +
+                             " offset sets for " + std::to_string(plans[c].geometry.pieces.size()) + " pieces");
       }
       for (const TetPositions& offsets : offsets_m[c]) {
         for (const Eigen::Vector3d& offset : offsets) {
@@ -465,62 +728,52 @@ EnrichmentResult DeformableBody::enrich_pieces(std::span<const TetCut> cuts,
     return displacement_m->segment<3>(3 * row);
   };
 
-  for (size_t c = 0; c < cuts.size(); ++c) {
-    const TetCut& cut = cuts[c];
-    CutTetGeometry& geometry = geometries[c];
-    const int old = cut_tet_index(cut.tet);
-    const Tet& tet = m_mesh.tets[static_cast<size_t>(cut.tet)];
+  // 1. The new ghosts' rows; a new row's sign is -H of the vertex for its first separating cut (a
+  // single cut: Psi = (H_p - H_j) / 2 = -H_j).
+  for (size_t n = 0; n < new_rows.size(); ++n) {
+    const int vertex = new_row_vertex[n];
+    const int k = enriched_dof_count();
+    const int row = m_tangent.append_block_row(m_enriched_row_capacity[static_cast<size_t>(vertex)]);
+    if (row != u_rows + k) throw std::logic_error("enrich: the tangent's rows and the unknowns disagree");
+    m_enriched_dofs.push_back(EnrichedDof{vertex, new_rows[n].cut_id[0], new_rows[n].side[0], row, new_rows[n]});
+    m_next_enriched_dof.push_back(m_first_enriched_dof[static_cast<size_t>(vertex)]);
+    m_first_enriched_dof[static_cast<size_t>(vertex)] = k;
+  }
+  const auto row_of = [&](int planned) { return planned >= -1 ? planned : u_rows + old_dofs + (-2 - planned); };
+  const auto sign_of = [&](int row) {
+    return -static_cast<double>(m_enriched_dofs[static_cast<size_t>(row - u_rows)].separated_by.side[0]);
+  };
+  m_ghost_users.resize(static_cast<size_t>(enriched_dof_count()), 0);
+  m_mass_kg.conservativeResize(dof_count());
+  m_external_force_n.conservativeResize(dof_count());
+  m_mass_kg.tail(3 * (enriched_dof_count() - old_dofs)).setZero();
+  m_external_force_n.tail(3 * (enriched_dof_count() - old_dofs)).setZero();
 
-    // 1. The pieces' ghosts: one enriched unknown per (vertex, separating cuts), appended as block rows.
+  for (size_t c = 0; c < plans.size(); ++c) {
+    Plan& plan = plans[c];
+    const int old = plan.old;
+    CutTetGeometry& geometry = plan.geometry;
+    const Tet& tet = m_mesh.tets[static_cast<size_t>(plan.tet)];
+
+    // 2. The pieces: rows and signs, and where each starts: where its parent had the vertex.
     std::vector<CutPiece> pieces(geometry.pieces.size());
-    std::vector<Eigen::Matrix3d> rotations(geometry.pieces.size(), m_elasticity.rotation(cut.tet));
+    std::vector<Eigen::Matrix3d> rotations(geometry.pieces.size(), m_elasticity.rotation(plan.tet));
     for (size_t q = 0; q < pieces.size(); ++q) {
-      pieces[q].weight = geometry.pieces[q].volume_fraction;
-      if (old >= 0) rotations[q] = m_xfem.rotation(old, geometry.pieces[q].parent);
-    }
-    // Vertex by vertex (unknowns are created in local-vertex order), each piece's ghost of it.
-    for (size_t j = 0; j < 4; ++j) {
-      for (size_t q = 0; q < pieces.size(); ++q) {
-        const TetPiece& shape = geometry.pieces[q];
-        CutPiece& piece = pieces[q];
-        if (vertex_in_piece(geometry.cuts, shape.sides, static_cast<int>(j))) continue;
-        SeparatingCuts separated;
-        for (size_t k = 0; k < geometry.cuts.size(); ++k) {
-          const std::uint32_t bit = 1u << k;
-          const int vertex_side = geometry.cuts[k].side[j];
-          if ((vertex_side > 0) == ((shape.sides.above & bit) != 0)) continue;
-          const auto n = static_cast<size_t>(separated.count++);
-          separated.cut_id[n] = geometry.cuts[k].cut_id;
-          separated.side[n] = static_cast<std::int8_t>(vertex_side);
-        }
-        // Sorted by cut id (insertion sort of at most MAX_PIECE_CUTS pairs).
-        for (int a = 1; a < separated.count; ++a) {
-          for (int b = a; b > 0 && separated.cut_id[static_cast<size_t>(b)] < separated.cut_id[static_cast<size_t>(b - 1)]; --b) {
-            std::swap(separated.cut_id[static_cast<size_t>(b)], separated.cut_id[static_cast<size_t>(b - 1)]);
-            std::swap(separated.side[static_cast<size_t>(b)], separated.side[static_cast<size_t>(b - 1)]);
-          }
-        }
-        int k = find_ghost(tet[j], separated);
-        if (k < 0) {
-          k = enriched_dof_count();
-          const int row = m_tangent.append_block_row(m_enriched_row_capacity[static_cast<size_t>(tet[j])]);
-          if (row != u_rows + k) throw std::logic_error("enrich: the tangent's rows and the unknowns disagree");
-          m_enriched_dofs.push_back(EnrichedDof{tet[j], separated.cut_id[0], separated.side[0], row, separated});
-          m_next_enriched_dof.push_back(m_first_enriched_dof[static_cast<size_t>(tet[j])]);
-          m_first_enriched_dof[static_cast<size_t>(tet[j])] = k;
-        }
-        const int row = m_enriched_dofs[static_cast<size_t>(k)].row;
-        // The ghost's sign is a function of its key: -H of the vertex for the first separating cut
-        // (a single cut: Psi = (H_p - H_j) / 2 = -H_j).
-        const double sign = -static_cast<double>(separated.side[0]);
+      CutPiece& piece = pieces[q];
+      piece.weight = geometry.pieces[q].volume_fraction;
+      const int parent_index = plan.from_cut ? geometry.pieces[q].parent : static_cast<int>(q);
+      const CutPiece* parent = old >= 0 ? &m_xfem.piece(old, parent_index) : nullptr;
+      if (old >= 0) rotations[q] = m_xfem.rotation(old, parent_index);
+      for (size_t j = 0; j < 4; ++j) {
+        const int row = row_of(plan.rows[q][j]);
+        if (row < 0) continue;
+        const double sign = sign_of(row);
         piece.ghost_row[j] = row;
         piece.ghost_sign[j] = sign;
-        // Where the piece starts: where its parent had the vertex (x_j + parent's ghost, or x_j).
         if (!offsets_m.empty()) {
           piece.offset_m[j] = offsets_m[c][q][j];
         } else {
           Eigen::Vector3d from_real_m = Eigen::Vector3d::Zero();
-          const CutPiece* parent = old >= 0 ? &m_xfem.piece(old, shape.parent) : nullptr;
           if (parent != nullptr && parent->ghost_row[j] >= 0) {
             from_real_m = parent->ghost_sign[j] * (current_a(parent->ghost_row[j]) - parent->offset_m[j]);
           }
@@ -529,22 +782,14 @@ EnrichmentResult DeformableBody::enrich_pieces(std::span<const TetCut> cuts,
       }
     }
 
-    // 2. Mass and external force: new rows start at zero; the retired cut tet's share leaves its
-    // ghosts, the new one's arrives.
-    const Eigen::Index old_size = m_mass_kg.size();
-    m_ghost_users.resize(static_cast<size_t>(enriched_dof_count()), 0);
-    m_mass_kg.conservativeResize(dof_count());
-    m_external_force_n.conservativeResize(dof_count());
-    m_mass_kg.tail(dof_count() - old_size).setZero();
-    m_external_force_n.tail(dof_count() - old_size).setZero();
+    // 3. Mass and external force: the retired cut tet's share leaves its ghosts, the new one's arrives.
     if (old >= 0) {
       add_ghost_loads(old, -1.0);
       m_xfem.retire(old);
     } else {
-      m_elasticity.exclude(cut.tet);
+      m_elasticity.exclude(plan.tet);
       ++m_tets_cut;
     }
-
     CutTet cut_tet;
     cut_tet.cut = geometry.cuts.front();
     cut_tet.vertices = tet;
@@ -552,7 +797,7 @@ EnrichmentResult DeformableBody::enrich_pieces(std::span<const TetCut> cuts,
       cut_tet.weight_above = pieces[0].weight;
       cut_tet.weight_below = pieces[1].weight;
       for (size_t j = 0; j < 4; ++j) {
-        const CutPiece& ghost_piece = pieces[cut.side[j] > 0 ? 1 : 0];  // the piece across the cut
+        const CutPiece& ghost_piece = pieces[geometry.cuts.front().side[j] > 0 ? 1 : 0];  // the piece across the cut
         cut_tet.enriched_row[j] = ghost_piece.ghost_row[j];
         cut_tet.enrichment_offset_m[j] = ghost_piece.offset_m[j];
       }
@@ -560,12 +805,12 @@ EnrichmentResult DeformableBody::enrich_pieces(std::span<const TetCut> cuts,
       cut_tet.enriched_row = {-1, -1, -1, -1};
     }
     const int k = m_xfem.cut_tet_count();
-    m_cut_index[static_cast<size_t>(cut.tet)] = k;
-    m_xfem.add(cut_tet, pieces, m_elasticity.rest(cut.tet), rotations);
+    m_cut_index[static_cast<size_t>(plan.tet)] = k;
+    m_xfem.add(cut_tet, pieces, m_elasticity.rest(plan.tet), rotations);
     m_cut_geometry.push_back(std::move(geometry));
     add_ghost_loads(k, 1.0);
-    // A ghost no piece uses any more (the pieces that used it moved to ghosts behind more cuts): it
-    // keeps a mass so the system stays regular, and loses its load; nothing moves it.
+    // A ghost no piece uses any more (its pieces moved to other ghosts): it keeps a mass so the
+    // system stays regular, and loses its load; nothing moves it.
     if (old >= 0) {
       for (const int row : m_xfem.ghost_rows(old)) {
         const auto dof = static_cast<size_t>(row - u_rows);
@@ -576,7 +821,7 @@ EnrichmentResult DeformableBody::enrich_pieces(std::span<const TetCut> cuts,
       }
     }
 
-    // 3. The blocks its pieces couple beyond u-u (which exist already), into the reserved room.
+    // 4. The blocks its pieces couple beyond u-u (which exist already), into the reserved room.
     const int dofs = m_xfem.dof_count(k);
     for (int r = 0; r < dofs; ++r) {
       for (int col = 0; col < dofs; ++col) {
@@ -589,10 +834,12 @@ EnrichmentResult DeformableBody::enrich_pieces(std::span<const TetCut> cuts,
       }
     }
   }
-  result.new_cut_tets = static_cast<int>(cuts.size());
+  // An orphan that a later cut tet of the batch took up again is no orphan.
+  std::erase_if(m_orphaned_rows, [&](int row) { return m_ghost_users[static_cast<size_t>(row - u_rows)] != 0; });
+  result.new_cut_tets = static_cast<int>(plans.size());
   result.new_enriched_dofs = enriched_dof_count() - old_dofs;
 
-  // 4. Slots: of the new cut tets only, unless the storage moved (rare: room is reserved ahead).
+  // 5. Slots: of the new cut tets only, unless the storage moved (rare: room is reserved ahead).
   result.matrix_relayout = m_tangent.layout_revision() != layout_before;
   if (result.matrix_relayout) {
     refresh_all_slots();

@@ -69,7 +69,7 @@ struct CutTetGeometry {
 
 /// What an enrichment changed.
 struct EnrichmentResult {
-  int new_cut_tets = 0;
+  int new_cut_tets = 0;  ///< cut tets made (one per cut, and those remade with other ghosts)
   int new_enriched_dofs = 0;     ///< new block rows (3 unknowns each), appended at the end
   bool matrix_relayout = false;  ///< the tangent's storage was re-laid out (layout_revision() changed)
 };
@@ -121,9 +121,14 @@ class DeformableBody final : public DynamicsModel {
   /// or by MAX_PIECE_CUTS cuts, lacks a sign or has a sign other than +-1, has a volume fraction
   /// outside (0, 1) or not finite, or (cutting a cut tet) lacks the edge crossings of a plane.
   ///
+  /// Around each vertex of the cut tets, the pieces that the same cuts separate from it and that
+  /// touch across faces share one ghost (the virtual-node algorithm's copies): a cut tet whose
+  /// pieces move to other ghosts is made again too (EnrichmentResult::new_cut_tets counts every cut
+  /// tet made: the cuts' first, in order, then those).
+  ///
   /// This form is for a body whose existing enriched unknowns are still at a = 0 (no step taken
-  /// since they were made, as in tests), or to replay recorded cuts: `offsets_m`, empty or one list
-  /// per cut, are the offsets of the new cut tet's pieces (CutPiece::offset_m) when it was made.
+  /// since they were made, as in tests), or to replay recorded cuts: `offsets_m`, empty or at least
+  /// one list per cut tet made, are the offsets of its pieces (CutPiece::offset_m) when it was made.
   EnrichmentResult enrich(std::span<const TetCut> cuts, std::span<const std::vector<TetPositions>> offsets_m = {});
   EnrichmentResult enrich(const TetCut& cut) { return enrich(std::span<const TetCut>(&cut, 1)); }
 
@@ -238,6 +243,8 @@ class DeformableBody final : public DynamicsModel {
   std::vector<EnrichedDof> m_enriched_dofs;
   std::vector<CutTetGeometry> m_cut_geometry;  // per cut tet
   std::vector<int> m_ghost_users;              // per enriched unknown: pieces of live cut tets using it
+  std::vector<int> m_vertex_tet_begin;         // CSR: the tets holding vertex v are
+  std::vector<int> m_vertex_tets;              //   m_vertex_tets[m_vertex_tet_begin[v] .. [v + 1])
   std::vector<int> m_orphaned_rows;            // rows the last enrich() left unused
   int m_tets_cut = 0;
   double m_largest_shape_gradient_per_m = 0.0;  // max |grad(phi_i)| over the mesh: 1 / the lowest altitude
