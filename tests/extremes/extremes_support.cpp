@@ -311,7 +311,7 @@ bool Run::step() {
   }
   ++m_outcome.steps;
   m_outcome.max_internal_steps = std::max(m_outcome.max_internal_steps, report.dynamics.internal_steps);
-  m_outcome.cut_tets = static_cast<int>(tissue.body().cut_tets().size());
+  m_outcome.cut_tets = tissue.body().cut_tet_count();
   m_outcome.touched = m_outcome.touched || tissue.contact().active;
   m_outcome.max_inverted_tets = std::max(m_outcome.max_inverted_tets, inverted_tet_count(tissue));
   // The Tissue holds the tool it applies to the hand's top speed (tip and blade end).
@@ -374,7 +374,7 @@ bool Run::step() {
         "linear %ld, unknowns %d, cut tets %zu, contact %d, %.3g ms\n",
         m_name.c_str(), m_outcome.steps, tissue.time_s(), m_last_energy_j, m_last_bound_j, m_tool_work_j,
         report.dynamics.internal_steps, report.dynamics.newton_iterations, report.dynamics.linear_iterations,
-        tissue.body().dof_count(), tissue.body().cut_tets().size(), tissue.contact().active ? 1 : 0,
+        tissue.body().dof_count(), static_cast<size_t>(tissue.body().cut_tet_count()), tissue.contact().active ? 1 : 0,
         1e3 * std::chrono::duration<double>(std::chrono::steady_clock::now() - step_start).count());
   }
   if (m_running &&

@@ -118,7 +118,7 @@ TEST_P(EveryScenario, RunsOfflineAsExpectedAndReproducibly) {
 INSTANTIATE_TEST_SUITE_P(HostScenarios, EveryScenario,
                          ::testing::Values("poke_frog", "cut_frog_complete", "cut_frog_partial", "beam_two_cuts",
                                            "careless_hand", "cantilever_release", "hand_press_frog",
-                                           "hand_cut_frog", "x_cut_frog"));
+                                           "hand_cut_frog", "x_cut_frog", "flap_frog"));
 
 // The hand's figures reach the summary (device kind "hand"): a hand pressing the frog was in contact,
 // and the device's force did work on it.
