@@ -119,6 +119,7 @@ DeformableBody::DeformableBody(TetMesh mesh, BodySettings settings)
   }
   m_positions_m.resize(3 * m_mesh.vertex_count());
   m_vertex_forces_n.resize(3 * m_mesh.vertex_count());
+  m_face_neighbor = build_adjacency(m_mesh).face_neighbor;
   m_vertex_tet_begin.assign(static_cast<size_t>(m_mesh.vertex_count()) + 1, 0);
   for (const Tet& tet : m_mesh.tets) {
     for (const int v : tet) ++m_vertex_tet_begin[static_cast<size_t>(v) + 1];
@@ -464,36 +465,39 @@ CutPlane face_cut_plane(const std::array<Eigen::Vector3d, 4>& corners, TetCut cu
 }
 
 // Twice the area of the part of the triangle `face` (rest positions) that lies in piece q of a tet
-// (rest corners `x`) and in piece r of another (rest corners `y`): the triangle clipped by the planes
-// that bound either piece, each on its piece's side.
-double shared_face_area(const std::array<Eigen::Vector3d, 3>& face, const std::array<Eigen::Vector3d, 4>& x,
-                        const CutTetGeometry& first, size_t q, const std::array<Eigen::Vector3d, 4>& y,
+// and in piece r of another: the triangle clipped by the planes (CutTetGeometry::planes) that bound
+// either piece, each on its piece's side. No allocation: a triangle clipped by up to 2
+// MAX_PIECE_CUTS planes has at most 3 + 2 MAX_PIECE_CUTS corners.
+double shared_face_area(const std::array<Eigen::Vector3d, 3>& face, const CutTetGeometry& first, size_t q,
                         const CutTetGeometry& second, size_t r) {
-  std::vector<Eigen::Vector3d> polygon(face.begin(), face.end());
-  std::vector<Eigen::Vector3d> kept;
+  constexpr size_t CAPACITY = 3 + 2 * MAX_PIECE_CUTS + 1;
+  std::array<Eigen::Vector3d, CAPACITY> polygon{face[0], face[1], face[2]};
+  std::array<Eigen::Vector3d, CAPACITY> kept;
+  size_t corners = 3;
   const auto clip = [&](const CutPlane& plane, bool above) {
-    kept.clear();
+    size_t count = 0;
     const double sign = above ? 1.0 : -1.0;
-    for (size_t i = 0; i < polygon.size(); ++i) {
+    for (size_t i = 0; i < corners; ++i) {
       const Eigen::Vector3d& a = polygon[i];
-      const Eigen::Vector3d& b = polygon[(i + 1) % polygon.size()];
+      const Eigen::Vector3d& b = polygon[(i + 1) % corners];
       const double da = sign * plane.signed_distance(a);
       const double db = sign * plane.signed_distance(b);
-      if (da >= 0.0) kept.push_back(a);
-      if ((da > 0.0 && db < 0.0) || (da < 0.0 && db > 0.0)) kept.push_back(a + (b - a) * (da / (da - db)));
+      if (da >= 0.0 && count < CAPACITY) kept[count++] = a;
+      if (((da > 0.0 && db < 0.0) || (da < 0.0 && db > 0.0)) && count < CAPACITY) kept[count++] = a + (b - a) * (da / (da - db));
     }
-    polygon.swap(kept);
+    std::copy(kept.begin(), kept.begin() + static_cast<std::ptrdiff_t>(count), polygon.begin());
+    corners = count;
   };
-  for (const auto& [corners, geometry, piece] : {std::tuple{&x, &first, q}, std::tuple{&y, &second, r}}) {
+  for (const auto& [geometry, piece] : {std::pair{&first, q}, std::pair{&second, r}}) {
     const PieceSides& sides = geometry->pieces[piece].sides;
-    for (size_t k = 0; k < geometry->cuts.size() && polygon.size() >= 3; ++k) {
+    for (size_t k = 0; k < geometry->cuts.size() && corners >= 3; ++k) {
       if ((sides.bounded & (1u << k)) == 0) continue;
-      clip(face_cut_plane(*corners, geometry->cuts[k]), (sides.above & (1u << k)) != 0);
+      clip(geometry->planes[k], (sides.above & (1u << k)) != 0);
     }
   }
-  if (polygon.size() < 3) return 0.0;
+  if (corners < 3) return 0.0;
   Eigen::Vector3d normal = Eigen::Vector3d::Zero();
-  for (size_t i = 0; i < polygon.size(); ++i) normal += polygon[i].cross(polygon[(i + 1) % polygon.size()]);
+  for (size_t i = 0; i < corners; ++i) normal += polygon[i].cross(polygon[(i + 1) % corners]);
   return normal.norm();
 }
 
@@ -538,6 +542,8 @@ EnrichmentResult DeformableBody::enrich_pieces(std::span<const TetCut> cuts,
       throw ParameterError("enrich: cut " + std::to_string(c) + ": " + error.what());
     }
     if (plan.geometry.pieces.size() < 2) throw ParameterError("enrich: cut " + std::to_string(c) + " leaves one piece");
+    if (plan.old >= 0) plan.geometry.planes = m_cut_geometry[static_cast<size_t>(plan.old)].planes;
+    plan.geometry.planes.push_back(face_cut_plane(rest_corners(plan.tet), cuts[c]));
     plan.rows.assign(plan.geometry.pieces.size(), {-1, -1, -1, -1});
     plan_of_tet[static_cast<size_t>(plan.tet)] = static_cast<int>(plans.size());
     plans.push_back(std::move(plan));
@@ -596,57 +602,68 @@ EnrichmentResult DeformableBody::enrich_pieces(std::span<const TetCut> cuts,
     }
     // Components, key by key: pieces of the key and the uncut tets of the star (whose material is
     // whole), joined where two of them share a face with material of both on it.
-    std::vector<int> connectors;  // the star's uncut tets
-    for (const int t : star) {
-      if (plan_of_tet[static_cast<size_t>(t)] < 0 && cut_tet_index(t) < 0) connectors.push_back(t);
-    }
     const auto geometry_of = [&](int t) -> const CutTetGeometry& {
       const int p = plan_of_tet[static_cast<size_t>(t)];
       return p >= 0 ? plans[static_cast<size_t>(p)].geometry : m_cut_geometry[static_cast<size_t>(cut_tet_index(t))];
     };
-    // The face two tets share (rest positions), if they share one.
-    const auto shared_face = [&](int first, int second) -> std::optional<std::array<Eigen::Vector3d, 3>> {
-      const Tet& a = m_mesh.tets[static_cast<size_t>(first)];
-      const Tet& b = m_mesh.tets[static_cast<size_t>(second)];
-      std::array<Eigen::Vector3d, 3> face;
-      size_t count = 0;
-      for (const int w : a) {
-        if (std::find(b.begin(), b.end(), w) == b.end()) continue;
-        if (count == 3) return std::nullopt;  // the same tet
-        face[count++] = m_mesh.rest_positions_m[static_cast<size_t>(w)];
+    const auto is_uncut = [&](int t) { return plan_of_tet[static_cast<size_t>(t)] < 0 && cut_tet_index(t) < 0; };
+    // The faces the star's tets share (star indices and the face's rest corners).
+    struct StarFace {
+      size_t a, b;
+      std::array<Eigen::Vector3d, 3> corners;
+      double area_threshold;
+    };
+    std::vector<StarFace> faces;
+    for (size_t a = 0; a < star.size(); ++a) {
+      const int t = star[a];
+      for (size_t k = 0; k < 4; ++k) {
+        const int neighbour = m_face_neighbor[static_cast<size_t>(t)][k];
+        if (neighbour < t) continue;  // none, or the pair is seen from the other side
+        const auto b = static_cast<size_t>(std::find(star.begin(), star.end(), neighbour) - star.begin());
+        if (b == star.size()) continue;
+        const Tet& tet = m_mesh.tets[static_cast<size_t>(t)];
+        std::array<Eigen::Vector3d, 3> corners;
+        for (size_t c = 0; c < 3; ++c) corners[c] = m_mesh.rest_positions_m[static_cast<size_t>(tet[static_cast<size_t>(TET_FACES[k][c])])];
+        faces.push_back(StarFace{a, b, corners, 1e-9 * (corners[1] - corners[0]).cross(corners[2] - corners[0]).norm()});
       }
-      if (count != 3) return std::nullopt;
-      return face;
-    };
-    const auto touch = [&](const std::array<Eigen::Vector3d, 3>& face, double area) {
-      return area > 1e-9 * (face[1] - face[0]).cross(face[2] - face[0]).norm();
-    };
-    static const CutTetGeometry WHOLE{{}, {TetPiece{}}};  // an uncut tet as a piece bounded by nothing
+    }
+    static const CutTetGeometry WHOLE{{}, {TetPiece{}}, {}};  // an uncut tet as a piece bounded by nothing
     std::vector<bool> done(nodes.size(), false);
+    std::vector<std::vector<int>> elements(star.size());  // per star tet: its elements of this key
     for (size_t first = 0; first < nodes.size(); ++first) {
       if (done[first]) continue;
-      std::vector<size_t> members;  // the nodes of this key, then the connectors (offset by their count)
+      std::vector<size_t> members;  // the nodes of this key; elements n, n + 1, ... are the uncut tets
       for (size_t i = first; i < nodes.size(); ++i) {
         if (nodes[i].key == nodes[first].key) members.push_back(i);
       }
       for (const size_t i : members) done[i] = true;
       const size_t n = members.size();
-      parent_of.resize(n + connectors.size());
-      for (size_t i = 0; i < parent_of.size(); ++i) parent_of[i] = static_cast<int>(i);
-      const auto tet_of = [&](size_t m) { return m < n ? nodes[members[m]].tet : connectors[m - n]; };
-      for (size_t i = 0; i < parent_of.size(); ++i) {
-        for (size_t j = i + 1; j < parent_of.size(); ++j) {
-          if (find(static_cast<int>(i)) == find(static_cast<int>(j))) continue;
-          const auto face = shared_face(tet_of(i), tet_of(j));
-          if (!face) continue;
-          const bool joined =
-              i >= n || j >= n
-                  ? touch(*face, shared_face_area(*face, rest_corners(tet_of(i)), i < n ? geometry_of(tet_of(i)) : WHOLE,
-                                                  i < n ? nodes[members[i]].piece : 0, rest_corners(tet_of(j)),
-                                                  j < n ? geometry_of(tet_of(j)) : WHOLE, j < n ? nodes[members[j]].piece : 0))
-                  : touch(*face, shared_face_area(*face, rest_corners(tet_of(i)), geometry_of(tet_of(i)), nodes[members[i]].piece,
-                                                  rest_corners(tet_of(j)), geometry_of(tet_of(j)), nodes[members[j]].piece));
-          if (joined) parent_of[static_cast<size_t>(find(static_cast<int>(j)))] = find(static_cast<int>(i));
+      for (auto& list : elements) list.clear();
+      size_t count = n;
+      for (size_t s = 0; s < star.size(); ++s) {
+        if (is_uncut(star[s])) elements[s].push_back(static_cast<int>(count++));
+      }
+      for (size_t m = 0; m < n; ++m) {
+        const auto s = static_cast<size_t>(std::find(star.begin(), star.end(), nodes[members[m]].tet) - star.begin());
+        elements[s].push_back(static_cast<int>(m));
+      }
+      parent_of.resize(count);
+      for (size_t i = 0; i < count; ++i) parent_of[i] = static_cast<int>(i);
+      for (const StarFace& face : faces) {
+        for (const int i : elements[face.a]) {
+          for (const int j : elements[face.b]) {
+            if (find(i) == find(j)) continue;
+            const bool i_piece = static_cast<size_t>(i) < n;
+            const bool j_piece = static_cast<size_t>(j) < n;
+            const double area =
+                !i_piece && !j_piece
+                    ? 1.0
+                    : shared_face_area(face.corners, i_piece ? geometry_of(star[face.a]) : WHOLE,
+                                       i_piece ? nodes[members[static_cast<size_t>(i)]].piece : 0,
+                                       j_piece ? geometry_of(star[face.b]) : WHOLE,
+                                       j_piece ? nodes[members[static_cast<size_t>(j)]].piece : 0);
+            if (area > face.area_threshold) parent_of[static_cast<size_t>(find(j))] = find(i);
+          }
         }
       }
       // Each component keeps the row most of its nodes use (one component per row), or gets a new one.
@@ -663,10 +680,10 @@ EnrichmentResult DeformableBody::enrich_pieces(std::span<const TetCut> cuts,
         }
         int row = -1;
         int best = 0;
-        for (const auto& [candidate, count] : votes) {
-          if (count > best && std::find(claimed.begin(), claimed.end(), candidate) == claimed.end()) {
+        for (const auto& [candidate, voters] : votes) {
+          if (voters > best && std::find(claimed.begin(), claimed.end(), candidate) == claimed.end()) {
             row = candidate;
-            best = count;
+            best = voters;
           }
         }
         if (row < 0) {

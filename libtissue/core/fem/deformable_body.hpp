@@ -65,6 +65,9 @@ struct EnrichedDof {
 struct CutTetGeometry {
   std::vector<TetCut> cuts;
   std::vector<TetPiece> pieces;
+  /// Per cut, its plane (cut_plane; a cut given without its crossings, as in tests, through the
+  /// middles of the edges it crosses): what tells which face material a piece has.
+  std::vector<CutPlane> planes;
 };
 
 /// What an enrichment changed.
@@ -243,6 +246,7 @@ class DeformableBody final : public DynamicsModel {
   std::vector<EnrichedDof> m_enriched_dofs;
   std::vector<CutTetGeometry> m_cut_geometry;  // per cut tet
   std::vector<int> m_ghost_users;              // per enriched unknown: pieces of live cut tets using it
+  std::vector<std::array<int, 4>> m_face_neighbor;  // the tet across each local face (TET_FACES), or -1
   std::vector<int> m_vertex_tet_begin;         // CSR: the tets holding vertex v are
   std::vector<int> m_vertex_tets;              //   m_vertex_tets[m_vertex_tet_begin[v] .. [v + 1])
   std::vector<int> m_orphaned_rows;            // rows the last enrich() left unused
