@@ -80,7 +80,8 @@ struct CutSpecimen {
     state.displacement_m = Eigen::VectorXd::Zero(body.dof_count());
     state.velocity_m_per_s = Eigen::VectorXd::Zero(body.dof_count());
     Eigen::VectorXd rest(3 * mesh.vertex_count());
-    for (int v = 0; v < mesh.vertex_count(); ++v) rest.segment<3>(3 * v) = mesh.rest_positions_m[static_cast<size_t>(v)];
+    for (int v = 0; v < mesh.vertex_count(); ++v)
+      rest.segment<3>(3 * v) = mesh.rest_positions_m[static_cast<size_t>(v)];
     const SurfaceBvh bvh(surface.triangles, rest);
     CutterSettings exact;
     exact.vertex_snap_fraction = 0.0;
@@ -139,7 +140,8 @@ void expect_pieces_fall_as_regions(CutSpecimen& specimen, const RegionOf& region
     EXPECT_EQ(body.cut_tet_index(tet), k);
     const CutTetGeometry& geometry = body.cut_geometry(k);
     for (int p = 0; p < static_cast<int>(body.xfem().piece_count(k)); ++p) {
-      const ConvexPiece cell = piece_geometry(rest_corners(mesh, tet), geometry.cuts, geometry.pieces[static_cast<size_t>(p)].sides);
+      const ConvexPiece cell =
+          piece_geometry(rest_corners(mesh, tet), geometry.cuts, geometry.pieces[static_cast<size_t>(p)].sides);
       const int region = region_of(cell.centroid_m());
       mass_kg[static_cast<size_t>(region)] += body.piece_mass_kg(k, p);
       ++pieces;
@@ -196,7 +198,8 @@ void expect_pieces_fall_as_regions(CutSpecimen& specimen, const RegionOf& region
       if (static_cast<int>(r) == held) continue;
       momentum[r] = (momentum[r] - STEP_S * mass_kg[r] * GRAVITY) / (1.0 + STEP_S * ALPHA_PER_S);
       const double measured = c_z[r].dot(body.mass_kg().cwiseProduct(specimen.state.velocity_m_per_s));
-      worst_error[r] = std::max(worst_error[r], std::abs(measured - momentum[r]) / (mass_kg[r] * GRAVITY * STEP_S * steps));
+      worst_error[r] =
+          std::max(worst_error[r], std::abs(measured - momentum[r]) / (mass_kg[r] * GRAVITY * STEP_S * steps));
     }
   }
   ASSERT_TRUE(specimen.state.displacement_m.allFinite());
@@ -272,8 +275,10 @@ TEST(CrossingCuts, AnXCutLeavesFourPiecesOfTheExactVolumesAndTheThreeFreeOnesFal
       shoelace_m2({{0.0, 0.0}, bottom_first, CROSSING, top_second, {0.0, w}}) * w;
   volumes_m3[static_cast<size_t>(x_region({BEAM_LENGTH_M, 0.5 * w, 0.0}))] =
       shoelace_m2({bottom_second, {BEAM_LENGTH_M, 0.0}, {BEAM_LENGTH_M, w}, top_first, CROSSING}) * w;
-  volumes_m3[static_cast<size_t>(x_region({CROSSING.x(), 0.0, 0.0}))] = shoelace_m2({bottom_first, bottom_second, CROSSING}) * w;
-  volumes_m3[static_cast<size_t>(x_region({CROSSING.x(), w, 0.0}))] = shoelace_m2({top_second, CROSSING, top_first}) * w;
+  volumes_m3[static_cast<size_t>(x_region({CROSSING.x(), 0.0, 0.0}))] =
+      shoelace_m2({bottom_first, bottom_second, CROSSING}) * w;
+  volumes_m3[static_cast<size_t>(x_region({CROSSING.x(), w, 0.0}))] =
+      shoelace_m2({top_second, CROSSING, top_first}) * w;
   expect_pieces_fall_as_regions(beam, x_region, volumes_m3, x_region({0.0, 0.5 * w, 0.0}), 150, 5e-3);
 }
 

@@ -124,12 +124,14 @@ DeformableBody::DeformableBody(TetMesh mesh, BodySettings settings)
   for (const Tet& tet : m_mesh.tets) {
     for (const int v : tet) ++m_vertex_tet_begin[static_cast<size_t>(v) + 1];
   }
-  for (size_t v = 0; v < static_cast<size_t>(m_mesh.vertex_count()); ++v) m_vertex_tet_begin[v + 1] += m_vertex_tet_begin[v];
+  for (size_t v = 0; v < static_cast<size_t>(m_mesh.vertex_count()); ++v)
+    m_vertex_tet_begin[v + 1] += m_vertex_tet_begin[v];
   m_vertex_tets.resize(static_cast<size_t>(m_vertex_tet_begin.back()));
   {
     std::vector<int> next(m_vertex_tet_begin.begin(), m_vertex_tet_begin.end() - 1);
     for (int t = 0; t < m_mesh.tet_count(); ++t) {
-      for (const int v : m_mesh.tets[static_cast<size_t>(t)]) m_vertex_tets[static_cast<size_t>(next[static_cast<size_t>(v)]++)] = t;
+      for (const int v : m_mesh.tets[static_cast<size_t>(t)])
+        m_vertex_tets[static_cast<size_t>(next[static_cast<size_t>(v)]++)] = t;
     }
   }
   positions(Eigen::VectorXd::Zero(dof_count()), m_positions_m);
@@ -405,14 +407,17 @@ EnrichmentResult DeformableBody::enrich(std::span<const TetCut> cuts, DynamicSta
   return result;
 }
 
-EnrichmentResult DeformableBody::enrich(std::span<const TetCut> cuts, std::span<const std::vector<TetPositions>> offsets_m) {
+EnrichmentResult DeformableBody::enrich(std::span<const TetCut> cuts,
+                                        std::span<const std::vector<TetPositions>> offsets_m) {
   return enrich_pieces(cuts, offsets_m, nullptr);
 }
 
 std::array<Eigen::Vector3d, 4> DeformableBody::rest_corners(int tet) const {
   const Tet& vertices = m_mesh.tets[static_cast<size_t>(tet)];
-  return {m_mesh.rest_positions_m[static_cast<size_t>(vertices[0])], m_mesh.rest_positions_m[static_cast<size_t>(vertices[1])],
-          m_mesh.rest_positions_m[static_cast<size_t>(vertices[2])], m_mesh.rest_positions_m[static_cast<size_t>(vertices[3])]};
+  return {m_mesh.rest_positions_m[static_cast<size_t>(vertices[0])],
+          m_mesh.rest_positions_m[static_cast<size_t>(vertices[1])],
+          m_mesh.rest_positions_m[static_cast<size_t>(vertices[2])],
+          m_mesh.rest_positions_m[static_cast<size_t>(vertices[3])]};
 }
 
 void DeformableBody::add_ghost_loads(int k, double sign) {
@@ -425,7 +430,8 @@ void DeformableBody::add_ghost_loads(int k, double sign) {
       const int row = piece.ghost_row[j];
       if (row < 0) continue;
       m_mass_kg.segment<3>(3 * row).array() += sign * quarter_mass_kg;
-      m_external_force_n.segment<3>(3 * row) += sign * piece.ghost_sign[j] * quarter_mass_kg * m_settings.gravity_m_per_s2;
+      m_external_force_n.segment<3>(3 * row) +=
+          sign * piece.ghost_sign[j] * quarter_mass_kg * m_settings.gravity_m_per_s2;
       m_ghost_users[static_cast<size_t>(row - u_rows)] += sign > 0.0 ? 1 : -1;
     }
   }
@@ -446,7 +452,8 @@ SeparatingCuts separating_cuts(const CutTetGeometry& geometry, size_t q, size_t 
     separated.side[n] = static_cast<std::int8_t>(vertex_side);
   }
   for (int a = 1; a < separated.count; ++a) {  // insertion sort of at most MAX_PIECE_CUTS pairs
-    for (int b = a; b > 0 && separated.cut_id[static_cast<size_t>(b)] < separated.cut_id[static_cast<size_t>(b - 1)]; --b) {
+    for (int b = a; b > 0 && separated.cut_id[static_cast<size_t>(b)] < separated.cut_id[static_cast<size_t>(b - 1)];
+         --b) {
       std::swap(separated.cut_id[static_cast<size_t>(b)], separated.cut_id[static_cast<size_t>(b - 1)]);
       std::swap(separated.side[static_cast<size_t>(b)], separated.side[static_cast<size_t>(b - 1)]);
     }
@@ -458,7 +465,8 @@ SeparatingCuts separating_cuts(const CutTetGeometry& geometry, size_t q, size_t 
 // (by hand, as in tests; a tet cut once needs none) crosses its edges at their middles.
 CutPlane face_cut_plane(const std::array<Eigen::Vector3d, 4>& corners, TetCut cut) {
   for (size_t e = 0; e < 6; ++e) {
-    const bool crossed = cut.side[static_cast<size_t>(TET_EDGES[e][0])] != cut.side[static_cast<size_t>(TET_EDGES[e][1])];
+    const bool crossed =
+        cut.side[static_cast<size_t>(TET_EDGES[e][0])] != cut.side[static_cast<size_t>(TET_EDGES[e][1])];
     if (crossed && cut.edge_ratio[e] < 0.0) cut.edge_ratio[e] = 0.5;
   }
   return cut_plane(corners, cut);
@@ -483,7 +491,8 @@ double shared_face_area(const std::array<Eigen::Vector3d, 3>& face, const CutTet
       const double da = sign * plane.signed_distance(a);
       const double db = sign * plane.signed_distance(b);
       if (da >= 0.0 && count < CAPACITY) kept[count++] = a;
-      if (((da > 0.0 && db < 0.0) || (da < 0.0 && db > 0.0)) && count < CAPACITY) kept[count++] = a + (b - a) * (da / (da - db));
+      if (((da > 0.0 && db < 0.0) || (da < 0.0 && db > 0.0)) && count < CAPACITY)
+        kept[count++] = a + (b - a) * (da / (da - db));
     }
     std::copy(kept.begin(), kept.begin() + static_cast<std::ptrdiff_t>(count), polygon.begin());
     corners = count;
@@ -533,9 +542,9 @@ EnrichmentResult DeformableBody::enrich_pieces(std::span<const TetCut> cuts,
     plan.old = cut_tet_index(cuts[c].tet);
     if (plan.old >= 0) plan.geometry.cuts = m_cut_geometry[static_cast<size_t>(plan.old)].cuts;
     plan.geometry.cuts.push_back(cuts[c]);
-    const std::span<const TetPiece> previous = plan.old >= 0
-                                                   ? std::span<const TetPiece>(m_cut_geometry[static_cast<size_t>(plan.old)].pieces)
-                                                   : std::span<const TetPiece>();
+    const std::span<const TetPiece> previous =
+        plan.old >= 0 ? std::span<const TetPiece>(m_cut_geometry[static_cast<size_t>(plan.old)].pieces)
+                      : std::span<const TetPiece>();
     try {
       plan.geometry.pieces = split_pieces(rest_corners(plan.tet), plan.geometry.cuts, previous);
     } catch (const std::invalid_argument& error) {
@@ -568,21 +577,24 @@ EnrichmentResult DeformableBody::enrich_pieces(std::span<const TetCut> cuts,
   std::vector<Node> nodes;
   std::vector<int> parent_of;  // union-find over nodes
   const auto find = [&](int i) {
-    while (parent_of[static_cast<size_t>(i)] != i) i = parent_of[static_cast<size_t>(i)] = parent_of[static_cast<size_t>(parent_of[static_cast<size_t>(i)])];
+    while (parent_of[static_cast<size_t>(i)] != i)
+      i = parent_of[static_cast<size_t>(i)] = parent_of[static_cast<size_t>(parent_of[static_cast<size_t>(i)])];
     return i;
   };
   for (const int v : vertices) {
     nodes.clear();
-    const auto star = std::span(m_vertex_tets).subspan(static_cast<size_t>(m_vertex_tet_begin[static_cast<size_t>(v)]),
-                                                        static_cast<size_t>(m_vertex_tet_begin[static_cast<size_t>(v) + 1] -
-                                                                            m_vertex_tet_begin[static_cast<size_t>(v)]));
+    const auto star = std::span(m_vertex_tets)
+                          .subspan(static_cast<size_t>(m_vertex_tet_begin[static_cast<size_t>(v)]),
+                                   static_cast<size_t>(m_vertex_tet_begin[static_cast<size_t>(v) + 1] -
+                                                       m_vertex_tet_begin[static_cast<size_t>(v)]));
     for (const int t : star) {
       const Tet& tet = m_mesh.tets[static_cast<size_t>(t)];
       const auto local = static_cast<size_t>(std::find(tet.begin(), tet.end(), v) - tet.begin());
       const int p = plan_of_tet[static_cast<size_t>(t)];
       const int k = cut_tet_index(t);
       if (p < 0 && k < 0) continue;  // uncut: v is real there
-      const CutTetGeometry& geometry = p >= 0 ? plans[static_cast<size_t>(p)].geometry : m_cut_geometry[static_cast<size_t>(k)];
+      const CutTetGeometry& geometry =
+          p >= 0 ? plans[static_cast<size_t>(p)].geometry : m_cut_geometry[static_cast<size_t>(k)];
       for (size_t q = 0; q < geometry.pieces.size(); ++q) {
         const SeparatingCuts key = separating_cuts(geometry, q, local);
         if (key.count == 0) continue;
@@ -594,7 +606,8 @@ EnrichmentResult DeformableBody::enrich_pieces(std::span<const TetCut> cuts,
         } else if (!plan.from_cut) {
           candidate = plan.rows[q][local];
         }
-        if (candidate >= 0 && !(m_enriched_dofs[static_cast<size_t>(candidate - m_dofs.free_vertex_count())].separated_by == key)) {
+        if (candidate >= 0 &&
+            !(m_enriched_dofs[static_cast<size_t>(candidate - m_dofs.free_vertex_count())].separated_by == key)) {
           candidate = -1;  // a ghost behind other cuts
         }
         nodes.push_back(Node{t, q, local, key, candidate});
@@ -623,8 +636,10 @@ EnrichmentResult DeformableBody::enrich_pieces(std::span<const TetCut> cuts,
         if (b == star.size()) continue;
         const Tet& tet = m_mesh.tets[static_cast<size_t>(t)];
         std::array<Eigen::Vector3d, 3> corners;
-        for (size_t c = 0; c < 3; ++c) corners[c] = m_mesh.rest_positions_m[static_cast<size_t>(tet[static_cast<size_t>(TET_FACES[k][c])])];
-        faces.push_back(StarFace{a, b, corners, 1e-9 * (corners[1] - corners[0]).cross(corners[2] - corners[0]).norm()});
+        for (size_t c = 0; c < 3; ++c)
+          corners[c] = m_mesh.rest_positions_m[static_cast<size_t>(tet[static_cast<size_t>(TET_FACES[k][c])])];
+        faces.push_back(
+            StarFace{a, b, corners, 1e-9 * (corners[1] - corners[0]).cross(corners[2] - corners[0]).norm()});
       }
     }
     static const CutTetGeometry WHOLE{{}, {TetPiece{}}, {}};  // an uncut tet as a piece bounded by nothing
@@ -655,13 +670,12 @@ EnrichmentResult DeformableBody::enrich_pieces(std::span<const TetCut> cuts,
             if (find(i) == find(j)) continue;
             const bool i_piece = static_cast<size_t>(i) < n;
             const bool j_piece = static_cast<size_t>(j) < n;
-            const double area =
-                !i_piece && !j_piece
-                    ? 1.0
-                    : shared_face_area(face.corners, i_piece ? geometry_of(star[face.a]) : WHOLE,
-                                       i_piece ? nodes[members[static_cast<size_t>(i)]].piece : 0,
-                                       j_piece ? geometry_of(star[face.b]) : WHOLE,
-                                       j_piece ? nodes[members[static_cast<size_t>(j)]].piece : 0);
+            const double area = !i_piece && !j_piece
+                                    ? 1.0
+                                    : shared_face_area(face.corners, i_piece ? geometry_of(star[face.a]) : WHOLE,
+                                                       i_piece ? nodes[members[static_cast<size_t>(i)]].piece : 0,
+                                                       j_piece ? geometry_of(star[face.b]) : WHOLE,
+                                                       j_piece ? nodes[members[static_cast<size_t>(j)]].piece : 0);
             if (area > face.area_threshold) parent_of[static_cast<size_t>(find(j))] = find(i);
           }
         }
@@ -676,7 +690,8 @@ EnrichmentResult DeformableBody::enrich_pieces(std::span<const TetCut> cuts,
       for (const int root : roots) {
         std::map<int, int> votes;
         for (size_t m = 0; m < n; ++m) {
-          if (find(static_cast<int>(m)) == root && nodes[members[m]].candidate >= 0) ++votes[nodes[members[m]].candidate];
+          if (find(static_cast<int>(m)) == root && nodes[members[m]].candidate >= 0)
+            ++votes[nodes[members[m]].candidate];
         }
         int row = -1;
         int best = 0;
@@ -705,7 +720,8 @@ EnrichmentResult DeformableBody::enrich_pieces(std::span<const TetCut> cuts,
             plan.old = k;
             plan.from_cut = false;
             plan.geometry = m_cut_geometry[static_cast<size_t>(k)];
-            for (int q = 0; q < static_cast<int>(m_xfem.piece_count(k)); ++q) plan.rows.push_back(m_xfem.piece(k, q).ghost_row);
+            for (int q = 0; q < static_cast<int>(m_xfem.piece_count(k)); ++q)
+              plan.rows.push_back(m_xfem.piece(k, q).ghost_row);
             p = static_cast<int>(plans.size());
             plan_of_tet[static_cast<size_t>(node.tet)] = p;
             plans.push_back(std::move(plan));
@@ -831,7 +847,9 @@ EnrichmentResult DeformableBody::enrich_pieces(std::span<const TetCut> cuts,
     if (old >= 0) {
       for (const int row : m_xfem.ghost_rows(old)) {
         const auto dof = static_cast<size_t>(row - u_rows);
-        if (m_ghost_users[dof] != 0 || std::find(m_orphaned_rows.begin(), m_orphaned_rows.end(), row) != m_orphaned_rows.end()) continue;
+        if (m_ghost_users[dof] != 0 ||
+            std::find(m_orphaned_rows.begin(), m_orphaned_rows.end(), row) != m_orphaned_rows.end())
+          continue;
         m_mass_kg.segment<3>(3 * row).setConstant(m_vertex_mass_kg[static_cast<size_t>(m_enriched_dofs[dof].vertex)]);
         m_external_force_n.segment<3>(3 * row).setZero();
         m_orphaned_rows.push_back(row);
@@ -910,7 +928,8 @@ void DeformableBody::grow_state(DynamicState& state) const {
   state.velocity_m_per_s.tail(dof_count() - old_size).setZero();
 }
 
-TetPositions DeformableBody::piece_positions(const Eigen::VectorXd& displacement_m, int cut_tet_index, int piece) const {
+TetPositions DeformableBody::piece_positions(const Eigen::VectorXd& displacement_m, int cut_tet_index,
+                                             int piece) const {
   const CutTet& cut_tet = m_xfem.cut_tets().at(static_cast<size_t>(cut_tet_index));
   TetPositions real_m;
   for (size_t j = 0; j < 4; ++j) {

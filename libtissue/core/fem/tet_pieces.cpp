@@ -15,7 +15,8 @@ namespace {
 
 double largest_edge_m(const std::array<Eigen::Vector3d, 4>& x) {
   double longest = 0.0;
-  for (const auto& edge : TET_EDGES) longest = std::max(longest, (x[static_cast<std::size_t>(edge[1])] - x[static_cast<std::size_t>(edge[0])]).norm());
+  for (const auto& edge : TET_EDGES)
+    longest = std::max(longest, (x[static_cast<std::size_t>(edge[1])] - x[static_cast<std::size_t>(edge[0])]).norm());
   return longest;
 }
 
@@ -37,7 +38,9 @@ CutPlane cut_plane(const std::array<Eigen::Vector3d, 4>& rest_m, const TetCut& c
     for (int k = 0; k < count; ++k) seen = seen || (points[static_cast<std::size_t>(k)] - p).norm() <= merge_m;
     if (!seen) points[static_cast<std::size_t>(count++)] = p;
   }
-  if (count < 3) throw std::invalid_argument("cut_plane: the cut of tet " + std::to_string(cut.tet) + " has fewer than three points");
+  if (count < 3)
+    throw std::invalid_argument("cut_plane: the cut of tet " + std::to_string(cut.tet) +
+                                " has fewer than three points");
   Eigen::Vector3d centre = Eigen::Vector3d::Zero();
   for (int k = 0; k < count; ++k) centre += points[static_cast<std::size_t>(k)];
   centre /= count;
@@ -105,14 +108,15 @@ std::vector<TetPiece> split_pieces(const std::array<Eigen::Vector3d, 4>& rest_m,
     const double smallest_m3 = cut.min_volume_fraction * tet_volume_m3;
     if (above_m3 < smallest_m3 || below_m3 < smallest_m3) {
       const std::uint32_t side = above_m3 >= below_m3 ? bit : 0u;
-      pieces.push_back(TetPiece{PieceSides{old.sides.bounded, old.sides.above | side}, old.volume_fraction,
-                                static_cast<int>(p)});
+      pieces.push_back(
+          TetPiece{PieceSides{old.sides.bounded, old.sides.above | side}, old.volume_fraction, static_cast<int>(p)});
       continue;
     }
     const double above_fraction = old.volume_fraction * above_m3 / (above_m3 + below_m3);
-    pieces.push_back(TetPiece{PieceSides{old.sides.bounded | bit, old.sides.above | bit}, above_fraction, static_cast<int>(p)});
-    pieces.push_back(TetPiece{PieceSides{old.sides.bounded | bit, old.sides.above}, old.volume_fraction - above_fraction,
-                              static_cast<int>(p)});
+    pieces.push_back(
+        TetPiece{PieceSides{old.sides.bounded | bit, old.sides.above | bit}, above_fraction, static_cast<int>(p)});
+    pieces.push_back(TetPiece{PieceSides{old.sides.bounded | bit, old.sides.above},
+                              old.volume_fraction - above_fraction, static_cast<int>(p)});
   }
   return pieces;
 }
