@@ -178,7 +178,6 @@ Tissue::Tissue(TetMesh mesh, TissueSettings settings)
       m_surface(extract_surface(m_body.mesh())),
       // Only what the scene requires (DESIGN section 1): the edge adjacency and the cutter only with
       // cutting, the surface BVH only with contact or cutting.
-      m_adjacency(m_settings.interaction.cutting_enabled ? build_adjacency(m_body.mesh()) : TetAdjacency{}),
       m_vertex_positions_m(rest_positions(m_body)),
       m_positions_m(m_vertex_positions_m),
       m_cut_surface(m_body.mesh().vertex_count()),
@@ -193,7 +192,7 @@ Tissue::Tissue(TetMesh mesh, TissueSettings settings)
   m_state.velocity_m_per_s.setZero(m_body.dof_count());
   m_body.attach(m_contact_spring);
   if (m_settings.interaction.cutting_enabled) {
-    m_cutter.emplace(m_body.mesh(), m_adjacency, m_surface, m_settings.interaction.cutter);
+    m_cutter.emplace(m_body.mesh(), m_body.adjacency(), m_surface, m_settings.interaction.cutter);
   }
 }
 

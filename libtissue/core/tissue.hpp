@@ -254,7 +254,6 @@ class Tissue {
   std::unique_ptr<Integrator> m_integrator;
   DynamicState m_state;
   SurfaceMesh m_surface;
-  TetAdjacency m_adjacency;
   Eigen::VectorXd m_vertex_positions_m;
   Eigen::VectorXd m_positions_m;
   CutSurface m_cut_surface;

@@ -59,12 +59,6 @@ CutPlane stroke_plane(const Stroke& stroke) {
 
 using RegionOf = std::function<int(const Eigen::Vector3d&)>;
 
-std::array<Eigen::Vector3d, 4> rest_corners(const TetMesh& mesh, int tet) {
-  const Tet& v = mesh.tets[static_cast<size_t>(tet)];
-  return {mesh.rest_positions_m[static_cast<size_t>(v[0])], mesh.rest_positions_m[static_cast<size_t>(v[1])],
-          mesh.rest_positions_m[static_cast<size_t>(v[2])], mesh.rest_positions_m[static_cast<size_t>(v[3])]};
-}
-
 /// A specimen cut by strokes at rest, with nothing snapped and pieces as small as they come.
 struct CutSpecimen {
   TetMesh mesh;
@@ -127,7 +121,7 @@ void expect_pieces_fall_as_regions(CutSpecimen& specimen, const RegionOf& region
   std::vector<double> mass_kg(regions, 0.0);
   for (int t = 0; t < mesh.tet_count(); ++t) {
     if (body.cut_tet_index(t) >= 0) continue;
-    const auto x = rest_corners(mesh, t);
+    const auto x = mesh.rest_corners(t);
     mass_kg[static_cast<size_t>(region_of(0.25 * (x[0] + x[1] + x[2] + x[3])))] +=
         DENSITY * body.elasticity().rest(t).volume_m3;
   }
@@ -141,7 +135,7 @@ void expect_pieces_fall_as_regions(CutSpecimen& specimen, const RegionOf& region
     const CutTetGeometry& geometry = body.cut_geometry(k);
     for (int p = 0; p < static_cast<int>(body.xfem().piece_count(k)); ++p) {
       const ConvexPiece cell =
-          piece_geometry(rest_corners(mesh, tet), geometry.cuts, geometry.pieces[static_cast<size_t>(p)].sides);
+          piece_geometry(mesh.rest_corners(tet), geometry.cuts, geometry.pieces[static_cast<size_t>(p)].sides);
       const int region = region_of(cell.centroid_m());
       mass_kg[static_cast<size_t>(region)] += body.piece_mass_kg(k, p);
       ++pieces;
@@ -314,7 +308,7 @@ TEST(CrossingCuts, ThreeStrokesCutATriangularFlapOutOfTheFrogThatFallsWithThePri
   double prism_m3 = 0.0;
   double frog_m3 = 0.0;
   for (int t = 0; t < mesh.tet_count(); ++t) {
-    ConvexPiece piece = ConvexPiece::tet(rest_corners(mesh, t));
+    ConvexPiece piece = ConvexPiece::tet(mesh.rest_corners(t));
     frog_m3 += piece.volume_m3();
     for (const CutPlane& plane : inside) piece = piece.clipped(plane, true, 0.0);
     prism_m3 += piece.volume_m3();

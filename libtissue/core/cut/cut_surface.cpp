@@ -105,9 +105,7 @@ void CutSurface::add_piece_faces(const DeformableBody& body, int k, const Surfac
   const CutTetGeometry& geometry = body.cut_geometry(k);
   const TetMesh& mesh = body.mesh();
   const int tet_index = body.cut_tets()[static_cast<size_t>(k)].cut.tet;
-  const Tet& tet = mesh.tets[static_cast<size_t>(tet_index)];
-  std::array<Eigen::Vector3d, 4> rest;
-  for (size_t j = 0; j < 4; ++j) rest[j] = mesh.rest_positions_m[static_cast<size_t>(tet[j])];
+  const std::array<Eigen::Vector3d, 4> rest = mesh.rest_corners(tet_index);
   // Which local faces of the tet are on the mesh's surface.
   std::array<bool, 4> on_surface{};
   const auto [first, last] = std::equal_range(surface.triangle_tet.begin(), surface.triangle_tet.end(), tet_index);

@@ -420,9 +420,7 @@ void VolumeCutter::complete_touched_tets(CutStepReport& report) {
       crossings.upper_end[k] =
           static_cast<std::int8_t>(same_direction ? m_edge_upper_end[at(edge)] : -m_edge_upper_end[at(edge)]);
     }
-    const std::array<Eigen::Vector3d, 4> rest = {
-        m_mesh.rest_positions_m[at(vertices[0])], m_mesh.rest_positions_m[at(vertices[1])],
-        m_mesh.rest_positions_m[at(vertices[2])], m_mesh.rest_positions_m[at(vertices[3])]};
+    const std::array<Eigen::Vector3d, 4> rest = m_mesh.rest_corners(tet);
     auto cut = classify_tet_cut(rest, crossings, m_settings.vertex_snap_fraction, m_settings.min_volume_fraction);
     if (!cut) continue;
     if (m_tet_cut_count[at(tet)] >= MAX_PIECE_CUTS) {  // the pieces' capacity (convex_piece.hpp)

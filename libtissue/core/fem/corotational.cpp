@@ -31,13 +31,7 @@ CorotationalElasticity::CorotationalElasticity(const TetMesh& mesh, const Materi
       m_lame((validate(material), lame_parameters(material))),
       m_rotation_settings((validate(rotation), rotation)) {
   m_rest.reserve(m_tets.size());
-  for (const Tet& tet : m_tets) {
-    TetPositions rest_positions;
-    for (int i = 0; i < 4; ++i) {
-      rest_positions[static_cast<size_t>(i)] = mesh.rest_positions_m[static_cast<size_t>(tet[static_cast<size_t>(i)])];
-    }
-    m_rest.push_back(precompute_tet(rest_positions));
-  }
+  for (int t = 0; t < mesh.tet_count(); ++t) m_rest.push_back(precompute_tet(mesh.rest_corners(t)));
   partition(mesh);
   m_rotations.assign(m_tets.size(), Eigen::Matrix3d::Identity());
   m_warm_starts.assign(m_tets.size(), Eigen::Quaterniond::Identity());

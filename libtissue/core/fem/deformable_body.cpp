@@ -99,6 +99,7 @@ std::vector<int> enriched_row_capacities(const TetMesh& mesh, const DofMap& dofs
 
 DeformableBody::DeformableBody(TetMesh mesh, BodySettings settings)
     : m_mesh(std::move(mesh)),
+      m_adjacency(build_adjacency(m_mesh)),
       m_settings(checked(std::move(settings), m_mesh.vertex_count())),
       m_dofs(make_dof_map(m_mesh.vertex_count(), m_settings.fixed_vertices)),
       m_elasticity(m_mesh, m_settings.material, m_settings.rotation),
@@ -119,21 +120,6 @@ DeformableBody::DeformableBody(TetMesh mesh, BodySettings settings)
   }
   m_positions_m.resize(3 * m_mesh.vertex_count());
   m_vertex_forces_n.resize(3 * m_mesh.vertex_count());
-  m_face_neighbor = build_adjacency(m_mesh).face_neighbor;
-  m_vertex_tet_begin.assign(static_cast<size_t>(m_mesh.vertex_count()) + 1, 0);
-  for (const Tet& tet : m_mesh.tets) {
-    for (const int v : tet) ++m_vertex_tet_begin[static_cast<size_t>(v) + 1];
-  }
-  for (size_t v = 0; v < static_cast<size_t>(m_mesh.vertex_count()); ++v)
-    m_vertex_tet_begin[v + 1] += m_vertex_tet_begin[v];
-  m_vertex_tets.resize(static_cast<size_t>(m_vertex_tet_begin.back()));
-  {
-    std::vector<int> next(m_vertex_tet_begin.begin(), m_vertex_tet_begin.end() - 1);
-    for (int t = 0; t < m_mesh.tet_count(); ++t) {
-      for (const int v : m_mesh.tets[static_cast<size_t>(t)])
-        m_vertex_tets[static_cast<size_t>(next[static_cast<size_t>(v)]++)] = t;
-    }
-  }
   positions(Eigen::VectorXd::Zero(dof_count()), m_positions_m);
   // Room for the enrichments the matrix has room for (the dissertation's 150% DOFs).
   const int spare_rows = m_tangent.block_row_capacity() - m_tangent.block_rows();
@@ -412,14 +398,6 @@ EnrichmentResult DeformableBody::enrich(std::span<const TetCut> cuts,
   return enrich_pieces(cuts, offsets_m, nullptr);
 }
 
-std::array<Eigen::Vector3d, 4> DeformableBody::rest_corners(int tet) const {
-  const Tet& vertices = m_mesh.tets[static_cast<size_t>(tet)];
-  return {m_mesh.rest_positions_m[static_cast<size_t>(vertices[0])],
-          m_mesh.rest_positions_m[static_cast<size_t>(vertices[1])],
-          m_mesh.rest_positions_m[static_cast<size_t>(vertices[2])],
-          m_mesh.rest_positions_m[static_cast<size_t>(vertices[3])]};
-}
-
 void DeformableBody::add_ghost_loads(int k, double sign) {
   const int u_rows = m_dofs.free_vertex_count();
   const double tet_mass_kg = m_settings.material.density_kg_per_m3 * m_xfem.rest(k).volume_m3;
@@ -546,13 +524,13 @@ EnrichmentResult DeformableBody::enrich_pieces(std::span<const TetCut> cuts,
         plan.old >= 0 ? std::span<const TetPiece>(m_cut_geometry[static_cast<size_t>(plan.old)].pieces)
                       : std::span<const TetPiece>();
     try {
-      plan.geometry.pieces = split_pieces(rest_corners(plan.tet), plan.geometry.cuts, previous);
+      plan.geometry.pieces = split_pieces(m_mesh.rest_corners(plan.tet), plan.geometry.cuts, previous);
     } catch (const std::invalid_argument& error) {
       throw ParameterError("enrich: cut " + std::to_string(c) + ": " + error.what());
     }
     if (plan.geometry.pieces.size() < 2) throw ParameterError("enrich: cut " + std::to_string(c) + " leaves one piece");
     if (plan.old >= 0) plan.geometry.planes = m_cut_geometry[static_cast<size_t>(plan.old)].planes;
-    plan.geometry.planes.push_back(face_cut_plane(rest_corners(plan.tet), cuts[c]));
+    plan.geometry.planes.push_back(face_cut_plane(m_mesh.rest_corners(plan.tet), cuts[c]));
     plan.rows.assign(plan.geometry.pieces.size(), {-1, -1, -1, -1});
     plan_of_tet[static_cast<size_t>(plan.tet)] = static_cast<int>(plans.size());
     plans.push_back(std::move(plan));
@@ -583,10 +561,10 @@ EnrichmentResult DeformableBody::enrich_pieces(std::span<const TetCut> cuts,
   };
   for (const int v : vertices) {
     nodes.clear();
-    const auto star = std::span(m_vertex_tets)
-                          .subspan(static_cast<size_t>(m_vertex_tet_begin[static_cast<size_t>(v)]),
-                                   static_cast<size_t>(m_vertex_tet_begin[static_cast<size_t>(v) + 1] -
-                                                       m_vertex_tet_begin[static_cast<size_t>(v)]));
+    const auto star_begin = static_cast<size_t>(m_adjacency.vertex_tets_begin[static_cast<size_t>(v)]);
+    const auto star = std::span(m_adjacency.vertex_tets)
+                          .subspan(star_begin, static_cast<size_t>(m_adjacency.vertex_tets_begin[static_cast<size_t>(v) + 1]) -
+                                                   star_begin);
     for (const int t : star) {
       const Tet& tet = m_mesh.tets[static_cast<size_t>(t)];
       const auto local = static_cast<size_t>(std::find(tet.begin(), tet.end(), v) - tet.begin());
@@ -630,7 +608,7 @@ EnrichmentResult DeformableBody::enrich_pieces(std::span<const TetCut> cuts,
     for (size_t a = 0; a < star.size(); ++a) {
       const int t = star[a];
       for (size_t k = 0; k < 4; ++k) {
-        const int neighbour = m_face_neighbor[static_cast<size_t>(t)][k];
+        const int neighbour = m_adjacency.face_neighbor[static_cast<size_t>(t)][k];
         if (neighbour < t) continue;  // none, or the pair is seen from the other side
         const auto b = static_cast<size_t>(std::find(star.begin(), star.end(), neighbour) - star.begin());
         if (b == star.size()) continue;

@@ -16,6 +16,7 @@
 #include "core/fem/material.hpp"
 #include "core/fem/xfem_elasticity.hpp"
 #include "core/mesh/tet_mesh.hpp"
+#include "core/mesh/topology.hpp"
 #include "core/system/assembly.hpp"
 #include "core/system/block_sparse_matrix.hpp"
 #include "core/system/dynamics_model.hpp"
@@ -102,6 +103,8 @@ class DeformableBody final : public DynamicsModel {
   [[nodiscard]] double potential_energy_j(const Eigen::VectorXd& displacement_m) override;
 
   [[nodiscard]] const TetMesh& mesh() const { return m_mesh; }
+  /// The mesh's faces, edges and vertex stars (build_adjacency), made once here.
+  [[nodiscard]] const TetAdjacency& adjacency() const { return m_adjacency; }
   [[nodiscard]] const DofMap& dofs() const { return m_dofs; }
   [[nodiscard]] const BodySettings& settings() const { return m_settings; }
   [[nodiscard]] const CorotationalElasticity& elasticity() const { return m_elasticity; }
@@ -213,6 +216,7 @@ class DeformableBody final : public DynamicsModel {
 
  private:
   TetMesh m_mesh;
+  TetAdjacency m_adjacency;  // faces and vertex stars, for grouping the pieces' ghosts
   BodySettings m_settings;
   DofMap m_dofs;
   CorotationalElasticity m_elasticity;
@@ -233,7 +237,6 @@ class DeformableBody final : public DynamicsModel {
   void check_cuts(std::span<const TetCut> cuts) const;
   EnrichmentResult enrich_pieces(std::span<const TetCut> cuts, std::span<const std::vector<TetPositions>> offsets_m,
                                  const Eigen::VectorXd* displacement_m);
-  [[nodiscard]] std::array<Eigen::Vector3d, 4> rest_corners(int tet) const;
   // Adds (sign +1) or removes (-1) what cut tet k's ghosts carry: rho w_p V / 4 of mass and gravity.
   void add_ghost_loads(int k, double sign);
   void check_unknowns(const Eigen::VectorXd& displacement_m) const;
@@ -246,9 +249,6 @@ class DeformableBody final : public DynamicsModel {
   std::vector<EnrichedDof> m_enriched_dofs;
   std::vector<CutTetGeometry> m_cut_geometry;  // per cut tet
   std::vector<int> m_ghost_users;              // per enriched unknown: pieces of live cut tets using it
-  std::vector<std::array<int, 4>> m_face_neighbor;  // the tet across each local face (TET_FACES), or -1
-  std::vector<int> m_vertex_tet_begin;         // CSR: the tets holding vertex v are
-  std::vector<int> m_vertex_tets;              //   m_vertex_tets[m_vertex_tet_begin[v] .. [v + 1])
   std::vector<int> m_orphaned_rows;            // rows the last enrich() left unused
   int m_tets_cut = 0;
   double m_largest_shape_gradient_per_m = 0.0;  // max |grad(phi_i)| over the mesh: 1 / the lowest altitude

@@ -20,6 +20,12 @@ struct TetMesh {
 
   [[nodiscard]] int vertex_count() const { return static_cast<int>(rest_positions_m.size()); }
   [[nodiscard]] int tet_count() const { return static_cast<int>(tets.size()); }
+  /// The rest positions of tet t's four vertices, in its local order [m].
+  [[nodiscard]] std::array<Eigen::Vector3d, 4> rest_corners(int t) const {
+    const Tet& tet = tets[static_cast<size_t>(t)];
+    return {rest_positions_m[static_cast<size_t>(tet[0])], rest_positions_m[static_cast<size_t>(tet[1])],
+            rest_positions_m[static_cast<size_t>(tet[2])], rest_positions_m[static_cast<size_t>(tet[3])]};
+  }
 };
 
 /// Signed volume of the tet (a, b, c, d): ((b-a) x (c-a)) . (d-a) / 6. Positive = correctly oriented.
