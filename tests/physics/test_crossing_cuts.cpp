@@ -4,6 +4,8 @@
 // * The X: two strokes crossing in the middle of a cantilever beam leave four pieces.
 // * The flap: three strokes that overshoot each other's ends cut a triangular prism out of the
 //   frog's back.
+// * The spiral (one stroke, two turns through a slab): checked against the spiral's own geometry
+//   below, at its test.
 // Each material point belongs to the region of the stroke lines it lies in (seen from above). For
 // each specimen:
 // * every uncut tet and every piece of a cut tet (its rest cell's centroid) is put in its region;
@@ -29,6 +31,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdio>
 #include <functional>
 #include <map>
 #include <memory>
@@ -44,11 +47,28 @@ constexpr double ALPHA_PER_S = 1.0;
 constexpr double STEP_S = 1e-3;
 
 /// A stroke seen from above: a vertical blade from below to above the specimen, swept from `from`
-/// to `to` (x, y) in `steps` cutter steps.
+/// to `to` (x, y).
 struct Stroke {
   Eigen::Vector2d from;
   Eigen::Vector2d to;
 };
+
+/// Where the blade stands (x, y) at each cutter step of one session.
+using BladePath = std::vector<Eigen::Vector2d>;
+
+/// A straight stroke in 40 cutter steps.
+BladePath straight_path(const Stroke& stroke) {
+  constexpr int STEPS = 40;
+  BladePath path;
+  for (int n = 0; n <= STEPS; ++n) path.push_back(stroke.from + (stroke.to - stroke.from) * n / STEPS);
+  return path;
+}
+
+std::vector<BladePath> straight_paths(const std::vector<Stroke>& strokes) {
+  std::vector<BladePath> paths;
+  for (const Stroke& stroke : strokes) paths.push_back(straight_path(stroke));
+  return paths;
+}
 
 /// The vertical plane of a stroke, positive to the stroke's left.
 CutPlane stroke_plane(const Stroke& stroke) {
@@ -68,7 +88,7 @@ struct CutSpecimen {
   DynamicState state;
   int recut_tets = 0;  ///< cuts of tets an earlier stroke cut
 
-  CutSpecimen(TetMesh tet_mesh, std::vector<int> fixed, const std::vector<Stroke>& strokes, double z_below,
+  CutSpecimen(TetMesh tet_mesh, std::vector<int> fixed, const std::vector<BladePath>& strokes, double z_below,
               double z_above)
       : mesh(std::move(tet_mesh)), body(mesh, settings(std::move(fixed))) {
     state.displacement_m = Eigen::VectorXd::Zero(body.dof_count());
@@ -81,11 +101,10 @@ struct CutSpecimen {
     exact.vertex_snap_fraction = 0.0;
     exact.min_volume_fraction = SMALLEST_MIN_VOLUME_FRACTION;
     VolumeCutter cutter(mesh, adjacency, surface, exact);
-    constexpr int STEPS = 40;
-    for (const Stroke& stroke : strokes) {
+    for (const BladePath& stroke : strokes) {
       Blade previous;
-      for (int n = 0; n <= STEPS; ++n) {
-        const Eigen::Vector2d at = stroke.from + (stroke.to - stroke.from) * n / STEPS;
+      for (size_t n = 0; n < stroke.size(); ++n) {
+        const Eigen::Vector2d& at = stroke[n];
         const Blade blade{Eigen::Vector3d(at.x(), at.y(), z_below), Eigen::Vector3d(at.x(), at.y(), z_above)};
         cutter.step(n == 0 ? blade : previous, blade, rest, bvh);
         previous = blade;
@@ -258,7 +277,7 @@ TEST(CrossingCuts, AnXCutLeavesFourPiecesOfTheExactVolumesAndTheThreeFreeOnesFal
   };
   TetMesh mesh = make_box_mesh(10, 2, 2, 0.01);
   std::vector<int> fixed = vertices_at_minimum(mesh, 0, 1e-6);
-  CutSpecimen beam(std::move(mesh), std::move(fixed), {stroke(0), stroke(1)}, -0.02, 0.04);
+  CutSpecimen beam(std::move(mesh), std::move(fixed), straight_paths({stroke(0), stroke(1)}), -0.02, 0.04);
   ASSERT_GT(beam.recut_tets, 0);  // the second stroke cut tets of the first again
 
   // The exact volumes: prisms over the regions' polygons.
@@ -324,10 +343,139 @@ TEST(CrossingCuts, ThreeStrokesCutATriangularFlapOutOfTheFrogThatFallsWithThePri
   for (int v = 0; v < mesh.vertex_count(); ++v) {
     if (mesh.rest_positions_m[static_cast<size_t>(v)].x() > x_max - 0.15 * (x_max - x_min)) fixed.push_back(v);
   }
-  CutSpecimen frog(std::move(mesh), std::move(fixed), strokes, -0.03, 0.06);
+  CutSpecimen frog(std::move(mesh), std::move(fixed), straight_paths(strokes), -0.03, 0.06);
   ASSERT_GT(frog.recut_tets, 0);  // the corners' tets were cut twice
   // The frog sags between its held ends; the flap falls away from it.
   expect_pieces_fall_as_regions(frog, flap_region, {frog_m3 - prism_m3, prism_m3}, 0, 40, 5e-3);
+}
+
+// --- the spiral through a slab --------------------------------------------------------------------
+
+// The dissertation's figure 7.1: a spiral stroke, where one global Heaviside leaves a vertex between
+// two turns on both sides of the same cut. An Archimedean spiral r = b theta about SPIRAL_CENTRE,
+// two turns from theta = 2 pi + SPIRAL_ENDS to 6 pi + SPIRAL_ENDS (both ends on one ray), with a
+// pitch 2 pi b of 2 cube edges: no tet (longest edge, a face diagonal: sqrt 2 cube edges) meets
+// both turns; the stars of some vertices between the turns meet both.
+constexpr double SLAB_EDGE_M = 0.005;
+const Eigen::Vector2d SPIRAL_CENTRE(0.0501, 0.0502);
+constexpr double SPIRAL_PITCH_M = 2.0 * SLAB_EDGE_M;
+constexpr double SPIRAL_ENDS = 0.3;
+
+double spiral_radius_m(double theta) { return SPIRAL_PITCH_M / (2.0 * M_PI) * theta; }
+
+/// A tet's cut is one plane: where the spiral bends, it passes the tet's vertices at up to the
+/// sagitta of its longest edge (a face diagonal) over the turn's radius from the curve, on either
+/// side (an edge may even dip across the curve and back). A vertex closer than this to the curve may
+/// be on either side.
+double spiral_side_tolerance_m(double radius_m) { return std::pow(std::sqrt(2.0) * SLAB_EDGE_M, 2) / (8.0 * radius_m); }
+
+/// How many turns of the spiral lie between the centre and `p` on the ray through `p` (seen from
+/// above): 0 inside the inner turn, 1 between the turns, 2 outside; -1 within the side tolerance of a
+/// turn. Two points of different bands are separated by the cut wherever both ends of the
+/// spiral are far.
+int spiral_band(const Eigen::Vector3d& p) {
+  const Eigen::Vector2d d = p.head<2>() - SPIRAL_CENTRE;
+  double phi = std::atan2(d.y(), d.x());
+  if (phi < 0.0) phi += 2.0 * M_PI;
+  int band = 0;
+  for (int turn = 0; turn < 4; ++turn) {
+    const double theta = phi + 2.0 * M_PI * turn;
+    if (theta < 2.0 * M_PI + SPIRAL_ENDS || theta > 6.0 * M_PI + SPIRAL_ENDS) continue;
+    if (std::abs(spiral_radius_m(theta) - d.norm()) < spiral_side_tolerance_m(spiral_radius_m(theta))) return -1;
+    if (spiral_radius_m(theta) < d.norm()) ++band;
+  }
+  return band;
+}
+
+/// Distance (seen from above) from `p` to the ray on which the spiral starts and ends.
+double distance_to_ends_ray_m(const Eigen::Vector3d& p) {
+  const Eigen::Vector2d ray(std::cos(SPIRAL_ENDS), std::sin(SPIRAL_ENDS));
+  const Eigen::Vector2d d = p.head<2>() - SPIRAL_CENTRE;
+  const double along = std::max(0.0, d.dot(ray));
+  return (d - along * ray).norm();
+}
+
+TEST(CrossingCuts, ASpiralStrokeCutsAlongItsWholePathWithEveryPieceOnItsSideOfTheTurns) {
+  // A 10 x 10 x 1 cm slab of 5 mm cubes; one session, the blade about 1 mm a step.
+  TetMesh mesh = make_box_mesh(20, 20, 2, SLAB_EDGE_M);
+  BladePath spiral;
+  for (double theta = 2.0 * M_PI + SPIRAL_ENDS; theta <= 6.0 * M_PI + SPIRAL_ENDS;
+       theta += 1e-3 / spiral_radius_m(theta)) {
+    spiral.push_back(SPIRAL_CENTRE + spiral_radius_m(theta) * Eigen::Vector2d(std::cos(theta), std::sin(theta)));
+  }
+  double slab_m3 = 0.0;
+  for (int t = 0; t < mesh.tet_count(); ++t) slab_m3 += ConvexPiece::tet(mesh.rest_corners(t)).volume_m3();
+  CutSpecimen slab(std::move(mesh), {}, {spiral}, -0.01, 0.02);
+  const DeformableBody& body = slab.body;
+  const TetMesh& slab_mesh = slab.mesh;
+  EXPECT_NEAR(body.total_mass_kg(), DENSITY * slab_m3, 1e-12 * DENSITY * slab_m3);
+
+  // Judged away from the spiral's two ends (where the blade stood inside the body, the tets around
+  // it stay whole): every vertex of a tet at least 1.5 cm (three cube edges) from their ray.
+  const auto vertex_band = [&](int v) { return spiral_band(slab_mesh.rest_positions_m[static_cast<size_t>(v)]); };
+  const auto judged = [&](int tet) {
+    for (int v : slab_mesh.tets[static_cast<size_t>(tet)]) {
+      if (distance_to_ends_ray_m(slab_mesh.rest_positions_m[static_cast<size_t>(v)]) < 3.0 * SLAB_EDGE_M) return false;
+    }
+    return true;
+  };
+  // Cut along the whole path: a judged tet is cut exactly when the turns separate its vertices.
+  int judged_cut = 0;
+  for (int t = 0; t < slab_mesh.tet_count(); ++t) {
+    if (!judged(t)) continue;
+    const auto& tet = slab_mesh.tets[static_cast<size_t>(t)];
+    if (std::any_of(tet.begin(), tet.end(), [&](int v) { return vertex_band(v) < 0; })) continue;
+    const bool separated = std::any_of(tet.begin(), tet.end(), [&](int v) { return vertex_band(v) != vertex_band(tet[0]); });
+    EXPECT_EQ(body.cut_tet_index(t) >= 0, separated) << "tet " << t;
+    judged_cut += separated ? 1 : 0;
+  }
+  EXPECT_GT(judged_cut, 200);
+  EXPECT_EQ(slab.recut_tets, 0);  // no tet meets both turns
+
+  // No vertex on the wrong side: a piece's real vertices lie in one band (the piece's); a ghost of
+  // vertex v is used by pieces of one band only, not v's. Between the turns, a vertex whose ghosts
+  // carry the pieces beyond the inner turn and beyond the outer one is the figure's vertex.
+  std::map<int, int> ghost_band;  // block row -> band of the pieces using it
+  std::map<int, std::vector<int>> vertex_ghost_bands;
+  int judged_ghost_uses = 0;
+  for (int k = 0; k < static_cast<int>(body.cut_tets().size()); ++k) {
+    const int tet = body.cut_tets()[static_cast<size_t>(k)].cut.tet;
+    if (body.retired(k) || !judged(tet)) continue;
+    for (int p = 0; p < static_cast<int>(body.xfem().piece_count(k)); ++p) {
+      const CutPiece& piece = body.xfem().piece(k, p);
+      int band = -1;
+      for (size_t j = 0; j < 4; ++j) {
+        if (piece.ghost_row[j] >= 0) continue;
+        const int real_band = vertex_band(slab_mesh.tets[static_cast<size_t>(tet)][j]);
+        if (real_band < 0) continue;
+        if (band < 0) band = real_band;
+        EXPECT_EQ(real_band, band) << "a real vertex of tet " << tet << " on the wrong side of the spiral";
+      }
+      if (band < 0) continue;  // its real vertices lie on the curve
+      for (size_t j = 0; j < 4; ++j) {
+        const int row = piece.ghost_row[j];
+        if (row < 0) continue;
+        const int v = slab_mesh.tets[static_cast<size_t>(tet)][j];
+        EXPECT_NE(vertex_band(v), band) << "a ghost of vertex " << v << " on the vertex's own side";
+        ++judged_ghost_uses;
+        const auto [it, added] = ghost_band.emplace(row, band);
+        EXPECT_EQ(it->second, band) << "ghost row " << row << " of vertex " << v << " joins two bands";
+        if (added) vertex_ghost_bands[v].push_back(band);
+      }
+    }
+  }
+  int between_turns = 0;
+  for (const auto& [v, bands] : vertex_ghost_bands) {
+    between_turns += (vertex_band(v) == 1 && std::count(bands.begin(), bands.end(), 0) > 0 &&
+                      std::count(bands.begin(), bands.end(), 2) > 0)
+                         ? 1
+                         : 0;
+  }
+  EXPECT_GT(between_turns, 0);
+  EXPECT_GT(judged_ghost_uses, 1000);
+  std::printf("spiral: %d judged tets cut, %d ghost uses judged, %d vertices between the turns with ghosts beyond "
+              "both\n",
+              judged_cut, judged_ghost_uses, between_turns);
 }
 
 }  // namespace
