@@ -1,6 +1,8 @@
 #!/usr/bin/python3
 """Builds the frog specimen: writes meshes/frog.geo, meshes it with Gmsh (OpenCASCADE union
-of ellipsoids and cylinders), checks the result and converts it to meshes/frog.veg.
+of ellipsoids and cylinders), checks the result and converts it to meshes/frog.veg. Also meshes
+the same shape's surface finely (RENDER_SIZE_M) into meshes/frog_surface.obj, the render surface
+that rides on the tets (issue 22): closed, manifold, oriented outward.
 
     /usr/bin/python3 meshes/make_frog.py [--gmsh gmsh]
 
@@ -26,6 +28,10 @@ TOLERANCE = 0.15
 # Largest tet edge [m]. Uniform sizing; the legs (radius 4.5-5.5 mm) get about one element
 # across, which is what a coarse real-time specimen of ~800 vertices can afford.
 MESH_SIZE_M = 0.0070
+
+# Largest triangle edge of the render surface [m]: over 20k triangles.
+RENDER_SIZE_M = 0.0013
+MIN_RENDER_TRIANGLES = 20000
 
 # (centre, semi-axes) of the ellipsoids [m].
 BODY = ((0.0, 0.0, 0.020), (0.035, 0.024, 0.016))
@@ -89,8 +95,9 @@ def geo_text():
     return "\n".join(lines) + "\n"
 
 
-def read_msh41(path):
-    """Minimal Gmsh 4.1 ASCII reader: returns (node tags, coordinates, tets as node tags, volumes)."""
+def read_msh41(path, element_type=4):
+    """Minimal Gmsh 4.1 ASCII reader: returns (node tags, coordinates, elements of `element_type`
+    (4 tets, 2 triangles) as node tags, volumes)."""
     with open(path) as f:
         lines = f.read().split("\n")
 
@@ -119,10 +126,11 @@ def read_msh41(path):
     p += 1
     tets = []
     for _ in range(blocks):
-        _, _, element_type, count = map(int, lines[p].split())
+        _, _, block_type, count = map(int, lines[p].split())
         p += 1
-        if element_type == 4:
-            tets += [tuple(map(int, lines[p + n].split()[1:5])) for n in range(count)]
+        if block_type == element_type:
+            corners = 4 if element_type == 4 else 3
+            tets += [tuple(map(int, lines[p + n].split()[1:1 + corners])) for n in range(count)]
         p += count
     return tags, coords, tets, volumes
 
@@ -160,6 +168,81 @@ def check(coords, tets, volumes):
     if euler != 2:
         problems.append("surface Euler characteristic %d, expected 2" % euler)
     return problems, (lower, upper)
+
+
+def oriented_surface(coords, triangles):
+    """The triangles wound consistently (a flood over shared edges), outward (positive enclosed
+    volume), and the problems that refuse them: an edge not shared by exactly two triangles, more
+    than one piece, a surface that is not a sphere's (V - E + F != 2)."""
+    problems = []
+    edge_triangles = {}
+    for n, (a, b, c) in enumerate(triangles):
+        for u, v in ((a, b), (b, c), (c, a)):
+            edge_triangles.setdefault((min(u, v), max(u, v)), []).append(n)
+    bad = [edge for edge, users in edge_triangles.items() if len(users) != 2]
+    if bad:
+        return triangles, ["%d edges are not shared by exactly two triangles (first: %s)" % (len(bad), bad[0])]
+    wound = [None] * len(triangles)
+    wound[0] = triangles[0]
+    stack = [0]
+    while stack:
+        n = stack.pop()
+        a, b, c = wound[n]
+        for u, v in ((a, b), (b, c), (c, a)):
+            for m in edge_triangles[(min(u, v), max(u, v))]:
+                if wound[m] is not None:
+                    continue
+                x, y, z = triangles[m]
+                # A neighbour wound the same way runs the shared edge the other way (v -> u).
+                runs_uv = (x, y) == (u, v) or (y, z) == (u, v) or (z, x) == (u, v)
+                wound[m] = (x, z, y) if runs_uv else (x, y, z)
+                stack.append(m)
+    if any(t is None for t in wound):
+        problems.append("the surface is in more than one piece")
+        return triangles, problems
+    volume = sum(signed_volume((0.0, 0.0, 0.0), coords[a], coords[b], coords[c]) for a, b, c in wound)
+    if volume < 0.0:
+        wound = [(a, c, b) for a, b, c in wound]
+    used = set(v for t in wound for v in t)
+    if len(used) - len(edge_triangles) + len(wound) != 2:
+        problems.append("surface Euler characteristic %d, expected 2" % (len(used) - len(edge_triangles) + len(wound)))
+    return wound, problems
+
+
+def write_obj(path, coords, triangles, comment):
+    used = sorted(set(v for t in triangles for v in t))
+    index_of = {v: n + 1 for n, v in enumerate(used)}
+    lines = ["# " + comment, "# %d vertices, %d triangles" % (len(used), len(triangles))]
+    lines += ["v %r %r %r" % coords[v] for v in used]
+    lines += ["f %d %d %d" % tuple(index_of[v] for v in t) for t in triangles]
+    with open(path, "w", newline="\n") as out:
+        out.write("\n".join(lines) + "\n")
+
+
+def make_render_surface(gmsh, here):
+    """Meshes the frog's surface at RENDER_SIZE_M into frog_surface.obj (refused if not closed)."""
+    render_geo = os.path.join(here, "frog_surface.geo")
+    with open(render_geo, "w", newline="\n") as out:
+        out.write('// The frog render surface (meshes/make_frog.py): frog.geo meshed in 2D, finer.\n'
+                  'Include "frog.geo";\nMesh.MeshSizeMax = %r;\n' % RENDER_SIZE_M)
+    tmp = os.path.join(here, "frog_surface.msh.tmp")
+    result = subprocess.run([gmsh, "frog_surface.geo", "-2", "-nt", "1", "-format", "msh41", "-o",
+                             os.path.basename(tmp)], cwd=here, capture_output=True, text=True)
+    if result.returncode != 0 or not os.path.exists(tmp):
+        sys.stderr.write(result.stdout + result.stderr)
+        sys.exit("gmsh failed on the render surface")
+    tags, coords, triangles, _ = read_msh41(tmp, element_type=2)
+    os.remove(tmp)
+    index_of = {tag: n for n, tag in enumerate(tags)}
+    triangles = [tuple(index_of[tag] for tag in t) for t in triangles]
+    triangles, problems = oriented_surface(coords, triangles)
+    if len(triangles) < MIN_RENDER_TRIANGLES:
+        problems.append("%d triangles, fewer than %d: lower RENDER_SIZE_M" % (len(triangles), MIN_RENDER_TRIANGLES))
+    if problems:
+        sys.exit("frog render surface refused:\n  " + "\n  ".join(problems))
+    write_obj(os.path.join(here, "frog_surface.obj"), coords, triangles,
+              "frog render surface from frog_surface.geo by meshes/make_frog.py (largest edge %g m)" % RENDER_SIZE_M)
+    print("frog render surface: %d triangles" % len(triangles))
 
 
 def write_veg(path, coords, tets, comment):
@@ -210,6 +293,7 @@ def main():
     comment = "frog specimen converted from frog.msh by meshes/make_frog.py (%.3f x %.3f x %.3f m)" % tuple(size)
     write_veg(veg, coords, tets, comment)
     print("frog: %d vertices, %d tets, %.3f x %.3f x %.3f m" % ((len(coords), len(tets)) + tuple(size)))
+    make_render_surface(args.gmsh, here)
     return 0
 
 

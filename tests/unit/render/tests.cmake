@@ -1,0 +1,1 @@
+tissue_add_test(test_render LABELS unit SOURCES render/test_embedded_surface.cpp)
