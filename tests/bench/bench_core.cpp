@@ -3,6 +3,7 @@
 // CHOLMOD factorization + solve. Counters report DOFs and non-zeros.
 #include "core/fixed_region.hpp"
 #include "core/mesh/mesh_io.hpp"
+#include "core/render/embedded_surface.hpp"
 #include "core/tissue.hpp"
 #include "resources/default_mesh.hpp"
 
@@ -108,6 +109,27 @@ void BM_RotationExtraction(benchmark::State& state) {
   }
 }
 BENCHMARK(BM_RotationExtraction)->Unit(benchmark::kNanosecond);
+
+// Issue 22: mapping the frog's render surface (meshes/frog_surface.obj, 23240 triangles) onto
+// deformed tets: positions and normals of one frame. Target: <= 0.3 ms on one core.
+void BM_RenderSurfaceMap(benchmark::State& state) {
+  const TetMesh mesh = read_mesh(std::string(TISSUE_MESH_DIR) + "/frog.veg");
+  EmbeddedSurface render(mesh, read_obj(std::string(TISSUE_MESH_DIR) + "/frog_surface.obj"),
+                         default_max_outside_m(mesh));
+  Eigen::VectorXd positions(3 * mesh.vertex_count());
+  std::mt19937 rng(22);
+  std::uniform_real_distribution<double> jitter(-1e-3, 1e-3);
+  for (int v = 0; v < mesh.vertex_count(); ++v) {
+    positions.segment<3>(3 * v) = mesh.rest_positions_m[static_cast<size_t>(v)] +
+                                  Eigen::Vector3d(jitter(rng), jitter(rng), jitter(rng));
+  }
+  for (auto _ : state) {
+    render.update(positions);
+    benchmark::DoNotOptimize(render.normals().data());
+  }
+  state.counters["triangles"] = static_cast<double>(render.surface().triangles.size());
+}
+BENCHMARK(BM_RenderSurfaceMap)->Unit(benchmark::kMicrosecond);
 
 }  // namespace
 }  // namespace tissue
