@@ -70,12 +70,16 @@ void check_manifold(const TriangleSurface& surface, const std::string& source_na
   }
 }
 
-Eigen::Vector4d barycentric(const std::array<Eigen::Vector3d, 4>& x, const Eigen::Vector3d& p) {
+}  // namespace
+
+Eigen::Vector4d barycentric_weights(const std::array<Eigen::Vector3d, 4>& x, const Eigen::Vector3d& p) {
   Eigen::Matrix3d edges;
   edges << x[1] - x[0], x[2] - x[0], x[3] - x[0];
   const Eigen::Vector3d w = edges.partialPivLu().solve(p - x[0]);
   return {1.0 - w.sum(), w.x(), w.y(), w.z()};
 }
+
+namespace {
 
 // Distance from p to the triangle abc (Ericson, Real-Time Collision Detection, 5.1.5).
 double point_triangle_distance(const Eigen::Vector3d& p, const Eigen::Vector3d& a, const Eigen::Vector3d& b,
@@ -270,7 +274,7 @@ std::vector<SurfaceEmbedding> embed_surface(const TetMesh& mesh, const TriangleS
     SurfaceEmbedding inside, outside;
     grid.near(p, max_outside_m, candidates);
     for (const int t : candidates) {
-      const Eigen::Vector4d weights = barycentric(mesh.rest_corners(t), p);
+      const Eigen::Vector4d weights = barycentric_weights(mesh.rest_corners(t), p);
       if (weights.minCoeff() >= 0.0 && weights.minCoeff() > best_inside) {
         best_inside = weights.minCoeff();
         inside = {t, weights};
@@ -278,7 +282,7 @@ std::vector<SurfaceEmbedding> embed_surface(const TetMesh& mesh, const TriangleS
     }
     for (size_t c = 0; c < candidates.size() && inside.tet < 0; ++c) {
       const auto x = mesh.rest_corners(candidates[c]);
-      const Eigen::Vector4d weights = barycentric(x, p);
+      const Eigen::Vector4d weights = barycentric_weights(x, p);
       const double distance_m = point_tet_distance(x, weights, p);
       if (distance_m < nearest_m) {
         nearest_m = distance_m;
@@ -320,15 +324,21 @@ void EmbeddedSurface::update(const Eigen::VectorXd& vertex_positions_m) {
     for (int k = 0; k < 4; ++k) x += e.weights(k) * vertex_positions_m.segment<3>(3 * tet[static_cast<size_t>(k)]);
     m_positions_m[v] = x;
   }
-  for (Eigen::Vector3d& n : m_normals) n.setZero();
-  for (const auto& [a, b, c] : m_surface.triangles) {
-    const Eigen::Vector3d area_normal = (m_positions_m[static_cast<size_t>(b)] - m_positions_m[static_cast<size_t>(a)])
-                                            .cross(m_positions_m[static_cast<size_t>(c)] - m_positions_m[static_cast<size_t>(a)]);
-    m_normals[static_cast<size_t>(a)] += area_normal;
-    m_normals[static_cast<size_t>(b)] += area_normal;
-    m_normals[static_cast<size_t>(c)] += area_normal;
+  vertex_normals(m_positions_m, m_surface.triangles, m_normals);
+}
+
+void vertex_normals(const std::vector<Eigen::Vector3d>& positions_m, const std::vector<std::array<int, 3>>& triangles,
+                    std::vector<Eigen::Vector3d>& normals) {
+  normals.resize(positions_m.size());
+  for (Eigen::Vector3d& n : normals) n.setZero();
+  for (const auto& [a, b, c] : triangles) {
+    const Eigen::Vector3d area_normal = (positions_m[static_cast<size_t>(b)] - positions_m[static_cast<size_t>(a)])
+                                            .cross(positions_m[static_cast<size_t>(c)] - positions_m[static_cast<size_t>(a)]);
+    normals[static_cast<size_t>(a)] += area_normal;
+    normals[static_cast<size_t>(b)] += area_normal;
+    normals[static_cast<size_t>(c)] += area_normal;
   }
-  for (Eigen::Vector3d& n : m_normals) {
+  for (Eigen::Vector3d& n : normals) {
     const double length = n.norm();
     if (length > 0.0) n /= length;
   }

@@ -42,6 +42,9 @@ struct SurfaceEmbedding {
   Eigen::Vector4d weights = Eigen::Vector4d::Zero();
 };
 
+/// The barycentric weights of `p` in the tet `x` (affine: they reproduce p exactly, negative outside).
+Eigen::Vector4d barycentric_weights(const std::array<Eigen::Vector3d, 4>& x, const Eigen::Vector3d& p);
+
 /// How far outside the tet mesh a render vertex may lie, by default: a quarter of the mesh's mean
 /// edge (a smooth surface bulges out of its tets' flat faces by the sagitta, h^2 / (8 R)). [m]
 double default_max_outside_m(const TetMesh& mesh);
@@ -52,6 +55,11 @@ double default_max_outside_m(const TetMesh& mesh);
 /// from every tet.
 std::vector<SurfaceEmbedding> embed_surface(const TetMesh& mesh, const TriangleSurface& surface,
                                             double max_outside_m, const std::string& source_name);
+
+/// Unit vertex normals of `triangles` over `positions_m`: area-weighted means of the triangles around
+/// each vertex (zero for a vertex no triangle uses). `normals` is resized to the positions.
+void vertex_normals(const std::vector<Eigen::Vector3d>& positions_m, const std::vector<std::array<int, 3>>& triangles,
+                    std::vector<Eigen::Vector3d>& normals);
 
 /// A render surface moved by the tets' vertex positions.
 class EmbeddedSurface {
