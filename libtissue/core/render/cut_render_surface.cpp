@@ -6,7 +6,10 @@
 #include <cmath>
 #include <limits>
 #include <map>
+#include <numeric>
+#include <set>
 #include <unordered_map>
+#include <unordered_set>
 #include <utility>
 
 namespace tissue {
@@ -26,27 +29,35 @@ double outside_piece_m(const CutTetGeometry& geometry, size_t piece, const Eigen
   return outside;
 }
 
-// Where the segment from `from` to `to` leaves the piece holding `from` (a fraction in [0, 1]), or
-// -1 if `to` is in the piece too.
-double leaves_piece_at(const CutTetGeometry& geometry, size_t piece, const Eigen::Vector3d& from,
-                       const Eigen::Vector3d& to) {
+// Where the segment from `from` to `to` leaves the piece holding `from`: a fraction in [0, 1] and the
+// index of the cut whose plane it crosses there; fraction -1 if `to` is in the piece too.
+std::pair<double, int> leaves_piece_at(const CutTetGeometry& geometry, size_t piece, const Eigen::Vector3d& from,
+                                       const Eigen::Vector3d& to) {
   const PieceSides& sides = geometry.pieces[piece].sides;
   double first = std::numeric_limits<double>::infinity();
+  int crossed = -1;
   for (size_t c = 0; c < geometry.cuts.size(); ++c) {
     if ((sides.bounded & (1u << c)) == 0) continue;
     const double toward_inside = (sides.above & (1u << c)) != 0 ? 1.0 : -1.0;
     const double d_from = toward_inside * geometry.planes[c].signed_distance(from);
     const double d_to = toward_inside * geometry.planes[c].signed_distance(to);
     if (d_to >= 0.0) continue;
-    first = std::min(first, d_from <= 0.0 ? 0.0 : d_from / (d_from - d_to));
+    const double at = d_from <= 0.0 ? 0.0 : d_from / (d_from - d_to);
+    if (at < first) {
+      first = at;
+      crossed = static_cast<int>(c);
+    }
   }
-  return std::isfinite(first) ? first : -1.0;
+  return {crossed >= 0 ? first : -1.0, crossed};
 }
 
 // Triangulates the closed polygon `loop` (point indices, positions `x`) by ear clipping in its
-// best-fit plane, each triangle wound as the polygon (counter-clockwise about its Newell normal).
+// best-fit plane, each triangle wound as the polygon (counter-clockwise about its Newell normal),
+// never cutting along an edge the mesh has already (edge_exists(u, v), either way: it would then
+// have four triangles).
+template <typename EdgeExists>
 void ear_clip(const std::vector<int>& loop, const std::vector<Eigen::Vector3d>& x,
-              std::vector<std::array<int, 3>>& triangles) {
+              std::vector<std::array<int, 3>>& triangles, const EdgeExists& edge_exists) {
   const size_t n = loop.size();
   if (n < 3) return;
   Eigen::Vector3d normal = Eigen::Vector3d::Zero();
@@ -74,6 +85,7 @@ void ear_clip(const std::vector<int>& loop, const std::vector<Eigen::Vector3d>& 
     for (size_t i = 0; i < m && ear == m; ++i) {
       const Eigen::Vector2d a = at(left[(i + m - 1) % m]), b = at(left[i]), c = at(left[(i + 1) % m]);
       if (cross(a, b, c) <= 0.0) continue;  // reflex or flat
+      if (m > 3 && edge_exists(left[(i + 1) % m], left[(i + m - 1) % m])) continue;  // a diagonal the mesh has
       bool empty = true;
       for (size_t j = 0; j < m && empty; ++j) {
         if (j == i || j == (i + m - 1) % m || j == (i + 1) % m) continue;
@@ -100,6 +112,12 @@ CutRenderSurface::CutRenderSurface(const TetMesh& mesh, TriangleSurface surface,
   for (const SurfaceEmbedding& e : m_embedding) m_points.push_back(Point{e.tet, e.weights, -1, -1});
   m_rest_m = m_surface.vertices_m;
   m_triangles = m_surface.triangles;
+  for (const auto& triangle : m_surface.triangles) {
+    for (size_t k = 0; k < 3; ++k) {
+      const int u = std::min(triangle[k], triangle[(k + 1) % 3]), v = std::max(triangle[k], triangle[(k + 1) % 3]);
+      m_surface_edges.insert((static_cast<long long>(u) << 32) | static_cast<unsigned int>(v));
+    }
+  }
 }
 
 CutRenderSurface::Point CutRenderSurface::locate(const DeformableBody& body, int tet,
@@ -122,22 +140,42 @@ void CutRenderSurface::rebuild(const DeformableBody& body) {
   const size_t vertices = m_surface.vertices_m.size();
   m_points.resize(vertices);
   m_rest_m.resize(vertices);
-  for (size_t v = 0; v < vertices; ++v) m_points[v] = locate(body, m_embedding[v].tet, m_surface.vertices_m[v]);
+  m_point_cut.assign(vertices, -1);
+  for (size_t v = 0; v < vertices; ++v) {
+    const SurfaceEmbedding& e = m_embedding[v];
+    m_points[v] = body.cut_tet_index(e.tet) < 0 ? Point{e.tet, e.weights, -1, -1}
+                                                 : locate(body, e.tet, m_surface.vertices_m[v]);
+  }
 
   // Each edge once: is it cut, and its two split points (the lower vertex's side first).
-  std::map<std::pair<int, int>, std::array<int, 2>> splits;
+  // Only an edge with an end in a cut tet can be cut; the others are not looked up.
+  std::unordered_map<long long, std::array<int, 2>> splits;
   const auto split = [&](int u, int v) -> const std::array<int, 2>* {
-    const std::pair<int, int> key{std::min(u, v), std::max(u, v)};
+    const int lo = std::min(u, v), hi = std::max(u, v);
+    if (m_points[static_cast<size_t>(lo)].cut_tet < 0 && m_points[static_cast<size_t>(hi)].cut_tet < 0) return nullptr;
+    const long long key = (static_cast<long long>(lo) << 32) | static_cast<unsigned int>(hi);
     if (const auto it = splits.find(key); it != splits.end()) return it->second[0] < 0 ? nullptr : &it->second;
-    const Point low = m_points[static_cast<size_t>(key.first)];  // copies: m_points grows below
-    const Point high = m_points[static_cast<size_t>(key.second)];
-    const Eigen::Vector3d& x_low = m_surface.vertices_m[static_cast<size_t>(key.first)];
-    const Eigen::Vector3d& x_high = m_surface.vertices_m[static_cast<size_t>(key.second)];
+    const Point low = m_points[static_cast<size_t>(lo)];  // copies: m_points grows below
+    const Point high = m_points[static_cast<size_t>(hi)];
+    const Eigen::Vector3d& x_low = m_surface.vertices_m[static_cast<size_t>(lo)];
+    const Eigen::Vector3d& x_high = m_surface.vertices_m[static_cast<size_t>(hi)];
     double s = -1.0;
-    if (low.cut_tet >= 0) s = leaves_piece_at(body.cut_geometry(low.cut_tet), static_cast<size_t>(low.piece), x_low, x_high);
+    int cut_id = -1;
+    if (low.cut_tet >= 0) {
+      const CutTetGeometry& geometry = body.cut_geometry(low.cut_tet);
+      const auto [at, cut] = leaves_piece_at(geometry, static_cast<size_t>(low.piece), x_low, x_high);
+      if (at >= 0.0) {
+        s = at;
+        cut_id = geometry.cuts[static_cast<size_t>(cut)].cut_id;
+      }
+    }
     if (s < 0.0 && high.cut_tet >= 0) {
-      const double back = leaves_piece_at(body.cut_geometry(high.cut_tet), static_cast<size_t>(high.piece), x_high, x_low);
-      if (back >= 0.0) s = 1.0 - back;
+      const CutTetGeometry& geometry = body.cut_geometry(high.cut_tet);
+      const auto [back, cut] = leaves_piece_at(geometry, static_cast<size_t>(high.piece), x_high, x_low);
+      if (back >= 0.0) {
+        s = 1.0 - back;
+        cut_id = geometry.cuts[static_cast<size_t>(cut)].cut_id;
+      }
     }
     if (s < 0.0) {
       splits.emplace(key, std::array<int, 2>{-1, -1});
@@ -150,6 +188,7 @@ void CutRenderSurface::rebuild(const DeformableBody& body) {
       copies[side] = static_cast<int>(m_points.size());
       m_points.push_back(Point{end.tet, barycentric_weights(m_mesh.rest_corners(end.tet), q), end.cut_tet, end.piece});
       m_rest_m.push_back(q);
+      m_point_cut.push_back(cut_id);
     }
     return &splits.emplace(key, copies).first->second;
   };
@@ -196,39 +235,293 @@ void CutRenderSurface::rebuild(const DeformableBody& body) {
     }
   }
   m_cut_edges = static_cast<int>((m_points.size() - vertices) / 2);
-  cap_loops();
+  cap_loops(body);
 }
 
-void CutRenderSurface::cap_loops() {
-  // Directed edges of the split surface; a border edge has no twin.
+int CutRenderSurface::add_point_like(int model, const Eigen::Vector3d& rest_m) {
+  const Point& like = m_points[static_cast<size_t>(model)];
+  m_points.push_back(Point{like.tet, barycentric_weights(m_mesh.rest_corners(like.tet), rest_m), like.cut_tet, like.piece});
+  m_rest_m.push_back(rest_m);
+  m_point_cut.push_back(-1);
+  return static_cast<int>(m_points.size()) - 1;
+}
+
+std::vector<int> CutRenderSurface::line_points(int from, int to) {
+  // Interior points about JOIN_SPACING_M apart on the straight rest segment; each half rides on the
+  // cell of its nearer end (exact under that piece's rigid motion).
+  constexpr double JOIN_SPACING_M = 0.0015;
+  const Eigen::Vector3d a = m_rest_m[static_cast<size_t>(from)];
+  const Eigen::Vector3d b = m_rest_m[static_cast<size_t>(to)];
+  // At least one point: the line must not coincide with an edge the skin may already have.
+  const int segments = std::max(2, static_cast<int>(std::ceil((b - a).norm() / JOIN_SPACING_M)));
+  std::vector<int> points;
+  for (int k = 1; k < segments; ++k) {
+    const double s = static_cast<double>(k) / segments;
+    points.push_back(add_point_like(s < 0.5 ? from : to, a + s * (b - a)));
+  }
+  return points;
+}
+
+void CutRenderSurface::cap_loops(const DeformableBody& body) {
+  // Directed edges of the split surface at its split points; a border edge has no twin. (An edge
+  // between two of the surface's own vertices keeps both its triangles: it is never a border.)
+  const auto vertices = static_cast<int>(m_surface.vertices_m.size());
   std::unordered_map<long long, int> directed;  // (u, v) -> count
   const auto key = [](int u, int v) { return (static_cast<long long>(u) << 32) | static_cast<unsigned int>(v); };
   for (const auto& [a, b, c] : m_triangles) {
-    ++directed[key(a, b)];
-    ++directed[key(b, c)];
-    ++directed[key(c, a)];
-  }
-  std::multimap<int, int> next;  // border edges u -> v
-  for (const auto& [a, b, c] : m_triangles) {
+    if (a < vertices && b < vertices && c < vertices) continue;
     for (const auto& [u, v] : {std::pair{a, b}, std::pair{b, c}, std::pair{c, a}}) {
-      if (!directed.contains(key(v, u))) next.emplace(u, v);
+      if (u >= vertices || v >= vertices) ++directed[key(u, v)];
     }
   }
-  const size_t surface_triangles = m_triangles.size();
+  const auto has_edge = [&](int u, int v) {
+    if (u < vertices && v < vertices) return m_surface_edges.contains(key(std::min(u, v), std::max(u, v)));
+    return directed.contains(key(u, v)) || directed.contains(key(v, u));
+  };
+  std::multimap<int, int> next;  // border edges u -> v
+  for (const auto& [edge, uses] : directed) {
+    const auto u = static_cast<int>(edge >> 32), v = static_cast<int>(edge & 0xffffffffLL);
+    if (!directed.contains(key(v, u))) next.emplace(u, v);
+  }
+  // The border loops, each in the order its cap runs them (against the skin).
+  std::vector<std::vector<int>> loops;
   while (!next.empty()) {
     std::vector<int> loop;
     const int start = next.begin()->first;
     int at = start;
     while (true) {
       const auto it = next.find(at);
-      if (it == next.end()) break;  // an open border (should not happen on a closed surface)
+      if (it == next.end()) break;
       loop.push_back(at);
       at = it->second;
       next.erase(it);
       if (at == start) break;
     }
-    std::reverse(loop.begin(), loop.end());  // the cap runs each border edge the other way
-    ear_clip(loop, m_rest_m, m_triangles);
+    std::reverse(loop.begin(), loop.end());
+    loops.push_back(std::move(loop));
+  }
+  const size_t surface_triangles = m_triangles.size();
+  m_open_loops = 0;
+  // The material parts of the body (cells joined where they share a copy of a vertex, real or
+  // ghost): the two ends of a junction line or of a crack front belong to one part.
+  const int vertex_count = m_mesh.vertex_count();
+  std::vector<int> part(static_cast<size_t>(vertex_count) + static_cast<size_t>(body.dof_count() / 3));
+  std::iota(part.begin(), part.end(), 0);
+  const auto find = [&](int i) {
+    while (part[static_cast<size_t>(i)] != i) i = part[static_cast<size_t>(i)] = part[static_cast<size_t>(part[static_cast<size_t>(i)])];
+    return i;
+  };
+  const auto copy_of = [&](int tet, int cut_tet, int piece, size_t j) {
+    const int vertex = m_mesh.tets[static_cast<size_t>(tet)][j];
+    if (cut_tet < 0) return vertex;
+    const int row = body.xfem().piece(cut_tet, piece).ghost_row[j];
+    return row < 0 ? vertex : vertex_count + row;
+  };
+  for (int t = 0; t < m_mesh.tet_count(); ++t) {
+    const int k = body.cut_tet_index(t);
+    const int pieces = k < 0 ? 1 : static_cast<int>(body.xfem().piece_count(k));
+    for (int p = 0; p < pieces; ++p) {
+      for (size_t j = 1; j < 4; ++j) part[static_cast<size_t>(find(copy_of(t, k, p, j)))] = find(copy_of(t, k, p, 0));
+    }
+  }
+  const auto part_of = [&](int point) {
+    const Point& at = m_points[static_cast<size_t>(point)];
+    return find(copy_of(at.tet, at.cut_tet, at.piece, 0));
+  };
+  // Which side of cut `cut` the material of a point's piece lies on (+1 above, -1 below, 0 unknown:
+  // a point riding on an uncut tet).
+  const auto facing = [&](int point, int cut) {
+    const Point& at = m_points[static_cast<size_t>(point)];
+    if (at.cut_tet < 0) return 0;
+    const CutTetGeometry& geometry = body.cut_geometry(at.cut_tet);
+    for (size_t c = 0; c < geometry.cuts.size(); ++c) {
+      if (geometry.cuts[c].cut_id != cut) continue;
+      return (geometry.pieces[static_cast<size_t>(at.piece)].sides.above & (1u << c)) != 0 ? 1 : -1;
+    }
+    return 0;
+  };
+
+  // Chains: maximal runs of points split by one cut, in loops that are not a single plane's opening.
+  struct Chain {
+    int loop, first, last;  // positions in the loop
+    int cut;
+    int facing;  // the side of the cut the chain's material lies on (majority of its points)
+  };
+  std::vector<Chain> chains;
+  std::map<int, size_t> chain_starting_at;  // first point -> chain
+  std::map<int, size_t> chain_ending_at;    // last point -> chain
+  // Each loop point's cut; where two cuts meet on the surface the points next to the junction may be
+  // split by either, so runs shorter than JUNCTION_RUN points between two other runs take a
+  // neighbour's cut (a slit's tip between two runs of one cut stays).
+  constexpr size_t JUNCTION_RUN = 4;
+  std::vector<std::vector<int>> labels(loops.size());
+  for (size_t l = 0; l < loops.size(); ++l) {
+    std::vector<int>& label = labels[l];
+    for (const int point : loops[l]) label.push_back(m_point_cut[static_cast<size_t>(point)]);
+    const size_t n = label.size();
+    for (bool changed = true; changed;) {
+      changed = false;
+      for (size_t i = 0; i < n && !changed; ++i) {
+        if (label[(i + n - 1) % n] == label[i]) continue;  // not a run's start
+        size_t length = 1;
+        while (length < n && label[(i + length) % n] == label[i]) ++length;
+        if (length >= JUNCTION_RUN || length == n) continue;
+        const int before = label[(i + n - 1) % n], after = label[(i + length) % n];
+        if (label[i] < 0 && before == after) continue;  // a slit's tip
+        if (before < 0 && after < 0) continue;
+        size_t before_length = 1, after_length = 1;
+        while (before_length < n && label[(i + n - 1 - before_length) % n] == before) ++before_length;
+        while (after_length < n && label[(i + length + after_length) % n] == after) ++after_length;
+        const int into = after < 0 || (before >= 0 && before_length >= after_length) ? before : after;
+        for (size_t k = 0; k < length; ++k) label[(i + k) % n] = into;
+        changed = true;
+      }
+    }
+  }
+  for (size_t l = 0; l < loops.size(); ++l) {
+    const std::vector<int>& loop = loops[l];
+    const size_t n = loop.size();
+    const auto cut_at = [&](size_t i) { return labels[l][i % n]; };
+    bool simple = true;
+    for (size_t i = 0; i < n && simple; ++i) simple = cut_at(i) >= 0 && cut_at(i) == cut_at(0);
+    if (simple) {  // the opening of a piece cut free by one plane
+      ear_clip(loop, m_rest_m, m_triangles, has_edge);
+      continue;
+    }
+    for (size_t i = 0; i < n; ++i) {
+      if (cut_at(i) < 0 || cut_at(i + n - 1) == cut_at(i)) continue;
+      size_t j = i;
+      int votes = 0;
+      while (cut_at(j + 1) == cut_at(i) && j + 1 < i + n) {
+        votes += facing(loop[j % n], cut_at(i));
+        ++j;
+      }
+      votes += facing(loop[j % n], cut_at(i));
+      chains.push_back(Chain{static_cast<int>(l), static_cast<int>(i), static_cast<int>(j % n), cut_at(i),
+                             votes > 0 ? 1 : (votes < 0 ? -1 : 0)});
+      chain_starting_at[loop[i]] = chains.size() - 1;
+      chain_ending_at[loop[j % n]] = chains.size() - 1;
+    }
+  }
+  const auto point_after = [&](const Chain& chain, int steps) {
+    const std::vector<int>& loop = loops[static_cast<size_t>(chain.loop)];
+    return loop[(static_cast<size_t>(chain.last) + static_cast<size_t>(steps)) % loop.size()];
+  };
+  const auto label_after = [&](const Chain& chain, int steps) {
+    const std::vector<int>& label = labels[static_cast<size_t>(chain.loop)];
+    return label[(static_cast<size_t>(chain.last) + static_cast<size_t>(steps)) % label.size()];
+  };
+
+  // How each chain's end continues: the points to add and the chain to go on with.
+  struct Link {
+    std::vector<int> bridge;
+    int next_first = -1;  // first point of the next chain; -1: the face cannot be closed
+  };
+  std::map<size_t, Link> link;
+  // Switches (two cuts meet: a junction line through the body between the two switches of one part
+  // and cut pair that run opposite ways) and tips (a partial cut: a crack front between two tips of
+  // one part and cut whose loops turn opposite ways, nearest first).
+  // (part, cut lo, cut hi, facing on lo, facing on hi: the quadrant) -> the chains ending there
+  std::map<std::array<int, 5>, std::vector<size_t>> switches;
+  struct Tip {
+    size_t chain;  // the chain ending at the tip
+    int point, part, cut, before, after;
+  };
+  std::vector<Tip> tips;
+  for (size_t c = 0; c < chains.size(); ++c) {
+    const Chain& chain = chains[c];
+    const int beyond = point_after(chain, 1);
+    const int beyond_cut = label_after(chain, 1);
+    if (beyond_cut >= 0) {
+      const auto after = chain_starting_at.find(beyond);
+      if (after == chain_starting_at.end()) continue;
+      const int after_facing = chains[after->second].facing;
+      const bool up = chain.cut < beyond_cut;
+      switches[{part_of(beyond), std::min(chain.cut, beyond_cut), std::max(chain.cut, beyond_cut),
+                up ? chain.facing : after_facing, up ? after_facing : chain.facing}]
+          .push_back(c);
+    } else if (const auto after = chain_starting_at.find(point_after(chain, 2)); after != chain_starting_at.end()) {
+      tips.push_back(Tip{c, beyond, part_of(beyond), chain.cut, chain.facing, chains[after->second].facing});
+    }
+  }
+  for (const auto& [junction, ends] : switches) {
+    if (ends.size() != 2) continue;
+    size_t forward = ends[0], backward = ends[1];  // forward leaves the lower cut
+    if (chains[forward].cut != junction[1]) std::swap(forward, backward);
+    if (chains[forward].cut != junction[1] || chains[backward].cut != junction[2]) continue;
+    const int b = point_after(chains[forward], 1);  // on the higher cut
+    const int c = loops[static_cast<size_t>(chains[backward].loop)][static_cast<size_t>(chains[backward].last)];
+    const int d = point_after(chains[backward], 1);  // on the lower cut
+    const std::vector<int> line = line_points(b, c);
+    Link& out = link[forward];
+    out.bridge.push_back(b);
+    out.bridge.insert(out.bridge.end(), line.begin(), line.end());
+    out.bridge.push_back(c);
+    out.next_first = d;
+    Link& back = link[backward];
+    back.bridge.assign(line.rbegin(), line.rend());
+    back.next_first = b;
+  }
+  std::vector<bool> tip_paired(tips.size(), false);
+  for (size_t a = 0; a < tips.size(); ++a) {
+    if (tip_paired[a]) continue;
+    size_t best = tips.size();
+    double nearest = std::numeric_limits<double>::infinity();
+    for (size_t b = 0; b < tips.size(); ++b) {
+      if (b == a || tip_paired[b] || tips[b].part != tips[a].part || tips[b].cut != tips[a].cut ||
+          tips[b].before != tips[a].after || tips[b].after != tips[a].before)
+        continue;
+      const double distance =
+          (m_rest_m[static_cast<size_t>(tips[a].point)] - m_rest_m[static_cast<size_t>(tips[b].point)]).norm();
+      if (distance < nearest) {
+        nearest = distance;
+        best = b;
+      }
+    }
+    if (best == tips.size()) continue;
+    tip_paired[a] = tip_paired[best] = true;
+    std::vector<int> front = line_points(tips[a].point, tips[best].point);  // one crack front for both walls
+    for (const auto& [from, to] : {std::pair{a, best}, std::pair{best, a}}) {
+      Link& out = link[tips[from].chain];
+      out.bridge.push_back(tips[from].point);
+      out.bridge.insert(out.bridge.end(), front.begin(), front.end());
+      out.bridge.push_back(tips[to].point);
+      out.next_first = point_after(chains[tips[to].chain], 2);
+      std::reverse(front.begin(), front.end());
+    }
+  }
+  // Faces: walk chain, link, chain, ... back to the first.
+  std::vector<bool> used(chains.size(), false);
+  for (size_t first = 0; first < chains.size(); ++first) {
+    if (used[first]) continue;
+    std::vector<int> face;
+    size_t at = first;
+    bool closed = false;
+    for (size_t guard = 0; guard <= chains.size(); ++guard) {
+      used[at] = true;
+      const Chain& chain = chains[at];
+      const std::vector<int>& loop = loops[static_cast<size_t>(chain.loop)];
+      for (size_t i = static_cast<size_t>(chain.first);; i = (i + 1) % loop.size()) {
+        face.push_back(loop[i]);
+        if (i == static_cast<size_t>(chain.last)) break;
+      }
+      const auto out = link.find(at);
+      if (out == link.end() || out->second.next_first < 0) break;
+      face.insert(face.end(), out->second.bridge.begin(), out->second.bridge.end());
+      const auto following = chain_starting_at.find(out->second.next_first);
+      if (following == chain_starting_at.end()) break;
+      if (following->second == first) {
+        closed = true;
+        break;
+      }
+      at = following->second;
+      if (used[at]) break;
+    }
+    if (closed) {
+      ear_clip(face, m_rest_m, m_triangles, has_edge);
+    } else {
+      ++m_open_loops;
+    }
   }
   m_cap_triangles = static_cast<int>(m_triangles.size() - surface_triangles);
 }

@@ -7,11 +7,22 @@
 // * A render edge is cut when one end lies beyond a plane that bounds the other's piece. It is split
 //   once, where it leaves that piece, into two points, one on each side; the triangles around it are
 //   split the same way (one cut edge: a crack tip, split through the opposite corner; two: the corner
-//   cut off; three: the three corners, where two cuts meet).
-// * Caps: the split surface's border runs in loops; each loop is triangulated by ear clipping in its
-//   own best-fit plane, wound against the loop, so every edge then has two triangles. Exact for a
-//   separated piece cut by one plane; a loop that runs through a crack tip (a partial cut) is capped
-//   across the slit too, and a loop over two planes (a corner of an X) in one projection.
+//   cut off; three: the three corners, where two cuts meet). Points next to a junction may be split
+//   by either cut: runs of fewer than 4 points between two other runs take a neighbour's cut.
+// * Caps: the split surface's border runs in loops (in cap order, against the skin). A loop on one
+//   cut is the opening of a piece cut free: ear-clipped in its best-fit plane. Otherwise a loop is
+//   cut into chains of points split by one cut; a face is made per chain walk on one cut, closed
+//   across to the next chain by a straight line of new points: where two cuts meet (a switch
+//   between two chains), the junction line to the other switch of the same material part, cut pair
+//   and quadrant (the chains' sides of the two cuts), and where a partial cut ends (a crack tip, an
+//   uncut surface vertex between two chains of one cut), the crack front to the tip of the same part
+//   and cut whose loop turns the other way, nearest first. Each face is ear-clipped, never along an
+//   edge the mesh has. The line's points ride on the cell of their nearer end.
+// * Material parts: cells joined where they share a copy of a vertex (real or ghost), the simulation's
+//   own connectivity.
+// Limits: the crack front is the straight line between the tips (right for a stroke through the
+// full depth), and its points follow one side; a flap whose strokes end inside the body leaves a few
+// non-manifold edges at a corner; rebuild re-meshes from scratch (2.4 ms on the X-cut frog).
 #pragma once
 
 #include "core/fem/deformable_body.hpp"
@@ -21,6 +32,7 @@
 
 #include <array>
 #include <string>
+#include <unordered_set>
 #include <vector>
 
 namespace tissue {
@@ -48,6 +60,8 @@ class CutRenderSurface {
   /// Render points: the surface's vertices first, then two per cut edge.
   [[nodiscard]] int point_count() const { return static_cast<int>(m_points.size()); }
   [[nodiscard]] int cut_edge_count() const { return m_cut_edges; }
+  /// Border loops left open by the last rebuild (none that the capping understands).
+  [[nodiscard]] int open_loop_count() const { return m_open_loops; }
 
  private:
   struct Point {
@@ -57,7 +71,11 @@ class CutRenderSurface {
     int piece = -1;    // its piece holding the point
   };
   [[nodiscard]] Point locate(const DeformableBody& body, int tet, const Eigen::Vector3d& rest_m) const;
-  void cap_loops();
+  void cap_loops(const DeformableBody& body);
+  /// A point at `rest_m` riding on the cell of point `model`.
+  int add_point_like(int model, const Eigen::Vector3d& rest_m);
+  /// Points on the straight rest segment between two points (ends excluded).
+  std::vector<int> line_points(int from, int to);
 
   const TetMesh& m_mesh;
   TriangleSurface m_surface;
@@ -67,6 +85,9 @@ class CutRenderSurface {
   std::vector<std::array<int, 3>> m_triangles;
   int m_cap_triangles = 0;
   int m_cut_edges = 0;
+  int m_open_loops = 0;
+  std::unordered_set<long long> m_surface_edges;  // the surface's own edges (lower vertex << 32 | higher)
+  std::vector<int> m_point_cut;  // per point: the cut id of the plane that split it, -1 for others
   std::vector<Eigen::Vector3d> m_positions_m;
   std::vector<Eigen::Vector3d> m_normals;
   Eigen::VectorXd m_real_positions_m;
