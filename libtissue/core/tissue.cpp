@@ -194,6 +194,29 @@ Tissue::Tissue(TetMesh mesh, TissueSettings settings)
   if (m_settings.interaction.cutting_enabled) {
     m_cutter.emplace(m_body.mesh(), m_body.adjacency(), m_surface, m_settings.interaction.cutter);
   }
+  if (m_settings.render_surface) {
+    try {
+      m_render = std::make_unique<CutRenderSurface>(m_body.mesh(), *m_settings.render_surface,
+                                                    default_max_outside_m(m_body.mesh()), "render surface");
+    } catch (const MeshError& error) {
+      throw ParameterError(error.what());
+    }
+  }
+}
+
+const CutRenderSurface* Tissue::render_surface() const {
+  if (!m_render) return nullptr;
+  if (!m_render_meshed || m_render_cut_tets != m_body.cut_tets().size()) {
+    m_render->rebuild(m_body);
+    m_render_cut_tets = m_body.cut_tets().size();
+    m_render_meshed = true;
+    m_render_mapped = false;
+  }
+  if (!m_render_mapped) {
+    m_render->update(m_body, m_state.displacement_m);
+    m_render_mapped = true;
+  }
+  return m_render.get();
 }
 
 const VolumeCutter& Tissue::cutter() const {
@@ -510,6 +533,7 @@ Eigen::Matrix3d Tissue::effective_contact_stiffness(int triangle) {
 }
 
 void Tissue::update_positions() {
+  m_render_mapped = false;
   m_body.positions(m_state.displacement_m, m_vertex_positions_m);
   m_positions_m.head(m_vertex_positions_m.size()) = m_vertex_positions_m;
   m_cut_surface.update_points(m_body, m_state.displacement_m, m_positions_m);

@@ -10,6 +10,7 @@
 #include "core/contact/point_contact.hpp"
 #include "core/contact/point_spring.hpp"
 #include "core/cut/cut_surface.hpp"
+#include "core/render/cut_render_surface.hpp"
 #include "core/cut/volume_cutter.hpp"
 #include "core/fem/deformable_body.hpp"
 #include "core/integrate/integrator.hpp"
@@ -88,6 +89,10 @@ struct TissueSettings {
   SolverSettings solver;          ///< backward Euler's linear solver
   InteractionSettings interaction;
   double step_size_s = 1e-3;
+  /// A finer surface of the same shape to draw (issue 22), riding on the tets and cut with them
+  /// (Tissue::render_surface()); none: the tet skin only. Not part of the model fingerprint: it does
+  /// not change the dynamics.
+  std::shared_ptr<const TriangleSurface> render_surface;
 };
 
 /// Throws ParameterError for an invalid setting (step size, material, damping, gravity, solver,
@@ -197,6 +202,10 @@ class Tissue {
   }
 
   [[nodiscard]] const SurfaceMesh& surface() const { return m_surface; }
+  /// The render surface (TissueSettings::render_surface) at the current state, re-meshed for the
+  /// cuts made since it was last asked for and mapped onto the current positions (both on demand:
+  /// a step does not pay for them); nullptr when the scene has none.
+  [[nodiscard]] const CutRenderSurface* render_surface() const;
   /// Over the surface and the cut faces; empty (no tree) when neither contact nor cutting is on.
   /// Fitted to the current positions (a step leaves the refit to the first query after it).
   [[nodiscard]] const SurfaceBvh& surface_bvh() const { return fitted_bvh(); }
@@ -284,6 +293,12 @@ class Tissue {
   std::uint64_t m_model_fingerprint = 0;
   std::vector<TetCut> m_cut_history;
   std::vector<int> m_cut_batch_ends;
+  // The render surface, brought up to date by render_surface() (re-meshed when the cut tets changed,
+  // mapped when the state changed).
+  mutable std::unique_ptr<CutRenderSurface> m_render;
+  mutable std::size_t m_render_cut_tets = 0;
+  mutable bool m_render_meshed = false;
+  mutable bool m_render_mapped = false;
 };
 
 /// Restores `snapshot` into `tissue`: in place when it can (Tissue::can_restore), else into a fresh

@@ -1,8 +1,12 @@
 // Kernels of one backward-Euler step on the embedded frog and on bar_40x8x8: rotation extraction,
 // force + tangent assembly, the block matrix-vector product, a 10-iteration PCG solve and a
 // CHOLMOD factorization + solve. Counters report DOFs and non-zeros.
+#include "core/collide/surface_bvh.hpp"
+#include "core/cut/volume_cutter.hpp"
 #include "core/fixed_region.hpp"
 #include "core/mesh/mesh_io.hpp"
+#include "core/mesh/topology.hpp"
+#include "core/render/cut_render_surface.hpp"
 #include "core/render/embedded_surface.hpp"
 #include "core/tissue.hpp"
 #include "resources/default_mesh.hpp"
@@ -130,6 +134,49 @@ void BM_RenderSurfaceMap(benchmark::State& state) {
   state.counters["triangles"] = static_cast<double>(render.surface().triangles.size());
 }
 BENCHMARK(BM_RenderSurfaceMap)->Unit(benchmark::kMicrosecond);
+
+// Issue 22: the render surface cut with the tets on the frog after an X of two full-height strokes
+// (made by the volume cutter at rest): arg 0 re-meshes it for the cuts (rebuild), arg 1 maps it
+// onto the state (update, pieces included).
+void BM_CutRenderSurface(benchmark::State& state) {
+  const TetMesh mesh = read_mesh(std::string(TISSUE_MESH_DIR) + "/frog.veg");
+  DeformableBody body(mesh, BodySettings{});
+  DynamicState dynamics;
+  dynamics.displacement_m = Eigen::VectorXd::Zero(body.dof_count());
+  dynamics.velocity_m_per_s = Eigen::VectorXd::Zero(body.dof_count());
+  const SurfaceMesh surface = extract_surface(mesh);
+  const TetAdjacency adjacency = build_adjacency(mesh);
+  Eigen::VectorXd rest(3 * mesh.vertex_count());
+  for (int v = 0; v < mesh.vertex_count(); ++v) rest.segment<3>(3 * v) = mesh.rest_positions_m[static_cast<size_t>(v)];
+  const SurfaceBvh bvh(surface.triangles, rest);
+  VolumeCutter cutter(mesh, adjacency, surface);
+  for (const auto& [from, to] : {std::pair{Eigen::Vector2d(-0.0301, -0.0702), Eigen::Vector2d(0.0399, 0.0698)},
+                                 std::pair{Eigen::Vector2d(-0.0301, 0.0698), Eigen::Vector2d(0.0399, -0.0702)}}) {
+    Blade previous;
+    for (int n = 0; n <= 40; ++n) {
+      const Eigen::Vector2d at = from + (to - from) * n / 40;
+      const Blade blade{Eigen::Vector3d(at.x(), at.y(), -0.03), Eigen::Vector3d(at.x(), at.y(), 0.06)};
+      cutter.step(n == 0 ? blade : previous, blade, rest, bvh);
+      previous = blade;
+      if (!cutter.new_cuts().empty()) body.enrich(cutter.new_cuts(), dynamics);
+    }
+    cutter.end_cut();
+  }
+  CutRenderSurface render(mesh, read_obj(std::string(TISSUE_MESH_DIR) + "/frog_surface.obj"),
+                          default_max_outside_m(mesh));
+  render.rebuild(body);
+  for (auto _ : state) {
+    if (state.range(0) == 0) {
+      render.rebuild(body);
+    } else {
+      render.update(body, dynamics.displacement_m);
+    }
+    benchmark::DoNotOptimize(render.triangles().data());
+  }
+  state.counters["triangles"] = static_cast<double>(render.triangles().size());
+  state.counters["cut_tets"] = body.cut_tet_count();
+}
+BENCHMARK(BM_CutRenderSurface)->Arg(0)->Arg(1)->Unit(benchmark::kMicrosecond);
 
 }  // namespace
 }  // namespace tissue

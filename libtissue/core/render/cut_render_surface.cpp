@@ -84,7 +84,7 @@ void ear_clip(const std::vector<int>& loop, const std::vector<Eigen::Vector3d>& 
     size_t ear = m;
     for (size_t i = 0; i < m && ear == m; ++i) {
       const Eigen::Vector2d a = at(left[(i + m - 1) % m]), b = at(left[i]), c = at(left[(i + 1) % m]);
-      if (cross(a, b, c) <= 0.0) continue;  // reflex or flat
+      if (cross(a, b, c) <= 1e-9 * (b - a).norm() * (c - b).norm()) continue;  // reflex or flat
       if (m > 3 && edge_exists(left[(i + 1) % m], left[(i + m - 1) % m])) continue;  // a diagonal the mesh has
       bool empty = true;
       for (size_t j = 0; j < m && empty; ++j) {
@@ -136,7 +136,71 @@ CutRenderSurface::Point CutRenderSurface::locate(const DeformableBody& body, int
   return point;
 }
 
+void CutRenderSurface::find_material_parts(const DeformableBody& body) {
+  // Union-find over the copies of the vertices (real: the vertex id; ghost: vertex count + its row),
+  // joined within each cell.
+  const int vertex_count = m_mesh.vertex_count();
+  m_copy_root.resize(static_cast<size_t>(vertex_count) + static_cast<size_t>(body.dof_count() / 3));
+  std::iota(m_copy_root.begin(), m_copy_root.end(), 0);
+  const auto find = [&](int i) {
+    while (m_copy_root[static_cast<size_t>(i)] != i) {
+      i = m_copy_root[static_cast<size_t>(i)] = m_copy_root[static_cast<size_t>(m_copy_root[static_cast<size_t>(i)])];
+    }
+    return i;
+  };
+  for (int t = 0; t < m_mesh.tet_count(); ++t) {
+    const int k = body.cut_tet_index(t);
+    const int pieces = k < 0 ? 1 : static_cast<int>(body.xfem().piece_count(k));
+    for (int p = 0; p < pieces; ++p) {
+      const int first = find(copy_of(body, t, k, p, 0));
+      for (size_t j = 1; j < 4; ++j) m_copy_root[static_cast<size_t>(find(copy_of(body, t, k, p, j)))] = first;
+    }
+  }
+  for (size_t i = 0; i < m_copy_root.size(); ++i) m_copy_root[i] = find(static_cast<int>(i));
+}
+
+int CutRenderSurface::copy_of(const DeformableBody& body, int tet, int cut_tet, int piece, size_t j) const {
+  const int vertex = m_mesh.tets[static_cast<size_t>(tet)][j];
+  if (cut_tet < 0) return vertex;
+  const int row = body.xfem().piece(cut_tet, piece).ghost_row[j];
+  return row < 0 ? vertex : m_mesh.vertex_count() + row;
+}
+
+std::pair<double, int> CutRenderSurface::crossing_near(const DeformableBody& body, int tet_a, int tet_b,
+                                                       const Eigen::Vector3d& a_m, const Eigen::Vector3d& b_m) const {
+  std::pair<double, int> best{0.5, -1};
+  double nearest_middle = std::numeric_limits<double>::infinity();
+  for (const int around : {tet_a, tet_b}) {
+    std::array<int, 5> tets{around, -1, -1, -1, -1};
+    for (size_t f = 0; f < 4; ++f) tets[f + 1] = body.adjacency().face_neighbor[static_cast<size_t>(around)][f];
+    for (const int t : tets) {
+      if (t < 0 || body.cut_tet_index(t) < 0) continue;
+      const CutTetGeometry& geometry = body.cut_geometry(body.cut_tet_index(t));
+      for (size_t c = 0; c < geometry.cuts.size(); ++c) {
+        const double da = geometry.planes[c].signed_distance(a_m), db = geometry.planes[c].signed_distance(b_m);
+        if ((da > 0.0) == (db > 0.0)) continue;
+        const double at = da / (da - db);
+        if (std::abs(at - 0.5) < nearest_middle) {
+          nearest_middle = std::abs(at - 0.5);
+          best = {at, geometry.cuts[c].cut_id};
+        }
+      }
+    }
+  }
+  if (best.second < 0) {  // no plane between them: the latest cut of either tet
+    for (const int t : {tet_a, tet_b}) {
+      if (body.cut_tet_index(t) >= 0) best.second = body.cut_geometry(body.cut_tet_index(t)).cuts.back().cut_id;
+    }
+  }
+  return best;
+}
+
+int CutRenderSurface::part_of(const DeformableBody& body, const Point& point) const {
+  return m_copy_root[static_cast<size_t>(copy_of(body, point.tet, point.cut_tet, point.piece, 0))];
+}
+
 void CutRenderSurface::rebuild(const DeformableBody& body) {
+  find_material_parts(body);
   const size_t vertices = m_surface.vertices_m.size();
   m_points.resize(vertices);
   m_rest_m.resize(vertices);
@@ -152,7 +216,10 @@ void CutRenderSurface::rebuild(const DeformableBody& body) {
   std::unordered_map<long long, std::array<int, 2>> splits;
   const auto split = [&](int u, int v) -> const std::array<int, 2>* {
     const int lo = std::min(u, v), hi = std::max(u, v);
-    if (m_points[static_cast<size_t>(lo)].cut_tet < 0 && m_points[static_cast<size_t>(hi)].cut_tet < 0) return nullptr;
+    if (m_points[static_cast<size_t>(lo)].cut_tet < 0 && m_points[static_cast<size_t>(hi)].cut_tet < 0 &&
+        part_of(body, m_points[static_cast<size_t>(lo)]) == part_of(body, m_points[static_cast<size_t>(hi)])) {
+      return nullptr;
+    }
     const long long key = (static_cast<long long>(lo) << 32) | static_cast<unsigned int>(hi);
     if (const auto it = splits.find(key); it != splits.end()) return it->second[0] < 0 ? nullptr : &it->second;
     const Point low = m_points[static_cast<size_t>(lo)];  // copies: m_points grows below
@@ -176,6 +243,13 @@ void CutRenderSurface::rebuild(const DeformableBody& body) {
         s = 1.0 - back;
         cut_id = geometry.cuts[static_cast<size_t>(cut)].cut_id;
       }
+    }
+    if (s < 0.0 && part_of(body, low) != part_of(body, high)) {
+      // Ends in two material parts that neither end's piece tells apart (the edge passes over a cut
+      // tet between theirs): split where it crosses a cut plane of the cut tets around its ends.
+      const auto [at, cut] = crossing_near(body, low.tet, high.tet, x_low, x_high);
+      s = at;
+      cut_id = cut;
     }
     if (s < 0.0) {
       splits.emplace(key, std::array<int, 2>{-1, -1});
@@ -274,9 +348,22 @@ void CutRenderSurface::cap_loops(const DeformableBody& body) {
       if (u >= vertices || v >= vertices) ++directed[key(u, v)];
     }
   }
+  std::unordered_set<long long> cap_edges;  // (lower, higher) of the caps' edges so far
   const auto has_edge = [&](int u, int v) {
-    if (u < vertices && v < vertices) return m_surface_edges.contains(key(std::min(u, v), std::max(u, v)));
+    const long long undirected = key(std::min(u, v), std::max(u, v));
+    if (cap_edges.contains(undirected)) return true;
+    if (u < vertices && v < vertices) return m_surface_edges.contains(undirected);
     return directed.contains(key(u, v)) || directed.contains(key(v, u));
+  };
+  const auto cap = [&](const std::vector<int>& polygon) {
+    const size_t before = m_triangles.size();
+    ear_clip(polygon, m_rest_m, m_triangles, has_edge);
+    for (size_t t = before; t < m_triangles.size(); ++t) {
+      for (size_t k = 0; k < 3; ++k) {
+        const int u = m_triangles[t][k], v = m_triangles[t][(k + 1) % 3];
+        cap_edges.insert(key(std::min(u, v), std::max(u, v)));
+      }
+    }
   };
   std::multimap<int, int> next;  // border edges u -> v
   for (const auto& [edge, uses] : directed) {
@@ -302,32 +389,7 @@ void CutRenderSurface::cap_loops(const DeformableBody& body) {
   }
   const size_t surface_triangles = m_triangles.size();
   m_open_loops = 0;
-  // The material parts of the body (cells joined where they share a copy of a vertex, real or
-  // ghost): the two ends of a junction line or of a crack front belong to one part.
-  const int vertex_count = m_mesh.vertex_count();
-  std::vector<int> part(static_cast<size_t>(vertex_count) + static_cast<size_t>(body.dof_count() / 3));
-  std::iota(part.begin(), part.end(), 0);
-  const auto find = [&](int i) {
-    while (part[static_cast<size_t>(i)] != i) i = part[static_cast<size_t>(i)] = part[static_cast<size_t>(part[static_cast<size_t>(i)])];
-    return i;
-  };
-  const auto copy_of = [&](int tet, int cut_tet, int piece, size_t j) {
-    const int vertex = m_mesh.tets[static_cast<size_t>(tet)][j];
-    if (cut_tet < 0) return vertex;
-    const int row = body.xfem().piece(cut_tet, piece).ghost_row[j];
-    return row < 0 ? vertex : vertex_count + row;
-  };
-  for (int t = 0; t < m_mesh.tet_count(); ++t) {
-    const int k = body.cut_tet_index(t);
-    const int pieces = k < 0 ? 1 : static_cast<int>(body.xfem().piece_count(k));
-    for (int p = 0; p < pieces; ++p) {
-      for (size_t j = 1; j < 4; ++j) part[static_cast<size_t>(find(copy_of(t, k, p, j)))] = find(copy_of(t, k, p, 0));
-    }
-  }
-  const auto part_of = [&](int point) {
-    const Point& at = m_points[static_cast<size_t>(point)];
-    return find(copy_of(at.tet, at.cut_tet, at.piece, 0));
-  };
+  const auto part_of_point = [&](int point) { return part_of(body, m_points[static_cast<size_t>(point)]); };
   // Which side of cut `cut` the material of a point's piece lies on (+1 above, -1 below, 0 unknown:
   // a point riding on an uncut tet).
   const auto facing = [&](int point, int cut) {
@@ -385,7 +447,7 @@ void CutRenderSurface::cap_loops(const DeformableBody& body) {
     bool simple = true;
     for (size_t i = 0; i < n && simple; ++i) simple = cut_at(i) >= 0 && cut_at(i) == cut_at(0);
     if (simple) {  // the opening of a piece cut free by one plane
-      ear_clip(loop, m_rest_m, m_triangles, has_edge);
+      cap(loop);
       continue;
     }
     for (size_t i = 0; i < n; ++i) {
@@ -437,11 +499,11 @@ void CutRenderSurface::cap_loops(const DeformableBody& body) {
       if (after == chain_starting_at.end()) continue;
       const int after_facing = chains[after->second].facing;
       const bool up = chain.cut < beyond_cut;
-      switches[{part_of(beyond), std::min(chain.cut, beyond_cut), std::max(chain.cut, beyond_cut),
+      switches[{part_of_point(beyond), std::min(chain.cut, beyond_cut), std::max(chain.cut, beyond_cut),
                 up ? chain.facing : after_facing, up ? after_facing : chain.facing}]
           .push_back(c);
     } else if (const auto after = chain_starting_at.find(point_after(chain, 2)); after != chain_starting_at.end()) {
-      tips.push_back(Tip{c, beyond, part_of(beyond), chain.cut, chain.facing, chains[after->second].facing});
+      tips.push_back(Tip{c, beyond, part_of_point(beyond), chain.cut, chain.facing, chains[after->second].facing});
     }
   }
   for (const auto& [junction, ends] : switches) {
@@ -518,7 +580,7 @@ void CutRenderSurface::cap_loops(const DeformableBody& body) {
       if (used[at]) break;
     }
     if (closed) {
-      ear_clip(face, m_rest_m, m_triangles, has_edge);
+      cap(face);
     } else {
       ++m_open_loops;
     }

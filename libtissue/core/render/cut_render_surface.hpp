@@ -20,9 +20,11 @@
 //   edge the mesh has. The line's points ride on the cell of their nearer end.
 // * Material parts: cells joined where they share a copy of a vertex (real or ghost), the simulation's
 //   own connectivity.
+// * An edge whose ends lie in two material parts that neither end's piece tells apart (it passes over
+//   a cut tet between theirs) is split where it crosses a cut plane of the cut tets around its ends.
 // Limits: the crack front is the straight line between the tips (right for a stroke through the
-// full depth), and its points follow one side; a flap whose strokes end inside the body leaves a few
-// non-manifold edges at a corner; rebuild re-meshes from scratch (2.4 ms on the X-cut frog).
+// full depth), and its points follow one side; rebuild re-meshes from scratch (2.4 ms on the X-cut
+// frog).
 #pragma once
 
 #include "core/fem/deformable_body.hpp"
@@ -72,6 +74,15 @@ class CutRenderSurface {
   };
   [[nodiscard]] Point locate(const DeformableBody& body, int tet, const Eigen::Vector3d& rest_m) const;
   void cap_loops(const DeformableBody& body);
+  void find_material_parts(const DeformableBody& body);
+  [[nodiscard]] int copy_of(const DeformableBody& body, int tet, int cut_tet, int piece, size_t j) const;
+  /// Where the segment a-b crosses a cut plane of the cut tets at or next to tet_a and tet_b (the
+  /// crossing nearest its middle): the fraction along it and the cut id (0.5 and the latest cut of
+  /// either tet when no plane lies between them; cut id -1 when neither is cut).
+  [[nodiscard]] std::pair<double, int> crossing_near(const DeformableBody& body, int tet_a, int tet_b,
+                                                     const Eigen::Vector3d& a_m, const Eigen::Vector3d& b_m) const;
+  /// The material part of a point's cell (after find_material_parts).
+  [[nodiscard]] int part_of(const DeformableBody& body, const Point& point) const;
   /// A point at `rest_m` riding on the cell of point `model`.
   int add_point_like(int model, const Eigen::Vector3d& rest_m);
   /// Points on the straight rest segment between two points (ends excluded).
@@ -87,7 +98,9 @@ class CutRenderSurface {
   int m_cut_edges = 0;
   int m_open_loops = 0;
   std::unordered_set<long long> m_surface_edges;  // the surface's own edges (lower vertex << 32 | higher)
-  std::vector<int> m_point_cut;  // per point: the cut id of the plane that split it, -1 for others
+  std::vector<int> m_point_cut;
+  std::vector<int> m_copy_root;  // per copy of a vertex (real, then ghost rows): its material part
+  // per point: the cut id of the plane that split it, -1 for others
   std::vector<Eigen::Vector3d> m_positions_m;
   std::vector<Eigen::Vector3d> m_normals;
   Eigen::VectorXd m_real_positions_m;
