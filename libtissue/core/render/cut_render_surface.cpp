@@ -7,7 +7,6 @@
 #include <limits>
 #include <map>
 #include <numeric>
-#include <set>
 #include <unordered_map>
 #include <unordered_set>
 #include <utility>
@@ -411,7 +410,6 @@ void CutRenderSurface::cap_loops(const DeformableBody& body) {
   };
   std::vector<Chain> chains;
   std::map<int, size_t> chain_starting_at;  // first point -> chain
-  std::map<int, size_t> chain_ending_at;    // last point -> chain
   // Each loop point's cut; where two cuts meet on the surface the points next to the junction may be
   // split by either, so runs shorter than JUNCTION_RUN points between two other runs take a
   // neighbour's cut (a slit's tip between two runs of one cut stays).
@@ -462,7 +460,6 @@ void CutRenderSurface::cap_loops(const DeformableBody& body) {
       chains.push_back(Chain{static_cast<int>(l), static_cast<int>(i), static_cast<int>(j % n), cut_at(i),
                              votes > 0 ? 1 : (votes < 0 ? -1 : 0)});
       chain_starting_at[loop[i]] = chains.size() - 1;
-      chain_ending_at[loop[j % n]] = chains.size() - 1;
     }
   }
   const auto point_after = [&](const Chain& chain, int steps) {
