@@ -100,6 +100,163 @@ void ear_clip(const std::vector<int>& loop, const std::vector<Eigen::Vector3d>& 
   triangles.push_back({left[0], left[1], left[2]});
 }
 
+// The border loops of a split surface from its directed edges at split points (a border edge has
+// no twin), each in the order its cap runs them (against the skin).
+std::vector<std::vector<int>> border_loops(const std::unordered_map<long long, int>& directed) {
+  const auto key = [](int u, int v) { return (static_cast<long long>(u) << 32) | static_cast<unsigned int>(v); };
+  std::multimap<int, int> next;  // border edges u -> v
+  for (const auto& [edge, uses] : directed) {
+    const auto u = static_cast<int>(edge >> 32), v = static_cast<int>(edge & 0xffffffffLL);
+    if (!directed.contains(key(v, u))) next.emplace(u, v);
+  }
+  std::vector<std::vector<int>> loops;
+  while (!next.empty()) {
+    std::vector<int> loop;
+    const int start = next.begin()->first;
+    int at = start;
+    while (true) {
+      const auto it = next.find(at);
+      if (it == next.end()) break;
+      loop.push_back(at);
+      at = it->second;
+      next.erase(it);
+      if (at == start) break;
+    }
+    std::reverse(loop.begin(), loop.end());
+    loops.push_back(std::move(loop));
+  }
+  return loops;
+}
+
+// A loop's points' cuts (-1: a surface vertex, a crack tip). Where two cuts meet on the surface the
+// points next to the junction may be split by either, so a run shorter than JUNCTION_RUN points
+// between two other runs takes a neighbour's cut (the longer's); a tip between two runs of one cut
+// (a slit's) stays.
+std::vector<int> junction_smoothed(std::vector<int> label) {
+  constexpr size_t JUNCTION_RUN = 4;
+  const size_t n = label.size();
+  for (bool changed = true; changed;) {
+    changed = false;
+    for (size_t i = 0; i < n && !changed; ++i) {
+      if (label[(i + n - 1) % n] == label[i]) continue;  // not a run's start
+      size_t length = 1;
+      while (length < n && label[(i + length) % n] == label[i]) ++length;
+      if (length >= JUNCTION_RUN || length == n) continue;
+      const int before = label[(i + n - 1) % n], after = label[(i + length) % n];
+      if (label[i] < 0 && before == after) continue;  // a slit's tip
+      if (before < 0 && after < 0) continue;
+      size_t before_length = 1, after_length = 1;
+      while (before_length < n && label[(i + n - 1 - before_length) % n] == before) ++before_length;
+      while (after_length < n && label[(i + length + after_length) % n] == after) ++after_length;
+      const int into = after < 0 || (before >= 0 && before_length >= after_length) ? before : after;
+      for (size_t k = 0; k < length; ++k) label[(i + k) % n] = into;
+      changed = true;
+    }
+  }
+  return label;
+}
+
+// A maximal run of a loop's points split by one cut.
+struct Chain {
+  int loop, first, last;  // positions in the loop
+  int cut;
+  int facing;  // the side of the cut the chain's material lies on (majority of its points)
+};
+
+// How a chain's end continues to the next chain of its face: the points in between.
+struct Link {
+  std::vector<int> bridge;
+  int next_first = -1;  // first point of the next chain; -1: the face cannot be closed
+};
+
+// A crack tip (a surface vertex between two chains of one cut, where a partial cut ends).
+struct Tip {
+  size_t chain;  // the chain ending at the tip
+  int point, part, cut, before, after;  // before, after: the facings of the chains either side
+};
+
+// The junctions' switch pairs (forward, backward): of the chains ending at a switch between two
+// cuts, keyed by (material part, cut lo, cut hi, facing on lo, facing on hi), the two whose switches
+// run opposite ways, forward leaving the lower cut. A key without exactly such a pair gets none.
+std::vector<std::pair<size_t, size_t>> paired_switches(const std::map<std::array<int, 5>, std::vector<size_t>>& switches,
+                                                       const std::vector<Chain>& chains) {
+  std::vector<std::pair<size_t, size_t>> pairs;
+  for (const auto& [junction, ends] : switches) {
+    if (ends.size() != 2) continue;
+    size_t forward = ends[0], backward = ends[1];
+    if (chains[forward].cut != junction[1]) std::swap(forward, backward);
+    if (chains[forward].cut != junction[1] || chains[backward].cut != junction[2]) continue;
+    pairs.emplace_back(forward, backward);
+  }
+  return pairs;
+}
+
+// The crack fronts' tip pairs: each tip with the nearest unpaired tip of the same material part and
+// cut whose loop turns the other way (its facings swapped).
+std::vector<std::pair<size_t, size_t>> paired_tips(const std::vector<Tip>& tips, const std::vector<Eigen::Vector3d>& rest_m) {
+  std::vector<std::pair<size_t, size_t>> pairs;
+  std::vector<bool> paired(tips.size(), false);
+  for (size_t a = 0; a < tips.size(); ++a) {
+    if (paired[a]) continue;
+    size_t best = tips.size();
+    double nearest = std::numeric_limits<double>::infinity();
+    for (size_t b = 0; b < tips.size(); ++b) {
+      if (b == a || paired[b] || tips[b].part != tips[a].part || tips[b].cut != tips[a].cut ||
+          tips[b].before != tips[a].after || tips[b].after != tips[a].before)
+        continue;
+      const double distance = (rest_m[static_cast<size_t>(tips[a].point)] - rest_m[static_cast<size_t>(tips[b].point)]).norm();
+      if (distance < nearest) {
+        nearest = distance;
+        best = b;
+      }
+    }
+    if (best == tips.size()) continue;
+    paired[a] = paired[best] = true;
+    pairs.emplace_back(a, best);
+  }
+  return pairs;
+}
+
+// The faces: chain, link, chain, ... back to the first. Returns how many walks did not close.
+int walk_faces(const std::vector<std::vector<int>>& loops, const std::vector<Chain>& chains,
+               const std::map<size_t, Link>& link, const std::map<int, size_t>& chain_starting_at,
+               std::vector<std::vector<int>>& faces) {
+  int open = 0;
+  std::vector<bool> used(chains.size(), false);
+  for (size_t first = 0; first < chains.size(); ++first) {
+    if (used[first]) continue;
+    std::vector<int> face;
+    size_t at = first;
+    bool closed = false;
+    for (size_t guard = 0; guard <= chains.size(); ++guard) {
+      used[at] = true;
+      const Chain& chain = chains[at];
+      const std::vector<int>& loop = loops[static_cast<size_t>(chain.loop)];
+      for (size_t i = static_cast<size_t>(chain.first);; i = (i + 1) % loop.size()) {
+        face.push_back(loop[i]);
+        if (i == static_cast<size_t>(chain.last)) break;
+      }
+      const auto out = link.find(at);
+      if (out == link.end() || out->second.next_first < 0) break;
+      face.insert(face.end(), out->second.bridge.begin(), out->second.bridge.end());
+      const auto following = chain_starting_at.find(out->second.next_first);
+      if (following == chain_starting_at.end()) break;
+      if (following->second == first) {
+        closed = true;
+        break;
+      }
+      at = following->second;
+      if (used[at]) break;
+    }
+    if (closed) {
+      faces.push_back(std::move(face));
+    } else {
+      ++open;
+    }
+  }
+  return open;
+}
+
 }  // namespace
 
 CutRenderSurface::CutRenderSurface(const TetMesh& mesh, TriangleSurface surface, double max_outside_m,
@@ -364,28 +521,7 @@ void CutRenderSurface::cap_loops(const DeformableBody& body) {
       }
     }
   };
-  std::multimap<int, int> next;  // border edges u -> v
-  for (const auto& [edge, uses] : directed) {
-    const auto u = static_cast<int>(edge >> 32), v = static_cast<int>(edge & 0xffffffffLL);
-    if (!directed.contains(key(v, u))) next.emplace(u, v);
-  }
-  // The border loops, each in the order its cap runs them (against the skin).
-  std::vector<std::vector<int>> loops;
-  while (!next.empty()) {
-    std::vector<int> loop;
-    const int start = next.begin()->first;
-    int at = start;
-    while (true) {
-      const auto it = next.find(at);
-      if (it == next.end()) break;
-      loop.push_back(at);
-      at = it->second;
-      next.erase(it);
-      if (at == start) break;
-    }
-    std::reverse(loop.begin(), loop.end());
-    loops.push_back(std::move(loop));
-  }
+  const std::vector<std::vector<int>> loops = border_loops(directed);
   const size_t surface_triangles = m_triangles.size();
   m_open_loops = 0;
   const auto part_of_point = [&](int point) { return part_of(body, m_points[static_cast<size_t>(point)]); };
@@ -403,40 +539,13 @@ void CutRenderSurface::cap_loops(const DeformableBody& body) {
   };
 
   // Chains: maximal runs of points split by one cut, in loops that are not a single plane's opening.
-  struct Chain {
-    int loop, first, last;  // positions in the loop
-    int cut;
-    int facing;  // the side of the cut the chain's material lies on (majority of its points)
-  };
   std::vector<Chain> chains;
   std::map<int, size_t> chain_starting_at;  // first point -> chain
-  // Each loop point's cut; where two cuts meet on the surface the points next to the junction may be
-  // split by either, so runs shorter than JUNCTION_RUN points between two other runs take a
-  // neighbour's cut (a slit's tip between two runs of one cut stays).
-  constexpr size_t JUNCTION_RUN = 4;
-  std::vector<std::vector<int>> labels(loops.size());
-  for (size_t l = 0; l < loops.size(); ++l) {
-    std::vector<int>& label = labels[l];
-    for (const int point : loops[l]) label.push_back(m_point_cut[static_cast<size_t>(point)]);
-    const size_t n = label.size();
-    for (bool changed = true; changed;) {
-      changed = false;
-      for (size_t i = 0; i < n && !changed; ++i) {
-        if (label[(i + n - 1) % n] == label[i]) continue;  // not a run's start
-        size_t length = 1;
-        while (length < n && label[(i + length) % n] == label[i]) ++length;
-        if (length >= JUNCTION_RUN || length == n) continue;
-        const int before = label[(i + n - 1) % n], after = label[(i + length) % n];
-        if (label[i] < 0 && before == after) continue;  // a slit's tip
-        if (before < 0 && after < 0) continue;
-        size_t before_length = 1, after_length = 1;
-        while (before_length < n && label[(i + n - 1 - before_length) % n] == before) ++before_length;
-        while (after_length < n && label[(i + length + after_length) % n] == after) ++after_length;
-        const int into = after < 0 || (before >= 0 && before_length >= after_length) ? before : after;
-        for (size_t k = 0; k < length; ++k) label[(i + k) % n] = into;
-        changed = true;
-      }
-    }
+  std::vector<std::vector<int>> labels;
+  for (const std::vector<int>& loop : loops) {
+    std::vector<int> cuts;
+    for (const int point : loop) cuts.push_back(m_point_cut[static_cast<size_t>(point)]);
+    labels.push_back(junction_smoothed(std::move(cuts)));
   }
   for (size_t l = 0; l < loops.size(); ++l) {
     const std::vector<int>& loop = loops[l];
@@ -472,20 +581,12 @@ void CutRenderSurface::cap_loops(const DeformableBody& body) {
   };
 
   // How each chain's end continues: the points to add and the chain to go on with.
-  struct Link {
-    std::vector<int> bridge;
-    int next_first = -1;  // first point of the next chain; -1: the face cannot be closed
-  };
   std::map<size_t, Link> link;
   // Switches (two cuts meet: a junction line through the body between the two switches of one part
   // and cut pair that run opposite ways) and tips (a partial cut: a crack front between two tips of
   // one part and cut whose loops turn opposite ways, nearest first).
   // (part, cut lo, cut hi, facing on lo, facing on hi: the quadrant) -> the chains ending there
   std::map<std::array<int, 5>, std::vector<size_t>> switches;
-  struct Tip {
-    size_t chain;  // the chain ending at the tip
-    int point, part, cut, before, after;
-  };
   std::vector<Tip> tips;
   for (size_t c = 0; c < chains.size(); ++c) {
     const Chain& chain = chains[c];
@@ -503,42 +604,21 @@ void CutRenderSurface::cap_loops(const DeformableBody& body) {
       tips.push_back(Tip{c, beyond, part_of_point(beyond), chain.cut, chain.facing, chains[after->second].facing});
     }
   }
-  for (const auto& [junction, ends] : switches) {
-    if (ends.size() != 2) continue;
-    size_t forward = ends[0], backward = ends[1];  // forward leaves the lower cut
-    if (chains[forward].cut != junction[1]) std::swap(forward, backward);
-    if (chains[forward].cut != junction[1] || chains[backward].cut != junction[2]) continue;
-    const int b = point_after(chains[forward], 1);  // on the higher cut
-    const int c = loops[static_cast<size_t>(chains[backward].loop)][static_cast<size_t>(chains[backward].last)];
-    const int d = point_after(chains[backward], 1);  // on the lower cut
-    const std::vector<int> line = line_points(b, c);
+  for (const auto& [forward, backward] : paired_switches(switches, chains)) {
+    // The lower cut's face takes both switch edges and the line; the higher cut's runs it back.
+    const int line_start = point_after(chains[forward], 1);  // on the higher cut
+    const int line_end = loops[static_cast<size_t>(chains[backward].loop)][static_cast<size_t>(chains[backward].last)];
+    const std::vector<int> line = line_points(line_start, line_end);
     Link& out = link[forward];
-    out.bridge.push_back(b);
+    out.bridge.push_back(line_start);
     out.bridge.insert(out.bridge.end(), line.begin(), line.end());
-    out.bridge.push_back(c);
-    out.next_first = d;
+    out.bridge.push_back(line_end);
+    out.next_first = point_after(chains[backward], 1);  // back on the lower cut
     Link& back = link[backward];
     back.bridge.assign(line.rbegin(), line.rend());
-    back.next_first = b;
+    back.next_first = line_start;
   }
-  std::vector<bool> tip_paired(tips.size(), false);
-  for (size_t a = 0; a < tips.size(); ++a) {
-    if (tip_paired[a]) continue;
-    size_t best = tips.size();
-    double nearest = std::numeric_limits<double>::infinity();
-    for (size_t b = 0; b < tips.size(); ++b) {
-      if (b == a || tip_paired[b] || tips[b].part != tips[a].part || tips[b].cut != tips[a].cut ||
-          tips[b].before != tips[a].after || tips[b].after != tips[a].before)
-        continue;
-      const double distance =
-          (m_rest_m[static_cast<size_t>(tips[a].point)] - m_rest_m[static_cast<size_t>(tips[b].point)]).norm();
-      if (distance < nearest) {
-        nearest = distance;
-        best = b;
-      }
-    }
-    if (best == tips.size()) continue;
-    tip_paired[a] = tip_paired[best] = true;
+  for (const auto& [a, best] : paired_tips(tips, m_rest_m)) {
     std::vector<int> front = line_points(tips[a].point, tips[best].point);  // one crack front for both walls
     for (const auto& [from, to] : {std::pair{a, best}, std::pair{best, a}}) {
       Link& out = link[tips[from].chain];
@@ -549,39 +629,9 @@ void CutRenderSurface::cap_loops(const DeformableBody& body) {
       std::reverse(front.begin(), front.end());
     }
   }
-  // Faces: walk chain, link, chain, ... back to the first.
-  std::vector<bool> used(chains.size(), false);
-  for (size_t first = 0; first < chains.size(); ++first) {
-    if (used[first]) continue;
-    std::vector<int> face;
-    size_t at = first;
-    bool closed = false;
-    for (size_t guard = 0; guard <= chains.size(); ++guard) {
-      used[at] = true;
-      const Chain& chain = chains[at];
-      const std::vector<int>& loop = loops[static_cast<size_t>(chain.loop)];
-      for (size_t i = static_cast<size_t>(chain.first);; i = (i + 1) % loop.size()) {
-        face.push_back(loop[i]);
-        if (i == static_cast<size_t>(chain.last)) break;
-      }
-      const auto out = link.find(at);
-      if (out == link.end() || out->second.next_first < 0) break;
-      face.insert(face.end(), out->second.bridge.begin(), out->second.bridge.end());
-      const auto following = chain_starting_at.find(out->second.next_first);
-      if (following == chain_starting_at.end()) break;
-      if (following->second == first) {
-        closed = true;
-        break;
-      }
-      at = following->second;
-      if (used[at]) break;
-    }
-    if (closed) {
-      cap(face);
-    } else {
-      ++m_open_loops;
-    }
-  }
+  std::vector<std::vector<int>> faces;
+  m_open_loops += walk_faces(loops, chains, link, chain_starting_at, faces);
+  for (const std::vector<int>& face : faces) cap(face);
   m_cap_triangles = static_cast<int>(m_triangles.size() - surface_triangles);
 }
 
