@@ -1,10 +1,14 @@
 // Mesh readers: Vega .veg, TetGen .node/.ele and Gmsh .msh 4.1 (ASCII), plus Vega .bou
-// fixed-vertex lists. Every reader checks what it reads (see validate_tets) and throws
-// MeshError naming file, line and element; inverted tets are re-oriented with a warning.
+// fixed-vertex lists and Wavefront .obj render surfaces. Every reader checks what it reads (see
+// validate_tets) and throws MeshError naming file, line and element; inverted tets are re-oriented
+// with a warning.
 #pragma once
 
 #include "core/mesh/tet_mesh.hpp"
 
+#include <Eigen/Core>
+
+#include <array>
 #include <filesystem>
 #include <string>
 #include <string_view>
@@ -30,6 +34,21 @@ TetMesh read_tetgen(const std::filesystem::path& path, MeshWarnings* warnings = 
 /// Gmsh .msh 4.1 ASCII: $Nodes and $Elements (type 4 = 4-node tet); other element types are ignored.
 TetMesh read_gmsh(const std::filesystem::path& path, MeshWarnings* warnings = nullptr);
 TetMesh parse_gmsh(std::string_view text, const std::string& source_name, MeshWarnings* warnings = nullptr);
+
+/// A closed triangle mesh [m], triangles wound outward (right-hand rule): a render surface (issue 22).
+struct TriangleSurface {
+  std::vector<Eigen::Vector3d> vertices_m;
+  std::vector<std::array<int, 3>> triangles;
+};
+
+/// Wavefront OBJ: `v x y z` and `f a b c ...` (1-based, negative indices relative to the vertices
+/// read so far, `a/t/n` forms take the vertex); a face of more than 3 corners is fanned; other
+/// records and '#' comments are skipped. Throws MeshError naming the file, line and element for: a
+/// coordinate that is not a finite number, an index out of range, a face with fewer than 3 or
+/// repeated corners, an edge shared by more than two triangles (not manifold) or by one (not
+/// closed), an edge two triangles run the same way (not consistently oriented), or no triangle.
+TriangleSurface read_obj(const std::filesystem::path& path);
+TriangleSurface parse_obj(std::string_view text, const std::string& source_name);
 
 /// Dispatches on the extension: .veg, .node/.ele, .msh.
 TetMesh read_mesh(const std::filesystem::path& path, MeshWarnings* warnings = nullptr);

@@ -1,108 +1,23 @@
 #include "core/render/embedded_surface.hpp"
 
+#include "core/collide/geometry.hpp"
+
 #include <Eigen/Dense>
 
 #include <algorithm>
-#include <charconv>
 #include <cmath>
-#include <fstream>
 #include <limits>
-#include <map>
 #include <sstream>
 #include <stdexcept>
 #include <utility>
 
 namespace tissue {
 
-namespace {
-
-std::string_view trimmed(std::string_view s) {
-  while (!s.empty() && (s.front() == ' ' || s.front() == '\t')) s.remove_prefix(1);
-  while (!s.empty() && (s.back() == ' ' || s.back() == '\t' || s.back() == '\r')) s.remove_suffix(1);
-  return s;
-}
-
-std::vector<std::string_view> fields(std::string_view line) {
-  std::vector<std::string_view> out;
-  size_t at = 0;
-  while (at < line.size()) {
-    while (at < line.size() && (line[at] == ' ' || line[at] == '\t')) ++at;
-    const size_t start = at;
-    while (at < line.size() && line[at] != ' ' && line[at] != '\t') ++at;
-    if (at > start) out.push_back(line.substr(start, at - start));
-  }
-  return out;
-}
-
-// An edge of the surface, smaller vertex first.
-using Edge = std::pair<int, int>;
-
-// The surface of a solid: every edge run by exactly two triangles, once each way.
-void check_manifold(const TriangleSurface& surface, const std::string& source_name,
-                    const std::vector<int>& triangle_lines) {
-  std::map<Edge, std::pair<int, int>> runs;  // edge -> (triangles running it a->b, b->a) as counts
-  for (size_t t = 0; t < surface.triangles.size(); ++t) {
-    const auto& tri = surface.triangles[t];
-    for (size_t k = 0; k < 3; ++k) {
-      const int a = tri[k], b = tri[(k + 1) % 3];
-      auto& [forward, backward] = runs[{std::min(a, b), std::max(a, b)}];
-      (a < b ? forward : backward) += 1;
-      const int line = triangle_lines.empty() ? 0 : triangle_lines[t];
-      if (forward + backward > 2) {
-        throw MeshError(source_name + ":" + std::to_string(line) + ": triangle " + std::to_string(t + 1) + ": edge " +
-                            std::to_string(a + 1) + "-" + std::to_string(b + 1) +
-                            " is shared by more than two triangles (not manifold)",
-                        source_name, line, static_cast<int>(t + 1));
-      }
-      if (forward > 1 || backward > 1) {
-        throw MeshError(source_name + ":" + std::to_string(line) + ": triangle " + std::to_string(t + 1) + ": edge " +
-                            std::to_string(a + 1) + "-" + std::to_string(b + 1) +
-                            " is run the same way by two triangles (not consistently oriented)",
-                        source_name, line, static_cast<int>(t + 1));
-      }
-    }
-  }
-  for (const auto& [edge, counts] : runs) {
-    if (counts.first + counts.second == 2) continue;
-    throw MeshError(source_name + ": edge " + std::to_string(edge.first + 1) + "-" + std::to_string(edge.second + 1) +
-                        " borders a single triangle (the surface is not closed)",
-                    source_name, 0, 0);
-  }
-}
-
-}  // namespace
-
 Eigen::Vector4d barycentric_weights(const std::array<Eigen::Vector3d, 4>& x, const Eigen::Vector3d& p) {
-  Eigen::Matrix3d edges;
-  edges << x[1] - x[0], x[2] - x[0], x[3] - x[0];
-  const Eigen::Vector3d w = edges.partialPivLu().solve(p - x[0]);
-  return {1.0 - w.sum(), w.x(), w.y(), w.z()};
+  return *tet_barycentric(p, x[0], x[1], x[2], x[3]);  // mesh tets are never degenerate (validate_tets)
 }
 
 namespace {
-
-// Distance from p to the triangle abc (Ericson, Real-Time Collision Detection, 5.1.5).
-double point_triangle_distance(const Eigen::Vector3d& p, const Eigen::Vector3d& a, const Eigen::Vector3d& b,
-                               const Eigen::Vector3d& c) {
-  const Eigen::Vector3d ab = b - a, ac = c - a, ap = p - a;
-  const double d1 = ab.dot(ap), d2 = ac.dot(ap);
-  if (d1 <= 0.0 && d2 <= 0.0) return ap.norm();
-  const Eigen::Vector3d bp = p - b;
-  const double d3 = ab.dot(bp), d4 = ac.dot(bp);
-  if (d3 >= 0.0 && d4 <= d3) return bp.norm();
-  const double vc = d1 * d4 - d3 * d2;
-  if (vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0) return (p - (a + d1 / (d1 - d3) * ab)).norm();
-  const Eigen::Vector3d cp = p - c;
-  const double d5 = ab.dot(cp), d6 = ac.dot(cp);
-  if (d6 >= 0.0 && d5 <= d6) return cp.norm();
-  const double vb = d5 * d2 - d1 * d6;
-  if (vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0) return (p - (a + d2 / (d2 - d6) * ac)).norm();
-  const double va = d3 * d6 - d5 * d4;
-  if (va <= 0.0 && (d4 - d3) >= 0.0 && (d5 - d6) >= 0.0)
-    return (p - (b + (d4 - d3) / ((d4 - d3) + (d5 - d6)) * (c - b))).norm();
-  const double denominator = 1.0 / (va + vb + vc);
-  return (p - (a + ab * (vb * denominator) + ac * (vc * denominator))).norm();
-}
 
 // Distance from p to the tet (0 inside), given p's barycentric weights in it.
 double point_tet_distance(const std::array<Eigen::Vector3d, 4>& x, const Eigen::Vector4d& weights,
@@ -116,7 +31,8 @@ double point_tet_distance(const std::array<Eigen::Vector3d, 4>& x, const Eigen::
     for (int k = 0; k < 4; ++k) {
       if (k != skip) face[static_cast<size_t>(n++)] = x[static_cast<size_t>(k)];
     }
-    nearest = std::min(nearest, point_triangle_distance(p, face[0], face[1], face[2]));
+    const Eigen::Vector3d closest = closest_point_on_triangle(p, face[0], face[1], face[2]);
+    nearest = std::min(nearest, (p - (closest.x() * face[0] + closest.y() * face[1] + closest.z() * face[2])).norm());
   }
   return nearest;
 }
@@ -186,72 +102,6 @@ double mean_edge_m(const TetMesh& mesh) {
 }
 
 }  // namespace
-
-TriangleSurface parse_obj(std::string_view text, const std::string& source_name) {
-  TriangleSurface surface;
-  std::vector<int> triangle_lines;
-  const auto fail = [&](int line, const std::string& what) {
-    throw MeshError(source_name + ":" + std::to_string(line) + ": " + what, source_name, line, 0);
-  };
-  int line_number = 0;
-  size_t at = 0;
-  while (at <= text.size()) {
-    const size_t end = std::min(text.find('\n', at), text.size());
-    const std::string_view line = trimmed(text.substr(at, end - at));
-    at = end + 1;
-    ++line_number;
-    if (line.empty() || line.front() == '#') continue;
-    const auto parts = fields(line);
-    if (parts[0] == "v") {
-      if (parts.size() < 4) fail(line_number, "vertex " + std::to_string(surface.vertices_m.size() + 1) + ": fewer than 3 coordinates");
-      Eigen::Vector3d p;
-      for (int a = 0; a < 3; ++a) {
-        const std::string_view field = parts[static_cast<size_t>(a + 1)];
-        const auto [ptr, error] = std::from_chars(field.data(), field.data() + field.size(), p(a));
-        if (error != std::errc() || ptr != field.data() + field.size() || !std::isfinite(p(a))) {
-          fail(line_number, "vertex " + std::to_string(surface.vertices_m.size() + 1) + ": coordinate '" +
-                                std::string(field) + "' is not a finite number");
-        }
-      }
-      surface.vertices_m.push_back(p);
-    } else if (parts[0] == "f") {
-      const int face = static_cast<int>(triangle_lines.size()) + 1;
-      if (parts.size() < 4) fail(line_number, "face with fewer than 3 corners");
-      std::vector<int> corners;
-      for (size_t k = 1; k < parts.size(); ++k) {
-        const std::string_view field = parts[k].substr(0, parts[k].find('/'));
-        long index = 0;
-        const auto [ptr, error] = std::from_chars(field.data(), field.data() + field.size(), index);
-        const long count = static_cast<long>(surface.vertices_m.size());
-        const long resolved = index < 0 ? count + index : index - 1;
-        if (error != std::errc() || ptr != field.data() + field.size() || index == 0 || resolved < 0 ||
-            resolved >= count) {
-          fail(line_number, "face corner '" + std::string(parts[k]) + "' is not a vertex (" + std::to_string(count) +
-                                " read so far)");
-        }
-        corners.push_back(static_cast<int>(resolved));
-      }
-      for (size_t a = 0; a < corners.size(); ++a)
-        for (size_t b = a + 1; b < corners.size(); ++b)
-          if (corners[a] == corners[b]) fail(line_number, "face " + std::to_string(face) + " repeats vertex " + std::to_string(corners[a] + 1));
-      for (size_t k = 1; k + 1 < corners.size(); ++k) {
-        surface.triangles.push_back({corners[0], corners[k], corners[k + 1]});
-        triangle_lines.push_back(line_number);
-      }
-    }
-  }
-  if (surface.triangles.empty()) throw MeshError(source_name + ": no triangle (no 'f' record)", source_name, 0, 0);
-  check_manifold(surface, source_name, triangle_lines);
-  return surface;
-}
-
-TriangleSurface read_obj(const std::filesystem::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw MeshError("cannot open " + path.string(), path.string(), 0, 0);
-  std::ostringstream text;
-  text << in.rdbuf();
-  return parse_obj(text.str(), path.string());
-}
 
 double default_max_outside_m(const TetMesh& mesh) { return 0.25 * mean_edge_m(mesh); }
 

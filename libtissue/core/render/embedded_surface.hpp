@@ -8,32 +8,16 @@
 // (The cut render surface is the next part of issue 22; this part knows nothing of cuts.)
 #pragma once
 
+#include "core/mesh/mesh_io.hpp"
 #include "core/mesh/tet_mesh.hpp"
 
 #include <Eigen/Core>
 
 #include <array>
-#include <filesystem>
 #include <string>
-#include <string_view>
 #include <vector>
 
 namespace tissue {
-
-/// A triangle mesh [m]; triangles wound outward (right-hand rule).
-struct TriangleSurface {
-  std::vector<Eigen::Vector3d> vertices_m;
-  std::vector<std::array<int, 3>> triangles;
-};
-
-/// Wavefront OBJ: `v x y z` and `f a b c ...` (1-based, negative indices relative to the vertices
-/// read so far, `a/t/n` forms take the vertex); a face of more than 3 corners is fanned; other
-/// records are skipped. Throws MeshError naming the file, line and element for: a coordinate that is
-/// not a finite number, an index out of range, a face with fewer than 3 or repeated corners, an edge
-/// shared by more than two triangles (not manifold) or by one (not closed), an edge two triangles
-/// run the same way (not consistently oriented), or no triangle at all.
-TriangleSurface read_obj(const std::filesystem::path& path);
-TriangleSurface parse_obj(std::string_view text, const std::string& source_name);
 
 /// Where a render vertex rides: a tet and its barycentric weights (sum 1; some negative for a vertex
 /// outside the tet).
@@ -42,7 +26,8 @@ struct SurfaceEmbedding {
   Eigen::Vector4d weights = Eigen::Vector4d::Zero();
 };
 
-/// The barycentric weights of `p` in the tet `x` (affine: they reproduce p exactly, negative outside).
+/// The barycentric weights of `p` in the mesh tet `x` (affine: they reproduce p exactly, negative
+/// outside): collide/geometry's tet_barycentric for a tet the mesh readers let through (never degenerate).
 Eigen::Vector4d barycentric_weights(const std::array<Eigen::Vector3d, 4>& x, const Eigen::Vector3d& p);
 
 /// How far outside the tet mesh a render vertex may lie, by default: a quarter of the mesh's mean
