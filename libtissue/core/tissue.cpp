@@ -206,10 +206,9 @@ Tissue::Tissue(TetMesh mesh, TissueSettings settings)
 
 const CutRenderSurface* Tissue::render_surface() const {
   if (!m_render) return nullptr;
-  if (!m_render_meshed || m_render_cut_tets != m_body.cut_tets().size()) {
+  if (m_render_cut_tets != m_body.cut_tets().size()) {
     m_render->rebuild(m_body);
     m_render_cut_tets = m_body.cut_tets().size();
-    m_render_meshed = true;
     m_render_mapped = false;
   }
   if (!m_render_mapped) {

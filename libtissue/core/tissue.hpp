@@ -296,8 +296,7 @@ class Tissue {
   // The render surface, brought up to date by render_surface() (re-meshed when the cut tets changed,
   // mapped when the state changed).
   mutable std::unique_ptr<CutRenderSurface> m_render;
-  mutable std::size_t m_render_cut_tets = 0;
-  mutable bool m_render_meshed = false;
+  mutable std::optional<std::size_t> m_render_cut_tets;  // the cut tets it was meshed for (none: not yet)
   mutable bool m_render_mapped = false;
 };
 
