@@ -64,6 +64,14 @@ struct CutFrog {
       cutter.end_cut();
     }
   }
+  /// The frog's render surface (meshes/frog_surface.obj).
+  static TriangleSurface render_surface() { return read_obj(std::string(TISSUE_MESH_DIR) + "/frog_surface.obj"); }
+  /// The render surface cut with this frog's cuts, at rest.
+  [[nodiscard]] CutRenderSurface cut_render_surface() const {
+    CutRenderSurface render(mesh, render_surface(), default_max_outside_m(mesh), "frog_surface.obj");
+    render.rebuild(body);
+    return render;
+  }
   /// Gravity -z; the vertices behind `held_below_x_m` held.
   static BodySettings settings(const TetMesh& mesh, double held_below_x_m) {
     BodySettings settings;
@@ -224,12 +232,10 @@ TEST(CutRenderSurface, ACompleteCutLeavesTwoClosedPiecesOfTheSimulatedVolumes) {
   // Across the body, a little behind the front legs, through the whole frog.
   CutFrog frog({{Eigen::Vector2d(0.0051, -0.07), Eigen::Vector2d(0.0051, 0.07)}});
   ASSERT_GT(frog.body.cut_tet_count(), 50);
-  CutRenderSurface render(frog.mesh, read_obj(std::string(TISSUE_MESH_DIR) + "/frog_surface.obj"),
-                          default_max_outside_m(frog.mesh), "frog_surface.obj");
-  render.rebuild(frog.body);
+  CutRenderSurface render = frog.cut_render_surface();
   EXPECT_EQ(material_part_volumes_m3(frog.mesh, frog.body).size(), 2U);
   EXPECT_EQ(render.open_loop_count(), 0);
-  const TriangleSurface uncut = read_obj(std::string(TISSUE_MESH_DIR) + "/frog_surface.obj");
+  const TriangleSurface uncut = CutFrog::render_surface();
   for (const RenderPart& part : expect_closed_parts(render, frog)) {
     const double ideal_m3 = prism_volume_m3(
         uncut, {stroke_plane(Eigen::Vector2d(0.0051, -0.07), Eigen::Vector2d(0.0051, 0.07), part.centroid_m)});
@@ -244,9 +250,7 @@ TEST(CutRenderSurface, APartialCutIsASlitWithAWallOnEachSide) {
   // surface closed, the slit's two walls meeting along the crack front.
   CutFrog frog({{Eigen::Vector2d(0.0051, -0.07), Eigen::Vector2d(0.0051, 0.0)}});
   ASSERT_GT(frog.body.cut_tet_count(), 20);
-  CutRenderSurface render(frog.mesh, read_obj(std::string(TISSUE_MESH_DIR) + "/frog_surface.obj"),
-                          default_max_outside_m(frog.mesh), "frog_surface.obj");
-  render.rebuild(frog.body);
+  CutRenderSurface render = frog.cut_render_surface();
   EXPECT_EQ(material_part_volumes_m3(frog.mesh, frog.body).size(), 1U);
   EXPECT_EQ(render.open_loop_count(), 0);
   EXPECT_GT(render.cap_triangle_count(), 0);
@@ -257,12 +261,10 @@ TEST(CutRenderSurface, AnXLeavesFourClosedPiecesOfTheSimulatedVolumes) {
   // Two strokes crossing on the back, each through the whole frog.
   CutFrog frog({{Eigen::Vector2d(-0.0301, -0.0702), Eigen::Vector2d(0.0399, 0.0698)},
                 {Eigen::Vector2d(-0.0301, 0.0698), Eigen::Vector2d(0.0399, -0.0702)}});
-  CutRenderSurface render(frog.mesh, read_obj(std::string(TISSUE_MESH_DIR) + "/frog_surface.obj"),
-                          default_max_outside_m(frog.mesh), "frog_surface.obj");
-  render.rebuild(frog.body);
+  CutRenderSurface render = frog.cut_render_surface();
   EXPECT_EQ(material_part_volumes_m3(frog.mesh, frog.body).size(), 4U);
   EXPECT_EQ(render.open_loop_count(), 0);
-  const TriangleSurface uncut = read_obj(std::string(TISSUE_MESH_DIR) + "/frog_surface.obj");
+  const TriangleSurface uncut = CutFrog::render_surface();
   for (const RenderPart& part : expect_closed_parts(render, frog)) {
     const double ideal_m3 = prism_volume_m3(
         uncut, {stroke_plane(Eigen::Vector2d(-0.0301, -0.0702), Eigen::Vector2d(0.0399, 0.0698), part.centroid_m),
@@ -284,16 +286,14 @@ TEST(CutRenderSurface, AFlapCutFreeByThreeStrokesIsClosed) {
     strokes.push_back({corner[k] - 0.02 * along, corner[(k + 1) % 3] + 0.02 * along});
   }
   CutFrog frog(strokes);
-  CutRenderSurface render(frog.mesh, read_obj(std::string(TISSUE_MESH_DIR) + "/frog_surface.obj"),
-                          default_max_outside_m(frog.mesh), "frog_surface.obj");
-  render.rebuild(frog.body);
+  CutRenderSurface render = frog.cut_render_surface();
   EXPECT_EQ(render.open_loop_count(), 0);
   // The flap: the part whose centroid lies inside the triangle.
   const Eigen::Vector2d centre = (corner[0] + corner[1] + corner[2]) / 3.0;
   std::vector<CutPlane> inside;
   for (size_t k = 0; k < 3; ++k)
     inside.push_back(stroke_plane(corner[k], corner[(k + 1) % 3], Eigen::Vector3d(centre.x(), centre.y(), 0.0)));
-  const TriangleSurface uncut = read_obj(std::string(TISSUE_MESH_DIR) + "/frog_surface.obj");
+  const TriangleSurface uncut = CutFrog::render_surface();
   const double ideal_m3 = prism_volume_m3(uncut, inside);
   int flaps = 0;
   for (const RenderPart& part : expect_closed_parts(render, frog)) {
@@ -310,9 +310,7 @@ TEST(CutRenderSurface, APieceThatFallsAwayStretchesNoTriangleAcrossTheOpening) {
   // The head end cut off across the body and falling; the hind part held (behind x = -0.02 m).
   const double cut_x = 0.0051;
   CutFrog frog({{Eigen::Vector2d(cut_x, -0.07), Eigen::Vector2d(cut_x, 0.07)}}, -0.02);
-  CutRenderSurface render(frog.mesh, read_obj(std::string(TISSUE_MESH_DIR) + "/frog_surface.obj"),
-                          default_max_outside_m(frog.mesh), "frog_surface.obj");
-  render.rebuild(frog.body);
+  CutRenderSurface render = frog.cut_render_surface();
   render.update(frog.body, frog.state.displacement_m);
   const std::span<const std::array<int, 3>> all(render.triangles());
   const auto skin = all.first(all.size() - static_cast<size_t>(render.cap_triangle_count()));
