@@ -13,8 +13,10 @@ function(tissue_embed_text output input namespace function)
        "#include <string_view>\n"
        "namespace ${namespace} {\n"
        "std::string_view ${function}() {\n"
-       "  static constexpr std::string_view TEXT = R\"tissue_embed(${content})tissue_embed\";\n"
-       "  return TEXT;\n"
+       "  // An array, not a constexpr string_view: its length is sizeof, not a constexpr loop over a\n"
+       "  // text that may exceed the compiler's loop limit (the frog's render surface is 1.1 MB).\n"
+       "  static constexpr char TEXT[] = R\"tissue_embed(${content})tissue_embed\";\n"
+       "  return {TEXT, sizeof(TEXT) - 1};\n"
        "}\n"
        "}  // namespace ${namespace}\n")
   file(COPY_FILE "${output}.tmp" "${output}" ONLY_IF_DIFFERENT)

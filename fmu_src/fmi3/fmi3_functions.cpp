@@ -200,13 +200,16 @@ TISSUE_GET_SET(Boolean, fmi3Boolean)
 TISSUE_GET_SET(String, fmi3String)
 #undef TISSUE_GET_SET
 
-fmi3Status fmi3GetBinary(fmi3Instance instance, const fmi3ValueReference[], size_t, size_t[], fmi3Binary[], size_t) {
-  return not_offered(instance, "fmi3GetBinary", "no Binary variable");
+fmi3Status fmi3GetBinary(fmi3Instance instance, const fmi3ValueReference vr[], size_t nvr, size_t valueSizes[],
+                         fmi3Binary values[], size_t nValues) {
+  return run(instance, Call::get_value, "fmi3GetBinary", [&](Instance& self) {
+    self.get_binary(input_span(vr, nvr), output_span(valueSizes, nValues), output_span(values, nValues));
+  });
 }
 
 fmi3Status fmi3SetBinary(fmi3Instance instance, const fmi3ValueReference[], size_t, const size_t[], const fmi3Binary[],
                          size_t) {
-  return not_offered(instance, "fmi3SetBinary", "no Binary variable");
+  return not_offered(instance, "fmi3SetBinary", "no Binary input or parameter");
 }
 
 fmi3Status fmi3GetClock(fmi3Instance instance, const fmi3ValueReference[], size_t, fmi3Clock[]) {

@@ -215,6 +215,24 @@ void Instance::set(std::span<const ValueReference> vrs, std::span<const T> value
   if (parameter_set) m_model->parameters_changed();
 }
 
+void Instance::get_binary(std::span<const ValueReference> vrs, std::span<std::size_t> sizes,
+                          std::span<const std::uint8_t*> values) {
+  if (sizes.size() != vrs.size() || values.size() != vrs.size()) {
+    throw VariableError("the Binary variables have " + std::to_string(vrs.size()) + " values, " +
+                        std::to_string(values.size()) + " were passed");
+  }
+  for (std::size_t k = 0; k < vrs.size(); ++k) {
+    const VariableInfo& info = variable(vrs[k], false);
+    if (info.type != VariableType::binary) {
+      throw VariableError(std::string(info.name) + " (value reference " + std::to_string(vrs[k]) + ") is of type " +
+                          std::string(to_string(info.type)) + ", not Binary");
+    }
+    const std::span<const std::uint8_t> bytes = m_model->get_binary(info);
+    sizes[k] = bytes.size();
+    values[k] = bytes.data();
+  }
+}
+
 #define TISSUE_INSTANCE_TYPES(T)                                                 \
   template void Instance::get<T>(std::span<const ValueReference>, std::span<T>); \
   template void Instance::set<T>(std::span<const ValueReference>, std::span<const T>);

@@ -58,6 +58,9 @@ class Instance {
   void get(std::span<const ValueReference> vrs, std::span<T> values);
   template <class T>
   void set(std::span<const ValueReference> vrs, std::span<const T> values);
+  /// Binary outputs: per variable its size and a pointer to the model's bytes.
+  void get_binary(std::span<const ValueReference> vrs, std::span<std::size_t> sizes,
+                  std::span<const std::uint8_t*> values);
 
   [[nodiscard]] std::unique_ptr<InstanceState> save() const;
   void restore(const InstanceState& saved);

@@ -33,5 +33,9 @@ void Model::get_uint32(const VariableInfo& info, std::span<std::uint32_t>) { no_
 void Model::get_uint64(const VariableInfo& info, std::span<std::uint64_t>) { no_value(info, "UInt64"); }
 void Model::get_int64(const VariableInfo& info, std::span<std::int64_t>) { no_value(info, "Int64"); }
 void Model::get_boolean(const VariableInfo& info, std::span<bool>) { no_value(info, "Boolean"); }
+std::span<const std::uint8_t> Model::get_binary(const VariableInfo& info) {
+  no_value(info, "Binary");
+  return {};
+}
 
 }  // namespace tissue::fmi3

@@ -76,6 +76,9 @@ class Model {
   virtual void get_uint64(const VariableInfo& info, std::span<std::uint64_t> values);
   virtual void get_int64(const VariableInfo& info, std::span<std::int64_t> values);
   virtual void get_boolean(const VariableInfo& info, std::span<bool> values);
+  /// A Binary output's bytes, owned by the model and valid until the model's next call (each Binary
+  /// variable its own buffer: one fmi3GetBinary may ask for several).
+  virtual std::span<const std::uint8_t> get_binary(const VariableInfo& info);
 
   /// The model's state (not the stored values, which the layer saves); throws if there is none.
   [[nodiscard]] virtual std::unique_ptr<ModelState> save() const = 0;

@@ -146,6 +146,11 @@ std::string model_description_xml(const ModelDescription& description) {
     throw SchemaError(std::string(description.model_identifier) +
                       ": the variables are not in strictly increasing value-reference order");
   }
+  for (const VariableInfo& info : description.variables) {
+    if (info.type == VariableType::binary && (info.causality != Causality::output || info.rank != 0)) {
+      throw SchemaError(std::string(info.name) + ": a Binary variable must be a scalar output");
+    }
+  }
   std::ostringstream out;
   out.precision(17);
   out << "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n";

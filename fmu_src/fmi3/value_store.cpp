@@ -26,6 +26,7 @@ Storage storage_of(VariableType type) {
     case VariableType::int64:
     case VariableType::enumeration:
     case VariableType::boolean:
+    case VariableType::binary:  // never stored (an output): value_store never gets here for one
       return Storage::integer;
   }
   return Storage::integer;

@@ -38,6 +38,8 @@ std::string_view to_string(VariableType type) {
       return "String";
     case VariableType::enumeration:
       return "Enumeration";
+    case VariableType::binary:
+      return "Binary";
   }
   return "";
 }

@@ -18,7 +18,8 @@ namespace tissue::fmi3 {
 using ValueReference = std::uint32_t;
 
 /// The element type in the XML. An enumeration is got and set as Int64 in FMI 3.
-enum class VariableType { float64, int32, uint32, int64, uint64, boolean, string, enumeration };
+/// A Binary is an output only, scalar, got as bytes the model owns (Model::get_binary).
+enum class VariableType { float64, int32, uint32, int64, uint64, boolean, string, enumeration, binary };
 enum class Causality { independent, structural_parameter, parameter, input, output };
 enum class Variability { fixed, tunable, discrete, continuous };
 

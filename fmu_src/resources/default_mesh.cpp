@@ -14,4 +14,11 @@ TetMesh load_mesh(std::string_view name_or_path, MeshWarnings* warnings) {
   return read_mesh(std::filesystem::path(std::string(name_or_path)), warnings);
 }
 
+TriangleSurface load_render_surface(std::string_view name_or_path) {
+  if (name_or_path == DEFAULT_MESH_NAME) {
+    return parse_obj(resources::frog_surface_obj_text(), "embedded:frog_surface.obj");
+  }
+  return read_obj(std::filesystem::path(std::string(name_or_path)));
+}
+
 }  // namespace tissue

@@ -137,28 +137,108 @@ void TissueModel::build() {
   if (name == DEFAULT_MESH_NAME) {
     mesh = load_default_mesh();
   } else {
-    std::filesystem::path path(name);
-    if (path.is_relative()) {
-      if (m_context.resource_path.empty()) {
-        throw VariableError("mesh '" + name + "' is relative, but no resource path was given");
-      }
-      path = std::filesystem::path(m_context.resource_path) / path;
-    }
     try {
-      mesh = load_mesh(path.string());
+      mesh = load_mesh(resolve_path(name, "mesh"));
     } catch (const std::exception& error) {
       throw VariableError("mesh '" + name + "' cannot be loaded: " + error.what());
     }
   }
   TissueSettings settings = tissue_settings(m_values, &mesh);
+  if (const std::string& render = m_values.string(vr(Vr::render_surface)); render != NO_RENDER_SURFACE) {
+    try {
+      TriangleSurface surface =
+          load_render_surface(render == DEFAULT_MESH_NAME ? render : resolve_path(render, "surface.renderSurface"));
+      surface.source_name = "surface.renderSurface " + surface.source_name;  // the embedding's messages name both
+      settings.render_surface = std::make_shared<const TriangleSurface>(std::move(surface));
+    } catch (const std::exception& error) {
+      throw VariableError("surface.renderSurface '" + render + "' cannot be loaded: " + error.what());
+    }
+  }
   m_tissue = std::make_unique<Tissue>(std::move(mesh), std::move(settings));
   m_tissue->set_tool(tool_pose(m_values));
   m_dirty = false;
   m_surface_revision = 0;
   m_integrator_iterations = 0;
   m_surface_triangles = m_tissue->drawn_triangle_count();
+  m_surface_cut_tets = 0;
+  m_drawn_current = false;
   m_capacity_warned = false;
   update_near_surface();
+}
+
+std::string TissueModel::resolve_path(const std::string& name, const char* what) const {
+  std::filesystem::path path(name);
+  if (path.is_relative()) {
+    if (m_context.resource_path.empty()) {
+      throw VariableError(std::string(what) + " '" + name + "' is relative, but no resource path was given");
+    }
+    path = std::filesystem::path(m_context.resource_path) / path;
+  }
+  return path.string();
+}
+
+const ports::SurfaceMesh& TissueModel::drawn_mesh() {
+  ensure_built();
+  if (m_drawn_current) return m_drawn;
+  const Tissue& tissue = *m_tissue;
+  m_drawn.positions_m.clear();
+  m_drawn.triangles.clear();
+  if (const CutRenderSurface* render = tissue.render_surface()) {
+    for (const Eigen::Vector3d& x : render->positions_m()) m_drawn.positions_m.insert(m_drawn.positions_m.end(), x.data(), x.data() + 3);
+    for (const auto& triangle : render->triangles()) {
+      for (const int v : triangle) m_drawn.triangles.push_back(static_cast<std::uint32_t>(v));
+    }
+    m_drawn.cut_triangle_count = static_cast<std::uint64_t>(render->cap_triangle_count());
+  } else {
+    const Eigen::VectorXd& x = tissue.current_positions_m();
+    m_drawn.positions_m.assign(x.data(), x.data() + x.size());
+    tissue.for_each_drawn_triangle([&](const std::array<int, 3>& triangle) {
+      for (const int v : triangle) m_drawn.triangles.push_back(static_cast<std::uint32_t>(v));
+    });
+    m_drawn.cut_triangle_count = tissue.cut_surface().drawn_triangles().size();
+  }
+  m_drawn_current = true;
+  return m_drawn;
+}
+
+void TissueModel::drawn_embedding(ports::SurfaceEmbedding& embedding) {
+  const ports::SurfaceMesh& drawn = drawn_mesh();
+  embedding.revision = m_surface_revision;
+  embedding.triangles = drawn.triangles;
+  embedding.cut_triangle_count = drawn.cut_triangle_count;
+  const std::size_t points = drawn.positions_m.size() / 3;
+  embedding.point_nodes.resize(4 * points);
+  embedding.point_weights.resize(4 * points);
+  if (const CutRenderSurface* render = m_tissue->render_surface()) {
+    embedding.node_count = static_cast<std::uint64_t>(render->node_count());
+    for (std::size_t i = 0; i < points; ++i) {
+      const Eigen::Vector4d w = render->point_weights(static_cast<int>(i));
+      for (std::size_t k = 0; k < 4; ++k) {
+        embedding.point_nodes[4 * i + k] = static_cast<std::uint32_t>(render->point_nodes()[i][k]);
+        embedding.point_weights[4 * i + k] = w(static_cast<Eigen::Index>(k));
+      }
+    }
+    return;
+  }
+  // The tet skin: each point is its own node.
+  embedding.node_count = points;
+  for (std::size_t i = 0; i < points; ++i) {
+    for (std::size_t k = 0; k < 4; ++k) {
+      embedding.point_nodes[4 * i + k] = static_cast<std::uint32_t>(i);
+      embedding.point_weights[4 * i + k] = k == 0 ? 1.0 : 0.0;
+    }
+  }
+}
+
+void TissueModel::drawn_nodes(ports::SurfaceNodes& nodes) {
+  const ports::SurfaceMesh& drawn = drawn_mesh();
+  nodes.revision = m_surface_revision;
+  if (const CutRenderSurface* render = m_tissue->render_surface()) {
+    nodes.positions_m.clear();
+    for (const Eigen::Vector3d& x : render->node_positions_m()) nodes.positions_m.insert(nodes.positions_m.end(), x.data(), x.data() + 3);
+    return;
+  }
+  nodes.positions_m = drawn.positions_m;
 }
 
 void TissueModel::ensure_built() {
@@ -166,22 +246,27 @@ void TissueModel::ensure_built() {
 }
 
 void TissueModel::update_surface_counters() {
+  m_drawn_current = false;
   const std::size_t triangles = m_tissue->drawn_triangle_count();
-  if (triangles != m_surface_triangles) {
+  const std::size_t cut_tets = m_tissue->body().cut_tets().size();
+  if (triangles != m_surface_triangles || cut_tets != m_surface_cut_tets) {
     ++m_surface_revision;
     m_surface_triangles = triangles;
+    m_surface_cut_tets = cut_tets;
   }
   if (!m_values.boolean(vr(Vr::mesh_output_enabled)) || m_capacity_warned) return;
-  const auto vertices = static_cast<std::uint64_t>(m_tissue->current_positions_m().size() / 3);
+  const ports::SurfaceMesh& drawn = drawn_mesh();
+  const std::uint64_t vertices = drawn.positions_m.size() / 3;
   const std::uint64_t vertex_capacity = m_values.uint64(vr(Vr::vertex_capacity));
   const std::uint64_t triangle_capacity = m_values.uint64(vr(Vr::triangle_capacity));
-  if (vertices > vertex_capacity || triangles > triangle_capacity) {
+  if (vertices > vertex_capacity || drawn.triangles.size() / 3 > triangle_capacity) {
     m_capacity_warned = true;
     m_context.log(fmi3::LogLevel::warning,
-                  "the surface (" + std::to_string(vertices) + " vertices, " + std::to_string(triangles) +
+                  "the surface (" + std::to_string(vertices) + " vertices, " + std::to_string(drawn.triangles.size() / 3) +
                       " triangles) outgrew surface.vertexCapacity / surface.triangleCapacity (" +
                       std::to_string(vertex_capacity) + ", " + std::to_string(triangle_capacity) +
-                      "): the arrays hold the first ones only; instantiate with larger capacities");
+                      "): the arrays hold the first ones only; surface.mesh holds the whole surface (or instantiate "
+                      "with larger capacities)");
   }
 }
 
@@ -294,9 +379,8 @@ void TissueModel::get_float64(const VariableInfo& info, std::span<double> out) {
     case Vr::vertex_positions: {
       std::fill(out.begin(), out.end(), 0.0);
       if (!m_values.boolean(vr(Vr::mesh_output_enabled))) return;
-      const Eigen::VectorXd& x = tissue.current_positions_m();
-      const std::size_t count = std::min<std::size_t>(static_cast<std::size_t>(x.size()), out.size());
-      std::copy(x.data(), x.data() + count, out.begin());
+      const std::vector<double>& x = drawn_mesh().positions_m;
+      std::copy_n(x.begin(), std::min(x.size(), out.size()), out.begin());
       return;
     }
     default:
@@ -309,19 +393,18 @@ void TissueModel::get_uint32(const VariableInfo& info, std::span<std::uint32_t> 
   ensure_built();
   std::fill(out.begin(), out.end(), 0U);
   if (!m_values.boolean(vr(Vr::mesh_output_enabled))) return;
-  std::size_t at = 0;
-  m_tissue->for_each_drawn_triangle([&](const std::array<int, 3>& triangle) {
-    if (at + 3 > out.size()) return;
-    for (const int v : triangle) out[at++] = static_cast<std::uint32_t>(v);
-  });
+  // Whole rows only.
+  const std::vector<std::uint32_t>& triangles = drawn_mesh().triangles;
+  std::copy_n(triangles.begin(), std::min(triangles.size(), out.size() / 3 * 3), out.begin());
 }
 
 void TissueModel::get_uint64(const VariableInfo& info, std::span<std::uint64_t> out) {
   ensure_built();
   const Tissue& tissue = *m_tissue;
-  const auto vertices = static_cast<std::uint64_t>(tissue.current_positions_m().size() / 3);
-  const auto triangles = static_cast<std::uint64_t>(m_tissue->drawn_triangle_count());
   const bool mesh_out = m_values.boolean(vr(Vr::mesh_output_enabled));
+  const ports::SurfaceMesh* drawn = mesh_out ? &drawn_mesh() : nullptr;
+  const std::uint64_t vertices = mesh_out ? drawn->positions_m.size() / 3 : 0;
+  const std::uint64_t triangles = mesh_out ? drawn->triangles.size() / 3 : 0;
   switch (static_cast<Vr>(info.vr)) {
     case Vr::vertex_count:
       out[0] = mesh_out ? std::min(vertices, m_values.uint64(vr(Vr::vertex_capacity))) : 0;
@@ -333,7 +416,7 @@ void TissueModel::get_uint64(const VariableInfo& info, std::span<std::uint64_t> 
       out[0] = m_surface_revision;
       return;
     case Vr::cut_triangle_count:
-      out[0] = mesh_out ? std::min<std::uint64_t>(tissue.cut_surface().drawn_triangles().size(), triangles) : 0;
+      out[0] = mesh_out ? std::min(drawn->cut_triangle_count, triangles) : 0;
       return;
     case Vr::cut_tets:
       out[0] = static_cast<std::uint64_t>(tissue.body().cut_tet_count());
@@ -359,6 +442,38 @@ void TissueModel::get_boolean(const VariableInfo& info, std::span<bool> out) {
   out[0] = which == Vr::contact_active ? m_tissue->contact().active : m_near.has_value();
 }
 
+std::span<const std::uint8_t> TissueModel::get_binary(const VariableInfo& info) {
+  ensure_built();
+  const bool mesh_out = m_values.boolean(vr(Vr::mesh_output_enabled));
+  switch (static_cast<Vr>(info.vr)) {
+    case Vr::surface_mesh: {
+      static const ports::SurfaceMesh NONE;
+      ports::encode(mesh_out ? drawn_mesh() : NONE, m_mesh_bytes);
+      return m_mesh_bytes;
+    }
+    case Vr::surface_embedding:
+      if (mesh_out) {
+        drawn_embedding(m_embedding);
+      } else {
+        m_embedding = ports::SurfaceEmbedding{};
+        m_embedding.revision = m_surface_revision;
+      }
+      ports::encode(m_embedding, m_embedding_bytes);
+      return m_embedding_bytes;
+    case Vr::surface_nodes:
+      if (mesh_out) {
+        drawn_nodes(m_nodes);
+      } else {
+        m_nodes = ports::SurfaceNodes{};
+        m_nodes.revision = m_surface_revision;
+      }
+      ports::encode(m_nodes, m_nodes_bytes);
+      return m_nodes_bytes;
+    default:
+      return Model::get_binary(info);
+  }
+}
+
 // --- FMU states ---
 
 std::unique_ptr<fmi3::ModelState> TissueModel::save() const {
@@ -382,6 +497,8 @@ void TissueModel::restore(const fmi3::ModelState& model_state) {
   m_surface_revision = state->surface_revision;
   m_integrator_iterations = state->integrator_iterations;
   m_surface_triangles = m_tissue->drawn_triangle_count();
+  m_surface_cut_tets = m_tissue->body().cut_tets().size();
+  m_drawn_current = false;
   update_near_surface();
 }
 

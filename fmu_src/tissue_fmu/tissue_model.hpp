@@ -7,6 +7,7 @@
 #include "core/contact/surface_near.hpp"
 #include "core/tissue.hpp"
 #include "fmi3/model.hpp"
+#include "ports/surface_binary.hpp"
 #include "tissue_fmu/variables.hpp"
 
 #include <cstdint>
@@ -38,6 +39,7 @@ class TissueModel final : public fmi3::Model {
   void get_uint32(const fmi3::VariableInfo& info, std::span<std::uint32_t> values) override;
   void get_uint64(const fmi3::VariableInfo& info, std::span<std::uint64_t> values) override;
   void get_boolean(const fmi3::VariableInfo& info, std::span<bool> values) override;
+  std::span<const std::uint8_t> get_binary(const fmi3::VariableInfo& info) override;
 
   [[nodiscard]] std::unique_ptr<fmi3::ModelState> save() const override;
   void restore(const fmi3::ModelState& state) override;
@@ -51,6 +53,13 @@ class TissueModel final : public fmi3::Model {
   void build();
   void ensure_built();
   void update_surface_counters();
+  /// A mesh or render-surface file named by a parameter: absolute, or in the resources folder.
+  [[nodiscard]] std::string resolve_path(const std::string& name, const char* what) const;
+  /// The drawn surface (the render surface when surface.renderSurface names one, else the tet skin),
+  /// brought up to date on the first read after a build, a step or a restore.
+  const ports::SurfaceMesh& drawn_mesh();
+  void drawn_embedding(ports::SurfaceEmbedding& embedding);
+  void drawn_nodes(ports::SurfaceNodes& nodes);
   /// contact.near and the surface it reports, after a build, a step or a restore.
   void update_near_surface();
 
@@ -62,6 +71,12 @@ class TissueModel final : public fmi3::Model {
   std::uint64_t m_surface_revision = 0;
   std::uint64_t m_integrator_iterations = 0;  ///< integrator.iterations
   std::uint64_t m_surface_triangles = 0;  // at the last revision check
+  std::size_t m_surface_cut_tets = 0;     // at the last revision check
+  ports::SurfaceMesh m_drawn;
+  bool m_drawn_current = false;
+  ports::SurfaceEmbedding m_embedding;     // scratch of get_binary
+  ports::SurfaceNodes m_nodes;             // scratch of get_binary
+  std::vector<std::uint8_t> m_mesh_bytes, m_embedding_bytes, m_nodes_bytes;
   bool m_capacity_warned = false;
   std::optional<NearSurface> m_near;                  ///< contact.near's surface, if near
   std::vector<SurfaceBvh::SphereHit> m_near_hits;     // scratch of update_near_surface()

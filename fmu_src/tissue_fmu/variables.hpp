@@ -68,6 +68,9 @@ enum class Vr : std::uint32_t {
   vertex_positions = 53,
   triangles = 54,
   cut_triangle_count = 55,
+  surface_mesh = 56,       // issue 22: the Binary surface outputs
+  surface_embedding = 57,
+  surface_nodes = 58,
   cut_tets = 60,
   enriched_vertices = 61,
   dofs = 62,
@@ -84,6 +87,7 @@ enum class Vr : std::uint32_t {
   ida_linear_solver = 75,
   tool_max_speed = 76,
   contact_near_margin = 77,  // issue 20
+  render_surface = 78,       // issue 22
   tool_applied_position = ports::sample_field("tool.appliedPosition").tissue_vr
 };
 
@@ -226,11 +230,13 @@ constexpr auto structural_parameters() {
     structural_parameter(Vr::vertex_capacity, "surface.vertexCapacity", uint64)
         .start("8192")
         .min("1")
-        .describe("Rows of surface.vertexPositions: the most surface vertices that can be output"),
+        .describe("Rows of surface.vertexPositions: the most surface vertices the arrays hold (surface.mesh "
+                  "always holds all of them)"),
     structural_parameter(Vr::triangle_capacity, "surface.triangleCapacity", uint64)
         .start("8192")
         .min("1")
-        .describe("Rows of surface.triangles: the most surface triangles that can be output"),
+        .describe("Rows of surface.triangles: the most surface triangles the arrays hold (surface.mesh always "
+                  "holds all of them)"),
 });
 }
 
@@ -274,12 +280,14 @@ constexpr auto outputs() {
     output(Vr::triangle_count, "surface.triangleCount", uint64, discrete)
         .describe("Rows of surface.triangles in use (at most surface.triangleCapacity)"),
     output(Vr::surface_revision, "surface.revision", uint64, discrete)
-        .describe("Changes when the surface topology changes (a cut); re-read surface.triangles then"),
+        .describe("Changes when the surface topology changes (a cut); re-read surface.triangles and "
+                  "surface.embedding then"),
     output(Vr::vertex_positions, "surface.vertexPositions", float64, continuous)
         .unit("m")
         .shape(sized_by(Vr::vertex_capacity), fixed_size(3))
-        .describe("Deformed surface vertex positions (x y z per row): the mesh vertices in mesh order, then the "
-                  "corners of the cut faces; rows from surface.vertexCount on are 0"),
+        .describe("Deformed surface vertex positions (x y z per row): for the tet skin the mesh vertices in mesh "
+                  "order, then the corners of the cut faces; for a render surface its vertices, then the points "
+                  "its cuts added; rows from surface.vertexCount on are 0"),
     output(Vr::triangles, "surface.triangles", uint32, discrete)
         .shape(sized_by(Vr::triangle_capacity), fixed_size(3))
         .describe("Surface triangles as 0-based rows of surface.vertexPositions, counter-clockwise seen from "
@@ -287,6 +295,16 @@ constexpr auto outputs() {
                   "the cut), then the faces the cuts opened; rows from surface.triangleCount on are 0"),
     output(Vr::cut_triangle_count, "surface.cutTriangleCount", uint64, discrete)
         .describe("How many of the surface.triangleCount rows, at the end, are faces the cuts opened"),
+    output(Vr::surface_mesh, "surface.mesh", binary, discrete)
+        .describe("The whole drawn surface, never truncated (docs/FMU_VARIABLES.md, \"Binary surface outputs\"): "
+                  "\"TSM1\", version, vertex, triangle and cut-face counts, then Float64 positions [m] and UInt32 "
+                  "triangles, little-endian"),
+    output(Vr::surface_embedding, "surface.embedding", binary, discrete)
+        .describe("The drawn surface's points as weighted sums of four nodes each, and its triangles (\"TSE1\"); "
+                  "changes with surface.revision"),
+    output(Vr::surface_nodes, "surface.nodes", binary, discrete)
+        .describe("The nodes' positions for surface.embedding (\"TSN1\"): a viewer maps the points itself, reading "
+                  "the coarse nodes every step and the embedding once per revision"),
     output(Vr::cut_tets, "cutTets", uint64, discrete).describe("Number of tetrahedra cut so far"),
     output(Vr::enriched_vertices, "enrichedVertices", uint64, discrete)
         .describe("Number of enriched (XFEM) vertex unknowns the cuts added"),
@@ -348,12 +366,26 @@ constexpr auto integrator_parameters() {
 });
 }
 
+/// What is drawn (issue 22; 78).
+constexpr auto surface_parameters() {
+  using namespace fmi3;  // NOLINT(google-build-using-namespace): the table reads as the XML
+  using enum VariableType;
+  return std::to_array<VariableInfo>({
+    parameter(Vr::render_surface, "surface.renderSurface", string)
+        .start("none")
+        .describe("The surface the surface.* outputs draw: \"none\" for the tet mesh's own skin, \"frog\" for the "
+                  "embedded frog's fine render surface (meshes/frog_surface.obj), otherwise an OBJ file in the FMU's "
+                  "resources folder or an absolute path; it rides on the tets and is cut with them"),
+});
+}
+
 /// The Tissue FMU's own variables: the independent time and the parts above.
 constexpr auto own_variables() {
   using fmi3::merged;
   const auto independent = std::to_array<fmi3::VariableInfo>({fmi3::independent_time(Vr::time)});
   const auto parameters =
-      merged(merged(merged(body_parameters(), solver_parameters()), scene_parameters()), integrator_parameters());
+      merged(merged(merged(merged(body_parameters(), solver_parameters()), scene_parameters()), integrator_parameters()),
+             surface_parameters());
   return merged(merged(merged(merged(independent, parameters), structural_parameters()), inputs()), outputs());
 }
 }  // namespace variables_detail

@@ -224,6 +224,12 @@ TISSUE_HOST_THIN_ACCESS(boolean, Boolean, fmi3Boolean)
 TISSUE_HOST_THIN_ACCESS(string, String, fmi3String)
 #undef TISSUE_HOST_THIN_ACCESS
 
+fmi3Status Fmu3Instance::get_binary(std::span<const fmi3ValueReference> vrs, std::span<std::size_t> sizes,
+                                    std::span<fmi3Binary> values) {
+  return m_fmu->functions().fmi3GetBinary(m_instance, vrs.data(), vrs.size(), sizes.data(), values.data(),
+                                          values.size());
+}
+
 fmi3Status Fmu3Instance::get_uint64(std::span<const fmi3ValueReference> vrs, std::span<fmi3UInt64> values) {
   return m_fmu->functions().fmi3GetUInt64(m_instance, vrs.data(), vrs.size(), values.data(), values.size());
 }

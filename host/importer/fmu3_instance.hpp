@@ -99,6 +99,9 @@ class Fmu3Instance {
   fmi3Status get_uint64(std::span<const fmi3ValueReference> vrs, std::span<fmi3UInt64> values);
   /// Not std::vector<bool> (not contiguous); use e.g. std::unique_ptr<bool[]> or std::array.
   fmi3Status get_boolean(std::span<const fmi3ValueReference> vrs, std::span<fmi3Boolean> values);
+  /// Binary values: their sizes and pointers to bytes the FMU owns, valid until its next call.
+  fmi3Status get_binary(std::span<const fmi3ValueReference> vrs, std::span<std::size_t> sizes,
+                        std::span<fmi3Binary> values);
   /// The strings belong to the FMU and stay valid only until its next call.
   fmi3Status get_string(std::span<const fmi3ValueReference> vrs, std::span<fmi3String> values);
 

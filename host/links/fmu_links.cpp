@@ -92,22 +92,15 @@ TissueLink::TissueLink(const Fmu3& fmu, const std::vector<ParameterSetting>& par
       m_tool_position(vr(m_instance, "tool.position")),
       m_tool_orientation(vr(m_instance, "tool.orientation")),
       m_tool_mode(vr(m_instance, "tool.mode")),
-      m_vertex_count(vr(m_instance, "surface.vertexCount")),
-      m_triangle_count(vr(m_instance, "surface.triangleCount")),
-      m_positions(vr(m_instance, "surface.vertexPositions")),
-      m_triangles(vr(m_instance, "surface.triangles")),
+      m_revision(vr(m_instance, "surface.revision")),
+      m_embedding_vr(vr(m_instance, "surface.embedding")),
+      m_nodes_vr(vr(m_instance, "surface.nodes")),
       m_cut_tets(vr(m_instance, "cutTets")),
-      m_enriched(vr(m_instance, "enrichedVertices")),
-      m_cut_triangles(vr(m_instance, "surface.cutTriangleCount")) {
+      m_enriched(vr(m_instance, "enrichedVertices")) {
   apply_parameters(m_instance, parameters, "tissue.parameters");
   expect_ok(m_instance.enter_initialization_mode(std::nullopt, 0.0, std::nullopt), m_instance,
             "Tissue: enter initialization mode");
   expect_ok(m_instance.exit_initialization_mode(), m_instance, "Tissue: exit initialization mode");
-  std::vector<std::uint64_t> capacity;
-  expect_ok(m_instance.get_uint64("surface.vertexCapacity", capacity), m_instance, "Tissue: vertex capacity");
-  m_vertex_capacity = static_cast<std::size_t>(capacity.at(0));
-  expect_ok(m_instance.get_uint64("surface.triangleCapacity", capacity), m_instance, "Tissue: triangle capacity");
-  m_triangle_capacity = static_cast<std::size_t>(capacity.at(0));
   std::vector<double> blade;
   expect_ok(m_instance.get_float64("tool.bladeLength", blade), m_instance, "Tissue: blade length");
   m_blade_length_m = blade.at(0);
@@ -148,22 +141,39 @@ void TissueLink::read_counters(TissueSample& sample) {
 }
 
 void TissueLink::reserve(SurfaceFrame& frame) const {
-  frame.positions_m.reserve(3 * m_vertex_capacity);
-  frame.triangles.reserve(3 * m_triangle_capacity);
+  if (!m_embedding) return;
+  frame.positions_m.reserve(2 * 3 * m_embedding->point_count());
+  frame.triangles.reserve(2 * m_embedding->triangles.size());
+  frame.node_positions_m.reserve(2 * 3 * m_embedding->node_count);
 }
 
 void TissueLink::read_surface(SurfaceFrame& frame) {
-  std::array<fmi3UInt64, 3> counts{};
-  const std::array<fmi3ValueReference, 3> count_vrs{m_vertex_count, m_triangle_count, m_cut_triangles};
-  (void)m_instance.get_uint64(count_vrs, counts);
-  frame.positions_m.resize(3 * m_vertex_capacity);
-  frame.triangles.resize(3 * m_triangle_capacity);
-  (void)m_instance.get_float64(std::span<const fmi3ValueReference>(&m_positions, 1), frame.positions_m);
-  (void)m_instance.get_uint32(std::span<const fmi3ValueReference>(&m_triangles, 1), frame.triangles);
-  frame.positions_m.resize(3 * static_cast<std::size_t>(counts[0]));
-  frame.triangles.resize(3 * static_cast<std::size_t>(counts[1]));
+  const auto binary = [&](fmi3ValueReference which, const char* what) {
+    std::size_t size = 0;
+    fmi3Binary bytes = nullptr;
+    const fmi3Status status = m_instance.get_binary(std::span(&which, 1), std::span(&size, 1), std::span(&bytes, 1));
+    if (status != fmi3OK) expect_ok(status, m_instance, std::string("Tissue: ") + what);  // the message only if needed
+    if (bytes == nullptr && size > 0) throw FmuError(std::string("Tissue: ") + what + " is a null pointer");
+    return std::span<const std::uint8_t>(bytes, size);
+  };
+  try {
+    fmi3UInt64 revision = 0;
+    (void)m_instance.get_uint64(std::span(&m_revision, 1), std::span(&revision, 1));
+    if (!m_embedding || m_embedding->revision != revision) {
+      auto embedding = std::make_shared<ports::SurfaceEmbedding>();
+      ports::decode(binary(m_embedding_vr, "surface.embedding"), *embedding);
+      m_embedding = std::move(embedding);
+    }
+    ports::decode(binary(m_nodes_vr, "surface.nodes"), m_nodes);
+    ports::map_points(*m_embedding, m_nodes, frame.positions_m);
+  } catch (const ports::SurfaceBinaryError& error) {
+    throw FmuError(std::string("Tissue: ") + error.what());
+  }
+  frame.embedding = m_embedding;
+  frame.node_positions_m.assign(m_nodes.positions_m.begin(), m_nodes.positions_m.end());
+  frame.triangles.assign(m_embedding->triangles.begin(), m_embedding->triangles.end());
   // The cut faces are the last rows; the rest is the skin.
-  frame.mesh_triangle_count = frame.triangle_count() - std::min<std::size_t>(counts[2], frame.triangle_count());
+  frame.mesh_triangle_count = frame.triangle_count() - static_cast<std::size_t>(m_embedding->cut_triangle_count);
 }
 
 // --- HapticLoop ---

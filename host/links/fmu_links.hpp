@@ -50,9 +50,12 @@ class TissueLink {
   DoStepResult step(double time_s, double step_s);
   /// The cut counters into `sample` (the relay reads the sample's fields).
   void read_counters(TissueSample& sample);
-  /// The surface into `frame` (its vectors keep their capacity: no allocation after the first).
+  /// The surface into `frame` from surface.embedding (re-read when surface.revision changes: a cut)
+  /// and surface.nodes: its points mapped, its nodes and embedding for a viewer. Its vectors keep
+  /// their capacity: between cuts no allocation after the first. Throws FmuError for outputs that do
+  /// not decode.
   void read_surface(SurfaceFrame& frame);
-  /// Gives `frame` the capacity read_surface() needs, so that reading into it allocates nothing.
+  /// Gives `frame` room for twice the surface at rest, so that reading into it rarely allocates.
   void reserve(SurfaceFrame& frame) const;
   /// Axis-aligned box of the surface at rest (after initialization).
   [[nodiscard]] const std::array<double, 3>& rest_lower() const { return m_rest_lower; }
@@ -63,9 +66,9 @@ class TissueLink {
  private:
   Fmu3Instance m_instance;
   fmi3ValueReference m_tool_position, m_tool_orientation, m_tool_mode;
-  fmi3ValueReference m_vertex_count, m_triangle_count, m_positions, m_triangles, m_cut_tets, m_enriched,
-      m_cut_triangles;
-  std::size_t m_vertex_capacity = 0, m_triangle_capacity = 0;
+  fmi3ValueReference m_revision, m_embedding_vr, m_nodes_vr, m_cut_tets, m_enriched;
+  std::shared_ptr<const ports::SurfaceEmbedding> m_embedding;
+  ports::SurfaceNodes m_nodes;
   std::array<double, 3> m_rest_lower{}, m_rest_upper{};
   double m_blade_length_m = 0.0;
 };

@@ -4,12 +4,15 @@
 // write that replaces a file whole (so that ParaView never reads half a frame).
 #pragma once
 
+#include "ports/surface_binary.hpp"
+
 #include <array>
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
 #include <filesystem>
 #include <fstream>
+#include <memory>
 #include <stdexcept>
 #include <string>
 #include <string_view>
@@ -37,6 +40,12 @@ struct SurfaceFrame {
   std::vector<double> positions_m;
   std::vector<std::uint32_t> triangles;
   std::size_t mesh_triangle_count = 0;
+  /// The surface as a map of coarse nodes (the Tissue FMU's surface.embedding and surface.nodes), for
+  /// a viewer that maps on its side: the embedding (shared, replaced when a cut changes it) and the
+  /// nodes' positions; positions_m and triangles are then the mapped points and the embedding's
+  /// triangles. Null: the frame has positions only.
+  std::shared_ptr<const ports::SurfaceEmbedding> embedding;
+  std::vector<double> node_positions_m;
   // Optional overlays.
   bool has_tool = false;
   std::array<double, 3> tool_tip_m{}, tool_handle_m{};
@@ -82,6 +91,15 @@ inline void validate_surface_frame(const SurfaceFrame& frame, const std::string&
     if (frame.triangles[i] >= vertex_count) {
       fail("triangle " + std::to_string(i / 3) + " references vertex " + std::to_string(frame.triangles[i]) + " of " +
            std::to_string(vertex_count));
+    }
+  }
+  if (frame.embedding != nullptr) {
+    if (frame.node_positions_m.size() != 3 * frame.embedding->node_count ||
+        frame.embedding->point_count() != vertex_count || frame.embedding->triangles != frame.triangles) {
+      fail("the nodes, points or triangles are not those of the embedding");
+    }
+    if (!detail::all_finite(frame.node_positions_m.data(), frame.node_positions_m.size())) {
+      fail("a node has a non-finite coordinate");
     }
   }
   if (frame.mesh_triangle_count > frame.triangle_count()) {

@@ -197,7 +197,8 @@ Tissue::Tissue(TetMesh mesh, TissueSettings settings)
   if (m_settings.render_surface) {
     try {
       m_render = std::make_unique<CutRenderSurface>(m_body.mesh(), *m_settings.render_surface,
-                                                    default_max_outside_m(m_body.mesh()), "render surface");
+                                                    default_max_outside_m(m_body.mesh()),
+                                                    m_settings.render_surface->source_name);
     } catch (const MeshError& error) {
       throw ParameterError(error.what());
     }

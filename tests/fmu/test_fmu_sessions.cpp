@@ -9,6 +9,7 @@
 #include "importer/fmu3.hpp"
 #include "importer/fmu3_instance.hpp"
 #include "importer/fmu_error.hpp"
+#include "ports/surface_binary.hpp"
 
 #include <gtest/gtest.h>
 
@@ -18,6 +19,7 @@
 #include <filesystem>
 #include <fstream>
 #include <limits>
+#include <map>
 #include <memory>
 #include <string>
 #include <utility>
@@ -141,6 +143,47 @@ FrogGeometry rest_geometry() {
   Session probe;
   probe.start();
   return geometry(probe.outputs());
+}
+
+// A Binary output's bytes (copied: they are the FMU's until its next call).
+std::vector<std::uint8_t> binary(Fmu3Instance& fmu, std::string_view name) {
+  const fmi3ValueReference which = fmu.description().variable(name).value_reference;
+  std::size_t size = 0;
+  fmi3Binary bytes = nullptr;
+  EXPECT_EQ(fmu.get_binary(std::span(&which, 1), std::span(&size, 1), std::span(&bytes, 1)), fmi3OK) << fmu.log_text();
+  return bytes == nullptr ? std::vector<std::uint8_t>{} : std::vector<std::uint8_t>(bytes, bytes + size);
+}
+
+// The three Binary surface outputs, decoded; `mapped` the embedding's points at the nodes.
+struct BinarySurface {
+  ports::SurfaceMesh mesh;
+  ports::SurfaceEmbedding embedding;
+  ports::SurfaceNodes nodes;
+  std::vector<double> mapped_m;
+};
+
+BinarySurface binary_surface(Fmu3Instance& fmu) {
+  BinarySurface b;
+  ports::decode(binary(fmu, "surface.mesh"), b.mesh);
+  ports::decode(binary(fmu, "surface.embedding"), b.embedding);
+  ports::decode(binary(fmu, "surface.nodes"), b.nodes);
+  ports::map_points(b.embedding, b.nodes, b.mapped_m);
+  return b;
+}
+
+// Directed edges without their twin, and directed edges used twice: 0 and 0 for a closed, consistently
+// oriented surface.
+std::pair<std::size_t, std::size_t> border_and_repeated_edges(const std::vector<std::uint32_t>& triangles) {
+  std::map<std::pair<std::uint32_t, std::uint32_t>, int> directed;
+  for (std::size_t t = 0; t + 2 < triangles.size(); t += 3) {
+    for (std::size_t k = 0; k < 3; ++k) ++directed[{triangles[t + k], triangles[t + (k + 1) % 3]}];
+  }
+  std::size_t border = 0, repeated = 0;
+  for (const auto& [edge, count] : directed) {
+    border += directed.contains({edge.second, edge.first}) ? 0 : 1;
+    repeated += count > 1 ? 1 : 0;
+  }
+  return {border, repeated};
 }
 
 TEST(TissueFmu, WithNoParameterSetIsAWorkingFrog) {
@@ -476,6 +519,70 @@ TEST(TissueFmu, TwoInstancesSideBySideDoNotAffectEachOther) {
 // refused (values stay readable, for debugging). Each case below checks that, and that the saved
 // state (or a reset) leads on and that the refused call changed nothing.
 
+// The Binary surface outputs carry what the arrays carry, whole: for the tet skin the same rows
+// bitwise, and the embedding (each point its own node) maps to the same positions bitwise.
+TEST(TissueFmu, TheBinarySurfaceIsTheArraysWhole) {
+  const FrogGeometry g = rest_geometry();
+  Session s;
+  s.start();
+  run(s, g, 0, LAST);
+  ASSERT_FALSE(HasFatalFailure());
+  const Outputs cut = s.outputs();
+  const BinarySurface b = binary_surface(s.fmu());
+  ASSERT_EQ(b.mesh.positions_m.size(), 3 * cut.counters[0]);
+  EXPECT_TRUE(std::equal(b.mesh.positions_m.begin(), b.mesh.positions_m.end(), cut.positions.begin()));
+  std::vector<std::uint32_t> triangles;
+  ASSERT_EQ(s.fmu().get_uint32("surface.triangles", triangles), fmi3OK);
+  ASSERT_EQ(b.mesh.triangles.size(), 3 * cut.counters[1]);
+  EXPECT_TRUE(std::equal(b.mesh.triangles.begin(), b.mesh.triangles.end(), triangles.begin()));
+  std::vector<std::uint64_t> cut_faces;
+  ASSERT_EQ(s.fmu().get_uint64("surface.cutTriangleCount", cut_faces), fmi3OK);
+  EXPECT_EQ(b.mesh.cut_triangle_count, cut_faces[0]);
+  EXPECT_GT(cut_faces[0], 0u);
+  EXPECT_EQ(b.embedding.revision, cut.counters[2]);
+  EXPECT_EQ(b.embedding.triangles, b.mesh.triangles);
+  EXPECT_EQ(b.mapped_m, b.mesh.positions_m);
+}
+
+// With the frog's render surface switched on, the outputs draw it (>= 20k triangles) and cut it: after
+// the scripted stroke through the body every edge of the surface.mesh has its twin (the pieces are
+// closed, the openings capped), none is used twice, and the embedding at the nodes is the mesh. The
+// arrays, at their default 8192 rows, cannot hold it: the FMU says so once and surface.mesh holds all.
+TEST(TissueFmu, TheRenderSurfaceIsDrawnWholeAndClosedAfterTheCut) {
+  const FrogGeometry g = rest_geometry();
+  Session s;
+  ASSERT_EQ(s.fmu().set_string("surface.renderSurface", {"frog"}), fmi3OK);
+  s.start();
+  const BinarySurface rest = binary_surface(s.fmu());
+  EXPECT_EQ(rest.mesh.positions_m.size(), 3u * 11622u);  // meshes/frog_surface.obj
+  EXPECT_EQ(rest.mesh.triangles.size(), 3u * 23240u);
+  EXPECT_EQ(rest.embedding.node_count, 817u);  // the frog's vertices: no piece yet
+  run(s, g, 0, LAST);
+  ASSERT_FALSE(HasFatalFailure());
+  const BinarySurface cut = binary_surface(s.fmu());
+  EXPECT_GT(cut.mesh.triangles.size(), rest.mesh.triangles.size());
+  EXPECT_GT(cut.mesh.cut_triangle_count, 100u);
+  const auto [border, repeated] = border_and_repeated_edges(cut.mesh.triangles);
+  EXPECT_EQ(border, 0u);
+  EXPECT_EQ(repeated, 0u);
+  ASSERT_EQ(cut.mapped_m.size(), cut.mesh.positions_m.size());
+  for (std::size_t i = 0; i < cut.mapped_m.size(); ++i) {
+    ASSERT_NEAR(cut.mapped_m[i], cut.mesh.positions_m[i], 1e-12) << "coordinate " << i;
+  }
+  // The nodes are the coarse mesh's (its vertices and the cut tets' pieces), far fewer than the points.
+  EXPECT_LT(4 * cut.embedding.node_count, cut.embedding.point_count());
+  std::vector<std::uint64_t> vertex_count;
+  ASSERT_EQ(s.fmu().get_uint64("surface.vertexCount", vertex_count), fmi3OK);
+  EXPECT_EQ(vertex_count[0], 8192u);
+  int warnings = 0;
+  for (const LogRecord& record : s.fmu().log()) {
+    if (record.status != fmi3Warning) continue;
+    ++warnings;
+    EXPECT_NE(record.message.find("surface.mesh holds the whole surface"), std::string::npos) << record.message;
+  }
+  EXPECT_EQ(warnings, 1);
+}
+
 class BadUse : public ::testing::Test {
  protected:
   void expect_error(fmi3Status status, const std::string& what) {
@@ -604,6 +711,46 @@ TEST_F(BadUse, AMissingOrMalformedMeshIsRefused) {
   ASSERT_EQ(m_fmu.reset(), fmi3OK);
   ASSERT_EQ(m_fmu.enter_initialization_mode(std::nullopt, 0.0, std::nullopt), fmi3OK);
   ASSERT_EQ(m_fmu.exit_initialization_mode(), fmi3OK) << m_fmu.log_text();  // the reset restored mesh = "frog"
+}
+
+// A render surface that is missing, lies outside the tet mesh or has a NaN vertex is refused at
+// initialization with the parameter, the file and the element named; Binary is got only from Binary
+// outputs, only once there is a model.
+TEST_F(BadUse, BadRenderSurfacesAndBinaryMisuseAreRefused) {
+  const fmi3ValueReference mesh_vr = m_fmu.description().variable("surface.mesh").value_reference;
+  const fmi3ValueReference time_vr = m_fmu.description().variable("time").value_reference;
+  std::size_t size = 0;
+  fmi3Binary bytes = nullptr;
+  expect_error(m_fmu.get_binary(std::span(&mesh_vr, 1), std::span(&size, 1), std::span(&bytes, 1)),
+               "Binary before initialization");
+  ASSERT_EQ(m_fmu.reset(), fmi3OK);
+  const std::filesystem::path dir = std::filesystem::temp_directory_path();
+  const auto refused = [&](const std::string& name, const std::string& expected) {
+    ASSERT_EQ(m_fmu.set_string("surface.renderSurface", {name}), fmi3OK);
+    ASSERT_EQ(m_fmu.enter_initialization_mode(std::nullopt, 0.0, std::nullopt), fmi3OK);
+    EXPECT_EQ(m_fmu.exit_initialization_mode(), fmi3Error) << name;
+    const std::string log = m_fmu.log_text();
+    EXPECT_NE(log.find("surface.renderSurface"), std::string::npos) << log;
+    EXPECT_NE(log.find(expected), std::string::npos) << log;
+    m_fmu.clear_log();
+    ASSERT_EQ(m_fmu.reset(), fmi3OK);
+  };
+  refused((dir / "no_such_surface.obj").string(), "no_such_surface.obj");
+  const std::filesystem::path far = dir / "tissue_fmu_far_surface.obj";
+  std::ofstream(far) << "v 10 10 10\nv 11 10 10\nv 10 11 10\nv 10 10 11\nf 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n";
+  refused(far.string(), "tissue_fmu_far_surface.obj: vertex 1");
+  const std::filesystem::path nan = dir / "tissue_fmu_nan_surface.obj";
+  std::ofstream(nan) << "v 0 0 0\nv nan 0 0\nv 0 1 0\nv 0 0 1\nf 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n";
+  refused(nan.string(), "tissue_fmu_nan_surface.obj:2: vertex 2");
+  std::filesystem::remove(far);
+  std::filesystem::remove(nan);
+  ASSERT_EQ(m_fmu.set_string("surface.renderSurface", {"none"}), fmi3OK);
+  start();
+  expect_error(m_fmu.get_binary(std::span(&time_vr, 1), std::span(&size, 1), std::span(&bytes, 1)),
+               "Binary of a Float64");
+  EXPECT_EQ(m_fmu.get_binary(std::span(&mesh_vr, 1), std::span(&size, 1), std::span(&bytes, 1)), fmi3OK)
+      << m_fmu.log_text();
+  EXPECT_GT(size, 0u);
 }
 
 TEST(TissueFmu, ErrorsReachTheImporterEvenWithLoggingOff) {

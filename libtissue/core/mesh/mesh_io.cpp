@@ -967,6 +967,7 @@ void check_closed_manifold(const TriangleSurface& surface, const std::string& so
 
 TriangleSurface parse_obj(std::string_view text, const std::string& source_name) {
   TriangleSurface surface;
+  surface.source_name = source_name;
   std::vector<int> triangle_lines;
   LineReader reader(text, '#', false);
   while (reader.next()) {

@@ -39,6 +39,7 @@ TetMesh parse_gmsh(std::string_view text, const std::string& source_name, MeshWa
 struct TriangleSurface {
   std::vector<Eigen::Vector3d> vertices_m;
   std::vector<std::array<int, 3>> triangles;
+  std::string source_name = "render surface";  ///< where it was read from, for messages
 };
 
 /// Wavefront OBJ: `v x y z` and `f a b c ...` (1-based, negative indices relative to the vertices

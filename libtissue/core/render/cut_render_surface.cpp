@@ -466,6 +466,36 @@ void CutRenderSurface::rebuild(const DeformableBody& body) {
   }
   m_cut_edges = static_cast<int>((m_points.size() - vertices) / 2);
   cap_loops(body);
+  map_points_to_nodes();
+}
+
+void CutRenderSurface::map_points_to_nodes() {
+  std::unordered_map<long long, int> slot_of;
+  m_slots.clear();
+  m_point_nodes.resize(m_points.size());
+  for (size_t i = 0; i < m_points.size(); ++i) {
+    const Point& point = m_points[i];
+    std::array<int, 4>& nodes = m_point_nodes[i];
+    if (point.cut_tet < 0) {
+      for (size_t j = 0; j < 4; ++j) nodes[j] = m_mesh.tets[static_cast<size_t>(point.tet)][j];
+      continue;
+    }
+    const long long key = (static_cast<long long>(point.cut_tet) << 16) | point.piece;
+    auto [it, added] = slot_of.emplace(key, static_cast<int>(m_slots.size()));
+    if (added) m_slots.push_back({point.cut_tet, point.piece});
+    for (size_t j = 0; j < 4; ++j) nodes[j] = m_mesh.vertex_count() + 4 * it->second + static_cast<int>(j);
+  }
+}
+
+void CutRenderSurface::node_positions(const DeformableBody& body, const Eigen::VectorXd& displacement_m,
+                                      std::vector<Eigen::Vector3d>& nodes_m) const {
+  body.positions(displacement_m, m_real_positions_m);
+  nodes_m.resize(static_cast<size_t>(node_count()));
+  for (int v = 0; v < m_mesh.vertex_count(); ++v) nodes_m[static_cast<size_t>(v)] = m_real_positions_m.segment<3>(3 * v);
+  for (size_t s = 0; s < m_slots.size(); ++s) {
+    const TetPositions corners = body.piece_positions(displacement_m, m_slots[s][0], m_slots[s][1]);
+    for (size_t j = 0; j < 4; ++j) nodes_m[static_cast<size_t>(m_mesh.vertex_count()) + 4 * s + j] = corners[j];
+  }
 }
 
 int CutRenderSurface::add_point_like(int model, const Eigen::Vector3d& rest_m) {
@@ -601,7 +631,15 @@ void CutRenderSurface::cap_loops(const DeformableBody& body) {
                 up ? chain.facing : after_facing, up ? after_facing : chain.facing}]
           .push_back(c);
     } else if (const auto after = chain_starting_at.find(point_after(chain, 2)); after != chain_starting_at.end()) {
-      tips.push_back(Tip{c, beyond, part_of_point(beyond), chain.cut, chain.facing, chains[after->second].facing});
+      const int after_facing = chains[after->second].facing;
+      if (chain.facing != 0 && after_facing == chain.facing) {
+        // Not where a cut ends: the material lies on one side before and after, the loop only passes
+        // a surface vertex the split left on the border (its edges' tests disagreed). The face goes on
+        // through it.
+        link[c] = Link{{beyond}, point_after(chain, 2)};
+        continue;
+      }
+      tips.push_back(Tip{c, beyond, part_of_point(beyond), chain.cut, chain.facing, after_facing});
     }
   }
   for (const auto& [forward, backward] : paired_switches(switches, chains)) {
@@ -636,21 +674,13 @@ void CutRenderSurface::cap_loops(const DeformableBody& body) {
 }
 
 void CutRenderSurface::update(const DeformableBody& body, const Eigen::VectorXd& displacement_m) {
-  body.positions(displacement_m, m_real_positions_m);
-  std::unordered_map<long long, TetPositions> pieces;
+  node_positions(body, displacement_m, m_node_positions_m);
   m_positions_m.resize(m_points.size());
   for (size_t i = 0; i < m_points.size(); ++i) {
-    const Point& point = m_points[i];
+    const Eigen::Vector4d& weights = m_points[i].weights;
+    const std::array<int, 4>& nodes = m_point_nodes[i];
     Eigen::Vector3d x = Eigen::Vector3d::Zero();
-    if (point.cut_tet < 0) {
-      const Tet& tet = m_mesh.tets[static_cast<size_t>(point.tet)];
-      for (size_t j = 0; j < 4; ++j) x += point.weights(static_cast<Eigen::Index>(j)) * m_real_positions_m.segment<3>(3 * tet[j]);
-    } else {
-      const long long id = (static_cast<long long>(point.cut_tet) << 16) | point.piece;
-      auto it = pieces.find(id);
-      if (it == pieces.end()) it = pieces.emplace(id, body.piece_positions(displacement_m, point.cut_tet, point.piece)).first;
-      for (size_t j = 0; j < 4; ++j) x += point.weights(static_cast<Eigen::Index>(j)) * it->second[j];
-    }
+    for (size_t k = 0; k < 4; ++k) x += weights(static_cast<Eigen::Index>(k)) * m_node_positions_m[static_cast<size_t>(nodes[k])];
     m_positions_m[i] = x;
   }
   vertex_normals(m_positions_m, m_triangles, m_normals);

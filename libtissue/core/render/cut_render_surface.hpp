@@ -65,6 +65,19 @@ class CutRenderSurface {
   /// Border loops left open by the last rebuild (none that the capping understands).
   [[nodiscard]] int open_loop_count() const { return m_open_loops; }
 
+  // The surface as a linear map of a few coarse nodes (for a viewer that maps on its side: the
+  // mapping is sent once per rebuild, the nodes every frame). Nodes: the mesh's vertices, then four
+  // per piece of a cut tet that holds points (the piece's corners, real or ghost). Point i is at
+  // sum_k point_weights()[i](k) * node point_nodes()[i][k].
+  [[nodiscard]] int node_count() const { return m_mesh.vertex_count() + 4 * static_cast<int>(m_slots.size()); }
+  [[nodiscard]] const std::vector<std::array<int, 4>>& point_nodes() const { return m_point_nodes; }
+  [[nodiscard]] Eigen::Vector4d point_weights(int point) const { return m_points[static_cast<size_t>(point)].weights; }
+  /// The nodes' positions at the last update(). [m]
+  [[nodiscard]] const std::vector<Eigen::Vector3d>& node_positions_m() const { return m_node_positions_m; }
+  /// The nodes' positions for the body's state (after rebuild for the body's current cuts). [m]
+  void node_positions(const DeformableBody& body, const Eigen::VectorXd& displacement_m,
+                      std::vector<Eigen::Vector3d>& nodes_m) const;
+
  private:
   struct Point {
     int tet = -1;
@@ -75,6 +88,8 @@ class CutRenderSurface {
   [[nodiscard]] Point locate(const DeformableBody& body, int tet, const Eigen::Vector3d& rest_m) const;
   void cap_loops(const DeformableBody& body);
   void find_material_parts(const DeformableBody& body);
+  /// The nodes of every point (after the points are final).
+  void map_points_to_nodes();
   [[nodiscard]] int copy_of(const DeformableBody& body, int tet, int cut_tet, int piece, size_t j) const;
   /// Where the segment a-b crosses a cut plane of the cut tets at or next to tet_a and tet_b (the
   /// crossing nearest its middle): the fraction along it and the cut id (0.5 and the latest cut of
@@ -101,9 +116,12 @@ class CutRenderSurface {
   std::vector<int> m_point_cut;
   std::vector<int> m_copy_root;  // per copy of a vertex (real, then ghost rows): its material part
   // per point: the cut id of the plane that split it, -1 for others
+  std::vector<std::array<int, 2>> m_slots;  // the (cut tet, piece) of each group of four nodes
+  std::vector<std::array<int, 4>> m_point_nodes;
+  std::vector<Eigen::Vector3d> m_node_positions_m;
   std::vector<Eigen::Vector3d> m_positions_m;
   std::vector<Eigen::Vector3d> m_normals;
-  Eigen::VectorXd m_real_positions_m;
+  mutable Eigen::VectorXd m_real_positions_m;
 };
 
 }  // namespace tissue
