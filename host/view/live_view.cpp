@@ -114,6 +114,7 @@ void LiveView::record_tick(double period_s, std::uint64_t deadline_misses, const
 void LiveView::run() {
   std::string plain, with_triangles;
   std::uint64_t last_hash = 0;
+  std::uint64_t last_embedding = 0;  // the FMU's surface.revision of the last frame's embedding
   std::uint32_t revision = 0;
   auto next_stats = std::chrono::steady_clock::now();
   while (m_running.load()) {
@@ -133,8 +134,11 @@ void LiveView::run() {
     if (m_frames.update()) {
       const SurfaceFrame& frame = m_frames.read_buffer();
       const std::uint64_t hash = triangle_hash(frame.triangles);
-      if (hash != last_hash) {
+      // A new embedding (a cut) may keep the triangles but move points onto new nodes.
+      const std::uint64_t embedding = frame.embedding ? frame.embedding->revision : 0;
+      if (hash != last_hash || embedding != last_embedding) {
         last_hash = hash;
+        last_embedding = embedding;
         ++revision;
       }
       ViewOverlay overlay;

@@ -20,13 +20,15 @@ void put_vector(std::string& out, const std::array<double, 3>& v) {
   for (const double x : v) put(out, static_cast<float>(x));
 }
 
-// The header and the positions, with the triangles flag clear.
+// The header and the positions (the nodes, for a mapped frame), with the triangles flag clear.
 void encode_plain(const SurfaceFrame& frame, const ViewOverlay& overlay, std::string& out) {
   validate_surface_frame(frame, "view frame");
+  const bool mapped = frame.embedding != nullptr;
+  const std::vector<double>& positions_m = mapped ? frame.node_positions_m : frame.positions_m;
   out.clear();
   put(out, VIEW_FRAME_MAGIC);
-  put(out, std::uint32_t{0});  // flags: no triangles
-  put(out, static_cast<std::uint32_t>(frame.vertex_count()));
+  put(out, mapped ? VIEW_FRAME_MAPPED : std::uint32_t{0});  // flags: no triangles
+  put(out, static_cast<std::uint32_t>(positions_m.size() / 3));
   put(out, static_cast<std::uint32_t>(frame.triangle_count()));
   put(out, static_cast<std::uint32_t>(frame.mesh_triangle_count));
   put(out, overlay.topology_revision);
@@ -40,8 +42,8 @@ void encode_plain(const SurfaceFrame& frame, const ViewOverlay& overlay, std::st
   put_vector(out, frame.contact_point_m);
   put_vector(out, overlay.device_force_n);
   put(out, static_cast<float>(overlay.device_max_force_n));
-  put(out, std::uint32_t{0});
-  for (const double x : frame.positions_m) put(out, static_cast<float>(x));
+  put(out, static_cast<std::uint32_t>(mapped ? frame.vertex_count() : 0));  // the points P of a mapped frame
+  for (const double x : positions_m) put(out, static_cast<float>(x));
 }
 
 }  // namespace
@@ -50,8 +52,12 @@ void encode_view_frames(const SurfaceFrame& frame, const ViewOverlay& overlay, s
                         std::string& with_triangles) {
   encode_plain(frame, overlay, plain);
   with_triangles = plain;
-  const std::uint32_t flags = 1;  // triangles included
+  const std::uint32_t flags = VIEW_FRAME_TRIANGLES | (frame.embedding != nullptr ? VIEW_FRAME_MAPPED : 0U);
   std::memcpy(with_triangles.data() + 4, &flags, sizeof(flags));
+  if (frame.embedding != nullptr) {  // the embedding travels with the triangles
+    for (const std::uint32_t node : frame.embedding->point_nodes) put(with_triangles, node);
+    for (const double weight : frame.embedding->point_weights) put(with_triangles, static_cast<float>(weight));
+  }
   for (const std::uint32_t index : frame.triangles) put(with_triangles, index);
 }
 

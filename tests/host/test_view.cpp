@@ -16,6 +16,7 @@
 
 #include <cstring>
 #include <filesystem>
+#include <memory>
 #include <fstream>
 #include <string>
 #include <thread>
@@ -106,6 +107,61 @@ TEST(ViewFrame, HeaderPositionsAndTrianglesAsDocumented) {
   EXPECT_EQ(std::memcmp(&plain[4], "\0\0\0\0", 4), 0);     // no triangles flag
   frame.positions_m[4] = std::nan("");
   EXPECT_THROW(encode_view_frames(frame, overlay, plain, full), OutputError);
+}
+
+// A frame with an embedding goes out mapped: the nodes as positions (the plain frame is 12 bytes per
+// node, not per point), the embedding with the triangles; mapping the points from the bytes as the
+// page does gives the frame's positions (to float precision). An embedding the nodes do not fit is
+// refused.
+TEST(ViewFrame, AMappedFrameCarriesTheNodesAndOnceTheEmbedding) {
+  auto embedding = std::make_shared<ports::SurfaceEmbedding>();
+  embedding->node_count = 4;  // a tet's corners; five points in it, a fan of four triangles
+  embedding->point_nodes = {0, 1, 2, 3, 0, 1, 2, 3, 0, 1, 2, 3, 0, 1, 2, 3, 0, 1, 2, 3};
+  embedding->point_weights = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0.25, 0.25, 0.25, 0.25};
+  embedding->triangles = {4, 0, 1, 4, 1, 2, 4, 2, 3, 4, 3, 0};
+  embedding->cut_triangle_count = 1;
+  SurfaceFrame frame;
+  frame.embedding = embedding;
+  frame.node_positions_m = {0, 0, 0, 0.2, 0, 0, 0, 0.2, 0, 0, 0, 0.2};
+  ports::SurfaceNodes nodes{0, frame.node_positions_m};
+  ports::map_points(*embedding, nodes, frame.positions_m);
+  frame.triangles = embedding->triangles;
+  frame.mesh_triangle_count = 3;
+  std::string plain, full;
+  encode_view_frames(frame, ViewOverlay{}, plain, full);
+  const auto u32 = [&full](std::size_t offset) {
+    std::uint32_t v;
+    std::memcpy(&v, full.data() + offset, 4);
+    return v;
+  };
+  const auto f32 = [&full](std::size_t offset) {
+    float v;
+    std::memcpy(&v, full.data() + offset, 4);
+    return v;
+  };
+  const std::size_t nodes_n = 4, points = 5, triangles = 4;
+  EXPECT_EQ(plain.size(), VIEW_FRAME_HEADER_BYTES + 12 * nodes_n);
+  EXPECT_EQ(full.size(), VIEW_FRAME_HEADER_BYTES + 12 * nodes_n + 32 * points + 12 * triangles);
+  EXPECT_EQ(u32(4), VIEW_FRAME_TRIANGLES | VIEW_FRAME_MAPPED);
+  EXPECT_EQ(u32(8), nodes_n);
+  EXPECT_EQ(u32(12), triangles);
+  EXPECT_EQ(u32(16), 3u);
+  EXPECT_EQ(u32(92), points);
+  const std::size_t at_nodes = VIEW_FRAME_HEADER_BYTES, at_index = at_nodes + 12 * nodes_n,
+                    at_weights = at_index + 16 * points, at_triangles = at_weights + 16 * points;
+  for (std::size_t i = 0; i < points; ++i) {
+    for (std::size_t c = 0; c < 3; ++c) {
+      double x = 0.0;
+      for (std::size_t k = 0; k < 4; ++k) {
+        x += f32(at_weights + 4 * (4 * i + k)) * f32(at_nodes + 4 * (3 * u32(at_index + 4 * (4 * i + k)) + c));
+      }
+      EXPECT_NEAR(x, frame.positions_m[3 * i + c], 1e-7) << "point " << i;
+    }
+  }
+  EXPECT_EQ(u32(at_triangles), 4u);
+  EXPECT_EQ(u32(at_triangles + 4 * 11), 0u);
+  frame.node_positions_m.resize(9);
+  EXPECT_THROW(encode_view_frames(frame, ViewOverlay{}, plain, full), OutputError);
 }
 
 DevicePose away() {

@@ -33,6 +33,8 @@ const tv = {
   statsReceived: 0,
   posesSent: 0,
   fps: 0,
+  applyMsTotal: 0,    // time spent applying frames (mapping the points, normals) and rendering, summed
+  renderMsTotal: 0,
   webgl: false,
   error: null,
 };
@@ -264,8 +266,30 @@ function onStats(s) {
 
 // ---------------------------------------------------------------------------------------------
 // frame: parsed on arrival, applied to the scene in the next animation frame (only the latest).
-let pendingFrame = null;       // { header, positions: Float32Array }
-let pendingTriangles = null;   // { triangles: Uint32Array, meshCount, revision }
+let pendingFrame = null;       // { header, positions: Float32Array } (a mapped frame's: the nodes)
+let pendingTriangles = null;   // { triangles: Uint32Array, meshCount, revision, embedding }
+// A mapped surface (flag 2): each point at sum_k weight[4i+k] * node[pointNodes[4i+k]]; the
+// embedding comes with the triangles, the nodes with every frame (VIEW_PROTOCOL.md).
+let embedding = null;          // { pointNodes: Uint32Array, weights: Float32Array, nodeCount } or null
+let mappedPositions = new Float32Array(0);
+
+// The points of a mapped frame at its nodes (null if the nodes are not the embedding's).
+function mapPoints(nodes) {
+  if (!embedding || nodes.length !== 3 * embedding.nodeCount) return null;
+  const { pointNodes, weights } = embedding;
+  const points = weights.length / 4;
+  if (mappedPositions.length < 3 * points) mappedPositions = new Float32Array(3 * points);
+  const out = mappedPositions;
+  for (let i = 0; i < points; i++) {
+    let x = 0, y = 0, z = 0;
+    for (let k = 4 * i; k < 4 * i + 4; k++) {
+      const w = weights[k], n = 3 * pointNodes[k];
+      x += w * nodes[n]; y += w * nodes[n + 1]; z += w * nodes[n + 2];
+    }
+    out[3 * i] = x; out[3 * i + 1] = y; out[3 * i + 2] = z;
+  }
+  return out.subarray(0, 3 * points);
+}
 
 function onFrame(buf) {
   if (buf.byteLength < HEADER_BYTES) return;
@@ -276,11 +300,13 @@ function onFrame(buf) {
   const T = dv.getUint32(12, true);
   const M = dv.getUint32(16, true);
   const hasTriangles = (flags & 1) !== 0;
-  const need = HEADER_BYTES + 12 * V + (hasTriangles ? 12 * T : 0);
+  const mapped = (flags & 2) !== 0;
+  const P = mapped ? dv.getUint32(92, true) : 0;   // a mapped frame's points (V are its nodes)
+  const need = HEADER_BYTES + 12 * V + (hasTriangles ? 32 * P + 12 * T : 0);
   if (buf.byteLength < need || M > T) return;   // malformed: ignore
   const f3 = (o) => [dv.getFloat32(o, true), dv.getFloat32(o + 4, true), dv.getFloat32(o + 8, true)];
   const header = {
-    flags, vertexCount: V, triangleCount: T, meshTriangleCount: M,
+    flags, mapped, vertexCount: mapped ? P : V, nodeCount: V, triangleCount: T, meshTriangleCount: M,
     topologyRevision: dv.getUint32(20, true),
     time: dv.getFloat64(24, true),
     tip: f3(32), handle: f3(44),
@@ -290,8 +316,15 @@ function onFrame(buf) {
   // binaryType 'arraybuffer' gives a fresh buffer per message, so these views stay valid.
   const positions = new Float32Array(buf, HEADER_BYTES, 3 * V);
   if (hasTriangles) {
-    pendingTriangles = { triangles: new Uint32Array(buf, HEADER_BYTES + 12 * V, 3 * T), meshCount: M,
-                         revision: header.topologyRevision };
+    let at = HEADER_BYTES + 12 * V;
+    let frameEmbedding = null;
+    if (mapped) {
+      frameEmbedding = { pointNodes: new Uint32Array(buf, at, 4 * P), weights: new Float32Array(buf, at + 16 * P, 4 * P),
+                         nodeCount: V };
+      at += 32 * P;
+    }
+    pendingTriangles = { triangles: new Uint32Array(buf, at, 3 * T), meshCount: M,
+                         revision: header.topologyRevision, embedding: frameEmbedding };
   }
   pendingFrame = { header, positions };
   tv.framesReceived++;
@@ -306,9 +339,32 @@ function onFrame(buf) {
 // so cutting does not leak GPU memory.
 const capacityFor = (n) => Math.max(1024, 2 ** Math.ceil(Math.log2(n)));
 
+// Area-weighted vertex normals over typed arrays (three.js' computeVertexNormals goes through
+// Vector3 objects: 5 ms a frame for the frog's fine surface in the page, this about a tenth).
+function vertexNormals(positions, index, normal) {
+  const n = normal.array, p = positions, idx = index.array;
+  n.fill(0);
+  for (let t = 0; t < idx.length; t += 3) {
+    const a = 3 * idx[t], b = 3 * idx[t + 1], c = 3 * idx[t + 2];
+    if (a === b) continue;   // the unused tail: degenerate
+    const ux = p[b] - p[a], uy = p[b + 1] - p[a + 1], uz = p[b + 2] - p[a + 2];
+    const vx = p[c] - p[a], vy = p[c + 1] - p[a + 1], vz = p[c + 2] - p[a + 2];
+    const nx = uy * vz - uz * vy, ny = uz * vx - ux * vz, nz = ux * vy - uy * vx;
+    n[a] += nx; n[a + 1] += ny; n[a + 2] += nz;
+    n[b] += nx; n[b + 1] += ny; n[b + 2] += nz;
+    n[c] += nx; n[c + 1] += ny; n[c + 2] += nz;
+  }
+  for (let v = 0; v < p.length; v += 3) {
+    const len = Math.hypot(n[v], n[v + 1], n[v + 2]);
+    if (len > 0) { n[v] /= len; n[v + 1] /= len; n[v + 2] /= len; }
+  }
+  normal.needsUpdate = true;
+}
+
 function applyFrame() {
   if (pendingTriangles) {
     const { triangles, meshCount } = pendingTriangles;
+    embedding = pendingTriangles.embedding;
     pendingTriangles = null;
     let max = -1;
     for (let i = 0; i < triangles.length; i++) if (triangles[i] > max) max = triangles[i];
@@ -329,8 +385,13 @@ function applyFrame() {
     surfaceGeometry.addGroup(3 * meshCount, triangles.length - 3 * meshCount, 1);
   }
   if (!pendingFrame) return;
-  const { header, positions } = pendingFrame;
+  const { header } = pendingFrame;
+  const positions = header.mapped ? mapPoints(pendingFrame.positions) : pendingFrame.positions;
   pendingFrame = null;
+  if (!positions) {   // nodes of an embedding not held yet: the surface waits for the next topology
+    updateToolVisuals(header);
+    return;
+  }
 
   let attr = surfaceGeometry.getAttribute('position');
   if (!attr || attr.array.length < positions.length) {
@@ -338,14 +399,15 @@ function applyFrame() {
     attr = new THREE.BufferAttribute(new Float32Array(3 * capacityFor(positions.length / 3)), 3);
     attr.setUsage(THREE.DynamicDrawUsage);
     surfaceGeometry.setAttribute('position', attr);
-    // computeVertexNormals() reuses an existing normal attribute: drop the one of the old size.
-    surfaceGeometry.deleteAttribute('normal');
+    const normal = new THREE.BufferAttribute(new Float32Array(attr.array.length), 3);
+    normal.setUsage(THREE.DynamicDrawUsage);
+    surfaceGeometry.setAttribute('normal', normal);
   }
   attr.array.set(positions);
   attr.needsUpdate = true;
   // Draw only when the triangles held refer to vertices that exist.
   surface.visible = triangleMaxIndex >= 0 && triangleMaxIndex < header.vertexCount;
-  if (surface.visible) surfaceGeometry.computeVertexNormals();
+  if (surface.visible) vertexNormals(positions, surfaceGeometry.getIndex(), surfaceGeometry.getAttribute('normal'));
 
   updateToolVisuals(header);
 }
@@ -578,10 +640,14 @@ function updateGhost() {
 function animate(now) {
   requestAnimationFrame(animate);
   if (poseDirty && sendPose(now)) poseDirty = false;   // at most one pose per animation frame
+  const t0 = performance.now();
   applyFrame();
+  const t1 = performance.now();
   updateGhost();
   orbit.update();
   if (renderer) renderer.render(scene, camera);
+  tv.applyMsTotal += t1 - t0;   // the frame's surface: mapping, upload, normals
+  tv.renderMsTotal += performance.now() - t1;
   tv.framesRendered++;
   renderTimes.push(now);
   while (renderTimes.length && renderTimes[0] <= now - 1000) renderTimes.shift();

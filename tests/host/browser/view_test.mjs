@@ -72,7 +72,7 @@ const snapshot = (page) => page.evaluate(() => {
   const t = window.tissueView;
   return { t: performance.now(), connected: t.connected, framesReceived: t.framesReceived,
            framesRendered: t.framesRendered, posesSent: t.posesSent, statsReceived: t.statsReceived,
-           fps: t.fps };
+           fps: t.fps, applyMs: t.applyMsTotal, renderMs: t.renderMsTotal };
 });
 
 // ---------------------------------------------------------------------------------------------
@@ -252,6 +252,9 @@ async function main() {
     const rate = (k) => end.map((e, i) => +((e[k] - start[i][k]) / ((e.t - start[i].t) / 1000)).toFixed(2));
     const framesPerS = rate('framesReceived');
     const fps = rate('framesRendered');
+    // Milliseconds per rendered frame spent applying the surface and in three.js' render call.
+    const per = (k) => end.map((e, i) => +((e[k] - start[i][k]) / Math.max(1, e.framesRendered - start[i].framesRendered)).toFixed(2));
+    const applyMs = per('applyMs'), renderMs = per('renderMs');
     end.forEach((e, i) => { if (!e.connected) failures.push(`page ${i + 1}: disconnected during the measurement`); });
 
     if (o.screenshot) await pages[0].screenshot({ path: o.screenshot });
@@ -263,7 +266,7 @@ async function main() {
     const final = await Promise.all(pages.map(snapshot));
     const lastStats = await pages[0].evaluate(() => window.tissueView.lastStats);
     Object.assign(result, {
-      frames_per_s: framesPerS, fps,
+      frames_per_s: framesPerS, fps, apply_ms_per_frame: applyMs, render_ms_per_frame: renderMs,
       poses_sent: final[0].posesSent,
       bad_messages: bad,
       last_stats: lastStats,
