@@ -9,11 +9,13 @@
 #include "importer/fmu_error.hpp"
 #include "importer/model_description.hpp"
 #include "links/sample_relay.hpp"
+#include "ports/surface_binary.hpp"
 #include "tissue_fmu/variables.hpp"
 
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <array>
 #include <string>
 
@@ -39,6 +41,64 @@ static_assert(fmi3::strictly_ordered(EXTENDED_TISSUE) && fmi3::strictly_ordered(
 
 ModelDescription written_and_read(const fmi3::ModelDescription& description) {
   return parse_model_description(fmi3::model_description_xml(description));
+}
+
+// The Binary surface outputs round-trip, and bytes that are not their layout are refused with the
+// output's name: truncated, trailing bytes, another output's magic, an index out of range, a NaN.
+TEST(SurfaceBinary, RoundTripsAndRefusesWhatIsNotItsLayout) {
+  ports::SurfaceMesh mesh{{0, 0, 0, 1, 0, 0, 0, 1, 0}, {0, 1, 2}, 1};
+  std::vector<std::uint8_t> bytes;
+  ports::encode(mesh, bytes);
+  EXPECT_EQ(bytes.size(), 32u + 9 * 8 + 3 * 4);
+  ports::SurfaceMesh back;
+  ports::decode(bytes, back);
+  EXPECT_EQ(back.positions_m, mesh.positions_m);
+  EXPECT_EQ(back.triangles, mesh.triangles);
+  EXPECT_EQ(back.cut_triangle_count, 1u);
+  const auto refused = [](std::vector<std::uint8_t> b, const std::string& why) {
+    ports::SurfaceMesh m;
+    try {
+      ports::decode(b, m);
+      ADD_FAILURE() << "accepted: " << why;
+    } catch (const ports::SurfaceBinaryError& error) {
+      EXPECT_NE(std::string(error.what()).find("surface.mesh: " + why), std::string::npos) << error.what();
+    }
+  };
+  refused({bytes.begin(), bytes.end() - 1}, "truncated");
+  std::vector<std::uint8_t> longer = bytes;
+  longer.push_back(0);
+  refused(longer, "trailing bytes");
+  std::vector<std::uint8_t> other = bytes;
+  other[3] = 'X';
+  refused(other, "not this output");
+  ports::SurfaceMesh bad_index = mesh;
+  bad_index.triangles[2] = 3;
+  ports::encode(bad_index, bytes);
+  refused(bytes, "a triangle names row 3 of 3");
+  ports::SurfaceMesh nan = mesh;
+  nan.positions_m[4] = std::nan("");
+  ports::encode(nan, bytes);
+  refused(bytes, "a non-finite position");
+
+  ports::SurfaceEmbedding embedding;
+  embedding.revision = 7;
+  embedding.node_count = 2;
+  embedding.point_nodes = {0, 1, 1, 1, 1, 0, 0, 0, 0, 1, 0, 0};
+  embedding.point_weights = {0.5, 0.5, 0, 0, 1, 0, 0, 0, 0.25, 0.75, 0, 0};
+  embedding.triangles = {0, 1, 2};
+  ports::encode(embedding, bytes);
+  ports::SurfaceEmbedding embedding_back;
+  ports::decode(bytes, embedding_back);
+  EXPECT_EQ(embedding_back.point_nodes, embedding.point_nodes);
+  EXPECT_EQ(embedding_back.revision, 7u);
+  std::vector<double> mapped;
+  ports::map_points(embedding_back, ports::SurfaceNodes{7, {0, 0, 0, 4, 0, 0}}, mapped);
+  EXPECT_EQ(mapped, (std::vector<double>{2, 0, 0, 4, 0, 0, 3, 0, 0}));
+  EXPECT_THROW(ports::map_points(embedding_back, ports::SurfaceNodes{6, {0, 0, 0, 4, 0, 0}}, mapped),
+               ports::SurfaceBinaryError);
+  embedding.point_nodes[5] = 2;
+  ports::encode(embedding, bytes);
+  EXPECT_THROW(ports::decode(bytes, embedding_back), ports::SurfaceBinaryError);
 }
 
 TEST(PortSchema, EverySampleFieldIsATissueOutputAndAHapticInputInTheWrittenXml) {
