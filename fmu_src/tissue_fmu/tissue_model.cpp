@@ -254,6 +254,9 @@ void TissueModel::update_surface_counters() {
     m_surface_triangles = triangles;
     m_surface_cut_tets = cut_tets;
   }
+}
+
+void TissueModel::warn_if_arrays_truncate() {
   if (!m_values.boolean(vr(Vr::mesh_output_enabled)) || m_capacity_warned) return;
   const ports::SurfaceMesh& drawn = drawn_mesh();
   const std::uint64_t vertices = drawn.positions_m.size() / 3;
@@ -379,6 +382,7 @@ void TissueModel::get_float64(const VariableInfo& info, std::span<double> out) {
     case Vr::vertex_positions: {
       std::fill(out.begin(), out.end(), 0.0);
       if (!m_values.boolean(vr(Vr::mesh_output_enabled))) return;
+      warn_if_arrays_truncate();
       const std::vector<double>& x = drawn_mesh().positions_m;
       std::copy_n(x.begin(), std::min(x.size(), out.size()), out.begin());
       return;
@@ -393,6 +397,7 @@ void TissueModel::get_uint32(const VariableInfo& info, std::span<std::uint32_t> 
   ensure_built();
   std::fill(out.begin(), out.end(), 0U);
   if (!m_values.boolean(vr(Vr::mesh_output_enabled))) return;
+  warn_if_arrays_truncate();
   // Whole rows only.
   const std::vector<std::uint32_t>& triangles = drawn_mesh().triangles;
   std::copy_n(triangles.begin(), std::min(triangles.size(), out.size() / 3 * 3), out.begin());
@@ -407,9 +412,11 @@ void TissueModel::get_uint64(const VariableInfo& info, std::span<std::uint64_t> 
   const std::uint64_t triangles = mesh_out ? drawn->triangles.size() / 3 : 0;
   switch (static_cast<Vr>(info.vr)) {
     case Vr::vertex_count:
+      warn_if_arrays_truncate();
       out[0] = mesh_out ? std::min(vertices, m_values.uint64(vr(Vr::vertex_capacity))) : 0;
       return;
     case Vr::triangle_count:
+      warn_if_arrays_truncate();
       out[0] = mesh_out ? std::min(triangles, m_values.uint64(vr(Vr::triangle_capacity))) : 0;
       return;
     case Vr::surface_revision:

@@ -52,7 +52,10 @@ class TissueModel final : public fmi3::Model {
  private:
   void build();
   void ensure_built();
+  /// surface.revision after a step or a restore (the drawn surface is brought up to date only when read).
   void update_surface_counters();
+  /// Logs once that the surface outgrew the arrays' capacities (on reading the arrays or their counts).
+  void warn_if_arrays_truncate();
   /// A mesh or render-surface file named by a parameter: absolute, or in the resources folder.
   [[nodiscard]] std::string resolve_path(const std::string& name, const char* what) const;
   /// The drawn surface (the render surface when surface.renderSurface names one, else the tet skin),

@@ -132,21 +132,14 @@ std::vector<std::uint32_t> vtu_triangles(const std::filesystem::path& file) {
   return triangles;
 }
 
-// The complete cut with the frog's render surface switched on (the scenario's surface.renderSurface):
-// the last frame is the fine surface (more than its 23240 triangles: split and capped), closed and
-// consistently oriented (every directed edge has its twin, none is used twice), in two pieces. A
-// partly cut border vertex the split left on the opening (a pass-through, not a crack tip) once left
-// the held half's opening uncapped here (226 border edges).
-TEST(RenderSurface, TheCompleteCutDrawsTheFrogInTwoClosedPieces) {
-  const Scenario scenario = load_scenario(SCENARIOS / "cut_frog_complete.toml");
-  const std::filesystem::path dir = fresh_dir("render_complete");
-  const SessionSummary s = run_offline(scenario, dir);
-  ASSERT_GT(s.cut_tets, 50u);
-  std::vector<std::filesystem::path> frames;
-  for (const auto& entry : std::filesystem::directory_iterator(dir / "frames")) frames.push_back(entry.path());
-  ASSERT_FALSE(frames.empty());
-  const std::vector<std::uint32_t> triangles = vtu_triangles(*std::max_element(frames.begin(), frames.end()));
-  EXPECT_GT(triangles.size(), 3u * 23240u);
+// Border edges (directed edges without their twin), directed edges used twice, and connected pieces
+// of a triangle surface.
+struct SurfaceShape {
+  std::size_t border = 0, repeated = 0;
+  long pieces = 0;
+};
+
+SurfaceShape shape_of(const std::vector<std::uint32_t>& triangles) {
   std::map<std::pair<std::uint32_t, std::uint32_t>, int> directed;
   std::vector<std::uint32_t> root(*std::max_element(triangles.begin(), triangles.end()) + 1);
   std::iota(root.begin(), root.end(), 0u);
@@ -160,16 +153,42 @@ TEST(RenderSurface, TheCompleteCutDrawsTheFrogInTwoClosedPieces) {
       root[find(triangles[t + k])] = find(triangles[t + (k + 1) % 3]);
     }
   }
-  std::size_t border = 0, repeated = 0;
+  SurfaceShape shape;
   for (const auto& [edge, count] : directed) {
-    border += directed.contains({edge.second, edge.first}) ? 0 : 1;
-    repeated += count > 1 ? 1 : 0;
+    shape.border += directed.contains({edge.second, edge.first}) ? 0 : 1;
+    shape.repeated += count > 1 ? 1 : 0;
   }
-  EXPECT_EQ(border, 0u);
-  EXPECT_EQ(repeated, 0u);
   std::vector<bool> is_root(root.size(), false);
   for (const std::uint32_t v : triangles) is_root[find(v)] = true;
-  EXPECT_EQ(std::count(is_root.begin(), is_root.end(), true), 2);
+  shape.pieces = std::count(is_root.begin(), is_root.end(), true);
+  return shape;
+}
+
+// The complete cut with the frog's render surface switched on (the scenario's surface.renderSurface):
+// every frame, while the blade is in the body and after, is the fine surface closed and consistently
+// oriented (every directed edge has its twin, none is used twice); the last (more than its 23240
+// triangles: split and capped) is in two pieces. Two cap failures this test caught: a border vertex
+// the split left on the opening with material on one side (a pass-through, not a crack tip) left
+// the held half's opening uncapped (226 border edges in the last frame); and a crack tip smeared
+// over split points on no piece's side (the front meeting the surface obliquely) left the slit's
+// walls uncapped at 1.8 s (97).
+TEST(RenderSurface, TheCompleteCutDrawsTheFrogClosedInEveryFrameAndInTwoPiecesAtTheEnd) {
+  const Scenario scenario = load_scenario(SCENARIOS / "cut_frog_complete.toml");
+  const std::filesystem::path dir = fresh_dir("render_complete");
+  const SessionSummary s = run_offline(scenario, dir);
+  ASSERT_GT(s.cut_tets, 50u);
+  std::vector<std::filesystem::path> frames;
+  for (const auto& entry : std::filesystem::directory_iterator(dir / "frames")) frames.push_back(entry.path());
+  ASSERT_GT(frames.size(), 40u);
+  std::sort(frames.begin(), frames.end());
+  for (const std::filesystem::path& frame : frames) {
+    const SurfaceShape shape = shape_of(vtu_triangles(frame));
+    EXPECT_EQ(shape.border, 0u) << frame.filename();
+    EXPECT_EQ(shape.repeated, 0u) << frame.filename();
+  }
+  const std::vector<std::uint32_t> triangles = vtu_triangles(frames.back());
+  EXPECT_GT(triangles.size(), 3u * 23240u);
+  EXPECT_EQ(shape_of(triangles).pieces, 2);
 }
 
 // The hand's figures reach the summary (device kind "hand"): a hand pressing the frog was in contact,

@@ -71,24 +71,30 @@ void ear_clip(const std::vector<int>& loop, const std::vector<Eigen::Vector3d>& 
   normal.normalize();
   const Eigen::Vector3d e1 = normal.unitOrthogonal();
   const Eigen::Vector3d e2 = normal.cross(e1);
-  const auto at = [&](int point) {
-    const Eigen::Vector3d& p = x[static_cast<size_t>(point)];
-    return Eigen::Vector2d(p.dot(e1), p.dot(e2));
-  };
+  // The loop's points in the plane, once, beside `left`.
+  std::vector<Eigen::Vector2d> flat(n);
+  for (size_t i = 0; i < n; ++i) {
+    const Eigen::Vector3d& p = x[static_cast<size_t>(loop[i])];
+    flat[i] = Eigen::Vector2d(p.dot(e1), p.dot(e2));
+  }
   const auto cross = [](const Eigen::Vector2d& a, const Eigen::Vector2d& b, const Eigen::Vector2d& c) {
     return (b - a).x() * (c - a).y() - (b - a).y() * (c - a).x();
   };
+  size_t from = 0;  // the search goes on where the last ear was cut
   while (left.size() > 3) {
     const size_t m = left.size();
     size_t ear = m;
-    for (size_t i = 0; i < m && ear == m; ++i) {
-      const Eigen::Vector2d a = at(left[(i + m - 1) % m]), b = at(left[i]), c = at(left[(i + 1) % m]);
+    for (size_t k = 0; k < m && ear == m; ++k) {
+      const size_t i = (from + k) % m;
+      const Eigen::Vector2d& a = flat[(i + m - 1) % m];
+      const Eigen::Vector2d& b = flat[i];
+      const Eigen::Vector2d& c = flat[(i + 1) % m];
       if (cross(a, b, c) <= 1e-9 * (b - a).norm() * (c - b).norm()) continue;  // reflex or flat
       if (m > 3 && edge_exists(left[(i + 1) % m], left[(i + m - 1) % m])) continue;  // a diagonal the mesh has
       bool empty = true;
       for (size_t j = 0; j < m && empty; ++j) {
         if (j == i || j == (i + m - 1) % m || j == (i + 1) % m) continue;
-        const Eigen::Vector2d p = at(left[j]);
+        const Eigen::Vector2d& p = flat[j];
         empty = !(cross(a, b, p) > 0.0 && cross(b, c, p) > 0.0 && cross(c, a, p) > 0.0);
       }
       if (empty) ear = i;
@@ -96,6 +102,8 @@ void ear_clip(const std::vector<int>& loop, const std::vector<Eigen::Vector3d>& 
     if (ear == m) ear = 0;  // no clean ear (a degenerate loop): cut one anyway, the topology stays closed
     triangles.push_back({left[(ear + m - 1) % m], left[ear], left[(ear + 1) % m]});
     left.erase(left.begin() + static_cast<std::ptrdiff_t>(ear));
+    flat.erase(flat.begin() + static_cast<std::ptrdiff_t>(ear));
+    from = ear % (m - 1);
   }
   triangles.push_back({left[0], left[1], left[2]});
 }
@@ -169,10 +177,15 @@ struct Link {
   int next_first = -1;  // first point of the next chain; -1: the face cannot be closed
 };
 
-// A crack tip (a surface vertex between two chains of one cut, where a partial cut ends).
+// A crack tip (surface points between two chains of one cut, where a partial cut ends): usually one
+// unsplit surface vertex; with a run of split points no piece sides (the front meeting the surface
+// obliquely) more.
 struct Tip {
-  size_t chain;  // the chain ending at the tip
-  int point, part, cut, before, after;  // before, after: the facings of the chains either side
+  size_t chain;           // the chain ending at the tip
+  std::vector<int> run;   // the points up to the next chain; the front starts at the last
+  int first_after;        // the next chain's first point
+  int part, cut, before, after;  // before, after: the facings of the chains either side
+  [[nodiscard]] int point() const { return run.back(); }
 };
 
 // The junctions' switch pairs (forward, backward): of the chains ending at a switch between two
@@ -204,7 +217,7 @@ std::vector<std::pair<size_t, size_t>> paired_tips(const std::vector<Tip>& tips,
       if (b == a || paired[b] || tips[b].part != tips[a].part || tips[b].cut != tips[a].cut ||
           tips[b].before != tips[a].after || tips[b].after != tips[a].before)
         continue;
-      const double distance = (rest_m[static_cast<size_t>(tips[a].point)] - rest_m[static_cast<size_t>(tips[b].point)]).norm();
+      const double distance = (rest_m[static_cast<size_t>(tips[a].point())] - rest_m[static_cast<size_t>(tips[b].point())]).norm();
       if (distance < nearest) {
         nearest = distance;
         best = b;
@@ -369,11 +382,16 @@ void CutRenderSurface::rebuild(const DeformableBody& body) {
 
   // Each edge once: is it cut, and its two split points (the lower vertex's side first).
   // Only an edge with an end in a cut tet can be cut; the others are not looked up.
+  // The material part of each surface vertex riding on an uncut tet (-1 for the others): an edge
+  // between two of them is cut only if their parts differ.
+  std::vector<int> uncut_part(vertices, -1);
+  for (size_t v = 0; v < vertices; ++v) {
+    if (m_points[v].cut_tet < 0) uncut_part[v] = part_of(body, m_points[v]);
+  }
   std::unordered_map<long long, std::array<int, 2>> splits;
   const auto split = [&](int u, int v) -> const std::array<int, 2>* {
     const int lo = std::min(u, v), hi = std::max(u, v);
-    if (m_points[static_cast<size_t>(lo)].cut_tet < 0 && m_points[static_cast<size_t>(hi)].cut_tet < 0 &&
-        part_of(body, m_points[static_cast<size_t>(lo)]) == part_of(body, m_points[static_cast<size_t>(hi)])) {
+    if (uncut_part[static_cast<size_t>(lo)] >= 0 && uncut_part[static_cast<size_t>(lo)] == uncut_part[static_cast<size_t>(hi)]) {
       return nullptr;
     }
     const long long key = (static_cast<long long>(lo) << 32) | static_cast<unsigned int>(hi);
@@ -577,6 +595,26 @@ void CutRenderSurface::cap_loops(const DeformableBody& body) {
     for (const int point : loop) cuts.push_back(m_point_cut[static_cast<size_t>(point)]);
     labels.push_back(junction_smoothed(std::move(cuts)));
   }
+  // A run of one cut whose points lie on no side of it (they ride on uncut tets: split only because
+  // their ends lie in two material parts) between two unsplit points is where the crack front meets
+  // the surface obliquely: unlabelled, it becomes part of the tip around it.
+  for (size_t l = 0; l < loops.size(); ++l) {
+    std::vector<int>& label = labels[l];
+    const size_t n = label.size();
+    for (size_t i = 0; i < n; ++i) {
+      if (label[i] < 0 || label[(i + n - 1) % n] >= 0) continue;
+      size_t j = i;
+      int votes = 0;
+      while (label[(j + 1) % n] == label[i] && j + 1 < i + n) {
+        votes += std::abs(facing(loops[l][j % n], label[i]));
+        ++j;
+      }
+      votes += std::abs(facing(loops[l][j % n], label[i]));
+      if (votes == 0 && label[(j + 1) % n] < 0 && j + 1 < i + n) {
+        for (size_t k = i; k <= j; ++k) label[k % n] = -1;
+      }
+    }
+  }
   for (size_t l = 0; l < loops.size(); ++l) {
     const std::vector<int>& loop = loops[l];
     const size_t n = loop.size();
@@ -630,16 +668,24 @@ void CutRenderSurface::cap_loops(const DeformableBody& body) {
       switches[{part_of_point(beyond), std::min(chain.cut, beyond_cut), std::max(chain.cut, beyond_cut),
                 up ? chain.facing : after_facing, up ? after_facing : chain.facing}]
           .push_back(c);
-    } else if (const auto after = chain_starting_at.find(point_after(chain, 2)); after != chain_starting_at.end()) {
+    } else {
+      std::vector<int> run{beyond};  // the unsplit points up to the next chain
+      const auto length = static_cast<int>(loops[static_cast<size_t>(chain.loop)].size());
+      int steps = 2;
+      for (; steps <= length && label_after(chain, steps) < 0; ++steps) run.push_back(point_after(chain, steps));
+      // (The next chain may be this one: a loop of one chain and its run.)
+      const auto after = chain_starting_at.find(point_after(chain, steps));
+      if (steps > length || after == chain_starting_at.end() || chains[after->second].cut != chain.cut) continue;
       const int after_facing = chains[after->second].facing;
       if (chain.facing != 0 && after_facing == chain.facing) {
         // Not where a cut ends: the material lies on one side before and after, the loop only passes
-        // a surface vertex the split left on the border (its edges' tests disagreed). The face goes on
-        // through it.
-        link[c] = Link{{beyond}, point_after(chain, 2)};
+        // surface points the split left on the border (their edges' tests disagreed). The face goes on
+        // through them.
+        link[c] = Link{run, point_after(chain, steps)};
         continue;
       }
-      tips.push_back(Tip{c, beyond, part_of_point(beyond), chain.cut, chain.facing, after_facing});
+      tips.push_back(Tip{c, run, point_after(chain, steps), part_of_point(run.back()), chain.cut, chain.facing,
+                         after_facing});
     }
   }
   for (const auto& [forward, backward] : paired_switches(switches, chains)) {
@@ -657,13 +703,14 @@ void CutRenderSurface::cap_loops(const DeformableBody& body) {
     back.next_first = line_start;
   }
   for (const auto& [a, best] : paired_tips(tips, m_rest_m)) {
-    std::vector<int> front = line_points(tips[a].point, tips[best].point);  // one crack front for both walls
+    std::vector<int> front = line_points(tips[a].point(), tips[best].point());  // one crack front for both walls
     for (const auto& [from, to] : {std::pair{a, best}, std::pair{best, a}}) {
+      // The wall's own tip run, the front, the other tip's front end; then the chain after it.
       Link& out = link[tips[from].chain];
-      out.bridge.push_back(tips[from].point);
+      out.bridge = tips[from].run;
       out.bridge.insert(out.bridge.end(), front.begin(), front.end());
-      out.bridge.push_back(tips[to].point);
-      out.next_first = point_after(chains[tips[to].chain], 2);
+      out.bridge.push_back(tips[to].point());
+      out.next_first = tips[to].first_after;
       std::reverse(front.begin(), front.end());
     }
   }
