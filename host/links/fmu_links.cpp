@@ -104,19 +104,15 @@ TissueLink::TissueLink(const Fmu3& fmu, const std::vector<ParameterSetting>& par
   std::vector<double> blade;
   expect_ok(m_instance.get_float64("tool.bladeLength", blade), m_instance, "Tissue: blade length");
   m_blade_length_m = blade.at(0);
+  // The box of the nodes at rest: the tet mesh's vertices whichever surface is drawn (a render
+  // surface lies within the tets), so that a scenario's tool path is the same for both.
   SurfaceFrame rest;
   read_surface(rest);
-  const std::size_t vertices = rest.vertex_count();
   m_rest_lower.fill(std::numeric_limits<double>::infinity());
   m_rest_upper.fill(-std::numeric_limits<double>::infinity());
-  std::vector<bool> used(vertices, false);
-  for (const std::uint32_t v : rest.triangles) used[v] = true;
-  for (std::size_t v = 0; v < vertices; ++v) {
-    if (!used[v]) continue;
-    for (std::size_t a = 0; a < 3; ++a) {
-      m_rest_lower[a] = std::min(m_rest_lower[a], rest.positions_m[3 * v + a]);
-      m_rest_upper[a] = std::max(m_rest_upper[a], rest.positions_m[3 * v + a]);
-    }
+  for (std::size_t i = 0; i < rest.node_positions_m.size(); ++i) {
+    m_rest_lower[i % 3] = std::min(m_rest_lower[i % 3], rest.node_positions_m[i]);
+    m_rest_upper[i % 3] = std::max(m_rest_upper[i % 3], rest.node_positions_m[i]);
   }
 }
 

@@ -57,7 +57,7 @@ class TissueLink {
   void read_surface(SurfaceFrame& frame);
   /// Gives `frame` room for twice the surface at rest, so that reading into it rarely allocates.
   void reserve(SurfaceFrame& frame) const;
-  /// Axis-aligned box of the surface at rest (after initialization).
+  /// Axis-aligned box of the tet mesh at rest (after initialization), whichever surface is drawn.
   [[nodiscard]] const std::array<double, 3>& rest_lower() const { return m_rest_lower; }
   [[nodiscard]] const std::array<double, 3>& rest_upper() const { return m_rest_upper; }
   [[nodiscard]] double blade_length_m() const { return m_blade_length_m; }

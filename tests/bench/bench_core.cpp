@@ -178,6 +178,52 @@ void BM_CutRenderSurface(benchmark::State& state) {
 }
 BENCHMARK(BM_CutRenderSurface)->Arg(0)->Arg(1)->Unit(benchmark::kMicrosecond);
 
+// Issue 22: re-meshing the render surface after a careless hand: N strokes along y spread over the
+// body's length, then N across them (each a full-height stroke made by the volume cutter at rest).
+void BM_CutRenderSurfaceHatched(benchmark::State& state) {
+  const TetMesh mesh = read_mesh(std::string(TISSUE_MESH_DIR) + "/frog.veg");
+  DeformableBody body(mesh, BodySettings{});
+  DynamicState dynamics;
+  dynamics.displacement_m = Eigen::VectorXd::Zero(body.dof_count());
+  dynamics.velocity_m_per_s = Eigen::VectorXd::Zero(body.dof_count());
+  const SurfaceMesh surface = extract_surface(mesh);
+  const TetAdjacency adjacency = build_adjacency(mesh);
+  Eigen::VectorXd rest(3 * mesh.vertex_count());
+  for (int v = 0; v < mesh.vertex_count(); ++v) rest.segment<3>(3 * v) = mesh.rest_positions_m[static_cast<size_t>(v)];
+  const SurfaceBvh bvh(surface.triangles, rest);
+  VolumeCutter cutter(mesh, adjacency, surface);
+  const auto strokes = static_cast<int>(state.range(0));
+  const auto stroke = [&](const Eigen::Vector2d& from, const Eigen::Vector2d& to) {
+    Blade previous;
+    for (int n = 0; n <= 40; ++n) {
+      const Eigen::Vector2d at = from + (to - from) * n / 40;
+      const Blade blade{Eigen::Vector3d(at.x(), at.y(), -0.03), Eigen::Vector3d(at.x(), at.y(), 0.06)};
+      cutter.step(n == 0 ? blade : previous, blade, rest, bvh);
+      previous = blade;
+      if (!cutter.new_cuts().empty()) body.enrich(cutter.new_cuts(), dynamics);
+    }
+    cutter.end_cut();
+  };
+  for (int k = 0; k < strokes; ++k) {
+    const double x = -0.025 + 0.06 * (k + 0.5) / strokes;
+    stroke(Eigen::Vector2d(x, -0.0702), Eigen::Vector2d(x, 0.0698));
+  }
+  for (int k = 0; k < strokes; ++k) {
+    const double y = -0.05 + 0.10 * (k + 0.5) / strokes;
+    stroke(Eigen::Vector2d(-0.0301, y), Eigen::Vector2d(0.0399, y));
+  }
+  CutRenderSurface render(mesh, read_obj(std::string(TISSUE_MESH_DIR) + "/frog_surface.obj"),
+                          default_max_outside_m(mesh));
+  for (auto _ : state) {
+    render.rebuild(body);
+    benchmark::DoNotOptimize(render.triangles().data());
+  }
+  state.counters["triangles"] = static_cast<double>(render.triangles().size());
+  state.counters["cut_tets"] = body.cut_tet_count();
+  state.counters["open_loops"] = render.open_loop_count();
+}
+BENCHMARK(BM_CutRenderSurfaceHatched)->Arg(1)->Arg(3)->Arg(10)->Arg(30)->Unit(benchmark::kMillisecond);
+
 }  // namespace
 }  // namespace tissue
 

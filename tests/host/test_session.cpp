@@ -189,6 +189,18 @@ TEST(RenderSurface, TheCompleteCutDrawsTheFrogClosedInEveryFrameAndInTwoPiecesAt
   const std::vector<std::uint32_t> triangles = vtu_triangles(frames.back());
   EXPECT_GT(triangles.size(), 3u * 23240u);
   EXPECT_EQ(shape_of(triangles).pieces, 2);
+
+  // What is drawn changes nothing else: with the tet skin the session's log (tool, forces, tissue
+  // state per tick) is the same bytes. (The scripted path once followed the drawn surface's box.)
+  Scenario skin = scenario;
+  const auto render = std::find_if(skin.tissue_parameters.begin(), skin.tissue_parameters.end(),
+                                   [](const ParameterSetting& p) { return p.name == "surface.renderSurface"; });
+  ASSERT_NE(render, skin.tissue_parameters.end());
+  render->value = std::string("none");
+  const std::filesystem::path skin_dir = fresh_dir("render_complete_skin");
+  const SessionSummary t = run_offline(skin, skin_dir);
+  EXPECT_EQ(t.cut_tets, s.cut_tets);
+  EXPECT_TRUE(contents(skin_dir / "log.csv") == contents(dir / "log.csv")) << "the logs differ";
 }
 
 // The hand's figures reach the summary (device kind "hand"): a hand pressing the frog was in contact,
