@@ -213,6 +213,7 @@ class Run:
         self.max_v = self.max_t = self.max_c = 0
         self.border_steps = 0
         self.max_border = 0
+        self.first_border = None    # (step, t, stroke) of the first step with border edges
         self.max_repeated = 0
         self.truncated_steps = 0
         self.last_tris_bytes = None
@@ -343,6 +344,8 @@ class Run:
             self.last.update(border=border, repeated=repeated)
             if border:
                 self.border_steps += 1
+                if self.first_border is None:
+                    self.first_border = (self.steps, self.t, self.strokes_done + 1, border)
             self.max_border = max(self.max_border, border)
             self.max_repeated = max(self.max_repeated, repeated)
         except DecodeError as error:
@@ -447,9 +450,12 @@ class Run:
             print(f"final surface.mesh: V {L.get('v')}, T {L.get('t')}, C {L.get('c')}; arrays "
                   f"{L['vc']} / {L['tc']} rows; revision {L['revision']}; cut tets {L['cut_tets']}")
             print(f"max reached: V {self.max_v}, T {self.max_t}, C {self.max_c}")
-            print(f"steps with truncated arrays: {self.truncated_steps}")
-            print(f"border edges: {self.border_steps} of {self.steps} steps had some, max {self.max_border} "
+            print(f"checks with truncated arrays: {self.truncated_steps} of {self.steps + 1} (the rest state and every step)")
+            print(f"border edges: {self.border_steps} of {self.steps + 1} checks had some, max {self.max_border} "
                   f"(final {L.get('border')}); directed edges used twice: max {self.max_repeated}")
+            if self.first_border:
+                print(f"first border edges: step {self.first_border[0]} (t = {self.first_border[1]:.2f} s, during "
+                      f"stroke {self.first_border[2]}): {self.first_border[3]}")
             print(f"max |embedding mapped - surface.mesh|: {self.max_map_error:.3e} m")
             print(f"bytes at the end: surface.mesh {L['mesh_bytes']}, surface.embedding {L['embedding_bytes']}, "
                   f"surface.nodes {L['nodes_bytes']}")
