@@ -178,6 +178,54 @@ void BM_CutRenderSurface(benchmark::State& state) {
 }
 BENCHMARK(BM_CutRenderSurface)->Arg(0)->Arg(1)->Unit(benchmark::kMicrosecond);
 
+// Issue 22: re-meshing a step's new cuts (the target: <= 1 ms), as a session does: the X of
+// BM_CutRenderSurface made blade step by blade step, the render surface re-meshed after each step
+// that cut (only those re-meshes timed; the strokes start again when they are done).
+void BM_CutRenderSurfaceStep(benchmark::State& state) {
+  const TetMesh mesh = read_mesh(std::string(TISSUE_MESH_DIR) + "/frog.veg");
+  const SurfaceMesh surface = extract_surface(mesh);
+  const TetAdjacency adjacency = build_adjacency(mesh);
+  Eigen::VectorXd rest(3 * mesh.vertex_count());
+  for (int v = 0; v < mesh.vertex_count(); ++v) rest.segment<3>(3 * v) = mesh.rest_positions_m[static_cast<size_t>(v)];
+  const SurfaceBvh bvh(surface.triangles, rest);
+  const TriangleSurface render_surface = read_obj(std::string(TISSUE_MESH_DIR) + "/frog_surface.obj");
+  const std::array<std::pair<Eigen::Vector2d, Eigen::Vector2d>, 2> strokes{
+      std::pair{Eigen::Vector2d(-0.0301, -0.0702), Eigen::Vector2d(0.0399, 0.0698)},
+      std::pair{Eigen::Vector2d(-0.0301, 0.0698), Eigen::Vector2d(0.0399, -0.0702)}};
+  long remeshes = 0, incremental = 0;
+  while (state.KeepRunning()) {
+    state.PauseTiming();
+    DeformableBody body(mesh, BodySettings{});
+    DynamicState dynamics;
+    dynamics.displacement_m = Eigen::VectorXd::Zero(body.dof_count());
+    dynamics.velocity_m_per_s = Eigen::VectorXd::Zero(body.dof_count());
+    VolumeCutter cutter(mesh, adjacency, surface);
+    CutRenderSurface render(mesh, render_surface, default_max_outside_m(mesh));
+    render.rebuild(body);
+    for (const auto& [from, to] : strokes) {
+      Blade previous;
+      for (int n = 0; n <= 40; ++n) {
+        const Eigen::Vector2d at = from + (to - from) * n / 40;
+        const Blade blade{Eigen::Vector3d(at.x(), at.y(), -0.03), Eigen::Vector3d(at.x(), at.y(), 0.06)};
+        cutter.step(n == 0 ? blade : previous, blade, rest, bvh);
+        previous = blade;
+        if (cutter.new_cuts().empty()) continue;
+        body.enrich(cutter.new_cuts(), dynamics);
+        state.ResumeTiming();
+        render.rebuild(body);
+        state.PauseTiming();
+        ++remeshes;
+        incremental += render.rebuilt_from_scratch() ? 0 : 1;
+      }
+      cutter.end_cut();
+    }
+    state.ResumeTiming();
+  }
+  state.counters["remeshes_per_iteration"] = static_cast<double>(remeshes) / static_cast<double>(state.iterations());
+  state.counters["incremental_share"] = static_cast<double>(incremental) / static_cast<double>(remeshes);
+}
+BENCHMARK(BM_CutRenderSurfaceStep)->Unit(benchmark::kMillisecond);
+
 // Issue 22: re-meshing the render surface after a careless hand: N strokes along y spread over the
 // body's length, then N across them (each a full-height stroke made by the volume cutter at rest).
 void BM_CutRenderSurfaceHatched(benchmark::State& state) {

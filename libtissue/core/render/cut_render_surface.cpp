@@ -80,20 +80,30 @@ void ear_clip(const std::vector<int>& loop, const std::vector<Eigen::Vector3d>& 
   const auto cross = [](const Eigen::Vector2d& a, const Eigen::Vector2d& b, const Eigen::Vector2d& c) {
     return (b - a).x() * (c - a).y() - (b - a).y() * (c - a).x();
   };
+  // Only a corner that is not convex can lie inside a convex corner's triangle: the test of an ear
+  // looks at those (flagged, kept up to date for the two corners next to each ear cut).
+  const auto convex_at = [&](size_t i, size_t m) {
+    const Eigen::Vector2d& a = flat[(i + m - 1) % m];
+    const Eigen::Vector2d& b = flat[i];
+    const Eigen::Vector2d& c = flat[(i + 1) % m];
+    return cross(a, b, c) > 1e-9 * (b - a).norm() * (c - b).norm();
+  };
+  std::vector<char> convex(n);
+  for (size_t i = 0; i < n; ++i) convex[i] = convex_at(i, n) ? 1 : 0;
   size_t from = 0;  // the search goes on where the last ear was cut
   while (left.size() > 3) {
     const size_t m = left.size();
     size_t ear = m;
     for (size_t k = 0; k < m && ear == m; ++k) {
       const size_t i = (from + k) % m;
+      if (convex[i] == 0) continue;  // reflex or flat
       const Eigen::Vector2d& a = flat[(i + m - 1) % m];
       const Eigen::Vector2d& b = flat[i];
       const Eigen::Vector2d& c = flat[(i + 1) % m];
-      if (cross(a, b, c) <= 1e-9 * (b - a).norm() * (c - b).norm()) continue;  // reflex or flat
       if (m > 3 && edge_exists(left[(i + 1) % m], left[(i + m - 1) % m])) continue;  // a diagonal the mesh has
       bool empty = true;
       for (size_t j = 0; j < m && empty; ++j) {
-        if (j == i || j == (i + m - 1) % m || j == (i + 1) % m) continue;
+        if (convex[j] != 0 || j == i || j == (i + m - 1) % m || j == (i + 1) % m) continue;
         const Eigen::Vector2d& p = flat[j];
         empty = !(cross(a, b, p) > 0.0 && cross(b, c, p) > 0.0 && cross(c, a, p) > 0.0);
       }
@@ -103,7 +113,11 @@ void ear_clip(const std::vector<int>& loop, const std::vector<Eigen::Vector3d>& 
     triangles.push_back({left[(ear + m - 1) % m], left[ear], left[(ear + 1) % m]});
     left.erase(left.begin() + static_cast<std::ptrdiff_t>(ear));
     flat.erase(flat.begin() + static_cast<std::ptrdiff_t>(ear));
-    from = ear % (m - 1);
+    convex.erase(convex.begin() + static_cast<std::ptrdiff_t>(ear));
+    const size_t before = (ear + m - 2) % (m - 1), after = ear % (m - 1);
+    convex[before] = convex_at(before, m - 1) ? 1 : 0;
+    convex[after] = convex_at(after, m - 1) ? 1 : 0;
+    from = after;
   }
   triangles.push_back({left[0], left[1], left[2]});
 }
@@ -281,6 +295,16 @@ CutRenderSurface::CutRenderSurface(const TetMesh& mesh, TriangleSurface surface,
   for (const SurfaceEmbedding& e : m_embedding) m_points.push_back(Point{e.tet, e.weights, -1, -1});
   m_rest_m = m_surface.vertices_m;
   m_triangles = m_surface.triangles;
+  m_vertex_triangles_first.assign(m_surface.vertices_m.size() + 1, 0);
+  for (const auto& triangle : m_surface.triangles) {
+    for (const int v : triangle) ++m_vertex_triangles_first[static_cast<size_t>(v) + 1];
+  }
+  std::partial_sum(m_vertex_triangles_first.begin(), m_vertex_triangles_first.end(), m_vertex_triangles_first.begin());
+  m_vertex_triangles.resize(3 * m_surface.triangles.size());
+  std::vector<int> fill(m_vertex_triangles_first.begin(), m_vertex_triangles_first.end() - 1);
+  for (size_t t = 0; t < m_surface.triangles.size(); ++t) {
+    for (const int v : m_surface.triangles[t]) m_vertex_triangles[static_cast<size_t>(fill[static_cast<size_t>(v)]++)] = static_cast<int>(t);
+  }
   for (const auto& triangle : m_surface.triangles) {
     for (size_t k = 0; k < 3; ++k) {
       const int u = std::min(triangle[k], triangle[(k + 1) % 3]), v = std::max(triangle[k], triangle[(k + 1) % 3]);
@@ -371,13 +395,93 @@ int CutRenderSurface::part_of(const DeformableBody& body, const Point& point) co
 void CutRenderSurface::rebuild(const DeformableBody& body) {
   find_material_parts(body);
   const size_t vertices = m_surface.vertices_m.size();
-  m_points.resize(vertices);
-  m_rest_m.resize(vertices);
-  m_point_cut.assign(vertices, -1);
-  for (size_t v = 0; v < vertices; ++v) {
+  const auto tet_count = static_cast<size_t>(m_mesh.tet_count());
+  const auto locate_vertex = [&](size_t v) {
     const SurfaceEmbedding& e = m_embedding[v];
     m_points[v] = body.cut_tet_index(e.tet) < 0 ? Point{e.tet, e.weights, -1, -1}
                                                  : locate(body, e.tet, m_surface.vertices_m[v]);
+  };
+
+  // Incremental: only what rides on a tet whose cut changed since the last re-mesh, or on one of its
+  // face neighbours (whose cut planes an edge's split may use), is located and split again; every
+  // other edge keeps its split points and every other triangle its pieces. From scratch the first
+  // time, when the material parts of the unchanged points regrouped (a piece came free: an uncut
+  // edge may now be cut anywhere), and when dropped split points pile up.
+  bool scratch = m_tet_cut.size() != tet_count || m_orphan_points > static_cast<int>(vertices) / 4;
+  std::vector<char> dirty_tet(tet_count, scratch ? 1 : 0);
+  for (size_t t = 0; t < tet_count && !scratch; ++t) {
+    if (body.cut_tet_index(static_cast<int>(t)) == m_tet_cut[t]) continue;
+    dirty_tet[t] = 1;
+    for (const int n : body.adjacency().face_neighbor[t]) {
+      if (n >= 0) dirty_tet[static_cast<size_t>(n)] = 1;
+    }
+  }
+  std::vector<char> dirty(vertices, 1);
+  std::vector<int> part(vertices, -1);
+  if (!scratch) {
+    // The unchanged points' parts must group them as before: old and new part ids in one-to-one
+    // correspondence over them.
+    std::vector<int> old_to_new(m_part_ids, -1), new_to_old(m_copy_root.size(), -1);
+    for (size_t v = 0; v < vertices && !scratch; ++v) {
+      dirty[v] = dirty_tet[static_cast<size_t>(m_embedding[v].tet)];
+      if (dirty[v] != 0) continue;
+      part[v] = part_of(body, m_points[v]);
+      int& to_new = old_to_new[static_cast<size_t>(m_vertex_part[v])];
+      int& to_old = new_to_old[static_cast<size_t>(part[v])];
+      if (to_new < 0) to_new = part[v];
+      if (to_old < 0) to_old = m_vertex_part[v];
+      scratch = to_new != part[v] || to_old != m_vertex_part[v];
+    }
+  }
+  m_from_scratch = scratch;
+  if (scratch) {
+    std::fill(dirty.begin(), dirty.end(), 1);
+    m_splits.clear();
+    m_points.resize(vertices);
+    m_rest_m.resize(vertices);
+    m_point_cut.assign(vertices, -1);
+    m_cut_edges = 0;
+    m_orphan_points = 0;
+    m_skin.clear();
+    m_skin_first.assign(m_surface.triangles.size() + 1, 0);
+  } else {
+    m_points.resize(m_split_points);  // the last caps' points go: the caps are made again
+    m_rest_m.resize(m_split_points);
+    m_point_cut.resize(m_split_points);
+  }
+  for (size_t v = 0; v < vertices; ++v) {
+    if (dirty[v] != 0) {
+      locate_vertex(v);
+      part[v] = part_of(body, m_points[v]);
+    }
+  }
+  m_vertex_part = part;
+  m_part_ids = m_copy_root.size();
+  m_tet_cut.resize(tet_count);
+  for (size_t t = 0; t < tet_count; ++t) m_tet_cut[t] = body.cut_tet_index(static_cast<int>(t));
+  // The split points of an edge at a moved point are dropped (left unused, on no piece).
+  const auto key_of = [](int u, int v) {
+    return (static_cast<long long>(std::min(u, v)) << 32) | static_cast<unsigned int>(std::max(u, v));
+  };
+  if (!scratch) {
+    for (size_t v = 0; v < vertices; ++v) {
+      if (dirty[v] == 0) continue;
+      for (int i = m_vertex_triangles_first[v]; i < m_vertex_triangles_first[v + 1]; ++i) {
+        const auto& triangle = m_surface.triangles[static_cast<size_t>(m_vertex_triangles[static_cast<size_t>(i)])];
+      for (size_t k = 0; k < 3; ++k) {
+        const int u = triangle[k], w = triangle[(k + 1) % 3];
+        if (dirty[static_cast<size_t>(u)] == 0 && dirty[static_cast<size_t>(w)] == 0) continue;
+        const auto it = m_splits.find(key_of(u, w));
+        if (it == m_splits.end()) continue;
+        if (it->second[0] >= 0) {
+          for (const int p : it->second) m_points[static_cast<size_t>(p)].cut_tet = m_points[static_cast<size_t>(p)].piece = -1;
+          m_orphan_points += 2;
+          --m_cut_edges;
+        }
+        m_splits.erase(it);
+      }
+      }
+    }
   }
 
   // Each edge once: is it cut, and its two split points (the lower vertex's side first).
@@ -386,9 +490,9 @@ void CutRenderSurface::rebuild(const DeformableBody& body) {
   // between two of them is cut only if their parts differ.
   std::vector<int> uncut_part(vertices, -1);
   for (size_t v = 0; v < vertices; ++v) {
-    if (m_points[v].cut_tet < 0) uncut_part[v] = part_of(body, m_points[v]);
+    if (m_points[v].cut_tet < 0) uncut_part[v] = part[v];
   }
-  std::unordered_map<long long, std::array<int, 2>> splits;
+  std::unordered_map<long long, std::array<int, 2>>& splits = m_splits;
   const auto split = [&](int u, int v) -> const std::array<int, 2>* {
     const int lo = std::min(u, v), hi = std::max(u, v);
     if (uncut_part[static_cast<size_t>(lo)] >= 0 && uncut_part[static_cast<size_t>(lo)] == uncut_part[static_cast<size_t>(hi)]) {
@@ -438,13 +542,32 @@ void CutRenderSurface::rebuild(const DeformableBody& body) {
       m_rest_m.push_back(q);
       m_point_cut.push_back(cut_id);
     }
+    ++m_cut_edges;
     return &splits.emplace(key, copies).first->second;
   };
   // The copy of the split point of edge (u, v) on `end`'s side.
   const auto near = [](const std::array<int, 2>& copies, int end, int other) { return copies[end < other ? 0 : 1]; };
 
-  m_triangles.clear();
-  for (const auto& triangle : m_surface.triangles) {
+  std::vector<std::array<int, 3>> skin;
+  skin.reserve(m_surface.triangles.size() + m_skin.size() / 8);
+  std::vector<int> skin_first(m_surface.triangles.size() + 1, 0);
+  const auto is_clean = [&](size_t t) {
+    const auto& triangle = m_surface.triangles[t];
+    return dirty[static_cast<size_t>(triangle[0])] == 0 && dirty[static_cast<size_t>(triangle[1])] == 0 &&
+           dirty[static_cast<size_t>(triangle[2])] == 0;
+  };
+  for (size_t t = 0; t < m_surface.triangles.size(); ++t) {
+    if (is_clean(t)) {  // a run of triangles as they were, copied at once
+      size_t end = t + 1;
+      while (end < m_surface.triangles.size() && is_clean(end)) ++end;
+      const int shift = static_cast<int>(skin.size()) - m_skin_first[t];
+      for (size_t u = t; u < end; ++u) skin_first[u] = m_skin_first[u] + shift;
+      skin.insert(skin.end(), m_skin.begin() + m_skin_first[t], m_skin.begin() + m_skin_first[end]);
+      t = end - 1;
+      continue;
+    }
+    skin_first[t] = static_cast<int>(skin.size());
+    const auto& triangle = m_surface.triangles[t];
     std::array<const std::array<int, 2>*, 3> cut{};
     int cuts = 0;
     for (size_t k = 0; k < 3; ++k) {
@@ -452,13 +575,13 @@ void CutRenderSurface::rebuild(const DeformableBody& body) {
       cuts += cut[k] != nullptr ? 1 : 0;
     }
     if (cuts == 0) {
-      m_triangles.push_back(triangle);
+      skin.push_back(triangle);
       continue;
     }
     if (cuts == 3) {  // where two cuts meet: the three corners
       for (size_t k = 0; k < 3; ++k) {
         const int v = triangle[k], next = triangle[(k + 1) % 3], previous = triangle[(k + 2) % 3];
-        m_triangles.push_back({v, near(*cut[k], v, next), near(*cut[(k + 2) % 3], v, previous)});
+        skin.push_back({v, near(*cut[k], v, next), near(*cut[(k + 2) % 3], v, previous)});
       }
       continue;
     }
@@ -472,23 +595,34 @@ void CutRenderSurface::rebuild(const DeformableBody& body) {
     }
     const int a = triangle[r], b = triangle[(r + 1) % 3], c = triangle[(r + 2) % 3];
     if (cuts == 1) {  // a crack tip: split through the opposite corner, which both sides keep
-      m_triangles.push_back({a, near(*cut[r], a, b), c});
-      m_triangles.push_back({near(*cut[r], b, a), b, c});
+      skin.push_back({a, near(*cut[r], a, b), c});
+      skin.push_back({near(*cut[r], b, a), b, c});
     } else {  // corner a cut off
       const std::array<int, 2>& ab = *cut[r];
       const std::array<int, 2>& ca = *cut[(r + 2) % 3];
-      m_triangles.push_back({a, near(ab, a, b), near(ca, a, c)});
-      m_triangles.push_back({near(ab, b, a), b, c});
-      m_triangles.push_back({near(ab, b, a), c, near(ca, c, a)});
+      skin.push_back({a, near(ab, a, b), near(ca, a, c)});
+      skin.push_back({near(ab, b, a), b, c});
+      skin.push_back({near(ab, b, a), c, near(ca, c, a)});
     }
   }
-  m_cut_edges = static_cast<int>((m_points.size() - vertices) / 2);
+  skin_first.back() = static_cast<int>(skin.size());
+  m_skin = std::move(skin);
+  m_skin_first = std::move(skin_first);
+  m_split_points = m_points.size();
+  m_triangles = m_skin;
   cap_loops(body);
   map_points_to_nodes();
 }
 
 void CutRenderSurface::map_points_to_nodes() {
-  std::unordered_map<long long, int> slot_of;
+  // The slot of each (cut tet, piece) in use, by cut tet and piece.
+  int cut_tets = 0, pieces = 1;
+  for (const Point& point : m_points) {
+    cut_tets = std::max(cut_tets, point.cut_tet + 1);
+    pieces = std::max(pieces, point.piece + 1);
+  }
+  const auto stride = static_cast<size_t>(pieces);
+  std::vector<int> slot_of(static_cast<size_t>(cut_tets) * stride, -1);
   m_slots.clear();
   m_point_nodes.resize(m_points.size());
   for (size_t i = 0; i < m_points.size(); ++i) {
@@ -498,10 +632,12 @@ void CutRenderSurface::map_points_to_nodes() {
       for (size_t j = 0; j < 4; ++j) nodes[j] = m_mesh.tets[static_cast<size_t>(point.tet)][j];
       continue;
     }
-    const long long key = (static_cast<long long>(point.cut_tet) << 16) | point.piece;
-    auto [it, added] = slot_of.emplace(key, static_cast<int>(m_slots.size()));
-    if (added) m_slots.push_back({point.cut_tet, point.piece});
-    for (size_t j = 0; j < 4; ++j) nodes[j] = m_mesh.vertex_count() + 4 * it->second + static_cast<int>(j);
+    int& slot = slot_of[static_cast<size_t>(point.cut_tet) * stride + static_cast<size_t>(point.piece)];
+    if (slot < 0) {
+      slot = static_cast<int>(m_slots.size());
+      m_slots.push_back({point.cut_tet, point.piece});
+    }
+    for (size_t j = 0; j < 4; ++j) nodes[j] = m_mesh.vertex_count() + 4 * slot + static_cast<int>(j);
   }
 }
 
@@ -545,6 +681,7 @@ void CutRenderSurface::cap_loops(const DeformableBody& body) {
   // between two of the surface's own vertices keeps both its triangles: it is never a border.)
   const auto vertices = static_cast<int>(m_surface.vertices_m.size());
   std::unordered_map<long long, int> directed;  // (u, v) -> count
+  directed.reserve(8 * (m_points.size() - static_cast<size_t>(m_surface.vertices_m.size())) + 64);
   const auto key = [](int u, int v) { return (static_cast<long long>(u) << 32) | static_cast<unsigned int>(v); };
   for (const auto& [a, b, c] : m_triangles) {
     if (a < vertices && b < vertices && c < vertices) continue;
@@ -553,6 +690,7 @@ void CutRenderSurface::cap_loops(const DeformableBody& body) {
     }
   }
   std::unordered_set<long long> cap_edges;  // (lower, higher) of the caps' edges so far
+  cap_edges.reserve(directed.size() + 64);
   const auto has_edge = [&](int u, int v) {
     const long long undirected = key(std::min(u, v), std::max(u, v));
     if (cap_edges.contains(undirected)) return true;

@@ -22,9 +22,14 @@
 //   own connectivity.
 // * An edge whose ends lie in two material parts that neither end's piece tells apart (it passes over
 //   a cut tet between theirs) is split where it crosses a cut plane of the cut tets around its ends.
+// * Re-meshing is incremental: only the points on tets whose cut changed (and on their face
+//   neighbours) are located and their edges and triangles split again; the other edges keep their
+//   split points, the other triangles their pieces; the caps are made again. From scratch the first
+//   time, when the unchanged points' material parts regroup (a piece came free), and when the split
+//   points dropped by re-splits exceed a quarter of the surface's vertices.
 // Limits: the crack front is the straight line between the tips (right for a stroke through the
-// full depth), and its points follow one side; rebuild re-meshes from scratch (2.4 ms on the X-cut
-// frog).
+// full depth), and its points follow one side; where two partial cuts cross, a switch has no
+// partner (the junction line ends inside the body) and the loop stays open.
 #pragma once
 
 #include "core/fem/deformable_body.hpp"
@@ -34,6 +39,7 @@
 
 #include <array>
 #include <string>
+#include <unordered_map>
 #include <unordered_set>
 #include <vector>
 
@@ -45,8 +51,8 @@ class CutRenderSurface {
   CutRenderSurface(const TetMesh& mesh, TriangleSurface surface, double max_outside_m,
                    const std::string& source_name = "render surface");
 
-  /// Re-meshes the surface for the body's cuts (from the surface as given: cheap to call after each
-  /// batch of cuts).
+  /// Re-meshes the surface for the body's cuts: again only where the cut tets changed since the
+  /// last call (from the surface as given the first time, and when a piece came free).
   void rebuild(const DeformableBody& body);
   /// Positions and normals for the body's state (after rebuild for the body's current cuts).
   void update(const DeformableBody& body, const Eigen::VectorXd& displacement_m);
@@ -59,11 +65,14 @@ class CutRenderSurface {
   [[nodiscard]] const std::vector<Eigen::Vector3d>& normals() const { return m_normals; }
   /// Rest position of each point (the surface's vertices, then the split points). [m]
   [[nodiscard]] const std::vector<Eigen::Vector3d>& rest_positions_m() const { return m_rest_m; }
-  /// Render points: the surface's vertices first, then two per cut edge.
+  /// Render points: the surface's vertices first, then two per cut edge (and, after incremental
+  /// re-meshes, split points no triangle uses any more), then the caps' line points.
   [[nodiscard]] int point_count() const { return static_cast<int>(m_points.size()); }
   [[nodiscard]] int cut_edge_count() const { return m_cut_edges; }
   /// Border loops left open by the last rebuild (none that the capping understands).
   [[nodiscard]] int open_loop_count() const { return m_open_loops; }
+  /// Whether the last rebuild started from the surface as given (else it redid only what changed).
+  [[nodiscard]] bool rebuilt_from_scratch() const { return m_from_scratch; }
 
   // The surface as a linear map of a few coarse nodes (for a viewer that maps on its side: the
   // mapping is sent once per rebuild, the nodes every frame). Nodes: the mesh's vertices, then four
@@ -114,6 +123,20 @@ class CutRenderSurface {
   int m_open_loops = 0;
   std::unordered_set<long long> m_surface_edges;  // the surface's own edges (lower vertex << 32 | higher)
   std::vector<int> m_point_cut;
+  // What the next rebuild reuses: per tet its cut tet at the last re-mesh, per surface vertex its
+  // material part then, each edge's split (its two points, or -1 -1: not split), the skin's pieces
+  // per surface triangle (m_skin[m_skin_first[t] .. m_skin_first[t + 1]]), the points before the
+  // caps', and the split points dropped since the last re-mesh from scratch.
+  std::vector<int> m_tet_cut;
+  std::vector<int> m_vertex_part;
+  std::unordered_map<long long, std::array<int, 2>> m_splits;
+  std::vector<std::array<int, 3>> m_skin;
+  std::vector<int> m_skin_first;
+  size_t m_part_ids = 0;  // how many part ids m_vertex_part's come from
+  size_t m_split_points = 0;
+  std::vector<int> m_vertex_triangles_first, m_vertex_triangles;  // the surface's triangles at each vertex
+  int m_orphan_points = 0;
+  bool m_from_scratch = true;
   std::vector<int> m_copy_root;  // per copy of a vertex (real, then ghost rows): its material part
   // per point: the cut id of the plane that split it, -1 for others
   std::vector<std::array<int, 2>> m_slots;  // the (cut tet, piece) of each group of four nodes

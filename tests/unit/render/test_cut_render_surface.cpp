@@ -23,6 +23,7 @@
 
 #include <algorithm>
 #include <cstdio>
+#include <functional>
 #include <memory>
 #include <map>
 #include <numeric>
@@ -43,7 +44,9 @@ struct CutFrog {
   DeformableBody body;
   DynamicState state;
 
-  explicit CutFrog(const std::vector<std::array<Eigen::Vector2d, 2>>& strokes, double held_below_x_m = -1.0)
+  /// `after_cuts` is called after each blade step that cut.
+  explicit CutFrog(const std::vector<std::array<Eigen::Vector2d, 2>>& strokes, double held_below_x_m = -1.0,
+                   const std::function<void(const DeformableBody&)>& after_cuts = {})
       : body(mesh, settings(mesh, held_below_x_m)) {
     state.displacement_m = Eigen::VectorXd::Zero(body.dof_count());
     state.velocity_m_per_s = Eigen::VectorXd::Zero(body.dof_count());
@@ -59,7 +62,10 @@ struct CutFrog {
         const Blade blade{Eigen::Vector3d(at.x(), at.y(), -0.03), Eigen::Vector3d(at.x(), at.y(), 0.06)};
         cutter.step(n == 0 ? blade : previous, blade, rest, bvh);
         previous = blade;
-        if (!cutter.new_cuts().empty()) body.enrich(cutter.new_cuts(), state);
+        if (!cutter.new_cuts().empty()) {
+          body.enrich(cutter.new_cuts(), state);
+          if (after_cuts) after_cuts(body);
+        }
       }
       cutter.end_cut();
     }
@@ -304,6 +310,95 @@ TEST(CutRenderSurface, AFlapCutFreeByThreeStrokesIsClosed) {
     EXPECT_NEAR(part.volume_m3, ideal_m3, 3.0 * junction_tolerance_m3(uncut));  // three corners
   }
   EXPECT_EQ(flaps, 1);
+}
+
+// The skin's triangles by their corners' rest positions (a split point's is exact: the same fraction
+// of the same edge), sorted: two re-meshes are the same skin whatever their point numbering.
+std::vector<std::array<double, 9>> skin_at_rest(const CutRenderSurface& render) {
+  std::vector<std::array<double, 9>> skin;
+  const auto& triangles = render.triangles();
+  for (size_t t = 0; t + static_cast<size_t>(render.cap_triangle_count()) < triangles.size(); ++t) {
+    std::array<double, 9> corners{};
+    for (size_t k = 0; k < 3; ++k) {
+      for (int c = 0; c < 3; ++c) corners[3 * k + static_cast<size_t>(c)] = render.rest_positions_m()[static_cast<size_t>(triangles[t][k])](c);
+    }
+    // Start at the smallest corner (the winding kept).
+    size_t first = 0;
+    for (size_t k = 1; k < 3; ++k) {
+      if (std::lexicographical_compare(corners.begin() + 3 * k, corners.begin() + 3 * k + 3,
+                                       corners.begin() + 3 * first, corners.begin() + 3 * first + 3)) {
+        first = k;
+      }
+    }
+    std::array<double, 9> rotated{};
+    for (size_t k = 0; k < 9; ++k) rotated[k] = corners[(k + 3 * first) % 9];
+    skin.push_back(rotated);
+  }
+  std::sort(skin.begin(), skin.end());
+  return skin;
+}
+
+// The signed volume the whole render surface encloses at rest (its pieces' sum). [m^3]
+double enclosed_at_rest_m3(const CutRenderSurface& render) {
+  double six_v = 0.0;
+  for (const auto& [a, b, c] : render.triangles()) {
+    const auto& x = render.rest_positions_m();
+    six_v += x[static_cast<size_t>(a)].dot(x[static_cast<size_t>(b)].cross(x[static_cast<size_t>(c)]));
+  }
+  return six_v / 6.0;
+}
+
+// Re-meshing after every blade step that cut redoes only the tets whose cut changed (and their
+// neighbours) and keeps the rest; at every 7th step and at the end it is the surface re-meshed from
+// scratch for the same cuts: the same skin triangles (corner for corner at rest), as many open loops,
+// and the same enclosed volume (the caps lie in their cut planes, so how they are triangulated does
+// not change it: to round-off). The caps' triangles: as many for the X and the flap; within 1% for
+// 3 + 3 hatched strokes (re-cut tets, many crack tips: where several tips of one cut lie on a loop,
+// which pairs with which follows the loop's order, and so the points' numbering).
+TEST(CutRenderSurface, ReMeshingStepByStepIsReMeshingFromScratch) {
+  const std::array<Eigen::Vector2d, 3> corner{Eigen::Vector2d(-0.0213, -0.0117), Eigen::Vector2d(0.0161, -0.0129),
+                                              Eigen::Vector2d(-0.0019, 0.0147)};
+  std::vector<std::array<Eigen::Vector2d, 2>> flap;
+  for (size_t k = 0; k < 3; ++k) {
+    const Eigen::Vector2d along = (corner[(k + 1) % 3] - corner[k]).normalized();
+    flap.push_back({corner[k] - 0.02 * along, corner[(k + 1) % 3] + 0.02 * along});
+  }
+  std::vector<std::array<Eigen::Vector2d, 2>> hatched;
+  for (int k = 0; k < 3; ++k) hatched.push_back({Eigen::Vector2d(-0.025 + 0.02 * (k + 0.5), -0.0702), Eigen::Vector2d(-0.025 + 0.02 * (k + 0.5), 0.0698)});
+  for (int k = 0; k < 3; ++k) hatched.push_back({Eigen::Vector2d(-0.0301, -0.05 + 0.0333 * (k + 0.5)), Eigen::Vector2d(0.0399, -0.05 + 0.0333 * (k + 0.5))});
+  const std::vector<std::vector<std::array<Eigen::Vector2d, 2>>> cases{
+      {{Eigen::Vector2d(-0.0301, -0.0702), Eigen::Vector2d(0.0399, 0.0698)},
+       {Eigen::Vector2d(-0.0301, 0.0698), Eigen::Vector2d(0.0399, -0.0702)}},
+      flap, hatched};
+  const TetMesh mesh = read_mesh(std::string(TISSUE_MESH_DIR) + "/frog.veg");
+  const CutRenderSurface pristine(mesh, CutFrog::render_surface(), default_max_outside_m(mesh));
+  for (size_t c = 0; c < cases.size(); ++c) {
+    CutRenderSurface stepwise = pristine;
+    int steps = 0, incremental = 0;
+    const CutFrog frog(cases[c], -1.0, [&](const DeformableBody& body) {
+      stepwise.rebuild(body);
+      ++steps;
+      incremental += stepwise.rebuilt_from_scratch() ? 0 : 1;
+      if (steps % 7 != 0) return;  // compared every 7th step (and at the end)
+      CutRenderSurface scratch = pristine;
+      scratch.rebuild(body);
+      ASSERT_TRUE(scratch.rebuilt_from_scratch());
+      const double cap_tolerance = c == 2 ? 0.01 * scratch.cap_triangle_count() : 0.0;
+      EXPECT_NEAR(stepwise.cap_triangle_count(), scratch.cap_triangle_count(), cap_tolerance) << "case " << c << " step " << steps;
+      EXPECT_EQ(stepwise.open_loop_count(), scratch.open_loop_count()) << "case " << c << " step " << steps;
+      EXPECT_TRUE(skin_at_rest(stepwise) == skin_at_rest(scratch)) << "case " << c << " step " << steps;
+      EXPECT_NEAR(enclosed_at_rest_m3(stepwise), enclosed_at_rest_m3(scratch), 1e-15) << "case " << c << " step " << steps;
+    });
+    CutRenderSurface scratch = pristine;
+    scratch.rebuild(frog.body);
+    EXPECT_TRUE(skin_at_rest(stepwise) == skin_at_rest(scratch)) << "case " << c;
+    EXPECT_NEAR(stepwise.cap_triangle_count(), scratch.cap_triangle_count(), c == 2 ? 0.01 * scratch.cap_triangle_count() : 0.0)
+        << "case " << c;
+    EXPECT_EQ(stepwise.open_loop_count(), scratch.open_loop_count()) << "case " << c;
+    EXPECT_NEAR(enclosed_at_rest_m3(stepwise), enclosed_at_rest_m3(scratch), 1e-15) << "case " << c;
+    std::printf("case %zu: %d re-meshes, %d incremental\n", c, steps, incremental);
+    EXPECT_GT(incremental, steps / 2) << "case " << c;
+  }
 }
 
 TEST(CutRenderSurface, APieceThatFallsAwayStretchesNoTriangleAcrossTheOpening) {
