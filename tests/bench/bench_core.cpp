@@ -13,6 +13,8 @@
 
 #include <benchmark/benchmark.h>
 
+#include <functional>
+#include <optional>
 #include <random>
 
 namespace tissue {
@@ -135,73 +137,38 @@ void BM_RenderSurfaceMap(benchmark::State& state) {
 }
 BENCHMARK(BM_RenderSurfaceMap)->Unit(benchmark::kMicrosecond);
 
-// Issue 22: the render surface cut with the tets on the frog after an X of two full-height strokes
-// (made by the volume cutter at rest): arg 0 re-meshes it for the cuts (rebuild), arg 1 maps it
-// onto the state (update, pieces included).
-void BM_CutRenderSurface(benchmark::State& state) {
-  const TetMesh mesh = read_mesh(std::string(TISSUE_MESH_DIR) + "/frog.veg");
-  DeformableBody body(mesh, BodySettings{});
-  DynamicState dynamics;
-  dynamics.displacement_m = Eigen::VectorXd::Zero(body.dof_count());
-  dynamics.velocity_m_per_s = Eigen::VectorXd::Zero(body.dof_count());
-  const SurfaceMesh surface = extract_surface(mesh);
-  const TetAdjacency adjacency = build_adjacency(mesh);
-  Eigen::VectorXd rest(3 * mesh.vertex_count());
-  for (int v = 0; v < mesh.vertex_count(); ++v) rest.segment<3>(3 * v) = mesh.rest_positions_m[static_cast<size_t>(v)];
-  const SurfaceBvh bvh(surface.triangles, rest);
-  VolumeCutter cutter(mesh, adjacency, surface);
-  for (const auto& [from, to] : {std::pair{Eigen::Vector2d(-0.0301, -0.0702), Eigen::Vector2d(0.0399, 0.0698)},
-                                 std::pair{Eigen::Vector2d(-0.0301, 0.0698), Eigen::Vector2d(0.0399, -0.0702)}}) {
-    Blade previous;
-    for (int n = 0; n <= 40; ++n) {
-      const Eigen::Vector2d at = from + (to - from) * n / 40;
-      const Blade blade{Eigen::Vector3d(at.x(), at.y(), -0.03), Eigen::Vector3d(at.x(), at.y(), 0.06)};
-      cutter.step(n == 0 ? blade : previous, blade, rest, bvh);
-      previous = blade;
-      if (!cutter.new_cuts().empty()) body.enrich(cutter.new_cuts(), dynamics);
-    }
-    cutter.end_cut();
-  }
-  CutRenderSurface render(mesh, read_obj(std::string(TISSUE_MESH_DIR) + "/frog_surface.obj"),
-                          default_max_outside_m(mesh));
-  render.rebuild(body);
-  for (auto _ : state) {
-    if (state.range(0) == 0) {
-      render.rebuild(body);
-    } else {
-      render.update(body, dynamics.displacement_m);
-    }
-    benchmark::DoNotOptimize(render.triangles().data());
-  }
-  state.counters["triangles"] = static_cast<double>(render.triangles().size());
-  state.counters["cut_tets"] = body.cut_tet_count();
-}
-BENCHMARK(BM_CutRenderSurface)->Arg(0)->Arg(1)->Unit(benchmark::kMicrosecond);
+// Issue 22: the frog at rest cut by full-height vertical strokes of the volume cutter (40 blade
+// steps each, every stroke its own session), and its render surface (meshes/frog_surface.obj).
+struct FrogStrokes {
+  TetMesh mesh = read_mesh(std::string(TISSUE_MESH_DIR) + "/frog.veg");
+  SurfaceMesh surface = extract_surface(mesh);
+  TetAdjacency adjacency = build_adjacency(mesh);
+  Eigen::VectorXd rest = rest_positions(mesh);
+  SurfaceBvh bvh{surface.triangles, rest};
+  TriangleSurface render_surface = read_obj(std::string(TISSUE_MESH_DIR) + "/frog_surface.obj");
+  std::optional<DeformableBody> body{std::in_place, mesh, BodySettings{}};
+  DynamicState dynamics = at_rest(*body);
 
-// Issue 22: re-meshing a step's new cuts (the target: <= 1 ms), as a session does: the X of
-// BM_CutRenderSurface made blade step by blade step, the render surface re-meshed after each step
-// that cut (only those re-meshes timed; the strokes start again when they are done).
-void BM_CutRenderSurfaceStep(benchmark::State& state) {
-  const TetMesh mesh = read_mesh(std::string(TISSUE_MESH_DIR) + "/frog.veg");
-  const SurfaceMesh surface = extract_surface(mesh);
-  const TetAdjacency adjacency = build_adjacency(mesh);
-  Eigen::VectorXd rest(3 * mesh.vertex_count());
-  for (int v = 0; v < mesh.vertex_count(); ++v) rest.segment<3>(3 * v) = mesh.rest_positions_m[static_cast<size_t>(v)];
-  const SurfaceBvh bvh(surface.triangles, rest);
-  const TriangleSurface render_surface = read_obj(std::string(TISSUE_MESH_DIR) + "/frog_surface.obj");
-  const std::array<std::pair<Eigen::Vector2d, Eigen::Vector2d>, 2> strokes{
-      std::pair{Eigen::Vector2d(-0.0301, -0.0702), Eigen::Vector2d(0.0399, 0.0698)},
-      std::pair{Eigen::Vector2d(-0.0301, 0.0698), Eigen::Vector2d(0.0399, -0.0702)}};
-  long remeshes = 0, incremental = 0;
-  while (state.KeepRunning()) {
-    state.PauseTiming();
-    DeformableBody body(mesh, BodySettings{});
+  static Eigen::VectorXd rest_positions(const TetMesh& mesh) {
+    Eigen::VectorXd rest(3 * mesh.vertex_count());
+    for (int v = 0; v < mesh.vertex_count(); ++v) rest.segment<3>(3 * v) = mesh.rest_positions_m[static_cast<size_t>(v)];
+    return rest;
+  }
+  static DynamicState at_rest(const DeformableBody& body) {
     DynamicState dynamics;
     dynamics.displacement_m = Eigen::VectorXd::Zero(body.dof_count());
     dynamics.velocity_m_per_s = Eigen::VectorXd::Zero(body.dof_count());
+    return dynamics;
+  }
+  /// Back to the uncut frog.
+  void reset() {
+    body.emplace(mesh, BodySettings{});
+    dynamics = at_rest(*body);
+  }
+  /// Strokes (x, y from -> to) through the whole height; `after_cut` after each blade step that cut.
+  void cut(const std::vector<std::pair<Eigen::Vector2d, Eigen::Vector2d>>& strokes,
+           const std::function<void()>& after_cut = {}) {
     VolumeCutter cutter(mesh, adjacency, surface);
-    CutRenderSurface render(mesh, render_surface, default_max_outside_m(mesh));
-    render.rebuild(body);
     for (const auto& [from, to] : strokes) {
       Blade previous;
       for (int n = 0; n <= 40; ++n) {
@@ -210,15 +177,63 @@ void BM_CutRenderSurfaceStep(benchmark::State& state) {
         cutter.step(n == 0 ? blade : previous, blade, rest, bvh);
         previous = blade;
         if (cutter.new_cuts().empty()) continue;
-        body.enrich(cutter.new_cuts(), dynamics);
-        state.ResumeTiming();
-        render.rebuild(body);
-        state.PauseTiming();
-        ++remeshes;
-        incremental += render.rebuilt_from_scratch() ? 0 : 1;
+        body->enrich(cutter.new_cuts(), dynamics);
+        if (after_cut) after_cut();
       }
       cutter.end_cut();
     }
+  }
+  [[nodiscard]] CutRenderSurface render() const { return {mesh, render_surface, default_max_outside_m(mesh)}; }
+};
+
+// Two strokes crossing on the back: an X.
+const std::vector<std::pair<Eigen::Vector2d, Eigen::Vector2d>> X_STROKES{
+    {Eigen::Vector2d(-0.0301, -0.0702), Eigen::Vector2d(0.0399, 0.0698)},
+    {Eigen::Vector2d(-0.0301, 0.0698), Eigen::Vector2d(0.0399, -0.0702)}};
+
+// Issue 22: the render surface cut with the tets on the frog after the X: arg 0 re-meshes it for
+// all the cuts from scratch (rebuild), arg 1 maps it onto the state (update, pieces included).
+void BM_CutRenderSurface(benchmark::State& state) {
+  FrogStrokes frog;
+  frog.cut(X_STROKES);
+  const CutRenderSurface fresh = frog.render();
+  std::optional<CutRenderSurface> render(fresh);
+  render->rebuild(*frog.body);
+  for (auto _ : state) {
+    if (state.range(0) == 0) {  // a fresh copy each time: from scratch
+      state.PauseTiming();
+      render.emplace(fresh);
+      state.ResumeTiming();
+      render->rebuild(*frog.body);
+    } else {
+      render->update(*frog.body, frog.dynamics.displacement_m);
+    }
+    benchmark::DoNotOptimize(render->triangles().data());
+  }
+  state.counters["triangles"] = static_cast<double>(render->triangles().size());
+  state.counters["cut_tets"] = frog.body->cut_tet_count();
+}
+BENCHMARK(BM_CutRenderSurface)->Arg(0)->Arg(1)->Unit(benchmark::kMicrosecond);
+
+// Issue 22: re-meshing a step's new cuts (the target: <= 1 ms), as a session does: the X made blade
+// step by blade step, the render surface re-meshed after each step that cut (only those re-meshes
+// timed; the strokes start again when they are done).
+void BM_CutRenderSurfaceStep(benchmark::State& state) {
+  FrogStrokes frog;
+  const CutRenderSurface fresh = frog.render();
+  long remeshes = 0, incremental = 0;
+  while (state.KeepRunning()) {
+    state.PauseTiming();
+    frog.reset();
+    CutRenderSurface render(fresh);
+    render.rebuild(*frog.body);
+    frog.cut(X_STROKES, [&] {
+      state.ResumeTiming();
+      render.rebuild(*frog.body);
+      state.PauseTiming();
+      ++remeshes;
+      incremental += render.rebuilt_from_scratch() ? 0 : 1;
+    });
     state.ResumeTiming();
   }
   state.counters["remeshes_per_iteration"] = static_cast<double>(remeshes) / static_cast<double>(state.iterations());
@@ -226,49 +241,33 @@ void BM_CutRenderSurfaceStep(benchmark::State& state) {
 }
 BENCHMARK(BM_CutRenderSurfaceStep)->Unit(benchmark::kMillisecond);
 
-// Issue 22: re-meshing the render surface after a careless hand: N strokes along y spread over the
-// body's length, then N across them (each a full-height stroke made by the volume cutter at rest).
+// Issue 22: re-meshing the render surface from scratch after a careless hand: N strokes along y
+// spread over the body's length, then N across them.
 void BM_CutRenderSurfaceHatched(benchmark::State& state) {
-  const TetMesh mesh = read_mesh(std::string(TISSUE_MESH_DIR) + "/frog.veg");
-  DeformableBody body(mesh, BodySettings{});
-  DynamicState dynamics;
-  dynamics.displacement_m = Eigen::VectorXd::Zero(body.dof_count());
-  dynamics.velocity_m_per_s = Eigen::VectorXd::Zero(body.dof_count());
-  const SurfaceMesh surface = extract_surface(mesh);
-  const TetAdjacency adjacency = build_adjacency(mesh);
-  Eigen::VectorXd rest(3 * mesh.vertex_count());
-  for (int v = 0; v < mesh.vertex_count(); ++v) rest.segment<3>(3 * v) = mesh.rest_positions_m[static_cast<size_t>(v)];
-  const SurfaceBvh bvh(surface.triangles, rest);
-  VolumeCutter cutter(mesh, adjacency, surface);
+  FrogStrokes frog;
   const auto strokes = static_cast<int>(state.range(0));
-  const auto stroke = [&](const Eigen::Vector2d& from, const Eigen::Vector2d& to) {
-    Blade previous;
-    for (int n = 0; n <= 40; ++n) {
-      const Eigen::Vector2d at = from + (to - from) * n / 40;
-      const Blade blade{Eigen::Vector3d(at.x(), at.y(), -0.03), Eigen::Vector3d(at.x(), at.y(), 0.06)};
-      cutter.step(n == 0 ? blade : previous, blade, rest, bvh);
-      previous = blade;
-      if (!cutter.new_cuts().empty()) body.enrich(cutter.new_cuts(), dynamics);
-    }
-    cutter.end_cut();
-  };
+  std::vector<std::pair<Eigen::Vector2d, Eigen::Vector2d>> hatched;
   for (int k = 0; k < strokes; ++k) {
     const double x = -0.025 + 0.06 * (k + 0.5) / strokes;
-    stroke(Eigen::Vector2d(x, -0.0702), Eigen::Vector2d(x, 0.0698));
+    hatched.emplace_back(Eigen::Vector2d(x, -0.0702), Eigen::Vector2d(x, 0.0698));
   }
   for (int k = 0; k < strokes; ++k) {
     const double y = -0.05 + 0.10 * (k + 0.5) / strokes;
-    stroke(Eigen::Vector2d(-0.0301, y), Eigen::Vector2d(0.0399, y));
+    hatched.emplace_back(Eigen::Vector2d(-0.0301, y), Eigen::Vector2d(0.0399, y));
   }
-  CutRenderSurface render(mesh, read_obj(std::string(TISSUE_MESH_DIR) + "/frog_surface.obj"),
-                          default_max_outside_m(mesh));
+  frog.cut(hatched);
+  const CutRenderSurface fresh = frog.render();
+  std::optional<CutRenderSurface> render;
   for (auto _ : state) {
-    render.rebuild(body);
-    benchmark::DoNotOptimize(render.triangles().data());
+    state.PauseTiming();
+    render.emplace(fresh);
+    state.ResumeTiming();
+    render->rebuild(*frog.body);
+    benchmark::DoNotOptimize(render->triangles().data());
   }
-  state.counters["triangles"] = static_cast<double>(render.triangles().size());
-  state.counters["cut_tets"] = body.cut_tet_count();
-  state.counters["open_loops"] = render.open_loop_count();
+  state.counters["triangles"] = static_cast<double>(render->triangles().size());
+  state.counters["cut_tets"] = frog.body->cut_tet_count();
+  state.counters["open_loops"] = render->open_loop_count();
 }
 BENCHMARK(BM_CutRenderSurfaceHatched)->Arg(1)->Arg(3)->Arg(10)->Arg(30)->Unit(benchmark::kMillisecond);
 

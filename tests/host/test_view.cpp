@@ -60,6 +60,14 @@ TEST(ViewPoseMessage, RefusesEverythingElseWithAReason) {
   }
 }
 
+// A little-endian value of a frame at a byte offset.
+template <class T>
+T read_at(const std::string& bytes, std::size_t offset) {
+  T value;
+  std::memcpy(&value, bytes.data() + offset, sizeof(T));
+  return value;
+}
+
 TEST(ViewFrame, HeaderPositionsAndTrianglesAsDocumented) {
   SurfaceFrame frame;
   frame.time_s = 1.25;
@@ -77,16 +85,8 @@ TEST(ViewFrame, HeaderPositionsAndTrianglesAsDocumented) {
   encode_view_frames(frame, overlay, plain, full);
   EXPECT_EQ(plain.size(), VIEW_FRAME_HEADER_BYTES + 4 * 12);
   EXPECT_EQ(full.size(), VIEW_FRAME_HEADER_BYTES + 4 * 12 + 4 * 6);
-  const auto u32 = [&full](std::size_t offset) {
-    std::uint32_t v;
-    std::memcpy(&v, full.data() + offset, 4);
-    return v;
-  };
-  const auto f32 = [&full](std::size_t offset) {
-    float v;
-    std::memcpy(&v, full.data() + offset, 4);
-    return v;
-  };
+  const auto u32 = [&full](std::size_t offset) { return read_at<std::uint32_t>(full, offset); };
+  const auto f32 = [&full](std::size_t offset) { return read_at<float>(full, offset); };
   double time;
   std::memcpy(&time, full.data() + 24, 8);
   EXPECT_EQ(u32(0), VIEW_FRAME_MAGIC);
@@ -129,16 +129,8 @@ TEST(ViewFrame, AMappedFrameCarriesTheNodesAndOnceTheEmbedding) {
   frame.mesh_triangle_count = 3;
   std::string plain, full;
   encode_view_frames(frame, ViewOverlay{}, plain, full);
-  const auto u32 = [&full](std::size_t offset) {
-    std::uint32_t v;
-    std::memcpy(&v, full.data() + offset, 4);
-    return v;
-  };
-  const auto f32 = [&full](std::size_t offset) {
-    float v;
-    std::memcpy(&v, full.data() + offset, 4);
-    return v;
-  };
+  const auto u32 = [&full](std::size_t offset) { return read_at<std::uint32_t>(full, offset); };
+  const auto f32 = [&full](std::size_t offset) { return read_at<float>(full, offset); };
   const std::size_t nodes_n = 4, points = 5, triangles = 4;
   EXPECT_EQ(plain.size(), VIEW_FRAME_HEADER_BYTES + 12 * nodes_n);
   EXPECT_EQ(full.size(), VIEW_FRAME_HEADER_BYTES + 12 * nodes_n + 32 * points + 12 * triangles);
