@@ -3,6 +3,7 @@
 #include <Eigen/Dense>
 
 #include <algorithm>
+#include <climits>
 #include <cmath>
 #include <limits>
 #include <map>
@@ -126,22 +127,33 @@ void ear_clip(const std::vector<int>& loop, const std::vector<Eigen::Vector3d>& 
 // no twin), each in the order its cap runs them (against the skin).
 std::vector<std::vector<int>> border_loops(const std::unordered_map<long long, int>& directed) {
   const auto key = [](int u, int v) { return (static_cast<long long>(u) << 32) | static_cast<unsigned int>(v); };
-  std::multimap<int, int> next;  // border edges u -> v
+  std::vector<std::pair<int, int>> next;  // border edges u -> v, sorted
   for (const auto& [edge, uses] : directed) {
     const auto u = static_cast<int>(edge >> 32), v = static_cast<int>(edge & 0xffffffffLL);
-    if (!directed.contains(key(v, u))) next.emplace(u, v);
+    if (!directed.contains(key(v, u))) next.emplace_back(u, v);
   }
+  std::sort(next.begin(), next.end());
+  std::vector<char> used(next.size(), 0);
+  // The first unused border edge from `at` (next.size(): none).
+  const auto from = [&](int at) {
+    for (auto i = static_cast<size_t>(std::lower_bound(next.begin(), next.end(), std::pair{at, INT_MIN}) - next.begin());
+         i < next.size() && next[i].first == at; ++i) {
+      if (used[i] == 0) return i;
+    }
+    return next.size();
+  };
   std::vector<std::vector<int>> loops;
-  while (!next.empty()) {
+  for (size_t first = 0; first < next.size(); ++first) {
+    if (used[first] != 0) continue;
     std::vector<int> loop;
-    const int start = next.begin()->first;
+    const int start = next[first].first;
     int at = start;
     while (true) {
-      const auto it = next.find(at);
-      if (it == next.end()) break;
+      const size_t i = from(at);
+      if (i == next.size()) break;
       loop.push_back(at);
-      at = it->second;
-      next.erase(it);
+      at = next[i].second;
+      used[i] = 1;
       if (at == start) break;
     }
     std::reverse(loop.begin(), loop.end());
