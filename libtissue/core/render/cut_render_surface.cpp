@@ -827,10 +827,10 @@ void CutRenderSurface::cap_loops(const DeformableBody& body) {
       const auto after = chain_starting_at.find(point_after(chain, steps));
       if (steps > length || after == chain_starting_at.end() || chains[after->second].cut != chain.cut) continue;
       const int after_facing = chains[after->second].facing;
-      if (chain.facing != 0 && after_facing == chain.facing) {
-        // Not where a cut ends: the material lies on one side before and after, the loop only passes
-        // surface points the split left on the border (their edges' tests disagreed). The face goes on
-        // through them.
+      if ((chain.facing != 0 && after_facing == chain.facing) || after->second == c) {
+        // Not where a cut ends: the material lies on one side before and after (or the loop is this
+        // chain and its run alone: a pocket), the loop only passes surface points the split left on
+        // the border (their edges' tests disagreed). The face goes on through them.
         link[c] = Link{run, point_after(chain, steps)};
         continue;
       }
