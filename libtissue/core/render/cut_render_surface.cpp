@@ -446,6 +446,7 @@ void CutRenderSurface::rebuild(const DeformableBody& body) {
     }
   }
   m_from_scratch = scratch;
+  const size_t old_split_points = m_split_points;
   if (scratch) {
     std::fill(dirty.begin(), dirty.end(), 1);
     m_splits.clear();
@@ -620,37 +621,52 @@ void CutRenderSurface::rebuild(const DeformableBody& body) {
   skin_first.back() = static_cast<int>(skin.size());
   m_skin = std::move(skin);
   m_skin_first = std::move(skin_first);
+  const size_t first_new = scratch ? 0 : old_split_points;
   m_split_points = m_points.size();
   m_triangles = m_skin;
   cap_loops(body);
-  map_points_to_nodes();
+  map_points_to_nodes(first_new, dirty);
 }
 
-void CutRenderSurface::map_points_to_nodes() {
-  // The slot of each (cut tet, piece) in use, by cut tet and piece.
+void CutRenderSurface::map_points_to_nodes(size_t first_new, const std::vector<char>& dirty_vertices) {
+  // The slot of each (cut tet, piece) in use, by cut tet and piece. An incremental re-mesh keeps the
+  // slots (a piece no point rides on any more keeps its slot until the next re-mesh from scratch) and
+  // maps only the points it moved or added.
   int cut_tets = 0, pieces = 1;
   for (const Point& point : m_points) {
     cut_tets = std::max(cut_tets, point.cut_tet + 1);
     pieces = std::max(pieces, point.piece + 1);
   }
-  const auto stride = static_cast<size_t>(pieces);
-  std::vector<int> slot_of(static_cast<size_t>(cut_tets) * stride, -1);
-  m_slots.clear();
+  const bool all = m_from_scratch || static_cast<size_t>(pieces) > m_slot_stride;
+  if (all) {
+    m_slot_stride = static_cast<size_t>(pieces);
+    m_slot_of.clear();
+    m_slots.clear();
+  }
+  m_slot_of.resize(std::max(m_slot_of.size(), static_cast<size_t>(cut_tets) * m_slot_stride), -1);
   m_point_nodes.resize(m_points.size());
-  for (size_t i = 0; i < m_points.size(); ++i) {
+  const auto map = [&](size_t i) {
     const Point& point = m_points[i];
     std::array<int, 4>& nodes = m_point_nodes[i];
     if (point.cut_tet < 0) {
       for (size_t j = 0; j < 4; ++j) nodes[j] = m_mesh.tets[static_cast<size_t>(point.tet)][j];
-      continue;
+      return;
     }
-    int& slot = slot_of[static_cast<size_t>(point.cut_tet) * stride + static_cast<size_t>(point.piece)];
+    int& slot = m_slot_of[static_cast<size_t>(point.cut_tet) * m_slot_stride + static_cast<size_t>(point.piece)];
     if (slot < 0) {
       slot = static_cast<int>(m_slots.size());
       m_slots.push_back({point.cut_tet, point.piece});
     }
     for (size_t j = 0; j < 4; ++j) nodes[j] = m_mesh.vertex_count() + 4 * slot + static_cast<int>(j);
+  };
+  if (all) {
+    for (size_t i = 0; i < m_points.size(); ++i) map(i);
+    return;
   }
+  for (size_t v = 0; v < dirty_vertices.size(); ++v) {
+    if (dirty_vertices[v] != 0) map(v);
+  }
+  for (size_t i = first_new; i < m_points.size(); ++i) map(i);
 }
 
 void CutRenderSurface::node_positions(const DeformableBody& body, const Eigen::VectorXd& displacement_m,
@@ -720,6 +736,7 @@ void CutRenderSurface::cap_loops(const DeformableBody& body) {
     }
   };
   const std::vector<std::vector<int>> loops = border_loops(directed);
+  std::map<std::vector<int>, std::vector<std::array<int, 3>>> simple_caps;  // this re-mesh's, for the next
   const size_t surface_triangles = m_triangles.size();
   m_open_loops = 0;
   const auto part_of_point = [&](int point) { return part_of(body, m_points[static_cast<size_t>(point)]); };
@@ -772,7 +789,25 @@ void CutRenderSurface::cap_loops(const DeformableBody& body) {
     bool simple = true;
     for (size_t i = 0; i < n && simple; ++i) simple = cut_at(i) >= 0 && cut_at(i) == cut_at(0);
     if (simple) {  // the opening of a piece cut free by one plane
-      cap(loop);
+      // The same loop as at the last re-mesh (same points, which an incremental re-mesh keeps): its
+      // cap as it was.
+      std::vector<int> key_points(loop);
+      std::rotate(key_points.begin(), std::min_element(key_points.begin(), key_points.end()), key_points.end());
+      const auto kept = m_from_scratch ? m_simple_caps.end() : m_simple_caps.find(key_points);
+      const size_t before = m_triangles.size();
+      if (kept != m_simple_caps.end()) {
+        for (const auto& triangle : kept->second) {
+          m_triangles.push_back(triangle);
+          for (size_t k = 0; k < 3; ++k) {
+            const int u = triangle[k], v = triangle[(k + 1) % 3];
+            cap_edges.insert(key(std::min(u, v), std::max(u, v)));
+          }
+        }
+      } else {
+        cap(loop);
+      }
+      simple_caps.emplace(std::move(key_points),
+                          std::vector<std::array<int, 3>>(m_triangles.begin() + static_cast<std::ptrdiff_t>(before), m_triangles.end()));
       continue;
     }
     for (size_t i = 0; i < n; ++i) {
@@ -868,6 +903,7 @@ void CutRenderSurface::cap_loops(const DeformableBody& body) {
   m_open_loops += walk_faces(loops, chains, link, chain_starting_at, faces);
   for (const std::vector<int>& face : faces) cap(face);
   m_cap_triangles = static_cast<int>(m_triangles.size() - surface_triangles);
+  m_simple_caps = std::move(simple_caps);
 }
 
 void CutRenderSurface::update(const DeformableBody& body, const Eigen::VectorXd& displacement_m) {

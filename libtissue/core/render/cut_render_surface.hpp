@@ -38,6 +38,7 @@
 #include <Eigen/Core>
 
 #include <array>
+#include <map>
 #include <string>
 #include <unordered_map>
 #include <unordered_set>
@@ -97,8 +98,9 @@ class CutRenderSurface {
   [[nodiscard]] Point locate(const DeformableBody& body, int tet, const Eigen::Vector3d& rest_m) const;
   void cap_loops(const DeformableBody& body);
   void find_material_parts(const DeformableBody& body);
-  /// The nodes of every point (after the points are final).
-  void map_points_to_nodes();
+  /// The nodes of the points (after the points are final): all of them after a re-mesh from scratch,
+  /// else those of `dirty_vertices` and from `first_new` on.
+  void map_points_to_nodes(size_t first_new, const std::vector<char>& dirty_vertices);
   [[nodiscard]] int copy_of(const DeformableBody& body, int tet, int cut_tet, int piece, size_t j) const;
   /// Where the segment a-b crosses a cut plane of the cut tets at or next to tet_a and tet_b (the
   /// crossing nearest its middle): the fraction along it and the cut id (0.5 and the latest cut of
@@ -133,6 +135,8 @@ class CutRenderSurface {
   std::vector<std::array<int, 3>> m_skin;
   std::vector<int> m_skin_first;
   size_t m_part_ids = 0;  // how many part ids m_vertex_part's come from
+  // The caps of the last re-mesh's single-cut loops, by loop (its points from the smallest on).
+  std::map<std::vector<int>, std::vector<std::array<int, 3>>> m_simple_caps;
   size_t m_split_points = 0;
   std::vector<int> m_vertex_triangles_first, m_vertex_triangles;  // the surface's triangles at each vertex
   int m_orphan_points = 0;
@@ -140,6 +144,8 @@ class CutRenderSurface {
   std::vector<int> m_copy_root;  // per copy of a vertex (real, then ghost rows): its material part
   // per point: the cut id of the plane that split it, -1 for others
   std::vector<std::array<int, 2>> m_slots;  // the (cut tet, piece) of each group of four nodes
+  std::vector<int> m_slot_of;               // by cut tet * m_slot_stride + piece: its slot, or -1
+  size_t m_slot_stride = 0;
   std::vector<std::array<int, 4>> m_point_nodes;
   std::vector<Eigen::Vector3d> m_node_positions_m;
   std::vector<Eigen::Vector3d> m_positions_m;
