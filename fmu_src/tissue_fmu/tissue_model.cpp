@@ -407,23 +407,22 @@ void TissueModel::get_uint64(const VariableInfo& info, std::span<std::uint64_t> 
   ensure_built();
   const Tissue& tissue = *m_tissue;
   const bool mesh_out = m_values.boolean(vr(Vr::mesh_output_enabled));
-  const ports::SurfaceMesh* drawn = mesh_out ? &drawn_mesh() : nullptr;
-  const std::uint64_t vertices = mesh_out ? drawn->positions_m.size() / 3 : 0;
-  const std::uint64_t triangles = mesh_out ? drawn->triangles.size() / 3 : 0;
+  // The drawn surface is brought up to date only for the variables that count it: reading the cut
+  // counters after a step re-meshes and maps nothing.
   switch (static_cast<Vr>(info.vr)) {
     case Vr::vertex_count:
       warn_if_arrays_truncate();
-      out[0] = mesh_out ? std::min(vertices, m_values.uint64(vr(Vr::vertex_capacity))) : 0;
+      out[0] = mesh_out ? std::min<std::uint64_t>(drawn_mesh().positions_m.size() / 3, m_values.uint64(vr(Vr::vertex_capacity))) : 0;
       return;
     case Vr::triangle_count:
       warn_if_arrays_truncate();
-      out[0] = mesh_out ? std::min(triangles, m_values.uint64(vr(Vr::triangle_capacity))) : 0;
+      out[0] = mesh_out ? std::min<std::uint64_t>(drawn_mesh().triangles.size() / 3, m_values.uint64(vr(Vr::triangle_capacity))) : 0;
       return;
     case Vr::surface_revision:
       out[0] = m_surface_revision;
       return;
     case Vr::cut_triangle_count:
-      out[0] = mesh_out ? std::min(drawn->cut_triangle_count, triangles) : 0;
+      out[0] = mesh_out ? std::min<std::uint64_t>(drawn_mesh().cut_triangle_count, drawn_mesh().triangles.size() / 3) : 0;
       return;
     case Vr::cut_tets:
       out[0] = static_cast<std::uint64_t>(tissue.body().cut_tet_count());

@@ -29,6 +29,10 @@ double outside_piece_m(const CutTetGeometry& geometry, size_t piece, const Eigen
   return outside;
 }
 
+// An edge as one integer: (u, v) directed, and the same for either direction (lower, higher).
+long long directed_key(int u, int v) { return (static_cast<long long>(u) << 32) | static_cast<unsigned int>(v); }
+long long edge_key(int u, int v) { return directed_key(std::min(u, v), std::max(u, v)); }
+
 // Where the segment from `from` to `to` leaves the piece holding `from`: a fraction in [0, 1] and the
 // index of the cut whose plane it crosses there; fraction -1 if `to` is in the piece too.
 std::pair<double, int> leaves_piece_at(const CutTetGeometry& geometry, size_t piece, const Eigen::Vector3d& from,
@@ -126,11 +130,10 @@ void ear_clip(const std::vector<int>& loop, const std::vector<Eigen::Vector3d>& 
 // The border loops of a split surface from its directed edges at split points (a border edge has
 // no twin), each in the order its cap runs them (against the skin).
 std::vector<std::vector<int>> border_loops(const std::unordered_map<long long, int>& directed) {
-  const auto key = [](int u, int v) { return (static_cast<long long>(u) << 32) | static_cast<unsigned int>(v); };
   std::vector<std::pair<int, int>> next;  // border edges u -> v, sorted
   for (const auto& [edge, uses] : directed) {
     const auto u = static_cast<int>(edge >> 32), v = static_cast<int>(edge & 0xffffffffLL);
-    if (!directed.contains(key(v, u))) next.emplace_back(u, v);
+    if (!directed.contains(directed_key(v, u))) next.emplace_back(u, v);
   }
   std::sort(next.begin(), next.end());
   std::vector<char> used(next.size(), 0);
@@ -318,10 +321,7 @@ CutRenderSurface::CutRenderSurface(const TetMesh& mesh, TriangleSurface surface,
     for (const int v : m_surface.triangles[t]) m_vertex_triangles[static_cast<size_t>(fill[static_cast<size_t>(v)]++)] = static_cast<int>(t);
   }
   for (const auto& triangle : m_surface.triangles) {
-    for (size_t k = 0; k < 3; ++k) {
-      const int u = std::min(triangle[k], triangle[(k + 1) % 3]), v = std::max(triangle[k], triangle[(k + 1) % 3]);
-      m_surface_edges.insert((static_cast<long long>(u) << 32) | static_cast<unsigned int>(v));
-    }
+    for (size_t k = 0; k < 3; ++k) m_surface_edges.insert(edge_key(triangle[k], triangle[(k + 1) % 3]));
   }
 }
 
@@ -473,9 +473,6 @@ void CutRenderSurface::rebuild(const DeformableBody& body) {
   m_tet_cut.resize(tet_count);
   for (size_t t = 0; t < tet_count; ++t) m_tet_cut[t] = body.cut_tet_index(static_cast<int>(t));
   // The split points of an edge at a moved point are dropped (left unused, on no piece).
-  const auto key_of = [](int u, int v) {
-    return (static_cast<long long>(std::min(u, v)) << 32) | static_cast<unsigned int>(std::max(u, v));
-  };
   if (!scratch) {
     for (size_t v = 0; v < vertices; ++v) {
       if (dirty[v] == 0) continue;
@@ -484,7 +481,7 @@ void CutRenderSurface::rebuild(const DeformableBody& body) {
       for (size_t k = 0; k < 3; ++k) {
         const int u = triangle[k], w = triangle[(k + 1) % 3];
         if (dirty[static_cast<size_t>(u)] == 0 && dirty[static_cast<size_t>(w)] == 0) continue;
-        const auto it = m_splits.find(key_of(u, w));
+        const auto it = m_splits.find(edge_key(u, w));
         if (it == m_splits.end()) continue;
         if (it->second[0] >= 0) {
           for (const int p : it->second) m_points[static_cast<size_t>(p)].cut_tet = m_points[static_cast<size_t>(p)].piece = -1;
@@ -511,7 +508,7 @@ void CutRenderSurface::rebuild(const DeformableBody& body) {
     if (uncut_part[static_cast<size_t>(lo)] >= 0 && uncut_part[static_cast<size_t>(lo)] == uncut_part[static_cast<size_t>(hi)]) {
       return nullptr;
     }
-    const long long key = (static_cast<long long>(lo) << 32) | static_cast<unsigned int>(hi);
+    const long long key = edge_key(lo, hi);
     if (const auto it = splits.find(key); it != splits.end()) return it->second[0] < 0 ? nullptr : &it->second;
     const Point low = m_points[static_cast<size_t>(lo)];  // copies: m_points grows below
     const Point high = m_points[static_cast<size_t>(hi)];
@@ -710,20 +707,19 @@ void CutRenderSurface::cap_loops(const DeformableBody& body) {
   const auto vertices = static_cast<int>(m_surface.vertices_m.size());
   std::unordered_map<long long, int> directed;  // (u, v) -> count
   directed.reserve(8 * (m_points.size() - static_cast<size_t>(m_surface.vertices_m.size())) + 64);
-  const auto key = [](int u, int v) { return (static_cast<long long>(u) << 32) | static_cast<unsigned int>(v); };
   for (const auto& [a, b, c] : m_triangles) {
     if (a < vertices && b < vertices && c < vertices) continue;
     for (const auto& [u, v] : {std::pair{a, b}, std::pair{b, c}, std::pair{c, a}}) {
-      if (u >= vertices || v >= vertices) ++directed[key(u, v)];
+      if (u >= vertices || v >= vertices) ++directed[directed_key(u, v)];
     }
   }
   std::unordered_set<long long> cap_edges;  // (lower, higher) of the caps' edges so far
   cap_edges.reserve(directed.size() + 64);
   const auto has_edge = [&](int u, int v) {
-    const long long undirected = key(std::min(u, v), std::max(u, v));
+    const long long undirected = edge_key(u, v);
     if (cap_edges.contains(undirected)) return true;
     if (u < vertices && v < vertices) return m_surface_edges.contains(undirected);
-    return directed.contains(key(u, v)) || directed.contains(key(v, u));
+    return directed.contains(directed_key(u, v)) || directed.contains(directed_key(v, u));
   };
   const auto cap = [&](const std::vector<int>& polygon) {
     const size_t before = m_triangles.size();
@@ -731,7 +727,7 @@ void CutRenderSurface::cap_loops(const DeformableBody& body) {
     for (size_t t = before; t < m_triangles.size(); ++t) {
       for (size_t k = 0; k < 3; ++k) {
         const int u = m_triangles[t][k], v = m_triangles[t][(k + 1) % 3];
-        cap_edges.insert(key(std::min(u, v), std::max(u, v)));
+        cap_edges.insert(edge_key(u, v));
       }
     }
   };
@@ -800,7 +796,7 @@ void CutRenderSurface::cap_loops(const DeformableBody& body) {
           m_triangles.push_back(triangle);
           for (size_t k = 0; k < 3; ++k) {
             const int u = triangle[k], v = triangle[(k + 1) % 3];
-            cap_edges.insert(key(std::min(u, v), std::max(u, v)));
+            cap_edges.insert(edge_key(u, v));
           }
         }
       } else {
