@@ -47,6 +47,8 @@ void add_scene_options(CLI::App& app, SceneOptions& options) {
       ->capture_default_str();
   app.add_option("--tolerance", options.tolerance, "PCG (and pcg-cholesky) relative residual tolerance")
       ->capture_default_str();
+  app.add_flag("--double-matrix", options.double_matrix,
+               "PCG products stream A in double precision (default: single for tolerances >= 1e-5; sums in double)");
   app.add_option("--max-iterations", options.max_iterations, "PCG (and pcg-cholesky) iteration cap")
       ->capture_default_str();
   app.add_option("--refresh-iterations", options.refresh.refresh_iterations,
@@ -84,7 +86,9 @@ Scene make_scene(const SceneOptions& options) {
   TissueSettings& settings = scene.settings;
   settings.step_size_s = options.step_size_s;
   settings.solver.kind = parse_linear_solver_kind(options.solver);
-  settings.solver.pcg = PcgSolver::Settings{options.tolerance, options.max_iterations};
+  settings.solver.pcg = PcgSolver::Settings{options.tolerance, options.max_iterations,
+                                           options.double_matrix ? MatrixPrecision::double_precision
+                                                                 : MatrixPrecision::automatic};
   settings.solver.refresh = options.refresh;
   settings.solver.warm_start = options.warm_start;
   settings.body.material = options.material;

@@ -26,6 +26,7 @@ struct SceneOptions {
   std::string solver = "pcg";
   double tolerance = 1e-6;
   int max_iterations = 10000;
+  bool double_matrix = false;  ///< PCG products in double precision (MatrixPrecision)
   /// pcg-cholesky's refresh rules; the benches ask for the worker thread unless told not to.
   CholeskyPcgSolver::Refresh refresh = with_background_refactor();
   bool warm_start = false;

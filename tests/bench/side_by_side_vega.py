@@ -11,8 +11,11 @@ Each round runs Vega and ours twice (the same linearized step as Vega's, and our
 large-turn protections), each first in turn; a run's figure is its median ms per step; the table
 gives the median over rounds and the ratios Vega / ours. Prints a Markdown table with the machine.
 
-Usage: tests/bench/side_by_side_vega.py [--vega PATH] [--bench PATH] [--rounds 5] [--steps 200]
-Uses only the Python standard library.
+Usage: tests/bench/side_by_side_vega.py [--vega PATH] [--bench PATH] [--rounds 5] [--steps 200] [--only TEXT]
+                                       [--scaling [--plot PNG]]
+Ours is also run with two threads (defaults), unpinned. --scaling adds the organ at two sizes between the
+bridge and it (meshes/make_liver.py and Gmsh) and prints ms per step against tet count with the fitted
+exponent (and a log-log plot with matplotlib). Uses only the Python standard library otherwise.
 """
 import argparse
 import os
@@ -33,7 +36,12 @@ CASES = [
     ("simpleBridge (Vega), 12.8k tets", VEGA_MESHES / "simpleBridge" / "simpleBridge-ic_128_0.15_.1.veg",
      VEGA_MESHES / "simpleBridge" / "simpleBridge.bou", 0.07, BRIDGE),
     ("frog (ours), 2450 tets", ROOT / "meshes" / "frog.veg", None, 0.01, DISSERTATION),
+    ("organ (meshes/liver.veg), 51.9k tets", ROOT / "meshes" / "liver.veg", ROOT / "meshes" / "liver.bou", 0.01,
+     DISSERTATION),
 ]
+# --scaling: the organ's shape meshed at these largest edges [m] as well (meshes/make_liver.py, Gmsh),
+# sizes between the bridge and the organ.
+SCALING_SIZES_M = (0.0072, 0.0058)
 SETTING = (1e-3, 10)  # the real-time setting: eps, iteration cap
 
 
@@ -61,11 +69,13 @@ def run_vega(vega, case, steps):
     return float(match.group(1))
 
 
-def run_ours(bench, case, steps, protection):
+def run_ours(bench, case, steps, protection, threads=1):
     name, mesh, bou, dt, material = case
     eps, cap = SETTING
-    extra = ["--mass-damping", "0", "--stiffness-damping", "0"] + ([] if protection else ["--no-large-turn-protection"])
-    result = run_tissue_bench(bench, mesh, bou, dt, material, eps, cap, steps, extra=extra, prefix=pinned([]),
+    extra = ["--mass-damping", "0", "--stiffness-damping", "0", "--threads", str(threads)]
+    extra += [] if protection else ["--no-large-turn-protection"]
+    pin = pinned([]) if threads == 1 else []
+    result = run_tissue_bench(bench, mesh, bou, dt, material, eps, cap, steps, extra=extra, prefix=pin,
                               env=environment())
     return result["ms_per_step"]["median"], result
 
@@ -86,27 +96,40 @@ def main():
     parser.add_argument("--bench", default=str(ROOT / "build" / "release" / "fmu_src" / "apps" / "tissue-bench"))
     parser.add_argument("--rounds", type=int, default=5)
     parser.add_argument("--steps", type=int, default=200)
+    parser.add_argument("--only", default="", help="run only the cases whose name contains this")
+    parser.add_argument("--scaling", action="store_true",
+                        help="also the organ at two sizes between the bridge and it (needs gmsh); print the "
+                             "scaling table and the fitted exponents")
+    parser.add_argument("--plot", default="", help="with --scaling: write the log-log plot here (needs matplotlib)")
     args = parser.parse_args()
     for path in (args.vega, args.bench):
         if not pathlib.Path(path).exists():
             sys.exit("missing " + path + " (Vega: ../shared/peers/build-vega.sh; ours: cmake --build --preset release)")
 
+    cases = [case for case in CASES if args.only in case[0]]
+    if args.scaling:
+        cases += scaling_cases()
+    two_threads = (os.cpu_count() or 1) >= 2
     rows = []
-    for case in CASES:
-        times = {"vega": [], "same": [], "defaults": []}
+    for case in cases:
+        times = {"vega": [], "same": [], "defaults": [], "defaults2": []}
         details = {}
         for k in range(args.rounds):
-            order = ["vega", "same", "defaults"]
-            order = order[k % 3:] + order[:k % 3]  # each goes first in turn
+            order = ["vega", "same", "defaults"] + (["defaults2"] if two_threads else [])
+            order = order[k % len(order):] + order[:k % len(order)]  # each goes first in turn
             for who in order:
                 if who == "vega":
                     times["vega"].append(run_vega(args.vega, case, args.steps))
                 else:
-                    ms, details[who] = run_ours(args.bench, case, args.steps, protection=(who == "defaults"))
+                    ms, details[who] = run_ours(args.bench, case, args.steps, protection=(who != "same"),
+                                                threads=2 if who == "defaults2" else 1)
                     times[who].append(ms)
-            print("  %s: round %d/%d: Vega %.3f ms, ours %.3f ms (same step), %.3f ms (defaults)"
-                  % (case[0], k + 1, args.rounds, times["vega"][-1], times["same"][-1], times["defaults"][-1]),
+            print("  %s: round %d/%d: Vega %.3f ms, ours %.3f ms (same step), %.3f ms (defaults), %s (2 threads)"
+                  % (case[0], k + 1, args.rounds, times["vega"][-1], times["same"][-1], times["defaults"][-1],
+                     "%.3f ms" % times["defaults2"][-1] if two_threads else "-"),
                   file=sys.stderr)
+        if not two_threads:
+            times["defaults2"] = [float("nan")]
         rows.append((case, {who: statistics.median(t) for who, t in times.items()},
                      {who: (min(t), max(t)) for who, t in times.items()}, details))
 
@@ -117,15 +140,79 @@ def main():
           "act on steps that turn elements far).\n"
           % (os.cpu_count(), cpu_model(), args.rounds, args.steps, SETTING[0], SETTING[1]))
     print("| mesh | dt | Vega (ms/step) | ours, same step (ms/step) | Vega / ours | ours, defaults (ms/step) | "
-          "Vega / ours | defaults: Newton iterations, guarded steps | same step: assembly / solve (ms) |")
-    print("|---|---|---|---|---|---|---|---|---|")
+          "Vega / ours | defaults / same step | defaults, 2 threads (ms/step) | defaults: Newton iterations, "
+          "guarded steps | same step: assembly / solve (ms) |")
+    print("|---|---|---|---|---|---|---|---|---|---|---|")
     for case, median, span, details in rows:
         same, defaults = details["same"], details["defaults"]
-        print("| %s | %g s | %.3f (%.3f-%.3f) | %.3f (%.3f-%.3f) | %.2f | %.3f (%.3f-%.3f) | %.2f | %d, %d | %.3f / %.3f |"
+        print("| %s | %g s | %.3f (%.3f-%.3f) | %.3f (%.3f-%.3f) | %.2f | %.3f (%.3f-%.3f) | %.2f | %.2f | %.3f (%.3f-%.3f) "
+              "| %d, %d | %.3f / %.3f |"
               % (case[0], case[3], median["vega"], *span["vega"], median["same"], *span["same"],
                  median["vega"] / median["same"], median["defaults"], *span["defaults"],
-                 median["vega"] / median["defaults"], defaults["newton_iterations"],
+                 median["vega"] / median["defaults"], median["defaults"] / median["same"], median["defaults2"],
+                 *span["defaults2"], defaults["newton_iterations"],
                  defaults["energy_guarded_steps"], same["assembly_ms"], same["solve_ms"]))
+    if args.scaling:
+        print_scaling(rows, args.plot)
+
+
+def scaling_cases():
+    """The organ's shape at SCALING_SIZES_M, made into a temporary folder by meshes/make_liver.py."""
+    import tempfile
+    folder = pathlib.Path(tempfile.mkdtemp(prefix="tissue-scaling-"))
+    cases = []
+    for size in SCALING_SIZES_M:
+        out = folder / ("%g" % size)
+        out.mkdir()
+        subprocess.run(["/usr/bin/python3", str(ROOT / "meshes" / "make_liver.py"), "--mesh-size", str(size),
+                        "--output-dir", str(out)], check=True, capture_output=True, text=True)
+        tets = int(re.search(r"# (\d+) vertices, (\d+) elements", (out / "liver.veg").read_text()).group(2))
+        cases.append(("organ at %g m, %.1fk tets" % (size, tets / 1000), out / "liver.veg", out / "liver.bou", 0.01,
+                      DISSERTATION))
+    return cases
+
+
+def print_scaling(rows, plot):
+    """ms per step against tet count, the least-squares exponent of ms ~ tets^k, and a log-log plot."""
+    import math
+    points = sorted((details["same"]["tets"], median) for case, median, span, details in rows)
+    print("\n| tets | Vega (ms/step) | ours, same step | ours, defaults | ours, defaults, 2 threads |")
+    print("|---:|---:|---:|---:|---:|")
+    for tets, median in points:
+        print("| %d | %.3f | %.3f | %.3f | %.3f |" % (tets, median["vega"], median["same"], median["defaults"],
+                                                    median["defaults2"]))
+    fits = {}
+    for who in ("vega", "same", "defaults", "defaults2"):
+        xs = [math.log(tets) for tets, median in points if math.isfinite(median[who])]
+        ys = [math.log(median[who]) for tets, median in points if math.isfinite(median[who])]
+        if len(xs) < 2:
+            continue
+        mx, my = sum(xs) / len(xs), sum(ys) / len(ys)
+        fits[who] = sum((x - mx) * (y - my) for x, y in zip(xs, ys)) / sum((x - mx) ** 2 for x in xs)
+    print("\nFitted exponent k of ms/step ~ tets^k (least squares in log-log): " +
+          ", ".join("%s %.3f" % (who, k) for who, k in fits.items()))
+    if plot:
+        import matplotlib
+        matplotlib.use("Agg")
+        import matplotlib.pyplot as plt
+        labels = {"vega": "Vega FEM 4.0 (1 thread)", "same": "ours, same step (1 thread)",
+                  "defaults": "ours, defaults (1 thread)", "defaults2": "ours, defaults (2 threads)"}
+        fig, ax = plt.subplots(figsize=(6.4, 4.4), dpi=120)
+        for who, marker in (("vega", "s"), ("same", "o"), ("defaults", "^"), ("defaults2", "v")):
+            if who not in fits:
+                continue
+            ax.loglog([t for t, m in points], [m[who] for t, m in points], marker=marker,
+                      label="%s, k = %.2f" % (labels[who], fits[who]))
+        ax.axhline(10.0, color="grey", linestyle=":", linewidth=1)
+        ax.text(points[0][0], 10.5, "10 ms: a 100 Hz step", color="grey", fontsize=8)
+        ax.set_xlabel("tets")
+        ax.set_ylabel("ms per step (median)")
+        ax.set_title("Step time against mesh size (real-time setting: PCG 1e-3 / 10)", fontsize=10)
+        ax.grid(True, which="both", linewidth=0.3)
+        ax.legend(fontsize=8)
+        fig.tight_layout()
+        fig.savefig(plot)
+        print("plot: " + plot)
 
 
 if __name__ == "__main__":

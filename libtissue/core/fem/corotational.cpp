@@ -26,13 +26,16 @@ TetPositions gather(const Eigen::VectorXd& positions_m, const Tet& tet) {
 }  // namespace
 
 CorotationalElasticity::CorotationalElasticity(const TetMesh& mesh, const Material& material,
-                                               const RotationSettings& rotation)
-    : m_tets(mesh.tets),
-      m_lame((validate(material), lame_parameters(material))),
+                                               const RotationSettings& rotation, const std::vector<int>& vertex_order)
+    : m_lame((validate(material), lame_parameters(material))),
       m_rotation_settings((validate(rotation), rotation)) {
-  m_rest.reserve(m_tets.size());
-  for (int t = 0; t < mesh.tet_count(); ++t) m_rest.push_back(precompute_tet(mesh.rest_corners(t)));
-  partition(mesh);
+  partition(mesh, vertex_order);
+  m_tets.reserve(m_tet_id.size());
+  m_rest.reserve(m_tet_id.size());
+  for (const int t : m_tet_id) {
+    m_tets.push_back(mesh.tets[static_cast<size_t>(t)]);
+    m_rest.push_back(precompute_tet(mesh.rest_corners(t)));
+  }
   m_rotations.assign(m_tets.size(), Eigen::Matrix3d::Identity());
   m_warm_starts.assign(m_tets.size(), Eigen::Quaterniond::Identity());
   m_excluded.assign(m_tets.size(), 0);
@@ -84,9 +87,9 @@ void split(const TetMesh& mesh, const std::vector<int>& tets, CorotationalElasti
 
 }  // namespace
 
-void CorotationalElasticity::partition(const TetMesh& mesh) {
+void CorotationalElasticity::partition(const TetMesh& mesh, const std::vector<int>& vertex_order) {
   static_assert(ASSEMBLY_PARTS == 2, "split() halves");
-  std::vector<int> remaining(m_tets.size());
+  std::vector<int> remaining(mesh.tets.size());
   std::iota(remaining.begin(), remaining.end(), 0);
   std::vector<unsigned char> vertex_halves(static_cast<size_t>(mesh.vertex_count()));
   m_phases.assign(ASSEMBLY_LEVELS, AssemblyPhase{});
@@ -96,6 +99,53 @@ void CorotationalElasticity::partition(const TetMesh& mesh) {
     remaining.swap(separator);
   }
   m_serial_tets = std::move(remaining);
+  sort_lists(mesh, vertex_order);
+
+  // Storage in visiting order; the lists become storage indices.
+  m_tet_id.clear();
+  for (const AssemblyPhase& phase : m_phases) {
+    for (const std::vector<int>& part : phase) m_tet_id.insert(m_tet_id.end(), part.begin(), part.end());
+  }
+  m_tet_id.insert(m_tet_id.end(), m_serial_tets.begin(), m_serial_tets.end());
+  m_storage.assign(m_tet_id.size(), -1);
+  for (size_t k = 0; k < m_tet_id.size(); ++k) m_storage[static_cast<size_t>(m_tet_id[k])] = static_cast<int>(k);
+  for (AssemblyPhase& phase : m_phases) {
+    for (std::vector<int>& part : phase) {
+      for (int& t : part) t = m_storage[static_cast<size_t>(t)];
+    }
+  }
+  for (int& t : m_serial_tets) t = m_storage[static_cast<size_t>(t)];
+}
+
+void CorotationalElasticity::sort_lists(const TetMesh& mesh, const std::vector<int>& vertex_order) {
+  // Each list by the earliest position of its tets' vertices in the order (ties by id).
+  if (vertex_order.empty()) return;
+  if (vertex_order.size() != static_cast<size_t>(mesh.vertex_count())) {
+    throw std::invalid_argument("CorotationalElasticity: the vertex order lists " + std::to_string(vertex_order.size()) +
+                                " vertices, the mesh has " + std::to_string(mesh.vertex_count()));
+  }
+  std::vector<int> rank(vertex_order.size(), -1);
+  for (size_t k = 0; k < vertex_order.size(); ++k) {
+    const int v = vertex_order[k];
+    if (v < 0 || v >= mesh.vertex_count() || rank[static_cast<size_t>(v)] >= 0) {
+      throw std::invalid_argument("CorotationalElasticity: the vertex order is not a permutation of the vertices");
+    }
+    rank[static_cast<size_t>(v)] = static_cast<int>(k);
+  }
+  std::vector<int> tet_rank(mesh.tets.size());
+  for (size_t t = 0; t < mesh.tets.size(); ++t) {
+    int earliest = rank[static_cast<size_t>(mesh.tets[t][0])];
+    for (const int v : mesh.tets[t]) earliest = std::min(earliest, rank[static_cast<size_t>(v)]);
+    tet_rank[t] = earliest;
+  }
+  const auto by_rank = [&](int a, int b) {
+    return tet_rank[static_cast<size_t>(a)] < tet_rank[static_cast<size_t>(b)] ||
+           (tet_rank[static_cast<size_t>(a)] == tet_rank[static_cast<size_t>(b)] && a < b);
+  };
+  for (AssemblyPhase& phase : m_phases) {
+    for (std::vector<int>& part : phase) std::sort(part.begin(), part.end(), by_rank);
+  }
+  std::sort(m_serial_tets.begin(), m_serial_tets.end(), by_rank);
 }
 
 void CorotationalElasticity::exclude(int tet) {
@@ -103,7 +153,19 @@ void CorotationalElasticity::exclude(int tet) {
     throw ParameterError("CorotationalElasticity::exclude: tet " + std::to_string(tet) + " outside [0, " +
                          std::to_string(tet_count()) + ")");
   }
-  m_excluded[static_cast<size_t>(tet)] = 1;
+  m_excluded[stored(tet)] = 1;
+}
+
+std::vector<Eigen::Matrix3d> CorotationalElasticity::rotations() const {
+  std::vector<Eigen::Matrix3d> by_tet(m_rotations.size());
+  for (size_t k = 0; k < m_rotations.size(); ++k) by_tet[static_cast<size_t>(m_tet_id[k])] = m_rotations[k];
+  return by_tet;
+}
+
+std::vector<Eigen::Quaterniond> CorotationalElasticity::warm_starts() const {
+  std::vector<Eigen::Quaterniond> by_tet(m_warm_starts.size());
+  for (size_t k = 0; k < m_warm_starts.size(); ++k) by_tet[static_cast<size_t>(m_tet_id[k])] = m_warm_starts[k];
+  return by_tet;
 }
 
 void CorotationalElasticity::restore_rotations(const std::vector<Eigen::Matrix3d>& rotations,
@@ -113,8 +175,10 @@ void CorotationalElasticity::restore_rotations(const std::vector<Eigen::Matrix3d
                                 std::to_string(m_tets.size()) + "), got " + std::to_string(rotations.size()) +
                                 " and " + std::to_string(warm_starts.size()));
   }
-  m_rotations = rotations;
-  m_warm_starts = warm_starts;
+  for (size_t t = 0; t < rotations.size(); ++t) {
+    m_rotations[stored(static_cast<int>(t))] = rotations[t];
+    m_warm_starts[stored(static_cast<int>(t))] = warm_starts[t];
+  }
 }
 
 void CorotationalElasticity::reset_rotations() {
@@ -185,11 +249,11 @@ TISSUE_HOT_KERNEL void CorotationalElasticity::add_tets(const std::vector<int>& 
       });
 }
 
-TISSUE_HOT_KERNEL void CorotationalElasticity::add_tet(size_t t, const Eigen::Matrix3d& f, Eigen::VectorXd& internal_forces_n,
+TISSUE_HOT_KERNEL void CorotationalElasticity::add_tet(size_t k, const Eigen::Matrix3d& f, Eigen::VectorXd& internal_forces_n,
                                      BlockSparseMatrix* tangent, const std::vector<TetSlots>* slots) const {
-  const Tet& tet = m_tets[t];
-  const TetRest& rest = m_rest[t];
-  const Eigen::Matrix3d& r = m_rotations[t];
+  const Tet& tet = m_tets[k];
+  const TetRest& rest = m_rest[k];
+  const Eigen::Matrix3d& r = m_rotations[k];
 
   // f_i = V R sigma g_i (equal to R K_e (R^T x - X), see DESIGN section 4).
   const Eigen::Matrix<double, 3, 4> forces = corotated_forces(rest, r, f, m_lame);
@@ -197,7 +261,7 @@ TISSUE_HOT_KERNEL void CorotationalElasticity::add_tet(size_t t, const Eigen::Ma
 
   if (tangent == nullptr) return;
   const Eigen::Matrix<double, 3, 4> c = r * rest.shape_gradients_per_m;  // rotated shape gradients
-  const TetSlots& tet_slots = (*slots)[t];
+  const TetSlots& tet_slots = (*slots)[static_cast<size_t>(m_tet_id[k])];
   for (int i = 0; i < 4; ++i) {
     for (int j = i; j < 4; ++j) {
       const int slot_ij = tet_slots[static_cast<size_t>(4 * i + j)];

@@ -23,17 +23,21 @@ class CorotationalElasticity {
  public:
   /// Precomputes shape gradients and volumes. Throws ParameterError for an invalid material or
   /// rotation setting.
-  CorotationalElasticity(const TetMesh& mesh, const Material& material, const RotationSettings& rotation = {});
+  /// `vertex_order` (a permutation of the vertices, such as locality_order(), or empty for vertex
+  /// order): each assembly part visits its tets by the earliest of their vertices in it, so that
+  /// consecutive tets write nearby blocks when the system's rows are numbered in the same order.
+  CorotationalElasticity(const TetMesh& mesh, const Material& material, const RotationSettings& rotation = {},
+                         const std::vector<int>& vertex_order = {});
 
   [[nodiscard]] int tet_count() const { return static_cast<int>(m_tets.size()); }
   [[nodiscard]] const LameParameters& lame() const { return m_lame; }
-  [[nodiscard]] const TetRest& rest(int tet) const { return m_rest[static_cast<size_t>(tet)]; }
-  [[nodiscard]] const Eigen::Matrix3d& rotation(int tet) const { return m_rotations[static_cast<size_t>(tet)]; }
+  [[nodiscard]] const TetRest& rest(int tet) const { return m_rest[stored(tet)]; }
+  [[nodiscard]] const Eigen::Matrix3d& rotation(int tet) const { return m_rotations[stored(tet)]; }
 
   /// Hands `tet` over to another model (a cut tet, modelled by XfemElasticity): evaluate() and
   /// elastic_energy_j() skip it from now on. Throws ParameterError for an id out of range.
   void exclude(int tet);
-  [[nodiscard]] bool is_excluded(int tet) const { return m_excluded[static_cast<size_t>(tet)] != 0; }
+  [[nodiscard]] bool is_excluded(int tet) const { return m_excluded[stored(tet)] != 0; }
 
   /// One pass over the (not excluded) tets at the current positions (3 per vertex, [m]):
   /// updates each R_e (warm-started from the last step), adds the internal force f_int
@@ -51,11 +55,16 @@ class CorotationalElasticity {
 
   /// How many parts the assembly runs side by side (a team's members beyond this wait).
   static constexpr int ASSEMBLY_PARTS = MAX_STEP_THREADS;
-  /// One phase of the assembly: parts that share no vertex (each list ascending).
+  /// One phase of the assembly: parts that share no vertex. The lists hold storage indices (see
+  /// tet_id()): the per-tet data is stored in the order the assembly visits it, phase by phase and
+  /// part by part, each part by the earliest of its tets' vertices in the vertex order, so that a
+  /// step streams it.
   using AssemblyPhase = std::array<std::vector<int>, ASSEMBLY_PARTS>;
   [[nodiscard]] const std::vector<AssemblyPhase>& assembly_phases() const { return m_phases; }
-  /// The tets assembled alone, after the phases.
+  /// The tets assembled alone, after the phases (storage indices).
   [[nodiscard]] const std::vector<int>& serial_tets() const { return m_serial_tets; }
+  /// The mesh's id of the tet at storage index k.
+  [[nodiscard]] int tet_id(int k) const { return m_tet_id[static_cast<size_t>(k)]; }
 
   /// Elastic energy sum_e V_e (mu eps:eps + lambda/2 tr(eps)^2), eps = sym(R_e^T F_e) - I, with the
   /// rotations of these positions (the stored warm starts are not changed). [J]
@@ -63,16 +72,18 @@ class CorotationalElasticity {
 
   /// Forgets the warm starts (rotations back to identity), e.g. after a state was restored.
   void reset_rotations();
-  /// The rotations and their warm starts, per tet (what a saved state must carry to continue bitwise).
-  [[nodiscard]] const std::vector<Eigen::Matrix3d>& rotations() const { return m_rotations; }
-  [[nodiscard]] const std::vector<Eigen::Quaterniond>& warm_starts() const { return m_warm_starts; }
+  /// The rotations and their warm starts, per tet in mesh order (what a saved state must carry to
+  /// continue bitwise).
+  [[nodiscard]] std::vector<Eigen::Matrix3d> rotations() const;
+  [[nodiscard]] std::vector<Eigen::Quaterniond> warm_starts() const;
   /// Sets both; throws std::invalid_argument (nothing changed) unless there is one of each per tet.
   void restore_rotations(const std::vector<Eigen::Matrix3d>& rotations,
                          const std::vector<Eigen::Quaterniond>& warm_starts);
 
  private:
-  /// Adds tet t's force and (with `tangent`) its blocks, with F = f and the rotation already extracted.
-  void add_tet(size_t t, const Eigen::Matrix3d& f, Eigen::VectorXd& internal_forces_n, BlockSparseMatrix* tangent,
+  /// Adds the force of the tet at storage index k and (with `tangent`) its blocks, with F = f and
+  /// the rotation already extracted.
+  void add_tet(size_t k, const Eigen::Matrix3d& f, Eigen::VectorXd& internal_forces_n, BlockSparseMatrix* tangent,
                const std::vector<TetSlots>* slots) const;
 
   /// visit(t, F, R) for the tets tet_at(0) .. tet_at(count - 1) that are not excluded, in order, their
@@ -90,8 +101,15 @@ class CorotationalElasticity {
                 BlockSparseMatrix* tangent, const std::vector<TetSlots>* slots);
 
   /// Splits the tets into the parts and the separator (see evaluate()).
-  void partition(const TetMesh& mesh);
+  /// Then stores the per-tet data in assembly order (m_tet_id, m_storage).
+  void partition(const TetMesh& mesh, const std::vector<int>& vertex_order);
+  /// Sorts each list by the vertex order (see assembly_phases()).
+  void sort_lists(const TetMesh& mesh, const std::vector<int>& vertex_order);
+  [[nodiscard]] size_t stored(int tet) const { return static_cast<size_t>(m_storage[static_cast<size_t>(tet)]); }
 
+  // Per tet, by storage index (the assembly's order):
+  std::vector<int> m_tet_id;   // the mesh's id
+  std::vector<int> m_storage;  // per mesh id: the storage index
   std::vector<Tet> m_tets;
   std::vector<AssemblyPhase> m_phases;
   std::vector<int> m_serial_tets;

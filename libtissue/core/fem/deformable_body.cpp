@@ -100,9 +100,10 @@ std::vector<int> enriched_row_capacities(const TetMesh& mesh, const DofMap& dofs
 DeformableBody::DeformableBody(TetMesh mesh, BodySettings settings)
     : m_mesh(std::move(mesh)),
       m_adjacency(build_adjacency(m_mesh)),
+      m_vertex_order(locality_order(m_adjacency, m_mesh.vertex_count())),
       m_settings(checked(std::move(settings), m_mesh.vertex_count())),
-      m_dofs(make_dof_map(m_mesh.vertex_count(), m_settings.fixed_vertices)),
-      m_elasticity(m_mesh, m_settings.material, m_settings.rotation),
+      m_dofs(make_dof_map(m_mesh.vertex_count(), m_settings.fixed_vertices, m_vertex_order)),
+      m_elasticity(m_mesh, m_settings.material, m_settings.rotation, m_vertex_order),
       m_vertex_mass_kg(lumped_vertex_masses(m_mesh, m_settings.material.density_kg_per_m3)),
       m_tangent(stiffness_pattern(m_mesh, m_dofs), m_settings.reserve, u_row_capacities(m_mesh, m_dofs)),
       m_slots(make_tet_slots(m_mesh, m_dofs, m_tangent)),

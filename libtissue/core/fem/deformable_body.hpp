@@ -217,6 +217,7 @@ class DeformableBody final : public DynamicsModel {
  private:
   TetMesh m_mesh;
   TetAdjacency m_adjacency;  // faces and vertex stars, for grouping the pieces' ghosts
+  std::vector<int> m_vertex_order;  // locality_order(): the block rows' and the assembly's sequence
   BodySettings m_settings;
   DofMap m_dofs;
   CorotationalElasticity m_elasticity;

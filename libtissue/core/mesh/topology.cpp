@@ -4,6 +4,8 @@
 #include "core/mesh/topology.hpp"
 
 #include <algorithm>
+#include <cstdlib>
+#include <numeric>
 #include <string>
 #include <tuple>
 
@@ -158,6 +160,93 @@ TetAdjacency build_adjacency(const TetMesh& mesh) {
     }
   }
   return adjacency;
+}
+
+namespace {
+// The mesh's own numbering is kept when its mean edge span (|i - j| over the edges) is at most
+// this many times the reordering's.
+constexpr double OWN_ORDER_SPAN_FACTOR = 2.0;
+}  // namespace
+
+std::vector<int> locality_order(const TetAdjacency& adjacency, int vertex_count) {
+  const auto n = static_cast<size_t>(vertex_count);
+  // The edge graph in CSR form.
+  std::vector<int> begin(n + 1, 0);
+  for (const auto& edge : adjacency.edges) {
+    ++begin[static_cast<size_t>(edge[0]) + 1];
+    ++begin[static_cast<size_t>(edge[1]) + 1];
+  }
+  for (size_t v = 0; v < n; ++v) begin[v + 1] += begin[v];
+  std::vector<int> neighbours(static_cast<size_t>(begin[n]));
+  std::vector<int> fill(begin.begin(), begin.end() - 1);
+  for (const auto& edge : adjacency.edges) {
+    neighbours[static_cast<size_t>(fill[static_cast<size_t>(edge[0])]++)] = edge[1];
+    neighbours[static_cast<size_t>(fill[static_cast<size_t>(edge[1])]++)] = edge[0];
+  }
+  const auto degree = [&](int v) { return begin[static_cast<size_t>(v) + 1] - begin[static_cast<size_t>(v)]; };
+  for (size_t v = 0; v < n; ++v) {  // by increasing degree, ties by id: the order BFS visits them in
+    std::sort(neighbours.begin() + begin[v], neighbours.begin() + begin[v + 1],
+              [&](int a, int b) { return degree(a) < degree(b) || (degree(a) == degree(b) && a < b); });
+  }
+
+  std::vector<int> order;
+  order.reserve(n);
+  std::vector<int> level(n, -1);
+  // Breadth-first from `root` over the unvisited vertices (level -1), appending to `order`;
+  // returns the first vertex of least degree on the last level.
+  const auto sweep = [&](int root, int mark_base) {
+    const size_t first = order.size();
+    level[static_cast<size_t>(root)] = mark_base;
+    order.push_back(root);
+    for (size_t k = first; k < order.size(); ++k) {
+      const int v = order[k];
+      for (int e = begin[static_cast<size_t>(v)]; e < begin[static_cast<size_t>(v) + 1]; ++e) {
+        const int w = neighbours[static_cast<size_t>(e)];
+        if (level[static_cast<size_t>(w)] < mark_base) {
+          level[static_cast<size_t>(w)] = level[static_cast<size_t>(v)] + 1;
+          order.push_back(w);
+        }
+      }
+    }
+    int far = order.back();
+    for (size_t k = first; k < order.size(); ++k) {
+      const int v = order[k];
+      if (level[static_cast<size_t>(v)] == level[static_cast<size_t>(far)] && degree(v) < degree(far)) far = v;
+    }
+    return far;
+  };
+  // Levels of a trial sweep are offset so that the final sweep sees its vertices as unvisited.
+  constexpr int TRIAL_BASE = 0;
+  const int final_base = vertex_count + 1;
+  for (int start = 0; start < vertex_count; ++start) {
+    if (level[static_cast<size_t>(start)] >= 0 || degree(start) == 0) continue;
+    // A pseudo-peripheral root: sweep twice from the far end of the last sweep.
+    const size_t first = order.size();
+    int root = sweep(start, TRIAL_BASE);
+    for (size_t k = first; k < order.size(); ++k) level[static_cast<size_t>(order[k])] = -1;
+    order.resize(first);
+    const int farther = sweep(root, TRIAL_BASE);
+    for (size_t k = first; k < order.size(); ++k) level[static_cast<size_t>(order[k])] = -1;
+    order.resize(first);
+    root = farther;
+    sweep(root, final_base);
+    std::reverse(order.begin() + static_cast<std::ptrdiff_t>(first), order.end());
+  }
+  for (int v = 0; v < vertex_count; ++v) {
+    if (degree(v) == 0) order.push_back(v);
+  }
+
+  // A mesh numbered with locality already (a structured grid, a mesh its maker renumbered) keeps
+  // its own order: it also keeps the vertex-indexed arrays (positions, forces) in step with the rows.
+  std::vector<int> rank(n);
+  for (size_t k = 0; k < n; ++k) rank[static_cast<size_t>(order[k])] = static_cast<int>(k);
+  double own_span = 0.0, new_span = 0.0;
+  for (const auto& edge : adjacency.edges) {
+    own_span += std::abs(edge[0] - edge[1]);
+    new_span += std::abs(rank[static_cast<size_t>(edge[0])] - rank[static_cast<size_t>(edge[1])]);
+  }
+  if (own_span <= OWN_ORDER_SPAN_FACTOR * new_span) std::iota(order.begin(), order.end(), 0);
+  return order;
 }
 
 }  // namespace tissue

@@ -45,4 +45,14 @@ struct TetAdjacency {
 /// in increasing order. Throws MeshError like extract_surface for a face shared by more than two tets.
 TetAdjacency build_adjacency(const TetMesh& mesh);
 
+/// The vertices in an order that keeps neighbours close (reverse Cuthill-McKee over the edge graph:
+/// each connected part from a pseudo-peripheral vertex, neighbours by increasing degree, ties by
+/// id), as order[k] = vertex. Numbering a system's block rows and visiting its tets in this order
+/// keeps the blocks a tet writes, and the entries a mat-vec reads, close in memory: a mesh from a
+/// Delaunay mesher comes numbered in insertion order, and its assembly then misses the cache on
+/// nearly every block (docs/BENCHMARKS.md, issue 23). Deterministic; vertices on no edge go last.
+/// A mesh whose own numbering is about as local (its mean edge span at most twice the reordering's)
+/// keeps it: the identity order, which also keeps vertex-indexed arrays in step with the rows.
+std::vector<int> locality_order(const TetAdjacency& adjacency, int vertex_count);
+
 }  // namespace tissue

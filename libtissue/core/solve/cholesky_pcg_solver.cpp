@@ -52,7 +52,7 @@ struct CholeskyPcgSolver::Impl {
   std::vector<Eigen::Matrix3d> active_frames, spare_frames, turns;
   Eigen::VectorXd turned_residual, turned_solution;  // Q^T r and (L L^T)^-1 Q^T r on the factor's rows
 
-  Impl(PcgSolver::Settings p, Refresh r) : pcg(p), refresh(r) {}
+  Impl(PcgSolver::Settings p, Refresh r) : pcg(p), refresh(r) { work.matrix = HalfMatrix(resolved_precision(p.matrix_precision, p.tolerance)); }
   ~Impl() { join(); }
   Impl(const Impl&) = delete;
   Impl& operator=(const Impl&) = delete;
@@ -217,6 +217,7 @@ void CholeskyPcgSolver::setup(const ShiftedSystem& system) {
   impl.counters.factor_rows = impl.active->rows();
   impl.update_turns(system);
   impl.work.resize(n);
+  impl.work.matrix.assign(system);
   impl.system = system;
 }
 

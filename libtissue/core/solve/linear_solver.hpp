@@ -5,6 +5,7 @@
 // stiffness_scale = h*beta + h^2, d = (1 + h*alpha) m; IDA's Newton matrix has the same shape.
 #pragma once
 
+#include "core/solve/half_matrix.hpp"
 #include "core/system/block_sparse_matrix.hpp"
 #include "core/system/work_team.hpp"
 
@@ -81,6 +82,7 @@ class LinearSolver {
 /// Conjugate gradients' vectors, kept between solves so that a solve of an unchanged size does not allocate.
 struct PcgWorkspace {
   Eigen::VectorXd residual, direction, preconditioned, product;
+  HalfMatrix matrix;  ///< A as the products stream it, made at each setup
 
   void resize(long n) {
     if (residual.size() == n) return;
@@ -98,6 +100,10 @@ class PcgSolver final : public LinearSolver {
   struct Settings {
     double tolerance = 1e-6;
     int max_iterations = 10000;
+    /// The entries of A the products stream (half_matrix.hpp): single halves the bytes again, and
+    /// changes a 200-step run by ~1e-7 relative (docs/BENCHMARKS.md, issue 23); automatic takes it
+    /// for tolerances >= 1e-5 (the real-time setting is 1e-3).
+    MatrixPrecision matrix_precision = MatrixPrecision::automatic;
   };
   explicit PcgSolver(Settings settings);
   using LinearSolver::solve;

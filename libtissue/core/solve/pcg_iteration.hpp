@@ -1,7 +1,8 @@
 // The preconditioned conjugate-gradient loop (internal to core/solve), written once for every
 // preconditioner: PcgSolver passes Jacobi, CholeskyPcgSolver a lagged Cholesky factor.
 //
-// The vectors are worked on in two parts of block rows of about equal matrix work (VectorParts);
+// The products stream the compact copy of A (HalfMatrix, half_matrix.hpp), whose two parts are
+// VectorParts'. The vectors are worked on in two parts of block rows of about equal matrix work (VectorParts);
 // with a team of two threads each member takes one part of every mat-vec and vector update, and
 // the dot products are the sum of the parts' dots in part order with one thread or two, so two
 // threads give bitwise the iterates of one. A row-wise preconditioner (Jacobi) is applied part by
@@ -69,7 +70,7 @@ struct PartSums {
   }
 };
 
-/// Solves A x = b from the initial guess x (a non-finite guess is replaced by zero) until
+/// Solves A x = b (A as work.matrix holds it: the caller's setup assigned it from `system`) from the initial guess x (a non-finite guess is replaced by zero) until
 /// ||r|| <= tolerance * ||b|| or max_iterations. `precondition(r, z, first, count)` sets
 /// z = P^-1 r for an SPD P: with ROW_WISE it is called for each part's rows (z_i depends on r_i
 /// only) and must write only those; otherwise once for all rows (first 0, count rows()). z has r's
@@ -99,8 +100,9 @@ SolveReport preconditioned_cg(const ShiftedSystem& system, const Eigen::VectorXd
     work.residual = b;
     r_squared = b_squared;
   } else {
+    parts.run([&](int part) { work.matrix.multiply_part(x, work.product, part); });
     parts.run([&](int part) {
-      system.multiply_rows(x, work.product, parts.first_block_row(part), parts.end_block_row(part));
+      work.matrix.finish_part(work.product, part);
       segment(work.residual, part) = segment(b, part) - segment(work.product, part);
       r_squared.values[static_cast<size_t>(part)] = segment(work.residual, part).squaredNorm();
     });
@@ -134,8 +136,9 @@ SolveReport preconditioned_cg(const ShiftedSystem& system, const Eigen::VectorXd
   double alpha = 0.0;
   double beta = 0.0;
   for (int k = 1; k <= max_iterations; ++k) {
+    parts.run([&](int part) { work.matrix.multiply_part(work.direction, work.product, part); });
     parts.run([&](int part) {
-      system.multiply_rows(work.direction, work.product, parts.first_block_row(part), parts.end_block_row(part));
+      work.matrix.finish_part(work.product, part);
       curvature_parts.values[static_cast<size_t>(part)] = segment(work.direction, part).dot(segment(work.product, part));
     });
     const double curvature = curvature_parts.total();

@@ -39,7 +39,10 @@ void check_system(const ShiftedSystem& system, const char* who) {
   }
 }
 
-PcgSolver::PcgSolver(Settings settings) : m_settings(settings) { validate_pcg_settings(settings, "PcgSolver"); }
+PcgSolver::PcgSolver(Settings settings) : m_settings(settings) {
+  validate_pcg_settings(settings, "PcgSolver");
+  m_work.matrix = HalfMatrix(resolved_precision(settings.matrix_precision, settings.tolerance));
+}
 
 void PcgSolver::setup(const ShiftedSystem& system) {
   m_system = ShiftedSystem{nullptr, 1.0, nullptr};
@@ -47,6 +50,7 @@ void PcgSolver::setup(const ShiftedSystem& system) {
   m_work.resize(system.rows());  // the only allocations: when the system grows
   // Jacobi preconditioner from the diagonal of A; taken at each setup as K changes every step.
   jacobi_inverse_diagonal(system, m_inverse_diagonal, "PcgSolver");
+  m_work.matrix.assign(system);
   m_system = system;
 }
 

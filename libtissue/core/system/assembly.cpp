@@ -31,7 +31,7 @@ void check_dofs_match(const TetMesh& mesh, const DofMap& dofs) {
 
 }  // namespace
 
-DofMap make_dof_map(int vertex_count, const std::vector<int>& fixed_vertices) {
+DofMap make_dof_map(int vertex_count, const std::vector<int>& fixed_vertices, const std::vector<int>& order) {
   if (vertex_count < 0) throw std::invalid_argument("make_dof_map: negative vertex count");
   std::vector<char> fixed(to_size(vertex_count), 0);
   for (const int v : fixed_vertices) {
@@ -42,8 +42,21 @@ DofMap make_dof_map(int vertex_count, const std::vector<int>& fixed_vertices) {
     fixed[to_size(v)] = 1;
   }
   DofMap dofs;
+  if (!order.empty() && order.size() != to_size(vertex_count)) {
+    throw std::invalid_argument("make_dof_map: the order lists " + std::to_string(order.size()) + " vertices, the mesh has " +
+                                std::to_string(vertex_count));
+  }
   dofs.vertex_row.assign(to_size(vertex_count), -1);
-  for (int v = 0; v < vertex_count; ++v) {
+  std::vector<char> listed(order.empty() ? 0 : to_size(vertex_count), 0);
+  for (int k = 0; k < vertex_count; ++k) {
+    const int v = order.empty() ? k : order[to_size(k)];
+    if (!order.empty()) {
+      if (v < 0 || v >= vertex_count || listed[to_size(v)] != 0) {
+        throw std::invalid_argument("make_dof_map: the order is not a permutation of the vertices (entry " +
+                                    std::to_string(k) + " is " + std::to_string(v) + ")");
+      }
+      listed[to_size(v)] = 1;
+    }
     if (fixed[to_size(v)] != 0) continue;
     dofs.vertex_row[to_size(v)] = static_cast<int>(dofs.row_vertex.size());
     dofs.row_vertex.push_back(v);

@@ -17,8 +17,10 @@ struct DofMap {
   [[nodiscard]] int free_vertex_count() const { return static_cast<int>(row_vertex.size()); }
 };
 
-/// Numbers the vertices not in `fixed_vertices` (sorted or not) consecutively, in vertex order.
-DofMap make_dof_map(int vertex_count, const std::vector<int>& fixed_vertices);
+/// Numbers the vertices not in `fixed_vertices` (sorted or not) consecutively: in `order` (a
+/// permutation of the vertices, such as locality_order()), or in vertex order when it is empty.
+/// Throws std::invalid_argument if `order` is not a permutation of [0, vertex_count).
+DofMap make_dof_map(int vertex_count, const std::vector<int>& fixed_vertices, const std::vector<int>& order = {});
 
 /// Block sparsity of the stiffness on the free vertices: row r holds every free vertex sharing a tet with it.
 std::vector<std::vector<int>> stiffness_pattern(const TetMesh& mesh, const DofMap& dofs);

@@ -90,7 +90,8 @@ TEST(AssemblySplit, EveryTetOnceAndTheHalvesOfAPhaseShareNoVertex) {
   for (const CorotationalElasticity::AssemblyPhase& phase : elasticity.assembly_phases()) {
     std::vector<int> vertex_part(static_cast<size_t>(mesh.vertex_count()), -1);
     for (int part = 0; part < CorotationalElasticity::ASSEMBLY_PARTS; ++part) {
-      for (const int t : phase[static_cast<size_t>(part)]) {
+      for (const int k : phase[static_cast<size_t>(part)]) {  // storage indices
+        const int t = elasticity.tet_id(k);
         ++seen[static_cast<size_t>(t)];
         for (const int v : mesh.tets[static_cast<size_t>(t)]) {
           int& owner = vertex_part[static_cast<size_t>(v)];
@@ -101,7 +102,7 @@ TEST(AssemblySplit, EveryTetOnceAndTheHalvesOfAPhaseShareNoVertex) {
     }
     std::printf("frog: a phase of %zu + %zu tets\n", phase[0].size(), phase[1].size());
   }
-  for (const int t : elasticity.serial_tets()) ++seen[static_cast<size_t>(t)];
+  for (const int k : elasticity.serial_tets()) ++seen[static_cast<size_t>(elasticity.tet_id(k))];
   EXPECT_EQ(seen, std::vector<int>(seen.size(), 1));
   // The split is worth having: few tets are left to one thread.
   EXPECT_LT(elasticity.serial_tets().size(), static_cast<size_t>(mesh.tet_count()) / 20);

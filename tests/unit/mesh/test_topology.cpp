@@ -10,7 +10,9 @@
 #include <Eigen/Geometry>
 
 #include <algorithm>
+#include <cstdio>
 #include <map>
+#include <numeric>
 #include <random>
 #include <set>
 #include <utility>
@@ -362,6 +364,73 @@ TEST(BuildAdjacency, BeamAndBarAreBallsByEuler) {
 }
 
 TEST(BuildAdjacency, FrogIsABallByEuler) { EXPECT_EQ(check_adjacency(read_mesh(MESH_DIR / "frog.msh")), 1); }
+
+// Mean |rank(a) - rank(b)| over the mesh's edges, ranks by `order` (order[k] = vertex).
+double mean_edge_span(const TetAdjacency& adjacency, const std::vector<int>& order) {
+  std::vector<int> rank(order.size());
+  for (size_t k = 0; k < order.size(); ++k) rank[static_cast<size_t>(order[k])] = static_cast<int>(k);
+  double sum = 0.0;
+  for (const auto& edge : adjacency.edges) sum += std::abs(rank[static_cast<size_t>(edge[0])] - rank[static_cast<size_t>(edge[1])]);
+  return sum / static_cast<double>(adjacency.edges.size());
+}
+
+bool is_permutation_of(const std::vector<int>& order, int n) {
+  std::vector<int> sorted = order;
+  std::sort(sorted.begin(), sorted.end());
+  for (int k = 0; k < n; ++k) {
+    if (sorted.size() != static_cast<size_t>(n) || sorted[static_cast<size_t>(k)] != k) return false;
+  }
+  return true;
+}
+
+TEST(LocalityOrder, BringsTheNeighboursOfAShuffledMeshClose) {
+  const TetMesh box = make_box_mesh(12, 6, 6, 0.01);
+  // The same mesh with its vertices numbered at random, as a Delaunay mesher's insertion order.
+  std::vector<int> shuffle(static_cast<size_t>(box.vertex_count()));
+  std::iota(shuffle.begin(), shuffle.end(), 0);
+  std::mt19937 rng(23);
+  std::shuffle(shuffle.begin(), shuffle.end(), rng);
+  TetMesh shuffled = box;
+  for (size_t v = 0; v < shuffle.size(); ++v) shuffled.rest_positions_m[static_cast<size_t>(shuffle[v])] = box.rest_positions_m[v];
+  for (Tet& tet : shuffled.tets) {
+    for (int& v : tet) v = shuffle[static_cast<size_t>(v)];
+  }
+  const TetAdjacency adjacency = build_adjacency(shuffled);
+  const std::vector<int> order = locality_order(adjacency, shuffled.vertex_count());
+  ASSERT_TRUE(is_permutation_of(order, shuffled.vertex_count()));
+  std::vector<int> own(order.size());
+  std::iota(own.begin(), own.end(), 0);
+  const double before = mean_edge_span(adjacency, own);
+  const double after = mean_edge_span(adjacency, order);
+  std::printf("shuffled 12x6x6 box: mean edge span %.1f -> %.1f\n", before, after);
+  // Random ranks are n/3 apart on average (~340 here); a level-by-level order keeps an edge within
+  // about one cross-section of 7 x 7 vertices.
+  EXPECT_LT(after, 0.2 * before);
+  EXPECT_LT(after, 7.0 * 7.0);
+}
+
+TEST(LocalityOrder, KeepsAnOrderThatIsLocalAlready) {
+  const TetMesh box = make_box_mesh(12, 6, 6, 0.01);  // x fastest: neighbours are close already
+  const std::vector<int> order = locality_order(build_adjacency(box), box.vertex_count());
+  std::vector<int> own(order.size());
+  std::iota(own.begin(), own.end(), 0);
+  EXPECT_EQ(order, own);
+}
+
+TEST(LocalityOrder, ListsEveryVertexOfSeveralPiecesAndUnusedOnes) {
+  TetMesh mesh = make_box_mesh(2, 1, 1, 0.01);
+  const int first_piece = mesh.vertex_count();
+  const TetMesh second = make_box_mesh(1, 1, 1, 0.01);
+  for (const Eigen::Vector3d& p : second.rest_positions_m) mesh.rest_positions_m.push_back(p + Eigen::Vector3d(1, 0, 0));
+  for (Tet tet : second.tets) {
+    for (int& v : tet) v += first_piece;
+    mesh.tets.push_back(tet);
+  }
+  mesh.rest_positions_m.push_back(Eigen::Vector3d(5, 5, 5));  // on no tet
+  const std::vector<int> order = locality_order(build_adjacency(mesh), mesh.vertex_count());
+  ASSERT_TRUE(is_permutation_of(order, mesh.vertex_count()));
+  EXPECT_EQ(order.back(), mesh.vertex_count() - 1);
+}
 
 }  // namespace
 }  // namespace tissue

@@ -1,0 +1,141 @@
+// HalfMatrix (half_matrix.hpp): the compact copy and its product kernel.
+#include "core/solve/half_matrix.hpp"
+
+#include "core/solve/linear_solver.hpp"
+#include "core/system/hot_kernel.hpp"
+
+#include <algorithm>
+
+namespace tissue {
+
+void HalfMatrix::derive_pattern(const BlockSparseMatrix& k) {
+  const int n = k.block_rows();
+  m_row_begin.assign(1, 0);
+  m_column.clear();
+  m_full_slot.clear();
+  for (int r = 0; r < n; ++r) {
+    const int begin = k.row_begin(r);
+    const int end = begin + k.row_size(r);
+    const size_t first = m_column.size();
+    for (int slot = begin; slot < end; ++slot) {
+      const int c = k.slot_column(slot);
+      if (c < r) continue;
+      m_column.push_back(c);
+      m_full_slot.push_back(slot);
+    }
+    // The diagonal first, the others by column (rows of K may hold appended blocks out of order).
+    std::vector<std::pair<int, int>> row;
+    for (size_t b = first; b < m_column.size(); ++b) row.emplace_back(m_column[b] == r ? -1 : m_column[b], m_full_slot[b]);
+    std::sort(row.begin(), row.end());
+    for (size_t b = first; b < m_column.size(); ++b) {
+      m_column[b] = row[b - first].first < 0 ? r : row[b - first].first;
+      m_full_slot[b] = row[b - first].second;
+    }
+    m_row_begin.push_back(static_cast<int>(m_column.size()));
+  }
+  for (int part = 0; part <= PARTS; ++part) {
+    m_first_block_row[static_cast<size_t>(part)] = part == PARTS ? n : k.balanced_row_split(part, PARTS);
+  }
+  m_spill_end = end_block_row(0);
+  for (int r = first_block_row(0); r < end_block_row(0); ++r) {
+    for (int b = m_row_begin[static_cast<size_t>(r)]; b < m_row_begin[static_cast<size_t>(r) + 1]; ++b) {
+      m_spill_end = std::max(m_spill_end, m_column[static_cast<size_t>(b)] + 1);
+    }
+  }
+  m_spill.setZero(3L * n);
+  m_source = &k;
+  m_pattern_revision = k.pattern_revision();
+  m_layout_revision = k.layout_revision();
+}
+
+void HalfMatrix::assign(const ShiftedSystem& system) {
+  const BlockSparseMatrix& k = *system.stiffness;
+  if (m_source != &k || m_pattern_revision != k.pattern_revision() || m_layout_revision != k.layout_revision() ||
+      block_rows() != k.block_rows()) {
+    derive_pattern(k);
+  }
+  const size_t blocks = m_column.size();
+  const double s = system.stiffness_scale;
+  if (m_precision == MatrixPrecision::single) {
+    m_single.resize(9 * blocks);
+    for (size_t b = 0; b < blocks; ++b) {
+      const double* from = k.block(m_full_slot[b]).data();
+      float* to = &m_single[9 * b];
+      for (int e = 0; e < 9; ++e) to[e] = static_cast<float>(s * from[e]);
+    }
+  } else {
+    m_double.resize(9 * blocks);
+    for (size_t b = 0; b < blocks; ++b) {
+      const double* from = k.block(m_full_slot[b]).data();
+      double* to = &m_double[9 * b];
+      for (int e = 0; e < 9; ++e) to[e] = s * from[e];
+    }
+  }
+  m_diagonal = *system.diagonal;
+}
+
+long HalfMatrix::streamed_bytes() const {
+  const long value_bytes = m_precision == MatrixPrecision::single ? 4 : 8;
+  return static_cast<long>(m_column.size()) * (9 * value_bytes + 4);
+}
+
+template <class Real>
+TISSUE_HOT_KERNEL void HalfMatrix::multiply_rows(const Real* __restrict values, const double* __restrict x,
+                                                 double* __restrict y, int part) const {
+  const int first = first_block_row(part);
+  const int end = end_block_row(part);
+  const int* __restrict column = m_column.data();
+  const int* __restrict row_begin = m_row_begin.data();
+  const double* __restrict d = m_diagonal.data();
+  double* __restrict spill = m_spill.data();
+  std::fill(y + 3L * first, y + 3L * end, 0.0);
+  if (part == 0) std::fill(spill + 3L * end, spill + 3L * m_spill_end, 0.0);
+  for (int r = first; r < end; ++r) {
+    const double x0 = x[3 * r], x1 = x[3 * r + 1], x2 = x[3 * r + 2];
+    const int begin = row_begin[r];
+    const int stop = row_begin[r + 1];
+    // The diagonal block (symmetric) and d.
+    const Real* b = values + 9L * begin;
+    double y0 = b[0] * x0 + b[3] * x1 + b[6] * x2 + d[3 * r] * x0;
+    double y1 = b[1] * x0 + b[4] * x1 + b[7] * x2 + d[3 * r + 1] * x1;
+    double y2 = b[2] * x0 + b[5] * x1 + b[8] * x2 + d[3 * r + 2] * x2;
+    for (int k = begin + 1; k < stop; ++k) {
+      b = values + 9L * k;
+      const int c = column[k];
+      const double* xc = x + 3L * c;
+      y0 += b[0] * xc[0] + b[3] * xc[1] + b[6] * xc[2];
+      y1 += b[1] * xc[0] + b[4] * xc[1] + b[7] * xc[2];
+      y2 += b[2] * xc[0] + b[5] * xc[1] + b[8] * xc[2];
+      double* to = (c < end ? y : spill) + 3L * c;  // the transposed term, B^T x_r, for row c
+      to[0] += b[0] * x0 + b[1] * x1 + b[2] * x2;
+      to[1] += b[3] * x0 + b[4] * x1 + b[5] * x2;
+      to[2] += b[6] * x0 + b[7] * x1 + b[8] * x2;
+    }
+    y[3 * r] += y0;
+    y[3 * r + 1] += y1;
+    y[3 * r + 2] += y2;
+  }
+}
+
+void HalfMatrix::multiply_part(const Eigen::VectorXd& x, Eigen::VectorXd& y, int part) const {
+  if (m_precision == MatrixPrecision::single) {
+    multiply_rows(m_single.data(), x.data(), y.data(), part);
+  } else {
+    multiply_rows(m_double.data(), x.data(), y.data(), part);
+  }
+}
+
+void HalfMatrix::finish_part(Eigen::VectorXd& y, int part) const {
+  if (part == 0) return;
+  const long first = 3L * first_block_row(part);
+  const long end = std::min(3L * end_block_row(part), 3L * m_spill_end);
+  for (long i = first; i < end; ++i) y[i] += m_spill[i];
+}
+
+void HalfMatrix::multiply(const Eigen::VectorXd& x, Eigen::VectorXd& y) const {
+  y.resize(3L * block_rows());
+  for (int part = 0; part < PARTS; ++part) multiply_part(x, y, part);
+  for (int part = 0; part < PARTS; ++part) finish_part(y, part);
+}
+
+}  // namespace tissue

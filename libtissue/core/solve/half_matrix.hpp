@@ -1,0 +1,88 @@
+// HalfMatrix: the system matrix A = s K + diag(d) of a CG solve, stored for its products only: the
+// diagonal and upper blocks of s K (K is symmetric), in single precision by default, beside d in
+// double. Made at each solver setup from K's full double blocks (BlockSparseMatrix), it is what the
+// ten products of a real-time step stream: on the 52k-tet organ the full double matrix is 11 MB per
+// product, the half single one 3.3 MB (docs/BENCHMARKS.md, issue 23). Sums are taken in double;
+// single precision rounds the entries of s K to 6e-8 relative, far below the solve's tolerance
+// (the accuracy figure is in BENCHMARKS).
+//
+// Two threads: the rows are in the parts of VectorParts (balanced_row_split). A row's upper block
+// (r, c) also gives the transposed term to row c; part 0 sends the terms for part 1's rows to a spill
+// vector that part 1 adds after both are done (finish_part). Every entry receives its terms in the
+// same order whether the parts run side by side or one after the other: bitwise the same results.
+#pragma once
+
+#include "core/system/block_sparse_matrix.hpp"
+#include "core/system/work_team.hpp"
+
+#include <Eigen/Core>
+
+#include <array>
+#include <cstdint>
+#include <vector>
+
+namespace tissue {
+
+struct ShiftedSystem;
+
+/// The precision of the matrix entries a CG product streams (its sums are always double).
+/// `automatic`: single when the solve's relative tolerance is at least SINGLE_PRECISION_TOLERANCE
+/// (entries rounded to 6e-8 relative change the residual 100x less than the tolerance allows),
+/// double for tighter solves.
+enum class MatrixPrecision { automatic, single, double_precision };
+inline constexpr double SINGLE_PRECISION_TOLERANCE = 1e-5;
+/// The precision `precision` means for a solve of relative tolerance `tolerance`.
+[[nodiscard]] inline MatrixPrecision resolved_precision(MatrixPrecision precision, double tolerance) {
+  if (precision != MatrixPrecision::automatic) return precision;
+  return tolerance >= SINGLE_PRECISION_TOLERANCE ? MatrixPrecision::single : MatrixPrecision::double_precision;
+}
+
+class HalfMatrix {
+ public:
+  static constexpr int PARTS = MAX_STEP_THREADS;
+  static_assert(PARTS == 2, "one spill: from part 0 to part 1");
+
+  /// `precision`: single or double_precision (automatic is resolved by the solver).
+  explicit HalfMatrix(MatrixPrecision precision = MatrixPrecision::double_precision) : m_precision(precision) {}
+
+  /// Copies s K's diagonal and upper blocks and d (the block pattern is re-derived only when K's
+  /// pattern or layout changed). The system must be checked (K and d set, sizes agreeing).
+  void assign(const ShiftedSystem& system);
+
+  [[nodiscard]] int block_rows() const { return static_cast<int>(m_row_begin.size()) - 1; }
+  [[nodiscard]] int first_block_row(int part) const { return m_first_block_row[static_cast<size_t>(part)]; }
+  [[nodiscard]] int end_block_row(int part) const { return m_first_block_row[static_cast<size_t>(part) + 1]; }
+
+  /// y = A x on the rows of `part`, except the terms part 0 sends to later parts (finish_part adds
+  /// them). Parts may run side by side; finish_part(y, p) only after every multiply_part.
+  void multiply_part(const Eigen::VectorXd& x, Eigen::VectorXd& y, int part) const;
+  /// Adds to the rows of `part` the terms earlier parts sent them.
+  void finish_part(Eigen::VectorXd& y, int part) const;
+  /// y = A x, all parts on this thread (y resized if needed).
+  void multiply(const Eigen::VectorXd& x, Eigen::VectorXd& y) const;
+
+  [[nodiscard]] MatrixPrecision precision() const { return m_precision; }
+  /// Bytes of matrix values and column indices one product streams.
+  [[nodiscard]] long streamed_bytes() const;
+
+ private:
+  template <class Real>
+  void multiply_rows(const Real* values, const double* x, double* y, int part) const;
+  void derive_pattern(const BlockSparseMatrix& k);
+
+  MatrixPrecision m_precision;
+  // Pattern: per block row its diagonal block first, then its upper blocks by column.
+  std::vector<int> m_row_begin;   // block rows + 1
+  std::vector<int> m_column;      // per stored block
+  std::vector<int> m_full_slot;   // per stored block: the slot of K it copies
+  std::vector<float> m_single;    // 9 per stored block, column-major, s K
+  std::vector<double> m_double;
+  Eigen::VectorXd m_diagonal;     // d
+  std::array<int, PARTS + 1> m_first_block_row{};
+  int m_spill_end = 0;                   // 1 + the last block row part 0 sends terms to
+  mutable Eigen::VectorXd m_spill;       // the terms for rows [end_block_row(0), m_spill_end)
+  const BlockSparseMatrix* m_source = nullptr;
+  std::uint64_t m_pattern_revision = 0, m_layout_revision = 0;
+};
+
+}  // namespace tissue

@@ -1,0 +1,230 @@
+#!/usr/bin/python3
+"""Builds the organ-scale specimen (issue 23): a liver-sized organ of about 50k tets.
+
+    /usr/bin/python3 meshes/make_liver.py [--gmsh gmsh]
+
+The shape is one smooth closed surface: the unit sphere mapped by a smooth function into a
+liver-like wedge (a thick right lobe tapering to a thin left lobe, domed on top, 22 cm across),
+with a ridge on its back, the "ligament": the vertices of that ridge (the slab of the mesh within
+LIGAMENT_FRACTION of its extent from the minimum y, `fixedRegion.axis = 1`) are the fixed region,
+as the coronary ligament and the bare area hold a liver to the diaphragm. The script writes the
+mapped sphere as an STL (a fine triangulation of the smooth shape), lets Gmsh re-mesh that
+surface and fill it with tets of at most MESH_SIZE_M (liver.geo), checks the result (every tet
+positive, one closed surface, the tet count within 15% of TARGET_TETS, the ligament slab holding
+only ridge vertices), renumbers the vertices and tets for locality and writes meshes/liver.veg and the ligament's vertices as
+meshes/liver.bou (Vega's fixed-vertex list, 1-based, for side-by-side runs). Gmsh 4.8.4 (single thread, fixed seed) wrote
+the committed files; the script reuses make_frog.py's reader and checks. Frame: x from the right
+lobe to the left, y from back to front, z up; metres.
+"""
+
+import argparse
+import math
+import os
+import subprocess
+import sys
+
+from make_bar import signed_volume
+from make_frog import check, read_msh41, write_veg
+
+TARGET_TETS = 50000
+TOLERANCE = 0.15
+MESH_SIZE_M = 0.0046  # largest tet edge: lands near TARGET_TETS
+SPHERE_LEVEL = 5  # icosphere subdivisions of the shape's STL (20480 triangles)
+
+HALF_LENGTH_M = 0.11  # x: right lobe tip to left lobe tip, 22 cm
+HALF_DEPTH_M = 0.075  # y: back to front at mid length
+HALF_THICKNESS_M = 0.06  # z: the right lobe's half thickness before tapering
+DOME_M = 0.012  # the upper (diaphragmatic) surface bulges up this much at mid length
+RIDGE_M = 0.012  # how far the ligament ridge stands out of the back
+RIDGE_CENTRE = (-0.1, 0.25)  # (u, w) on the unit sphere: right of centre, upper back
+RIDGE_WIDTH = (0.45, 0.35)
+LIGAMENT_FRACTION = 0.04  # the fixed slab: the ridge's top 4% of the extent in y (~7 mm)
+
+
+def liver_point(u, v, w):
+    """The smooth map of a point (u, v, w) of the unit sphere onto the organ's surface [m]."""
+    taper = 0.55 - 0.35 * u  # 0.9 at the right lobe's tip, 0.2 at the left's
+    x = HALF_LENGTH_M * u
+    y = HALF_DEPTH_M * v * (0.85 - 0.15 * u)
+    z = HALF_THICKNESS_M * taper * w + DOME_M * (1.0 - u * u) * (1.0 - 0.5 * v * v)
+    back = max(0.0, -v) ** 3  # C2: the ridge grows out of the back only
+    du = (u - RIDGE_CENTRE[0]) / RIDGE_WIDTH[0]
+    dw = (w - RIDGE_CENTRE[1]) / RIDGE_WIDTH[1]
+    y -= RIDGE_M * back * math.exp(-du * du - dw * dw)
+    return (x, y, z)
+
+
+def icosphere(level):
+    """Vertices on the unit sphere and triangles (outward), an icosahedron subdivided `level` times."""
+    t = (1.0 + math.sqrt(5.0)) / 2.0
+    points = [(-1, t, 0), (1, t, 0), (-1, -t, 0), (1, -t, 0), (0, -1, t), (0, 1, t), (0, -1, -t), (0, 1, -t),
+              (t, 0, -1), (t, 0, 1), (-t, 0, -1), (-t, 0, 1)]
+    points = [tuple(c / math.sqrt(sum(x * x for x in p)) for c in p) for p in points]
+    faces = [(0, 11, 5), (0, 5, 1), (0, 1, 7), (0, 7, 10), (0, 10, 11), (1, 5, 9), (5, 11, 4), (11, 10, 2),
+             (10, 7, 6), (7, 1, 8), (3, 9, 4), (3, 4, 2), (3, 2, 6), (3, 6, 8), (3, 8, 9), (4, 9, 5), (2, 4, 11),
+             (6, 2, 10), (8, 6, 7), (9, 8, 1)]
+    for _ in range(level):
+        middle = {}
+
+        def midpoint(a, b):
+            key = (min(a, b), max(a, b))
+            if key not in middle:
+                p = [(points[a][n] + points[b][n]) / 2.0 for n in range(3)]
+                norm = math.sqrt(sum(x * x for x in p))
+                points.append(tuple(x / norm for x in p))
+                middle[key] = len(points) - 1
+            return middle[key]
+
+        finer = []
+        for a, b, c in faces:
+            ab, bc, ca = midpoint(a, b), midpoint(b, c), midpoint(c, a)
+            finer += [(a, ab, ca), (b, bc, ab), (c, ca, bc), (ab, bc, ca)]
+        faces = finer
+    return points, faces
+
+
+def write_stl(path, points, faces):
+    def normal(a, b, c):
+        e1 = [b[n] - a[n] for n in range(3)]
+        e2 = [c[n] - a[n] for n in range(3)]
+        n = (e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2], e1[0] * e2[1] - e1[1] * e2[0])
+        length = math.sqrt(sum(x * x for x in n)) or 1.0
+        return tuple(x / length for x in n)
+
+    lines = ["solid liver"]
+    for face in faces:
+        a, b, c = (points[k] for k in face)
+        lines.append("facet normal %.9e %.9e %.9e" % normal(a, b, c))
+        lines.append("outer loop")
+        lines += ["vertex %.9e %.9e %.9e" % p for p in (a, b, c)]
+        lines += ["endloop", "endfacet"]
+    lines.append("endsolid liver")
+    with open(path, "w", newline="\n") as out:
+        out.write("\n".join(lines) + "\n")
+
+
+def geo_text(stl_name, mesh_size_m):
+    return "\n".join([
+        "// Liver-sized organ, written by meshes/make_liver.py: edit the script, not this file.",
+        "// The smooth shape comes as an STL (%s, written by the script); Gmsh re-meshes it." % stl_name,
+        "General.NumThreads = 1;        // single-threaded meshing is reproducible",
+        "Mesh.RandomSeed = 1;",
+        "Mesh.RandomFactor = 1e-9;",
+        "Mesh.Algorithm = 6;            // Frontal-Delaunay surfaces",
+        "Mesh.Algorithm3D = 1;          // Delaunay volume",
+        "Mesh.Optimize = 1;",
+        "Mesh.MeshSizeFromCurvature = 0;",
+        "Mesh.MeshSizeMin = 0;",
+        "Mesh.MeshSizeMax = %r;" % mesh_size_m,
+        "Mesh.ElementOrder = 1;",
+        'Merge "%s";' % stl_name,
+        "// One smooth surface: split into patches Gmsh can parametrize, then re-mesh them.",
+        "ClassifySurfaces{Pi / 4, 1, 1, Pi};",
+        "CreateGeometry;",
+        "Surface Loop(1) = Surface{:};",
+        "Volume(1) = {1};",
+        "",
+    ])
+
+
+def renumbered_for_locality(coords, tets):
+    """Vertices in reverse Cuthill-McKee order (from a pseudo-peripheral vertex, neighbours by
+    degree) and tets by their earliest vertex: Gmsh numbers the vertices as its Delaunay kernel
+    inserted them, scattered through the volume, and a step that gathers and scatters by vertex
+    then misses the cache on nearly every access (docs/BENCHMARKS.md, issue 23)."""
+    n = len(coords)
+    neighbours = [set() for _ in range(n)]
+    for tet in tets:
+        for a in tet:
+            neighbours[a].update(b for b in tet if b != a)
+    degree = [len(nb) for nb in neighbours]
+    neighbours = [sorted(nb, key=lambda w: (degree[w], w)) for nb in neighbours]
+
+    def sweep(root):
+        level = {root: 0}
+        order = [root]
+        for v in order:
+            for w in neighbours[v]:
+                if w not in level:
+                    level[w] = level[v] + 1
+                    order.append(w)
+        last = level[order[-1]]
+        return order, min((v for v in order if level[v] == last), key=lambda v: (degree[v], v))
+
+    _, root = sweep(0)  # the gmsh volume is one piece (check() refuses otherwise)
+    _, root = sweep(root)
+    order, _ = sweep(root)
+    order.reverse()
+    new_id = {v: k for k, v in enumerate(order)}
+    tets = sorted((tuple(new_id[v] for v in tet) for tet in tets), key=lambda t: (min(t), sorted(t)))
+    return [coords[v] for v in order], tets
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("--gmsh", default="gmsh", help="the gmsh executable (4.8.4 made the committed files)")
+    parser.add_argument("--mesh-size", type=float, default=MESH_SIZE_M,
+                        help="largest tet edge [m]; another size than the default skips the tet-count target "
+                             "(the scaling benchmark's sizes)")
+    parser.add_argument("--output-dir", default=None, help="where liver.veg and liver.bou go (default: meshes/)")
+    args = parser.parse_args()
+
+    here = os.path.dirname(os.path.abspath(__file__))
+    out_dir = os.path.abspath(args.output_dir) if args.output_dir else here
+    committed = args.mesh_size == MESH_SIZE_M and out_dir == here
+    stl_name = "liver_shape.stl"  # temporary: removed after meshing
+    points, faces = icosphere(SPHERE_LEVEL)
+    write_stl(os.path.join(here, stl_name), [liver_point(*p) for p in points], faces)
+    geo_name = "liver.geo" if committed else "liver_size_tmp.geo"
+    with open(os.path.join(here, geo_name), "w", newline="\n") as out:
+        out.write(geo_text(stl_name, args.mesh_size))
+    tmp = os.path.join(here, "liver.msh.tmp")
+    result = subprocess.run([args.gmsh, geo_name, "-3", "-nt", "1", "-format", "msh41", "-o",
+                             os.path.basename(tmp)], cwd=here, capture_output=True, text=True)
+    os.remove(os.path.join(here, stl_name))
+    if not committed:
+        os.remove(os.path.join(here, geo_name))
+    if result.returncode != 0 or not os.path.exists(tmp):
+        sys.stderr.write(result.stdout + result.stderr)
+        sys.exit("gmsh failed")
+
+    tags, coords, tets, _ = read_msh41(tmp)
+    os.remove(tmp)
+    index_of = {tag: n for n, tag in enumerate(tags)}
+    tets = [tuple(index_of[tag] for tag in tet) for tet in tets]
+    used = sorted(set(v for tet in tets for v in tet))  # drop the STL's nodes that no tet uses
+    renumber = {v: n for n, v in enumerate(used)}
+    coords = [coords[v] for v in used]
+    tets = [tuple(renumber[v] for v in tet) for tet in tets]
+    coords, tets = renumbered_for_locality(coords, tets)
+    problems, (lower, upper) = check(coords, tets, 1)
+    if committed and abs(len(tets) - TARGET_TETS) > TOLERANCE * TARGET_TETS:
+        problems.append("%d tets, target %d within %d%%: tune MESH_SIZE_M" % (len(tets), TARGET_TETS,
+                                                                           round(100 * TOLERANCE)))
+    # The fixed slab must hold the ridge and nothing else: its vertices lie within the ridge's width.
+    slab_top = lower[1] + LIGAMENT_FRACTION * (upper[1] - lower[1])
+    fixed_ids = [n for n, c in enumerate(coords) if c[1] <= slab_top]
+    fixed = [coords[n] for n in fixed_ids]
+    ridge_x = HALF_LENGTH_M * RIDGE_CENTRE[0]
+    if not 10 <= len(fixed) <= 1000 or any(abs(c[0] - ridge_x) > 2.0 * HALF_LENGTH_M * RIDGE_WIDTH[0] for c in fixed):
+        problems.append("the ligament slab holds %d vertices, not only the ridge's: tune RIDGE_M or "
+                        "LIGAMENT_FRACTION" % len(fixed))
+    if problems:
+        sys.exit("liver mesh refused:\n  " + "\n  ".join(problems))
+
+    size = [upper[n] - lower[n] for n in range(3)]
+    volume_l = 1e3 * sum(signed_volume(*(coords[v] for v in tet)) for tet in tets)
+    comment = ("liver-sized organ by meshes/make_liver.py (%.3f x %.3f x %.3f m, %.2f l); fixed region: "
+               "fixedRegion.axis = 1, fixedRegion.fraction = %g (%d vertices, the ligament ridge)"
+               % (size[0], size[1], size[2], volume_l, LIGAMENT_FRACTION, len(fixed)))
+    write_veg(os.path.join(out_dir, "liver.veg"), coords, tets, comment)
+    with open(os.path.join(out_dir, "liver.bou"), "w", newline="\n") as out:  # the same vertices, for Vega
+        ids = [str(n + 1) for n in fixed_ids]
+        out.write("".join(",".join(ids[k:k + 8]) + ",\n" for k in range(0, len(ids), 8)))
+    print("liver: %d vertices, %d tets, %.3f x %.3f x %.3f m, %.2f l, %d ligament vertices"
+          % ((len(coords), len(tets)) + tuple(size) + (volume_l, len(fixed))))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
