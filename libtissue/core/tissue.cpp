@@ -63,6 +63,7 @@ std::uint64_t model_fingerprint_of(const TetMesh& mesh, const TissueSettings& se
   f.add_all(body.fixed_vertices);
   f.add(body.reserve.extra_row_fraction);  // field by field: a struct's padding bytes are not values
   f.add(body.reserve.row_capacity_factor);
+  if (body.reserve.spare_row_capacity != 0) f.add(body.reserve.spare_row_capacity);  // older fingerprints stay
   f.add(body.rotation.max_iterations);
   f.add(body.rotation.max_error_rad);
   f.add(settings.integrator.kind);
@@ -80,6 +81,7 @@ std::uint64_t model_fingerprint_of(const TetMesh& mesh, const TissueSettings& se
   f.add(settings.solver.pcg.tolerance);
   f.add(settings.solver.pcg.max_iterations);
   f.add(settings.solver.warm_start);
+  if (settings.solver.pcg.matrix_precision != MatrixPrecision::automatic) f.add(settings.solver.pcg.matrix_precision);
   if (settings.solver.kind == LinearSolverKind::pcg_cholesky) {  // so that older fingerprints stay as they were
     f.add(settings.solver.refresh.refresh_iterations);          // background_refactor changes no result
     f.add(settings.solver.refresh.pickup_setups);

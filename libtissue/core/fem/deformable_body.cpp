@@ -21,6 +21,7 @@
 #include "core/system/hot_kernel.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <map>
 #include <optional>
@@ -78,21 +79,22 @@ Neighbourhoods neighbourhoods(const TetMesh& mesh, const DofMap& dofs) {
 // holds a-u blocks with the free neighbours and a-a blocks with their ghosts, as many.
 constexpr int GHOSTS_PER_NEIGHBOUR = 3;
 
-std::vector<int> u_row_capacities(const TetMesh& mesh, const DofMap& dofs) {
-  const Neighbourhoods counts = neighbourhoods(mesh, dofs);
-  std::vector<int> capacities(static_cast<size_t>(dofs.free_vertex_count()));
-  for (size_t row = 0; row < capacities.size(); ++row) {
-    const auto v = static_cast<size_t>(dofs.row_vertex[row]);
-    capacities[row] = counts.free[v] + GHOSTS_PER_NEIGHBOUR * counts.all[v];
-  }
-  return capacities;
-}
-
 std::vector<int> enriched_row_capacities(const TetMesh& mesh, const DofMap& dofs) {
   const Neighbourhoods counts = neighbourhoods(mesh, dofs);
   std::vector<int> capacities(counts.all.size());
   for (size_t v = 0; v < capacities.size(); ++v) capacities[v] = counts.free[v] + GHOSTS_PER_NEIGHBOUR * counts.all[v];
   return capacities;
+}
+
+// The reserve with spare rows of an enriched row's mean room (unless the settings give one), so
+// that a cut's new rows come from the pool.
+MatrixReserve with_ghost_room(MatrixReserve reserve, const TetMesh& mesh, const DofMap& dofs) {
+  if (reserve.spare_row_capacity > 0 || mesh.vertex_count() == 0) return reserve;
+  const std::vector<int> room = enriched_row_capacities(mesh, dofs);
+  long total = 0;
+  for (const int r : room) total += r;
+  reserve.spare_row_capacity = static_cast<int>((total + mesh.vertex_count() - 1) / mesh.vertex_count());
+  return reserve;
 }
 
 }  // namespace
@@ -105,7 +107,7 @@ DeformableBody::DeformableBody(TetMesh mesh, BodySettings settings)
       m_dofs(make_dof_map(m_mesh.vertex_count(), m_settings.fixed_vertices, m_vertex_order)),
       m_elasticity(m_mesh, m_settings.material, m_settings.rotation, m_vertex_order),
       m_vertex_mass_kg(lumped_vertex_masses(m_mesh, m_settings.material.density_kg_per_m3)),
-      m_tangent(stiffness_pattern(m_mesh, m_dofs), m_settings.reserve, u_row_capacities(m_mesh, m_dofs)),
+      m_tangent(stiffness_pattern(m_mesh, m_dofs), with_ghost_room(m_settings.reserve, m_mesh, m_dofs)),
       m_slots(make_tet_slots(m_mesh, m_dofs, m_tangent)),
       m_xfem(m_elasticity.lame(), m_settings.rotation),
       m_enriched_row_capacity(enriched_row_capacities(m_mesh, m_dofs)),
@@ -199,14 +201,29 @@ TISSUE_HOT_KERNEL double DeformableBody::largest_element_turn_rad(const Eigen::V
     const int row = vertex_block_row(vertex);
     return row < 0 ? Eigen::Vector3d::Zero() : Eigen::Vector3d(increment_m.segment<3>(3 * row));
   };
-  double largest_rad = 0.0;
-  TetPositions increment;
-  for (int t = 0; t < m_mesh.tet_count(); ++t) {
-    if (m_cut_index[static_cast<size_t>(t)] >= 0) continue;
-    const Tet& tet = m_mesh.tets[static_cast<size_t>(t)];
-    for (size_t j = 0; j < 4; ++j) increment[j] = vertex_increment(tet[j]);
-    largest_rad = std::max(largest_rad, turn_angle_rad(m_elasticity.rest(t), m_elasticity.rotation(t), increment));
+  // The uncut tets in halves, side by side with a team (a maximum: the same in any order).
+  std::array<double, MAX_STEP_THREADS> largest_of_part{};
+  const int parts = m_team != nullptr ? m_team->size() : 1;
+  auto uncut_part = [&](int member) {
+    TetPositions increment;
+    double largest = 0.0;
+    const int tets = m_mesh.tet_count();
+    const int end = static_cast<int>(static_cast<long>(tets) * (member + 1) / parts);
+    for (int t = static_cast<int>(static_cast<long>(tets) * member / parts); t < end; ++t) {
+      if (m_cut_index[static_cast<size_t>(t)] >= 0) continue;
+      const Tet& tet = m_mesh.tets[static_cast<size_t>(t)];
+      for (size_t j = 0; j < 4; ++j) increment[j] = vertex_increment(tet[j]);
+      largest = std::max(largest, turn_angle_rad(m_elasticity.rest(t), m_elasticity.rotation(t), increment));
+    }
+    largest_of_part[static_cast<size_t>(member)] = largest;
+  };
+  if (parts > 1) {
+    m_team->run(uncut_part);
+  } else {
+    uncut_part(0);
   }
+  double largest_rad = *std::max_element(largest_of_part.begin(), largest_of_part.end());
+  TetPositions increment;
   for (int k = 0; k < m_xfem.cut_tet_count(); ++k) {
     if (m_xfem.retired(k)) continue;
     const CutTet& cut_tet = m_xfem.cut_tets()[static_cast<size_t>(k)];
@@ -252,7 +269,7 @@ void DeformableBody::evaluate(const Eigen::VectorXd& displacement_m, Eigen::Vect
   check_unknowns(displacement_m);
   positions(displacement_m, m_positions_m);
   m_vertex_forces_n.setZero();
-  if (update_tangent) m_tangent.set_zero();
+  if (update_tangent) m_tangent.set_zero(m_team);
   BlockSparseMatrix* tangent = update_tangent ? &m_tangent : nullptr;
   m_elasticity.evaluate(m_positions_m, m_vertex_forces_n, tangent, &m_slots, m_team);
   internal_force_n.resize(dof_count());
@@ -733,6 +750,7 @@ EnrichmentResult DeformableBody::enrich_pieces(std::span<const TetCut> cuts,
   const int u_rows = m_dofs.free_vertex_count();
   const int old_dofs = enriched_dof_count();
   const int first_new_cut_tet = m_xfem.cut_tet_count();
+  std::vector<std::pair<int, int>> new_blocks;  // (row, column) the new cut tets couple
   m_orphaned_rows.clear();
   // The current a of an unknown (new ones, and every one without a running state, are zero).
   const auto current_a = [&](int row) -> Eigen::Vector3d {
@@ -835,7 +853,7 @@ EnrichmentResult DeformableBody::enrich_pieces(std::span<const TetCut> cuts,
       }
     }
 
-    // 4. The blocks its pieces couple beyond u-u (which exist already), into the reserved room.
+    // 4. The blocks its pieces couple beyond u-u (which exist already): listed, inserted below.
     const int dofs = m_xfem.dof_count(k);
     for (int r = 0; r < dofs; ++r) {
       for (int col = 0; col < dofs; ++col) {
@@ -844,19 +862,46 @@ EnrichmentResult DeformableBody::enrich_pieces(std::span<const TetCut> cuts,
         const int row = cut_tet_dof_row(k, r);
         const int column = cut_tet_dof_row(k, col);
         if (row < 0 || column < 0) continue;  // a fixed vertex's u
-        m_tangent.insert_block(row, column);
+        new_blocks.emplace_back(row, column);
       }
     }
   }
+  // The batch's new blocks: room for all of them at once (rows start compact, MatrixReserve), then in.
+  // The rows around the cut tets also get a cut's room (their ghost room, as an enriched row's), so
+  // that the next strokes of a blade moving on find it: one re-layout where a cut starts, not one
+  // per step.
+  std::sort(new_blocks.begin(), new_blocks.end());
+  new_blocks.erase(std::unique(new_blocks.begin(), new_blocks.end()), new_blocks.end());
+  std::map<int, int> extra_of_row;
+  for (const auto& [row, column] : new_blocks) {
+    if (m_tangent.find_slot(row, column) < 0) ++extra_of_row[row];
+  }
+  for (int k = first_new_cut_tet; k < m_xfem.cut_tet_count(); ++k) {
+    for (const int v : m_xfem.cut_tets()[static_cast<size_t>(k)].vertices) {
+      const auto first = static_cast<size_t>(m_adjacency.vertex_tets_begin[static_cast<size_t>(v)]);
+      const auto end = static_cast<size_t>(m_adjacency.vertex_tets_begin[static_cast<size_t>(v) + 1]);
+      for (size_t e = first; e < end; ++e) {
+        for (const int w : m_mesh.tets[static_cast<size_t>(m_adjacency.vertex_tets[e])]) {
+          const int row = vertex_block_row(w);
+          if (row < 0) continue;
+          const int room = m_enriched_row_capacity[static_cast<size_t>(w)] - m_tangent.row_size(row);
+          int& extra = extra_of_row[row];
+          extra = std::max(extra, room);
+        }
+      }
+    }
+  }
+  m_tangent.reserve_room(std::vector<std::pair<int, int>>(extra_of_row.begin(), extra_of_row.end()));
+  for (const auto& [row, column] : new_blocks) m_tangent.insert_block(row, column);
   // An orphan that a later cut tet of the batch took up again is no orphan.
   std::erase_if(m_orphaned_rows, [&](int row) { return m_ghost_users[static_cast<size_t>(row - u_rows)] != 0; });
   result.new_cut_tets = static_cast<int>(plans.size());
   result.new_enriched_dofs = enriched_dof_count() - old_dofs;
 
-  // 5. Slots: of the new cut tets only, unless the storage moved (rare: room is reserved ahead).
+  // 5. Slots: of the new cut tets only, unless the storage moved (a row outgrew its room).
   result.matrix_relayout = m_tangent.layout_revision() != layout_before;
   if (result.matrix_relayout) {
-    refresh_all_slots();
+    refresh_all_slots(m_tangent.layout_revision() == layout_before + 1);
   } else {
     for (int k = first_new_cut_tet; k < m_xfem.cut_tet_count(); ++k) refresh_cut_tet_slots(k);
   }
@@ -888,8 +933,18 @@ void DeformableBody::refresh_cut_tet_slots(int cut_tet_index) {
   }
 }
 
-void DeformableBody::refresh_all_slots() {
-  m_slots = make_tet_slots(m_mesh, m_dofs, m_tangent);
+void DeformableBody::refresh_all_slots(bool one_relayout) {
+  if (one_relayout) {
+    // The uncut tets' blocks moved by the re-layout's map: no search (52k tets x 16 blocks).
+    const std::vector<int>& moved = m_tangent.relayout_slot_map();
+    for (TetSlots& tet_slots : m_slots) {
+      for (int& slot : tet_slots) {
+        if (slot >= 0) slot = moved[static_cast<size_t>(slot)];
+      }
+    }
+  } else {
+    m_slots = make_tet_slots(m_mesh, m_dofs, m_tangent);
+  }
   for (int k = 0; k < m_xfem.cut_tet_count(); ++k) refresh_cut_tet_slots(k);
   for (ForceTerm* term : m_force_terms) term->locate(term_layout());
 }

@@ -230,7 +230,9 @@ class DeformableBody final : public DynamicsModel {
   Eigen::VectorXd m_vertex_forces_n;  // all vertices
 
   // Looks up every slot held (uncut tets, cut tets, force terms) again: after a relayout.
-  void refresh_all_slots();
+  // All slots again after the tangent was re-laid out: by its slot map when it was re-laid out once
+  // since they were right (`one_relayout`), else by search.
+  void refresh_all_slots(bool one_relayout);
   void refresh_cut_tet_slots(int cut_tet_index);
   /// The block row of local DOF `dof` of a cut tet (XfemElasticity::dof_count): u of a local vertex
   /// (-1 if fixed) or a ghost row.

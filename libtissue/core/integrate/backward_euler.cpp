@@ -111,7 +111,7 @@ StepReport BackwardEuler::step(DynamicsModel& model, DynamicState& state, double
 
   // rhs = h (f_ext - f_int - alpha M v - (beta + h) K v)
   m_stiffness_times_velocity.resize(n);
-  stiffness.multiply(state.velocity_m_per_s, m_stiffness_times_velocity);
+  stiffness.multiply(state.velocity_m_per_s, m_stiffness_times_velocity, team ? &*team : nullptr);
   m_rhs.resize(n);
   m_rhs.noalias() = h * (model.external_force_n() - m_internal_force_n -
                          damping.mass_damping_per_s * mass.cwiseProduct(state.velocity_m_per_s) -
@@ -143,7 +143,7 @@ StepReport BackwardEuler::step(DynamicsModel& model, DynamicState& state, double
   double turn_rad =
       model.largest_turn_rad(m_end_displacement, std::min(newton.trigger_angle_rad, newton.energy_guard_angle_rad));
   if (turn_rad > newton.trigger_angle_rad) {
-    correct(model, state, h, report);
+    correct(model, state, h, report, team ? &*team : nullptr);
     m_velocity_change.noalias() = m_end_velocity - state.velocity_m_per_s;
     m_end_displacement.noalias() = h * m_end_velocity;
     turn_rad = model.largest_turn_rad(m_end_displacement, newton.energy_guard_angle_rad);
@@ -194,7 +194,8 @@ bool BackwardEuler::guard_energy(DynamicsModel& model, const DynamicState& state
 // Newton on the backward-Euler equations in v1 (u1 = u0 + h v1):
 //   r(v1) = h (f_ext - f_int(u1) - alpha M v1 - beta K(u1) v1) - M (v1 - v0) = 0,
 // with the matrix of the step, (1 + h alpha) M + (h beta + h^2) K(u1), taken at each iterate.
-void BackwardEuler::correct(DynamicsModel& model, const DynamicState& state, double h, StepReport& report) {
+void BackwardEuler::correct(DynamicsModel& model, const DynamicState& state, double h, StepReport& report,
+                            WorkTeam* team) {
   const int n = model.dof_count();
   const RayleighDamping& damping = model.damping();
   const Eigen::VectorXd& mass = model.mass_kg();
@@ -203,7 +204,7 @@ void BackwardEuler::correct(DynamicsModel& model, const DynamicState& state, dou
     m_end_displacement.noalias() = state.displacement_m + h * m_end_velocity;
     model.evaluate(m_end_displacement, m_internal_force_n, /*update_tangent=*/true);
     const BlockSparseMatrix& stiffness = model.tangent();
-    stiffness.multiply(m_end_velocity, m_stiffness_times_velocity);
+    stiffness.multiply(m_end_velocity, m_stiffness_times_velocity, team);
     m_rhs.noalias() = h * (model.external_force_n() - m_internal_force_n -
                            damping.mass_damping_per_s * mass.cwiseProduct(m_end_velocity) -
                            damping.stiffness_damping_s * m_stiffness_times_velocity) -

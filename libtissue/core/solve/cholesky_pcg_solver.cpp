@@ -217,7 +217,7 @@ void CholeskyPcgSolver::setup(const ShiftedSystem& system) {
   impl.counters.factor_rows = impl.active->rows();
   impl.update_turns(system);
   impl.work.resize(n);
-  impl.work.matrix.assign(system);
+  impl.work.matrix.assign(system, impl.team);
   impl.system = system;
 }
 

@@ -48,7 +48,17 @@ void HalfMatrix::derive_pattern(const BlockSparseMatrix& k) {
   m_layout_revision = k.layout_revision();
 }
 
-void HalfMatrix::assign(const ShiftedSystem& system) {
+template <class Real>
+void HalfMatrix::copy_part(const BlockSparseMatrix& k, double scale, std::vector<Real>& to, int part) {
+  const auto end = static_cast<size_t>(m_row_begin[static_cast<size_t>(end_block_row(part))]);
+  for (auto b = static_cast<size_t>(m_row_begin[static_cast<size_t>(first_block_row(part))]); b < end; ++b) {
+    const double* from = k.block(m_full_slot[b]).data();
+    Real* block = &to[9 * b];
+    for (int e = 0; e < 9; ++e) block[e] = static_cast<Real>(scale * from[e]);
+  }
+}
+
+void HalfMatrix::assign(const ShiftedSystem& system, WorkTeam* team) {
   const BlockSparseMatrix& k = *system.stiffness;
   if (m_source != &k || m_pattern_revision != k.pattern_revision() || m_layout_revision != k.layout_revision() ||
       block_rows() != k.block_rows()) {
@@ -58,18 +68,20 @@ void HalfMatrix::assign(const ShiftedSystem& system) {
   const double s = system.stiffness_scale;
   if (m_precision == MatrixPrecision::single) {
     m_single.resize(9 * blocks);
-    for (size_t b = 0; b < blocks; ++b) {
-      const double* from = k.block(m_full_slot[b]).data();
-      float* to = &m_single[9 * b];
-      for (int e = 0; e < 9; ++e) to[e] = static_cast<float>(s * from[e]);
-    }
   } else {
     m_double.resize(9 * blocks);
-    for (size_t b = 0; b < blocks; ++b) {
-      const double* from = k.block(m_full_slot[b]).data();
-      double* to = &m_double[9 * b];
-      for (int e = 0; e < 9; ++e) to[e] = s * from[e];
+  }
+  auto copy = [&](int part) {
+    if (m_precision == MatrixPrecision::single) {
+      copy_part(k, s, m_single, part);
+    } else {
+      copy_part(k, s, m_double, part);
     }
+  };
+  if (team != nullptr && team->size() == PARTS) {
+    team->run(copy);
+  } else {
+    for (int part = 0; part < PARTS; ++part) copy(part);
   }
   m_diagonal = *system.diagonal;
 }

@@ -46,8 +46,9 @@ class HalfMatrix {
   explicit HalfMatrix(MatrixPrecision precision = MatrixPrecision::double_precision) : m_precision(precision) {}
 
   /// Copies s K's diagonal and upper blocks and d (the block pattern is re-derived only when K's
-  /// pattern or layout changed). The system must be checked (K and d set, sizes agreeing).
-  void assign(const ShiftedSystem& system);
+  /// pattern or layout changed), each part's rows by one of `team`'s members when given. The system
+  /// must be checked (K and d set, sizes agreeing).
+  void assign(const ShiftedSystem& system, WorkTeam* team = nullptr);
 
   [[nodiscard]] int block_rows() const { return static_cast<int>(m_row_begin.size()) - 1; }
   [[nodiscard]] int first_block_row(int part) const { return m_first_block_row[static_cast<size_t>(part)]; }
@@ -66,6 +67,8 @@ class HalfMatrix {
   [[nodiscard]] long streamed_bytes() const;
 
  private:
+  template <class Real>
+  void copy_part(const BlockSparseMatrix& k, double scale, std::vector<Real>& to, int part);
   template <class Real>
   void multiply_rows(const Real* values, const double* x, double* y, int part) const;
   void derive_pattern(const BlockSparseMatrix& k);

@@ -50,7 +50,7 @@ void PcgSolver::setup(const ShiftedSystem& system) {
   m_work.resize(system.rows());  // the only allocations: when the system grows
   // Jacobi preconditioner from the diagonal of A; taken at each setup as K changes every step.
   jacobi_inverse_diagonal(system, m_inverse_diagonal, "PcgSolver");
-  m_work.matrix.assign(system);
+  m_work.matrix.assign(system, m_team);
   m_system = system;
 }
 

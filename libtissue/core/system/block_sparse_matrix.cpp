@@ -9,6 +9,7 @@
 #include "core/system/block_sparse_matrix.hpp"
 
 #include "core/system/hot_kernel.hpp"
+#include "core/system/work_team.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -36,9 +37,10 @@ BlockSparseMatrix::BlockSparseMatrix(const std::vector<std::vector<int>>& patter
                                      const std::vector<int>& min_row_capacity)
     : m_reserve(reserve) {
   if (!(reserve.extra_row_fraction >= 0.0) || !std::isfinite(reserve.extra_row_fraction) ||
-      reserve.row_capacity_factor < 1) {
+      reserve.row_capacity_factor < 1 || reserve.spare_row_capacity < 0) {
     throw std::invalid_argument(
-        "BlockSparseMatrix: reserve needs extra_row_fraction >= 0 and row_capacity_factor >= 1");
+        "BlockSparseMatrix: reserve needs extra_row_fraction >= 0, row_capacity_factor >= 1 and "
+        "spare_row_capacity >= 0");
   }
   const int n = static_cast<int>(pattern.size());
   if (!min_row_capacity.empty() && min_row_capacity.size() != pattern.size()) {
@@ -68,7 +70,9 @@ BlockSparseMatrix::BlockSparseMatrix(const std::vector<std::vector<int>>& patter
   }
 
   const int spare_rows = spare_row_count(reserve.extra_row_fraction, n);
-  m_spare_row_capacity = n > 0 ? static_cast<int>((total_capacity + n - 1) / n) : DEFAULT_SPARE_ROW_CAPACITY;
+  m_spare_row_capacity = reserve.spare_row_capacity > 0 ? reserve.spare_row_capacity
+                         : n > 0                        ? static_cast<int>((total_capacity + n - 1) / n)
+                                                        : DEFAULT_SPARE_ROW_CAPACITY;
   const long slot_count = total_capacity + static_cast<long>(spare_rows) * m_spare_row_capacity;
   if (slot_count > (1L << 31) / 9 - 1)
     throw std::length_error("BlockSparseMatrix: too many blocks for int slot indices");
@@ -107,13 +111,23 @@ int BlockSparseMatrix::find_slot(int row, int col) const {
   return -1;
 }
 
-void BlockSparseMatrix::set_zero() {
+void BlockSparseMatrix::set_zero() { set_zero(nullptr); }
+
+void BlockSparseMatrix::set_zero(WorkTeam* team) {
   // Only the used slots: unused slots are zero already (relayout and insert keep them so).
-  double* values = m_values.data();
-  const int n = block_rows();
-  for (int r = 0; r < n; ++r) {
-    double* first = values + 9 * to_size(m_row_begin[to_size(r)]);
-    std::fill(first, first + 9 * to_size(m_row_size[to_size(r)]), 0.0);
+  const int parts = team != nullptr ? team->size() : 1;
+  auto zero_rows = [&](int member) {
+    double* values = m_values.data();
+    const int end = balanced_row_split(member + 1, parts);
+    for (int r = balanced_row_split(member, parts); r < end; ++r) {
+      double* first = values + 9 * to_size(m_row_begin[to_size(r)]);
+      std::fill(first, first + 9 * to_size(m_row_size[to_size(r)]), 0.0);
+    }
+  };
+  if (parts > 1) {
+    team->run(zero_rows);
+  } else {
+    zero_rows(0);
   }
 }
 
@@ -128,9 +142,27 @@ void BlockSparseMatrix::multiply(const Eigen::VectorXd& x, Eigen::VectorXd& y) c
   multiply_rows(x, y, 0, n);
 }
 
+void BlockSparseMatrix::multiply(const Eigen::VectorXd& x, Eigen::VectorXd& y, WorkTeam* team) const {
+  if (team == nullptr || team->size() < 2) {
+    multiply(x, y);
+    return;
+  }
+  if (x.size() != rows()) {
+    throw std::invalid_argument("BlockSparseMatrix::multiply: x has length " + std::to_string(x.size()) +
+                                ", expected " + std::to_string(rows()));
+  }
+  if (&x == &y) throw std::invalid_argument("BlockSparseMatrix::multiply: x and y must be different vectors");
+  y.resize(rows());
+  const int parts = team->size();
+  auto rows_of_member = [&](int member) {
+    multiply_rows(x, y, balanced_row_split(member, parts), balanced_row_split(member + 1, parts));
+  };
+  team->run(rows_of_member);
+}
+
 int BlockSparseMatrix::balanced_row_split(int part, int parts) const {
-  if (part <= 0 || parts <= 1) return 0;
-  if (part >= parts) return block_rows();
+  if (part <= 0) return 0;
+  if (part >= parts) return block_rows();  // also the end of the only part when parts <= 1
   const long wanted = static_cast<long>(m_nonzero_blocks) * part / parts;
   long blocks = 0;
   int row = 0;
@@ -186,19 +218,18 @@ void BlockSparseMatrix::diagonal(Eigen::VectorXd& diagonal) const {
   for (int r = 0; r < n; ++r) diagonal.segment<3>(3 * r) = block(m_diagonal_slot[to_size(r)]).diagonal();
 }
 
-void BlockSparseMatrix::relayout(int grow_row, int spare_rows) {
+void BlockSparseMatrix::relayout(const std::vector<std::pair<int, int>>& min_capacity, int spare_rows) {
   const int n = block_rows();
   if (m_spare_row_capacity < 1) m_spare_row_capacity = DEFAULT_SPARE_ROW_CAPACITY;
 
   std::vector<int> capacity(to_size(n));
-  long slot_count = 0;
   for (int r = 0; r < n; ++r) {
     const int size = m_row_size[to_size(r)];
-    int cap = std::max(m_row_capacity[to_size(r)], size * m_reserve.row_capacity_factor);
-    if (r == grow_row) cap = std::max(cap, 2 * size);  // geometric growth: overflow stays rare
-    capacity[to_size(r)] = std::max(cap, 1);
-    slot_count += capacity[to_size(r)];
+    capacity[to_size(r)] = std::max({m_row_capacity[to_size(r)], size * m_reserve.row_capacity_factor, 1});
   }
+  for (const auto& [row, cap] : min_capacity) capacity[to_size(row)] = std::max(capacity[to_size(row)], cap);
+  long slot_count = 0;
+  for (int r = 0; r < n; ++r) slot_count += capacity[to_size(r)];
   slot_count += static_cast<long>(spare_rows) * m_spare_row_capacity;
   if (slot_count > (1L << 31) / 9 - 1)
     throw std::length_error("BlockSparseMatrix: too many blocks for int slot indices");
@@ -207,6 +238,7 @@ void BlockSparseMatrix::relayout(int grow_row, int spare_rows) {
   std::vector<int> column(static_cast<size_t>(slot_count), -1);
   std::vector<double> values(9 * static_cast<size_t>(slot_count), 0.0);
   std::vector<std::pair<int, int>> order;  // (column, old slot) of one row
+  m_relayout_slot_map.assign(m_column.size(), -1);
   int begin = 0;
   for (int r = 0; r < n; ++r) {
     row_begin[to_size(r)] = begin;
@@ -219,6 +251,7 @@ void BlockSparseMatrix::relayout(int grow_row, int spare_rows) {
       const int slot = begin + k;
       column[to_size(slot)] = order[to_size(k)].first;
       std::copy_n(&m_values[9 * to_size(order[to_size(k)].second)], 9, &values[9 * to_size(slot)]);
+      m_relayout_slot_map[to_size(order[to_size(k)].second)] = slot;
       if (order[to_size(k)].first == r) m_diagonal_slot[to_size(r)] = slot;
     }
     begin += capacity[to_size(r)];
@@ -244,7 +277,7 @@ int BlockSparseMatrix::append_block_row(int min_capacity) {
     // pool: a row that takes more than the spare-row capacity leaves less for the others.
     const int per_row = m_spare_row_capacity > 0 ? m_spare_row_capacity : DEFAULT_SPARE_ROW_CAPACITY;
     const int rows_for_this_one = (std::max(min_capacity, per_row) + per_row - 1) / per_row;
-    relayout(-1, std::max(spare_row_count(m_reserve.extra_row_fraction, n), n / 4 + 1) + rows_for_this_one);
+    relayout({}, std::max(spare_row_count(m_reserve.extra_row_fraction, n), n / 4 + 1) + rows_for_this_one);
     capacity = std::max(m_spare_row_capacity, min_capacity);
     begin = n == 0 ? 0 : m_row_begin[to_size(n - 1)] + m_row_capacity[to_size(n - 1)];
   }
@@ -268,7 +301,9 @@ int BlockSparseMatrix::insert_block(int row, int col) {
   const int existing = find_slot(row, col);
   if (existing >= 0) return existing;
 
-  if (m_row_size[to_size(row)] == m_row_capacity[to_size(row)]) relayout(row, m_block_row_capacity - n);
+  if (m_row_size[to_size(row)] == m_row_capacity[to_size(row)]) {
+    relayout({{row, 2 * m_row_size[to_size(row)]}}, m_block_row_capacity - n);  // geometric growth
+  }
   const int slot = m_row_begin[to_size(row)] + m_row_size[to_size(row)];
   m_column[to_size(slot)] = col;
   std::fill_n(&m_values[9 * to_size(slot)], 9, 0.0);
@@ -276,6 +311,29 @@ int BlockSparseMatrix::insert_block(int row, int col) {
   ++m_nonzero_blocks;
   ++m_pattern_revision;
   return slot;
+}
+
+bool BlockSparseMatrix::reserve_room(const std::vector<std::pair<int, int>>& row_extra) {
+  const int n = block_rows();
+  std::vector<std::pair<int, int>> needed;  // (row, blocks it must hold)
+  std::vector<int> extra_of;
+  for (const auto& [row, extra] : row_extra) {
+    if (row < 0 || row >= n || extra < 0) {
+      throw std::out_of_range("BlockSparseMatrix::reserve_room: row " + std::to_string(row) + " (of " +
+                              std::to_string(n) + ") with " + std::to_string(extra) + " extra blocks");
+    }
+    if (extra_of.empty()) extra_of.assign(to_size(n), 0);
+    extra_of[to_size(row)] += extra;
+  }
+  for (int r = 0; r < static_cast<int>(extra_of.size()); ++r) {
+    const int wanted = m_row_size[to_size(r)] + extra_of[to_size(r)];
+    if (extra_of[to_size(r)] > 0 && wanted > m_row_capacity[to_size(r)]) {
+      needed.emplace_back(r, std::max(wanted, 2 * m_row_size[to_size(r)]));  // at least doubled: geometric
+    }
+  }
+  if (needed.empty()) return false;
+  relayout(needed, m_block_row_capacity - n);
+  return true;
 }
 
 }  // namespace tissue

@@ -7,14 +7,22 @@
 #include <Eigen/Core>
 
 #include <cstdint>
+#include <utility>
 #include <vector>
 
 namespace tissue {
 
-/// Room reserved ahead for growth (the dissertation reserves 150% DOFs and doubles the row capacity).
+class WorkTeam;
+
+/// Room reserved ahead for growth. The dissertation reserves 150% DOFs and doubles every row's
+/// capacity; spare rows cost nothing in a step (they follow the last row), but room inside the rows
+/// spreads a step's blocks over more memory: on the 52k-tet organ, rows with room for XFEM's ghosts
+/// made a step 25% slower (docs/BENCHMARKS.md, issue 23). So rows start compact and a cut makes room
+/// for the rows it grows, all at once (reserve_room), doubling them.
 struct MatrixReserve {
   double extra_row_fraction = 0.5;  ///< spare block rows, as a fraction of the initial rows (150% DOFs)
-  int row_capacity_factor = 2;      ///< each row gets room for this many times its initial blocks
+  int row_capacity_factor = 1;      ///< each row gets room for this many times its initial blocks
+  int spare_row_capacity = 0;       ///< slots per spare row; 0: the mean initial row's capacity
 };
 
 class BlockSparseMatrix {
@@ -46,9 +54,13 @@ class BlockSparseMatrix {
 
   /// Zeroes all values (pattern kept).
   void set_zero();
+  /// The same, the rows shared among `team`'s members (nullptr: this thread).
+  void set_zero(WorkTeam* team);
 
   /// y = A x, both of length rows(). y is overwritten. No allocation.
   void multiply(const Eigen::VectorXd& x, Eigen::VectorXd& y) const;
+  /// The same, the rows shared among `team`'s members (nullptr: this thread); bitwise the same.
+  void multiply(const Eigen::VectorXd& x, Eigen::VectorXd& y, WorkTeam* team) const;
   /// The block rows [first_block_row, end_block_row) of y = A x; y must have length rows() already
   /// (two threads may fill disjoint row ranges of one y). Sizes are the caller's to check.
   void multiply_rows(const Eigen::VectorXd& x, Eigen::VectorXd& y, int first_block_row, int end_block_row) const;
@@ -76,10 +88,17 @@ class BlockSparseMatrix {
   /// New blocks are zero. When the row has no room left, the storage is re-laid out and
   /// layout_revision() changes: every slot index held elsewhere must then be looked up again.
   int insert_block(int row, int col);
+  /// Makes room for `extra` more blocks in each listed row (row, extra): rows that lack it get what
+  /// they need, at least twice their blocks, in one re-layout (none when every row has the room).
+  /// Pairs need not be unique (a row's extras add up). Returns whether the storage was re-laid out.
+  bool reserve_room(const std::vector<std::pair<int, int>>& row_extra);
+  /// After a re-layout: the new slot of each old slot (-1: an unused one), until the next re-layout.
+  [[nodiscard]] const std::vector<int>& relayout_slot_map() const { return m_relayout_slot_map; }
 
   /// Changes whenever the set of blocks changes (append_block_row, insert_block of a new block).
   [[nodiscard]] std::uint64_t pattern_revision() const { return m_pattern_revision; }
-  /// Changes only when existing slots moved (storage re-laid out). Rare: room is reserved ahead.
+  /// Changes only when existing slots moved (storage re-laid out: a row outgrew its room, or the
+  /// spare rows ran out).
   [[nodiscard]] std::uint64_t layout_revision() const { return m_layout_revision; }
   /// Reserved capacity, in block rows and in slots.
   [[nodiscard]] int block_row_capacity() const { return m_block_row_capacity; }
@@ -89,7 +108,8 @@ class BlockSparseMatrix {
   /// Rebuilds the storage with room to spare: every row keeps at least its capacity (and
   /// row_size * row_capacity_factor), `grow_row` (or -1) at least doubles, and `spare_rows`
   /// empty rows of m_spare_row_capacity slots follow the last row. Rows come out sorted.
-  void relayout(int grow_row, int spare_rows);
+  /// `min_capacity` (row, capacity): rows that get at least that much.
+  void relayout(const std::vector<std::pair<int, int>>& min_capacity, int spare_rows);
 
   std::vector<int> m_row_begin;      // first slot of each block row
   std::vector<int> m_row_size;       // blocks in use in each row
@@ -97,6 +117,7 @@ class BlockSparseMatrix {
   std::vector<int> m_column;         // block column of each slot (-1 = unused)
   std::vector<double> m_values;      // 9 per slot, column-major 3x3
   std::vector<int> m_diagonal_slot;  // slot of the diagonal block of each row (always present)
+  std::vector<int> m_relayout_slot_map;  // old slot -> new slot of the last re-layout
   int m_nonzero_blocks = 0;
   int m_spare_row_capacity = 0;  // slots reserved per spare row (appended rows take at least this)
   int m_block_row_capacity = 0;

@@ -45,7 +45,7 @@ TEST(Cholmod, AgreesWithDenseLlt) {
 }
 
 TEST(Cholmod, ReusesTheAnalysisUntilThePatternChanges) {
-  test::TestSystem system = test::make_grid_system(4, 4, 3, 23);
+  test::TestSystem system = test::make_grid_system(4, 4, 3, 23, 0.05, {0.5, 2});  // rows with room
   CholmodSolver solver;
   std::mt19937 rng(24);
   EXPECT_EQ(solver.symbolic_analysis_count(), 0);

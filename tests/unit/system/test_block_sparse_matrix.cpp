@@ -167,6 +167,8 @@ TEST(BlockSparseMatrix, RowPartsOfTheProductMakeTheWholeAndBalanceTheBlocks) {
     const int split = matrix.balanced_row_split(1, 2);
     ASSERT_EQ(matrix.balanced_row_split(0, 2), 0);
     ASSERT_EQ(matrix.balanced_row_split(2, 2), n);
+    // One part holds every row (set_zero with no team zeroed nothing while this returned 0).
+    ASSERT_EQ(matrix.balanced_row_split(1, 1), n);
     ASSERT_GE(split, 0);
     ASSERT_LE(split, n);
     Eigen::VectorXd parts = Eigen::VectorXd::Constant(matrix.rows(), std::numeric_limits<double>::quiet_NaN());

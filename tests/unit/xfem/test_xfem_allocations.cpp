@@ -36,7 +36,7 @@ TEST(XfemAllocations, StepOfACutBodyWithAPointSpringAllocatesNothing) {
 
   const auto cuts = xfem_test::plane_cuts(mesh, xfem_test::Plane{Eigen::Vector3d(1, 0.1, 0.05).normalized(), 0.063});
   ASSERT_GT(cuts.size(), 20u);
-  EXPECT_FALSE(body.enrich(cuts).matrix_relayout);
+  body.enrich(cuts);  // may re-lay the tangent out (rows start compact); the steps after must not allocate
   body.grow_state(state);
   integrator.step(body, state, 0.01);  // sizes the work buffers to the grown system
   const long before = g_allocations.load();
