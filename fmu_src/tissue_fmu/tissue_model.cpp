@@ -80,8 +80,10 @@ TissueSettings tissue_settings(const ValueStore& values, const TetMesh* mesh) {
   s.solver.kind = linear_solver(values.int64(vr(Vr::linear_solver)));
   s.solver.pcg = PcgSolver::Settings{values.float64(vr(Vr::pcg_tolerance)), values.int32(vr(Vr::pcg_max_iterations))};
   s.solver.warm_start = values.boolean(vr(Vr::warm_start));
-  // No FMI switch says an importer allows threads: the core's default, no worker thread (pcgCholesky
-  // refactorizes at pick-up in the calling thread, the same results; DESIGN "Threads").
+  // No FMI switch says an importer allows threads: none unless the user asks (integrator.threads; a
+  // step's team lives for the step only), and no refactorization worker (pcgCholesky refactorizes at
+  // pick-up in the calling thread, the same results; DESIGN "Threads").
+  s.integrator.threads = values.int32(vr(Vr::step_threads));
   s.step_size_s = values.float64(vr(Vr::step_size));
   InteractionSettings& i = s.interaction;
   i.contact_enabled = values.boolean(vr(Vr::contact_enabled));

@@ -88,6 +88,7 @@ enum class Vr : std::uint32_t {
   tool_max_speed = 76,
   contact_near_margin = 77,  // issue 20
   render_surface = 78,       // issue 22
+  step_threads = 79,         // issue 23
   tool_applied_position = ports::sample_field("tool.appliedPosition").tissue_vr
 };
 
@@ -148,7 +149,7 @@ constexpr auto body_parameters() {
 });
 }
 
-/// The backward-Euler step: its linear solver, PCG's settings, the internal step (10-14).
+/// The backward-Euler step: its linear solver, PCG's settings, the internal step, its threads (10-14, 79).
 constexpr auto solver_parameters() {
   using namespace fmi3;  // NOLINT(google-build-using-namespace): the table reads as the XML
   using enum VariableType;
@@ -172,6 +173,12 @@ constexpr auto solver_parameters() {
         .unit("s")
         .start("0.001")
         .describe("Internal backward-Euler step; must be > 0. A communication step must be a whole multiple of it"),
+    parameter(Vr::step_threads, "integrator.threads", int32)
+        .start("1")
+        .min("1")
+        .max("2")
+        .describe("Threads of a backward-Euler step: 1, or 2 to let a doStep run a second thread for its own duration "
+                  "(made and joined by each step; the results are bitwise the same)"),
 });
 }
 

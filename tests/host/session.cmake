@@ -5,6 +5,7 @@ if(NOT TARGET tissue::host_session)
 endif()
 add_executable(test_host_session ${CMAKE_CURRENT_LIST_DIR}/test_session.cpp)
 target_link_libraries(test_host_session PRIVATE tissue::host_session GTest::gtest GTest::gtest_main tissue::warnings)
+target_include_directories(test_host_session PRIVATE ${PROJECT_SOURCE_DIR}/tests)  # support/under_sanitizer.hpp
 target_compile_definitions(test_host_session PRIVATE TISSUE_SCENARIO_DIR="${PROJECT_SOURCE_DIR}/host/scenarios"
                                                      TISSUE_FMU_DIR="${CMAKE_BINARY_DIR}/fmus")
 add_dependencies(test_host_session tissue_fmu_package hapticloop_fmu_package)

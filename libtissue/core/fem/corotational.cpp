@@ -273,16 +273,35 @@ TISSUE_HOT_KERNEL void CorotationalElasticity::add_tet(size_t k, const Eigen::Ma
   }
 }
 
-TISSUE_HOT_KERNEL double CorotationalElasticity::elastic_energy_j(const Eigen::VectorXd& positions_m) const {
+TISSUE_HOT_KERNEL double CorotationalElasticity::energy_of_range(const Eigen::VectorXd& positions_m, size_t first,
+                                                                   size_t end) const {
   // Rotations in SIMD lanes as in a step (the energy guard evaluates this twice on a step that
-  // turns elements far), from copies of the warm starts; the terms are added in tet order.
+  // turns elements far), from copies of the warm starts; the terms are added in storage order.
   double energy = 0.0;
   in_rotation_batches(
-      m_tets.size(), [](size_t k) { return k; }, positions_m, nullptr, nullptr,
+      end - first, [first](size_t k) { return first + k; }, positions_m, nullptr, nullptr,
       [&](size_t t, const Eigen::Matrix3d& f, const Eigen::Matrix3d& rotation) {
         energy += corotated_energy_j(m_rest[t], rotation, f, m_lame);
       });
   return energy;
+}
+
+double CorotationalElasticity::elastic_energy_j(const Eigen::VectorXd& positions_m, WorkTeam* team) const {
+  std::array<double, 2> half{};
+  const size_t n = m_tets.size();
+  const int members = (team != nullptr && team->size() > 1) ? team->size() : 1;
+  auto half_job = [&](int member) {
+    for (int h = member; h < 2; h += members) {
+      half[static_cast<size_t>(h)] = energy_of_range(positions_m, n * static_cast<size_t>(h) / 2,
+                                                     n * static_cast<size_t>(h + 1) / 2);
+    }
+  };
+  if (members > 1) {
+    team->run(half_job);
+  } else {
+    half_job(0);
+  }
+  return half[0] + half[1];
 }
 
 std::vector<double> lumped_vertex_masses(const TetMesh& mesh, double density_kg_per_m3) {

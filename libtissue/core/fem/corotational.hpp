@@ -68,7 +68,9 @@ class CorotationalElasticity {
 
   /// Elastic energy sum_e V_e (mu eps:eps + lambda/2 tr(eps)^2), eps = sym(R_e^T F_e) - I, with the
   /// rotations of these positions (the stored warm starts are not changed). [J]
-  [[nodiscard]] double elastic_energy_j(const Eigen::VectorXd& positions_m) const;
+  /// The tets in two halves (side by side with a team of two), added half by half: bitwise the same
+  /// with one thread or two.
+  [[nodiscard]] double elastic_energy_j(const Eigen::VectorXd& positions_m, WorkTeam* team = nullptr) const;
 
   /// Forgets the warm starts (rotations back to identity), e.g. after a state was restored.
   void reset_rotations();
@@ -91,6 +93,9 @@ class CorotationalElasticity {
   /// own warm starts and rotations when given (a step); else from copies of the warm starts, the
   /// rotations kept in the batch (reporting must not change the dynamics). Defined in the .cpp, for
   /// the hot kernels there.
+  /// The energy of the tets at storage indices [first, end).
+  [[nodiscard]] double energy_of_range(const Eigen::VectorXd& positions_m, size_t first, size_t end) const;
+
   template <class TetAt, class Visit>
   void in_rotation_batches(size_t count, TetAt tet_at, const Eigen::VectorXd& positions_m,
                            std::vector<Eigen::Quaterniond>* warm_starts, std::vector<Eigen::Matrix3d>* rotations,

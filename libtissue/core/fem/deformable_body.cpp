@@ -291,7 +291,7 @@ void DeformableBody::evaluate(const Eigen::VectorXd& displacement_m, Eigen::Vect
 double DeformableBody::elastic_energy_j(const Eigen::VectorXd& displacement_m) {
   check_unknowns(displacement_m);
   positions(displacement_m, m_positions_m);
-  return m_elasticity.elastic_energy_j(m_positions_m) + m_xfem.elastic_energy_j(m_positions_m, displacement_m);
+  return m_elasticity.elastic_energy_j(m_positions_m, m_team) + m_xfem.elastic_energy_j(m_positions_m, displacement_m);
 }
 
 double DeformableBody::potential_energy_j(const Eigen::VectorXd& displacement_m) {
