@@ -46,6 +46,18 @@ SHIN = ((-0.040, 0.040, 0.008), (-0.068, 0.028, 0.004), 0.0045)
 KNEE_RADIUS_M = 0.0055  # a sphere rounds the joint between thigh and shin
 
 
+# Gmsh's options for a reproducible first-order mesh (shared with make_liver.py).
+GMSH_OPTIONS = [
+    "General.NumThreads = 1;        // single-threaded meshing is reproducible",
+    "Mesh.RandomSeed = 1;",
+    "Mesh.RandomFactor = 1e-9;",
+    "Mesh.Algorithm = 6;            // Frontal-Delaunay surfaces",
+    "Mesh.Algorithm3D = 1;          // Delaunay volume",
+    "Mesh.Optimize = 1;",
+    "Mesh.MeshSizeFromCurvature = 0;",
+]
+
+
 def mirror(point):
     return (point[0], -point[1], point[2])
 
@@ -68,13 +80,7 @@ def geo_text():
         "// Frog specimen, written by meshes/make_frog.py: edit the script, not this file.",
         "// Body and head are ellipsoids, the legs cylinders; one OpenCASCADE union.",
         'SetFactory("OpenCASCADE");',
-        "General.NumThreads = 1;        // single-threaded meshing is reproducible",
-        "Mesh.RandomSeed = 1;",
-        "Mesh.RandomFactor = 1e-9;",
-        "Mesh.Algorithm = 6;            // Frontal-Delaunay surfaces",
-        "Mesh.Algorithm3D = 1;          // Delaunay volume",
-        "Mesh.Optimize = 1;",
-        "Mesh.MeshSizeFromCurvature = 0;",
+        *GMSH_OPTIONS,
         "Mesh.MeshSizeExtendFromBoundary = 1;",
         "Mesh.MeshSizeMin = 0;",
         "Mesh.MeshSizeMax = %s;" % num(MESH_SIZE_M),

@@ -24,7 +24,7 @@ import subprocess
 import sys
 
 from make_bar import signed_volume
-from make_frog import check, read_msh41, write_veg
+from make_frog import GMSH_OPTIONS, check, read_msh41, write_veg
 
 TARGET_TETS = 50000
 TOLERANCE = 0.15
@@ -107,13 +107,7 @@ def geo_text(stl_name, mesh_size_m):
     return "\n".join([
         "// Liver-sized organ, written by meshes/make_liver.py: edit the script, not this file.",
         "// The smooth shape comes as an STL (%s, written by the script); Gmsh re-meshes it." % stl_name,
-        "General.NumThreads = 1;        // single-threaded meshing is reproducible",
-        "Mesh.RandomSeed = 1;",
-        "Mesh.RandomFactor = 1e-9;",
-        "Mesh.Algorithm = 6;            // Frontal-Delaunay surfaces",
-        "Mesh.Algorithm3D = 1;          // Delaunay volume",
-        "Mesh.Optimize = 1;",
-        "Mesh.MeshSizeFromCurvature = 0;",
+        *GMSH_OPTIONS,
         "Mesh.MeshSizeMin = 0;",
         "Mesh.MeshSizeMax = %r;" % mesh_size_m,
         "Mesh.ElementOrder = 1;",
