@@ -114,7 +114,13 @@ void ear_clip(const std::vector<int>& loop, const std::vector<Eigen::Vector3d>& 
       }
       if (empty) ear = i;
     }
-    if (ear == m) ear = 0;  // no clean ear (a degenerate loop): cut one anyway, the topology stays closed
+    // No clean ear (a degenerate loop): cut one anyway, the topology stays closed; one whose
+    // diagonal the mesh lacks, so that no edge gets four triangles (cutting the first corner along a
+    // surface edge made the complete-cut frog non-manifold in 4 frames under baseline x86-64).
+    for (size_t i = 0; i < m && ear == m; ++i) {
+      if (!edge_exists(left[(i + 1) % m], left[(i + m - 1) % m])) ear = i;
+    }
+    if (ear == m) ear = 0;
     triangles.push_back({left[(ear + m - 1) % m], left[ear], left[(ear + 1) % m]});
     left.erase(left.begin() + static_cast<std::ptrdiff_t>(ear));
     flat.erase(flat.begin() + static_cast<std::ptrdiff_t>(ear));
