@@ -1,8 +1,8 @@
 // HalfMatrix: the system matrix A = s K + diag(d) of a CG solve, stored for its products only: the
 // diagonal and upper blocks of s K (K is symmetric), in single precision by default, beside d in
 // double. Made at each solver setup from K's full double blocks (BlockSparseMatrix), it is what the
-// ten products of a real-time step stream: on the 52k-tet organ the full double matrix is 11 MB per
-// product, the half single one 3.3 MB (docs/BENCHMARKS.md, issue 23). Sums are taken in double;
+// ten products of a real-time step stream: on the 52k-tet organ the full double matrix is 10.2 MB per
+// product, the half single one 3.0 MB (docs/BENCHMARKS.md, issue 23). Sums are taken in double;
 // single precision rounds the entries of s K to 6e-8 relative, far below the solve's tolerance
 // (the accuracy figure is in BENCHMARKS).
 //
