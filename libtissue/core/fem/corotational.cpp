@@ -5,6 +5,7 @@
 #include "core/fem/corotational.hpp"
 
 #include "core/fem/corotational_kernel.hpp"
+#include "core/mesh/topology.hpp"
 #include "core/system/hot_kernel.hpp"
 
 #include <algorithm>
@@ -120,18 +121,7 @@ void CorotationalElasticity::partition(const TetMesh& mesh, const std::vector<in
 void CorotationalElasticity::sort_lists(const TetMesh& mesh, const std::vector<int>& vertex_order) {
   // Each list by the earliest position of its tets' vertices in the order (ties by id).
   if (vertex_order.empty()) return;
-  if (vertex_order.size() != static_cast<size_t>(mesh.vertex_count())) {
-    throw std::invalid_argument("CorotationalElasticity: the vertex order lists " + std::to_string(vertex_order.size()) +
-                                " vertices, the mesh has " + std::to_string(mesh.vertex_count()));
-  }
-  std::vector<int> rank(vertex_order.size(), -1);
-  for (size_t k = 0; k < vertex_order.size(); ++k) {
-    const int v = vertex_order[k];
-    if (v < 0 || v >= mesh.vertex_count() || rank[static_cast<size_t>(v)] >= 0) {
-      throw std::invalid_argument("CorotationalElasticity: the vertex order is not a permutation of the vertices");
-    }
-    rank[static_cast<size_t>(v)] = static_cast<int>(k);
-  }
+  const std::vector<int> rank = order_ranks(vertex_order, mesh.vertex_count(), "CorotationalElasticity");
   std::vector<int> tet_rank(mesh.tets.size());
   for (size_t t = 0; t < mesh.tets.size(); ++t) {
     int earliest = rank[static_cast<size_t>(mesh.tets[t][0])];

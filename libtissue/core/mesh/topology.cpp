@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cstdlib>
 #include <numeric>
+#include <stdexcept>
 #include <string>
 #include <tuple>
 
@@ -238,8 +239,7 @@ std::vector<int> locality_order(const TetAdjacency& adjacency, int vertex_count)
 
   // A mesh numbered with locality already (a structured grid, a mesh its maker renumbered) keeps
   // its own order: it also keeps the vertex-indexed arrays (positions, forces) in step with the rows.
-  std::vector<int> rank(n);
-  for (size_t k = 0; k < n; ++k) rank[static_cast<size_t>(order[k])] = static_cast<int>(k);
+  const std::vector<int> rank = order_ranks(order, vertex_count, "locality_order");
   double own_span = 0.0, new_span = 0.0;
   for (const auto& edge : adjacency.edges) {
     own_span += std::abs(edge[0] - edge[1]);
@@ -247,6 +247,23 @@ std::vector<int> locality_order(const TetAdjacency& adjacency, int vertex_count)
   }
   if (own_span <= OWN_ORDER_SPAN_FACTOR * new_span) std::iota(order.begin(), order.end(), 0);
   return order;
+}
+
+std::vector<int> order_ranks(const std::vector<int>& order, int vertex_count, const char* who) {
+  if (order.size() != static_cast<size_t>(std::max(vertex_count, 0))) {
+    throw std::invalid_argument(std::string(who) + ": the vertex order lists " + std::to_string(order.size()) +
+                                " vertices, the mesh has " + std::to_string(vertex_count));
+  }
+  std::vector<int> rank(order.size(), -1);
+  for (size_t k = 0; k < order.size(); ++k) {
+    const int v = order[k];
+    if (v < 0 || v >= vertex_count || rank[static_cast<size_t>(v)] >= 0) {
+      throw std::invalid_argument(std::string(who) + ": the vertex order is not a permutation of the vertices (entry " +
+                                  std::to_string(k) + " is " + std::to_string(v) + ")");
+    }
+    rank[static_cast<size_t>(v)] = static_cast<int>(k);
+  }
+  return rank;
 }
 
 }  // namespace tissue

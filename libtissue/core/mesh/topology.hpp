@@ -55,4 +55,8 @@ TetAdjacency build_adjacency(const TetMesh& mesh);
 /// keeps it: the identity order, which also keeps vertex-indexed arrays in step with the rows.
 std::vector<int> locality_order(const TetAdjacency& adjacency, int vertex_count);
 
+/// rank[v] = k where order[k] = v: the position of each vertex in a vertex order. Throws
+/// std::invalid_argument (prefixed by `who`) unless `order` is a permutation of [0, vertex_count).
+std::vector<int> order_ranks(const std::vector<int>& order, int vertex_count, const char* who);
+
 }  // namespace tissue

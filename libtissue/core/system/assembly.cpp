@@ -2,6 +2,8 @@
 // the per-tet slot table that lets a step assemble R K_e R^T without any index search.
 #include "core/system/assembly.hpp"
 
+#include "core/mesh/topology.hpp"
+
 #include <algorithm>
 #include <stdexcept>
 #include <string>
@@ -42,21 +44,10 @@ DofMap make_dof_map(int vertex_count, const std::vector<int>& fixed_vertices, co
     fixed[to_size(v)] = 1;
   }
   DofMap dofs;
-  if (!order.empty() && order.size() != to_size(vertex_count)) {
-    throw std::invalid_argument("make_dof_map: the order lists " + std::to_string(order.size()) + " vertices, the mesh has " +
-                                std::to_string(vertex_count));
-  }
+  if (!order.empty()) (void)order_ranks(order, vertex_count, "make_dof_map");  // refuses a non-permutation
   dofs.vertex_row.assign(to_size(vertex_count), -1);
-  std::vector<char> listed(order.empty() ? 0 : to_size(vertex_count), 0);
   for (int k = 0; k < vertex_count; ++k) {
     const int v = order.empty() ? k : order[to_size(k)];
-    if (!order.empty()) {
-      if (v < 0 || v >= vertex_count || listed[to_size(v)] != 0) {
-        throw std::invalid_argument("make_dof_map: the order is not a permutation of the vertices (entry " +
-                                    std::to_string(k) + " is " + std::to_string(v) + ")");
-      }
-      listed[to_size(v)] = 1;
-    }
     if (fixed[to_size(v)] != 0) continue;
     dofs.vertex_row[to_size(v)] = static_cast<int>(dofs.row_vertex.size());
     dofs.row_vertex.push_back(v);

@@ -417,6 +417,13 @@ TEST(LocalityOrder, KeepsAnOrderThatIsLocalAlready) {
   EXPECT_EQ(order, own);
 }
 
+TEST(OrderRanks, InvertAPermutationAndRefuseAnythingElse) {
+  EXPECT_EQ(order_ranks({2, 0, 1}, 3, "test"), (std::vector<int>{1, 2, 0}));
+  EXPECT_THROW((void)order_ranks({2, 0, 2}, 3, "test"), std::invalid_argument);  // a vertex twice
+  EXPECT_THROW((void)order_ranks({0, 1}, 3, "test"), std::invalid_argument);     // one missing
+  EXPECT_THROW((void)order_ranks({0, 1, 3}, 3, "test"), std::invalid_argument);  // out of range
+}
+
 TEST(LocalityOrder, ListsEveryVertexOfSeveralPiecesAndUnusedOnes) {
   TetMesh mesh = make_box_mesh(2, 1, 1, 0.01);
   const int first_piece = mesh.vertex_count();
