@@ -82,7 +82,8 @@ TissueSettings tissue_settings(const ValueStore& values, const TetMesh* mesh) {
   s.solver.warm_start = values.boolean(vr(Vr::warm_start));
   // No FMI switch says an importer allows threads: none unless the user asks (integrator.threads; a
   // step's team lives for the step only), and no refactorization worker (pcgCholesky refactorizes at
-  // pick-up in the calling thread, the same results; DESIGN "Threads").
+  // pick-up in the calling thread, the same results; DESIGN "Threads"; the contact stiffness's worker
+  // only when contact.stiffnessInBackground asks for it).
   s.integrator.threads = values.int32(vr(Vr::step_threads));
   s.step_size_s = values.float64(vr(Vr::step_size));
   InteractionSettings& i = s.interaction;
@@ -93,6 +94,7 @@ TissueSettings tissue_settings(const ValueStore& values, const TetMesh* mesh) {
   i.contact_spring_stiffness_n_per_m = values.float64(vr(Vr::contact_spring_stiffness));
   i.contact_stiffness_model = stiffness_model(values.int64(vr(Vr::contact_stiffness_model)));
   i.contact_stiffness_refresh_steps = values.int32(vr(Vr::contact_stiffness_refresh_steps));
+  i.contact_stiffness_in_background = values.boolean(vr(Vr::contact_stiffness_in_background));
   i.max_tool_speed_m_per_s = values.float64(vr(Vr::tool_max_speed));
   i.probe_radius_m = values.float64(vr(Vr::probe_radius));
   validate(s);

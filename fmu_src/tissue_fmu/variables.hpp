@@ -89,6 +89,7 @@ enum class Vr : std::uint32_t {
   contact_near_margin = 77,  // issue 20
   render_surface = 78,       // issue 22
   step_threads = 79,         // issue 23
+  contact_stiffness_in_background = 80,  // issue 23
   tool_applied_position = ports::sample_field("tool.appliedPosition").tissue_vr
 };
 
@@ -370,6 +371,12 @@ constexpr auto integrator_parameters() {
         .describe("A probe not in contact but this close to the surface reports it (contact.near): the nearest surface "
                   "point, its normal and stiffness, so that a haptic loop feels the surface from the tick the tool "
                   "crosses it; 0: never"),
+    parameter(Vr::contact_stiffness_in_background, "contact.stiffnessInBackground", boolean)
+        .start("false")
+        .describe("The effectiveStatic contact stiffness's factorization runs in a worker thread beside the step "
+                  "(started by a step, joined by the next, which renders it) instead of in the step: a refresh reaches "
+                  "contact.stiffness one internal step later, and a new contact starts with the elementLocal estimate "
+                  "for its first step. The results are the same with or without the thread"),
 });
 }
 

@@ -193,6 +193,14 @@ void read_tissue(const Reader& r, const toml::table& root, const std::filesystem
                    [](const ParameterSetting& p) { return p.name == "stepSize"; })) {
     s.tissue_parameters.push_back(ParameterSetting{"stepSize", s.tissue_step_s});
   }
+  // The host runs beside the tissue's threads anyway: our Tissue.fmu refreshes its contact stiffness
+  // in a worker, off the step's 10 ms slot (a CHOLMOD factorization: ~7 ms on the frog), unless the
+  // scenario says otherwise. Another tissue FMU is given only what the scenario says.
+  if (s.tissue_fmu.empty() &&
+      std::none_of(s.tissue_parameters.begin(), s.tissue_parameters.end(),
+                   [](const ParameterSetting& p) { return p.name == "contact.stiffnessInBackground"; })) {
+    s.tissue_parameters.push_back(ParameterSetting{"contact.stiffnessInBackground", true});
+  }
 }
 
 // [haptic] (optional): the FMU, the period, the parameters; the tissue step a whole number of periods.

@@ -97,17 +97,18 @@ std::uint64_t model_fingerprint_of(const TetMesh& mesh, const TissueSettings& se
   f.add(interaction.contact_spring_stiffness_n_per_m);
   f.add(interaction.contact_stiffness_model);
   f.add(interaction.contact_stiffness_refresh_steps);
+  f.add(interaction.contact_stiffness_in_background);
   f.add(interaction.max_tool_speed_m_per_s);
   if (interaction.probe_radius_m != 0.0) f.add(interaction.probe_radius_m);  // older fingerprints unchanged
   f.add(settings.step_size_s);
   return f.value();
 }
 
-// The largest turn of the blade one cutter sweep covers (its two triangles span the ruled surface
-// of a turning segment to within ~ L (1 - cos(angle / 2)), 0.1 mm for a 3 cm blade at 5 degrees).
 // Below this fraction of the contact stiffness scale, a static K_c belongs to a piece nothing holds.
 constexpr double FREE_PIECE_STIFFNESS_FRACTION = 1e-6;
 
+// The largest turn of the blade one cutter sweep covers (its two triangles span the ruled surface
+// of a turning segment to within ~ L (1 - cos(angle / 2)), 0.1 mm for a 3 cm blade at 5 degrees).
 constexpr double MAX_SWEEP_ANGLE_RAD = 5.0 * 3.14159265358979323846 / 180.0;
 
 bool same_cut(const TetCut& a, const TetCut& b) {
@@ -356,6 +357,15 @@ void Tissue::save(TissueSnapshot& snapshot) const {
   snapshot.applied_tool_position_m = m_applied_tool_position_m;
   snapshot.contact_output = m_contact_output;
   snapshot.steps_since_stiffness = m_steps_since_stiffness;
+  m_stiffness_refresh.wait();
+  using Pending = TissueSnapshot::PendingStiffness;
+  snapshot.pending_stiffness = Pending::none;
+  snapshot.pending_stiffness_n_per_m.setZero();
+  if (m_stiffness_refresh.state() == BackgroundContactStiffness::State::done) {
+    const std::optional<Eigen::Matrix3d>& result = m_stiffness_refresh.result();
+    snapshot.pending_stiffness = result ? Pending::ready : Pending::failed;
+    if (result) snapshot.pending_stiffness_n_per_m = *result;
+  }
 }
 
 std::vector<std::vector<TetPositions>> Tissue::cut_offsets() const {
@@ -451,6 +461,11 @@ void Tissue::restore(const TissueSnapshot& snapshot) {
   m_stepped = true;  // the snapshot's applied position stands until the next step
   m_contact_output = snapshot.contact_output;
   m_steps_since_stiffness = snapshot.steps_since_stiffness;
+  switch (snapshot.pending_stiffness) {
+    case TissueSnapshot::PendingStiffness::none: m_stiffness_refresh.cancel(); break;
+    case TissueSnapshot::PendingStiffness::failed: m_stiffness_refresh.set_done(std::nullopt); break;
+    case TissueSnapshot::PendingStiffness::ready: m_stiffness_refresh.set_done(snapshot.pending_stiffness_n_per_m); break;
+  }
   update_positions();
   m_bvh_stale = true;  // refitted by the first query (fitted_bvh)
 }
@@ -478,6 +493,7 @@ void Tissue::interact_with_probe(const ToolPose& previous, const ToolPose& curre
 void Tissue::update_contact_output() {
   ContactOutput& out = m_contact_output;
   if (!m_contact.in_contact()) {
+    m_stiffness_refresh.cancel();
     out = ContactOutput{};
     return;
   }
@@ -489,16 +505,26 @@ void Tissue::update_contact_output() {
   out.penetration_depth_m = (m_previous_tool.tip_position_m - out.point_m).norm();
 
   const int triangle = m_contact.proxy().triangle;
-  if (m_settings.interaction.contact_stiffness_model == ContactStiffnessModel::element_local) {
+  const InteractionSettings& interaction = m_settings.interaction;
+  if (interaction.contact_stiffness_model == ContactStiffnessModel::element_local) {
     out.stiffness_n_per_m = element_local_contact_stiffness(m_body.elasticity(), m_surface, triangle);
     return;
   }
-  if (m_steps_since_stiffness >= 0 &&
-      m_steps_since_stiffness < m_settings.interaction.contact_stiffness_refresh_steps) {
+  // A refresh started in the background at the last step is rendered from this step on.
+  if (m_stiffness_refresh.state() != BackgroundContactStiffness::State::idle) {
+    out.stiffness_n_per_m = landed_contact_stiffness(m_stiffness_refresh.take(), triangle);
+  }
+  const bool new_contact = m_steps_since_stiffness < 0;
+  if (!new_contact && m_steps_since_stiffness < interaction.contact_stiffness_refresh_steps) {
     ++m_steps_since_stiffness;
     return;
   }
   m_steps_since_stiffness = 1;
+  if (interaction.contact_stiffness_in_background) {
+    if (new_contact) out.stiffness_n_per_m = element_local_contact_stiffness(m_body.elasticity(), m_surface, triangle);
+    start_effective_contact_stiffness(triangle);
+    return;
+  }
   try {
     out.stiffness_n_per_m = effective_contact_stiffness(triangle);
   } catch (const std::exception&) {
@@ -508,30 +534,63 @@ void Tissue::update_contact_output() {
   }
 }
 
+ContactInterpolation Tissue::contact_point(int triangle) const {
+  return contact_interpolation(m_body.dofs(), m_bvh.triangle(triangle), m_contact.proxy().barycentric);
+}
+
+namespace {
+
+// CHOLMOD may factorize a singular K through rounding; the point of a free piece then comes out with
+// a K_c at rounding level. Held points of the frog measure 0.0017 to 14 times the contact scale
+// (contact_stiffness.hpp): below 1e-6 of it, the piece is taken as held by nothing.
+double free_piece_floor_n_per_m(double contact_stiffness_scale_n_per_m) {
+  return FREE_PIECE_STIFFNESS_FRACTION * contact_stiffness_scale_n_per_m;
+}
+
+}  // namespace
+
+std::optional<Eigen::Matrix3d> Tissue::step_matrix_contact_stiffness(const ContactInterpolation& point) {
+  const ShiftedSystem step = m_integrator->newton_stiffness(m_body, m_settings.step_size_s, m_contact_system_diagonal);
+  return condensed_contact_stiffness(m_effective_stiffness, step, m_body.dofs(), point, m_contact_spring.spring(),
+                                     contact_spring_stiffness_n_per_m(), 0.0);
+}
+
 Eigen::Matrix3d Tissue::effective_contact_stiffness(int triangle) {
-  const std::array<int, 3>& vertices = m_bvh.triangle(triangle);
-  const ContactInterpolation point = contact_interpolation(m_body.dofs(), vertices, m_contact.proxy().barycentric);
-  // K_c of a factorized matrix, the contact spring taken out (contact_stiffness.hpp); a point on
-  // fixed vertices only is a rigid support: the spring alone.
-  const auto condensed = [&](const ShiftedSystem& system, double floor_n_per_m) {
-    return condensed_contact_stiffness(m_effective_stiffness, system, m_body.dofs(), point, m_contact_spring.spring(),
-                                       contact_spring_stiffness_n_per_m(), floor_n_per_m);
-  };
+  const ContactInterpolation point = contact_point(triangle);
   // DESIGN section 4: the static K where the body is held; the step's Newton matrix, asked of the
   // integrator, where nothing holds it, or where the static K fails because a cut set the
-  // contacted piece free (K singular there; issue 10).
+  // contacted piece free (K singular there; issue 10). The contact spring is taken out of either
+  // (contact_stiffness.hpp); a point on fixed vertices only is a rigid support: the spring alone.
   if (!m_body.settings().fixed_vertices.empty()) {
-    // CHOLMOD may factorize a singular K through rounding; the point of a free piece then comes out
-    // with a K_c at rounding level. Held points of the frog measure 0.0017 to 14 times the contact
-    // scale (contact_stiffness.hpp): below 1e-6 of it, the piece is taken as held by nothing.
-    if (const auto stiffness = condensed(static_contact_system(m_body.tangent(), m_contact_system_diagonal),
-                                         FREE_PIECE_STIFFNESS_FRACTION * m_contact_stiffness_scale_n_per_m)) {
+    if (const auto stiffness = condensed_contact_stiffness(
+            m_effective_stiffness, static_contact_system(m_body.tangent(), m_contact_system_diagonal), m_body.dofs(),
+            point, m_contact_spring.spring(), contact_spring_stiffness_n_per_m(),
+            free_piece_floor_n_per_m(m_contact_stiffness_scale_n_per_m))) {
       return *stiffness;
     }
   }
-  const ShiftedSystem step = m_integrator->newton_stiffness(m_body, m_settings.step_size_s, m_contact_system_diagonal);
-  if (const auto stiffness = condensed(step, 0.0)) return *stiffness;
+  if (const auto stiffness = step_matrix_contact_stiffness(point)) return *stiffness;
   throw SolverError("the contact stiffness cannot be condensed from the static or the step matrix");
+}
+
+void Tissue::start_effective_contact_stiffness(int triangle) {
+  const bool held = !m_body.settings().fixed_vertices.empty();
+  const ShiftedSystem system = held ? static_contact_system(m_body.tangent(), m_contact_system_diagonal)
+                                    : m_integrator->newton_stiffness(m_body, m_settings.step_size_s,
+                                                                     m_contact_system_diagonal);
+  m_stiffness_refresh.start(
+      system, contact_stiffness_request(system, m_body.dofs(), contact_point(triangle), m_contact_spring.spring(),
+                                        contact_spring_stiffness_n_per_m(),
+                                        held ? free_piece_floor_n_per_m(m_contact_stiffness_scale_n_per_m) : 0.0));
+}
+
+Eigen::Matrix3d Tissue::landed_contact_stiffness(const std::optional<Eigen::Matrix3d>& landed, int triangle) {
+  if (landed) return *landed;
+  if (!m_body.settings().fixed_vertices.empty()) {
+    if (const auto stiffness = step_matrix_contact_stiffness(contact_point(triangle))) return *stiffness;
+  }
+  ++m_contact_stiffness_fallbacks;
+  return Eigen::Matrix3d::Identity() * contact_spring_stiffness_n_per_m();
 }
 
 void Tissue::update_positions() {

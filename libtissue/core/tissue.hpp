@@ -6,6 +6,7 @@
 #pragma once
 
 #include "core/collide/surface_bvh.hpp"
+#include "core/contact/background_contact_stiffness.hpp"
 #include "core/contact/contact_stiffness.hpp"
 #include "core/contact/point_contact.hpp"
 #include "core/contact/point_spring.hpp"
@@ -72,6 +73,12 @@ struct InteractionSettings {
   /// The effective (reference) K_c costs a factorization: it is recomputed when a contact starts and
   /// then every this many steps (>= 1); the element-local model is recomputed every step.
   int contact_stiffness_refresh_steps = 10;
+  /// The effective K_c's factorization runs in a worker thread beside the step
+  /// (background_contact_stiffness.hpp) instead of in it: a refresh started at a step is rendered
+  /// from the next step on, the previous K_c standing until then; at a new contact, the element-local
+  /// estimate (the one the near-surface report gave) stands for that first step. The results are
+  /// the same with or without a thread to be had. Off: no thread unless asked (the FMU's rule).
+  bool contact_stiffness_in_background = false;
   /// The fastest a hand moves the tool (tip or blade end) [m/s]: a pose farther than this times the
   /// step from the last pose the tissue applied is approached at this speed (DESIGN section 7).
   double max_tool_speed_m_per_s = 5.0;
@@ -146,6 +153,11 @@ struct TissueSnapshot {
   Eigen::Vector3d applied_tool_position_m = Eigen::Vector3d::Zero();
   ContactOutput contact_output;
   int steps_since_stiffness = 0;
+  /// A K_c refresh started in the background and not yet rendered (Tissue::update_contact_output):
+  /// none, done without a result (the fallbacks follow), or done with `pending_stiffness_n_per_m`.
+  enum class PendingStiffness : std::uint8_t { none, failed, ready };
+  PendingStiffness pending_stiffness = PendingStiffness::none;
+  Eigen::Matrix3d pending_stiffness_n_per_m = Eigen::Matrix3d::Zero();
 };
 
 class Tissue {
@@ -248,6 +260,16 @@ class Tissue {
   void update_contact_output();
   /// K_c at the proxy on `triangle` (DESIGN section 4). Throws SolverError when no matrix works.
   Eigen::Matrix3d effective_contact_stiffness(int triangle);
+  /// The point on `triangle` the contact spring pulls, in the body's unknowns.
+  [[nodiscard]] ContactInterpolation contact_point(int triangle) const;
+  /// K_c from the step's Newton matrix (a body with nothing fixed, or a piece a cut set free).
+  std::optional<Eigen::Matrix3d> step_matrix_contact_stiffness(const ContactInterpolation& point);
+  /// Starts the effective K_c at the proxy on `triangle` in the background (from the static K where
+  /// the body is held, else the step's Newton matrix).
+  void start_effective_contact_stiffness(int triangle);
+  /// The K_c a background refresh gave, or its fallbacks computed now: the step's Newton matrix
+  /// where the static K failed, else the spring alone (counted).
+  Eigen::Matrix3d landed_contact_stiffness(const std::optional<Eigen::Matrix3d>& landed, int triangle);
   void update_positions();
   /// Enriches `cuts` (one batch), grows the state, adds the opened faces to the surface and the BVH.
   // Live (offsets empty: taken from the state) or replayed from a snapshot (its recorded offsets).
@@ -283,6 +305,7 @@ class Tissue {
   EffectiveContactStiffness m_effective_stiffness;
   Eigen::VectorXd m_contact_system_diagonal;
   int m_steps_since_stiffness = 0;
+  mutable BackgroundContactStiffness m_stiffness_refresh;  // save() waits for a running one
   int m_contact_stiffness_fallbacks = 0;
   ContactOutput m_contact_output;
   ToolPose m_tool;

@@ -12,7 +12,7 @@ namespace {
 constexpr std::uint64_t MAGIC = 0x31305353'49535354ULL;  // "TSSISS01" read as little-endian bytes
 // 2: PointSpring::tangent_fraction; 3: the cuts' enrichment offsets; 4: the applied tool position;
 // 5: several cuts per tet (pieces' offsets and rotations, the cuts' smallest fraction, cut counts)
-constexpr std::uint32_t VERSION = 5;
+constexpr std::uint32_t VERSION = 6;
 
 // The core's Eigen types and cut records on top of the shared byte stream.
 class Writer : public serial::ByteWriter {
@@ -170,6 +170,8 @@ std::vector<std::uint8_t> serialize_snapshot(const TissueSnapshot& s) {
   w.put(o.stiffness_n_per_m);
   w.put(o.penetration_depth_m);
   w.put(s.steps_since_stiffness);
+  w.put(static_cast<std::uint8_t>(s.pending_stiffness));
+  w.put(s.pending_stiffness_n_per_m);
   return w.take();
 }
 
@@ -231,6 +233,12 @@ TissueSnapshot read_snapshot(std::span<const std::uint8_t> bytes) {
   r.get(o.stiffness_n_per_m);
   r.get(o.penetration_depth_m);
   r.get(s.steps_since_stiffness);
+  const auto pending = r.get<std::uint8_t>();
+  if (pending > static_cast<std::uint8_t>(TissueSnapshot::PendingStiffness::ready)) {
+    serial::ByteReader::fail("pending contact stiffness state " + std::to_string(pending) + " is not 0, 1 or 2");
+  }
+  s.pending_stiffness = static_cast<TissueSnapshot::PendingStiffness>(pending);
+  r.get(s.pending_stiffness_n_per_m);
   r.finish();
   return s;
 }

@@ -436,6 +436,29 @@ TEST(ScenarioFile, AParameterTheFmuRefusesStopsTheSessionBeforeItStarts) {
   EXPECT_THROW((void)run_offline(scenario, fresh_dir("refused")), ScenarioError);
 }
 
+// Our Tissue.fmu refreshes its contact stiffness in the background unless the scenario says
+// otherwise; a tissue FMU of the user's is given only what the scenario says.
+TEST(ScenarioFile, OurTissueRefreshesItsContactStiffnessInTheBackground) {
+  const auto background = [](const Scenario& scenario) -> std::optional<decltype(ParameterSetting::value)> {
+    for (const ParameterSetting& p : scenario.tissue_parameters) {
+      if (p.name == "contact.stiffnessInBackground") return p.value;
+    }
+    return std::nullopt;
+  };
+  const std::string device = "\n[device]\nwaypoints = [ { t = 0.0, position = [0, 0, 0] } ]\n";
+  const Scenario ours = parse_scenario("[scenario]\nduration = 1.0\n" + device, "test.toml");
+  ASSERT_TRUE(background(ours).has_value());
+  EXPECT_EQ(std::get<bool>(*background(ours)), true);
+  const Scenario asked = parse_scenario(
+      "[scenario]\nduration = 1.0\n[tissue.parameters]\n\"contact.stiffnessInBackground\" = false\n" + device,
+      "test.toml");
+  ASSERT_TRUE(background(asked).has_value());
+  EXPECT_EQ(std::get<bool>(*background(asked)), false);
+  const Scenario theirs = parse_scenario("[scenario]\nduration = 1.0\n[tissue]\nfmu = \"Other.fmu\"\n" + device,
+                                         std::filesystem::temp_directory_path() / "test.toml");
+  EXPECT_FALSE(background(theirs).has_value());
+}
+
 TEST(ScenarioFile, TheMouseNeedsTheLiveViewInRealTime) {
   // frog_mouse.toml's device is the browser: offline, or without --view, nothing could drive it.
   const Scenario scenario = load_scenario(SCENARIOS / "frog_mouse.toml");

@@ -2,6 +2,7 @@
 #include "core/contact/contact_stiffness.hpp"
 
 #include "core/fem/material.hpp"
+#include "core/solve/cholmod_factor.hpp"
 #include "core/fem/tet_element.hpp"
 
 #include <Eigen/Dense>
@@ -9,6 +10,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <span>
 #include <stdexcept>
 #include <string>
 
@@ -45,14 +47,53 @@ ShiftedSystem static_contact_system(const BlockSparseMatrix& tangent, Eigen::Vec
   return ShiftedSystem{&tangent, 1.0, &diagonal};
 }
 
+EffectiveContactStiffness::EffectiveContactStiffness()
+    // Solves without BLAS: they may run in a worker beside the step's own CHOLMOD calls
+    // (cholmod_factor.hpp); the frog's factor is simplicial anyway.
+    : m_factor(std::make_unique<CholmodFactor>(CholmodFactor::Solves::without_blas)) {}
+
+EffectiveContactStiffness::~EffectiveContactStiffness() = default;
+
 void EffectiveContactStiffness::factorize(const ShiftedSystem& system) {
+  load(system);
+  factorize_loaded();
+}
+
+void EffectiveContactStiffness::load(const ShiftedSystem& system) {
   m_rows = 0;
-  m_solver.setup(system);
-  m_rows = system.rows();
+  m_loaded_rows = 0;
+  if (system.stiffness == nullptr || system.diagonal == nullptr) {
+    throw SolverError("effective contact stiffness: the system has no stiffness or no diagonal");
+  }
+  const long n = system.rows();
+  if (system.diagonal->size() != n) {
+    throw SolverError("effective contact stiffness: the diagonal has length " + std::to_string(system.diagonal->size()) +
+                      ", the system has " + std::to_string(n) + " rows");
+  }
+  m_factor->load(system);
+  m_loaded_rows = static_cast<int>(n);
+}
+
+void EffectiveContactStiffness::factorize_loaded() {
+  m_rows = 0;
+  if (m_loaded_rows == 0) throw SolverError("effective contact stiffness: nothing loaded to factorize");
+  if (m_factor->factorize() != CholmodFactor::Status::ok) {
+    throw SolverError(m_factor->failure_message("effective contact stiffness"));
+  }
+  m_rows = m_loaded_rows;
+}
+
+void EffectiveContactStiffness::solve(const Eigen::VectorXd& b, Eigen::VectorXd& x) {
+  if (m_rows == 0 || b.size() != m_rows) {
+    throw SolverError("effective contact stiffness: solve without a factor or with the wrong length");
+  }
+  x.resize(m_rows);
+  m_factor->solve(std::span<const double>(b.data(), static_cast<size_t>(m_rows)),
+                  std::span<double>(x.data(), static_cast<size_t>(m_rows)));
 }
 
 bool EffectiveContactStiffness::check(const ContactInterpolation& point) const {
-  if (!m_solver.is_set_up() || m_rows == 0) {
+  if (m_rows == 0) {
     throw SolverError("effective contact stiffness: no factorized matrix (call factorize())");
   }
   bool moves = false;
@@ -75,7 +116,7 @@ void EffectiveContactStiffness::solve_columns(const ContactInterpolation& point,
     for (size_t k = 0; k < 3; ++k) {
       if (point.rows[k] >= 0) m_column[3 * point.rows[k] + axis] += point.weights[static_cast<Eigen::Index>(k)];
     }
-    (void)m_solver.solve(m_column, m_solution);
+    solve(m_column, m_solution);
     response.col(axis) = m_solution;
     m_column.setZero();
   }
@@ -187,29 +228,50 @@ double contact_stiffness_scale_n_per_m(const DeformableBody& body, const Surface
   return (lame.lambda_pa + 2.0 * lame.mu_pa) * mean_surface_edge_m(body, surface);
 }
 
+ContactStiffnessRequest contact_stiffness_request(const ShiftedSystem& system, const DofMap& dofs,
+                                                  const ContactInterpolation& point,
+                                                  const std::optional<PointSpring>& spring,
+                                                  double rigid_support_n_per_m, double floor_n_per_m) {
+  ContactStiffnessRequest request;
+  request.point = point;
+  if (spring) {
+    request.spring_point = contact_interpolation(dofs, spring->vertices, spring->weights);
+    request.spring_in_matrix_n_per_m = system.stiffness_scale * spring->tangent_fraction * spring->stiffness_n_per_m;
+  }
+  request.rigid_support_n_per_m = rigid_support_n_per_m;
+  request.floor_n_per_m = floor_n_per_m;
+  return request;
+}
+
+std::optional<Eigen::Matrix3d> condense_loaded(EffectiveContactStiffness& effective,
+                                               const ContactStiffnessRequest& request) {
+  try {
+    effective.factorize_loaded();
+    const std::optional<Eigen::Matrix3d> stiffness =
+        request.spring_point
+            ? effective.stiffness_n_per_m(request.point, *request.spring_point, request.spring_in_matrix_n_per_m)
+            : effective.stiffness_n_per_m(request.point);
+    if (!stiffness) return Eigen::Matrix3d::Identity() * request.rigid_support_n_per_m;
+    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eigen(*stiffness, Eigen::EigenvaluesOnly);
+    if (!stiffness->allFinite() || !(eigen.eigenvalues().minCoeff() > request.floor_n_per_m)) return std::nullopt;
+    return stiffness;
+  } catch (const SolverError&) {
+    return std::nullopt;
+  }
+}
+
 std::optional<Eigen::Matrix3d> condensed_contact_stiffness(EffectiveContactStiffness& effective,
                                                           const ShiftedSystem& system, const DofMap& dofs,
                                                           const ContactInterpolation& point,
                                                           const std::optional<PointSpring>& spring,
                                                           double rigid_support_n_per_m, double floor_n_per_m) {
   try {
-    effective.factorize(system);
-    std::optional<Eigen::Matrix3d> stiffness;
-    if (spring) {
-      // What the factorized matrix holds of the spring: its share of the tangent, times the scale.
-      const double in_matrix = system.stiffness_scale * spring->tangent_fraction * spring->stiffness_n_per_m;
-      stiffness =
-          effective.stiffness_n_per_m(point, contact_interpolation(dofs, spring->vertices, spring->weights), in_matrix);
-    } else {
-      stiffness = effective.stiffness_n_per_m(point);
-    }
-    if (!stiffness) return Eigen::Matrix3d::Identity() * rigid_support_n_per_m;
-    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eigen(*stiffness, Eigen::EigenvaluesOnly);
-    if (!stiffness->allFinite() || !(eigen.eigenvalues().minCoeff() > floor_n_per_m)) return std::nullopt;
-    return stiffness;
+    effective.load(system);
   } catch (const SolverError&) {
     return std::nullopt;
   }
+  return condense_loaded(effective,
+                         contact_stiffness_request(system, dofs, point, spring, rigid_support_n_per_m, floor_n_per_m));
 }
 
 }  // namespace tissue

@@ -30,10 +30,13 @@
 #include <Eigen/Core>
 
 #include <array>
+#include <memory>
 #include <optional>
 #include <string_view>
 
 namespace tissue {
+
+class CholmodFactor;
 
 enum class ContactStiffnessModel { effective_static, element_local };
 
@@ -62,11 +65,24 @@ ShiftedSystem static_contact_system(const BlockSparseMatrix& tangent, Eigen::Vec
 // any supported body) by the inertial part, ~ m_local / h^2.
 
 /// K_c = (P^T A^-1 P)^-1 with CHOLMOD: factorize once per matrix, then any number of points
-/// (three solves each). The symbolic analysis is kept while the pattern does not change.
+/// (three solves each). The symbolic analysis is kept while the pattern does not change. The object
+/// holds its own copy of A once loaded, so the factorization and the solves may run in another thread
+/// while the body goes on (BackgroundContactStiffness); one object is not thread-safe.
 class EffectiveContactStiffness {
  public:
-  /// Throws SolverError when A is not positive definite (e.g. K of a body with nothing fixed).
+  EffectiveContactStiffness();
+  ~EffectiveContactStiffness();
+  EffectiveContactStiffness(const EffectiveContactStiffness&) = delete;
+  EffectiveContactStiffness& operator=(const EffectiveContactStiffness&) = delete;
+
+  /// load() then factorize_loaded().
   void factorize(const ShiftedSystem& system);
+  /// Copies A into the object and drops the previous factor. Throws SolverError for a system without
+  /// a stiffness or with a diagonal of another size, or when CHOLMOD cannot allocate.
+  void load(const ShiftedSystem& system);
+  /// Factorizes the loaded A, reading nothing outside the object. Throws SolverError when A is not
+  /// positive definite (e.g. K of a body with nothing fixed) or nothing is loaded.
+  void factorize_loaded();
   /// K_c [N/m], symmetric positive definite; nothing when the point does not move with the
   /// unknowns (all its weight on fixed vertices: a rigid support). Throws SolverError without a
   /// factor, std::invalid_argument for a row outside the factorized matrix.
@@ -82,8 +98,8 @@ class EffectiveContactStiffness {
   /// A^-1 P of the last stiffness_n_per_m() (rows() x 3; A without the spring): the displacement
   /// field of a unit force at the point along each axis.
   [[nodiscard]] const ResponseMatrix& unit_force_response() const { return m_response; }
-  /// x = A^-1 b with the same factor.
-  void solve(const Eigen::VectorXd& b, Eigen::VectorXd& x) { (void)m_solver.solve(b, x); }
+  /// x = A^-1 b with the same factor. Throws SolverError without one.
+  void solve(const Eigen::VectorXd& b, Eigen::VectorXd& x);
   [[nodiscard]] int rows() const { return m_rows; }
 
  private:
@@ -92,18 +108,43 @@ class EffectiveContactStiffness {
   /// response = A'^-1 P (A' the factorized matrix), three solves.
   void solve_columns(const ContactInterpolation& point, ResponseMatrix& response);
 
-  CholmodSolver m_solver;
-  int m_rows = 0;
+  std::unique_ptr<CholmodFactor> m_factor;
+  int m_loaded_rows = 0;
+  int m_rows = 0;  ///< of the factorized matrix, 0 without a factor
   Eigen::VectorXd m_column;
   Eigen::VectorXd m_solution;
   ResponseMatrix m_response;
   ResponseMatrix m_spring_response;
 };
 
-/// K_c of the tissue alone at `point` from `system`, factorized into `effective`: the contact spring,
-/// if set, is in the matrix as its tangent share times the system's scale and is taken out exactly.
-/// A point on fixed vertices only is a rigid support: `rigid_support_n_per_m` I. Nothing when the
-/// factor fails, or when K_c is not finite or its smallest eigenvalue is not above `floor_n_per_m`.
+/// What K_c at a contact point needs besides the factorized matrix, copied from the body when the
+/// matrix is loaded (so that the factorization and the solves need nothing of the body).
+struct ContactStiffnessRequest {
+  ContactInterpolation point;
+  std::optional<ContactInterpolation> spring_point;  ///< the contact spring's point, while a spring is set
+  double spring_in_matrix_n_per_m = 0.0;             ///< what the matrix holds of the spring
+  double rigid_support_n_per_m = 0.0;                ///< K_c = this I at a point on fixed vertices only
+  double floor_n_per_m = 0.0;                        ///< K_c's smallest eigenvalue must be above this
+};
+
+/// The request for `point` on `system`: the contact spring, if set, is in the matrix as its tangent
+/// share times the system's scale.
+ContactStiffnessRequest contact_stiffness_request(const ShiftedSystem& system, const DofMap& dofs,
+                                                  const ContactInterpolation& point,
+                                                  const std::optional<PointSpring>& spring,
+                                                  double rigid_support_n_per_m, double floor_n_per_m);
+
+/// K_c of the tissue alone from the matrix loaded into `effective`: factorizes it, the spring taken out
+/// exactly. Nothing when the factor fails, or when K_c is not finite or its smallest eigenvalue is not
+/// above the request's floor. Reads nothing but `effective` and `request`. Throws std::invalid_argument
+/// for a request that does not fit the matrix (contact_stiffness_request for another body).
+std::optional<Eigen::Matrix3d> condense_loaded(EffectiveContactStiffness& effective,
+                                               const ContactStiffnessRequest& request);
+
+/// K_c of the tissue alone at `point` from `system`, factorized into `effective` (load, then
+/// condense_loaded). A point on fixed vertices only is a rigid support: `rigid_support_n_per_m` I.
+/// Nothing when the factor fails, or when K_c is not finite or its smallest eigenvalue is not above
+/// `floor_n_per_m`.
 std::optional<Eigen::Matrix3d> condensed_contact_stiffness(EffectiveContactStiffness& effective,
                                                           const ShiftedSystem& system, const DofMap& dofs,
                                                           const ContactInterpolation& point,

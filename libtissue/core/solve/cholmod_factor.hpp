@@ -1,4 +1,4 @@
-// CholmodFactor: the one CHOLMOD wrapper of the solvers (internal to core/solve). Holds the upper
+// CholmodFactor: the one CHOLMOD wrapper (core/solve, and the contact stiffness of core/contact). Holds the upper
 // triangle of A = s K + diag(d) in compressed columns, the value map from K's slots to it (built
 // once per pattern), the symbolic analysis and the numeric factor, and the dense buffers of the
 // solves. CholmodSolver factorizes with one every setup; CholeskyPcgSolver keeps two (the factor

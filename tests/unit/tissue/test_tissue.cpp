@@ -212,6 +212,55 @@ TEST(Tissue, FreeBodyContactStiffnessLeavesTheSpringOut) {
   EXPECT_LT((tissue.contact().stiffness_n_per_m - *k_c).norm(), 1e-9 * k_c->norm());
 }
 
+// In the background (contact_stiffness_in_background), a refresh started at a step is what the next
+// step renders: the K_c the caller's thread condenses from the static K and the proxy as they were
+// when the step that started it ended. A new contact's first step renders the element-local
+// estimate (what the near-surface report gives before the touch).
+TEST(Tissue, ABackgroundContactStiffnessIsRenderedOneStepLate) {
+  const TetMesh mesh = make_box_mesh(6, 4, 2, 0.01);
+  TissueSettings settings;
+  settings.body.gravity_m_per_s2.setZero();
+  settings.body.fixed_vertices = vertices_at_minimum(mesh, 0, 0.0);
+  settings.step_size_s = 0.01;
+  settings.interaction.contact_stiffness_in_background = true;
+  settings.interaction.contact_stiffness_refresh_steps = 1;
+  Tissue tissue(mesh, settings);
+  const Eigen::Vector3d above(0.0413, 0.0187, 0.025);
+  tissue.set_tool({above, Eigen::Quaterniond::Identity(), ToolMode::probe});
+  tissue.step();
+  Eigen::Matrix3d expected = Eigen::Matrix3d::Zero();
+  EffectiveContactStiffness reference;
+  Eigen::VectorXd zero_diagonal;
+  for (int n = 1; n <= 12; ++n) {
+    const double depth_m = 2e-4 * n;
+    tissue.set_tool({Eigen::Vector3d(above.x(), above.y(), 0.02 - depth_m), Eigen::Quaterniond::Identity(),
+                     ToolMode::probe});
+    tissue.step();
+    ASSERT_TRUE(tissue.contact().active) << n;
+    const int triangle = tissue.point_contact().proxy().triangle;
+    if (n == 1) {
+      EXPECT_TRUE(tissue.contact().stiffness_n_per_m ==
+                  element_local_contact_stiffness(tissue.body().elasticity(), tissue.surface(), triangle));
+    } else {
+      EXPECT_TRUE(tissue.contact().stiffness_n_per_m == expected)
+          << "step " << n << ": max difference " << (tissue.contact().stiffness_n_per_m - expected).cwiseAbs().maxCoeff();
+    }
+    // What the next step will render: K_c condensed here, now.
+    const SurfacePoint& proxy = tissue.point_contact().proxy();
+    const std::optional<Eigen::Matrix3d> now = condensed_contact_stiffness(
+        reference, static_contact_system(tissue.body().tangent(), zero_diagonal), tissue.body().dofs(),
+        contact_interpolation(tissue.body().dofs(), tissue.surface_bvh().triangle(proxy.triangle), proxy.barycentric),
+        tissue.contact_spring().spring(), tissue.contact_spring_stiffness_n_per_m(), 0.0);
+    ASSERT_TRUE(now.has_value());
+    // The stiffness changes as the probe presses in, so that rendering it a step late is seen.
+    if (n >= 3) {
+      EXPECT_FALSE(tissue.contact().stiffness_n_per_m == *now) << n;
+    }
+    expected = *now;
+  }
+  EXPECT_EQ(tissue.contact_stiffness_fallbacks(), 0);
+}
+
 TEST(Tissue, BuildsOnlyWhatTheSceneRequires) {
   const TetMesh mesh = make_box_mesh(10, 2, 2, 0.01);
   const auto run_scene = [&](bool contact, bool cutting) {

@@ -137,6 +137,39 @@ TEST_P(TissueState, SerializedIntoAFreshInstanceContinuesBitwise) {
   expect_same_continuation(original, fresh);
 }
 
+// With the contact stiffness refreshed in the background at every step, a refresh is always under
+// way when the state is saved: its result is saved with it, so the restored instance renders at the
+// next step what the original renders (without it, the restored one would keep the saved K_c).
+TEST(TissueState, ABackgroundStiffnessRefreshUnderWayIsSavedWithTheState) {
+  const TetMesh mesh = frog();
+  Session session(mesh);
+  TissueSettings settings = frog_settings(mesh);
+  settings.interaction.contact_stiffness_in_background = true;
+  settings.interaction.contact_stiffness_refresh_steps = 1;
+  Tissue original(mesh, settings);
+  session.set_top(top_of_back(original, session));
+  constexpr int SAVED_AT = 8;
+  run(original, session, 0, SAVED_AT);
+  ASSERT_TRUE(original.contact().active);
+  TissueSnapshot snapshot;
+  original.save(snapshot);
+  ASSERT_EQ(snapshot.pending_stiffness, TissueSnapshot::PendingStiffness::ready);
+  const std::vector<std::uint8_t> bytes = serialize_snapshot(snapshot);
+  Tissue fresh(mesh, settings);
+  fresh.restore(deserialize_snapshot(bytes));
+  for (int n = SAVED_AT; n < 20; ++n) {
+    run(original, session, n, n + 1);
+    run(fresh, session, n, n + 1);
+    ASSERT_TRUE(original.contact().active) << n;
+    EXPECT_TRUE(original.contact().stiffness_n_per_m == fresh.contact().stiffness_n_per_m) << "step " << n;
+  }
+  expect_same_continuation(original, fresh);
+  // A state with a bad pending-refresh tag is refused.
+  std::vector<std::uint8_t> corrupt = bytes;
+  corrupt[corrupt.size() - 1 - 9 * sizeof(double)] = 7;
+  EXPECT_THROW((void)deserialize_snapshot(corrupt), StateError);
+}
+
 // Pressing (contact and its stiffness refresh), before the stroke, mid-stroke (a session open and
 // tets partly cut), between the strokes, mid-way through the second (cut tets cut again) and after.
 INSTANTIATE_TEST_SUITE_P(SavedAtStep, TissueState, ::testing::Values(15, 21, 40, 63, 85, 107));

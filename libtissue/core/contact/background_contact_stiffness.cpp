@@ -1,0 +1,68 @@
+// BackgroundContactStiffness (see background_contact_stiffness.hpp).
+#include "core/contact/background_contact_stiffness.hpp"
+
+#include <system_error>
+
+namespace tissue {
+
+BackgroundContactStiffness::~BackgroundContactStiffness() {
+  if (m_worker.joinable()) m_worker.join();
+}
+
+void BackgroundContactStiffness::compute() noexcept {
+  try {
+    m_result = condense_loaded(m_effective, m_request);
+  } catch (...) {  // a request that does not fit, no memory: no K_c (the caller falls back)
+    m_result = std::nullopt;
+  }
+  m_computed = true;
+}
+
+void BackgroundContactStiffness::start(const ShiftedSystem& system, const ContactStiffnessRequest& request) {
+  cancel();
+  m_request = request;
+  m_result = std::nullopt;
+  m_computed = false;
+  m_state = State::running;
+  try {
+    m_effective.load(system);
+  } catch (const SolverError&) {
+    m_computed = true;  // nothing to factorize: a failed result
+    m_state = State::done;
+    return;
+  }
+  try {
+    m_worker = std::thread([this] { compute(); });
+  } catch (const std::system_error&) {
+    // No thread to be had: wait() computes it in the caller, with the same result.
+  }
+}
+
+void BackgroundContactStiffness::wait() {
+  if (m_state != State::running) return;
+  if (m_worker.joinable()) m_worker.join();
+  if (!m_computed) compute();
+  m_state = State::done;
+}
+
+std::optional<Eigen::Matrix3d> BackgroundContactStiffness::take() {
+  wait();
+  if (m_state != State::done) return std::nullopt;
+  m_state = State::idle;
+  return m_result;
+}
+
+void BackgroundContactStiffness::cancel() {
+  wait();
+  m_state = State::idle;
+  m_result = std::nullopt;
+}
+
+void BackgroundContactStiffness::set_done(const std::optional<Eigen::Matrix3d>& result) {
+  cancel();
+  m_result = result;
+  m_computed = true;
+  m_state = State::done;
+}
+
+}  // namespace tissue

@@ -1,0 +1,59 @@
+// BackgroundContactStiffness: the effective contact stiffness K_c computed in a worker thread, so
+// that the factorization it costs (the frog: ~7 ms, most of a 10 ms step slot) leaves the step's
+// critical path. start() copies the matrix and the request in the caller's thread; the worker
+// factorizes the copy and condenses it (condense_loaded), touching nothing of the body; take()
+// joins and hands the result over.
+//
+// Determinism: the caller takes the result at a fixed step (Tissue: the next one), never "when
+// ready", so a run gives the same K_c with or without the thread (no thread to be had: take()
+// computes it in the caller). A finished result can be set from a saved state (restore), so that a
+// restored run takes what the original took.
+#pragma once
+
+#include "core/contact/contact_stiffness.hpp"
+
+#include <Eigen/Core>
+
+#include <optional>
+#include <thread>
+
+namespace tissue {
+
+class BackgroundContactStiffness {
+ public:
+  enum class State { idle, running, done };
+
+  BackgroundContactStiffness() = default;
+  ~BackgroundContactStiffness();  ///< joins a running worker
+  BackgroundContactStiffness(const BackgroundContactStiffness&) = delete;
+  BackgroundContactStiffness& operator=(const BackgroundContactStiffness&) = delete;
+
+  /// Copies `system`'s matrix and starts the worker on it (a running one is joined and dropped
+  /// first). A matrix that cannot be copied gives a done, failed result.
+  void start(const ShiftedSystem& system, const ContactStiffnessRequest& request);
+  /// Joins a running worker (running -> done); the result stays to be taken.
+  void wait();
+  /// Waits, then hands over the result (done -> idle): K_c, or nothing when it could not be condensed
+  /// (condense_loaded). Nothing as well when idle.
+  std::optional<Eigen::Matrix3d> take();
+  /// Waits and drops the result (-> idle).
+  void cancel();
+  /// A finished result, as if a worker had computed it (a restored state); drops a running one.
+  void set_done(const std::optional<Eigen::Matrix3d>& result);
+
+  [[nodiscard]] State state() const { return m_state; }
+  /// The finished result (valid in state done, after wait()).
+  [[nodiscard]] const std::optional<Eigen::Matrix3d>& result() const { return m_result; }
+
+ private:
+  void compute() noexcept;  // the worker's job (or the caller's, without a thread)
+
+  EffectiveContactStiffness m_effective;
+  ContactStiffnessRequest m_request;
+  std::optional<Eigen::Matrix3d> m_result;
+  std::thread m_worker;
+  bool m_computed = false;  // m_result holds the job's outcome (false: loaded, no thread ran it)
+  State m_state = State::idle;
+};
+
+}  // namespace tissue
