@@ -180,16 +180,9 @@ void CorotationalElasticity::evaluate(const Eigen::VectorXd& positions_m, Eigen:
                                       BlockSparseMatrix* tangent, const std::vector<TetSlots>* slots, WorkTeam* team) {
   assert(tangent == nullptr || (slots != nullptr && slots->size() == m_tets.size()));
   for (const AssemblyPhase& phase : m_phases) {
-    if (team != nullptr && team->size() > 1) {
-      auto halves = [&](int member) {
-        for (int part = member; part < ASSEMBLY_PARTS; part += team->size()) {
-          add_tets(phase[static_cast<size_t>(part)], positions_m, internal_forces_n, tangent, slots);
-        }
-      };
-      team->run(halves);
-    } else {
-      for (const std::vector<int>& part : phase) add_tets(part, positions_m, internal_forces_n, tangent, slots);
-    }
+    run_parts(team, ASSEMBLY_PARTS, [&](int part) {
+      add_tets(phase[static_cast<size_t>(part)], positions_m, internal_forces_n, tangent, slots);
+    });
   }
   add_tets(m_serial_tets, positions_m, internal_forces_n, tangent, slots);
 }
@@ -279,18 +272,10 @@ TISSUE_HOT_KERNEL double CorotationalElasticity::energy_of_range(const Eigen::Ve
 double CorotationalElasticity::elastic_energy_j(const Eigen::VectorXd& positions_m, WorkTeam* team) const {
   std::array<double, 2> half{};
   const size_t n = m_tets.size();
-  const int members = (team != nullptr && team->size() > 1) ? team->size() : 1;
-  auto half_job = [&](int member) {
-    for (int h = member; h < 2; h += members) {
-      half[static_cast<size_t>(h)] = energy_of_range(positions_m, n * static_cast<size_t>(h) / 2,
-                                                     n * static_cast<size_t>(h + 1) / 2);
-    }
-  };
-  if (members > 1) {
-    team->run(half_job);
-  } else {
-    half_job(0);
-  }
+  run_parts(team, 2, [&](int h) {
+    half[static_cast<size_t>(h)] =
+        energy_of_range(positions_m, n * static_cast<size_t>(h) / 2, n * static_cast<size_t>(h + 1) / 2);
+  });
   return half[0] + half[1];
 }
 

@@ -38,6 +38,14 @@ class CorotationalElasticity {
   /// elastic_energy_j() skip it from now on. Throws ParameterError for an id out of range.
   void exclude(int tet);
   [[nodiscard]] bool is_excluded(int tet) const { return m_excluded[stored(tet)] != 0; }
+  /// visit(vertices, rest, rotation) for the tets not excluded at storage indices [first, end)
+  /// (tet_id()), in storage order: a pass that streams the per-tet data as a step does.
+  template <class Visit>
+  void for_each_included(size_t first, size_t end, Visit&& visit) const {
+    for (size_t k = first; k < end; ++k) {
+      if (m_excluded[k] == 0) visit(m_tets[k], m_rest[k], m_rotations[k]);
+    }
+  }
 
   /// One pass over the (not excluded) tets at the current positions (3 per vertex, [m]):
   /// updates each R_e (warm-started from the last step), adds the internal force f_int

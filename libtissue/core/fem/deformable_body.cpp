@@ -201,27 +201,23 @@ TISSUE_HOT_KERNEL double DeformableBody::largest_element_turn_rad(const Eigen::V
     const int row = vertex_block_row(vertex);
     return row < 0 ? Eigen::Vector3d::Zero() : Eigen::Vector3d(increment_m.segment<3>(3 * row));
   };
-  // The uncut tets in halves, side by side with a team (a maximum: the same in any order).
+  // The uncut tets (those the co-rotational model has not handed to XFEM) in halves of its storage
+  // order, which streams its per-tet data, side by side with a team (a maximum: the same in any order).
   std::array<double, MAX_STEP_THREADS> largest_of_part{};
-  const int parts = m_team != nullptr ? m_team->size() : 1;
-  auto uncut_part = [&](int member) {
+  const int parts = team_parts(m_team);
+  run_parts(m_team, parts, [&](int member) {
     TetPositions increment;
     double largest = 0.0;
-    const int tets = m_mesh.tet_count();
-    const int end = static_cast<int>(static_cast<long>(tets) * (member + 1) / parts);
-    for (int t = static_cast<int>(static_cast<long>(tets) * member / parts); t < end; ++t) {
-      if (m_cut_index[static_cast<size_t>(t)] >= 0) continue;
-      const Tet& tet = m_mesh.tets[static_cast<size_t>(t)];
-      for (size_t j = 0; j < 4; ++j) increment[j] = vertex_increment(tet[j]);
-      largest = std::max(largest, turn_angle_rad(m_elasticity.rest(t), m_elasticity.rotation(t), increment));
-    }
+    const auto tets = static_cast<size_t>(m_elasticity.tet_count());
+    m_elasticity.for_each_included(
+        tets * static_cast<size_t>(member) / static_cast<size_t>(parts),
+        tets * static_cast<size_t>(member + 1) / static_cast<size_t>(parts),
+        [&](const Tet& tet, const TetRest& rest, const Eigen::Matrix3d& rotation) {
+          for (size_t j = 0; j < 4; ++j) increment[j] = vertex_increment(tet[j]);
+          largest = std::max(largest, turn_angle_rad(rest, rotation, increment));
+        });
     largest_of_part[static_cast<size_t>(member)] = largest;
-  };
-  if (parts > 1) {
-    m_team->run(uncut_part);
-  } else {
-    uncut_part(0);
-  }
+  });
   double largest_rad = *std::max_element(largest_of_part.begin(), largest_of_part.end());
   TetPositions increment;
   for (int k = 0; k < m_xfem.cut_tet_count(); ++k) {

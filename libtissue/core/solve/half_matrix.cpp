@@ -71,18 +71,13 @@ void HalfMatrix::assign(const ShiftedSystem& system, WorkTeam* team) {
   } else {
     m_double.resize(9 * blocks);
   }
-  auto copy = [&](int part) {
+  run_parts(team, PARTS, [&](int part) {
     if (m_precision == MatrixPrecision::single) {
       copy_part(k, s, m_single, part);
     } else {
       copy_part(k, s, m_double, part);
     }
-  };
-  if (team != nullptr && team->size() == PARTS) {
-    team->run(copy);
-  } else {
-    for (int part = 0; part < PARTS; ++part) copy(part);
-  }
+  });
   m_diagonal = *system.diagonal;
 }
 

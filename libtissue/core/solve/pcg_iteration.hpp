@@ -48,11 +48,7 @@ class VectorParts {
   /// job(part) for every part: side by side with a team of PARTS members, else in part order.
   template <class Job>
   void run(Job&& job) const {
-    if (m_team != nullptr && m_team->size() == PARTS) {
-      m_team->run(job);
-    } else {
-      for (int part = 0; part < PARTS; ++part) job(part);
-    }
+    run_parts(m_team, PARTS, job);
   }
 
  private:

@@ -115,20 +115,15 @@ void BlockSparseMatrix::set_zero() { set_zero(nullptr); }
 
 void BlockSparseMatrix::set_zero(WorkTeam* team) {
   // Only the used slots: unused slots are zero already (relayout and insert keep them so).
-  const int parts = team != nullptr ? team->size() : 1;
-  auto zero_rows = [&](int member) {
+  const int parts = team_parts(team);
+  run_parts(team, parts, [&](int part) {
     double* values = m_values.data();
-    const int end = balanced_row_split(member + 1, parts);
-    for (int r = balanced_row_split(member, parts); r < end; ++r) {
+    const int end = balanced_row_split(part + 1, parts);
+    for (int r = balanced_row_split(part, parts); r < end; ++r) {
       double* first = values + 9 * to_size(m_row_begin[to_size(r)]);
       std::fill(first, first + 9 * to_size(m_row_size[to_size(r)]), 0.0);
     }
-  };
-  if (parts > 1) {
-    team->run(zero_rows);
-  } else {
-    zero_rows(0);
-  }
+  });
 }
 
 void BlockSparseMatrix::multiply(const Eigen::VectorXd& x, Eigen::VectorXd& y) const {
@@ -154,10 +149,9 @@ void BlockSparseMatrix::multiply(const Eigen::VectorXd& x, Eigen::VectorXd& y, W
   if (&x == &y) throw std::invalid_argument("BlockSparseMatrix::multiply: x and y must be different vectors");
   y.resize(rows());
   const int parts = team->size();
-  auto rows_of_member = [&](int member) {
-    multiply_rows(x, y, balanced_row_split(member, parts), balanced_row_split(member + 1, parts));
-  };
-  team->run(rows_of_member);
+  run_parts(team, parts, [&](int part) {
+    multiply_rows(x, y, balanced_row_split(part, parts), balanced_row_split(part + 1, parts));
+  });
 }
 
 int BlockSparseMatrix::balanced_row_split(int part, int parts) const {

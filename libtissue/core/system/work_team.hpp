@@ -52,4 +52,19 @@ class WorkTeam {
   std::atomic<bool> m_stop{false};
 };
 
+/// The parts a pass over a step's data is split into with `team` (nullptr: none): its size, else 1.
+[[nodiscard]] inline int team_parts(const WorkTeam* team) { return team != nullptr ? team->size() : 1; }
+
+/// job(part) for every part 0 .. parts - 1: side by side on `team` when it has `parts` members,
+/// else one after another on the calling thread. A job that writes per-part results and combines
+/// them in part order gives bitwise the same with a team or without.
+template <class Job>
+void run_parts(WorkTeam* team, int parts, Job&& job) {
+  if (team != nullptr && team->size() == parts && parts > 1) {
+    team->run(job);
+  } else {
+    for (int part = 0; part < parts; ++part) job(part);
+  }
+}
+
 }  // namespace tissue
