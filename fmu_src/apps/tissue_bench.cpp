@@ -8,27 +8,30 @@
 #include <exception>
 #include <iostream>
 
+#include <nlohmann/json.hpp>
+
 namespace {
 
 using tissue::apps::Summary;
 
-void print_summary(const char* name, const Summary& s, bool last = false) {
-  std::printf("  \"%s\": {\"median\": %.6g, \"p90\": %.6g, \"max\": %.6g}%s\n", name, s.median, s.p90, s.max,
-              last ? "" : ",");
+nlohmann::ordered_json summary_json(const Summary& s) {
+  return {{"median", s.median}, {"p90", s.p90}, {"max", s.max}};
 }
 
 // pcg-cholesky's counters (how often its lagged factor was rebuilt), when that is the solver.
-void print_lagged_factor(const tissue::Tissue& tissue) {
+void add_lagged_factor(const tissue::Tissue& tissue, nlohmann::ordered_json& out) {
   const auto* integrator = dynamic_cast<const tissue::BackwardEuler*>(&tissue.integrator());
   const auto* solver =
       integrator != nullptr ? dynamic_cast<const tissue::CholeskyPcgSolver*>(&integrator->solver()) : nullptr;
   if (solver == nullptr) return;
   const tissue::CholeskyPcgSolver::Counters& c = solver->counters();
-  std::printf(
-      "  \"lagged_factor\": {\"setups\": %ld, \"factorizations\": %ld, \"refreshes_started\": %ld, "
-      "\"refreshes_picked_up\": %ld, \"refresh_failures\": %ld, \"pickups_waited\": %ld, \"iterations\": %ld},\n",
-      c.setups, c.factorizations, c.refreshes_started, c.refreshes_picked_up, c.refresh_failures, c.pickups_waited,
-      c.iterations);
+  out["lagged_factor"] = {{"setups", c.setups},
+                          {"factorizations", c.factorizations},
+                          {"refreshes_started", c.refreshes_started},
+                          {"refreshes_picked_up", c.refreshes_picked_up},
+                          {"refresh_failures", c.refresh_failures},
+                          {"pickups_waited", c.pickups_waited},
+                          {"iterations", c.iterations}};
 }
 
 int run(const tissue::apps::SceneOptions& options) {
@@ -55,24 +58,29 @@ int run(const tissue::apps::SceneOptions& options) {
     guarded_steps += report.energy_guarded ? 1 : 0;
   }
   const Summary iteration_summary = tissue::apps::summarize(iterations);
-  std::printf("{\n");
-  std::printf("  \"mesh\": \"%s\",\n", scene.mesh_name.c_str());
-  std::printf("  \"solver\": \"%s\",\n", options.solver.c_str());
-  std::printf("  \"tolerance\": %.3g,\n  \"max_iterations\": %d,\n", options.tolerance, options.max_iterations);
-  std::printf("  \"dt_s\": %.6g,\n  \"steps\": %d,\n", options.step_size_s, options.steps);
-  std::printf("  \"vertices\": %d,\n  \"tets\": %d,\n  \"fixed_vertices\": %d,\n", vertices, tets, fixed);
-  std::printf("  \"dofs\": %d,\n", tissue.body().dof_count());
-  std::printf("  \"nonzeros\": %ld,\n", tissue.body().tangent().nonzeros());
-  print_summary("ms_per_step", tissue::apps::summarize(step_ms));
-  std::printf("  \"assembly_ms\": %.6g,\n", tissue::apps::summarize(assembly_ms).median);
-  std::printf("  \"solve_ms\": %.6g,\n", tissue::apps::summarize(solve_ms).median);
-  std::printf("  \"cg_iterations\": {\"mean\": %.4g, \"max\": %.0f},\n", iteration_summary.mean, iteration_summary.max);
-  std::printf("  \"large_turn_protection\": %s,\n", options.large_turn_protection ? "true" : "false");
-  std::printf("  \"threads\": %d,\n", options.threads);
-  std::printf("  \"newton_iterations\": %ld,\n  \"energy_guarded_steps\": %ld,\n", newton_iterations, guarded_steps);
-  print_lagged_factor(tissue);
-  std::printf("  \"final_kinetic_energy_J\": %.6g\n", tissue.kinetic_energy_j());
-  std::printf("}\n");
+  nlohmann::ordered_json out;
+  out["mesh"] = scene.mesh_name;
+  out["solver"] = options.solver;
+  out["tolerance"] = options.tolerance;
+  out["max_iterations"] = options.max_iterations;
+  out["dt_s"] = options.step_size_s;
+  out["steps"] = options.steps;
+  out["vertices"] = vertices;
+  out["tets"] = tets;
+  out["fixed_vertices"] = fixed;
+  out["dofs"] = tissue.body().dof_count();
+  out["nonzeros"] = tissue.body().tangent().nonzeros();
+  out["ms_per_step"] = summary_json(tissue::apps::summarize(step_ms));
+  out["assembly_ms"] = tissue::apps::summarize(assembly_ms).median;
+  out["solve_ms"] = tissue::apps::summarize(solve_ms).median;
+  out["cg_iterations"] = {{"mean", iteration_summary.mean}, {"max", iteration_summary.max}};
+  out["large_turn_protection"] = options.large_turn_protection;
+  out["threads"] = options.threads;
+  out["newton_iterations"] = newton_iterations;
+  out["energy_guarded_steps"] = guarded_steps;
+  add_lagged_factor(tissue, out);
+  out["final_kinetic_energy_J"] = tissue.kinetic_energy_j();
+  std::printf("%s\n", out.dump(2, ' ', false, nlohmann::ordered_json::error_handler_t::replace).c_str());
   return 0;
 }
 

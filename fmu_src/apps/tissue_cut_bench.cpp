@@ -9,6 +9,8 @@
 
 #include <algorithm>
 #include <cstdio>
+
+#include <nlohmann/json.hpp>
 #include <exception>
 #include <iostream>
 
@@ -72,31 +74,44 @@ void run_scenario(const BenchOptions& options, const tissue::apps::CutScenario& 
   const Summary during = summarize(step_ms);
   const auto fill = [](long nonzeros, int n) { return static_cast<double>(nonzeros) / (double(n) * double(n)); };
 
-  std::printf("  {\"scenario\": \"%s\", \"cuts\": %zu, \"solver\": \"%s\", \"dt_s\": %g, \"speed_m_per_s\": %g,\n",
-              scenario.name.c_str(), scenario.strokes.size(), options.scene.solver.c_str(), options.scene.step_size_s,
-              options.stroke.speed_m_per_s);
-  std::printf("   \"dofs_before\": %d, \"dofs_after\": %d, \"enriched_vertices\": %d, \"cut_tets\": %d,\n",
-              dofs_before, dofs_after, tissue.body().enriched_dof_count(), tissue.body().cut_tet_count());
-  std::printf("   \"nonzeros_before\": %ld, \"nonzeros_after\": %ld, \"fill_before\": %.5f, \"fill_after\": %.5f,\n",
-              nonzeros_before, nonzeros_after, fill(nonzeros_before, dofs_before), fill(nonzeros_after, dofs_after));
-  std::printf("   \"ms_per_step_before\": %.4f, \"ms_per_step_after\": %.4f,\n", ms_before, ms_after);
-  std::printf(
-      "   \"stroke_steps\": %d, \"cutting_steps\": %zu, \"cutter_ms\": {\"mean\": %.4f, \"median\": %.4f, "
-      "\"max\": %.4f},\n",
-      steps, cutter_ms.size(), cutter.mean, cutter.median, cutter.max);
-  std::printf("   \"new_tets_per_cutting_step\": {\"mean\": %.3f, \"median\": %.1f, \"max\": %.0f},\n", tets.mean,
-              tets.median, tets.max);
-  std::printf("   \"step_ms_during_cuts\": {\"median\": %.4f, \"max\": %.4f}, \"worst_over_normal\": %.3f,\n",
-              during.median, worst_ms, worst_ms / ms_before);
-  std::printf(
-      "   \"worst_step_ms\": {\"cutter\": %.4f, \"enrich\": %.4f, \"assembly\": %.4f, \"solve\": %.4f, "
-      "\"contact\": %.4f, \"positions\": %.4f, \"rest\": %.4f, \"new_tets\": %d},\n",
-      1e3 * worst.cut_s, 1e3 * worst.enrich_s, 1e3 * worst.dynamics.assembly_s, 1e3 * worst.dynamics.solve_s,
-      1e3 * worst.contact_s, 1e3 * worst.positions_s,
-      1e3 * (worst.total_s - worst.cut_s - worst.enrich_s - worst.dynamics.assembly_s - worst.dynamics.solve_s -
-             worst.contact_s - worst.positions_s),
-      worst.cut.newly_cut_tets);
-  std::printf("   \"matrix_relayouts\": %d, \"ignored_cuts\": %d}%s\n", relayouts, ignored, last ? "" : ",");
+  const double rest_ms = 1e3 * (worst.total_s - worst.cut_s - worst.enrich_s - worst.dynamics.assembly_s -
+                                worst.dynamics.solve_s - worst.contact_s - worst.positions_s);
+  const nlohmann::ordered_json result = {
+      {"scenario", scenario.name},
+      {"cuts", scenario.strokes.size()},
+      {"solver", options.scene.solver},
+      {"dt_s", options.scene.step_size_s},
+      {"speed_m_per_s", options.stroke.speed_m_per_s},
+      {"dofs_before", dofs_before},
+      {"dofs_after", dofs_after},
+      {"enriched_vertices", tissue.body().enriched_dof_count()},
+      {"cut_tets", tissue.body().cut_tet_count()},
+      {"nonzeros_before", nonzeros_before},
+      {"nonzeros_after", nonzeros_after},
+      {"fill_before", fill(nonzeros_before, dofs_before)},
+      {"fill_after", fill(nonzeros_after, dofs_after)},
+      {"ms_per_step_before", ms_before},
+      {"ms_per_step_after", ms_after},
+      {"stroke_steps", steps},
+      {"cutting_steps", cutter_ms.size()},
+      {"cutter_ms", {{"mean", cutter.mean}, {"median", cutter.median}, {"max", cutter.max}}},
+      {"new_tets_per_cutting_step", {{"mean", tets.mean}, {"median", tets.median}, {"max", tets.max}}},
+      {"step_ms_during_cuts", {{"median", during.median}, {"max", worst_ms}}},
+      {"worst_over_normal", worst_ms / ms_before},
+      {"worst_step_ms",
+       {{"cutter", 1e3 * worst.cut_s},
+        {"enrich", 1e3 * worst.enrich_s},
+        {"assembly", 1e3 * worst.dynamics.assembly_s},
+        {"solve", 1e3 * worst.dynamics.solve_s},
+        {"contact", 1e3 * worst.contact_s},
+        {"positions", 1e3 * worst.positions_s},
+        {"rest", rest_ms},
+        {"new_tets", worst.cut.newly_cut_tets}}},
+      {"matrix_relayouts", relayouts},
+      {"ignored_cuts", ignored}};
+  // One element of the array per scenario as it finishes (a long run shows its progress).
+  std::printf("  %s%s\n", result.dump().c_str(), last ? "" : ",");
+  std::fflush(stdout);
 }
 
 }  // namespace

@@ -3,10 +3,12 @@
 
 #include "compare/compare_metrics.hpp"
 #include "compare/compare_settings.hpp"
-#include "output/json_text.hpp"
+
+#include <nlohmann/json.hpp>
 
 #include <algorithm>
 #include <charconv>
+#include <cmath>
 #include <cstdio>
 #include <fstream>
 #include <ostream>
@@ -39,46 +41,44 @@ std::vector<std::string> wrap(const std::string& text, std::size_t width) {
 }
 
 template <class T>
-std::string json_value(const std::optional<T>& value) {
-  if (!value) return "null";
-  if constexpr (std::is_floating_point_v<T>) {
-    char buffer[32];
-    const auto [end, error] = std::to_chars(buffer, buffer + sizeof(buffer), *value);
-    return std::string(buffer, error == std::errc() ? end : buffer);
-  } else {
-    return std::to_string(*value);
-  }
+nlohmann::ordered_json json_value(const std::optional<T>& value) {
+  return value ? nlohmann::ordered_json(*value) : nlohmann::ordered_json(nullptr);
 }
 
+// compare.json. nlohmann::json writes non-finite numbers (a metric of a failed run) as null.
 std::string json_document(const CompareReport& report) {
-  std::string out = "{\n  \"scenario\": " + json_string(report.scenario) + ",\n";
-  out += "  \"reference\": " + json_string(report.reference) + ",\n  \"notes\": [";
-  for (std::size_t k = 0; k < report.notes.size(); ++k) out += (k ? ", " : "") + json_string(report.notes[k]);
-  out += "],\n  \"rows\": [\n";
-  for (std::size_t k = 0; k < report.rows.size(); ++k) {
-    const CompareRow& r = report.rows[k];
-    out += "    {\"setting\": " + json_string(r.setting) + ", \"integrator\": " + json_string(r.integrator) +
-           ", \"linear_solver\": " + json_string(r.linear_solver) + ", \"tolerance\": " + json_value(r.tolerance) +
-           ", \"iteration_cap\": " + json_value(r.iteration_cap) +
-           ", \"internal_step_s\": " + json_value(std::optional<double>(r.internal_step_s)) +
-           ", \"cpu_s_per_sim_s\": " + json_value(r.cpu_s_per_sim_s) +
-           ", \"rms_error_m\": " + json_value(r.rms_error_m) + ", \"max_error_m\": " + json_value(r.max_error_m) +
-           ", \"force_error_n\": " + json_value(r.force_error_n) +
-           ", \"energy_drift_j\": " + json_value(r.energy_drift_j) + ", \"iterations\": " + json_value(r.iterations) +
-           ", \"failures\": " + std::to_string(r.failures) + ", \"pareto\": " + (r.pareto ? "true" : "false") +
-           ", \"note\": " + json_string(r.note) + "}" + (k + 1 < report.rows.size() ? ",\n" : "\n");
+  nlohmann::ordered_json j;
+  j["scenario"] = report.scenario;
+  j["reference"] = report.reference;
+  j["notes"] = report.notes;
+  nlohmann::ordered_json& rows = j["rows"] = nlohmann::ordered_json::array();
+  for (const CompareRow& r : report.rows) {
+    rows.push_back({{"setting", r.setting},
+                    {"integrator", r.integrator},
+                    {"linear_solver", r.linear_solver},
+                    {"tolerance", json_value(r.tolerance)},
+                    {"iteration_cap", json_value(r.iteration_cap)},
+                    {"internal_step_s", r.internal_step_s},
+                    {"cpu_s_per_sim_s", json_value(r.cpu_s_per_sim_s)},
+                    {"rms_error_m", json_value(r.rms_error_m)},
+                    {"max_error_m", json_value(r.max_error_m)},
+                    {"force_error_n", json_value(r.force_error_n)},
+                    {"energy_drift_j", json_value(r.energy_drift_j)},
+                    {"iterations", json_value(r.iterations)},
+                    {"failures", r.failures},
+                    {"pareto", r.pareto},
+                    {"note", r.note}});
   }
-  out += "  ],\n  \"recommendations\": [\n";
-  for (std::size_t k = 0; k < report.recommendations.size(); ++k) {
-    const Recommendation& r = report.recommendations[k];
-    out += "    {\"use\": " + json_string(r.use.name) +
-           ", \"setting\": " + (r.row ? json_string(report.rows[*r.row].setting) : std::string("null")) +
-           ", \"internal_step_s\": " +
-           (r.row ? json_value(std::optional<double>(report.rows[*r.row].internal_step_s)) : std::string("null")) +
-           ", \"text\": " + json_string(r.text) + "}" + (k + 1 < report.recommendations.size() ? ",\n" : "\n");
+  nlohmann::ordered_json& recommendations = j["recommendations"] = nlohmann::ordered_json::array();
+  for (const Recommendation& r : report.recommendations) {
+    recommendations.push_back(
+        {{"use", r.use.name},
+         {"setting", r.row ? nlohmann::ordered_json(report.rows[*r.row].setting) : nlohmann::ordered_json(nullptr)},
+         {"internal_step_s",
+          r.row ? nlohmann::ordered_json(report.rows[*r.row].internal_step_s) : nlohmann::ordered_json(nullptr)},
+         {"text", r.text}});
   }
-  out += "  ]\n}\n";
-  return out;
+  return j.dump(2, ' ', false, nlohmann::ordered_json::error_handler_t::replace) + "\n";
 }
 
 }  // namespace
@@ -106,7 +106,8 @@ LogLogPlot compare_plot(const CompareReport& report, std::vector<std::string>& o
   plot.y_title = "RMS surface error (m)";
   std::string zero, missing;
   for (const CompareRow& row : report.rows) {
-    const bool has = row.rms_error_m && row.cpu_s_per_sim_s && row.failures == 0;
+    const bool has = row.rms_error_m && row.cpu_s_per_sim_s && row.failures == 0 &&
+                     std::isfinite(*row.rms_error_m) && std::isfinite(*row.cpu_s_per_sim_s);
     if (has && *row.rms_error_m > 0.0 && *row.cpu_s_per_sim_s > 0.0) {
       const auto family = std::find(plot.series.begin(), plot.series.end(), row.family());
       const std::size_t series = static_cast<std::size_t>(family - plot.series.begin());
@@ -121,11 +122,11 @@ LogLogPlot compare_plot(const CompareReport& report, std::vector<std::string>& o
   }
   omitted.clear();
   if (!zero.empty()) omitted.push_back("not shown, zero error (no place on a log axis): " + zero);
-  if (!missing.empty()) omitted.push_back("not shown, no error or cost (not run, failed or not compared): " + missing);
+  if (!missing.empty()) omitted.push_back("not shown, no error or cost (not run, failed, not finite or not compared): " + missing);
   plot.notes.push_back("reference: " + report.reference);
   for (const std::string& note : report.notes) plot.notes.push_back(note);
   for (const std::string& line : omitted) plot.notes.push_back(line);
-  const std::size_t width = static_cast<std::size_t>((plot.width - 24) / 6);
+  const std::size_t width = note_characters(plot.width);
   std::vector<std::string> wrapped;
   for (const std::string& note : plot.notes) {
     for (std::string& line : wrap(note, width)) wrapped.push_back(std::move(line));

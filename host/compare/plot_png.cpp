@@ -1,11 +1,13 @@
-// render_log_log_plot (see plot_png.hpp): a small raster canvas (pixels, discs, rings, thick
-// lines, text in the 5 x 7 font, also turned upwards) and the plot's layout on it.
+// render_log_log_plot (see plot_png.hpp), drawn with cairo: anti-aliased discs, rings and lines,
+// and text in DejaVu Sans (measured, so that the layout fits the labels it has).
 #include "compare/plot_png.hpp"
 
-#include "compare/bitmap_font.hpp"
+#include <cairo.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <memory>
 #include <stdexcept>
 
 namespace tissue::host {
@@ -16,86 +18,109 @@ constexpr Rgb WHITE{255, 255, 255};
 constexpr Rgb GRID{222, 222, 226};
 constexpr Rgb TEXT{30, 30, 35};
 
-class Canvas {
+// Font sizes in pixels.
+constexpr double TITLE_SIZE = 18.0;
+constexpr double LABEL_SIZE = 14.0;  // tick labels, axis titles, legend
+constexpr double NOTE_SIZE = 12.0;
+constexpr double NOTE_LINE = 16.0;
+constexpr double POINT_RADIUS = 5.5;
+constexpr double RING_RADIUS = 8.75, RING_WIDTH = 2.5;  // the front's rings
+
+// A cairo image surface and its context, freed together.
+class Drawing {
  public:
-  Canvas(int width, int height) {
-    m_image.width = width;
-    m_image.height = height;
-    m_image.rgb.assign(static_cast<std::size_t>(3 * width * height), 255);
-  }
-
-  void put(int x, int y, const Rgb& c) {
-    if (x < 0 || y < 0 || x >= m_image.width || y >= m_image.height) return;
-    const auto at = static_cast<std::size_t>(3 * (y * m_image.width + x));
-    std::copy(c.begin(), c.end(), m_image.rgb.begin() + static_cast<std::ptrdiff_t>(at));
-  }
-  void fill_rect(int x0, int y0, int x1, int y1, const Rgb& c) {
-    for (int y = y0; y <= y1; ++y) {
-      for (int x = x0; x <= x1; ++x) put(x, y, c);
+  Drawing(int width, int height)
+      : m_surface(cairo_image_surface_create(CAIRO_FORMAT_RGB24, width, height), cairo_surface_destroy),
+        m_cr(cairo_create(m_surface.get()), cairo_destroy) {
+    if (cairo_surface_status(m_surface.get()) != CAIRO_STATUS_SUCCESS || cairo_status(m_cr.get()) != CAIRO_STATUS_SUCCESS) {
+      throw std::runtime_error("render_log_log_plot: cairo could not make a " + std::to_string(width) + " x " +
+                               std::to_string(height) + " image");
     }
+    cairo_select_font_face(m_cr.get(), "DejaVu Sans", CAIRO_FONT_SLANT_NORMAL, CAIRO_FONT_WEIGHT_NORMAL);
   }
-  void hline(int x0, int x1, int y, const Rgb& c) { fill_rect(std::min(x0, x1), y, std::max(x0, x1), y, c); }
-  void vline(int x, int y0, int y1, const Rgb& c) { fill_rect(x, std::min(y0, y1), x, std::max(y0, y1), c); }
+  [[nodiscard]] cairo_t* cr() const { return m_cr.get(); }
 
-  /// Pixels whose centres are within r of (cx, cy); with inner > 0 a ring from inner to r.
-  void disc(double cx, double cy, double r, const Rgb& c, double inner = -1.0) {
-    for (int y = static_cast<int>(std::floor(cy - r)); y <= static_cast<int>(std::ceil(cy + r)); ++y) {
-      for (int x = static_cast<int>(std::floor(cx - r)); x <= static_cast<int>(std::ceil(cx + r)); ++x) {
-        const double d = std::hypot(x + 0.5 - cx, y + 0.5 - cy);
-        if (d <= r && d > inner) put(x, y, c);
+  void colour(const Rgb& c) const { cairo_set_source_rgb(cr(), c[0] / 255.0, c[1] / 255.0, c[2] / 255.0); }
+  void fill_rect(double x, double y, double w, double h, const Rgb& c) const {
+    colour(c);
+    cairo_rectangle(cr(), x, y, w, h);
+    cairo_fill(cr());
+  }
+  /// A line one pixel wide on the pixel row or column through integer (x, y) coordinates: sharp.
+  void pixel_line(double x0, double y0, double x1, double y1, const Rgb& c) const {
+    colour(c);
+    cairo_set_line_width(cr(), 1.0);
+    cairo_move_to(cr(), std::floor(x0) + 0.5, std::floor(y0) + 0.5);
+    cairo_line_to(cr(), std::floor(x1) + 0.5, std::floor(y1) + 0.5);
+    cairo_stroke(cr());
+  }
+  void line(double x0, double y0, double x1, double y1, double width, const Rgb& c) const {
+    colour(c);
+    cairo_set_line_width(cr(), width);
+    cairo_set_line_cap(cr(), CAIRO_LINE_CAP_ROUND);
+    cairo_move_to(cr(), x0, y0);
+    cairo_line_to(cr(), x1, y1);
+    cairo_stroke(cr());
+  }
+  void disc(double x, double y, double r, const Rgb& c) const {
+    colour(c);
+    cairo_arc(cr(), x, y, r, 0.0, 2.0 * M_PI);
+    cairo_fill(cr());
+  }
+  void ring(double x, double y, double r, double width, const Rgb& c) const {
+    colour(c);
+    cairo_set_line_width(cr(), width);
+    cairo_arc(cr(), x, y, r, 0.0, 2.0 * M_PI);
+    cairo_stroke(cr());
+  }
+
+  [[nodiscard]] double text_width(const std::string& text, double size) const {
+    cairo_set_font_size(cr(), size);
+    cairo_text_extents_t extents;
+    cairo_text_extents(cr(), text.c_str(), &extents);
+    return extents.x_advance;
+  }
+  /// Text with its baseline at y, starting at x (align 0), centred on x (0.5) or ending at x (1).
+  void text(double x, double y, const std::string& text, double size, const Rgb& c, double align = 0.0) const {
+    colour(c);
+    cairo_set_font_size(cr(), size);
+    cairo_move_to(cr(), x - align * text_width(text, size), y);
+    cairo_show_text(cr(), text.c_str());
+  }
+  /// Text read upwards (a quarter turn anticlockwise), centred on (x, y), its baseline at x.
+  void text_up(double x, double y, const std::string& text, double size, const Rgb& c) const {
+    cairo_save(cr());
+    cairo_translate(cr(), x, y);
+    cairo_rotate(cr(), -M_PI / 2.0);
+    this->text(0.0, 0.0, text, size, c, 0.5);
+    cairo_restore(cr());
+  }
+
+  /// The pixels as 8-bit RGB rows.
+  [[nodiscard]] RgbImage take() const {
+    cairo_surface_flush(m_surface.get());
+    RgbImage image;
+    image.width = cairo_image_surface_get_width(m_surface.get());
+    image.height = cairo_image_surface_get_height(m_surface.get());
+    image.rgb.resize(static_cast<std::size_t>(3 * image.width * image.height));
+    const unsigned char* data = cairo_image_surface_get_data(m_surface.get());
+    const int stride = cairo_image_surface_get_stride(m_surface.get());
+    for (int y = 0; y < image.height; ++y) {
+      const auto* row = reinterpret_cast<const std::uint32_t*>(data + static_cast<std::ptrdiff_t>(y) * stride);
+      for (int x = 0; x < image.width; ++x) {
+        const std::uint32_t pixel = row[x];  // 0x00RRGGBB in the machine's byte order (CAIRO_FORMAT_RGB24)
+        const auto at = static_cast<std::size_t>(3 * (y * image.width + x));
+        image.rgb[at] = static_cast<std::uint8_t>(pixel >> 16);
+        image.rgb[at + 1] = static_cast<std::uint8_t>(pixel >> 8);
+        image.rgb[at + 2] = static_cast<std::uint8_t>(pixel);
       }
     }
+    return image;
   }
-  /// A line of the given width: discs stamped every half pixel.
-  void line(double x0, double y0, double x1, double y1, double width, const Rgb& c) {
-    const double length = std::hypot(x1 - x0, y1 - y0);
-    const int steps = std::max(1, static_cast<int>(std::ceil(length * 2.0)));
-    for (int k = 0; k <= steps; ++k) {
-      const double t = static_cast<double>(k) / steps;
-      disc(x0 + t * (x1 - x0), y0 + t * (y1 - y0), width / 2.0, c);
-    }
-  }
-
-  static int text_width(const std::string& text, int scale) {
-    return text.empty() ? 0 : static_cast<int>(text.size()) * (GLYPH_WIDTH + 1) * scale - scale;
-  }
-  static int text_height(int scale) { return GLYPH_HEIGHT * scale; }
-  /// Height of capitals and digits (the rows above the baseline).
-  static int cap_height(int scale) { return 7 * scale; }
-  /// Text with its top-left corner at (x, y).
-  void text(int x, int y, const std::string& text, int scale, const Rgb& c) {
-    for (std::size_t i = 0; i < text.size(); ++i) {
-      const auto& rows = glyph(text[i]);
-      const int left = x + static_cast<int>(i) * (GLYPH_WIDTH + 1) * scale;
-      for (int row = 0; row < GLYPH_HEIGHT; ++row) {
-        for (int column = 0; column < GLYPH_WIDTH; ++column) {
-          if ((rows[static_cast<std::size_t>(row)] >> (GLYPH_WIDTH - 1 - column) & 1U) == 0) continue;
-          fill_rect(left + column * scale, y + row * scale, left + (column + 1) * scale - 1, y + (row + 1) * scale - 1,
-                    c);
-        }
-      }
-    }
-  }
-  /// Text turned a quarter turn anticlockwise (read upwards), its bottom-left corner at (x, y).
-  void text_up(int x, int y, const std::string& text, int scale, const Rgb& c) {
-    for (std::size_t i = 0; i < text.size(); ++i) {
-      const auto& rows = glyph(text[i]);
-      const int bottom = y - static_cast<int>(i) * (GLYPH_WIDTH + 1) * scale;
-      for (int row = 0; row < GLYPH_HEIGHT; ++row) {
-        for (int column = 0; column < GLYPH_WIDTH; ++column) {
-          if ((rows[static_cast<std::size_t>(row)] >> (GLYPH_WIDTH - 1 - column) & 1U) == 0) continue;
-          // Glyph column -> up the image, glyph row -> right.
-          fill_rect(x + row * scale, bottom - (column + 1) * scale + 1, x + (row + 1) * scale - 1,
-                    bottom - column * scale, c);
-        }
-      }
-    }
-  }
-
-  RgbImage take() { return std::move(m_image); }
 
  private:
-  RgbImage m_image;
+  std::unique_ptr<cairo_surface_t, void (*)(cairo_surface_t*)> m_surface;
+  std::unique_ptr<cairo_t, void (*)(cairo_t*)> m_cr;
 };
 
 /// A decade's label: plain for 0.01 .. 1000, else "1e-5".
@@ -130,6 +155,11 @@ Decades decades(double lo, double hi) {
 
 }  // namespace
 
+std::size_t note_characters(int width) {
+  // DejaVu Sans at NOTE_SIZE: digits and lower case advance 6.5-7.7 px.
+  return static_cast<std::size_t>(std::max(10.0, (width - 24.0) / (0.64 * NOTE_SIZE)));
+}
+
 Rgb series_colour(std::size_t k) {
   // Tableau 10: distinct, and readable on white.
   static constexpr std::array<Rgb, 10> PALETTE{{{31, 119, 180},
@@ -147,11 +177,9 @@ Rgb series_colour(std::size_t k) {
 
 namespace {
 
-constexpr int BIG = 2;  // scale of the title, tick labels, axis titles and legend (notes: 1)
-
-// The plot area on the canvas, in pixels, and the log-log mapping into it.
+// The plot area on the image, in pixels, and the log-log mapping into it.
 struct PlotFrame {
-  int left = 110, top = 50, right = 0, bottom = 0;
+  double left = 0.0, top = 50.0, right = 0.0, bottom = 0.0;
   Decades xd, yd;
 
   [[nodiscard]] double px(double x) const {
@@ -160,8 +188,8 @@ struct PlotFrame {
   [[nodiscard]] double py(double y) const {
     return bottom - (std::log10(y) - yd.from) / (yd.to - yd.from) * (bottom - top);
   }
-  [[nodiscard]] int decade_x(int e) const { return static_cast<int>(std::lround(px(std::pow(10.0, e)))); }
-  [[nodiscard]] int decade_y(int e) const { return static_cast<int>(std::lround(py(std::pow(10.0, e)))); }
+  [[nodiscard]] double decade_x(int e) const { return std::round(px(std::pow(10.0, e))); }
+  [[nodiscard]] double decade_y(int e) const { return std::round(py(std::pow(10.0, e))); }
 };
 
 // The decades the two axes span; refuses points that are not positive and finite, and bad indices.
@@ -186,16 +214,19 @@ std::array<Decades, 2> axis_decades(const LogLogPlot& plot) {
   return {decades(x_lo, x_hi), decades(y_lo, y_hi)};
 }
 
-// Layout: title on top, legend on the right, tick labels and titles left and below, notes last.
-PlotFrame plot_frame(const LogLogPlot& plot, int note_line) {
+// Layout: title on top, legend on the right, tick labels and titles left and below, notes last;
+// the margins from the measured widths of the labels.
+PlotFrame plot_frame(const Drawing& d, const LogLogPlot& plot) {
   const std::array<Decades, 2> axes = axis_decades(plot);
-  int legend_width = Canvas::text_width(plot.front_name, BIG);
-  for (const std::string& name : plot.series) legend_width = std::max(legend_width, Canvas::text_width(name, BIG));
-  legend_width = std::min(legend_width + 36, plot.width / 3);
-  const int notes_height = static_cast<int>(plot.notes.size()) * note_line;
+  double legend_width = d.text_width(plot.front_name, LABEL_SIZE);
+  for (const std::string& name : plot.series) legend_width = std::max(legend_width, d.text_width(name, LABEL_SIZE));
+  legend_width = std::min(legend_width + 40.0, plot.width / 3.0);
+  double y_labels = 0.0;
+  for (int e = axes[1].first; e <= axes[1].last; ++e) y_labels = std::max(y_labels, d.text_width(decade_label(e), LABEL_SIZE));
   PlotFrame frame;
-  frame.right = plot.width - legend_width - 30;
-  frame.bottom = plot.height - 78 - notes_height;
+  frame.left = std::round(12.0 + LABEL_SIZE + 12.0 + y_labels + 10.0);  // y title, gap, tick labels, gap
+  frame.right = std::round(plot.width - legend_width - 24.0);
+  frame.bottom = std::round(plot.height - 66.0 - static_cast<double>(plot.notes.size()) * NOTE_LINE);
   if (frame.right - frame.left < 100 || frame.bottom - frame.top < 100) {
     throw std::invalid_argument("render_log_log_plot: too small");
   }
@@ -205,43 +236,41 @@ PlotFrame plot_frame(const LogLogPlot& plot, int note_line) {
 }
 
 // Grid, ticks and their labels (thinned to about ten per axis), the frame and the axis titles.
-void draw_axes(Canvas& canvas, const PlotFrame& f, const LogLogPlot& plot) {
+void draw_axes(const Drawing& d, const PlotFrame& f, const LogLogPlot& plot) {
   const int x_every = std::max(1, (f.xd.last - f.xd.first + 9) / 10);
   const int y_every = std::max(1, (f.yd.last - f.yd.first + 9) / 10);
   for (int e = f.xd.first; e <= f.xd.last; ++e) {
-    const int x = f.decade_x(e);
-    canvas.vline(x, f.top, f.bottom, GRID);
-    canvas.vline(x, f.bottom - 6, f.bottom, BLACK);
-    if ((e - f.xd.first) % x_every == 0) {
-      const std::string label = decade_label(e);
-      canvas.text(x - Canvas::text_width(label, BIG) / 2, f.bottom + 8, label, BIG, TEXT);
-    }
+    const double x = f.decade_x(e);
+    d.pixel_line(x, f.top, x, f.bottom, GRID);
+    d.pixel_line(x, f.bottom - 6, x, f.bottom, BLACK);
+    if ((e - f.xd.first) % x_every == 0) d.text(x, f.bottom + 8 + LABEL_SIZE, decade_label(e), LABEL_SIZE, TEXT, 0.5);
     for (int m = 2; m <= 9 && e < f.xd.last && f.xd.last - f.xd.first <= 8; ++m) {
-      canvas.vline(static_cast<int>(std::lround(f.px(m * std::pow(10.0, e)))), f.bottom - 3, f.bottom, BLACK);
+      const double minor = std::round(f.px(m * std::pow(10.0, e)));
+      d.pixel_line(minor, f.bottom - 3, minor, f.bottom, BLACK);
     }
   }
   for (int e = f.yd.first; e <= f.yd.last; ++e) {
-    const int y = f.decade_y(e);
-    canvas.hline(f.left, f.right, y, GRID);
-    canvas.hline(f.left, f.left + 6, y, BLACK);
+    const double y = f.decade_y(e);
+    d.pixel_line(f.left, y, f.right, y, GRID);
+    d.pixel_line(f.left, y, f.left + 6, y, BLACK);
     if ((e - f.yd.first) % y_every == 0) {
-      const std::string label = decade_label(e);
-      canvas.text(f.left - 8 - Canvas::text_width(label, BIG), y - Canvas::cap_height(BIG) / 2, label, BIG, TEXT);
+      d.text(f.left - 8, y + 0.36 * LABEL_SIZE, decade_label(e), LABEL_SIZE, TEXT, 1.0);
     }
     for (int m = 2; m <= 9 && e < f.yd.last && f.yd.last - f.yd.first <= 8; ++m) {
-      canvas.hline(f.left, f.left + 3, static_cast<int>(std::lround(f.py(m * std::pow(10.0, e)))), BLACK);
+      const double minor = std::round(f.py(m * std::pow(10.0, e)));
+      d.pixel_line(f.left, minor, f.left + 3, minor, BLACK);
     }
   }
-  canvas.hline(f.left, f.right, f.top, BLACK);
-  canvas.hline(f.left, f.right, f.bottom, BLACK);
-  canvas.vline(f.left, f.top, f.bottom, BLACK);
-  canvas.vline(f.right, f.top, f.bottom, BLACK);
-  canvas.text((f.left + f.right - Canvas::text_width(plot.x_title, BIG)) / 2, f.bottom + 36, plot.x_title, BIG, TEXT);
-  canvas.text_up(16, (f.top + f.bottom + Canvas::text_width(plot.y_title, BIG)) / 2, plot.y_title, BIG, TEXT);
+  d.pixel_line(f.left, f.top, f.right, f.top, BLACK);
+  d.pixel_line(f.left, f.bottom, f.right, f.bottom, BLACK);
+  d.pixel_line(f.left, f.top, f.left, f.bottom, BLACK);
+  d.pixel_line(f.right, f.top, f.right, f.bottom, BLACK);
+  d.text((f.left + f.right) / 2.0, f.bottom + 44, plot.x_title, LABEL_SIZE, TEXT, 0.5);
+  d.text_up(12.0 + LABEL_SIZE, (f.top + f.bottom) / 2.0, plot.y_title, LABEL_SIZE, TEXT);
 }
 
 // The front behind the points, then the points, then the rings.
-void draw_points(Canvas& canvas, const PlotFrame& f, const LogLogPlot& plot) {
+void draw_points(const Drawing& d, const PlotFrame& f, const LogLogPlot& plot) {
   std::vector<std::size_t> front = plot.front;
   std::sort(front.begin(), front.end(), [&](std::size_t a, std::size_t b) {
     return plot.points[a].x < plot.points[b].x ||
@@ -250,26 +279,26 @@ void draw_points(Canvas& canvas, const PlotFrame& f, const LogLogPlot& plot) {
   for (std::size_t k = 1; k < front.size(); ++k) {
     const PlotPoint& a = plot.points[front[k - 1]];
     const PlotPoint& b = plot.points[front[k]];
-    canvas.line(f.px(a.x), f.py(a.y), f.px(b.x), f.py(b.y), 2.0, BLACK);
+    d.line(f.px(a.x), f.py(a.y), f.px(b.x), f.py(b.y), 2.0, BLACK);
   }
-  for (const PlotPoint& p : plot.points) canvas.disc(f.px(p.x), f.py(p.y), 5.5, series_colour(p.series));
-  for (const std::size_t k : front) canvas.disc(f.px(plot.points[k].x), f.py(plot.points[k].y), 10.0, BLACK, 7.5);
+  for (const PlotPoint& p : plot.points) d.disc(f.px(p.x), f.py(p.y), POINT_RADIUS, series_colour(p.series));
+  for (const std::size_t k : front) d.ring(f.px(plot.points[k].x), f.py(plot.points[k].y), RING_RADIUS, RING_WIDTH, BLACK);
 }
 
 // One line per series, then the front's, right of the plot area.
-void draw_legend(Canvas& canvas, const PlotFrame& f, const LogLogPlot& plot) {
-  const int line_height = Canvas::text_height(BIG) + 8;
-  const int legend_x = f.right + 20;
-  int legend_y = f.top + 4;
-  for (std::size_t k = 0; k < plot.series.size(); ++k, legend_y += line_height) {
-    canvas.disc(legend_x + 10, legend_y + Canvas::cap_height(BIG) / 2, 5.5, series_colour(k));
-    canvas.text(legend_x + 26, legend_y, plot.series[k], BIG, TEXT);
+void draw_legend(const Drawing& d, const PlotFrame& f, const LogLogPlot& plot) {
+  const double line_height = LABEL_SIZE + 10.0;
+  const double x = f.right + 18.0;
+  double baseline = f.top + LABEL_SIZE;
+  for (std::size_t k = 0; k < plot.series.size(); ++k, baseline += line_height) {
+    d.disc(x + 10.0, baseline - 0.36 * LABEL_SIZE, POINT_RADIUS, series_colour(k));
+    d.text(x + 26.0, baseline, plot.series[k], LABEL_SIZE, TEXT);
   }
   if (!plot.front.empty()) {
-    const int middle = legend_y + Canvas::cap_height(BIG) / 2;
-    canvas.line(legend_x, middle, legend_x + 20, middle, 2.0, BLACK);
-    canvas.disc(legend_x + 10, middle, 10.0, BLACK, 7.5);
-    canvas.text(legend_x + 26, legend_y, plot.front_name, BIG, TEXT);
+    const double middle = baseline - 0.36 * LABEL_SIZE;
+    d.line(x, middle, x + 20.0, middle, 2.0, BLACK);
+    d.ring(x + 10.0, middle, RING_RADIUS, RING_WIDTH, BLACK);
+    d.text(x + 26.0, baseline, plot.front_name, LABEL_SIZE, TEXT);
   }
 }
 
@@ -279,20 +308,19 @@ RgbImage render_log_log_plot(const LogLogPlot& plot) {
   if (plot.width < 320 || plot.height < 240 || plot.width > 8192 || plot.height > 8192) {
     throw std::invalid_argument("render_log_log_plot: size must be 320 x 240 to 8192 x 8192");
   }
-  const int note_line = Canvas::text_height(1) + 3;
-  const PlotFrame frame = plot_frame(plot, note_line);
-  Canvas canvas(plot.width, plot.height);
-  canvas.fill_rect(0, 0, plot.width - 1, plot.height - 1, WHITE);
-  canvas.text((plot.width - Canvas::text_width(plot.title, BIG)) / 2, 14, plot.title, BIG, TEXT);
-  draw_axes(canvas, frame, plot);
-  draw_points(canvas, frame, plot);
-  draw_legend(canvas, frame, plot);
-  int note_y = frame.bottom + 62;
+  const Drawing drawing(plot.width, plot.height);
+  const PlotFrame frame = plot_frame(drawing, plot);
+  drawing.fill_rect(0, 0, plot.width, plot.height, WHITE);
+  drawing.text(plot.width / 2.0, 14.0 + TITLE_SIZE, plot.title, TITLE_SIZE, TEXT, 0.5);
+  draw_axes(drawing, frame, plot);
+  draw_points(drawing, frame, plot);
+  draw_legend(drawing, frame, plot);
+  double baseline = frame.bottom + 66.0 + NOTE_SIZE - 4.0;
   for (const std::string& note : plot.notes) {
-    canvas.text(12, note_y, note, 1, TEXT);
-    note_y += note_line;
+    drawing.text(12.0, baseline, note, NOTE_SIZE, TEXT);
+    baseline += NOTE_LINE;
   }
-  return canvas.take();
+  return drawing.take();
 }
 
 }  // namespace tissue::host

@@ -1,7 +1,7 @@
-// A log-log scatter plot drawn into an RgbImage (host/output writes it as PNG): points coloured
-// by series with a legend, a highlighted subset ringed and joined by a line (the Pareto front),
-// decade grid lines with labelled ticks ("1e-3"), minor ticks, axis titles and a title, all in the
-// built-in 5 x 7 font. Deterministic: the same plot gives the same pixels.
+// A log-log scatter plot drawn into an RgbImage (host/output writes it as PNG) with cairo: points
+// coloured by series with a legend, a highlighted subset ringed and joined by a line (the Pareto
+// front), decade grid lines with labelled ticks ("1e-3"), minor ticks, axis titles and a title, in
+// DejaVu Sans, anti-aliased. Deterministic: the same plot gives the same pixels on one machine.
 #pragma once
 
 #include "output/png_renderer.hpp"
@@ -27,11 +27,16 @@ struct LogLogPlot {
   std::vector<std::string> notes;  ///< lines under the plot
 };
 
+/// How many characters of a note fit on one line of a plot `width` pixels wide (the notes' font
+/// with room to spare; the caller wraps longer notes).
+[[nodiscard]] std::size_t note_characters(int width);
+
 /// The palette colour of series k (cycles after ten).
 [[nodiscard]] Rgb series_colour(std::size_t k);
 
 /// Draws the plot; throws std::invalid_argument for a point that is not positive and finite, a
-/// series index out of range, a front index out of range, or a size below 320 x 240.
+/// series index out of range, a front index out of range, or a size outside 320 x 240 to 8192 x 8192,
+/// std::runtime_error when cairo cannot make the image.
 [[nodiscard]] RgbImage render_log_log_plot(const LogLogPlot& plot);
 
 }  // namespace tissue::host

@@ -2,6 +2,7 @@
 # PNG render of the surface (libpng), the tick log and the device recording, and the summary.
 # Included from host/CMakeLists.txt; of the project it knows only the devices' pose type.
 find_package(PNG REQUIRED)
+find_package(nlohmann_json REQUIRED)
 
 add_library(tissue_host_output STATIC
   ${CMAKE_CURRENT_LIST_DIR}/vtu_writer.cpp
@@ -13,4 +14,4 @@ add_library(tissue::host_output ALIAS tissue_host_output)
 # Headers are included as "output/<file>.hpp".
 target_include_directories(tissue_host_output PUBLIC ${PROJECT_SOURCE_DIR}/host)
 target_compile_features(tissue_host_output PUBLIC cxx_std_20)
-target_link_libraries(tissue_host_output PUBLIC tissue::host_device PRIVATE PNG::PNG tissue::warnings)
+target_link_libraries(tissue_host_output PUBLIC tissue::host_device PRIVATE PNG::PNG nlohmann_json::nlohmann_json tissue::warnings)

@@ -1,18 +1,17 @@
 // SessionSummary as JSON and as text (see session_summary.hpp).
 #include "output/session_summary.hpp"
 
-#include "output/json_text.hpp"
+#include <nlohmann/json.hpp>
 
 #include <algorithm>
 #include <cmath>
 #include <ostream>
-#include <sstream>
 
 namespace tissue::host {
 namespace {
 
-void json_percentiles(std::ostringstream& out, const char* name, const Percentiles& p) {
-  out << "  \"" << name << "\": {\"p50\": " << p.p50 << ", \"p99\": " << p.p99 << ", \"max\": " << p.max << "},\n";
+nlohmann::ordered_json percentiles_json(const Percentiles& p) {
+  return {{"p50", p.p50}, {"p99", p.p99}, {"max", p.max}};
 }
 
 }  // namespace
@@ -31,73 +30,71 @@ Percentiles percentiles(std::vector<double> values, double scale) {
   return p;
 }
 
+// nlohmann::json writes non-finite numbers (a hand that never settled) as null.
 std::string SessionSummary::to_json() const {
-  std::ostringstream out;
-  out.precision(9);
-  out << "{\n";
-  out << "  \"scenario\": " << json_string(scenario) << ",\n";
-  out << "  \"mode\": \"" << (offline ? "offline" : "realtime") << "\",\n";
-  out << "  \"sim_time_s\": " << sim_time_s << ",\n";
-  out << "  \"wall_time_s\": " << wall_time_s << ",\n";
-  out << "  \"realtime_factor\": " << realtime_factor << ",\n";
-  out << "  \"haptic_rate_hz\": " << haptic_rate_hz << ",\n";
-  out << "  \"haptic_ticks\": " << haptic_ticks << ",\n";
-  json_percentiles(out, "haptic_period_us", haptic_period_us);
-  out << "  \"haptic_period_max_at_s\": " << haptic_period_max_at_s << ",\n";
-  out << "  \"haptic_first_tick_late_us\": " << haptic_first_tick_late_us << ",\n";
-  out << "  \"deadline_misses\": " << deadline_misses << ",\n";
-  out << "  \"tissue_communication_step_s\": " << tissue_step_s << ",\n";
-  out << "  \"tissue_steps\": " << tissue_steps << ",\n";
-  json_percentiles(out, "tissue_step_ms", tissue_step_ms);
-  json_percentiles(out, "tissue_step_before_cut_ms", tissue_step_before_cut_ms);
-  json_percentiles(out, "tissue_step_during_cut_ms", tissue_step_during_cut_ms);
-  out << "  \"tissue_overruns\": " << tissue_overruns << ",\n";
-  out << "  \"overrun_policy\": \"" << overrun_policy << "\",\n";
-  out << "  \"catch_up_slots\": " << catch_up_slots << ",\n";
-  out << "  \"skipped_slots\": " << skipped_slots << ",\n";
-  out << "  \"tissue_discards\": " << tissue_discards << ",\n";
-  out << "  \"tissue_errors\": " << tissue_errors << ",\n";
-  out << "  \"haptic_errors\": " << haptic_errors << ",\n";
-  out << "  \"samples_not_finite\": " << samples_not_finite << ",\n";
-  out << "  \"cut_tets\": " << cut_tets << ",\n";
-  out << "  \"enriched_vertices\": " << enriched_vertices << ",\n";
-  out << "  \"contact_seen\": " << (contact_seen ? "true" : "false") << ",\n";
-  out << "  \"max_device_force_N\": " << max_device_force_n << ",\n";
-  out << "  \"device_max_force_N\": " << device_max_force_n << ",\n";
-  out << "  \"device_max_force_rate_N_per_s\": " << device_max_force_rate_n_per_s << ",\n";
-  out << "  \"passivity_dissipated_J\": " << passivity_dissipated_j << ",\n";
-  out << "  \"passivity_observed_J\": " << passivity_observed_j << ",\n";
-  out << "  \"nan_detected\": " << (nan_detected ? "true" : "false") << ",\n";
-  out << "  \"device\": {\"name\": " << json_string(device_name) << ", \"received\": " << device.received
-      << ", \"accepted\": " << device.accepted << ", \"malformed\": " << device.malformed
-      << ", \"out_of_order\": " << device.out_of_order << ", \"duplicate\": " << device.duplicate
-      << ", \"stale\": " << device.stale << ", \"watchdog_trips\": " << device.watchdog_trips << "},\n";
+  nlohmann::ordered_json j;
+  j["scenario"] = scenario;
+  j["mode"] = offline ? "offline" : "realtime";
+  j["sim_time_s"] = sim_time_s;
+  j["wall_time_s"] = wall_time_s;
+  j["realtime_factor"] = realtime_factor;
+  j["haptic_rate_hz"] = haptic_rate_hz;
+  j["haptic_ticks"] = haptic_ticks;
+  j["haptic_period_us"] = percentiles_json(haptic_period_us);
+  j["haptic_period_max_at_s"] = haptic_period_max_at_s;
+  j["haptic_first_tick_late_us"] = haptic_first_tick_late_us;
+  j["deadline_misses"] = deadline_misses;
+  j["tissue_communication_step_s"] = tissue_step_s;
+  j["tissue_steps"] = tissue_steps;
+  j["tissue_step_ms"] = percentiles_json(tissue_step_ms);
+  j["tissue_step_before_cut_ms"] = percentiles_json(tissue_step_before_cut_ms);
+  j["tissue_step_during_cut_ms"] = percentiles_json(tissue_step_during_cut_ms);
+  j["tissue_overruns"] = tissue_overruns;
+  j["overrun_policy"] = overrun_policy;
+  j["catch_up_slots"] = catch_up_slots;
+  j["skipped_slots"] = skipped_slots;
+  j["tissue_discards"] = tissue_discards;
+  j["tissue_errors"] = tissue_errors;
+  j["haptic_errors"] = haptic_errors;
+  j["samples_not_finite"] = samples_not_finite;
+  j["cut_tets"] = cut_tets;
+  j["enriched_vertices"] = enriched_vertices;
+  j["contact_seen"] = contact_seen;
+  j["max_device_force_N"] = max_device_force_n;
+  j["device_max_force_N"] = device_max_force_n;
+  j["device_max_force_rate_N_per_s"] = device_max_force_rate_n_per_s;
+  j["passivity_dissipated_J"] = passivity_dissipated_j;
+  j["passivity_observed_J"] = passivity_observed_j;
+  j["nan_detected"] = nan_detected;
+  j["device"] = {{"name", device_name},         {"received", device.received},
+                 {"accepted", device.accepted}, {"malformed", device.malformed},
+                 {"out_of_order", device.out_of_order}, {"duplicate", device.duplicate},
+                 {"stale", device.stale},       {"watchdog_trips", device.watchdog_trips}};
   if (hand) {
-    const auto number = [](double x) { return json_number(x); };
-    out << "  \"hand\": {\"settle_time_s\": " << number(hand->settle_time_s)
-        << ", \"settle_speed_m_per_s\": " << number(hand->settle_speed_m_per_s)
-        << ", \"residual_speed_m_per_s\": " << number(hand->residual_speed_m_per_s)
-        << ", \"device_work_J\": " << number(hand->device_work_j)
-        << ", \"chatter_frequency_Hz\": " << number(hand->chatter_frequency_hz)
-        << ", \"chatter_amplitude_m\": " << number(hand->chatter_amplitude_m) << ", \"mean_force_N\": ["
-        << number(hand->mean_force_n[0]) << ", " << number(hand->mean_force_n[1]) << ", "
-        << number(hand->mean_force_n[2]) << "], \"mean_position_m\": [" << number(hand->mean_position_m[0]) << ", "
-        << number(hand->mean_position_m[1]) << ", " << number(hand->mean_position_m[2])
-        << "], \"window_s\": " << number(hand->window_s) << "},\n";
+    j["hand"] = {{"settle_time_s", hand->settle_time_s},
+                 {"settle_speed_m_per_s", hand->settle_speed_m_per_s},
+                 {"residual_speed_m_per_s", hand->residual_speed_m_per_s},
+                 {"device_work_J", hand->device_work_j},
+                 {"chatter_frequency_Hz", hand->chatter_frequency_hz},
+                 {"chatter_amplitude_m", hand->chatter_amplitude_m},
+                 {"mean_force_N", hand->mean_force_n},
+                 {"mean_position_m", hand->mean_position_m},
+                 {"window_s", hand->window_s}};
   }
-  out << "  \"frames_written\": " << frames_written << ",\n";
-  out << "  \"frames_dropped\": " << frames_dropped << ",\n";
+  j["frames_written"] = frames_written;
+  j["frames_dropped"] = frames_dropped;
   if (view) {
-    out << "  \"view\": {\"connections\": " << view_connections << ", \"frames_sent\": " << view_frames_sent
-        << ", \"frames_skipped\": " << view_frames_skipped << ", \"messages\": " << view_messages
-        << ", \"malformed\": " << view_malformed << ", \"oversized\": " << view_oversized << ", \"flood\": " << view_flood
-        << ", \"out_of_order\": " << view_out_of_order << ", \"withdrawals\": " << view_withdrawals << "},\n";
+    j["view"] = {{"connections", view_connections}, {"frames_sent", view_frames_sent},
+                 {"frames_skipped", view_frames_skipped}, {"messages", view_messages},
+                 {"malformed", view_malformed}, {"oversized", view_oversized},
+                 {"flood", view_flood}, {"out_of_order", view_out_of_order},
+                 {"withdrawals", view_withdrawals}};
   }
-  out << "  \"realtime_priority\": " << (realtime_priority ? "true" : "false") << ",\n";
-  out << "  \"realtime_priority_note\": " << json_string(realtime_priority_note) << ",\n";
-  out << "  \"first_error\": " << json_string(first_error) << "\n";
-  out << "}\n";
-  return out.str();
+  j["realtime_priority"] = realtime_priority;
+  j["realtime_priority_note"] = realtime_priority_note;
+  j["first_error"] = first_error;
+  // Text that is not UTF-8 (a device name, an error message) is replaced, not refused.
+  return j.dump(2, ' ', false, nlohmann::ordered_json::error_handler_t::replace) + "\n";
 }
 
 void print_summary(std::ostream& out, const SessionSummary& s, const std::filesystem::path& output_dir) {

@@ -1,12 +1,12 @@
 // live_view.cpp - see live_view.hpp.
 #include "view/live_view.hpp"
 
-#include "output/json_text.hpp"
 #include "view/view_frame.hpp"
+
+#include <nlohmann/json.hpp>
 
 #include <algorithm>
 #include <memory>
-#include <sstream>
 
 namespace tissue::host {
 namespace {
@@ -28,13 +28,6 @@ double percentile(std::vector<double> values, double q) {
   return values[k];
 }
 
-std::string vector_json(const std::array<double, 3>& v) {
-  std::ostringstream out;
-  out.precision(9);
-  out << '[' << v[0] << ',' << v[1] << ',' << v[2] << ']';
-  return out.str();
-}
-
 }  // namespace
 
 bool is_loopback_address(const std::string& address) { return address.rfind("127.", 0) == 0 || address == "::1"; }
@@ -53,14 +46,14 @@ LiveView::LiveView(LiveViewSettings settings, BrowserDevice* device)
           [this] {
             if (m_device != nullptr) m_device->tick();
           }) {
-  std::ostringstream hello;
-  hello.precision(9);
-  hello << "{\"type\":\"hello\",\"version\":1,\"controls\":" << (m_device != nullptr ? "true" : "false")
-        << ",\"bounds\":{\"lower\":" << vector_json(m_settings.rest_lower)
-        << ",\"upper\":" << vector_json(m_settings.rest_upper) << "},\"device_max_force_n\":"
-        << m_settings.device_max_force_n << ",\"blade_length_m\":" << m_settings.blade_length_m
-        << ",\"scenario\":" << json_string(m_settings.scenario) << "}";
-  m_server.set_hello(hello.str());
+  const nlohmann::json hello = {{"type", "hello"},
+                                 {"version", 1},
+                                 {"controls", m_device != nullptr},
+                                 {"bounds", {{"lower", m_settings.rest_lower}, {"upper", m_settings.rest_upper}}},
+                                 {"device_max_force_n", m_settings.device_max_force_n},
+                                 {"blade_length_m", m_settings.blade_length_m},
+                                 {"scenario", m_settings.scenario}};
+  m_server.set_hello(hello.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace));
   m_recent_periods_s.assign(2000, 0.0);
   m_recent_steps_s.assign(200, 0.0);
 }
@@ -173,22 +166,28 @@ std::string LiveView::stats_json() {
   }
   const double wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - m_started).count();
   const LiveViewCounters c = counters();
-  std::ostringstream out;
-  out.precision(6);
-  out << "{\"type\":\"stats\",\"sim_time_s\":" << m_last_tissue.time_s
-      << ",\"realtime_factor\":" << (wall_s > 0.0 ? m_last_tissue.time_s / wall_s : 0.0)
-      << ",\"haptic_period_us\":{\"p50\":" << 1e6 * percentile(periods, 0.5)
-      << ",\"p99\":" << 1e6 * percentile(periods, 0.99) << ",\"max\":"
-      << 1e6 * (periods.empty() ? 0.0 : *std::max_element(periods.begin(), periods.end()))
-      << "},\"deadline_misses\":" << m_last_haptic.deadline_misses << ",\"tissue_step_ms\":{\"p50\":"
-      << 1e3 * percentile(steps, 0.5) << ",\"p99\":" << 1e3 * percentile(steps, 0.99)
-      << "},\"cut_tets\":" << m_last_tissue.cut_tets << ",\"viewers\":" << c.server.open
-      << ",\"frames_sent\":" << c.server.frames_sent << ",\"frames_skipped\":" << c.server.frames_skipped
-      << ",\"messages\":{\"received\":" << c.server.messages << ",\"accepted\":" << c.device.accepted
-      << ",\"malformed\":" << c.device.malformed + c.server.binary << ",\"oversized\":" << c.server.oversized
-      << ",\"flood\":" << c.server.flood << ",\"out_of_order\":" << c.device.out_of_order
-      << ",\"withdrawals\":" << c.device.watchdog_trips << "}}";
-  return out.str();
+  const double haptic_max_s = periods.empty() ? 0.0 : *std::max_element(periods.begin(), periods.end());
+  const nlohmann::json stats = {
+      {"type", "stats"},
+      {"sim_time_s", m_last_tissue.time_s},
+      {"realtime_factor", wall_s > 0.0 ? m_last_tissue.time_s / wall_s : 0.0},
+      {"haptic_period_us",
+       {{"p50", 1e6 * percentile(periods, 0.5)}, {"p99", 1e6 * percentile(periods, 0.99)}, {"max", 1e6 * haptic_max_s}}},
+      {"deadline_misses", m_last_haptic.deadline_misses},
+      {"tissue_step_ms", {{"p50", 1e3 * percentile(steps, 0.5)}, {"p99", 1e3 * percentile(steps, 0.99)}}},
+      {"cut_tets", m_last_tissue.cut_tets},
+      {"viewers", c.server.open},
+      {"frames_sent", c.server.frames_sent},
+      {"frames_skipped", c.server.frames_skipped},
+      {"messages",
+       {{"received", c.server.messages},
+        {"accepted", c.device.accepted},
+        {"malformed", c.device.malformed + c.server.binary},
+        {"oversized", c.server.oversized},
+        {"flood", c.server.flood},
+        {"out_of_order", c.device.out_of_order},
+        {"withdrawals", c.device.watchdog_trips}}}};
+  return stats.dump();
 }
 
 }  // namespace tissue::host

@@ -8,7 +8,8 @@ find_package(PNG REQUIRED)
 
 add_executable(test_host_compare ${CMAKE_CURRENT_LIST_DIR}/test_compare.cpp)
 target_include_directories(test_host_compare PRIVATE ${CMAKE_CURRENT_LIST_DIR})
-target_link_libraries(test_host_compare PRIVATE tissue::host_compare PkgConfig::TISSUE_LIBZIP
+find_package(nlohmann_json REQUIRED)
+target_link_libraries(test_host_compare PRIVATE tissue::host_compare PkgConfig::TISSUE_LIBZIP nlohmann_json::nlohmann_json
                                                 GTest::gtest GTest::gtest_main tissue::warnings)
 gtest_discover_tests(test_host_compare PROPERTIES LABELS "host" DISCOVERY_TIMEOUT 60)
 

@@ -4,7 +4,9 @@ if(NOT TARGET tissue::host_session)
   return()
 endif()
 add_executable(test_host_session ${CMAKE_CURRENT_LIST_DIR}/test_session.cpp)
-target_link_libraries(test_host_session PRIVATE tissue::host_session GTest::gtest GTest::gtest_main tissue::warnings)
+find_package(nlohmann_json REQUIRED)
+target_link_libraries(test_host_session PRIVATE tissue::host_session nlohmann_json::nlohmann_json GTest::gtest GTest::gtest_main
+                                                tissue::warnings)
 target_include_directories(test_host_session PRIVATE ${PROJECT_SOURCE_DIR}/tests)  # support/under_sanitizer.hpp
 target_compile_definitions(test_host_session PRIVATE TISSUE_SCENARIO_DIR="${PROJECT_SOURCE_DIR}/host/scenarios"
                                                      TISSUE_FMU_DIR="${CMAKE_BINARY_DIR}/fmus")

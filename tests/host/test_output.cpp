@@ -3,6 +3,7 @@
 // cut faces in the cut colour, hidden faces hidden, insides shown, determinism and refusals.
 #include "output/png_renderer.hpp"
 #include "output/pvd_writer.hpp"
+#include "output/session_summary.hpp"
 #include "output/surface_frame.hpp"
 #include "output/vtu_writer.hpp"
 
@@ -10,6 +11,7 @@
 #include <pugixml.hpp>
 
 #include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
 
 #include <array>
 #include <cmath>
@@ -124,6 +126,40 @@ SurfaceFrame cube(double side, std::optional<CubeFace> cut_face = std::nullopt,
 /// The DataArray named @p name anywhere under @p parent.
 pugi::xml_node data_array(const pugi::xml_node& parent, const char* name) {
   return parent.find_child_by_attribute("DataArray", "Name", name);
+}
+
+// summary.json parses back to the summary's own values: text with quotes, backslashes, control
+// characters and bytes that are not UTF-8 (a device's name, an error from a library), numbers at
+// full precision, and null for the figures of a hand that never settled (NaN).
+TEST(SessionSummary, JsonParsesBackToItsValues) {
+  SessionSummary s;
+  s.scenario = "a \"quoted\" \\ name\twith\ncontrols";
+  s.sim_time_s = 1.0 / 3.0;
+  s.tissue_step_ms = {0.123456789012, 1.5e-7, 12345.678901234};
+  s.haptic_ticks = 18446744073709551615ULL;
+  s.device_name = "udp \xff\xfe";
+  s.first_error = "CHOLMOD: \"not positive definite\"";
+  HandFigures hand;
+  hand.settle_time_s = std::numeric_limits<double>::quiet_NaN();
+  hand.device_work_j = -0.0012345678901234;
+  hand.mean_force_n = {0.1, -0.2, std::numeric_limits<double>::infinity()};
+  s.hand = hand;
+  const nlohmann::json j = nlohmann::json::parse(s.to_json());
+  EXPECT_EQ(j["scenario"].get<std::string>(), s.scenario);
+  EXPECT_EQ(j["sim_time_s"].get<double>(), s.sim_time_s);
+  EXPECT_EQ(j["tissue_step_ms"]["p50"].get<double>(), s.tissue_step_ms.p50);
+  EXPECT_EQ(j["tissue_step_ms"]["p99"].get<double>(), s.tissue_step_ms.p99);
+  EXPECT_EQ(j["tissue_step_ms"]["max"].get<double>(), s.tissue_step_ms.max);
+  EXPECT_EQ(j["haptic_ticks"].get<std::uint64_t>(), s.haptic_ticks);
+  EXPECT_EQ(j["first_error"].get<std::string>(), s.first_error);
+  EXPECT_TRUE(j["device"]["name"].is_string());  // the bad bytes replaced, the rest kept
+  EXPECT_EQ(j["device"]["name"].get<std::string>().rfind("udp ", 0), 0u);
+  EXPECT_TRUE(j["hand"]["settle_time_s"].is_null());
+  EXPECT_EQ(j["hand"]["device_work_J"].get<double>(), hand.device_work_j);
+  EXPECT_EQ(j["hand"]["mean_force_N"][1].get<double>(), -0.2);
+  EXPECT_TRUE(j["hand"]["mean_force_N"][2].is_null());
+  EXPECT_FALSE(j.contains("view"));
+  EXPECT_EQ(nlohmann::ordered_json::parse(s.to_json()).begin().key(), "scenario");  // keys in their old order
 }
 
 TEST(VtuWriter, TetrahedronWithCutFaceParsesBack) {
