@@ -1,0 +1,121 @@
+"""The Python module `tissue` as a user scripts it: a probe press gives the force the C++ tests
+assert (springs in series with the effective contact stiffness), a scalpel stroke cuts the frog
+and opens its surface, a saved state restored continues bitwise, and bad input is refused with the
+core's message."""
+import math
+
+import numpy as np
+import pytest
+
+import tissue
+
+
+def clamped_block():
+    # tests/unit/tissue/test_tissue.cpp's clamped_block(): 4 x 4 x 2 cubes of 1 cm, held at z = 0.
+    return tissue.Tissue(box=(4, 4, 2), box_edge_m=0.01, fixed_axis=2, fixed_fraction=0.0,
+                         gravity_m_per_s2=(0.0, 0.0, 0.0), damping_alpha_per_s=20.0, damping_beta_s=0.0,
+                         linear_solver="cholmod", step_size_s=0.01)
+
+
+def test_a_held_press_settles_at_springs_in_series():
+    # The C++ test Tissue.ProbeTouchesPushesBackAndLetsGo: pressed 0.1 mm and held, the force along
+    # the normal is d / (1/k_n + 1/k), k_n the contact stiffness's frictionless normal stiffness and
+    # k the contact spring's, within 2 %; the tangential force below 5 % of it; K_c symmetric
+    # positive definite.
+    t = clamped_block()
+    above = (0.0213, 0.0187, 0.025)
+    t.set_tool(above, mode="probe")
+    t.step()
+    assert not t.contact["active"]
+    depth_m = 1e-4
+    t.set_tool((above[0], above[1], 0.02 - depth_m), mode="probe")
+    t.step(300)
+    contact = t.contact
+    assert contact["active"]
+    force = contact["force_on_tool_n"]
+    k_c = contact["stiffness_n_per_m"]
+    assert force.shape == (3,) and k_c.shape == (3, 3)
+    assert force[2] > 0.0
+    assert np.linalg.norm(force[:2]) < 0.05 * force[2]
+    assert np.all(np.linalg.eigvalsh(k_c) > 0.0)
+    assert np.linalg.norm(k_c - k_c.T) < 1e-9 * np.linalg.norm(k_c)
+    k_n = 1.0 / np.linalg.inv(k_c)[2, 2]
+    k = t.contact_spring_stiffness_n_per_m
+    expected = depth_m / (1.0 / k_n + 1.0 / k)
+    assert force[2] == pytest.approx(expected, rel=0.02)
+    t.set_tool(above, mode="probe")
+    t.step()
+    assert not t.contact["active"]
+
+
+def test_a_scalpel_stroke_cuts_the_frog_and_opens_its_surface():
+    t = tissue.Tissue(mesh="frog", gravity_m_per_s2=(0.0, 0.0, 0.0), step_size_s=0.01, blade_length_m=0.1)
+    rest = t.rest_positions_m
+    lower, upper = rest.min(axis=0), rest.max(axis=0)
+    points_before, triangles_before = t.surface()
+    assert points_before.shape[1] == 3 and triangles_before.shape[1] == 3
+    assert triangles_before.max() < len(points_before)
+    x = 0.5 * (lower[0] + upper[0])
+    for n in range(41):  # a vertical blade drawn across the body, 40 steps of 10 ms
+        y = lower[1] - 0.01 + n / 40 * (upper[1] - lower[1] + 0.02)
+        t.set_tool((x, y, lower[2] - 0.01), mode="scalpel")
+        t.step()
+    assert t.cut_tets > 50
+    assert t.enriched_vertices > 0
+    assert t.dof_count > 3 * (t.vertex_count - 0)  # enriched unknowns on top of the vertices'
+    points, triangles = t.surface()
+    assert len(triangles) > len(triangles_before)  # the cut faces are drawn
+    assert triangles.max() < len(points)
+    assert np.all(np.isfinite(points))
+
+
+def test_a_restored_state_continues_bitwise():
+    t = tissue.Tissue(mesh="frog", step_size_s=0.01)
+    top = t.rest_positions_m[:, 2].max()
+    centre = t.rest_positions_m.mean(axis=0)
+    t.set_tool((centre[0], centre[1], top + 0.002), mode="probe")
+    t.step(5)
+    t.set_tool((centre[0], centre[1], top - 0.003), mode="probe")
+    t.step(5)
+    state = t.save()
+    assert isinstance(state, bytes) and len(state) > 0
+    t.step(10)
+    expected = t.positions_m
+    expected_force = t.contact["force_on_tool_n"]
+
+    fresh = tissue.Tissue(mesh="frog", step_size_s=0.01)
+    fresh.restore(state)
+    fresh.set_tool((centre[0], centre[1], top - 0.003), mode="probe")
+    fresh.step(10)
+    assert fresh.time_s == t.time_s
+    assert np.array_equal(fresh.positions_m, expected)
+    assert np.array_equal(fresh.contact["force_on_tool_n"], expected_force)
+
+    # A state of another model is refused and changes nothing.
+    other = tissue.Tissue(mesh="frog", step_size_s=0.005)
+    before = other.positions_m
+    with pytest.raises(RuntimeError, match="another model|fingerprint|model"):
+        other.restore(state)
+    assert np.array_equal(other.positions_m, before)
+    with pytest.raises(RuntimeError):
+        fresh.restore(b"not a state")
+
+
+def test_bad_input_is_refused_with_the_cores_message():
+    with pytest.raises(ValueError, match="Poisson"):
+        tissue.Tissue(box=(2, 2, 2), poisson_ratio=0.5)
+    with pytest.raises(ValueError):
+        tissue.Tissue(box=(2, 2, 2), step_size_s=-1.0)
+    with pytest.raises(ValueError, match="linear solver|solver"):
+        tissue.Tissue(box=(2, 2, 2), linear_solver="lu")
+    with pytest.raises(Exception, match="nonexistent"):
+        tissue.Tissue(mesh="/nonexistent/mesh.veg")
+    t = tissue.Tissue(box=(2, 2, 2), fixed_fraction=0.0)
+    with pytest.raises(ValueError):
+        t.set_tool((math.nan, 0.0, 0.0))
+    with pytest.raises(ValueError, match="knife"):
+        t.set_tool((0.0, 0.0, 0.0), mode="knife")
+    with pytest.raises(ValueError):
+        t.step(0)
+    t.step()  # still usable
+    assert t.time_s > 0.0

@@ -1,0 +1,289 @@
+// The Python module `tissue` (pybind11) over the core: a Tissue made from a mesh (the embedded frog,
+// a .veg, .node/.ele or .msh file, or a box of cubes) with material, damping, gravity, the fixed
+// region and the integrator as keyword arguments in SI units; step it, move the probe or the
+// scalpel, read the state, the contact, the drawn surface and the cut state as numpy arrays, save
+// and restore the state as bytes. Errors come back as Python exceptions with the core's message:
+// ValueError for a bad setting or pose, RuntimeError for a failed step or a state that cannot be
+// restored. The core's arrays are copied out (numpy owns them), so nothing dangles after a step.
+#include "core/fixed_region.hpp"
+#include "core/mesh/box_mesh.hpp"
+#include "core/mesh/mesh_io.hpp"
+#include "core/tissue.hpp"
+#include "core/tissue_snapshot_io.hpp"
+#include "resources/default_mesh.hpp"
+
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+
+#include <array>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace py = pybind11;
+
+namespace tissue::python {
+namespace {
+
+using Array = py::array_t<double>;
+
+// An (rows x columns) float64 array holding a copy of `values` (row-major).
+Array matrix(const double* values, py::ssize_t rows, py::ssize_t columns) {
+  Array out({rows, columns});
+  std::copy(values, values + rows * columns, out.mutable_data());
+  return out;
+}
+
+Array vector3(const Eigen::Vector3d& v) {
+  Array out(3);
+  std::copy(v.data(), v.data() + 3, out.mutable_data());
+  return out;
+}
+
+Eigen::Vector3d to_vector3(const std::array<double, 3>& v) { return {v[0], v[1], v[2]}; }
+
+ToolMode tool_mode(const std::string& mode) {
+  if (mode == "none") return ToolMode::none;
+  if (mode == "probe") return ToolMode::probe;
+  if (mode == "scalpel") return ToolMode::scalpel;
+  throw ParameterError("tool mode '" + mode + "' is not none, probe or scalpel");
+}
+
+std::string tool_mode_name(ToolMode mode) {
+  return mode == ToolMode::probe ? "probe" : mode == ToolMode::scalpel ? "scalpel" : "none";
+}
+
+// The keyword arguments of the constructor, with the core's defaults where it has them.
+struct Options {
+  std::string mesh = "frog";
+  std::optional<std::array<int, 3>> box_cells;  // a box of cubes instead of a mesh
+  double box_edge_m = 0.01;
+  std::optional<std::vector<int>> fixed_vertices;
+  int fixed_axis = 0;
+  double fixed_fraction = 0.01;
+  double young_modulus_pa = 1e5;
+  double poisson_ratio = 0.4;
+  double density_kg_per_m3 = 1000.0;
+  double damping_alpha_per_s = 1.0;
+  double damping_beta_s = 1e-3;
+  std::array<double, 3> gravity_m_per_s2{0.0, 0.0, -9.81};
+  double step_size_s = 1e-3;
+  std::string integrator = "backward-euler";
+  std::string linear_solver = "pcg";
+  double pcg_tolerance = 1e-3;
+  int pcg_max_iterations = 10;
+  int threads = 1;
+  bool contact = true;
+  bool cutting = true;
+  double blade_length_m = 0.03;
+  double probe_radius_m = 0.0;
+};
+
+// A Tissue behind a pointer: restoring a state with other cuts replaces it (restore_or_replay).
+class PyTissue {
+ public:
+  explicit PyTissue(const Options& options) {
+    TetMesh mesh = options.box_cells ? make_box_mesh((*options.box_cells)[0], (*options.box_cells)[1],
+                                                     (*options.box_cells)[2], options.box_edge_m)
+                                     : load_mesh(options.mesh);
+    TissueSettings settings;
+    BodySettings& body = settings.body;
+    body.material = Material{options.young_modulus_pa, options.poisson_ratio, options.density_kg_per_m3};
+    body.damping = RayleighDamping{options.damping_alpha_per_s, options.damping_beta_s};
+    body.gravity_m_per_s2 = to_vector3(options.gravity_m_per_s2);
+    if (options.fixed_vertices) {
+      body.fixed_vertices = *options.fixed_vertices;
+    } else {
+      if (options.fixed_axis < 0 || options.fixed_axis > 2) throw ParameterError("fixed_axis must be 0, 1 or 2");
+      body.fixed_vertices = vertices_at_minimum(mesh, options.fixed_axis, options.fixed_fraction);
+    }
+    settings.step_size_s = options.step_size_s;
+    settings.integrator.kind = parse_integrator_kind(options.integrator);
+    settings.integrator.threads = options.threads;
+    settings.solver.kind = parse_linear_solver_kind(options.linear_solver);
+    settings.solver.pcg = PcgSolver::Settings{options.pcg_tolerance, options.pcg_max_iterations};
+    InteractionSettings& interaction = settings.interaction;
+    interaction.contact_enabled = options.contact;
+    interaction.cutting_enabled = options.cutting;
+    interaction.blade_length_m = options.blade_length_m;
+    interaction.probe_radius_m = options.probe_radius_m;
+    m_tissue = std::make_unique<Tissue>(std::move(mesh), settings);
+  }
+
+  void set_tool(const std::array<double, 3>& position_m, const std::array<double, 4>& orientation_wxyz,
+                const std::string& mode) {
+    m_tissue->set_tool({to_vector3(position_m),
+                        Eigen::Quaterniond(orientation_wxyz[0], orientation_wxyz[1], orientation_wxyz[2],
+                                           orientation_wxyz[3]),
+                        tool_mode(mode)});
+  }
+
+  // `steps` steps; the last one's report.
+  py::dict step(int steps) {
+    if (steps < 1) throw ParameterError("steps must be >= 1, got " + std::to_string(steps));
+    TissueStepReport report;
+    {
+      py::gil_scoped_release release;  // other Python threads run while the tissue steps
+      for (int n = 0; n < steps; ++n) report = m_tissue->step();
+    }
+    py::dict out;
+    out["newton_iterations"] = report.dynamics.newton_iterations;
+    out["linear_iterations"] = report.dynamics.linear_iterations;
+    out["energy_guarded"] = report.dynamics.energy_guarded;
+    out["newly_cut_tets"] = report.cut.newly_cut_tets;
+    out["total_s"] = report.total_s;
+    return out;
+  }
+
+  [[nodiscard]] double time_s() const { return m_tissue->time_s(); }
+  [[nodiscard]] int vertex_count() const { return m_tissue->body().mesh().vertex_count(); }
+  [[nodiscard]] int tet_count() const { return m_tissue->body().mesh().tet_count(); }
+  [[nodiscard]] int dof_count() const { return m_tissue->body().dof_count(); }
+  [[nodiscard]] std::size_t cut_tets() const { return m_tissue->body().cut_tets().size(); }
+  [[nodiscard]] int enriched_vertices() const { return m_tissue->body().enriched_dof_count(); }
+  [[nodiscard]] double kinetic_energy_j() const { return m_tissue->kinetic_energy_j(); }
+  [[nodiscard]] double elastic_energy_j() { return m_tissue->elastic_energy_j(); }
+
+  // Positions of the mesh vertices (vertex_count x 3) [m].
+  [[nodiscard]] Array positions_m() const {
+    Eigen::VectorXd positions;
+    m_tissue->vertex_positions(positions);
+    return matrix(positions.data(), positions.size() / 3, 3);
+  }
+  // Positions at rest (vertex_count x 3) [m].
+  [[nodiscard]] Array rest_positions_m() const {
+    const std::vector<Eigen::Vector3d>& rest = m_tissue->body().mesh().rest_positions_m;
+    Array out({static_cast<py::ssize_t>(rest.size()), py::ssize_t{3}});
+    for (std::size_t v = 0; v < rest.size(); ++v) std::copy(rest[v].data(), rest[v].data() + 3, out.mutable_data(v, 0));
+    return out;
+  }
+  // The drawn surface: (points m x 3 [m], triangles k x 3 indices into points): the mesh's surface
+  // without the triangles of cut tets, their pieces either side, then the cut faces.
+  [[nodiscard]] py::tuple surface() const {
+    const Eigen::VectorXd& points = m_tissue->current_positions_m();
+    std::vector<std::int32_t> triangles;
+    triangles.reserve(3 * m_tissue->drawn_triangle_count());
+    m_tissue->for_each_drawn_triangle([&](const std::array<int, 3>& t) { triangles.insert(triangles.end(), t.begin(), t.end()); });
+    py::array_t<std::int32_t> indices({static_cast<py::ssize_t>(triangles.size() / 3), py::ssize_t{3}});
+    std::copy(triangles.begin(), triangles.end(), indices.mutable_data());
+    return py::make_tuple(matrix(points.data(), points.size() / 3, 3), indices);
+  }
+  [[nodiscard]] py::dict contact() const {
+    const ContactOutput& c = m_tissue->contact();
+    py::dict out;
+    out["active"] = c.active;
+    out["point_m"] = vector3(c.point_m);
+    out["normal"] = vector3(c.normal);
+    out["force_on_tool_n"] = vector3(c.force_on_tool_n);
+    const Eigen::Matrix<double, 3, 3, Eigen::RowMajor> k = c.stiffness_n_per_m;
+    out["stiffness_n_per_m"] = matrix(k.data(), 3, 3);
+    out["depth_m"] = c.penetration_depth_m;
+    return out;
+  }
+  [[nodiscard]] double contact_spring_stiffness_n_per_m() const { return m_tissue->contact_spring_stiffness_n_per_m(); }
+  [[nodiscard]] py::dict tool() const {
+    const ToolPose& pose = m_tissue->applied_tool();
+    py::dict out;
+    out["position_m"] = vector3(m_tissue->applied_tool_position_m());
+    out["orientation_wxyz"] = py::make_tuple(pose.orientation.w(), pose.orientation.x(), pose.orientation.y(),
+                                             pose.orientation.z());
+    out["mode"] = tool_mode_name(pose.mode);
+    return out;
+  }
+
+  [[nodiscard]] py::bytes save() const {
+    TissueSnapshot snapshot;
+    m_tissue->save(snapshot);
+    const std::vector<std::uint8_t> bytes = serialize_snapshot(snapshot);
+    return {reinterpret_cast<const char*>(bytes.data()), bytes.size()};
+  }
+  void restore(const py::bytes& state) {
+    const std::string bytes = state;
+    const auto* data = reinterpret_cast<const std::uint8_t*>(bytes.data());
+    restore_or_replay(m_tissue, deserialize_snapshot(std::span<const std::uint8_t>(data, bytes.size())));
+  }
+
+ private:
+  std::unique_ptr<Tissue> m_tissue;
+};
+
+}  // namespace
+}  // namespace tissue::python
+
+PYBIND11_MODULE(tissue, m) {
+  using namespace tissue;
+  using tissue::python::Options;
+  using tissue::python::PyTissue;
+  m.doc() = "Real-time deformable tissue: co-rotational FEM, XFEM cutting, probe contact (SI units)";
+  py::register_exception<ParameterError>(m, "ParameterError", PyExc_ValueError);
+  py::register_exception<IntegrationError>(m, "IntegrationError", PyExc_RuntimeError);
+  py::register_exception<StateError>(m, "StateError", PyExc_RuntimeError);
+
+  py::class_<PyTissue>(m, "Tissue")
+      .def(py::init([](const std::string& mesh, std::optional<std::array<int, 3>> box, double box_edge_m,
+                       std::optional<std::vector<int>> fixed_vertices, int fixed_axis, double fixed_fraction,
+                       double young_modulus_pa, double poisson_ratio, double density_kg_per_m3,
+                       double damping_alpha_per_s, double damping_beta_s, std::array<double, 3> gravity_m_per_s2,
+                       double step_size_s, const std::string& integrator, const std::string& linear_solver,
+                       double pcg_tolerance, int pcg_max_iterations, int threads, bool contact, bool cutting,
+                       double blade_length_m, double probe_radius_m) {
+             Options o;
+             o.mesh = mesh;
+             o.box_cells = box;
+             o.box_edge_m = box_edge_m;
+             o.fixed_vertices = std::move(fixed_vertices);
+             o.fixed_axis = fixed_axis;
+             o.fixed_fraction = fixed_fraction;
+             o.young_modulus_pa = young_modulus_pa;
+             o.poisson_ratio = poisson_ratio;
+             o.density_kg_per_m3 = density_kg_per_m3;
+             o.damping_alpha_per_s = damping_alpha_per_s;
+             o.damping_beta_s = damping_beta_s;
+             o.gravity_m_per_s2 = gravity_m_per_s2;
+             o.step_size_s = step_size_s;
+             o.integrator = integrator;
+             o.linear_solver = linear_solver;
+             o.pcg_tolerance = pcg_tolerance;
+             o.pcg_max_iterations = pcg_max_iterations;
+             o.threads = threads;
+             o.contact = contact;
+             o.cutting = cutting;
+             o.blade_length_m = blade_length_m;
+             o.probe_radius_m = probe_radius_m;
+             return PyTissue(o);
+           }),
+           py::kw_only(), py::arg("mesh") = "frog", py::arg("box") = py::none(), py::arg("box_edge_m") = 0.01,
+           py::arg("fixed_vertices") = py::none(), py::arg("fixed_axis") = 0, py::arg("fixed_fraction") = 0.01,
+           py::arg("young_modulus_pa") = 1e5, py::arg("poisson_ratio") = 0.4, py::arg("density_kg_per_m3") = 1000.0,
+           py::arg("damping_alpha_per_s") = 1.0, py::arg("damping_beta_s") = 1e-3,
+           py::arg("gravity_m_per_s2") = std::array<double, 3>{0.0, 0.0, -9.81}, py::arg("step_size_s") = 1e-3,
+           py::arg("integrator") = "backward-euler", py::arg("linear_solver") = "pcg",
+           py::arg("pcg_tolerance") = 1e-3, py::arg("pcg_max_iterations") = 10, py::arg("threads") = 1,
+           py::arg("contact") = true, py::arg("cutting") = true, py::arg("blade_length_m") = 0.03,
+           py::arg("probe_radius_m") = 0.0,
+           "A tissue: mesh 'frog' (embedded) or a file path, or box=(nx, ny, nz) cubes of box_edge_m; fixed "
+           "vertices by index, or those within fixed_fraction of the extent from the minimum along fixed_axis")
+      .def("set_tool", &PyTissue::set_tool, py::arg("position_m"),
+           py::arg("orientation_wxyz") = std::array<double, 4>{1.0, 0.0, 0.0, 0.0}, py::arg("mode") = "probe",
+           "The tool pose for the next step: position [m], unit quaternion (w, x, y, z; the tool's axis is its "
+           "+z), mode 'none', 'probe' or 'scalpel'")
+      .def("step", &PyTissue::step, py::arg("steps") = 1, "Steps the tissue; the last step's report")
+      .def_property_readonly("time_s", &PyTissue::time_s)
+      .def_property_readonly("vertex_count", &PyTissue::vertex_count)
+      .def_property_readonly("tet_count", &PyTissue::tet_count)
+      .def_property_readonly("dof_count", &PyTissue::dof_count)
+      .def_property_readonly("cut_tets", &PyTissue::cut_tets)
+      .def_property_readonly("enriched_vertices", &PyTissue::enriched_vertices)
+      .def_property_readonly("kinetic_energy_j", &PyTissue::kinetic_energy_j)
+      .def_property_readonly("elastic_energy_j", &PyTissue::elastic_energy_j)
+      .def_property_readonly("positions_m", &PyTissue::positions_m, "Vertex positions (n x 3) [m]")
+      .def_property_readonly("rest_positions_m", &PyTissue::rest_positions_m, "Vertex rest positions (n x 3) [m]")
+      .def_property_readonly("contact", &PyTissue::contact, "The last step's contact (force on the tool, K_c)")
+      .def_property_readonly("contact_spring_stiffness_n_per_m", &PyTissue::contact_spring_stiffness_n_per_m)
+      .def_property_readonly("tool", &PyTissue::tool, "The pose the last step applied")
+      .def("surface", &PyTissue::surface, "The drawn surface: (points (m x 3) [m], triangles (k x 3))")
+      .def("save", &PyTissue::save, "The state as bytes (what FMI's serialized FMU state holds)")
+      .def("restore", &PyTissue::restore, py::arg("state"), "Restores a state save() gave, cuts and all");
+}
