@@ -141,7 +141,7 @@ class PyTissue {
   [[nodiscard]] int vertex_count() const { return m_tissue->body().mesh().vertex_count(); }
   [[nodiscard]] int tet_count() const { return m_tissue->body().mesh().tet_count(); }
   [[nodiscard]] int dof_count() const { return m_tissue->body().dof_count(); }
-  [[nodiscard]] std::size_t cut_tets() const { return m_tissue->body().cut_tets().size(); }
+  [[nodiscard]] int cut_tets() const { return m_tissue->body().cut_tet_count(); }
   [[nodiscard]] int enriched_vertices() const { return m_tissue->body().enriched_dof_count(); }
   [[nodiscard]] double kinetic_energy_j() const { return m_tissue->kinetic_energy_j(); }
   [[nodiscard]] double elastic_energy_j() { return m_tissue->elastic_energy_j(); }
@@ -169,6 +169,24 @@ class PyTissue {
     py::array_t<std::int32_t> indices({static_cast<py::ssize_t>(triangles.size() / 3), py::ssize_t{3}});
     std::copy(triangles.begin(), triangles.end(), indices.mutable_data());
     return py::make_tuple(matrix(points.data(), points.size() / 3, 3), indices);
+  }
+  // The mesh ids of the tets a cut went through (ascending).
+  [[nodiscard]] py::array_t<std::int32_t> cut_tet_ids() const {
+    std::vector<std::int32_t> ids;
+    const DeformableBody& body = m_tissue->body();
+    for (int t = 0; t < body.mesh().tet_count(); ++t) {
+      if (body.cut_tet_index(t) >= 0) ids.push_back(t);
+    }
+    py::array_t<std::int32_t> out(static_cast<py::ssize_t>(ids.size()));
+    std::copy(ids.begin(), ids.end(), out.mutable_data());
+    return out;
+  }
+  // The faces the cuts opened (k x 3, indices into surface()'s points), both sides.
+  [[nodiscard]] py::array_t<std::int32_t> cut_faces() const {
+    const std::vector<std::array<int, 3>>& faces = m_tissue->cut_surface().drawn_triangles();
+    py::array_t<std::int32_t> out({static_cast<py::ssize_t>(faces.size()), py::ssize_t{3}});
+    for (std::size_t f = 0; f < faces.size(); ++f) std::copy(faces[f].begin(), faces[f].end(), out.mutable_data(f, 0));
+    return out;
   }
   [[nodiscard]] py::dict contact() const {
     const ContactOutput& c = m_tissue->contact();
@@ -284,6 +302,8 @@ PYBIND11_MODULE(tissue, m) {
       .def_property_readonly("contact_spring_stiffness_n_per_m", &PyTissue::contact_spring_stiffness_n_per_m)
       .def_property_readonly("tool", &PyTissue::tool, "The pose the last step applied")
       .def("surface", &PyTissue::surface, "The drawn surface: (points (m x 3) [m], triangles (k x 3))")
+      .def_property_readonly("cut_tet_ids", &PyTissue::cut_tet_ids, "Mesh ids of the tets a cut went through")
+      .def("cut_faces", &PyTissue::cut_faces, "The faces the cuts opened (k x 3, into surface()'s points)")
       .def("save", &PyTissue::save, "The state as bytes (what FMI's serialized FMU state holds)")
       .def("restore", &PyTissue::restore, py::arg("state"), "Restores a state save() gave, cuts and all");
 }

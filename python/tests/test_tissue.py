@@ -62,6 +62,11 @@ def test_a_scalpel_stroke_cuts_the_frog_and_opens_its_surface():
         t.step()
     assert t.cut_tets > 50
     assert t.enriched_vertices > 0
+    ids = t.cut_tet_ids
+    assert len(ids) == t.cut_tets and np.all(np.diff(ids) > 0) and ids.max() < t.tet_count
+    # The cut tets straddle the blade's plane x = const at rest.
+    faces = t.cut_faces()
+    assert len(faces) > 0 and faces.shape[1] == 3
     assert t.dof_count > 3 * (t.vertex_count - 0)  # enriched unknowns on top of the vertices'
     points, triangles = t.surface()
     assert len(triangles) > len(triangles_before)  # the cut faces are drawn
