@@ -79,6 +79,7 @@ struct Options {
   bool cutting = true;
   double blade_length_m = 0.03;
   double probe_radius_m = 0.0;
+  std::string render_surface;  // "" none, "frog" the embedded frog's, else an OBJ file
 };
 
 // A Tissue behind a pointer: restoring a state with other cuts replaces it (restore_or_replay).
@@ -109,6 +110,9 @@ class PyTissue {
     interaction.cutting_enabled = options.cutting;
     interaction.blade_length_m = options.blade_length_m;
     interaction.probe_radius_m = options.probe_radius_m;
+    if (!options.render_surface.empty()) {
+      settings.render_surface = std::make_shared<const TriangleSurface>(load_render_surface(options.render_surface));
+    }
     m_tissue = std::make_unique<Tissue>(std::move(mesh), settings);
   }
 
@@ -169,6 +173,28 @@ class PyTissue {
     py::array_t<std::int32_t> indices({static_cast<py::ssize_t>(triangles.size() / 3), py::ssize_t{3}});
     std::copy(triangles.begin(), triangles.end(), indices.mutable_data());
     return py::make_tuple(matrix(points.data(), points.size() / 3, 3), indices);
+  }
+  // The render surface at the current state, cut with the tets: (positions m x 3 [m], normals m x 3,
+  // triangles k x 3, the last cap_triangles of them the caps over the cuts); None without one.
+  [[nodiscard]] py::object render_surface() const {
+    const CutRenderSurface* render = m_tissue->render_surface();
+    if (render == nullptr) return py::none();
+    const auto rows = [](const std::vector<Eigen::Vector3d>& v) {
+      Array out({static_cast<py::ssize_t>(v.size()), py::ssize_t{3}});
+      for (std::size_t i = 0; i < v.size(); ++i) std::copy(v[i].data(), v[i].data() + 3, out.mutable_data(i, 0));
+      return out;
+    };
+    const std::vector<std::array<int, 3>>& triangles = render->triangles();
+    py::array_t<std::int32_t> indices({static_cast<py::ssize_t>(triangles.size()), py::ssize_t{3}});
+    for (std::size_t t = 0; t < triangles.size(); ++t) {
+      std::copy(triangles[t].begin(), triangles[t].end(), indices.mutable_data(t, 0));
+    }
+    py::dict out;
+    out["positions_m"] = rows(render->positions_m());
+    out["normals"] = rows(render->normals());
+    out["triangles"] = indices;
+    out["cap_triangles"] = render->cap_triangle_count();
+    return out;
   }
   // The mesh ids of the tets a cut went through (ascending).
   [[nodiscard]] py::array_t<std::int32_t> cut_tet_ids() const {
@@ -246,7 +272,7 @@ PYBIND11_MODULE(tissue, m) {
                        double damping_alpha_per_s, double damping_beta_s, std::array<double, 3> gravity_m_per_s2,
                        double step_size_s, const std::string& integrator, const std::string& linear_solver,
                        double pcg_tolerance, int pcg_max_iterations, int threads, bool contact, bool cutting,
-                       double blade_length_m, double probe_radius_m) {
+                       double blade_length_m, double probe_radius_m, const std::string& render_surface) {
              Options o;
              o.mesh = mesh;
              o.box_cells = box;
@@ -270,6 +296,7 @@ PYBIND11_MODULE(tissue, m) {
              o.cutting = cutting;
              o.blade_length_m = blade_length_m;
              o.probe_radius_m = probe_radius_m;
+             o.render_surface = render_surface;
              return PyTissue(o);
            }),
            py::kw_only(), py::arg("mesh") = "frog", py::arg("box") = py::none(), py::arg("box_edge_m") = 0.01,
@@ -280,9 +307,10 @@ PYBIND11_MODULE(tissue, m) {
            py::arg("integrator") = "backward-euler", py::arg("linear_solver") = "pcg",
            py::arg("pcg_tolerance") = 1e-3, py::arg("pcg_max_iterations") = 10, py::arg("threads") = 1,
            py::arg("contact") = true, py::arg("cutting") = true, py::arg("blade_length_m") = 0.03,
-           py::arg("probe_radius_m") = 0.0,
+           py::arg("probe_radius_m") = 0.0, py::arg("render_surface") = "",
            "A tissue: mesh 'frog' (embedded) or a file path, or box=(nx, ny, nz) cubes of box_edge_m; fixed "
-           "vertices by index, or those within fixed_fraction of the extent from the minimum along fixed_axis")
+           "vertices by index, or those within fixed_fraction of the extent from the minimum along fixed_axis; "
+           "render_surface 'frog' (the embedded frog's fine surface) or an OBJ file to draw, riding on the tets")
       .def("set_tool", &PyTissue::set_tool, py::arg("position_m"),
            py::arg("orientation_wxyz") = std::array<double, 4>{1.0, 0.0, 0.0, 0.0}, py::arg("mode") = "probe",
            "The tool pose for the next step: position [m], unit quaternion (w, x, y, z; the tool's axis is its "
@@ -302,6 +330,9 @@ PYBIND11_MODULE(tissue, m) {
       .def_property_readonly("contact_spring_stiffness_n_per_m", &PyTissue::contact_spring_stiffness_n_per_m)
       .def_property_readonly("tool", &PyTissue::tool, "The pose the last step applied")
       .def("surface", &PyTissue::surface, "The drawn surface: (points (m x 3) [m], triangles (k x 3))")
+      .def("render_surface", &PyTissue::render_surface,
+           "The render surface cut with the tets: a dict of positions_m, normals, triangles, cap_triangles; None "
+           "without one")
       .def_property_readonly("cut_tet_ids", &PyTissue::cut_tet_ids, "Mesh ids of the tets a cut went through")
       .def("cut_faces", &PyTissue::cut_faces, "The faces the cuts opened (k x 3, into surface()'s points)")
       .def("save", &PyTissue::save, "The state as bytes (what FMI's serialized FMU state holds)")

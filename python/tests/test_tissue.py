@@ -74,6 +74,28 @@ def test_a_scalpel_stroke_cuts_the_frog_and_opens_its_surface():
     assert np.all(np.isfinite(points))
 
 
+def test_the_render_surface_is_cut_with_the_tets():
+    t = tissue.Tissue(mesh="frog", gravity_m_per_s2=(0.0, 0.0, 0.0), step_size_s=0.01, blade_length_m=0.1,
+                      render_surface="frog")
+    before = t.render_surface()
+    assert before["triangles"].shape == (23240, 3)  # meshes/frog_surface.obj
+    assert before["cap_triangles"] == 0
+    assert np.allclose(np.linalg.norm(before["normals"], axis=1), 1.0)
+    rest = t.rest_positions_m
+    lower, upper = rest.min(axis=0), rest.max(axis=0)
+    x = 0.5 * (lower[0] + upper[0])
+    for n in range(41):
+        y = lower[1] - 0.01 + n / 40 * (upper[1] - lower[1] + 0.02)
+        t.set_tool((x, y, lower[2] - 0.01), mode="scalpel")
+        t.step()
+    after = t.render_surface()
+    assert after["cap_triangles"] > 0  # the opening is capped
+    assert len(after["triangles"]) > len(before["triangles"])
+    assert after["triangles"].max() < len(after["positions_m"])
+    assert np.all(np.isfinite(after["positions_m"]))
+    assert tissue.Tissue(box=(2, 2, 2)).render_surface() is None
+
+
 def test_a_restored_state_continues_bitwise():
     t = tissue.Tissue(mesh="frog", step_size_s=0.01)
     top = t.rest_positions_m[:, 2].max()
@@ -115,6 +137,8 @@ def test_bad_input_is_refused_with_the_cores_message():
         tissue.Tissue(box=(2, 2, 2), linear_solver="lu")
     with pytest.raises(Exception, match="nonexistent"):
         tissue.Tissue(mesh="/nonexistent/mesh.veg")
+    with pytest.raises(Exception, match="nonexistent"):
+        tissue.Tissue(box=(2, 2, 2), render_surface="/nonexistent/surface.obj")
     t = tissue.Tissue(box=(2, 2, 2), fixed_fraction=0.0)
     with pytest.raises(ValueError):
         t.set_tool((math.nan, 0.0, 0.0))
