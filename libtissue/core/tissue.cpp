@@ -104,8 +104,14 @@ std::uint64_t model_fingerprint_of(const TetMesh& mesh, const TissueSettings& se
   return f.value();
 }
 
-// Below this fraction of the contact stiffness scale, a static K_c belongs to a piece nothing holds.
+// CHOLMOD may factorize a singular K through rounding; the point of a free piece then comes out with
+// a K_c at rounding level. Held points of the frog measure 0.0017 to 14 times the contact scale
+// (contact_stiffness.hpp): below 1e-6 of it, a static K_c belongs to a piece nothing holds.
 constexpr double FREE_PIECE_STIFFNESS_FRACTION = 1e-6;
+
+double free_piece_floor_n_per_m(double contact_stiffness_scale_n_per_m) {
+  return FREE_PIECE_STIFFNESS_FRACTION * contact_stiffness_scale_n_per_m;
+}
 
 // The largest turn of the blade one cutter sweep covers (its two triangles span the ruled surface
 // of a turning segment to within ~ L (1 - cos(angle / 2)), 0.1 mm for a 3 cm blade at 5 degrees).
@@ -520,13 +526,23 @@ void Tissue::update_contact_output() {
     return;
   }
   m_steps_since_stiffness = 1;
+  // DESIGN section 4: K_c from the static K where the body is held, from the step's Newton matrix
+  // (asked of the integrator) where nothing holds it; the contact spring taken out of either
+  // (contact_stiffness.hpp); a point on fixed vertices only is a rigid support: the spring alone.
+  const bool held = !m_body.settings().fixed_vertices.empty();
+  const ShiftedSystem system = held ? static_contact_system(m_body.tangent(), m_contact_system_diagonal)
+                                    : m_integrator->newton_stiffness(m_body, m_settings.step_size_s,
+                                                                     m_contact_system_diagonal);
+  const ContactStiffnessRequest request = contact_stiffness_request_at(
+      system, triangle, held ? free_piece_floor_n_per_m(m_contact_stiffness_scale_n_per_m) : 0.0);
   if (interaction.contact_stiffness_in_background) {
     if (new_contact) out.stiffness_n_per_m = element_local_contact_stiffness(m_body.elasticity(), m_surface, triangle);
-    start_effective_contact_stiffness(triangle);
+    m_stiffness_refresh.start(system, request);
     return;
   }
   try {
-    out.stiffness_n_per_m = effective_contact_stiffness(triangle);
+    out.stiffness_n_per_m =
+        landed_contact_stiffness(condensed_contact_stiffness(m_effective_stiffness, system, request), triangle);
   } catch (const std::exception&) {
     // Neither matrix could be factorized (non-finite values): render the spring alone, counted.
     ++m_contact_stiffness_fallbacks;
@@ -534,60 +550,25 @@ void Tissue::update_contact_output() {
   }
 }
 
-ContactInterpolation Tissue::contact_point(int triangle) const {
-  return contact_interpolation(m_body.dofs(), m_bvh.triangle(triangle), m_contact.proxy().barycentric);
-}
-
-namespace {
-
-// CHOLMOD may factorize a singular K through rounding; the point of a free piece then comes out with
-// a K_c at rounding level. Held points of the frog measure 0.0017 to 14 times the contact scale
-// (contact_stiffness.hpp): below 1e-6 of it, the piece is taken as held by nothing.
-double free_piece_floor_n_per_m(double contact_stiffness_scale_n_per_m) {
-  return FREE_PIECE_STIFFNESS_FRACTION * contact_stiffness_scale_n_per_m;
-}
-
-}  // namespace
-
-std::optional<Eigen::Matrix3d> Tissue::step_matrix_contact_stiffness(const ContactInterpolation& point) {
-  const ShiftedSystem step = m_integrator->newton_stiffness(m_body, m_settings.step_size_s, m_contact_system_diagonal);
-  return condensed_contact_stiffness(m_effective_stiffness, step, m_body.dofs(), point, m_contact_spring.spring(),
-                                     contact_spring_stiffness_n_per_m(), 0.0);
-}
-
-Eigen::Matrix3d Tissue::effective_contact_stiffness(int triangle) {
-  const ContactInterpolation point = contact_point(triangle);
-  // DESIGN section 4: the static K where the body is held; the step's Newton matrix, asked of the
-  // integrator, where nothing holds it, or where the static K fails because a cut set the
-  // contacted piece free (K singular there; issue 10). The contact spring is taken out of either
-  // (contact_stiffness.hpp); a point on fixed vertices only is a rigid support: the spring alone.
-  if (!m_body.settings().fixed_vertices.empty()) {
-    if (const auto stiffness = condensed_contact_stiffness(
-            m_effective_stiffness, static_contact_system(m_body.tangent(), m_contact_system_diagonal), m_body.dofs(),
-            point, m_contact_spring.spring(), contact_spring_stiffness_n_per_m(),
-            free_piece_floor_n_per_m(m_contact_stiffness_scale_n_per_m))) {
-      return *stiffness;
-    }
-  }
-  if (const auto stiffness = step_matrix_contact_stiffness(point)) return *stiffness;
-  throw SolverError("the contact stiffness cannot be condensed from the static or the step matrix");
-}
-
-void Tissue::start_effective_contact_stiffness(int triangle) {
-  const bool held = !m_body.settings().fixed_vertices.empty();
-  const ShiftedSystem system = held ? static_contact_system(m_body.tangent(), m_contact_system_diagonal)
-                                    : m_integrator->newton_stiffness(m_body, m_settings.step_size_s,
-                                                                     m_contact_system_diagonal);
-  m_stiffness_refresh.start(
-      system, contact_stiffness_request(system, m_body.dofs(), contact_point(triangle), m_contact_spring.spring(),
-                                        contact_spring_stiffness_n_per_m(),
-                                        held ? free_piece_floor_n_per_m(m_contact_stiffness_scale_n_per_m) : 0.0));
+ContactStiffnessRequest Tissue::contact_stiffness_request_at(const ShiftedSystem& system, int triangle,
+                                                              double floor_n_per_m) const {
+  const ContactInterpolation point =
+      contact_interpolation(m_body.dofs(), m_bvh.triangle(triangle), m_contact.proxy().barycentric);
+  return contact_stiffness_request(system, m_body.dofs(), point, m_contact_spring.spring(),
+                                   contact_spring_stiffness_n_per_m(), floor_n_per_m);
 }
 
 Eigen::Matrix3d Tissue::landed_contact_stiffness(const std::optional<Eigen::Matrix3d>& landed, int triangle) {
   if (landed) return *landed;
+  // The static K failed where a cut set the contacted piece free (K singular there; issue 10): the
+  // step's Newton matrix, now.
   if (!m_body.settings().fixed_vertices.empty()) {
-    if (const auto stiffness = step_matrix_contact_stiffness(contact_point(triangle))) return *stiffness;
+    const ShiftedSystem step =
+        m_integrator->newton_stiffness(m_body, m_settings.step_size_s, m_contact_system_diagonal);
+    if (const auto stiffness = condensed_contact_stiffness(m_effective_stiffness, step,
+                                                           contact_stiffness_request_at(step, triangle, 0.0))) {
+      return *stiffness;
+    }
   }
   ++m_contact_stiffness_fallbacks;
   return Eigen::Matrix3d::Identity() * contact_spring_stiffness_n_per_m();

@@ -258,17 +258,11 @@ class Tissue {
   void interact_with_scalpel(const ToolPose& previous, const ToolPose& current, TissueStepReport& report);
   void interact_with_probe(const ToolPose& previous, const ToolPose& current);
   void update_contact_output();
-  /// K_c at the proxy on `triangle` (DESIGN section 4). Throws SolverError when no matrix works.
-  Eigen::Matrix3d effective_contact_stiffness(int triangle);
-  /// The point on `triangle` the contact spring pulls, in the body's unknowns.
-  [[nodiscard]] ContactInterpolation contact_point(int triangle) const;
-  /// K_c from the step's Newton matrix (a body with nothing fixed, or a piece a cut set free).
-  std::optional<Eigen::Matrix3d> step_matrix_contact_stiffness(const ContactInterpolation& point);
-  /// Starts the effective K_c at the proxy on `triangle` in the background (from the static K where
-  /// the body is held, else the step's Newton matrix).
-  void start_effective_contact_stiffness(int triangle);
-  /// The K_c a background refresh gave, or its fallbacks computed now: the step's Newton matrix
-  /// where the static K failed, else the spring alone (counted).
+  /// What K_c at the proxy on `triangle` needs besides `system`'s factor (the point, the spring).
+  [[nodiscard]] ContactStiffnessRequest contact_stiffness_request_at(const ShiftedSystem& system, int triangle,
+                                                                     double floor_n_per_m) const;
+  /// The K_c a condensation gave (in this step or in the background), or its fallbacks computed now:
+  /// the step's Newton matrix where the static K failed, else the spring alone (counted).
   Eigen::Matrix3d landed_contact_stiffness(const std::optional<Eigen::Matrix3d>& landed, int triangle);
   void update_positions();
   /// Enriches `cuts` (one batch), grows the state, adds the opened faces to the surface and the BVH.

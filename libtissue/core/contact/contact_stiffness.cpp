@@ -60,48 +60,44 @@ void EffectiveContactStiffness::factorize(const ShiftedSystem& system) {
 }
 
 void EffectiveContactStiffness::load(const ShiftedSystem& system) {
-  m_rows = 0;
-  m_loaded_rows = 0;
-  if (system.stiffness == nullptr || system.diagonal == nullptr) {
-    throw SolverError("effective contact stiffness: the system has no stiffness or no diagonal");
-  }
-  const long n = system.rows();
-  if (system.diagonal->size() != n) {
-    throw SolverError("effective contact stiffness: the diagonal has length " + std::to_string(system.diagonal->size()) +
-                      ", the system has " + std::to_string(n) + " rows");
-  }
-  m_factor->load(system);
-  m_loaded_rows = static_cast<int>(n);
+  m_loaded = false;
+  system.check("effective contact stiffness");
+  m_factor->load(system);  // drops the factor
+  m_loaded = true;
 }
 
 void EffectiveContactStiffness::factorize_loaded() {
-  m_rows = 0;
-  if (m_loaded_rows == 0) throw SolverError("effective contact stiffness: nothing loaded to factorize");
+  if (!m_loaded) throw SolverError("effective contact stiffness: nothing loaded to factorize");
   if (m_factor->factorize() != CholmodFactor::Status::ok) {
     throw SolverError(m_factor->failure_message("effective contact stiffness"));
   }
-  m_rows = m_loaded_rows;
+}
+
+int EffectiveContactStiffness::rows() const {
+  return m_loaded && m_factor->factored() ? static_cast<int>(m_factor->rows()) : 0;
 }
 
 void EffectiveContactStiffness::solve(const Eigen::VectorXd& b, Eigen::VectorXd& x) {
-  if (m_rows == 0 || b.size() != m_rows) {
+  const int n = rows();
+  if (n == 0 || b.size() != n) {
     throw SolverError("effective contact stiffness: solve without a factor or with the wrong length");
   }
-  x.resize(m_rows);
-  m_factor->solve(std::span<const double>(b.data(), static_cast<size_t>(m_rows)),
-                  std::span<double>(x.data(), static_cast<size_t>(m_rows)));
+  x.resize(n);
+  m_factor->solve(std::span<const double>(b.data(), static_cast<size_t>(n)),
+                  std::span<double>(x.data(), static_cast<size_t>(n)));
 }
 
 bool EffectiveContactStiffness::check(const ContactInterpolation& point) const {
-  if (m_rows == 0) {
+  const int n = rows();
+  if (n == 0) {
     throw SolverError("effective contact stiffness: no factorized matrix (call factorize())");
   }
   bool moves = false;
   for (size_t k = 0; k < 3; ++k) {
     const int row = point.rows[k];
-    if (row < -1 || 3 * row + 2 >= m_rows) {
+    if (row < -1 || 3 * row + 2 >= n) {
       throw std::invalid_argument("effective contact stiffness: block row " + std::to_string(row) +
-                                  " outside the factorized matrix of " + std::to_string(m_rows) + " rows");
+                                  " outside the factorized matrix of " + std::to_string(n) + " rows");
     }
     moves = moves || (row >= 0 && point.weights[static_cast<Eigen::Index>(k)] != 0.0);
   }
@@ -110,8 +106,9 @@ bool EffectiveContactStiffness::check(const ContactInterpolation& point) const {
 
 void EffectiveContactStiffness::solve_columns(const ContactInterpolation& point, ResponseMatrix& response) {
   // Column a of P holds w_k at scalar row 3 row_k + a; A Z = P column by column.
-  response.resize(m_rows, 3);
-  m_column.setZero(m_rows);
+  const int n = rows();
+  response.resize(n, 3);
+  m_column.setZero(n);
   for (int axis = 0; axis < 3; ++axis) {
     for (size_t k = 0; k < 3; ++k) {
       if (point.rows[k] >= 0) m_column[3 * point.rows[k] + axis] += point.weights[static_cast<Eigen::Index>(k)];
@@ -261,17 +258,23 @@ std::optional<Eigen::Matrix3d> condense_loaded(EffectiveContactStiffness& effect
 }
 
 std::optional<Eigen::Matrix3d> condensed_contact_stiffness(EffectiveContactStiffness& effective,
-                                                          const ShiftedSystem& system, const DofMap& dofs,
-                                                          const ContactInterpolation& point,
-                                                          const std::optional<PointSpring>& spring,
-                                                          double rigid_support_n_per_m, double floor_n_per_m) {
+                                                          const ShiftedSystem& system,
+                                                          const ContactStiffnessRequest& request) {
   try {
     effective.load(system);
   } catch (const SolverError&) {
     return std::nullopt;
   }
-  return condense_loaded(effective,
-                         contact_stiffness_request(system, dofs, point, spring, rigid_support_n_per_m, floor_n_per_m));
+  return condense_loaded(effective, request);
+}
+
+std::optional<Eigen::Matrix3d> condensed_contact_stiffness(EffectiveContactStiffness& effective,
+                                                          const ShiftedSystem& system, const DofMap& dofs,
+                                                          const ContactInterpolation& point,
+                                                          const std::optional<PointSpring>& spring,
+                                                          double rigid_support_n_per_m, double floor_n_per_m) {
+  return condensed_contact_stiffness(
+      effective, system, contact_stiffness_request(system, dofs, point, spring, rigid_support_n_per_m, floor_n_per_m));
 }
 
 }  // namespace tissue

@@ -100,7 +100,8 @@ class EffectiveContactStiffness {
   [[nodiscard]] const ResponseMatrix& unit_force_response() const { return m_response; }
   /// x = A^-1 b with the same factor. Throws SolverError without one.
   void solve(const Eigen::VectorXd& b, Eigen::VectorXd& x);
-  [[nodiscard]] int rows() const { return m_rows; }
+  /// Rows of the factorized matrix, 0 without a factor.
+  [[nodiscard]] int rows() const;
 
  private:
   /// Whether the point moves with the unknowns; throws as documented above.
@@ -109,8 +110,7 @@ class EffectiveContactStiffness {
   void solve_columns(const ContactInterpolation& point, ResponseMatrix& response);
 
   std::unique_ptr<CholmodFactor> m_factor;
-  int m_loaded_rows = 0;
-  int m_rows = 0;  ///< of the factorized matrix, 0 without a factor
+  bool m_loaded = false;  ///< the factor holds a matrix the last load() copied (not one before a failed load)
   Eigen::VectorXd m_column;
   Eigen::VectorXd m_solution;
   ResponseMatrix m_response;
@@ -141,8 +141,14 @@ ContactStiffnessRequest contact_stiffness_request(const ShiftedSystem& system, c
 std::optional<Eigen::Matrix3d> condense_loaded(EffectiveContactStiffness& effective,
                                                const ContactStiffnessRequest& request);
 
-/// K_c of the tissue alone at `point` from `system`, factorized into `effective` (load, then
-/// condense_loaded). A point on fixed vertices only is a rigid support: `rigid_support_n_per_m` I.
+/// K_c of `request` from `system`, loaded into `effective` and condensed (condense_loaded); nothing
+/// when `system` cannot be loaded either.
+std::optional<Eigen::Matrix3d> condensed_contact_stiffness(EffectiveContactStiffness& effective,
+                                                          const ShiftedSystem& system,
+                                                          const ContactStiffnessRequest& request);
+
+/// K_c of the tissue alone at `point` from `system`, factorized into `effective` (the request made
+/// by contact_stiffness_request, then condensed as above). A point on fixed vertices only is a rigid support: `rigid_support_n_per_m` I.
 /// Nothing when the factor fails, or when K_c is not finite or its smallest eigenvalue is not above
 /// `floor_n_per_m`.
 std::optional<Eigen::Matrix3d> condensed_contact_stiffness(EffectiveContactStiffness& effective,

@@ -196,7 +196,7 @@ int CholeskyPcgSolver::symbolic_analysis_count() const {
 void CholeskyPcgSolver::setup(const ShiftedSystem& system) {
   Impl& impl = *m_impl;
   impl.system = ShiftedSystem{nullptr, 1.0, nullptr};
-  check_system(system, WHO);
+  system.check(WHO);
   const long n = system.rows();
   ++impl.counters.setups;
   if (impl.in_flight && ++impl.setups_since_start >= impl.refresh.pickup_setups) impl.pick_up(n);

@@ -27,13 +27,7 @@ bool CholmodSolver::is_set_up() const { return m_impl->factored_system.stiffness
 void CholmodSolver::setup(const ShiftedSystem& system) {
   Impl& impl = *m_impl;
   impl.factored_system = ShiftedSystem{nullptr, 1.0, nullptr};
-  if (system.stiffness == nullptr || system.diagonal == nullptr)
-    throw SolverError("CholmodSolver: the system has no stiffness or no diagonal");
-  const long n = system.rows();
-  if (system.diagonal->size() != n) {
-    throw SolverError("CholmodSolver: the diagonal d has length " + std::to_string(system.diagonal->size()) +
-                      ", the system has " + std::to_string(n) + " rows");
-  }
+  system.check("CholmodSolver");
   impl.factor.load(system);
   if (impl.factor.factorize() != CholmodFactor::Status::ok) {
     throw SolverError(impl.factor.failure_message("CholmodSolver"));

@@ -31,7 +31,9 @@ struct ShiftedSystem {
   void multiply(const Eigen::VectorXd& x, Eigen::VectorXd& y) const;
   /// The block rows [first_block_row, end_block_row) of y = A x (y has length rows() already).
   void multiply_rows(const Eigen::VectorXd& x, Eigen::VectorXd& y, int first_block_row, int end_block_row) const;
-  /// Throws SolverError unless K and d are set, and d, b and x all have length rows().
+  /// Throws SolverError ("<who>: ...") unless K and d are set and d has length rows().
+  void check(std::string_view who) const;
+  /// Throws SolverError unless check() passes and b and x have length rows().
   void check_sizes(const Eigen::VectorXd& b, const Eigen::VectorXd& x) const;
 };
 

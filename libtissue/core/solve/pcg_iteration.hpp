@@ -23,8 +23,6 @@ namespace tissue {
 
 /// Throws SolverError (prefixed by `who`) unless tolerance >= 0 (finite) and max_iterations >= 0.
 void validate_pcg_settings(const PcgSolver::Settings& settings, const char* who);
-/// Throws SolverError unless K and d are set and d has length rows().
-void check_system(const ShiftedSystem& system, const char* who);
 /// 1 / diag(A), length rows() (resized if needed); throws SolverError for an entry <= 0 or not finite.
 void jacobi_inverse_diagonal(const ShiftedSystem& system, Eigen::VectorXd& inverse_diagonal, const char* who);
 

@@ -29,16 +29,6 @@ void jacobi_inverse_diagonal(const ShiftedSystem& system, Eigen::VectorXd& inver
   }
 }
 
-void check_system(const ShiftedSystem& system, const char* who) {
-  if (system.stiffness == nullptr || system.diagonal == nullptr)
-    throw SolverError(std::string(who) + ": the system has no stiffness or no diagonal");
-  const long n = system.rows();
-  if (system.diagonal->size() != n) {
-    throw SolverError(std::string(who) + ": the diagonal d has length " + std::to_string(system.diagonal->size()) +
-                      ", the system has " + std::to_string(n) + " rows");
-  }
-}
-
 PcgSolver::PcgSolver(Settings settings) : m_settings(settings) {
   validate_pcg_settings(settings, "PcgSolver");
   m_work.matrix = HalfMatrix(resolved_precision(settings.matrix_precision, settings.tolerance));
@@ -46,7 +36,7 @@ PcgSolver::PcgSolver(Settings settings) : m_settings(settings) {
 
 void PcgSolver::setup(const ShiftedSystem& system) {
   m_system = ShiftedSystem{nullptr, 1.0, nullptr};
-  check_system(system, "PcgSolver");
+  system.check("PcgSolver");
   m_work.resize(system.rows());  // the only allocations: when the system grows
   // Jacobi preconditioner from the diagonal of A; taken at each setup as K changes every step.
   jacobi_inverse_diagonal(system, m_inverse_diagonal, "PcgSolver");

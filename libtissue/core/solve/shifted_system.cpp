@@ -30,15 +30,27 @@ void ShiftedSystem::multiply_rows(const Eigen::VectorXd& x, Eigen::VectorXd& y, 
   shift_rows(*this, x, y, first_block_row, end_block_row);
 }
 
+namespace {
+
+std::string length_mismatch(std::string_view who, const char* what, long size, long rows) {
+  return std::string(who) + ": " + what + " has length " + std::to_string(size) + ", the system has " +
+         std::to_string(rows) + " rows";
+}
+
+}  // namespace
+
+void ShiftedSystem::check(std::string_view who) const {
+  if (stiffness == nullptr || diagonal == nullptr) {
+    throw SolverError(std::string(who) + ": the system has no stiffness or no diagonal");
+  }
+  if (diagonal->size() != rows()) throw SolverError(length_mismatch(who, "the diagonal d", diagonal->size(), rows()));
+}
+
 void ShiftedSystem::check_sizes(const Eigen::VectorXd& b, const Eigen::VectorXd& x) const {
-  if (stiffness == nullptr || diagonal == nullptr)
-    throw SolverError("linear solve: the system has no stiffness or no diagonal");
+  constexpr std::string_view who = "linear solve";
+  check(who);
   const long n = rows();
-  const auto describe = [n](const char* what, long size) {
-    return std::string("linear solve: ") + what + " has length " + std::to_string(size) + ", the system has " +
-           std::to_string(n) + " rows";
-  };
-  if (diagonal->size() != n) throw SolverError(describe("the diagonal d", diagonal->size()));
+  const auto describe = [n, who](const char* what, long size) { return length_mismatch(who, what, size, n); };
   if (b.size() != n) throw SolverError(describe("the right-hand side b", b.size()));
   if (x.size() != n) throw SolverError(describe("the initial guess x", x.size()));
 }
