@@ -55,7 +55,7 @@ std::string tool_mode_name(ToolMode mode) {
   return mode == ToolMode::probe ? "probe" : mode == ToolMode::scalpel ? "scalpel" : "none";
 }
 
-// The keyword arguments of the constructor, with the core's defaults where it has them.
+// The keyword arguments of the constructor and their defaults (the one place they are written).
 struct Options {
   std::string mesh = "frog";
   std::optional<std::array<int, 3>> box_cells;  // a box of cubes instead of a mesh
@@ -265,6 +265,7 @@ PYBIND11_MODULE(tissue, m) {
   py::register_exception<IntegrationError>(m, "IntegrationError", PyExc_RuntimeError);
   py::register_exception<StateError>(m, "StateError", PyExc_RuntimeError);
 
+  const Options d;  // the keyword arguments' defaults
   py::class_<PyTissue>(m, "Tissue")
       .def(py::init([](const std::string& mesh, std::optional<std::array<int, 3>> box, double box_edge_m,
                        std::optional<std::vector<int>> fixed_vertices, int fixed_axis, double fixed_fraction,
@@ -299,15 +300,17 @@ PYBIND11_MODULE(tissue, m) {
              o.render_surface = render_surface;
              return PyTissue(o);
            }),
-           py::kw_only(), py::arg("mesh") = "frog", py::arg("box") = py::none(), py::arg("box_edge_m") = 0.01,
-           py::arg("fixed_vertices") = py::none(), py::arg("fixed_axis") = 0, py::arg("fixed_fraction") = 0.01,
-           py::arg("young_modulus_pa") = 1e5, py::arg("poisson_ratio") = 0.4, py::arg("density_kg_per_m3") = 1000.0,
-           py::arg("damping_alpha_per_s") = 1.0, py::arg("damping_beta_s") = 1e-3,
-           py::arg("gravity_m_per_s2") = std::array<double, 3>{0.0, 0.0, -9.81}, py::arg("step_size_s") = 1e-3,
-           py::arg("integrator") = "backward-euler", py::arg("linear_solver") = "pcg",
-           py::arg("pcg_tolerance") = 1e-3, py::arg("pcg_max_iterations") = 10, py::arg("threads") = 1,
-           py::arg("contact") = true, py::arg("cutting") = true, py::arg("blade_length_m") = 0.03,
-           py::arg("probe_radius_m") = 0.0, py::arg("render_surface") = "",
+           py::kw_only(), py::arg("mesh") = d.mesh, py::arg("box") = py::none(), py::arg("box_edge_m") = d.box_edge_m,
+           py::arg("fixed_vertices") = py::none(), py::arg("fixed_axis") = d.fixed_axis,
+           py::arg("fixed_fraction") = d.fixed_fraction, py::arg("young_modulus_pa") = d.young_modulus_pa,
+           py::arg("poisson_ratio") = d.poisson_ratio, py::arg("density_kg_per_m3") = d.density_kg_per_m3,
+           py::arg("damping_alpha_per_s") = d.damping_alpha_per_s, py::arg("damping_beta_s") = d.damping_beta_s,
+           py::arg("gravity_m_per_s2") = d.gravity_m_per_s2, py::arg("step_size_s") = d.step_size_s,
+           py::arg("integrator") = d.integrator, py::arg("linear_solver") = d.linear_solver,
+           py::arg("pcg_tolerance") = d.pcg_tolerance, py::arg("pcg_max_iterations") = d.pcg_max_iterations,
+           py::arg("threads") = d.threads, py::arg("contact") = d.contact, py::arg("cutting") = d.cutting,
+           py::arg("blade_length_m") = d.blade_length_m, py::arg("probe_radius_m") = d.probe_radius_m,
+           py::arg("render_surface") = d.render_surface,
            "A tissue: mesh 'frog' (embedded) or a file path, or box=(nx, ny, nz) cubes of box_edge_m; fixed "
            "vertices by index, or those within fixed_fraction of the extent from the minimum along fixed_axis; "
            "render_surface 'frog' (the embedded frog's fine surface) or an OBJ file to draw, riding on the tets")

@@ -170,6 +170,14 @@ void read_scenario_table(const Reader& r, const toml::table& root, const std::fi
   if (s.duration_s > 24.0 * 3600.0) r.fail("scenario.duration", "longer than a day");
 }
 
+// A default the host gives an FMU: `setting` unless the scenario sets that parameter itself.
+void add_unless_set(std::vector<ParameterSetting>& parameters, ParameterSetting setting) {
+  if (std::none_of(parameters.begin(), parameters.end(),
+                   [&](const ParameterSetting& p) { return p.name == setting.name; })) {
+    parameters.push_back(std::move(setting));
+  }
+}
+
 // [tissue] (optional): the FMU, the communication step, the parameters and a mesh file.
 void read_tissue(const Reader& r, const toml::table& root, const std::filesystem::path& base, Scenario& s) {
   if (const toml::table* tissue = root["tissue"].as_table()) {
@@ -189,18 +197,11 @@ void read_tissue(const Reader& r, const toml::table& root, const std::filesystem
   }
   // Unless the scenario says otherwise, one internal step per communication step: the frog's
   // backward-Euler step at 10 ms is stable and takes a fraction of its slot (docs/BENCHMARKS.md).
-  if (std::none_of(s.tissue_parameters.begin(), s.tissue_parameters.end(),
-                   [](const ParameterSetting& p) { return p.name == "stepSize"; })) {
-    s.tissue_parameters.push_back(ParameterSetting{"stepSize", s.tissue_step_s});
-  }
+  add_unless_set(s.tissue_parameters, ParameterSetting{"stepSize", s.tissue_step_s});
   // The host runs beside the tissue's threads anyway: our Tissue.fmu refreshes its contact stiffness
   // in a worker, off the step's 10 ms slot (a CHOLMOD factorization: ~7 ms on the frog), unless the
   // scenario says otherwise. Another tissue FMU is given only what the scenario says.
-  if (s.tissue_fmu.empty() &&
-      std::none_of(s.tissue_parameters.begin(), s.tissue_parameters.end(),
-                   [](const ParameterSetting& p) { return p.name == "contact.stiffnessInBackground"; })) {
-    s.tissue_parameters.push_back(ParameterSetting{"contact.stiffnessInBackground", true});
-  }
+  if (s.tissue_fmu.empty()) add_unless_set(s.tissue_parameters, ParameterSetting{"contact.stiffnessInBackground", true});
 }
 
 // [haptic] (optional): the FMU, the period, the parameters; the tissue step a whole number of periods.
