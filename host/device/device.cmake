@@ -5,6 +5,8 @@
 add_library(tissue_host_device STATIC
   ${CMAKE_CURRENT_LIST_DIR}/scripted_device.cpp
   ${CMAKE_CURRENT_LIST_DIR}/replay_device.cpp
+  ${CMAKE_CURRENT_LIST_DIR}/force_watchdog.cpp
+  ${CMAKE_CURRENT_LIST_DIR}/socket_address.cpp
   ${CMAKE_CURRENT_LIST_DIR}/udp_packet.cpp
   ${CMAKE_CURRENT_LIST_DIR}/udp_device.cpp
   ${CMAKE_CURRENT_LIST_DIR}/simulated_hand.cpp

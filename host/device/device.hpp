@@ -3,7 +3,8 @@
 // A device turns the user's hand into a pose and commands a force back to it. The host's haptic
 // thread calls read() and write_force() once per 1 kHz tick, so both must be real-time safe: no
 // allocation, no blocking, no exception. Devices: scripted (scenario waypoints), replay (CSV),
-// udp (a bridge to a separate driver process, see device/UDP_PROTOCOL.md). Nothing here knows
+// udp (a bridge to a separate driver process, see device/UDP_PROTOCOL.md), openigtlink
+// (igtl/OPENIGTLINK.md). Nothing here knows
 // about FMI or the tissue core: the host maps a DevicePose onto the FMU inputs.
 #pragma once
 
@@ -23,12 +24,13 @@ struct DevicePose {
   ToolMode mode = ToolMode::none;
 };
 
-/// Every packet or sample the device saw, and those it dropped, by reason. For a device that
-/// receives packets: received = accepted + malformed + out_of_order + duplicate + stale.
-/// watchdog_trips counts the times the input went silent and the force was ramped down.
+/// Every packet or message the device saw, and those it dropped, by reason. For a device that
+/// receives packets: received = accepted + malformed + oversized + out_of_order + duplicate + stale
+/// + ignored (oversized and ignored: OpenIGTLink messages too large to read, of another type or
+/// device name). watchdog_trips counts the times the input went silent and the force was ramped down.
 struct DeviceCounters {
-  std::uint64_t received = 0, accepted = 0, malformed = 0, out_of_order = 0, duplicate = 0, stale = 0,
-                watchdog_trips = 0;
+  std::uint64_t received = 0, accepted = 0, malformed = 0, oversized = 0, out_of_order = 0, duplicate = 0, stale = 0,
+                ignored = 0, watchdog_trips = 0;
 };
 
 /// A haptic input device. read() and write_force() belong to the haptic thread; the time passed

@@ -3,12 +3,13 @@
 //
 // Loopback only unless allow_remote is set. read() drains the socket without blocking and keeps
 // the newest valid pose; malformed, out-of-order, duplicate and stale packets are dropped and
-// counted. write_force() answers the sender of the newest accepted pose. A watchdog driven by
-// the session time passed to read()/write_force() (not by a wall clock, so that it is
-// reproducible) ramps the force to zero when accepted poses stop arriving.
+// counted. write_force() answers the sender of the newest accepted pose. A ForceWatchdog driven
+// by the session time passed to read()/write_force() ramps the force to zero when accepted poses
+// stop arriving.
 #pragma once
 
 #include "device/device.hpp"
+#include "device/force_watchdog.hpp"
 #include "device/udp_packet.hpp"
 
 #include <sys/socket.h>
@@ -31,10 +32,10 @@ struct UdpDeviceSettings {
   std::uint16_t port = udp::DEFAULT_PORT;
   /// Listen on a non-loopback address: anyone who can reach it moves the tool.
   bool allow_remote = false;
-  /// Session time without an accepted pose after which the force ramps down.
-  double watchdog_timeout_s = 0.050;
+  /// Session time without an accepted pose after which the force ramps down (ForceWatchdog).
+  double watchdog_timeout_s = ForceWatchdogSettings{}.timeout_s;
   /// Time of a full ramp between scale 1 and 0, in both directions (0: a step).
-  double ramp_time_s = 0.100;
+  double ramp_time_s = ForceWatchdogSettings{}.ramp_time_s;
   /// A packet whose one-way delay (receive - send time) exceeds the smallest one seen by more
   /// than this is stale (UDP_PROTOCOL.md "Stale packets").
   double stale_window_s = 0.020;
@@ -79,7 +80,7 @@ class UdpDevice final : public Device {
   /// The bound port (the ephemeral one when settings.port was 0).
   [[nodiscard]] std::uint16_t local_port() const { return m_local_port; }
   /// The factor in [0, 1] applied to the force at the last read()/write_force() time. Haptic thread only.
-  [[nodiscard]] double watchdog_scale() const { return m_scale; }
+  [[nodiscard]] double watchdog_scale() const { return m_watchdog.scale(); }
   /// Safe to call from any thread.
   [[nodiscard]] UdpSocketErrors socket_errors() const;
 
@@ -89,7 +90,6 @@ class UdpDevice final : public Device {
   static constexpr std::size_t RECEIVE_BUFFER_SIZE = 2048;
 
  private:
-  void advance_watchdog(double time_s);
   void handle_datagram(std::size_t size, double time_s, const sockaddr_storage& from, socklen_t from_length);
   void note_socket_error(int error, const char* call);
   static void bump(std::atomic<std::uint64_t>& counter);
@@ -101,19 +101,12 @@ class UdpDevice final : public Device {
   std::array<std::uint8_t, RECEIVE_BUFFER_SIZE> m_receive_buffer{};
 
   // Stream state (haptic thread only).
-  bool m_connected = false;  // a pose was accepted since construction or since the last trip
-  bool m_tripped = false;    // the watchdog tripped and no pose was accepted since
+  ForceWatchdog m_watchdog;
   std::uint64_t m_last_sequence = 0;
-  double m_last_accept_time_s = 0.0;
   DevicePose m_pose;
   sockaddr_storage m_peer{};
   socklen_t m_peer_length = 0;
   std::uint64_t m_force_sequence = 0;
-
-  // Watchdog ramp (haptic thread only).
-  double m_scale = 0.0;
-  double m_scale_time_s = 0.0;
-  bool m_scale_time_set = false;
 
   // One-way delay floor over two periods (UDP_PROTOCOL.md "Stale packets").
   double m_delay_floor_current_s = std::numeric_limits<double>::infinity();
@@ -122,7 +115,7 @@ class UdpDevice final : public Device {
 
   // Written by the haptic thread, read by any thread.
   std::atomic<std::uint64_t> m_received{0}, m_accepted{0}, m_malformed{0}, m_out_of_order{0}, m_duplicate{0},
-      m_stale{0}, m_watchdog_trips{0}, m_socket_errors{0};
+      m_stale{0}, m_socket_errors{0};
   std::atomic<int> m_first_errno{0};
   std::atomic<const char*> m_first_error_call{""};
 };

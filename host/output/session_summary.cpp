@@ -68,8 +68,9 @@ std::string SessionSummary::to_json() const {
   j["nan_detected"] = nan_detected;
   j["device"] = {{"name", device_name},         {"received", device.received},
                  {"accepted", device.accepted}, {"malformed", device.malformed},
-                 {"out_of_order", device.out_of_order}, {"duplicate", device.duplicate},
-                 {"stale", device.stale},       {"watchdog_trips", device.watchdog_trips}};
+                 {"oversized", device.oversized}, {"out_of_order", device.out_of_order},
+                 {"duplicate", device.duplicate}, {"stale", device.stale},
+                 {"ignored", device.ignored},   {"watchdog_trips", device.watchdog_trips}};
   if (hand) {
     j["hand"] = {{"settle_time_s", hand->settle_time_s},
                  {"settle_speed_m_per_s", hand->settle_speed_m_per_s},
@@ -89,6 +90,16 @@ std::string SessionSummary::to_json() const {
                  {"malformed", view_malformed}, {"oversized", view_oversized},
                  {"flood", view_flood}, {"out_of_order", view_out_of_order},
                  {"withdrawals", view_withdrawals}};
+  }
+  if (openigtlink) {
+    const IgtlCounters& c = *openigtlink;
+    j["openigtlink"] = {{"connections", c.connections}, {"refused_connections", c.refused_connections},
+                        {"received", c.received},       {"accepted", c.accepted},
+                        {"malformed", c.malformed},     {"oversized", c.oversized},
+                        {"out_of_order", c.out_of_order}, {"duplicate", c.duplicate},
+                        {"ignored", c.ignored},         {"forces_sent", c.forces_sent},
+                        {"forces_dropped", c.forces_dropped}, {"surfaces_sent", c.surfaces_sent},
+                        {"surfaces_skipped", c.surfaces_skipped}};
   }
   j["realtime_priority"] = realtime_priority;
   j["realtime_priority_note"] = realtime_priority_note;
@@ -118,6 +129,13 @@ void print_summary(std::ostream& out, const SessionSummary& s, const std::filesy
         << ", residual speed " << s.hand->residual_speed_m_per_s * 1e3 << " mm/s, chatter "
         << s.hand->chatter_frequency_hz << " Hz x " << s.hand->chatter_amplitude_m * 1e3
         << " mm, device work on the hand " << s.hand->device_work_j << " J\n";
+  }
+  if (s.openigtlink) {
+    const IgtlCounters& c = *s.openigtlink;
+    out << "  openigtlink: " << c.connections << " connection(s), " << c.accepted << " of " << c.received
+        << " messages accepted (malformed " << c.malformed << ", oversized " << c.oversized << ", out of order "
+        << c.out_of_order << ", duplicate " << c.duplicate << ", ignored " << c.ignored << "), forces sent "
+        << c.forces_sent << ", surfaces sent " << c.surfaces_sent << "\n";
   }
   if (!s.first_error.empty()) out << "  first error: " << s.first_error << "\n";
   out << "  outputs in " << output_dir.string() << ": summary.json, log.csv, ";

@@ -5,6 +5,7 @@
 
 #include "device/device.hpp"
 #include "device/hand_device.hpp"
+#include "device/igtl_counters.hpp"
 
 #include <cstdint>
 #include <filesystem>
@@ -43,6 +44,7 @@ struct SessionSummary {
   bool view = false;
   std::uint64_t view_connections = 0, view_frames_sent = 0, view_frames_skipped = 0, view_messages = 0,
                 view_malformed = 0, view_oversized = 0, view_flood = 0, view_out_of_order = 0, view_withdrawals = 0;
+  std::optional<IgtlCounters> openigtlink;  ///< the OpenIGTLink server's, when the session had one
   bool realtime_priority = false;
   std::string realtime_priority_note;
   std::string first_error;

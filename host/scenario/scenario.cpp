@@ -264,6 +264,12 @@ HandSettings read_hand(const Reader& r, const toml::table& device) {
   return hand;
 }
 
+std::uint16_t port_number(const Reader& r, const toml::node& node, const std::string& key) {
+  const double port = r.number(node, key);
+  if (port < 1 || port > 65535 || port != std::floor(port)) r.fail(key, "must be in 1..65535");
+  return static_cast<std::uint16_t>(port);
+}
+
 // [device]: scripted (waypoints), hand (waypoints held by a simulated hand), replay (a --record
 // file), udp (address, port) or browser.
 DeviceConfig read_device(const Reader& r, const toml::table& root, const std::filesystem::path& base) {
@@ -294,18 +300,53 @@ DeviceConfig read_device(const Reader& r, const toml::table& root, const std::fi
   } else if (kind_name == "udp") {
     config.kind = DeviceKind::udp;
     if (const toml::node* n = device->get("address")) config.udp_address = r.string(*n, "device.address");
-    if (const toml::node* n = device->get("port")) {
-      const double port = r.number(*n, "device.port");
-      if (port < 1 || port > 65535 || port != std::floor(port)) r.fail("device.port", "must be in 1..65535");
-      config.udp_port = static_cast<std::uint16_t>(port);
-    }
+    if (const toml::node* n = device->get("port")) config.udp_port = port_number(r, *n, "device.port");
     if (const toml::node* n = device->get("allow_remote"))
       config.udp_allow_remote = r.boolean(*n, "device.allow_remote");
   } else if (kind_name == "browser") {
     config.kind = DeviceKind::browser;  // the live view's mouse and keyboard (--view)
+  } else if (kind_name == "openigtlink") {
+    config.kind = DeviceKind::openigtlink;  // the [openigtlink] server's client
   } else {
-    r.fail("device.kind",
-           "must be \"scripted\", \"hand\", \"replay\", \"udp\" or \"browser\", got \"" + kind_name + "\"");
+    r.fail("device.kind", "must be \"scripted\", \"hand\", \"replay\", \"udp\", \"browser\" or \"openigtlink\", got \"" +
+                              kind_name + "\"");
+  }
+  if (kind_name != "udp") {
+    for (const char* key : {"address", "port", "allow_remote"}) {
+      if (device->contains(key)) {
+        r.fail(std::string("device.") + key,
+               kind_name == "openigtlink" ? "goes in the [openigtlink] table" : "is for kind = \"udp\" only");
+      }
+    }
+  }
+  return config;
+}
+
+// [openigtlink] (optional; the device kind "openigtlink" takes its defaults without it): the server.
+OpenIgtlinkConfig read_openigtlink(const Reader& r, const toml::table& table) {
+  r.only(table, "openigtlink",
+         {"address", "port", "allow_remote", "length_unit", "probe_transform", "scalpel_transform", "surface_rate"});
+  OpenIgtlinkConfig config;
+  if (const toml::node* n = table.get("address")) config.address = r.string(*n, "openigtlink.address");
+  if (const toml::node* n = table.get("port")) config.port = port_number(r, *n, "openigtlink.port");
+  if (const toml::node* n = table.get("allow_remote")) config.allow_remote = r.boolean(*n, "openigtlink.allow_remote");
+  if (const toml::node* n = table.get("length_unit")) {
+    config.length_unit_m = r.number(*n, "openigtlink.length_unit");
+    if (!(config.length_unit_m > 0.0 && config.length_unit_m <= 1.0)) {
+      r.fail("openigtlink.length_unit", "must be in (0, 1] m (metres per unit on the wire: 0.001 for mm)");
+    }
+  }
+  for (auto [key, name] : {std::pair{"probe_transform", &config.probe_transform},
+                           std::pair{"scalpel_transform", &config.scalpel_transform}}) {
+    if (const toml::node* n = table.get(key)) {
+      *name = r.string(*n, std::string("openigtlink.") + key);  // checked by the server (igtl_codec.cpp)
+    }
+  }
+  if (const toml::node* n = table.get("surface_rate")) {
+    config.surface_rate_hz = r.number(*n, "openigtlink.surface_rate");
+    if (config.surface_rate_hz < 0.0 || config.surface_rate_hz > 1000.0) {
+      r.fail("openigtlink.surface_rate", "must be in [0, 1000] Hz");
+    }
   }
   return config;
 }
@@ -369,7 +410,7 @@ Scenario parse_scenario(const std::string& text, const std::filesystem::path& or
   const Reader r(origin.string());
   const toml::table root = parse_toml(text, origin);
   // [compare] belongs to tissue-host compare (host/compare/compare_settings.*), which reads it itself.
-  r.only(root, "", {"scenario", "tissue", "haptic", "device", "realtime", "output", "expect", "compare"});
+  r.only(root, "", {"scenario", "tissue", "haptic", "device", "openigtlink", "realtime", "output", "expect", "compare"});
   Scenario s;
   s.file = origin;
   const std::filesystem::path base = origin.has_parent_path() ? origin.parent_path() : std::filesystem::path(".");
@@ -377,6 +418,11 @@ Scenario parse_scenario(const std::string& text, const std::filesystem::path& or
   read_tissue(r, root, base, s);
   read_haptic(r, root, base, s);
   s.device = read_device(r, root, base);
+  if (const toml::table* igtl = root["openigtlink"].as_table()) {
+    s.openigtlink = read_openigtlink(r, *igtl);
+  } else if (s.device.kind == DeviceKind::openigtlink) {
+    s.openigtlink = OpenIgtlinkConfig{};
+  }
   if (const toml::table* realtime = root["realtime"].as_table()) read_realtime(r, *realtime, s);
   if (const toml::table* output = root["output"].as_table()) read_output(r, *output, s);
   if (const toml::table* expect = root["expect"].as_table()) s.expect = read_expect(r, *expect);

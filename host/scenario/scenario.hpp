@@ -42,7 +42,7 @@ struct Waypoint {
   ToolMode mode = ToolMode::none;
 };
 
-enum class DeviceKind { scripted, hand, replay, udp, browser };
+enum class DeviceKind { scripted, hand, replay, udp, browser, openigtlink };
 
 struct DeviceConfig {
   DeviceKind kind = DeviceKind::scripted;
@@ -52,6 +52,18 @@ struct DeviceConfig {
   std::string udp_address = "127.0.0.1";
   std::uint16_t udp_port = 47001;
   bool udp_allow_remote = false;
+};
+
+/// The OpenIGTLink server ([openigtlink]; host/igtl/OPENIGTLINK.md): the pose in (device kind
+/// "openigtlink"), the force back, the surface out as POLYDATA.
+struct OpenIgtlinkConfig {
+  std::string address = "127.0.0.1";
+  std::uint16_t port = 18944;
+  bool allow_remote = false;
+  double length_unit_m = 1e-3;  ///< metres per length unit on the wire (3D Slicer and PLUS: mm)
+  std::string probe_transform = "ProbeToTissue";
+  std::string scalpel_transform = "ScalpelToTissue";
+  double surface_rate_hz = 30.0;  ///< POLYDATA per second (0: none)
 };
 
 /// What a tissue step that overran its slot leads to (never silent: overruns are counted).
@@ -85,6 +97,8 @@ struct Scenario {
   double haptic_period_s = 0.001;
   std::vector<ParameterSetting> haptic_parameters;
   DeviceConfig device;
+  /// Set when the scenario has an [openigtlink] table or the device kind "openigtlink".
+  std::optional<OpenIgtlinkConfig> openigtlink;
   // Real time.
   OverrunPolicy overrun_policy = OverrunPolicy::catch_up;
   int max_catch_up_slots = 4;

@@ -8,6 +8,6 @@ target_include_directories(tissue_host_session PUBLIC ${PROJECT_SOURCE_DIR}/host
 target_compile_features(tissue_host_session PUBLIC cxx_std_20)
 target_link_libraries(tissue_host_session
   PUBLIC tissue::fmi_importer tissue::host_scenario tissue::host_device tissue::host_links tissue::host_output
-         tissue::host_sync tissue::host_view tissue::host_schedule Threads::Threads
+         tissue::host_sync tissue::host_view tissue::host_schedule tissue::host_igtl Threads::Threads
   PRIVATE tissue::warnings)
 

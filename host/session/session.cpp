@@ -72,8 +72,9 @@ class Session final : public SessionSteps {
         m_blade_depth_slot(m_relay.layout().slot("cut.bladeDepth")),
         m_step_sample(m_relay.make_sample()),
         m_last_outputs(m_relay.make_sample()),
+        m_igtl(make_igtl_server(scenario)),
         m_device(make_device(options.browser_device ? browser_config() : scenario.device, m_tissue,
-                             scenario.haptic_period_s)),
+                             scenario.haptic_period_s, m_igtl)),
         m_schedule(make_schedule(scenario)) {
     if (options.view && options.offline) throw ScenarioError("--view: the live view needs a real-time run, not --offline");
     if (!options.view && dynamic_cast<BrowserDevice*>(m_device.get()) != nullptr) {
@@ -235,6 +236,10 @@ class Session final : public SessionSteps {
   }
 
   void tissue_sample_published(double time_s) override {
+    if (m_igtl && m_igtl->surface_due(time_s)) {
+      fill_frame(m_igtl->surface_buffer(), time_s);
+      m_igtl->publish_surface(time_s);
+    }
     if (!m_view) return;
     m_view->publish_tissue(TissueLive{time_s, m_step_s.empty() ? 0.0 : m_step_s.back(), m_step_sample.cut_tets});
     if (m_view->frame_due()) {
@@ -248,11 +253,13 @@ class Session final : public SessionSteps {
   }
   void capture_frame(SurfaceFrame& frame, double time_s) override {
     fill_frame(frame, time_s);
-    m_next_frame_s += 1.0 / m_scenario.frame_rate_hz;
+    // The next recorded frame is the first one due after this one (not a period past it).
+    while (m_next_frame_s <= time_s + 1e-9) m_next_frame_s += 1.0 / m_scenario.frame_rate_hz;
   }
   void frame_dropped() override { m_next_frame_s += 1.0 / m_scenario.frame_rate_hz; }
   void reserve_frame(SurfaceFrame& frame) override { m_tissue.reserve(frame); }
-  // The surface, the tool and the contact at `time_s` (the recording's frames and the live view's).
+  // The surface, the tool and the contact at `time_s` (the recording's frames, the live view's and
+  // the OpenIGTLink surfaces; each keeps its own rate).
   void fill_frame(SurfaceFrame& frame, double time_s) {
     m_tissue.read_surface(frame);
     frame.time_s = time_s;
@@ -267,7 +274,6 @@ class Session final : public SessionSteps {
     frame.contact_active = m_last_outputs.flag(m_contact_slot);
     frame.contact_point_m = m_last_outputs.vector3(m_point_slot);
     frame.force_n = m_last_outputs.vector3(m_force_slot);
-    while (m_next_frame_s <= time_s + 1e-9) m_next_frame_s += 1.0 / m_scenario.frame_rate_hz;
   }
 
   std::uint64_t cut_tets() const override { return m_cut_tets.load(std::memory_order_relaxed); }
@@ -312,6 +318,7 @@ class Session final : public SessionSteps {
     m_summary.passivity_dissipated_j = last.dissipated_energy_j;
     m_summary.passivity_observed_j = last.observed_energy_j;
     m_summary.device = m_device->counters();
+    if (m_igtl) m_summary.openigtlink = m_igtl->counters();
     if (const auto* hand = dynamic_cast<const HandDevice*>(m_device.get())) m_summary.hand = hand->figures();
     m_summary.nan_detected = m_haptic_nan || m_tissue_nan || !std::isfinite(m_summary.max_device_force_n);
     if (!m_options.write_outputs) return;
@@ -338,6 +345,7 @@ class Session final : public SessionSteps {
   SampleSlot m_contact_slot, m_point_slot, m_force_slot, m_blade_depth_slot;
   TissueSample m_step_sample;   // dynamics thread's: the step's sample, until published
   TissueSample m_last_outputs;  // dynamics thread's: the last step's sample
+  std::shared_ptr<IgtlServer> m_igtl;  // [openigtlink]: the device's and the surface stream's
   std::unique_ptr<Device> m_device;
   std::unique_ptr<LiveView> m_view;          // --view
   Schedule m_schedule;

@@ -5,6 +5,7 @@
 #include "device/replay_device.hpp"
 #include "device/scripted_device.hpp"
 #include "device/udp_device.hpp"
+#include "igtl/igtl_device.hpp"
 #include "view/browser_device.hpp"
 
 #include <vector>
@@ -33,7 +34,8 @@ std::vector<DeviceWaypoint> device_waypoints(const DeviceConfig& config, const T
 
 }  // namespace
 
-std::unique_ptr<Device> make_device(const DeviceConfig& config, const TissueLink& tissue, double haptic_period_s) {
+std::unique_ptr<Device> make_device(const DeviceConfig& config, const TissueLink& tissue, double haptic_period_s,
+                                    const std::shared_ptr<IgtlServer>& igtl) {
   switch (config.kind) {
     case DeviceKind::scripted:
       return std::make_unique<ScriptedDevice>(device_waypoints(config, tissue));
@@ -55,8 +57,29 @@ std::unique_ptr<Device> make_device(const DeviceConfig& config, const TissueLink
       settings.allow_remote = config.udp_allow_remote;
       return std::make_unique<UdpDevice>(settings);
     }
+    case DeviceKind::openigtlink:
+      if (igtl == nullptr) throw ScenarioError("device: kind \"openigtlink\" without an OpenIGTLink server");
+      return std::make_unique<IgtlDevice>(igtl);
   }
   throw ScenarioError("device: unknown kind");
+}
+
+std::shared_ptr<IgtlServer> make_igtl_server(const Scenario& scenario) {
+  if (!scenario.openigtlink) return nullptr;
+  const OpenIgtlinkConfig& c = *scenario.openigtlink;
+  IgtlServerSettings settings;
+  settings.address = c.address;
+  settings.port = c.port;
+  settings.allow_remote = c.allow_remote;
+  settings.codec.length_unit_m = c.length_unit_m;
+  settings.codec.probe_transform = c.probe_transform;
+  settings.codec.scalpel_transform = c.scalpel_transform;
+  settings.surface_rate_hz = c.surface_rate_hz;
+  try {
+    return std::make_shared<IgtlServer>(settings);
+  } catch (const std::invalid_argument& e) {
+    throw ScenarioError(scenario.file.string() + ": [openigtlink]: " + e.what());
+  }
 }
 
 DeviceConfig browser_config() {

@@ -23,3 +23,15 @@ add_executable(test_simulated_hand ${CMAKE_CURRENT_LIST_DIR}/test_simulated_hand
 target_link_libraries(test_simulated_hand PRIVATE tissue::host_device GTest::gtest GTest::gtest_main tissue::warnings)
 target_include_directories(test_simulated_hand PRIVATE ${PROJECT_SOURCE_DIR}/tests)
 gtest_discover_tests(test_simulated_hand PROPERTIES LABELS "host" DISCOVERY_TIMEOUT 60)
+
+# OpenIGTLink (host/igtl/): messages, server and device over loopback with a client built on the
+# same Debian library; and tissue-igtl-client, a scripted client for trying a session by hand.
+add_library(tissue_igtl_test_client STATIC ${CMAKE_CURRENT_LIST_DIR}/igtl_client.cpp)
+target_include_directories(tissue_igtl_test_client PUBLIC ${CMAKE_CURRENT_LIST_DIR})
+target_link_libraries(tissue_igtl_test_client PUBLIC tissue::host_device PRIVATE tissue_openigtlink tissue::warnings)
+add_executable(test_igtl ${CMAKE_CURRENT_LIST_DIR}/test_igtl.cpp)
+target_link_libraries(test_igtl PRIVATE tissue::host_igtl tissue_igtl_test_client tissue_openigtlink GTest::gtest
+                      GTest::gtest_main tissue::warnings)
+gtest_discover_tests(test_igtl PROPERTIES LABELS "host" DISCOVERY_TIMEOUT 60)
+add_executable(tissue-igtl-client ${CMAKE_CURRENT_LIST_DIR}/igtl_client_main.cpp)
+target_link_libraries(tissue-igtl-client PRIVATE tissue_igtl_test_client tissue::warnings)

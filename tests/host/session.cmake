@@ -31,3 +31,19 @@ target_compile_definitions(test_host_session_udp PRIVATE TISSUE_SCENARIO_DIR="${
                                                          TISSUE_FMU_DIR="${CMAKE_BINARY_DIR}/fmus")
 add_dependencies(test_host_session_udp tissue_fmu_package hapticloop_fmu_package)
 gtest_discover_tests(test_host_session_udp PROPERTIES LABELS "host" DISCOVERY_TIMEOUT 60)
+
+# OpenIGTLink end to end through a real-time session, with the library-built client as the tracker.
+add_executable(test_host_session_igtl ${CMAKE_CURRENT_LIST_DIR}/test_session_igtl.cpp)
+target_include_directories(test_host_session_igtl PRIVATE ${PROJECT_SOURCE_DIR}/tests)
+target_link_libraries(test_host_session_igtl PRIVATE tissue::host_session tissue_igtl_test_client GTest::gtest
+                                                     GTest::gtest_main tissue::warnings)
+target_compile_definitions(test_host_session_igtl PRIVATE TISSUE_SCENARIO_DIR="${PROJECT_SOURCE_DIR}/host/scenarios"
+                                                          TISSUE_FMU_DIR="${CMAKE_BINARY_DIR}/fmus")
+add_dependencies(test_host_session_igtl tissue_fmu_package hapticloop_fmu_package)
+gtest_discover_tests(test_host_session_igtl PROPERTIES LABELS "host" DISCOVERY_TIMEOUT 60)
+
+# docs/SLICER.md's runnable example: tissue-host and tissue-igtl-client on loopback port 18944.
+add_test(NAME SlicerHowTo.TissueHostAndAnOpenIgtlinkClient
+         COMMAND ${CMAKE_CURRENT_LIST_DIR}/slicer_howto.sh $<TARGET_FILE:tissue-host> $<TARGET_FILE:tissue-igtl-client>
+                 ${PROJECT_SOURCE_DIR} ${CMAKE_CURRENT_BINARY_DIR}/slicer_howto)
+set_tests_properties(SlicerHowTo.TissueHostAndAnOpenIgtlinkClient PROPERTIES LABELS "host" TIMEOUT 60)

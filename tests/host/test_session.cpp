@@ -177,6 +177,27 @@ SurfaceShape shape_of(const std::vector<std::uint32_t>& triangles) {
 // the held half's opening uncapped (226 border edges in the last frame); and a crack tip smeared
 // over split points on no piece's side (the front meeting the surface obliquely) left the slit's
 // walls uncapped at 1.8 s (97).
+// The recording keeps the scenario's frame rate: a frame every 1/rate of simulated time (it wrote
+// one every two periods, 31 frames for 2 s at 30 Hz, before the fix).
+TEST(Frames, TheRecordingKeepsTheScenariosFrameRate) {
+  Scenario scenario = load_scenario(SCENARIOS / "poke_frog.toml");
+  ASSERT_EQ(scenario.frame_rate_hz, 30.0);
+  ASSERT_EQ(scenario.duration_s, 2.0);
+  const SessionSummary s = run_offline(scenario, fresh_dir("frame_rate"));
+  EXPECT_GE(s.frames_written, 60u);  // frames at 0, 1/30, ..., 2 s: 60 or 61 by where the run ends
+  EXPECT_LE(s.frames_written, 61u);
+}
+
+TEST(ScenarioFile, TheSlicerScenarioListensForOpenIgtlinkInMillimetres) {
+  const Scenario scenario = load_scenario(SCENARIOS / "slicer_frog.toml");
+  EXPECT_EQ(scenario.device.kind, DeviceKind::openigtlink);
+  ASSERT_TRUE(scenario.openigtlink.has_value());
+  EXPECT_EQ(scenario.openigtlink->address, "127.0.0.1");
+  EXPECT_EQ(scenario.openigtlink->port, 18944);
+  EXPECT_EQ(scenario.openigtlink->length_unit_m, 0.001);
+  EXPECT_EQ(scenario.openigtlink->probe_transform, "ProbeToTissue");
+}
+
 TEST(RenderSurface, TheCompleteCutDrawsTheFrogClosedInEveryFrameAndInTwoPiecesAtTheEnd) {
   const Scenario scenario = load_scenario(SCENARIOS / "cut_frog_complete.toml");
   const std::filesystem::path dir = fresh_dir("render_complete");
@@ -416,6 +437,12 @@ TEST(ScenarioFile, MistakesAreRefusedNamingTheKey) {
   refused("[scenario]\nduration = 1.0\n[device]\nwaypoints = [ { t = 0.0, position = [0, 0, 0], mode = \"knife\" } ]\n",
           "mode");
   refused("[scenario]\nduration = 1.0\n[device]\nkind = \"joystick\"\n", "device.kind");
+  const std::string igtl = "[scenario]\nduration = 1.0\n[device]\nkind = \"openigtlink\"\n";
+  refused(igtl + "[openigtlink]\nport = 70000\n", "openigtlink.port");
+  refused(igtl + "[openigtlink]\nlength_unit = 0\n", "openigtlink.length_unit");
+  refused(igtl + "[openigtlink]\nsurface_rate = -1\n", "openigtlink.surface_rate");
+  refused(igtl + "[openigtlink]\nprobe = \"X\"\n", "openigtlink.probe");
+  refused(igtl + "port = 18944\n", "device.port");
   refused("[scenario\nduration = 1.0\n", "test.toml:1");
   refused("[scenario]\nduration = 1.0\n[device]\nkind = \"udp\"\nport = 70000\n", "device.port");
   // A simulated hand's settings: refused with the key and the allowed range; only for a hand.

@@ -1,0 +1,212 @@
+// OpenIGTLink end to end through tissue-host in real time (issue 24): a client built on Debian's
+// libopenigtlink (tests/host/igtl_client.*), as 3D Slicer or PLUS would be, sends a press of the
+// frog's back as TRANSFORM messages in millimetres at 1 kHz over loopback, with bad messages mixed
+// in, then goes silent; the session runs both FMUs on their threads. Checked: the force the client
+// reads back is the force of the same path run by the scripted device (offline), within the
+// host's timing (one tissue slot and the network); the surface arrives as POLYDATA; every bad
+// message is dropped, counted and changes nothing; silence zeroes the force.
+#include "igtl_client.hpp"
+#include "scenario/scenario.hpp"
+#include "session/session.hpp"
+#include "support/under_sanitizer.hpp"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <sstream>
+#include <string>
+#include <thread>
+#include <vector>
+
+namespace tissue::host {
+namespace {
+
+constexpr int PORT = 47393;
+constexpr double PRESS_S = 0.5, HOLD_UNTIL_S = 1.0;
+
+// The press: from 1 cm above the frog's back (near z = 0.036 m, meshes/frog.veg) to 3 mm into it
+// in PRESS_S, held until HOLD_UNTIL_S.
+DevicePose press_pose(double time_s) {
+  DevicePose pose;
+  pose.mode = ToolMode::probe;
+  pose.position_m = {-0.007, 0.0, 0.046 - 0.013 * std::min(1.0, time_s / PRESS_S)};
+  return pose;
+}
+
+struct LogRow {
+  double time_s = 0.0;
+  double device_z_m = 0.0;
+  std::array<double, 3> force_n{};
+};
+
+std::vector<LogRow> read_log(const std::filesystem::path& file) {
+  std::ifstream log(file);
+  std::string line;
+  std::getline(log, line);
+  std::vector<LogRow> rows;
+  while (std::getline(log, line)) {
+    std::vector<double> fields;
+    std::stringstream row(line);
+    for (std::string field; std::getline(row, field, ',');) fields.push_back(std::stod(field));
+    rows.push_back({fields.at(0), fields.at(3), {fields.at(8), fields.at(9), fields.at(10)}});
+  }
+  return rows;
+}
+
+std::filesystem::path fresh_dir(const std::string& name) {
+  const std::filesystem::path dir = std::filesystem::temp_directory_path() / ("tissue_host_test_" + name);
+  std::filesystem::remove_all(dir);
+  return dir;
+}
+
+// The same path run by the scripted device, offline, @p lead_s ahead of session time as the
+// client's was (so that the tissue's slots fall on the same points of the path).
+std::vector<LogRow> scripted_run(double lead_s) {
+  const double start_z = press_pose(lead_s).position_m[2];
+  const std::string text =
+      "[scenario]\nduration = 1.6\n[device]\nkind = \"scripted\"\nwaypoints = [\n"
+      "  { t = 0.0, position = [-0.007, 0.0, " +
+      std::to_string(start_z) +
+      "], mode = \"probe\" },\n"
+      "  { t = " +
+      std::to_string(PRESS_S - lead_s) +
+      ", position = [-0.007, 0.0, 0.033], mode = \"probe\" },\n"
+      "  { t = 1.6, position = [-0.007, 0.0, 0.033], mode = \"probe\" },\n]\n"
+      "[output]\nframe_rate = 0\npng = false\n";
+  const Scenario scenario = parse_scenario(text, std::filesystem::path(TISSUE_SCENARIO_DIR) / "igtl_scripted.toml");
+  SessionOptions options;
+  options.offline = true;
+  options.output_dir = fresh_dir("igtl_scripted");
+  options.fmu_dir = TISSUE_FMU_DIR;
+  run_session(scenario, options);
+  return read_log(options.output_dir / "log.csv");
+}
+
+TEST(IgtlSession, APressFromAnOpenIgtlinkClientFeelsLikeTheScriptedPressAndShowsTheSurface) {
+  const std::string text =
+      "[scenario]\nduration = 1.6\n[device]\nkind = \"openigtlink\"\n[openigtlink]\nport = " + std::to_string(PORT) +
+      "\nsurface_rate = 20\n[output]\nframe_rate = 0\npng = false\n";
+  const Scenario scenario = parse_scenario(text, std::filesystem::path(TISSUE_SCENARIO_DIR) / "igtl_test.toml");
+  SessionOptions options;
+  options.output_dir = fresh_dir("igtl");
+  options.fmu_dir = TISSUE_FMU_DIR;
+  options.realtime_priority = false;
+  std::atomic<bool> session_started{false};
+  options.haptic_thread_started = [&] { session_started.store(true); };
+
+  std::vector<test::ReceivedForce> forces;
+  std::optional<test::ReceivedSurface> surface;
+  std::size_t surfaces = 0;
+  std::thread client_thread([&] {
+    test::IgtlClient client("127.0.0.1", PORT);  // the server listens from the session's start
+    while (!session_started.load()) std::this_thread::sleep_for(std::chrono::microseconds(200));
+    const auto start = std::chrono::steady_clock::now();
+    std::uint64_t timestamp = 1ULL << 32U;
+    for (int n = 0; n < 1000; ++n) {
+      const DevicePose pose = press_pose(n * 1e-3);
+      client.send_transform("ProbeToTissue", pose, 1e-3, ++timestamp);
+      if (n == 300) {
+        DevicePose far = pose;
+        far.position_m = {0.5, 0.5, 0.5};
+        std::vector<std::uint8_t> corrupted = test::pack_transform("ProbeToTissue", far, 1e-3, timestamp + 1);
+        corrupted[70] ^= 0x10U;  // a body byte: the CRC fails
+        client.send_raw(corrupted);
+        client.send_transform("ProbeToTissue", far, 1e-3, timestamp - 5);    // out of order
+        client.send_transform("ProbeToTissue", far, 1e-3, timestamp);        // duplicate
+        client.send_transform("NeedleToTracker", far, 1e-3, timestamp + 1);  // another tool: ignored
+      }
+      std::this_thread::sleep_until(start + std::chrono::microseconds(1000 * (n + 1)));
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(500));  // silence
+    forces = client.forces();
+    surface = client.last_surface();
+    surfaces = client.surface_count();
+  });
+  const SessionSummary s = run_session(scenario, options);
+  client_thread.join();
+
+  EXPECT_FALSE(s.nan_detected);
+  EXPECT_EQ(s.tissue_errors, 0u) << s.first_error;
+  EXPECT_EQ(s.device_name, "openigtlink 127.0.0.1:" + std::to_string(PORT));
+  EXPECT_GE(s.device.accepted, 900u);  // of 1000 (a few may share a millisecond's read)
+  EXPECT_EQ(s.device.malformed, 1u);
+  EXPECT_EQ(s.device.out_of_order, 1u);
+  EXPECT_EQ(s.device.duplicate, 1u);
+  EXPECT_EQ(s.device.ignored, 1u);
+  EXPECT_EQ(s.device.watchdog_trips, 1u);
+  ASSERT_TRUE(s.openigtlink.has_value());
+  EXPECT_EQ(s.openigtlink->connections, 1u);
+
+  // The forces and the surface came back.
+  EXPECT_GT(forces.size(), 800u);
+  EXPECT_TRUE(std::all_of(forces.begin(), forces.end(), [](const test::ReceivedForce& f) { return f.unit_is_newton; }));
+  EXPECT_GE(surfaces, 10u);  // 20 Hz over ~1.5 s
+  ASSERT_TRUE(surface.has_value());
+  EXPECT_EQ(surface->name, "TissueSurface");
+  EXPECT_GT(surface->polygons, 1000u);
+  // In millimetres: the frog is ~126 mm long.
+  float x_min = 1e9F, x_max = -1e9F;
+  for (const auto& p : surface->point_list) {
+    x_min = std::min(x_min, p[0]);
+    x_max = std::max(x_max, p[0]);
+  }
+  EXPECT_NEAR(x_max - x_min, 126.0F, 10.0F);
+
+  const std::vector<LogRow> rows = read_log(options.output_dir / "log.csv");
+  // Silence: the force sent is exactly zero from 150 ms (timeout 50 + ramp 100) after the last pose.
+  double last_nonzero_s = 0.0;
+  for (const LogRow& r : rows) {
+    if (r.force_n != std::array<double, 3>{0.0, 0.0, 0.0}) last_nonzero_s = r.time_s;
+  }
+  EXPECT_LT(last_nonzero_s, HOLD_UNTIL_S + 0.150 + 0.050) << "the watchdog did not zero the force in time";
+
+  // The force matches the scripted run of the same path within the host's timing. The client's
+  // clock starts when the haptic thread does, some ms from session time 0: the lead is read off the
+  // poses the device delivered (the path is known) and the scripted path given the same lead, so
+  // that both runs have the path at the same session times. Then the tissue's result reaches the
+  // haptic loop within one slot (10 ms) of the offline worst case, and a pose crosses loopback
+  // within a few ms (5 ms allowed): at each tick of the press and hold the OpenIGTLink force lies
+  // within the scripted force's range over that window, give or take 2% of the peak.
+  if (tissue::test::UNDER_SANITIZER || s.tissue_overruns > 0) {
+    GTEST_SKIP() << "the tissue did not keep pace (" << s.tissue_overruns
+                 << " overruns): the timing comparison needs a run on its deadlines";
+  }
+  std::vector<double> offsets;
+  for (const LogRow& r : rows) {
+    if (r.time_s >= 0.05 && r.time_s <= PRESS_S - 0.05) offsets.push_back((0.046 - r.device_z_m) / 0.026 - r.time_s);
+  }
+  ASSERT_GT(offsets.size(), 300u);
+  std::nth_element(offsets.begin(), offsets.begin() + offsets.size() / 2, offsets.end());
+  const double offset_s = offsets[offsets.size() / 2];
+  std::cout << "the client's path runs " << offset_s * 1e3 << " ms ahead of session time\n";
+  ASSERT_LT(std::abs(offset_s), 0.1);
+  const std::vector<LogRow> scripted = scripted_run(offset_s);
+  double peak = 0.0;
+  for (const LogRow& r : scripted) peak = std::max(peak, std::abs(r.force_n[2]));
+  ASSERT_GT(peak, 0.5) << "the scripted press did not touch the frog";
+  const double window_s = 0.010 + 0.005, slack_n = 0.02 * peak;
+  std::size_t compared = 0, outside = 0;
+  for (const LogRow& r : rows) {
+    if (r.time_s < 0.05 || r.time_s > HOLD_UNTIL_S - 0.05) continue;
+    double lo = 1e9, hi = -1e9;
+    for (const LogRow& q : scripted) {
+      if (std::abs(q.time_s - r.time_s) <= window_s + 1e-9) {
+        lo = std::min(lo, q.force_n[2]);
+        hi = std::max(hi, q.force_n[2]);
+      }
+    }
+    ++compared;
+    if (r.force_n[2] < lo - slack_n || r.force_n[2] > hi + slack_n) ++outside;
+  }
+  EXPECT_GT(compared, 850u);
+  EXPECT_LE(outside, compared / 100) << outside << " of " << compared << " ticks outside the scripted band";
+}
+
+}  // namespace
+}  // namespace tissue::host
