@@ -22,7 +22,9 @@ constexpr auto UNITS = std::to_array<UnitDefinition>({
     {"N.s/m", 1, 0, -1},
 });
 
-std::string escaped(std::string_view text) {
+}  // namespace
+
+std::string xml_escaped(std::string_view text) {
   std::string out;
   out.reserve(text.size());
   for (const char c : text) {
@@ -46,13 +48,7 @@ std::string escaped(std::string_view text) {
   return out;
 }
 
-void attribute(std::ostream& out, std::string_view name, std::string_view value) {
-  if (!value.empty()) out << ' ' << name << "=\"" << escaped(value) << '"';
-}
-
-std::string element_name(VariableType type) { return std::string(to_string(type)); }
-
-void write_units(std::ostream& out, const ModelDescription& description) {
+void write_unit_definitions(std::ostream& out, const ModelDescription& description) {
   std::vector<std::string_view> used;
   for (const VariableInfo& info : description.variables) {
     if (info.unit.empty()) continue;
@@ -65,7 +61,7 @@ void write_units(std::ostream& out, const ModelDescription& description) {
   out << "  <UnitDefinitions>\n";
   for (const UnitDefinition& unit : UNITS) {  // in the table's order
     if (std::ranges::find(used, unit.name) == used.end()) continue;
-    out << "    <Unit name=\"" << escaped(unit.name) << "\"><BaseUnit";
+    out << "    <Unit name=\"" << xml_escaped(unit.name) << "\"><BaseUnit";
     if (unit.kg != 0) out << " kg=\"" << unit.kg << '"';
     if (unit.m != 0) out << " m=\"" << unit.m << '"';
     if (unit.s != 0) out << " s=\"" << unit.s << '"';
@@ -73,6 +69,16 @@ void write_units(std::ostream& out, const ModelDescription& description) {
   }
   out << "  </UnitDefinitions>\n\n";
 }
+
+namespace {
+
+std::string escaped(std::string_view text) { return xml_escaped(text); }
+
+void attribute(std::ostream& out, std::string_view name, std::string_view value) {
+  if (!value.empty()) out << ' ' << name << "=\"" << escaped(value) << '"';
+}
+
+std::string element_name(VariableType type) { return std::string(to_string(type)); }
 
 void write_enumerations(std::ostream& out, const ModelDescription& description) {
   if (description.enumerations.empty()) return;
@@ -166,7 +172,7 @@ std::string model_description_xml(const ModelDescription& description) {
          "    canSerializeFMUState=\"true\"\n    providesIntermediateUpdate=\"false\"\n"
          "    canReturnEarlyAfterIntermediateUpdate=\"false\"\n    hasEventMode=\"false\"\n"
          "    providesEvaluateDiscreteStates=\"false\"/>\n\n";
-  write_units(out, description);
+  write_unit_definitions(out, description);
   write_enumerations(out, description);
   out << "  <LogCategories>\n";
   for (const LogCategory& category : description.log_categories) {

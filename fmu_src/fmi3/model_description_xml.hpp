@@ -7,8 +7,10 @@
 
 #include "fmi3/variable_table.hpp"
 
+#include <iosfwd>
 #include <stdexcept>
 #include <string>
+#include <string_view>
 
 namespace tissue::fmi3 {
 
@@ -21,5 +23,11 @@ class SchemaError : public std::runtime_error {
 
 /// The modelDescription.xml of `description` (FMI 3.0, Co-Simulation). Throws SchemaError.
 std::string model_description_xml(const ModelDescription& description);
+
+// Shared with the FMI 2.0 writer (fmi2/model_description_xml.cpp), whose XML has the same units.
+/// `text` with & < > " escaped for an attribute.
+std::string xml_escaped(std::string_view text);
+/// <UnitDefinitions> of the units the variables use, in SI base units. Throws SchemaError for an unknown unit.
+void write_unit_definitions(std::ostream& out, const ModelDescription& description);
 
 }  // namespace tissue::fmi3

@@ -29,6 +29,7 @@ constexpr std::array<StateMask, static_cast<std::size_t>(Call::count)> ALLOWED =
     /* free_fmu_state */ ANY_BUT_FATAL | FATAL,
     /* serialize_fmu_state */ INITIALIZATION | STEP | TERMINATED | ERROR,
     /* do_step */ STEP,
+    /* setup_experiment */ INSTANTIATED,
     /* not_offered */ 0,
 };
 
@@ -57,7 +58,7 @@ void check_call(Call call, State state, std::string_view function) {
   if ((allowed & mask(state)) != 0) return;
   std::string message = std::string(function) + " is not allowed in the " + std::string(to_string(state)) + " state";
   if (allowed != 0) message += " (only in " + describe(allowed) + ")";
-  if (state == State::error) message += "; after an error only fmi3SetFMUState, fmi3Reset or fmi3FreeInstance lead on";
+  if (state == State::error) message += "; after an error only SetFMUState, Reset or FreeInstance lead on";
   throw CallOrderError(message);
 }
 

@@ -40,6 +40,7 @@ enum class Call : std::uint8_t {
   free_fmu_state,
   serialize_fmu_state,  ///< SerializedFMUStateSize, SerializeFMUState, DeserializeFMUState
   do_step,
+  setup_experiment,  ///< FMI 2.0's fmi2SetupExperiment (fmi2/): before initialization only
   not_offered,  ///< a function of an interface or feature the FMU does not offer
   count
 };

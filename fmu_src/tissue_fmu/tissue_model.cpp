@@ -340,6 +340,7 @@ void TissueModel::get_float64(const VariableInfo& info, std::span<double> out) {
   };
   switch (static_cast<Vr>(info.vr)) {
     case Vr::time:
+    case Vr::sample_time:
       out[0] = m_start_time_s + tissue.time_s();
       return;
     case Vr::contact_point: {

@@ -90,6 +90,7 @@ enum class Vr : std::uint32_t {
   render_surface = 78,       // issue 22
   step_threads = 79,         // issue 23
   contact_stiffness_in_background = 80,  // issue 23
+  sample_time = 81,                      // issue 24: for masters that cannot connect `time`
   tool_applied_position = ports::sample_field("tool.appliedPosition").tissue_vr
 };
 
@@ -325,6 +326,11 @@ constexpr auto outputs() {
     output(Vr::integrator_iterations, "integrator.iterations", uint64, discrete)
         .describe("Iterations of the integrator so far: PCG iterations (backward Euler with PCG), IDA's Newton "
                   "iterations plus its GMRES iterations (IDA); a direct solve counts none"),
+    output(Vr::sample_time, "sample.time", float64, continuous)
+        .unit("s")
+        .describe("The tissue time the outputs are for (the communication point reached), as an output: a "
+                  "co-simulation master that cannot connect the independent variable (FMI 2.0, SSP) connects "
+                  "this to the haptic loop's tissue.time"),
 });
 }
 

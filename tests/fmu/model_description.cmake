@@ -33,3 +33,15 @@ gtest_discover_tests(test_port_schema PROPERTIES LABELS "fmu" DISCOVERY_TIMEOUT 
 add_executable(test_fmi3_checks ${CMAKE_CURRENT_LIST_DIR}/test_fmi3_checks.cpp)
 target_link_libraries(test_fmi3_checks PRIVATE tissue::fmi3 GTest::gtest GTest::gtest_main tissue::warnings)
 gtest_discover_tests(test_fmi3_checks PROPERTIES LABELS "fmu" DISCOVERY_TIMEOUT 60)
+
+# test_fmi2: the FMI 2.0 variants beside the 3.0 FMUs (both loaded with dlopen): the XML against
+# the FMI 2.0 schema, the same outputs bit for bit, FMU states, element-wise sets, bad calls.
+add_executable(test_fmi2 ${CMAKE_CURRENT_LIST_DIR}/test_fmi2.cpp)
+target_link_libraries(test_fmi2 PRIVATE tissue::fmi2 tissue::ssp tissue::fmi2_abi tissue::fmi3_abi tissue::tissue_fmu_variables
+                                        tissue::haptic_loop_variables GTest::gtest GTest::gtest_main ${CMAKE_DL_LIBS}
+                                        tissue::warnings)
+target_compile_definitions(test_fmi2 PRIVATE TISSUE_FMU_DIR="${CMAKE_BINARY_DIR}/fmus" TISSUE_SSP_DIR="${CMAKE_BINARY_DIR}/ssp"
+                                             TISSUE_FMI2_SCHEMA_DIR="${PROJECT_SOURCE_DIR}/../shared/fmi/schema/fmi2")
+add_dependencies(test_fmi2 tissue_fmu_package hapticloop_fmu_package tissue_fmi2_fmu_package hapticloop_fmi2_fmu_package
+                 tissue_ssp_package)
+gtest_discover_tests(test_fmi2 PROPERTIES LABELS "fmu" DISCOVERY_TIMEOUT 60)
