@@ -1,6 +1,7 @@
 // The Python module `tissue` (pybind11) over the core: a Tissue made from a mesh (the embedded frog,
 // a .veg, .node/.ele or .msh file, or a box of cubes) with material, damping, gravity, the fixed
-// region and the integrator as keyword arguments in SI units; step it, move the probe or the
+// region and the integrator as keyword arguments in SI units, or from a tissue-host scenario (its
+// Tissue FMU parameters, through the FMU's own store and builder; its scripted hand's path); step it, move the probe or the
 // scalpel, read the state, the contact, the drawn surface and the cut state as numpy arrays, save
 // and restore the state as bytes. Errors come back as Python exceptions with the core's message:
 // ValueError for a bad setting or pose, RuntimeError for a failed step or a state that cannot be
@@ -10,13 +11,22 @@
 #include "core/mesh/mesh_io.hpp"
 #include "core/tissue.hpp"
 #include "core/tissue_snapshot_io.hpp"
+#include "device/scripted_device.hpp"
+#include "fmi3/value_store.hpp"
 #include "resources/default_mesh.hpp"
+#include "scenario/scenario.hpp"
+#include "tissue_fmu/tissue_model.hpp"
+#include "tissue_fmu/variables.hpp"
 
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
+#include <algorithm>
 #include <array>
+#include <climits>
+#include <cstdint>
+#include <variant>
 #include <memory>
 #include <optional>
 #include <string>
@@ -85,6 +95,7 @@ struct Options {
 // A Tissue behind a pointer: restoring a state with other cuts replaces it (restore_or_replay).
 class PyTissue {
  public:
+  explicit PyTissue(std::unique_ptr<Tissue> tissue) : m_tissue(std::move(tissue)) {}
   explicit PyTissue(const Options& options) {
     TetMesh mesh = options.box_cells ? make_box_mesh((*options.box_cells)[0], (*options.box_cells)[1],
                                                      (*options.box_cells)[2], options.box_edge_m)
@@ -142,6 +153,7 @@ class PyTissue {
   }
 
   [[nodiscard]] double time_s() const { return m_tissue->time_s(); }
+  [[nodiscard]] const Tissue& core() const { return *m_tissue; }
   [[nodiscard]] int vertex_count() const { return m_tissue->body().mesh().vertex_count(); }
   [[nodiscard]] int tet_count() const { return m_tissue->body().mesh().tet_count(); }
   [[nodiscard]] int dof_count() const { return m_tissue->body().dof_count(); }
@@ -253,6 +265,118 @@ class PyTissue {
   std::unique_ptr<Tissue> m_tissue;
 };
 
+// One scenario parameter into the Tissue FMU's stored values, checked as the FMU's set checks it
+// (the variable's type, finiteness, an enumeration's items, by name or value).
+void write_parameter(fmi3::ValueStore& store, const fmi3::ModelDescription& description, const host::ParameterSetting& p) {
+  using fmi3::VariableType;
+  const fmi3::VariableInfo* info = description.find(p.name);
+  const std::string key = "tissue.parameters." + p.name;
+  if (info == nullptr) throw host::ScenarioError(key + ": the Tissue has no such variable");
+  if (info->causality != fmi3::Causality::parameter) throw host::ScenarioError(key + ": not a parameter");
+  const auto* number = std::get_if<double>(&p.value);
+  const auto* integer = std::get_if<std::int64_t>(&p.value);
+  const auto* flag = std::get_if<bool>(&p.value);
+  const auto* text = std::get_if<std::string>(&p.value);
+  const auto* numbers = std::get_if<std::vector<double>>(&p.value);
+  try {
+    if (info->type == VariableType::float64 && numbers != nullptr) {
+      store.write<double>(*info, *numbers);
+    } else if (info->type == VariableType::float64 && (number != nullptr || integer != nullptr)) {
+      const double value = number != nullptr ? *number : static_cast<double>(*integer);
+      store.write<double>(*info, std::span<const double>(&value, 1));
+    } else if (info->type == VariableType::int32 && integer != nullptr) {
+      if (*integer < INT32_MIN || *integer > INT32_MAX) throw host::ScenarioError(key + ": out of the Int32 range");
+      const auto value = static_cast<std::int32_t>(*integer);
+      store.write<std::int32_t>(*info, std::span<const std::int32_t>(&value, 1));
+    } else if (info->type == VariableType::boolean && flag != nullptr) {
+      const bool value = *flag;
+      store.write<bool>(*info, std::span<const bool>(&value, 1));
+    } else if (info->type == VariableType::string && text != nullptr) {
+      const char* value = text->c_str();
+      store.write<const char*>(*info, std::span<const char* const>(&value, 1));
+    } else if (info->type == VariableType::enumeration && (integer != nullptr || text != nullptr)) {
+      std::int64_t item = integer != nullptr ? *integer : -1;
+      if (text != nullptr) {
+        const fmi3::EnumerationType* type = description.find_enumeration(info->declared_type);
+        const auto found = std::find_if(type->items.begin(), type->items.end(),
+                                        [&](const fmi3::EnumerationItem& i) { return i.name == *text; });
+        if (found == type->items.end()) {
+          throw host::ScenarioError(key + ": \"" + *text + "\" is not an item of " + std::string(info->declared_type));
+        }
+        item = found->value;
+      }
+      store.write<std::int64_t>(*info, std::span<const std::int64_t>(&item, 1));
+    } else {
+      throw host::ScenarioError(key + ": the value does not fit the variable's type " +
+                                std::string(fmi3::to_string(info->type)));
+    }
+  } catch (const fmi3::VariableError& error) {
+    throw host::ScenarioError(key + ": " + error.what());
+  }
+}
+
+// A tissue-host scenario: its tissue as the Tissue FMU would build it from the scenario's
+// parameters, and its scripted hand's path.
+class PyScenario {
+ public:
+  explicit PyScenario(const std::string& file)
+      : m_scenario(host::load_scenario(file)), m_values(tissue_fmu::tissue_model_description()) {
+    if (!m_scenario.tissue_fmu.empty()) {
+      throw host::ScenarioError(file + ": tissue.fmu names another FMU; only the built-in Tissue's parameters are known here");
+    }
+    m_values.set_starts();
+    for (const host::ParameterSetting& p : m_scenario.tissue_parameters) {
+      write_parameter(m_values, tissue_fmu::tissue_model_description(), p);
+    }
+    (void)tissue_fmu::tissue_settings(m_values, nullptr);  // the core's range checks, now rather than later
+  }
+
+  [[nodiscard]] PyTissue tissue() {
+    PyTissue made(tissue_fmu::make_tissue(m_values, m_scenario.file.parent_path().string()));
+    if (!m_rest_box) {
+      std::array<double, 3> lower{1e300, 1e300, 1e300}, upper{-1e300, -1e300, -1e300};
+      for (const Eigen::Vector3d& x : made.core().body().mesh().rest_positions_m) {
+        for (std::size_t a = 0; a < 3; ++a) {
+          lower[a] = std::min(lower[a], x[static_cast<Eigen::Index>(a)]);
+          upper[a] = std::max(upper[a], x[static_cast<Eigen::Index>(a)]);
+        }
+      }
+      m_rest_box = {lower, upper};
+      m_device = std::make_unique<host::ScriptedDevice>(host::placed_waypoints(m_scenario.device, lower, upper));
+    }
+    return made;
+  }
+
+  // The scripted hand at time t: (position_m, orientation_wxyz, mode), as set_tool takes them.
+  [[nodiscard]] py::tuple tool_at(double time_s) {
+    const host::DeviceKind kind = m_scenario.device.kind;
+    if (kind != host::DeviceKind::scripted && kind != host::DeviceKind::hand) {
+      throw host::ScenarioError("tool_at: the scenario's device is not scripted waypoints");
+    }
+    if (!m_device) (void)tissue();  // the waypoints need the rest box
+    const host::DevicePose pose = m_device->read(time_s);
+    return py::make_tuple(vector3(to_vector3(pose.position_m)),
+                          py::make_tuple(pose.orientation_wxyz[0], pose.orientation_wxyz[1], pose.orientation_wxyz[2],
+                                         pose.orientation_wxyz[3]),
+                          tool_mode_name(pose.mode));
+  }
+
+  [[nodiscard]] const host::Scenario& scenario() const { return m_scenario; }
+  [[nodiscard]] py::dict tissue_parameters() const {
+    py::dict out;
+    for (const host::ParameterSetting& p : m_scenario.tissue_parameters) {
+      std::visit([&](const auto& v) { out[py::str(p.name)] = py::cast(v); }, p.value);
+    }
+    return out;
+  }
+
+ private:
+  host::Scenario m_scenario;
+  fmi3::ValueStore m_values;
+  std::optional<std::pair<std::array<double, 3>, std::array<double, 3>>> m_rest_box;
+  std::unique_ptr<host::ScriptedDevice> m_device;
+};
+
 }  // namespace
 }  // namespace tissue::python
 
@@ -264,6 +388,8 @@ PYBIND11_MODULE(tissue, m) {
   py::register_exception<ParameterError>(m, "ParameterError", PyExc_ValueError);
   py::register_exception<IntegrationError>(m, "IntegrationError", PyExc_RuntimeError);
   py::register_exception<StateError>(m, "StateError", PyExc_RuntimeError);
+  py::register_exception<host::ScenarioError>(m, "ScenarioError", PyExc_ValueError);
+  py::register_exception<fmi3::VariableError>(m, "VariableError", PyExc_ValueError);
 
   const Options d;  // the keyword arguments' defaults
   py::class_<PyTissue>(m, "Tissue")
@@ -340,4 +466,22 @@ PYBIND11_MODULE(tissue, m) {
       .def("cut_faces", &PyTissue::cut_faces, "The faces the cuts opened (k x 3, into surface()'s points)")
       .def("save", &PyTissue::save, "The state as bytes (what FMI's serialized FMU state holds)")
       .def("restore", &PyTissue::restore, py::arg("state"), "Restores a state save() gave, cuts and all");
+
+  using tissue::python::PyScenario;
+  py::class_<PyScenario>(m, "Scenario")
+      .def(py::init<const std::string&>(), py::arg("file"),
+           "A tissue-host scenario file (TOML, host/README.md): its tissue parameters are checked as the Tissue FMU "
+           "checks them")
+      .def("tissue", &PyScenario::tissue,
+           "A new Tissue as the scenario's Tissue FMU builds it (mesh, material, integrator, contact, ...)")
+      .def("tool_at", &PyScenario::tool_at, py::arg("time_s"),
+           "The scripted hand at time_s: (position_m, orientation_wxyz, mode), for Tissue.set_tool")
+      .def_property_readonly("name", [](const PyScenario& s) { return s.scenario().name; })
+      .def_property_readonly("description", [](const PyScenario& s) { return s.scenario().description; })
+      .def_property_readonly("duration_s", [](const PyScenario& s) { return s.scenario().duration_s; })
+      .def_property_readonly("tissue_step_s", [](const PyScenario& s) { return s.scenario().tissue_step_s; },
+                             "The communication step (tissue-host steps the tissue once per slot)")
+      .def_property_readonly("haptic_period_s", [](const PyScenario& s) { return s.scenario().haptic_period_s; })
+      .def_property_readonly("tissue_parameters", &PyScenario::tissue_parameters,
+                             "The Tissue FMU parameters the scenario sets, by name");
 }

@@ -134,31 +134,50 @@ void TissueModel::update_near_surface() {
 
 // --- the model ---
 
-void TissueModel::build() {
-  const std::string& name = m_values.string(vr(Vr::mesh));
+namespace {
+
+std::string resolve_path(const std::string& name, const char* what, const std::string& resource_path) {
+  std::filesystem::path path(name);
+  if (path.is_relative()) {
+    if (resource_path.empty()) {
+      throw VariableError(std::string(what) + " '" + name + "' is relative, but no resource path was given");
+    }
+    path = std::filesystem::path(resource_path) / path;
+  }
+  return path.string();
+}
+
+}  // namespace
+
+std::unique_ptr<Tissue> make_tissue(const ValueStore& values, const std::string& resource_path) {
+  const std::string& name = values.string(vr(Vr::mesh));
   if (name.empty()) throw VariableError("mesh must be a non-empty name or path");
   TetMesh mesh;
   if (name == DEFAULT_MESH_NAME) {
     mesh = load_default_mesh();
   } else {
     try {
-      mesh = load_mesh(resolve_path(name, "mesh"));
+      mesh = load_mesh(resolve_path(name, "mesh", resource_path));
     } catch (const std::exception& error) {
       throw VariableError("mesh '" + name + "' cannot be loaded: " + error.what());
     }
   }
-  TissueSettings settings = tissue_settings(m_values, &mesh);
-  if (const std::string& render = m_values.string(vr(Vr::render_surface)); render != NO_RENDER_SURFACE) {
+  TissueSettings settings = tissue_settings(values, &mesh);
+  if (const std::string& render = values.string(vr(Vr::render_surface)); render != NO_RENDER_SURFACE) {
     try {
-      TriangleSurface surface =
-          load_render_surface(render == DEFAULT_MESH_NAME ? render : resolve_path(render, "surface.renderSurface"));
+      TriangleSurface surface = load_render_surface(
+          render == DEFAULT_MESH_NAME ? render : resolve_path(render, "surface.renderSurface", resource_path));
       surface.source_name = "surface.renderSurface " + surface.source_name;  // the embedding's messages name both
       settings.render_surface = std::make_shared<const TriangleSurface>(std::move(surface));
     } catch (const std::exception& error) {
       throw VariableError("surface.renderSurface '" + render + "' cannot be loaded: " + error.what());
     }
   }
-  m_tissue = std::make_unique<Tissue>(std::move(mesh), std::move(settings));
+  return std::make_unique<Tissue>(std::move(mesh), std::move(settings));
+}
+
+void TissueModel::build() {
+  m_tissue = make_tissue(m_values, m_context.resource_path);
   m_tissue->set_tool(tool_pose(m_values));
   m_dirty = false;
   m_surface_revision = 0;
@@ -168,17 +187,6 @@ void TissueModel::build() {
   m_drawn_current = false;
   m_capacity_warned = false;
   update_near_surface();
-}
-
-std::string TissueModel::resolve_path(const std::string& name, const char* what) const {
-  std::filesystem::path path(name);
-  if (path.is_relative()) {
-    if (m_context.resource_path.empty()) {
-      throw VariableError(std::string(what) + " '" + name + "' is relative, but no resource path was given");
-    }
-    path = std::filesystem::path(m_context.resource_path) / path;
-  }
-  return path.string();
 }
 
 const ports::SurfaceMesh& TissueModel::drawn_mesh() {

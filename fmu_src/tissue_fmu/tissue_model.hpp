@@ -23,6 +23,11 @@ namespace tissue::tissue_fmu {
 TissueSettings tissue_settings(const fmi3::ValueStore& values, const TetMesh* mesh);
 /// The tool pose from the tool inputs, as set (the core checks and normalizes it, Tissue::set_tool).
 ToolPose tool_pose(const fmi3::ValueStore& values);
+/// The core's Tissue the FMU's parameters describe: the mesh ("frog", the embedded one, or a file),
+/// the settings and the render surface, relative paths taken from `resource_path`. The FMU builds
+/// its tissue with it, the Python module a scenario's. Throws VariableError naming the parameter
+/// (a mesh or surface that cannot be loaded), ParameterError for values the core refuses.
+std::unique_ptr<Tissue> make_tissue(const fmi3::ValueStore& values, const std::string& resource_path);
 
 class TissueModel final : public fmi3::Model {
  public:
@@ -56,8 +61,6 @@ class TissueModel final : public fmi3::Model {
   void update_surface_counters();
   /// Logs once that the surface outgrew the arrays' capacities (on reading the arrays or their counts).
   void warn_if_arrays_truncate();
-  /// A mesh or render-surface file named by a parameter: absolute, or in the resources folder.
-  [[nodiscard]] std::string resolve_path(const std::string& name, const char* what) const;
   /// The drawn surface (the render surface when surface.renderSurface names one, else the tet skin),
   /// brought up to date on the first read after a build, a step or a restore.
   const ports::SurfaceMesh& drawn_mesh();

@@ -429,6 +429,23 @@ Scenario parse_scenario(const std::string& text, const std::filesystem::path& or
   return s;
 }
 
+std::vector<DeviceWaypoint> placed_waypoints(const DeviceConfig& config, const std::array<double, 3>& rest_lower,
+                                             const std::array<double, 3>& rest_upper) {
+  std::vector<DeviceWaypoint> waypoints;
+  for (const Waypoint& w : config.waypoints) {
+    DeviceWaypoint d;
+    d.time_s = w.time_s;
+    for (std::size_t a = 0; a < 3; ++a) {
+      d.pose.position_m[a] =
+          w.box_relative ? rest_lower[a] + w.position[a] * (rest_upper[a] - rest_lower[a]) : w.position[a];
+    }
+    d.pose.orientation_wxyz = w.orientation_wxyz;
+    d.pose.mode = w.mode;
+    waypoints.push_back(d);
+  }
+  return waypoints;
+}
+
 Scenario load_scenario(const std::filesystem::path& file) {
   std::ifstream in(file);
   if (!in) throw ScenarioError(file.string() + ": cannot be read");

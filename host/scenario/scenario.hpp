@@ -6,6 +6,8 @@
 // describe "across the body" without knowing the mesh's coordinates.
 #pragma once
 
+#include "device/scripted_device.hpp"
+
 #include "device/device.hpp"
 #include "device/simulated_hand.hpp"
 
@@ -107,6 +109,12 @@ struct Scenario {
   bool write_png = true;
   Expectations expect;
 };
+
+/// The device's waypoints in the scene frame: box-relative ones (`at`) placed in the tissue's rest
+/// box [rest_lower, rest_upper] [m], the others as they are (the session's scripted device and
+/// simulated hand, and the Python module's Scenario.tool_at, follow them).
+std::vector<DeviceWaypoint> placed_waypoints(const DeviceConfig& config, const std::array<double, 3>& rest_lower,
+                                             const std::array<double, 3>& rest_upper);
 
 /// Reads and checks a scenario. Throws ScenarioError naming the file, the key and the reason.
 Scenario load_scenario(const std::filesystem::path& file);

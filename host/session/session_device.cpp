@@ -12,35 +12,14 @@
 
 namespace tissue::host {
 
-namespace {
-
-// The scenario's waypoints in the scene frame (box-relative ones placed by the tissue's rest box).
-std::vector<DeviceWaypoint> device_waypoints(const DeviceConfig& config, const TissueLink& tissue) {
-  std::vector<DeviceWaypoint> waypoints;
-  for (const Waypoint& w : config.waypoints) {
-    DeviceWaypoint d;
-    d.time_s = w.time_s;
-    for (std::size_t a = 0; a < 3; ++a) {
-      d.pose.position_m[a] = w.box_relative ? tissue.rest_lower()[a] +
-                                                  w.position[a] * (tissue.rest_upper()[a] - tissue.rest_lower()[a])
-                                            : w.position[a];
-    }
-    d.pose.orientation_wxyz = w.orientation_wxyz;
-    d.pose.mode = w.mode;
-    waypoints.push_back(d);
-  }
-  return waypoints;
-}
-
-}  // namespace
-
 std::unique_ptr<Device> make_device(const DeviceConfig& config, const TissueLink& tissue, double haptic_period_s,
                                     const std::shared_ptr<IgtlServer>& igtl) {
   switch (config.kind) {
     case DeviceKind::scripted:
-      return std::make_unique<ScriptedDevice>(device_waypoints(config, tissue));
+      return std::make_unique<ScriptedDevice>(placed_waypoints(config, tissue.rest_lower(), tissue.rest_upper()));
     case DeviceKind::hand:
-      return std::make_unique<HandDevice>(device_waypoints(config, tissue), config.hand, haptic_period_s);
+      return std::make_unique<HandDevice>(placed_waypoints(config, tissue.rest_lower(), tissue.rest_upper()),
+                                          config.hand, haptic_period_s);
     case DeviceKind::replay:
       return std::make_unique<ReplayDevice>(config.replay_file);
     case DeviceKind::browser: {

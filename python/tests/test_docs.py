@@ -16,3 +16,14 @@ def test_the_example_in_the_docs_runs():
     assert frog.cut_tets == 0  # and the restore undid it
     points, triangles = namespace["points"], namespace["triangles"]
     assert points.shape[1] == 3 and triangles.shape[1] == 3
+
+
+def test_the_scenario_example_in_the_docs_runs(monkeypatch):
+    text = DOC.read_text()
+    blocks = re.findall(r"```python\n(.*?)```", text, flags=re.S)
+    assert len(blocks) >= 2, "docs/PYTHON.md has no scenario example"
+    monkeypatch.chdir(DOC.parents[1])  # the example names the scenario from the checkout's root
+    namespace = {}
+    exec(compile(blocks[1], str(DOC), "exec"), namespace)  # noqa: S102 - our own document
+    force_z = namespace["frog"].contact["force_on_tool_n"][2]
+    assert 1.0 < force_z < 2.0  # the press held 3 mm in
