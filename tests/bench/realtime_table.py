@@ -36,6 +36,8 @@ def main():
                 command = [args.host, "run", str(scenario), "-o", out, "-q"]
                 if 'kind = "browser"' in scenario.read_text():
                     command += ["--mouse", "--duration", "5"]  # the live view's mouse, no one at it: 5 s idle
+                if 'kind = "openigtlink"' in scenario.read_text():
+                    command += ["--duration", "5"]  # the OpenIGTLink server, no client: 5 s idle
                 subprocess.run(command, check=True, capture_output=True, text=True)
                 runs.append(json.loads((pathlib.Path(out) / "summary.json").read_text()))
             r = runs[-1]

@@ -15,8 +15,8 @@ gtest_discover_tests(test_host_session PROPERTIES LABELS "host" DISCOVERY_TIMEOU
 
 # The haptic thread allocates nothing (its own executable: it replaces operator new).
 add_executable(test_host_session_allocations ${CMAKE_CURRENT_LIST_DIR}/test_session_allocations.cpp)
-target_link_libraries(test_host_session_allocations PRIVATE tissue::host_session GTest::gtest GTest::gtest_main
-                                                            tissue::warnings)
+target_link_libraries(test_host_session_allocations PRIVATE tissue::host_session tissue_igtl_test_client GTest::gtest
+                                                            GTest::gtest_main tissue::warnings)
 target_compile_definitions(test_host_session_allocations
                            PRIVATE TISSUE_SCENARIO_DIR="${PROJECT_SOURCE_DIR}/host/scenarios"
                                    TISSUE_FMU_DIR="${CMAKE_BINARY_DIR}/fmus")
