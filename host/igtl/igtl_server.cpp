@@ -155,6 +155,7 @@ void IgtlServer::run() {
 void IgtlServer::accept_client() {
   const int client = ::accept4(m_listen, nullptr, nullptr, SOCK_NONBLOCK | SOCK_CLOEXEC);
   if (client < 0) return;
+  if (m_client >= 0) read_client();  // a client that left (its EOF waiting) makes room for this one
   if (m_client >= 0) {  // one client at a time: a second one would fight the first for the tool
     ::close(client);
     bump(m_refused);
