@@ -20,26 +20,11 @@ namespace {
 // The largest array FMI 2.0 scalarizes (3x3 matrices are the largest in the schemas).
 constexpr std::size_t MAX_ELEMENTS = 16;
 
-std::string_view type_name(ScalarType type) {
-  switch (type) {
-    case ScalarType::real:
-      return "Real";
-    case ScalarType::integer:
-      return "Integer";
-    case ScalarType::boolean:
-      return "Boolean";
-    case ScalarType::string:
-      return "String";
-    case ScalarType::enumeration:
-      return "Enumeration";
-  }
-  return "?";
-}
-
 // A 2.0 Integer from a layer value, refused beyond fmi2Integer's range.
 template <class V>
 int to_integer(V value, const VariableInfo& info) {
-  if (std::cmp_less(value, std::numeric_limits<int>::min()) || std::cmp_greater(value, std::numeric_limits<int>::max())) {
+  if (std::cmp_less(value, std::numeric_limits<int>::min()) ||
+      std::cmp_greater(value, std::numeric_limits<int>::max())) {
     throw VariableError(std::string(info.name) + " = " + std::to_string(value) +
                         " does not fit an FMI 2.0 Integer (32 bits)");
   }
@@ -98,7 +83,7 @@ const Scalar& Component::scalar(std::uint32_t vr, ScalarType expected) const {
   const bool integer_like = expected == ScalarType::integer && s->type == ScalarType::enumeration;
   if (s->type != expected && !integer_like) {
     throw VariableError(s->name + " (value reference " + std::to_string(vr) + ") is a " +
-                        std::string(type_name(s->type)) + ", not " + std::string(type_name(expected)));
+                        std::string(to_string(s->type)) + ", not " + std::string(to_string(expected)));
   }
   return *s;
 }
@@ -181,11 +166,13 @@ void Component::set(std::span<const std::uint32_t> vrs, std::span<const T> value
         for (std::size_t e = 0; e < n; ++e) squared += all[e] * all[e];
         if (!(std::sqrt(squared) > info.min_norm) && std::isfinite(squared)) {
           // Not yet a value the layer takes: held, if the variable may be set now at all.
-          if ((fmi3::variable_settable_states(info.causality, info.variability) & fmi3::mask(m_instance.state())) == 0) {
+          if ((fmi3::variable_settable_states(info.causality, info.variability) & fmi3::mask(m_instance.state())) ==
+              0) {
             m_instance.set<double>(vr, std::span<const double>(all.data(), n));  // refused, with the layer's reason
           }
           if (pending == m_pending.end()) {
-            m_pending.push_back({&info, std::vector<double>(all.begin(), all.begin() + static_cast<std::ptrdiff_t>(n))});
+            m_pending.push_back(
+                {&info, std::vector<double>(all.begin(), all.begin() + static_cast<std::ptrdiff_t>(n))});
           } else {
             pending->values.assign(all.begin(), all.begin() + static_cast<std::ptrdiff_t>(n));
           }

@@ -7,6 +7,7 @@
 // reason. Nothing throws or aborts across the ABI.
 #include "fmi2/component.hpp"
 #include "fmi2/scalar_layout.hpp"
+#include "fmi3/fmu_state_calls.hpp"
 #include "fmi3/model.hpp"
 
 #include "fmi2_abi.h"
@@ -127,7 +128,8 @@ extern "C" {
 const char* fmi2GetTypesPlatform(void) { return fmi2TypesPlatform; }
 const char* fmi2GetVersion(void) { return fmi2Version; }
 
-fmi2Status fmi2SetDebugLogging(fmi2Component c, fmi2Boolean loggingOn, size_t nCategories, const fmi2String categories[]) {
+fmi2Status fmi2SetDebugLogging(fmi2Component c, fmi2Boolean loggingOn, size_t nCategories,
+                               const fmi2String categories[]) {
   return run(c, Call::set_debug_logging, "fmi2SetDebugLogging", [&](Component& self) {
     self.instance().set_debug_logging(loggingOn != fmi2False, checked_span(categories, nCategories));
   });
@@ -141,7 +143,8 @@ fmi2Component fmi2Instantiate(fmi2String instanceName, fmi2Type fmuType, fmi2Str
     return nullptr;
   };
   try {
-    if (functions == nullptr || functions->logger == nullptr) return refuse("no callback functions (a logger is required)");
+    if (functions == nullptr || functions->logger == nullptr)
+      return refuse("no callback functions (a logger is required)");
     if (instanceName == nullptr || instanceName[0] == '\0') return refuse("the instance name is missing");
     if (fmuType != fmi2CoSimulation) return refuse("this FMU offers Co-Simulation only");
     const tissue::fmi3::ModelDescription& description = layout().description();
@@ -216,12 +219,8 @@ fmi2Status fmi2SetString(fmi2Component c, const fmi2ValueReference vr[], size_t 
 }
 
 fmi2Status fmi2GetFMUstate(fmi2Component c, fmi2FMUstate* state) {
-  return run(c, Call::get_fmu_state, "fmi2GetFMUstate", [&](Component& self) {
-    if (state == nullptr) throw VariableError("the state pointer is null");
-    std::unique_ptr<InstanceState> saved = self.instance().save();
-    if (*state != nullptr) delete static_cast<InstanceState*>(*state);  // the standard: overwrite it
-    *state = saved.release();
-  });
+  return run(c, Call::get_fmu_state, "fmi2GetFMUstate",
+             [&](Component& self) { tissue::fmi3::get_fmu_state(self.instance(), state); });
 }
 
 fmi2Status fmi2SetFMUstate(fmi2Component c, fmi2FMUstate state) {
@@ -232,39 +231,26 @@ fmi2Status fmi2SetFMUstate(fmi2Component c, fmi2FMUstate state) {
 }
 
 fmi2Status fmi2FreeFMUstate(fmi2Component c, fmi2FMUstate* state) {
-  return run(c, Call::free_fmu_state, "fmi2FreeFMUstate", [&](Component&) {
-    if (state == nullptr) return;
-    delete static_cast<InstanceState*>(*state);
-    *state = nullptr;
-  });
+  return run(c, Call::free_fmu_state, "fmi2FreeFMUstate", [&](Component&) { tissue::fmi3::free_fmu_state(state); });
 }
 
 fmi2Status fmi2SerializedFMUstateSize(fmi2Component c, fmi2FMUstate state, size_t* size) {
   return run(c, Call::serialize_fmu_state, "fmi2SerializedFMUstateSize", [&](Component& self) {
-    if (state == nullptr || size == nullptr) throw VariableError("null state or size");
-    *size = self.instance().serialize(*static_cast<const InstanceState*>(state)).size();
+    if (size == nullptr) throw VariableError("the size pointer is null");
+    *size = tissue::fmi3::serialized_fmu_state_size(self.instance(), state);
   });
 }
 
 fmi2Status fmi2SerializeFMUstate(fmi2Component c, fmi2FMUstate state, fmi2Byte serializedState[], size_t size) {
   return run(c, Call::serialize_fmu_state, "fmi2SerializeFMUstate", [&](Component& self) {
-    if (state == nullptr) throw VariableError("the state is null");
-    const std::vector<std::uint8_t> bytes = self.instance().serialize(*static_cast<const InstanceState*>(state));
-    if (size != bytes.size() || (size > 0 && serializedState == nullptr)) {
-      throw VariableError("the buffer holds " + std::to_string(size) + " bytes, the state needs " +
-                          std::to_string(bytes.size()) + " (fmi2SerializedFMUstateSize)");
-    }
-    std::copy(bytes.begin(), bytes.end(), serializedState);
+    tissue::fmi3::serialize_fmu_state(self.instance(), state, serializedState, size, "fmi2SerializedFMUstateSize");
   });
 }
 
-fmi2Status fmi2DeSerializeFMUstate(fmi2Component c, const fmi2Byte serializedState[], size_t size, fmi2FMUstate* state) {
+fmi2Status fmi2DeSerializeFMUstate(fmi2Component c, const fmi2Byte serializedState[], size_t size,
+                                   fmi2FMUstate* state) {
   return run(c, Call::serialize_fmu_state, "fmi2DeSerializeFMUstate", [&](Component& self) {
-    if (state == nullptr) throw VariableError("the state pointer is null");
-    const auto* bytes = reinterpret_cast<const std::uint8_t*>(checked_span(serializedState, size).data());
-    std::unique_ptr<InstanceState> saved = self.instance().deserialize(std::span(bytes, size));
-    if (*state != nullptr) delete static_cast<InstanceState*>(*state);
-    *state = saved.release();
+    tissue::fmi3::deserialize_fmu_state(self.instance(), serializedState, size, state);
   });
 }
 

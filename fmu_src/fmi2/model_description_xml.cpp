@@ -16,38 +16,6 @@ void attribute(std::ostream& out, std::string_view name, std::string_view value)
   if (!value.empty()) out << ' ' << name << "=\"" << xml_escaped(value) << '"';
 }
 
-std::string_view causality(Causality c) {
-  switch (c) {
-    case Causality::independent:
-      return "independent";
-    case Causality::parameter:
-      return "parameter";
-    case Causality::input:
-      return "input";
-    case Causality::output:
-      return "output";
-    case Causality::structural_parameter:
-      break;
-  }
-  throw fmi3::SchemaError("a structural parameter has no FMI 2.0 causality");
-}
-
-std::string_view element(ScalarType type) {
-  switch (type) {
-    case ScalarType::real:
-      return "Real";
-    case ScalarType::integer:
-      return "Integer";
-    case ScalarType::boolean:
-      return "Boolean";
-    case ScalarType::string:
-      return "String";
-    case ScalarType::enumeration:
-      return "Enumeration";
-  }
-  return "Real";
-}
-
 void write_type_definitions(std::ostream& out, const ModelDescription& description) {
   if (description.enumerations.empty()) return;
   out << "  <TypeDefinitions>\n";
@@ -76,9 +44,12 @@ void write_scalar(std::ostream& out, const Scalar& scalar, std::size_t value_ref
   out << "    <ScalarVariable";
   attribute(out, "name", scalar.name);
   out << " valueReference=\"" << value_reference << '"';
-  attribute(out, "causality", causality(info.causality));
+  if (info.causality == Causality::structural_parameter) {
+    throw fmi3::SchemaError(std::string(info.name) + ": a structural parameter has no FMI 2.0 causality");
+  }
+  attribute(out, "causality", fmi3::to_string(info.causality));
   attribute(out, "variability", fmi3::to_string(info.variability));
-  out << "\n      description=\"" << xml_escaped(info.description) << "\">\n      <" << element(scalar.type);
+  out << "\n      description=\"" << xml_escaped(info.description) << "\">\n      <" << to_string(scalar.type);
   attribute(out, "declaredType", info.declared_type);
   attribute(out, "unit", info.unit);
   attribute(out, "start", scalar.start);

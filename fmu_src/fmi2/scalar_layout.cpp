@@ -30,6 +30,22 @@ std::vector<std::string> element_starts(const VariableInfo& info, std::size_t co
 
 }  // namespace
 
+std::string_view to_string(ScalarType type) {
+  switch (type) {
+    case ScalarType::real:
+      return "Real";
+    case ScalarType::integer:
+      return "Integer";
+    case ScalarType::boolean:
+      return "Boolean";
+    case ScalarType::string:
+      return "String";
+    case ScalarType::enumeration:
+      return "Enumeration";
+  }
+  return "Real";
+}
+
 bool ScalarLayout::carried(const VariableInfo& info) {
   if (info.type == VariableType::binary || info.causality == Causality::structural_parameter) return false;
   for (int d = 0; d < info.rank; ++d) {

@@ -12,6 +12,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <string>
+#include <string_view>
 #include <vector>
 
 namespace tissue::fmi2 {
@@ -20,6 +21,8 @@ using fmi3::ModelDescription;
 using fmi3::VariableInfo;
 
 enum class ScalarType { real, integer, boolean, string, enumeration };
+/// The FMI 2.0 element name: "Real", "Integer", "Boolean", "String", "Enumeration".
+std::string_view to_string(ScalarType type);
 
 struct Scalar {
   const VariableInfo* variable = nullptr;

@@ -5,6 +5,7 @@
 // logged, the standard's transition after an error), and answers a status. Interfaces the FMUs do
 // not offer (Model Exchange, Scheduled Execution, clocks, event mode, derivatives, other integer
 // widths, binaries) answer fmi3Error with the reason. Nothing here throws or aborts across the ABI.
+#include "fmi3/fmu_state_calls.hpp"
 #include "fmi3/instance.hpp"
 #include "fmi3/model.hpp"
 
@@ -230,56 +231,36 @@ fmi3Status fmi3GetVariableDependencies(fmi3Instance instance, fmi3ValueReference
 }
 
 fmi3Status fmi3GetFMUState(fmi3Instance instance, fmi3FMUState* state) {
-  return run(instance, Call::get_fmu_state, "fmi3GetFMUState", [&](Instance& self) {
-    if (state == nullptr) throw VariableError("the state pointer is null");
-    std::unique_ptr<InstanceState> saved = self.save();
-    if (*state != nullptr) delete static_cast<InstanceState*>(*state);  // the standard: overwrite it
-    *state = saved.release();
-  });
+  return run(instance, Call::get_fmu_state, "fmi3GetFMUState",
+             [&](Instance& self) { tissue::fmi3::get_fmu_state(self, state); });
 }
 
 fmi3Status fmi3SetFMUState(fmi3Instance instance, fmi3FMUState state) {
-  return run(instance, Call::set_fmu_state, "fmi3SetFMUState", [&](Instance& self) {
-    if (state == nullptr) throw VariableError("the state is null");
-    self.restore(*static_cast<const InstanceState*>(state));
-  });
+  return run(instance, Call::set_fmu_state, "fmi3SetFMUState",
+             [&](Instance& self) { tissue::fmi3::set_fmu_state(self, state); });
 }
 
 fmi3Status fmi3FreeFMUState(fmi3Instance instance, fmi3FMUState* state) {
-  return run(instance, Call::free_fmu_state, "fmi3FreeFMUState", [&](Instance&) {
-    if (state == nullptr) return;
-    delete static_cast<InstanceState*>(*state);
-    *state = nullptr;
-  });
+  return run(instance, Call::free_fmu_state, "fmi3FreeFMUState", [&](Instance&) { tissue::fmi3::free_fmu_state(state); });
 }
 
 fmi3Status fmi3SerializedFMUStateSize(fmi3Instance instance, fmi3FMUState state, size_t* size) {
   return run(instance, Call::serialize_fmu_state, "fmi3SerializedFMUStateSize", [&](Instance& self) {
-    if (state == nullptr || size == nullptr) throw VariableError("null state or size");
-    *size = self.serialize(*static_cast<const InstanceState*>(state)).size();
+    if (size == nullptr) throw VariableError("the size pointer is null");
+    *size = tissue::fmi3::serialized_fmu_state_size(self, state);
   });
 }
 
 fmi3Status fmi3SerializeFMUState(fmi3Instance instance, fmi3FMUState state, fmi3Byte serializedState[], size_t size) {
   return run(instance, Call::serialize_fmu_state, "fmi3SerializeFMUState", [&](Instance& self) {
-    if (state == nullptr) throw VariableError("the state is null");
-    const std::vector<std::uint8_t> bytes = self.serialize(*static_cast<const InstanceState*>(state));
-    if (size != bytes.size() || (size > 0 && serializedState == nullptr)) {
-      throw VariableError("the buffer holds " + std::to_string(size) + " bytes, the state needs " +
-                          std::to_string(bytes.size()) + " (fmi3SerializedFMUStateSize)");
-    }
-    std::copy(bytes.begin(), bytes.end(), serializedState);
+    tissue::fmi3::serialize_fmu_state(self, state, serializedState, size, "fmi3SerializedFMUStateSize");
   });
 }
 
 fmi3Status fmi3DeserializeFMUState(fmi3Instance instance, const fmi3Byte serializedState[], size_t size,
                                    fmi3FMUState* state) {
-  return run(instance, Call::serialize_fmu_state, "fmi3DeserializeFMUState", [&](Instance& self) {
-    if (state == nullptr) throw VariableError("the state pointer is null");
-    std::unique_ptr<InstanceState> saved = self.deserialize(input_span(serializedState, size));
-    if (*state != nullptr) delete static_cast<InstanceState*>(*state);
-    *state = saved.release();
-  });
+  return run(instance, Call::serialize_fmu_state, "fmi3DeserializeFMUState",
+             [&](Instance& self) { tissue::fmi3::deserialize_fmu_state(self, serializedState, size, state); });
 }
 
 fmi3Status fmi3GetDirectionalDerivative(fmi3Instance instance, const fmi3ValueReference[], size_t,

@@ -3,6 +3,10 @@
 
 #include <algorithm>
 #include <array>
+#include <exception>
+#include <fstream>
+#include <iostream>
+#include <iterator>
 #include <sstream>
 #include <vector>
 
@@ -46,6 +50,29 @@ std::string xml_escaped(std::string_view text) {
     }
   }
   return out;
+}
+
+int write_description_main(int argc, char** argv, const char* what, const std::function<std::string()>& make_xml) {
+  if (argc != 2) {
+    std::cerr << "usage: " << argv[0] << " OUTPUT.xml\n";
+    return 2;
+  }
+  try {
+    const std::string xml = make_xml();
+    std::ifstream existing(argv[1], std::ios::binary);
+    if (existing && std::string(std::istreambuf_iterator<char>(existing), {}) == xml) return 0;
+    existing.close();
+    std::ofstream out(argv[1], std::ios::binary | std::ios::trunc);
+    out << xml;
+    if (!out) {
+      std::cerr << argv[1] << ": cannot be written\n";
+      return 1;
+    }
+  } catch (const std::exception& error) {
+    std::cerr << what << ": " << error.what() << "\n";
+    return 1;
+  }
+  return 0;
 }
 
 void write_unit_definitions(std::ostream& out, const ModelDescription& description) {

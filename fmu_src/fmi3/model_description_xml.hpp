@@ -7,6 +7,7 @@
 
 #include "fmi3/variable_table.hpp"
 
+#include <functional>
 #include <iosfwd>
 #include <stdexcept>
 #include <string>
@@ -27,6 +28,10 @@ std::string model_description_xml(const ModelDescription& description);
 // Shared with the FMI 2.0 writer (fmi2/model_description_xml.cpp), whose XML has the same units.
 /// `text` with & < > " escaped for an attribute.
 std::string xml_escaped(std::string_view text);
+/// The body of the build's writers (write_model_description.cpp, FMI 3.0 and 2.0): `argv[1]` is the
+/// output file, rewritten only when `make_xml()`'s text differs (so the FMU is not repackaged for
+/// nothing). Returns main's exit code; errors to stderr, prefixed by `what`.
+int write_description_main(int argc, char** argv, const char* what, const std::function<std::string()>& make_xml);
 /// <UnitDefinitions> of the units the variables use, in SI base units. Throws SchemaError for an unknown unit.
 void write_unit_definitions(std::ostream& out, const ModelDescription& description);
 

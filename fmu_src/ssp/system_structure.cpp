@@ -42,29 +42,13 @@ const Scalar& scalar(const ScalarLayout& layout, const std::string& element, con
   throw SchemaError("SSP: " + element + " has no FMI 2.0 variable " + name);
 }
 
-std::string_view type_element(ScalarType type) {
-  switch (type) {
-    case ScalarType::real:
-      return "Real";
-    case ScalarType::integer:
-      return "Integer";
-    case ScalarType::boolean:
-      return "Boolean";
-    case ScalarType::string:
-      return "String";
-    case ScalarType::enumeration:
-      return "Enumeration";
-  }
-  return "Real";
-}
-
 void connector(std::ostream& out, const std::string& indent, const std::string& name, const char* kind,
                const Scalar& s) {
   out << indent << "<ssd:Connector name=\"" << fmi3::xml_escaped(name) << "\" kind=\"" << kind << "\">";
   if (s.type == ScalarType::enumeration) {
     out << "<ssc:Enumeration name=\"" << fmi3::xml_escaped(s.variable->declared_type) << "\"/>";
   } else {
-    out << "<ssc:" << type_element(s.type) << "/>";
+    out << "<ssc:" << fmi2::to_string(s.type) << "/>";
   }
   out << "</ssd:Connector>\n";
 }
@@ -105,8 +89,8 @@ std::vector<Connection> connections(const ScalarLayout& tissue, const ScalarLayo
     if (c.start_element.empty()) continue;
     const Scalar& start = scalar(c.start_element == TISSUE ? tissue : haptic, c.start_element, c.start_connector);
     if (start.variable->causality != Causality::output || start.type != end.type) {
-      throw SchemaError("SSP: " + c.start_element + "." + c.start_connector + " is not an output of " +
-                        c.end_element + "." + c.end_connector + "'s type");
+      throw SchemaError("SSP: " + c.start_element + "." + c.start_connector + " is not an output of " + c.end_element +
+                        "." + c.end_connector + "'s type");
     }
   }
   return all;
@@ -125,19 +109,24 @@ std::string system_structure_ssd(const ScalarLayout& tissue, const ScalarLayout&
          "the tissue; the tissue's contact back to the haptic loop\">\n"
          "    <ssd:Connectors>\n";
   for (const Connection& c : all) {
-    if (c.start_element.empty()) connector(out, "      ", c.start_connector, "input", scalar(haptic, HAPTIC, c.end_connector));
-    if (c.end_element.empty()) connector(out, "      ", c.end_connector, "output", scalar(haptic, HAPTIC, c.start_connector));
+    if (c.start_element.empty())
+      connector(out, "      ", c.start_connector, "input", scalar(haptic, HAPTIC, c.end_connector));
+    if (c.end_element.empty())
+      connector(out, "      ", c.end_connector, "output", scalar(haptic, HAPTIC, c.start_connector));
   }
   out << "    </ssd:Connectors>\n    <ssd:ParameterBindings>\n"
          "      <ssd:ParameterBinding source=\"resources/TissueHaptic.ssv\"/>\n    </ssd:ParameterBindings>\n"
          "    <ssd:Elements>\n";
   for (const char* element : {TISSUE, HAPTIC}) {
     const ScalarLayout& layout = std::string(element) == TISSUE ? tissue : haptic;
-    out << "      <ssd:Component name=\"" << element << "\" type=\"application/x-fmu-sharedlibrary\" source=\"resources/"
-        << element << ".fmu\">\n        <ssd:Connectors>\n";
+    out << "      <ssd:Component name=\"" << element
+        << "\" type=\"application/x-fmu-sharedlibrary\" source=\"resources/" << element
+        << ".fmu\">\n        <ssd:Connectors>\n";
     for (const Connection& c : all) {
-      if (c.start_element == element) connector(out, "          ", c.start_connector, "output", scalar(layout, element, c.start_connector));
-      if (c.end_element == element) connector(out, "          ", c.end_connector, "input", scalar(layout, element, c.end_connector));
+      if (c.start_element == element)
+        connector(out, "          ", c.start_connector, "output", scalar(layout, element, c.start_connector));
+      if (c.end_element == element)
+        connector(out, "          ", c.end_connector, "input", scalar(layout, element, c.end_connector));
     }
     out << "        </ssd:Connectors>\n      </ssd:Component>\n";
   }

@@ -16,13 +16,13 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdarg>
-#include <cstring>
-#include <algorithm>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <map>
@@ -50,7 +50,9 @@ void log2(fmi2ComponentEnvironment, fmi2String, fmi2Status, fmi2String, fmi2Stri
   va_end(args);
   messages += std::string(text.data()) + "\n";
 }
-void log3(fmi3InstanceEnvironment, fmi3Status, fmi3String, fmi3String message) { messages += std::string(message) + "\n"; }
+void log3(fmi3InstanceEnvironment, fmi3Status, fmi3String, fmi3String message) {
+  messages += std::string(message) + "\n";
+}
 const fmi2CallbackFunctions CALLBACKS{log2, nullptr, nullptr, nullptr, nullptr};
 
 struct Library {
@@ -81,7 +83,7 @@ struct Pair {
     const std::string path3 = (FMUS / id / "resources").string() + "/";
     if (lib2.handle == nullptr || lib3.handle == nullptr) return;
     c2 = lib2.get<fmi2InstantiateTYPE>("fmi2Instantiate")("two", fmi2CoSimulation, token.c_str(), uri2.c_str(),
-                                                         &CALLBACKS, fmi2False, fmi2False);
+                                                          &CALLBACKS, fmi2False, fmi2False);
     c3 = lib3.get<fmi3InstantiateCoSimulationTYPE>("fmi3InstantiateCoSimulation")(
         "three", token.c_str(), path3.c_str(), fmi3False, fmi3False, fmi3False, fmi3False, nullptr, 0, nullptr, log3,
         nullptr);
@@ -242,8 +244,8 @@ TEST(Fmi2Layout, ArraysAreIndexedScalarsAndWhatFmi2CannotCarryIsLeftOut) {
   EXPECT_TRUE(has("contact.stiffness[2,3]"));
   EXPECT_TRUE(has("tool.orientation[4]"));
   EXPECT_TRUE(has("sample.time"));
-  EXPECT_FALSE(has("surface.mesh"));            // Binary
-  EXPECT_FALSE(has("surface.vertexCapacity"));  // structural parameter
+  EXPECT_FALSE(has("surface.mesh"));                  // Binary
+  EXPECT_FALSE(has("surface.vertexCapacity"));        // structural parameter
   EXPECT_FALSE(has("surface.vertexPositions[1,1]"));  // sized by one
   const Scalar& k23 = layout.scalars()[static_cast<std::size_t>(
       std::find(names.begin(), names.end(), "contact.stiffness[2,3]") - names.begin())];
@@ -284,7 +286,7 @@ TEST(Fmi2Tissue, GivesTheFmi3TissuesOutputsBitForBitAndKeepsItsStates) {
     for (int n = 40; n < 50; ++n) {
       const double z = 0.033 - 0.0002 * (n - 40);
       const std::array<fmi2ValueReference, 3> p{tissue.vr2("tool.position[1]"), tissue.vr2("tool.position[2]"),
-                                               tissue.vr2("tool.position[3]")};
+                                                tissue.vr2("tool.position[3]")};
       const std::array<double, 3> v{-0.007, 0.0, z};
       ASSERT_EQ(lib.get<fmi2SetRealTYPE>("fmi2SetReal")(tissue.c2, p.data(), 3, v.data()), fmi2OK);
       ASSERT_EQ(tissue.step2(n * h, h), fmi2OK) << messages;
