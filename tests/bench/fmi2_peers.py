@@ -34,6 +34,8 @@ def main():
             rows = sum(1 for _ in open(out)) - 1 if os.path.exists(out) else 0
             print(f"fmusim {name} (0.1 s, defaults): exit {rc}, {rows} rows")
 
+    state_round_trip(fmus["Tissue"])
+
     ssp = os.path.join(a.build, "ssp", "TissueHaptic.ssp")
     ssd = read_ssd(ssp)  # validates SystemStructure.ssd and the .ssv against FMPy's SSP 1.0 schemas
     parameters = ssd.system.parameterBindings[0].parameterValues[0]
@@ -69,6 +71,52 @@ def main():
     fig.tight_layout()
     fig.savefig(a.plot)
     print("plot:", a.plot)
+
+def state_round_trip(fmu):
+    """The 2.0 Tissue's FMU state through FMPy's FMU2Slave: pressed 30 steps, a state taken and
+    serialized, ten more steps; the state set back and the same ten; then the bytes deserialized,
+    set, and the same ten again. The contact force must repeat bit for bit."""
+    import shutil
+    from fmpy import extract, read_model_description
+    from fmpy.fmi2 import FMU2Slave
+    md = read_model_description(fmu)
+    vr = {v.name: v.valueReference for v in md.modelVariables}
+    folder = extract(fmu)
+    s = FMU2Slave(guid=md.guid, unzipDirectory=folder, modelIdentifier=md.coSimulation.modelIdentifier,
+                  instanceName="state")
+    s.instantiate()
+    s.setupExperiment(startTime=0.0)
+    s.enterInitializationMode()
+    s.exitInitializationMode()
+    s.setInteger([vr["tool.mode"]], [1])
+    position = [vr["tool.position[1]"], vr["tool.position[2]"], vr["tool.position[3]"]]
+
+    def run(first, count):
+        forces = []
+        for k in range(first, first + count):
+            s.setReal(position, [-0.007, 0.0, 0.046 - 0.013 * min(1.0, k / 30)])
+            s.doStep(currentCommunicationPoint=k * 0.01, communicationStepSize=0.01)
+            forces.append(s.getReal([vr["contact.force[3]"]])[0])
+        return forces
+
+    run(0, 30)
+    state = s.getFMUstate()
+    data = s.serializeFMUstate(state)
+    first = run(30, 10)
+    s.setFMUstate(state)
+    again = run(30, 10)
+    restored = s.deSerializeFMUstate(data)
+    s.setFMUstate(restored)
+    from_bytes = run(30, 10)
+    print(f"FMPy FMU2Slave state (Tissue): {len(data)} bytes serialized; the ten steps after set "
+          f"{'repeat bitwise' if again == first else 'DIFFER'}, after deserialize "
+          f"{'repeat bitwise' if from_bytes == first else 'DIFFER'} (force {first[-1]:.4f} N)")
+    s.freeFMUstate(state)
+    s.freeFMUstate(restored)
+    s.terminate()
+    s.freeInstance()
+    shutil.rmtree(folder)
+
 
 if __name__ == "__main__":
     main()
