@@ -17,8 +17,25 @@ using fmi3::VariableType;
 
 namespace {
 
-// The largest array FMI 2.0 scalarizes (3x3 matrices are the largest in the schemas).
-constexpr std::size_t MAX_ELEMENTS = 16;
+constexpr std::size_t MAX_ELEMENTS = ScalarLayout::MAX_ELEMENTS;
+
+// Calls `f` with a value of the C++ type the layer gets and sets an Integer variable of `type` as.
+template <class F>
+void with_integer_type(VariableType type, F&& f) {
+  switch (type) {
+    case VariableType::int32:
+      f(std::int32_t{});
+      break;
+    case VariableType::uint32:
+      f(std::uint32_t{});
+      break;
+    case VariableType::uint64:
+      f(std::uint64_t{});
+      break;
+    default:  // int64, enumeration
+      f(std::int64_t{});
+  }
+}
 
 // A 2.0 Integer from a layer value, refused beyond fmi2Integer's range.
 template <class V>
@@ -44,13 +61,7 @@ V from_integer(int value, const VariableInfo& info) {
 Component::Component(const ScalarLayout& layout, std::string name, std::string resource_path, bool logging_on,
                      fmi3::StatusLogger logger)
     : m_layout(layout),
-      m_instance(layout.description(), std::move(name), std::move(resource_path), logging_on, std::move(logger)) {
-  for (const Scalar& s : layout.scalars()) {
-    if (ScalarLayout::element_count(*s.variable) > MAX_ELEMENTS) {
-      throw VariableError(std::string(s.variable->name) + ": more elements than the FMI 2.0 adapter takes");
-    }
-  }
-}
+      m_instance(layout.description(), std::move(name), std::move(resource_path), logging_on, std::move(logger)) {}
 
 void Component::setup_experiment(double start_time_s) {
   if (!std::isfinite(start_time_s)) throw VariableError("fmi2SetupExperiment: the start time must be finite");
@@ -120,19 +131,7 @@ void Component::get(std::span<const std::uint32_t> vrs, std::span<T> values, Sca
         m_instance.get<V>(vr, std::span(all.data(), n));
         values[k] = to_integer(all[s.element], info);
       };
-      switch (info.type) {
-        case VariableType::int32:
-          pick(std::int32_t{});
-          break;
-        case VariableType::uint32:
-          pick(std::uint32_t{});
-          break;
-        case VariableType::uint64:
-          pick(std::uint64_t{});
-          break;
-        default:  // int64, enumeration
-          pick(std::int64_t{});
-      }
+      with_integer_type(info.type, pick);
     }
   }
   if constexpr (std::is_same_v<T, const char*>) {
@@ -197,19 +196,7 @@ void Component::set(std::span<const std::uint32_t> vrs, std::span<const T> value
         all[s.element] = from_integer<V>(values[k], info);
         m_instance.set<V>(vr, std::span<const V>(all.data(), n));
       };
-      switch (info.type) {
-        case VariableType::int32:
-          patch(std::int32_t{});
-          break;
-        case VariableType::uint32:
-          patch(std::uint32_t{});
-          break;
-        case VariableType::uint64:
-          patch(std::uint64_t{});
-          break;
-        default:  // int64, enumeration
-          patch(std::int64_t{});
-      }
+      with_integer_type(info.type, patch);
     }
   }
 }

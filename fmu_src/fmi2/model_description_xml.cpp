@@ -10,27 +10,18 @@ namespace {
 
 using fmi3::Causality;
 using fmi3::Variability;
+using fmi3::xml_attribute;
 using fmi3::xml_escaped;
-
-void attribute(std::ostream& out, std::string_view name, std::string_view value) {
-  if (!value.empty()) out << ' ' << name << "=\"" << xml_escaped(value) << '"';
-}
 
 void write_type_definitions(std::ostream& out, const ModelDescription& description) {
   if (description.enumerations.empty()) return;
   out << "  <TypeDefinitions>\n";
   for (const fmi3::EnumerationType& type : description.enumerations) {
     out << "    <SimpleType";
-    attribute(out, "name", type.name);
-    attribute(out, "description", type.description);
+    xml_attribute(out, "name", type.name);
+    xml_attribute(out, "description", type.description);
     out << ">\n      <Enumeration>\n";
-    for (const fmi3::EnumerationItem& item : type.items) {
-      out << "        <Item";
-      attribute(out, "name", item.name);
-      out << " value=\"" << item.value << '"';
-      attribute(out, "description", item.description);
-      out << "/>\n";
-    }
+    fmi3::write_enumeration_items(out, type, "        ");
     out << "      </Enumeration>\n    </SimpleType>\n";
   }
   out << "  </TypeDefinitions>\n\n";
@@ -42,20 +33,20 @@ void write_scalar(std::ostream& out, const Scalar& scalar, std::size_t value_ref
     throw fmi3::SchemaError(std::string(info.name) + ": only a Real can be continuous in FMI 2.0");
   }
   out << "    <ScalarVariable";
-  attribute(out, "name", scalar.name);
+  xml_attribute(out, "name", scalar.name);
   out << " valueReference=\"" << value_reference << '"';
   if (info.causality == Causality::structural_parameter) {
     throw fmi3::SchemaError(std::string(info.name) + ": a structural parameter has no FMI 2.0 causality");
   }
-  attribute(out, "causality", fmi3::to_string(info.causality));
-  attribute(out, "variability", fmi3::to_string(info.variability));
+  xml_attribute(out, "causality", fmi3::to_string(info.causality));
+  xml_attribute(out, "variability", fmi3::to_string(info.variability));
   out << "\n      description=\"" << xml_escaped(info.description) << "\">\n      <" << to_string(scalar.type);
-  attribute(out, "declaredType", info.declared_type);
-  attribute(out, "unit", info.unit);
-  attribute(out, "start", scalar.start);
+  xml_attribute(out, "declaredType", info.declared_type);
+  xml_attribute(out, "unit", info.unit);
+  xml_attribute(out, "start", scalar.start);
   if (scalar.type == ScalarType::real || scalar.type == ScalarType::integer) {
-    attribute(out, "min", info.min);
-    attribute(out, "max", info.max);
+    xml_attribute(out, "min", info.min);
+    xml_attribute(out, "max", info.max);
   }
   out << "/>\n    </ScalarVariable>\n";
 }
@@ -94,17 +85,7 @@ std::string model_description_xml(const ScalarLayout& layout) {
          "    canSerializeFMUstate=\"true\"\n    canNotUseMemoryManagementFunctions=\"true\"/>\n\n";
   fmi3::write_unit_definitions(out, description);
   write_type_definitions(out, description);
-  out << "  <LogCategories>\n";
-  for (const fmi3::LogCategory& category : description.log_categories) {
-    out << "    <Category";
-    attribute(out, "name", category.name);
-    attribute(out, "description", category.description);
-    out << "/>\n";
-  }
-  out << "  </LogCategories>\n\n";
-  const fmi3::DefaultExperiment& experiment = description.default_experiment;
-  out << "  <DefaultExperiment startTime=\"" << experiment.start_time_s << "\" stopTime=\"" << experiment.stop_time_s
-      << "\" stepSize=\"" << experiment.step_size_s << "\"/>\n\n";
+  fmi3::write_log_categories_and_default_experiment(out, description);
   out << "  <ModelVariables>\n";
   for (std::size_t k = 0; k < layout.scalars().size(); ++k) write_scalar(out, layout.scalars()[k], k);
   out << "  </ModelVariables>\n\n";

@@ -79,6 +79,11 @@ ScalarLayout::ScalarLayout(const ModelDescription& description) : m_description(
   for (const VariableInfo& info : description.variables) {
     if (!carried(info)) continue;
     const std::size_t count = element_count(info);
+    if (count > MAX_ELEMENTS) {
+      throw fmi3::SchemaError(std::string(info.name) + ": " + std::to_string(count) +
+                              " elements, more than the FMI 2.0 layer scalarizes (" + std::to_string(MAX_ELEMENTS) +
+                              ")");
+    }
     const std::vector<std::string> starts = element_starts(info, count);
     const std::size_t columns = info.rank == 2 ? info.dimensions[1].size : 1;
     for (std::size_t k = 0; k < count; ++k) {

@@ -34,6 +34,11 @@ struct Scalar {
 
 class ScalarLayout {
  public:
+  /// The largest array scalarized (3x3 matrices are the largest in the schemas): the 2.0 calls
+  /// gather a variable's elements in buffers of this size.
+  static constexpr std::size_t MAX_ELEMENTS = 16;
+
+  /// Throws fmi3::SchemaError for a carried array of more than MAX_ELEMENTS elements.
   explicit ScalarLayout(const ModelDescription& description);
 
   [[nodiscard]] const ModelDescription& description() const { return m_description; }

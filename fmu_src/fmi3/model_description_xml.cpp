@@ -97,13 +97,36 @@ void write_unit_definitions(std::ostream& out, const ModelDescription& descripti
   out << "  </UnitDefinitions>\n\n";
 }
 
+void xml_attribute(std::ostream& out, std::string_view name, std::string_view value) {
+  if (!value.empty()) out << ' ' << name << "=\"" << xml_escaped(value) << '"';
+}
+
+void write_enumeration_items(std::ostream& out, const EnumerationType& type, std::string_view indent) {
+  for (const EnumerationItem& item : type.items) {
+    out << indent << "<Item";
+    xml_attribute(out, "name", item.name);
+    out << " value=\"" << item.value << '"';
+    xml_attribute(out, "description", item.description);
+    out << "/>\n";
+  }
+}
+
+void write_log_categories_and_default_experiment(std::ostream& out, const ModelDescription& description) {
+  out << "  <LogCategories>\n";
+  for (const LogCategory& category : description.log_categories) {
+    out << "    <Category";
+    xml_attribute(out, "name", category.name);
+    xml_attribute(out, "description", category.description);
+    out << "/>\n";
+  }
+  out << "  </LogCategories>\n\n";
+  const DefaultExperiment& experiment = description.default_experiment;
+  out << "  <DefaultExperiment startTime=\"" << experiment.start_time_s << "\" stopTime=\"" << experiment.stop_time_s
+      << "\" stepSize=\"" << experiment.step_size_s << "\"/>\n\n";
+}
+
 namespace {
 
-std::string escaped(std::string_view text) { return xml_escaped(text); }
-
-void attribute(std::ostream& out, std::string_view name, std::string_view value) {
-  if (!value.empty()) out << ' ' << name << "=\"" << escaped(value) << '"';
-}
 
 std::string element_name(VariableType type) { return std::string(to_string(type)); }
 
@@ -112,16 +135,10 @@ void write_enumerations(std::ostream& out, const ModelDescription& description) 
   out << "  <TypeDefinitions>\n";
   for (const EnumerationType& type : description.enumerations) {
     out << "    <EnumerationType";
-    attribute(out, "name", type.name);
-    attribute(out, "description", type.description);
+    xml_attribute(out, "name", type.name);
+    xml_attribute(out, "description", type.description);
     out << ">\n";
-    for (const EnumerationItem& item : type.items) {
-      out << "      <Item";
-      attribute(out, "name", item.name);
-      out << " value=\"" << item.value << '"';
-      attribute(out, "description", item.description);
-      out << "/>\n";
-    }
+    write_enumeration_items(out, type, "      ");
     out << "    </EnumerationType>\n";
   }
   out << "  </TypeDefinitions>\n\n";
@@ -138,17 +155,17 @@ void write_dimension(std::ostream& out, const Dimension& dimension) {
 void write_variable(std::ostream& out, const VariableInfo& info) {
   const std::string element = element_name(info.type);
   out << "    <" << element;
-  attribute(out, "name", info.name);
+  xml_attribute(out, "name", info.name);
   out << " valueReference=\"" << info.vr << '"';
-  attribute(out, "causality", to_string(info.causality));
-  attribute(out, "variability", to_string(info.variability));
-  attribute(out, "declaredType", info.declared_type);
-  attribute(out, "unit", info.unit);
+  xml_attribute(out, "causality", to_string(info.causality));
+  xml_attribute(out, "variability", to_string(info.variability));
+  xml_attribute(out, "declaredType", info.declared_type);
+  xml_attribute(out, "unit", info.unit);
   // A String's start is an element; every other type's an attribute.
-  if (info.type != VariableType::string) attribute(out, "start", info.start);
-  attribute(out, "min", info.min);
-  attribute(out, "max", info.max);
-  out << "\n      description=\"" << escaped(info.description) << '"';
+  if (info.type != VariableType::string) xml_attribute(out, "start", info.start);
+  xml_attribute(out, "min", info.min);
+  xml_attribute(out, "max", info.max);
+  out << "\n      description=\"" << xml_escaped(info.description) << '"';
   const bool has_children = info.rank > 0 || (info.type == VariableType::string && !info.start.empty());
   if (!has_children) {
     out << "/>\n";
@@ -156,7 +173,7 @@ void write_variable(std::ostream& out, const VariableInfo& info) {
   }
   out << ">\n";
   if (info.type == VariableType::string && !info.start.empty()) {
-    out << "      <Start value=\"" << escaped(info.start) << "\"/>\n";
+    out << "      <Start value=\"" << xml_escaped(info.start) << "\"/>\n";
   }
   for (int d = 0; d < info.rank; ++d) write_dimension(out, info.dimensions[static_cast<std::size_t>(d)]);
   out << "    </" << element << ">\n";
@@ -190,28 +207,18 @@ std::string model_description_xml(const ModelDescription& description) {
   out << "<!-- The " << description.model_identifier
       << " FMU's model description (FMI 3.0 Co-Simulation), written by the build from the port schema in\n"
          "     fmu_src/ (tissue-model-description): do not edit. Reference: docs/FMU_VARIABLES.md. -->\n";
-  out << "<fmiModelDescription\n  fmiVersion=\"3.0\"\n  modelName=\"" << escaped(description.model_identifier)
-      << "\"\n  instantiationToken=\"" << escaped(description.instantiation_token) << "\"\n  description=\""
-      << escaped(description.description)
+  out << "<fmiModelDescription\n  fmiVersion=\"3.0\"\n  modelName=\"" << xml_escaped(description.model_identifier)
+      << "\"\n  instantiationToken=\"" << xml_escaped(description.instantiation_token) << "\"\n  description=\""
+      << xml_escaped(description.description)
       << "\"\n  generationTool=\"tissue\"\n  variableNamingConvention=\"structured\">\n\n";
-  out << "  <CoSimulation\n    modelIdentifier=\"" << escaped(description.model_identifier)
+  out << "  <CoSimulation\n    modelIdentifier=\"" << xml_escaped(description.model_identifier)
       << "\"\n    canHandleVariableCommunicationStepSize=\"true\"\n    canGetAndSetFMUState=\"true\"\n"
          "    canSerializeFMUState=\"true\"\n    providesIntermediateUpdate=\"false\"\n"
          "    canReturnEarlyAfterIntermediateUpdate=\"false\"\n    hasEventMode=\"false\"\n"
          "    providesEvaluateDiscreteStates=\"false\"/>\n\n";
   write_unit_definitions(out, description);
   write_enumerations(out, description);
-  out << "  <LogCategories>\n";
-  for (const LogCategory& category : description.log_categories) {
-    out << "    <Category";
-    attribute(out, "name", category.name);
-    attribute(out, "description", category.description);
-    out << "/>\n";
-  }
-  out << "  </LogCategories>\n\n";
-  const DefaultExperiment& experiment = description.default_experiment;
-  out << "  <DefaultExperiment startTime=\"" << experiment.start_time_s << "\" stopTime=\"" << experiment.stop_time_s
-      << "\" stepSize=\"" << experiment.step_size_s << "\"/>\n\n";
+  write_log_categories_and_default_experiment(out, description);
   out << "  <ModelVariables>\n";
   for (const VariableInfo& info : description.variables) write_variable(out, info);
   out << "  </ModelVariables>\n\n";

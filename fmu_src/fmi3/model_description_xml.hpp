@@ -32,6 +32,12 @@ std::string xml_escaped(std::string_view text);
 /// output file, rewritten only when `make_xml()`'s text differs (so the FMU is not repackaged for
 /// nothing). Returns main's exit code; errors to stderr, prefixed by `what`.
 int write_description_main(int argc, char** argv, const char* what, const std::function<std::string()>& make_xml);
+/// ` name="value"` (escaped), nothing when `value` is empty.
+void xml_attribute(std::ostream& out, std::string_view name, std::string_view value);
+/// The <Item .../> lines of an enumeration type, each indented by `indent` (the same element in FMI 2.0 and 3.0).
+void write_enumeration_items(std::ostream& out, const EnumerationType& type, std::string_view indent);
+/// <LogCategories> and <DefaultExperiment> (the same elements in FMI 2.0 and 3.0).
+void write_log_categories_and_default_experiment(std::ostream& out, const ModelDescription& description);
 /// <UnitDefinitions> of the units the variables use, in SI base units. Throws SchemaError for an unknown unit.
 void write_unit_definitions(std::ostream& out, const ModelDescription& description);
 

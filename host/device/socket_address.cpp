@@ -4,8 +4,12 @@
 #include <arpa/inet.h>
 #include <netinet/in.h>
 
+#include <unistd.h>
+
 #include <array>
+#include <cerrno>
 #include <stdexcept>
+#include <system_error>
 
 namespace tissue::host {
 
@@ -59,6 +63,24 @@ SocketAddress listen_address(const std::string& who, const std::string& host, st
                              "127.0.0.1 or ::1, or set allow_remote to listen on it anyway");
   }
   return address;
+}
+
+std::string errno_text(int error) { return std::system_category().message(error); }
+
+int open_bound_socket(const std::string& who, const SocketAddress& address, int type) {
+  const bool stream = type == SOCK_STREAM;
+  const std::string what = (stream ? "listen on tcp " : "bind udp ") + address.text();
+  const int fd = ::socket(address.storage.ss_family, type | SOCK_NONBLOCK | SOCK_CLOEXEC, 0);
+  if (fd < 0) throw std::runtime_error(who + ": cannot create a socket to " + what + ": " + errno_text(errno));
+  const int yes = 1;
+  if (stream) ::setsockopt(fd, SOL_SOCKET, SO_REUSEADDR, &yes, sizeof(yes));
+  if (::bind(fd, reinterpret_cast<const sockaddr*>(&address.storage), address.length) != 0 ||
+      (stream && ::listen(fd, 4) != 0)) {
+    const int error = errno;
+    ::close(fd);
+    throw std::runtime_error(who + ": cannot " + what + ": " + errno_text(error));
+  }
+  return fd;
 }
 
 SocketAddress bound_address(int socket) {

@@ -24,6 +24,14 @@ struct SocketAddress {
 /// @p allow_remote is false: anyone who can reach such an address moves the tool.
 SocketAddress listen_address(const std::string& who, const std::string& host, std::uint16_t port, bool allow_remote);
 
+/// A non-blocking, close-on-exec socket of @p type (SOCK_DGRAM or SOCK_STREAM) bound to @p address;
+/// a stream socket also listens (and may rebind a port in TIME_WAIT). Throws std::runtime_error
+/// "<who>: cannot bind udp <address>: <reason>" (or "cannot listen on tcp ...").
+int open_bound_socket(const std::string& who, const SocketAddress& address, int type);
+
+/// The reason for an errno value, as text.
+std::string errno_text(int error);
+
 /// The address @p socket is bound to (e.g. to learn an ephemeral port).
 SocketAddress bound_address(int socket);
 

@@ -22,8 +22,6 @@ constexpr double INF = std::numeric_limits<double>::infinity();
 
 [[noreturn]] void refuse(const std::string& what) { throw std::runtime_error("UdpDevice: " + what); }
 
-std::string errno_text(int error) { return std::system_category().message(error); }
-
 ForceWatchdog make_watchdog(const UdpDeviceSettings& s) {
   try {
     return ForceWatchdog(ForceWatchdogSettings{s.watchdog_timeout_s, s.ramp_time_s});
@@ -48,16 +46,7 @@ UdpDevice::UdpDevice(const UdpDeviceSettings& settings) : m_settings(settings), 
 
   const SocketAddress address = listen_address("UdpDevice", m_settings.bind_address, m_settings.port,
                                                m_settings.allow_remote);
-  const std::string endpoint = address.text();
-
-  m_socket = ::socket(address.storage.ss_family, SOCK_DGRAM | SOCK_NONBLOCK | SOCK_CLOEXEC, 0);
-  if (m_socket < 0) refuse("cannot create a UDP socket for " + endpoint + ": " + errno_text(errno));
-  if (::bind(m_socket, reinterpret_cast<const sockaddr*>(&address.storage), address.length) != 0) {
-    const int error = errno;
-    ::close(m_socket);
-    m_socket = -1;
-    refuse("cannot bind udp " + endpoint + ": " + errno_text(error));
-  }
+  m_socket = open_bound_socket("UdpDevice", address, SOCK_DGRAM);
   const SocketAddress bound = bound_address(m_socket);
   m_local_port = bound.port();
   m_name = "udp " + bound.text();

@@ -104,7 +104,11 @@ Codec::~Codec() = default;
 
 Verdict Codec::decode_pose(std::span<const std::uint8_t> message, DevicePose& pose) {
   if (message.size() < HEADER_SIZE) return Verdict::malformed;
-  const Header header = read_header(message.first<HEADER_SIZE>());
+  return decode_pose(read_header(message.first<HEADER_SIZE>()), message, pose);
+}
+
+Verdict Codec::decode_pose(const Header& header, std::span<const std::uint8_t> message, DevicePose& pose) {
+  if (message.size() < HEADER_SIZE) return Verdict::malformed;
   const std::size_t body_size = message.size() - HEADER_SIZE;
   if (header.body_size != body_size) return Verdict::malformed;
   const bool transform = header.type == "TRANSFORM";

@@ -57,6 +57,9 @@ class Codec {
   /// Decodes one whole message (header then body). On Verdict::pose, @p pose holds the tool's
   /// position [m], orientation (unit quaternion) and mode (probe or scalpel, by device name).
   Verdict decode_pose(std::span<const std::uint8_t> message, DevicePose& pose);
+  /// The same for a message whose header the caller has read already (the server, which reads
+  /// it to find where the message ends).
+  Verdict decode_pose(const Header& header, std::span<const std::uint8_t> message, DevicePose& pose);
   /// Appends a SENSOR message: 3 values, the force [N] in the scene frame, unit newton.
   void append_force(const std::array<double, 3>& force_n, std::vector<std::uint8_t>& out);
   /// Appends a POLYDATA message of @p frame's triangles, cut faces included (only the points they

@@ -18,8 +18,6 @@ namespace {
 
 [[noreturn]] void refuse(const std::string& what) { throw std::runtime_error("OpenIGTLink server: " + what); }
 
-std::string errno_text(int error) { return std::system_category().message(error); }
-
 // Bytes read from the client per wake-up at most, so that a flood does not hold back the force.
 constexpr std::size_t READ_CHUNK = 65536;
 constexpr int READ_CHUNKS_PER_WAKE = 8;
@@ -46,16 +44,7 @@ IgtlServer::IgtlServer(const IgtlServerSettings& settings)
       m_address(listen_address("OpenIGTLink server", settings.address, settings.port, settings.allow_remote)),
       m_codec(settings.codec) {
   check_settings(m_settings);
-  m_listen = ::socket(m_address.storage.ss_family, SOCK_STREAM | SOCK_NONBLOCK | SOCK_CLOEXEC, 0);
-  if (m_listen < 0) refuse("cannot create a TCP socket for " + m_address.text() + ": " + errno_text(errno));
-  const int yes = 1;
-  ::setsockopt(m_listen, SOL_SOCKET, SO_REUSEADDR, &yes, sizeof(yes));
-  if (::bind(m_listen, reinterpret_cast<const sockaddr*>(&m_address.storage), m_address.length) != 0 ||
-      ::listen(m_listen, 4) != 0) {
-    const int error = errno;
-    ::close(m_listen);
-    refuse("cannot listen on tcp " + m_address.text() + ": " + errno_text(error));
-  }
+  m_listen = open_bound_socket("OpenIGTLink server", m_address, SOCK_STREAM);
   m_address = bound_address(m_listen);
   m_name = "openigtlink " + m_address.text();
   m_wake = ::eventfd(0, EFD_NONBLOCK | EFD_CLOEXEC);
@@ -156,7 +145,7 @@ void IgtlServer::accept_client() {
   const int client = ::accept4(m_listen, nullptr, nullptr, SOCK_NONBLOCK | SOCK_CLOEXEC);
   if (client < 0) return;
   if (m_client >= 0) read_client();  // a client that left (its EOF waiting) makes room for this one
-  if (m_client >= 0) {  // one client at a time: a second one would fight the first for the tool
+  if (m_client >= 0) {               // one client at a time: a second one would fight the first for the tool
     ::close(client);
     bump(m_refused);
     return;
@@ -221,18 +210,18 @@ void IgtlServer::read_client() {
       }
       const std::size_t size = igtl_link::HEADER_SIZE + static_cast<std::size_t>(header.body_size);
       if (available < size) break;
-      handle_message(offset, size);
+      handle_message(header, offset, size);
       offset += size;
     }
     m_in.erase(m_in.begin(), m_in.begin() + static_cast<std::ptrdiff_t>(offset));
   }
 }
 
-void IgtlServer::handle_message(std::size_t offset, std::size_t size) {
+void IgtlServer::handle_message(const igtl_link::Header& header, std::size_t offset, std::size_t size) {
   bump(m_received);
   IgtlPoseSample& sample = m_pose.write_buffer();
   const std::span<const std::uint8_t> message(m_in.data() + offset, size);
-  switch (m_codec.decode_pose(message, sample.pose)) {
+  switch (m_codec.decode_pose(header, message, sample.pose)) {
     case igtl_link::Verdict::ignored:
       bump(m_ignored);
       return;
@@ -243,18 +232,15 @@ void IgtlServer::handle_message(std::size_t offset, std::size_t size) {
       break;
   }
   // The header's timestamp orders one tool's poses (0: the sender does not stamp them).
-  const std::uint64_t timestamp = igtl_link::read_header(std::span<const std::uint8_t, igtl_link::HEADER_SIZE>(
-                                                             message.data(), igtl_link::HEADER_SIZE))
-                                      .timestamp;
   std::uint64_t& last = m_last_timestamp[static_cast<std::size_t>(sample.pose.mode)];
-  if (timestamp != 0 && timestamp <= last) {
-    bump(timestamp == last ? m_duplicate : m_out_of_order);
+  if (header.timestamp != 0 && header.timestamp <= last) {
+    bump(header.timestamp == last ? m_duplicate : m_out_of_order);
     return;
   }
-  last = std::max(last, timestamp);
-  sample.accepted = ++m_accepted_total;
-  m_pose.publish();
+  last = std::max(last, header.timestamp);
   bump(m_accepted);
+  sample.accepted = m_accepted.load(std::memory_order_relaxed);  // this thread is its only writer
+  m_pose.publish();
 }
 
 void IgtlServer::queue_outgoing() {

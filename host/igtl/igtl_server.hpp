@@ -81,7 +81,7 @@ class IgtlServer {
   void run();
   void accept_client();
   void read_client();
-  void handle_message(std::size_t offset, std::size_t size);
+  void handle_message(const igtl_link::Header& header, std::size_t offset, std::size_t size);
   void queue_outgoing();
   void flush();
   void close_client();
@@ -108,7 +108,6 @@ class IgtlServer {
   std::size_t m_out_sent = 0;
   std::uint64_t m_discard = 0;                      // bytes of an oversized body still to skip
   std::array<std::uint64_t, 3> m_last_timestamp{};  // per ToolMode
-  std::uint64_t m_accepted_total = 0;
 
   std::atomic<std::uint64_t> m_connections{0}, m_refused{0}, m_received{0}, m_accepted{0}, m_malformed{0},
       m_oversized{0}, m_out_of_order{0}, m_duplicate{0}, m_ignored{0}, m_forces_sent{0}, m_forces_dropped{0},
