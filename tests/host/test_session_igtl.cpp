@@ -1,10 +1,10 @@
 // OpenIGTLink end to end through tissue-host in real time (issue 24): a client built on Debian's
 // libopenigtlink (tests/host/igtl_client.*), as 3D Slicer or PLUS would be, sends a press of the
 // frog's back as TRANSFORM messages in millimetres at 1 kHz over loopback, with bad messages mixed
-// in, then goes silent; the session runs both FMUs on their threads. Checked: the force the client
-// reads back is the force of the same path run by the scripted device (offline), within the
-// host's timing (one tissue slot and the network); the surface arrives as POLYDATA; every bad
-// message is dropped, counted and changes nothing; silence zeroes the force.
+// in, then goes silent; the session runs both FMUs on their threads. Checked: the poses arrive on
+// the client's path; the force the client reads back is the force of those poses replayed offline
+// from the session's recording, within the host's timing (one tissue slot); the surface arrives as
+// POLYDATA; every bad message is dropped, counted and changes nothing; silence zeroes the force.
 #include "igtl_client.hpp"
 #include "scenario/scenario.hpp"
 #include "session/session.hpp"
@@ -43,6 +43,7 @@ struct LogRow {
   double time_s = 0.0;
   double device_z_m = 0.0;
   std::array<double, 3> force_n{};
+  double tissue_time_s = 0.0;  ///< the time of the tissue sample the haptic loop rendered from
 };
 
 std::vector<LogRow> read_log(const std::filesystem::path& file) {
@@ -54,7 +55,7 @@ std::vector<LogRow> read_log(const std::filesystem::path& file) {
     std::vector<double> fields;
     std::stringstream row(line);
     for (std::string field; std::getline(row, field, ',');) fields.push_back(std::stod(field));
-    rows.push_back({fields.at(0), fields.at(3), {fields.at(8), fields.at(9), fields.at(10)}});
+    rows.push_back({fields.at(0), fields.at(3), {fields.at(8), fields.at(9), fields.at(10)}, fields.at(12)});
   }
   return rows;
 }
@@ -65,24 +66,16 @@ std::filesystem::path fresh_dir(const std::string& name) {
   return dir;
 }
 
-// The same path run by the scripted device, offline, @p lead_s ahead of session time as the
-// client's was (so that the tissue's slots fall on the same points of the path).
-std::vector<LogRow> scripted_run(double lead_s) {
-  const double start_z = press_pose(lead_s).position_m[2];
-  const std::string text =
-      "[scenario]\nduration = 1.6\n[device]\nkind = \"scripted\"\nwaypoints = [\n"
-      "  { t = 0.0, position = [-0.007, 0.0, " +
-      std::to_string(start_z) +
-      "], mode = \"probe\" },\n"
-      "  { t = " +
-      std::to_string(PRESS_S - lead_s) +
-      ", position = [-0.007, 0.0, 0.033], mode = \"probe\" },\n"
-      "  { t = 1.6, position = [-0.007, 0.0, 0.033], mode = \"probe\" },\n]\n"
-      "[output]\nframe_rate = 0\npng = false\n";
-  const Scenario scenario = parse_scenario(text, std::filesystem::path(TISSUE_SCENARIO_DIR) / "igtl_scripted.toml");
+// The poses the session received, as its recording (`--record`) kept them, replayed offline: the
+// same pose at every tick, so the two runs differ only in when the tissue's results reached the
+// haptic loop.
+std::vector<LogRow> replayed_run(const std::filesystem::path& recording) {
+  const std::string text = "[scenario]\nduration = 1.6\n[device]\nkind = \"replay\"\nfile = \"" + recording.string() +
+                           "\"\n[output]\nframe_rate = 0\npng = false\n";
+  const Scenario scenario = parse_scenario(text, std::filesystem::path(TISSUE_SCENARIO_DIR) / "igtl_replay.toml");
   SessionOptions options;
   options.offline = true;
-  options.output_dir = fresh_dir("igtl_scripted");
+  options.output_dir = fresh_dir("igtl_replay");
   options.fmu_dir = TISSUE_FMU_DIR;
   run_session(scenario, options);
   return read_log(options.output_dir / "log.csv");
@@ -96,7 +89,8 @@ TEST(IgtlSession, APressFromAnOpenIgtlinkClientFeelsLikeTheScriptedPressAndShows
   SessionOptions options;
   options.output_dir = fresh_dir("igtl");
   options.fmu_dir = TISSUE_FMU_DIR;
-  options.realtime_priority = false;
+  options.record = options.output_dir / "poses.csv";
+  options.realtime_priority = true;  // where allowed: fewer overruns, so the timing is compared more often
   std::atomic<bool> session_started{false};
   options.haptic_thread_started = [&] { session_started.store(true); };
 
@@ -167,36 +161,61 @@ TEST(IgtlSession, APressFromAnOpenIgtlinkClientFeelsLikeTheScriptedPressAndShows
   }
   EXPECT_LT(last_nonzero_s, HOLD_UNTIL_S + 0.150 + 0.050) << "the watchdog did not zero the force in time";
 
-  // The force matches the scripted run of the same path within the host's timing. The client's
-  // clock starts when the haptic thread does, some ms from session time 0: the lead is read off the
-  // poses the device delivered (the path is known) and the scripted path given the same lead, so
-  // that both runs have the path at the same session times. Then the tissue's result reaches the
-  // haptic loop within one slot (10 ms) of the offline worst case, and a pose crosses loopback
-  // within a few ms (5 ms allowed): at each tick of the press and hold the OpenIGTLink force lies
-  // within the scripted force's range over that window, give or take 2% of the peak.
-  if (tissue::test::UNDER_SANITIZER || s.tissue_overruns > 0) {
-    GTEST_SKIP() << "the tissue did not keep pace (" << s.tissue_overruns
-                 << " overruns): the timing comparison needs a run on its deadlines";
+  // The forces the client read are the forces the session rendered and logged (float64 on the wire,
+  // the log's shortest round-trip text), in the order it rendered them; the server sends the latest
+  // one, so some ticks may be passed over.
+  std::size_t logged = 0, matched = 0;
+  for (const test::ReceivedForce& f : forces) {
+    while (logged < rows.size() && rows[logged].force_n != f.force_n) ++logged;
+    if (logged < rows.size()) ++matched;
   }
+  EXPECT_EQ(matched, forces.size()) << "a force the client read is not in the session's log, or out of its order";
+
+  // The path arrived: the client's clock starts when the haptic thread does, some ms from session
+  // time 0, so the lead is read off the delivered poses (the median over the press) and, with it,
+  // nearly every pose of the press lies on the client's path. A late wake-up of the client's
+  // thread on a busy machine puts a pose a few ms behind: 3 ms of travel (78 um) are allowed.
   std::vector<double> offsets;
   for (const LogRow& r : rows) {
     if (r.time_s >= 0.05 && r.time_s <= PRESS_S - 0.05) offsets.push_back((0.046 - r.device_z_m) / 0.026 - r.time_s);
   }
   ASSERT_GT(offsets.size(), 300u);
-  std::nth_element(offsets.begin(), offsets.begin() + offsets.size() / 2, offsets.end());
-  const double offset_s = offsets[offsets.size() / 2];
+  std::vector<double> sorted = offsets;
+  std::nth_element(sorted.begin(), sorted.begin() + sorted.size() / 2, sorted.end());
+  const double offset_s = sorted[sorted.size() / 2];
   std::cout << "the client's path runs " << offset_s * 1e3 << " ms ahead of session time\n";
   ASSERT_LT(std::abs(offset_s), 0.1);
-  const std::vector<LogRow> scripted = scripted_run(offset_s);
+  const auto off_path = std::count_if(offsets.begin(), offsets.end(), [&](double o) { return std::abs(o - offset_s) > 0.003; });
+  EXPECT_LE(off_path, static_cast<std::ptrdiff_t>(offsets.size() / 20)) << off_path << " poses off the client's path";
+
+  // The force matches an offline replay of the poses received, within the host's timing. The
+  // real-time tissue takes the tool's pose when its step starts and publishes the result when it is
+  // done, the offline one at the slot's boundaries: the two render each tick from samples a slot
+  // (10 ms) apart at most, plus the difference of the two samples' ages. At each tick of the press
+  // and hold the OpenIGTLink force lies within the replayed force's range over that window either
+  // side, give or take 5% of the peak: the frog rings after the press (the replay's force swings by
+  // ~11% of the peak in the hold), and the pose a step starts from, up to a slot later in real time,
+  // shifts the ringing's phase. An overrun feeds the tissue a pose from further along the path, and the frog's
+  // response differs by more than that: such a run is not compared.
+  if (tissue::test::UNDER_SANITIZER || s.tissue_overruns > 0) {
+    GTEST_SKIP() << "the tissue did not keep pace (" << s.tissue_overruns
+                 << " overruns): the timing comparison needs a run on its deadlines";
+  }
+  const std::vector<LogRow> replayed = replayed_run(*options.record);
+  ASSERT_EQ(replayed.size(), rows.size());
   double peak = 0.0;
-  for (const LogRow& r : scripted) peak = std::max(peak, std::abs(r.force_n[2]));
-  ASSERT_GT(peak, 0.5) << "the scripted press did not touch the frog";
-  const double window_s = 0.010 + 0.005, slack_n = 0.02 * peak;
+  for (const LogRow& r : replayed) peak = std::max(peak, std::abs(r.force_n[2]));
+  ASSERT_GT(peak, 0.5) << "the replayed press did not touch the frog";
+  const double slack_n = 0.05 * peak;
   std::size_t compared = 0, outside = 0;
-  for (const LogRow& r : rows) {
+  double widest_s = 0.0;
+  for (std::size_t n = 0; n < rows.size(); ++n) {
+    const LogRow& r = rows[n];
     if (r.time_s < 0.05 || r.time_s > HOLD_UNTIL_S - 0.05) continue;
+    const double window_s = 0.010 + std::abs(r.tissue_time_s - replayed[n].tissue_time_s);
+    widest_s = std::max(widest_s, window_s);
     double lo = 1e9, hi = -1e9;
-    for (const LogRow& q : scripted) {
+    for (const LogRow& q : replayed) {
       if (std::abs(q.time_s - r.time_s) <= window_s + 1e-9) {
         lo = std::min(lo, q.force_n[2]);
         hi = std::max(hi, q.force_n[2]);
@@ -205,8 +224,9 @@ TEST(IgtlSession, APressFromAnOpenIgtlinkClientFeelsLikeTheScriptedPressAndShows
     ++compared;
     if (r.force_n[2] < lo - slack_n || r.force_n[2] > hi + slack_n) ++outside;
   }
+  std::cout << "widest window: " << widest_s * 1e3 << " ms\n";
   EXPECT_GT(compared, 850u);
-  EXPECT_LE(outside, compared / 100) << outside << " of " << compared << " ticks outside the scripted band";
+  EXPECT_LE(outside, compared / 100) << outside << " of " << compared << " ticks outside the replayed band";
 }
 
 }  // namespace
