@@ -185,28 +185,46 @@ TEST(IgtlSession, APressFromAnOpenIgtlinkClientFeelsLikeTheScriptedPressAndShows
   const double offset_s = sorted[sorted.size() / 2];
   std::cout << "the client's path runs " << offset_s * 1e3 << " ms ahead of session time\n";
   ASSERT_LT(std::abs(offset_s), 0.1);
-  const auto off_path = std::count_if(offsets.begin(), offsets.end(), [&](double o) { return std::abs(o - offset_s) > 0.003; });
-  EXPECT_LE(off_path, static_cast<std::ptrdiff_t>(offsets.size() / 20)) << off_path << " poses off the client's path";
+  // Off the path: a pose more than 3 ms of travel from where the client's path was at that tick.
+  std::vector<bool> off_path(rows.size(), false);
+  std::size_t off_path_count = 0, press_ticks = 0;
+  for (std::size_t n = 0; n < rows.size(); ++n) {
+    if (rows[n].time_s > HOLD_UNTIL_S) break;
+    off_path[n] = std::abs(rows[n].device_z_m - press_pose(rows[n].time_s + offset_s).position_m[2]) > 0.003 * 0.026;
+    off_path_count += off_path[n] ? 1 : 0;
+    ++press_ticks;
+  }
+  EXPECT_LE(off_path_count, press_ticks / 20) << off_path_count << " poses off the client's path";
 
   // The force matches an offline replay of the poses received, within the host's timing. The
   // real-time tissue takes the tool's pose when its step starts and publishes the result when it is
   // done, the offline one at the slot's boundaries: the two render each tick from samples a slot
   // (10 ms) apart at most, plus the difference of the two samples' ages. At each tick of the press
   // and hold the OpenIGTLink force lies within the replayed force's range over that window either
-  // side, give or take 5% of the peak: the frog rings after the press (the replay's force swings by
-  // ~11% of the peak in the hold), and the pose a step starts from, up to a slot later in real time,
-  // shifts the ringing's phase. An overrun feeds the tissue a pose from further along the path, and the frog's
-  // response differs by more than that: such a run is not compared.
-  if (tissue::test::UNDER_SANITIZER || s.tissue_overruns > 0) {
+  // side, give or take 5% of the held force: the frog rings after the press (the replay's force
+  // swings by ~12% of the held force after the press), and the pose a step starts from, up to a slot
+  // later in real time, shifts the ringing's phase. An overrun feeds the tissue a pose from further
+  // along the path, and the frog's response differs by more than that: a run with more than one
+  // overrun is not compared (one is allowed: where CHOLMOD's factorization is slower than a slot,
+  // the first contact step's synchronous K_c refresh overruns in every run). So does a pose that
+  // jumped back onto the path after the client's thread stalled (the tissue may be fed it in one
+  // run and not in the other): ticks within 20 ms before and the window after an off-path pose are
+  // passed over.
+  if (tissue::test::UNDER_SANITIZER || s.tissue_overruns > 1) {
     GTEST_SKIP() << "the tissue did not keep pace (" << s.tissue_overruns
                  << " overruns): the timing comparison needs a run on its deadlines";
   }
   const std::vector<LogRow> replayed = replayed_run(*options.record);
   ASSERT_EQ(replayed.size(), rows.size());
-  double peak = 0.0;
-  for (const LogRow& r : replayed) peak = std::max(peak, std::abs(r.force_n[2]));
-  ASSERT_GT(peak, 0.5) << "the replayed press did not touch the frog";
-  const double slack_n = 0.05 * peak;
+  std::vector<double> held_n;
+  for (const LogRow& r : replayed) {
+    if (r.time_s >= PRESS_S + 0.1 && r.time_s <= HOLD_UNTIL_S - 0.05) held_n.push_back(r.force_n[2]);
+  }
+  ASSERT_FALSE(held_n.empty());
+  std::nth_element(held_n.begin(), held_n.begin() + held_n.size() / 2, held_n.end());
+  const double held_force_n = held_n[held_n.size() / 2];
+  ASSERT_GT(held_force_n, 0.5) << "the replayed press did not touch the frog";
+  const double slack_n = 0.05 * held_force_n;
   std::size_t compared = 0, outside = 0;
   double widest_s = 0.0;
   for (std::size_t n = 0; n < rows.size(); ++n) {
@@ -214,6 +232,12 @@ TEST(IgtlSession, APressFromAnOpenIgtlinkClientFeelsLikeTheScriptedPressAndShows
     if (r.time_s < 0.05 || r.time_s > HOLD_UNTIL_S - 0.05) continue;
     const double window_s = 0.010 + std::abs(r.tissue_time_s - replayed[n].tissue_time_s);
     widest_s = std::max(widest_s, window_s);
+    bool near_a_stall = false;
+    for (std::size_t m = 0; m < rows.size() && !near_a_stall; ++m) {
+      near_a_stall =
+          off_path[m] && rows[m].time_s >= r.time_s - window_s - 0.020 && rows[m].time_s <= r.time_s + window_s;
+    }
+    if (near_a_stall) continue;
     double lo = 1e9, hi = -1e9;
     for (const LogRow& q : replayed) {
       if (std::abs(q.time_s - r.time_s) <= window_s + 1e-9) {
@@ -225,7 +249,7 @@ TEST(IgtlSession, APressFromAnOpenIgtlinkClientFeelsLikeTheScriptedPressAndShows
     if (r.force_n[2] < lo - slack_n || r.force_n[2] > hi + slack_n) ++outside;
   }
   std::cout << "widest window: " << widest_s * 1e3 << " ms\n";
-  EXPECT_GT(compared, 850u);
+  EXPECT_GT(compared, 750u);
   EXPECT_LE(outside, compared / 100) << outside << " of " << compared << " ticks outside the replayed band";
 }
 
