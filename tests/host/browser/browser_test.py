@@ -16,6 +16,7 @@ import argparse
 import json
 import pathlib
 import re
+import signal
 import subprocess
 import sys
 import threading
@@ -40,7 +41,9 @@ def main():
 
     out = pathlib.Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
-    duration = args.seconds + 14.0  # page start-up, the drag and the watch, with room
+    # Page start-up, the drag and the watch, with ample room (Chromium starts slowly on a busy
+    # machine): the session is ended with Ctrl-C once the browser script is done.
+    duration = args.seconds + 60.0
     host = subprocess.Popen(
         [args.host, "run", args.scenario, "--mouse", "--port", "0", "--output", str(out / "session"),
          "--duration", str(duration)] + ([] if args.rt else ["--no-rt-priority"]),
@@ -80,6 +83,7 @@ def main():
     if browser.returncode != 0:
         host.kill()
         fail("the browser script failed:\n" + browser.stdout + browser.stderr)
+    host.send_signal(signal.SIGINT)
     try:
         host.wait(timeout=duration + 120)
     except subprocess.TimeoutExpired:
