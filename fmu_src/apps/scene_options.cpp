@@ -68,6 +68,9 @@ void add_scene_options(CLI::App& app, SceneOptions& options) {
   app.add_option("--young", options.material.young_modulus_pa, "Young's modulus [Pa]")->capture_default_str();
   app.add_option("--poisson", options.material.poisson_ratio, "Poisson's ratio")->capture_default_str();
   app.add_option("--density", options.material.density_kg_per_m3, "Density [kg/m^3]")->capture_default_str();
+  app.add_flag("--single-material", options.single_material,
+               "Ignore the mesh file's regions and materials (Vega *REGION, Gmsh physical groups, TetGen region "
+               "attributes): --young, --poisson, --density everywhere");
   app.add_option("--mass-damping", options.damping.mass_damping_per_s, "Rayleigh alpha [1/s]")->capture_default_str();
   app.add_option("--stiffness-damping", options.damping.stiffness_damping_s, "Rayleigh beta [s]")
       ->capture_default_str();
@@ -82,6 +85,10 @@ Scene make_scene(const SceneOptions& options) {
   Scene scene;
   scene.mesh_name = options.mesh;
   scene.mesh = load_mesh(options.mesh);
+  if (options.single_material) {
+    scene.mesh.regions.clear();
+    scene.mesh.tet_regions.clear();
+  }
   if (options.steps < 1) throw ParameterError("--steps must be >= 1");
   TissueSettings& settings = scene.settings;
   settings.step_size_s = options.step_size_s;

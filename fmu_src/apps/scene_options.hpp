@@ -31,6 +31,9 @@ struct SceneOptions {
   CholeskyPcgSolver::Refresh refresh = with_background_refactor();
   bool warm_start = false;
   Material material{1.0e5, 0.4, 1000.0};
+  /// Ignore the mesh file's regions and their materials (Vega *REGION, ...): `material` everywhere,
+  /// as the benchmarks' side-by-side runs were measured before regions were read (issue 25).
+  bool single_material = false;
   RayleighDamping damping{0.0, 0.0};
   std::string gravity = "0,-9.81,0";
   /// Backward Euler's large-turn protections (BackwardEuler::NewtonCorrections); "off" = the

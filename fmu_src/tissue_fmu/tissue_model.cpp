@@ -60,6 +60,7 @@ TissueSettings tissue_settings(const ValueStore& values, const TetMesh* mesh) {
   s.body.material.young_modulus_pa = values.float64(vr(Vr::young_modulus));
   s.body.material.poisson_ratio = values.float64(vr(Vr::poisson_ratio));
   s.body.material.density_kg_per_m3 = values.float64(vr(Vr::density));
+  s.body.region_materials = parse_region_materials(values.string(vr(Vr::material_regions)), s.body.material);
   s.body.damping.mass_damping_per_s = values.float64(vr(Vr::damping_alpha));
   s.body.damping.stiffness_damping_s = values.float64(vr(Vr::damping_beta));
   const std::span<const double> gravity = values.float64_array(vr(Vr::gravity));

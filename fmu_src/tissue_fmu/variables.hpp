@@ -91,6 +91,7 @@ enum class Vr : std::uint32_t {
   step_threads = 79,         // issue 23
   contact_stiffness_in_background = 80,  // issue 23
   sample_time = 81,                      // issue 24: for masters that cannot connect `time`
+  material_regions = 82,                 // issue 25
   tool_applied_position = ports::sample_field("tool.appliedPosition").tissue_vr
 };
 
@@ -98,7 +99,7 @@ namespace variables_detail {
 // The table in parts, one kind of variable each, in value-reference order within each; own_variables()
 // merges them (fmi3::merged: by value reference).
 
-/// The body: mesh, material, damping, gravity, the fixed region (value references 1-9).
+/// The body: mesh, material, damping, gravity, the fixed region (value references 1-9), the regions' materials (82).
 constexpr auto body_parameters() {
   using namespace fmi3;  // NOLINT(google-build-using-namespace): the table reads as the XML
   using enum VariableType;
@@ -148,6 +149,12 @@ constexpr auto body_parameters() {
         .min("0")
         .max("1")
         .describe("Thickness of the fixed slab as a fraction of the mesh's extent along fixedRegion.axis"),
+    parameter(Vr::material_regions, "material.regions", string)
+        .start("none")
+        .describe("Materials by region name (the mesh's Vega *REGION sets, Gmsh physical groups or TetGen region "
+                  "numbers), replacing the file's: \"name: youngModulus=1e6, poissonRatio=0.45, density=1050; "
+                  "name2: ...\"; a key left out takes material.*. A region neither the file nor this gives a "
+                  "material has material.*. \"none\": none"),
 });
 }
 

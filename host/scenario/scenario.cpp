@@ -4,6 +4,7 @@
 #include "scenario/parameter_table.hpp"
 
 #include <algorithm>
+#include <charconv>
 #include <cmath>
 #include <fstream>
 #include <set>
@@ -178,15 +179,46 @@ void add_unless_set(std::vector<ParameterSetting>& parameters, ParameterSetting 
   }
 }
 
+// [tissue.regions.NAME] (optional): a region's material, as the Tissue FMU's material.regions text.
+std::string region_materials_text(const Reader& r, const toml::table& regions) {
+  std::string text;
+  for (const auto& [name, node] : regions) {
+    const std::string where = "tissue.regions." + std::string(name.str());
+    const toml::table* region = node.as_table();
+    if (region == nullptr) r.fail(where, "must be a table (youngModulus, poissonRatio, density)");
+    r.only(*region, where, {"youngModulus", "poissonRatio", "density"});
+    if (!text.empty()) text += "; ";
+    text += std::string(name.str()) + ":";
+    bool first = true;
+    for (const auto& [key, value] : *region) {
+      char number[32];  // shortest round-trip text
+      const auto end =
+          std::to_chars(number, number + sizeof(number), r.number(value, where + "." + std::string(key.str())));
+      text += (first ? " " : ", ") + std::string(key.str()) + "=" + std::string(number, end.ptr);
+      first = false;
+    }
+  }
+  return text;
+}
+
 // [tissue] (optional): the FMU, the communication step, the parameters and a mesh file.
 void read_tissue(const Reader& r, const toml::table& root, const std::filesystem::path& base, Scenario& s) {
   if (const toml::table* tissue = root["tissue"].as_table()) {
-    r.only(*tissue, "tissue", {"fmu", "communication_step", "mesh", "parameters"});
+    r.only(*tissue, "tissue", {"fmu", "communication_step", "mesh", "parameters", "regions"});
     if (const toml::node* n = tissue->get("fmu")) s.tissue_fmu = relative_to(base, r.string(*n, "tissue.fmu"));
     if (const toml::node* n = tissue->get("communication_step")) {
       s.tissue_step_s = r.positive(*n, "tissue.communication_step");
     }
     s.tissue_parameters = parameters(r, tissue->get_as<toml::table>("parameters"), "tissue.parameters");
+    if (const toml::node* n = tissue->get("regions")) {
+      const toml::table* regions = n->as_table();
+      if (regions == nullptr) r.fail("tissue.regions", "must be a table of regions ([tissue.regions.NAME])");
+      if (std::any_of(s.tissue_parameters.begin(), s.tissue_parameters.end(),
+                      [](const ParameterSetting& p) { return p.name == "material.regions"; })) {
+        r.fail("tissue.regions", "given twice: also as tissue.parameters.\"material.regions\"");
+      }
+      s.tissue_parameters.push_back(ParameterSetting{"material.regions", region_materials_text(r, *regions)});
+    }
     if (const toml::node* n = tissue->get("mesh")) {
       // A mesh file next to the scenario: the FMU is given its absolute path.
       const std::filesystem::path mesh = relative_to(base, r.string(*n, "tissue.mesh"));
@@ -201,7 +233,8 @@ void read_tissue(const Reader& r, const toml::table& root, const std::filesystem
   // The host runs beside the tissue's threads anyway: our Tissue.fmu refreshes its contact stiffness
   // in a worker, off the step's 10 ms slot (a CHOLMOD factorization: ~7 ms on the frog), unless the
   // scenario says otherwise. Another tissue FMU is given only what the scenario says.
-  if (s.tissue_fmu.empty()) add_unless_set(s.tissue_parameters, ParameterSetting{"contact.stiffnessInBackground", true});
+  if (s.tissue_fmu.empty())
+    add_unless_set(s.tissue_parameters, ParameterSetting{"contact.stiffnessInBackground", true});
 }
 
 // [haptic] (optional): the FMU, the period, the parameters; the tissue step a whole number of periods.
@@ -308,8 +341,9 @@ DeviceConfig read_device(const Reader& r, const toml::table& root, const std::fi
   } else if (kind_name == "openigtlink") {
     config.kind = DeviceKind::openigtlink;  // the [openigtlink] server's client
   } else {
-    r.fail("device.kind", "must be \"scripted\", \"hand\", \"replay\", \"udp\", \"browser\" or \"openigtlink\", got \"" +
-                              kind_name + "\"");
+    r.fail("device.kind",
+           "must be \"scripted\", \"hand\", \"replay\", \"udp\", \"browser\" or \"openigtlink\", got \"" + kind_name +
+               "\"");
   }
   if (kind_name != "udp") {
     for (const char* key : {"address", "port", "allow_remote"}) {
@@ -410,7 +444,8 @@ Scenario parse_scenario(const std::string& text, const std::filesystem::path& or
   const Reader r(origin.string());
   const toml::table root = parse_toml(text, origin);
   // [compare] belongs to tissue-host compare (host/compare/compare_settings.*), which reads it itself.
-  r.only(root, "", {"scenario", "tissue", "haptic", "device", "openigtlink", "realtime", "output", "expect", "compare"});
+  r.only(root, "",
+         {"scenario", "tissue", "haptic", "device", "openigtlink", "realtime", "output", "expect", "compare"});
   Scenario s;
   s.file = origin;
   const std::filesystem::path base = origin.has_parent_path() ? origin.parent_path() : std::filesystem::path(".");

@@ -1,7 +1,7 @@
 // Fixed-vertex selection by region.
 #include "core/fixed_region.hpp"
 
-#include "core/fem/material.hpp"
+#include "core/material/material.hpp"
 
 #include <limits>
 #include <string>

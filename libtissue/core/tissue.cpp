@@ -57,6 +57,14 @@ std::uint64_t model_fingerprint_of(const TetMesh& mesh, const TissueSettings& se
   f.add(body.material.young_modulus_pa);
   f.add(body.material.poisson_ratio);
   f.add(body.material.density_kg_per_m3);
+  if (!mesh.regions.empty()) {  // a mesh of one region keeps its older fingerprint
+    f.add_all(mesh.tet_regions);
+    for (const Material& material : resolve_region_materials(mesh.regions, body.material, body.region_materials)) {
+      f.add(material.young_modulus_pa);
+      f.add(material.poisson_ratio);
+      f.add(material.density_kg_per_m3);
+    }
+  }
   f.add(body.damping.mass_damping_per_s);
   f.add(body.damping.stiffness_damping_s);
   f.add(std::array<double, 3>{body.gravity_m_per_s2.x(), body.gravity_m_per_s2.y(), body.gravity_m_per_s2.z()});

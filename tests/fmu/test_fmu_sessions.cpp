@@ -713,6 +713,35 @@ TEST_F(BadUse, AMissingOrMalformedMeshIsRefused) {
   ASSERT_EQ(m_fmu.exit_initialization_mode(), fmi3OK) << m_fmu.log_text();  // the reset restored mesh = "frog"
 }
 
+// Materials by region name (issue 25): a region the mesh has takes them; a name it does not have
+// or a material out of range is refused at initialization, naming the region.
+TEST_F(BadUse, RegionMaterialsAreSetByNameAndMistakesAreRefused) {
+  const std::filesystem::path two = std::filesystem::temp_directory_path() / "tissue_fmu_two_regions.veg";
+  std::ofstream(two) << "*VERTICES\n5 3 0 0\n1 0 0 0\n2 0.01 0 0\n3 0 0.01 0\n4 0 0 0.01\n5 0.01 0.01 0.01\n"
+                        "*ELEMENTS\nTET\n2 4 0\n1 1 2 3 4\n2 2 5 3 4\n"
+                        "*MATERIAL soft\nENU, 1000, 1e5, 0.4\n*SET skin\n1\n*SET tumour\n2\n"
+                        "*REGION\nskin, soft\ntumour, soft\n";
+  ASSERT_EQ(m_fmu.set_string("mesh", {two.string()}), fmi3OK);
+  ASSERT_EQ(m_fmu.set_string("material.regions", {"tumour: youngModulus=1e6, density=1100"}), fmi3OK);
+  ASSERT_EQ(m_fmu.enter_initialization_mode(std::nullopt, 0.0, std::nullopt), fmi3OK);
+  ASSERT_EQ(m_fmu.exit_initialization_mode(), fmi3OK) << m_fmu.log_text();
+  ASSERT_EQ(m_fmu.reset(), fmi3OK);
+  ASSERT_EQ(m_fmu.set_string("mesh", {two.string()}), fmi3OK);
+  ASSERT_EQ(m_fmu.set_string("material.regions", {"liver: density=1100"}), fmi3OK);
+  ASSERT_EQ(m_fmu.enter_initialization_mode(std::nullopt, 0.0, std::nullopt), fmi3OK);
+  const fmi3Status unknown_region = m_fmu.exit_initialization_mode();
+  EXPECT_NE(m_fmu.log_text().find("\"liver\", which the mesh does not have (its regions: \"skin\", \"tumour\")"),
+            std::string::npos)
+      << m_fmu.log_text();
+  expect_error(unknown_region, "a region the mesh does not have");
+  ASSERT_EQ(m_fmu.reset(), fmi3OK);
+  // A material out of range is refused when set.
+  const fmi3Status out_of_range = m_fmu.set_string("material.regions", {"tumour: poissonRatio=0.5"});
+  EXPECT_NE(m_fmu.log_text().find("Poisson's ratio must be in [0, 0.5)"), std::string::npos) << m_fmu.log_text();
+  expect_error(out_of_range, "a region's material out of range");
+  std::filesystem::remove(two);
+}
+
 // A render surface that is missing, lies outside the tet mesh or has a NaN vertex is refused at
 // initialization with the parameter, the file and the element named; Binary is got only from Binary
 // outputs, only once there is a model.

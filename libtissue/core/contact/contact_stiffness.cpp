@@ -1,7 +1,7 @@
 // Contact stiffness models (see contact_stiffness.hpp).
 #include "core/contact/contact_stiffness.hpp"
 
-#include "core/fem/material.hpp"
+#include "core/material/material.hpp"
 #include "core/solve/cholmod_factor.hpp"
 #include "core/fem/tet_element.hpp"
 
@@ -177,7 +177,8 @@ Eigen::Matrix3d element_local_contact_stiffness(const CorotationalElasticity& el
   }
   const Eigen::Matrix3d& rotation = elasticity.rotation(tet);
   const Eigen::Matrix3d block =
-      linear_stiffness_block(elasticity.rest(tet), elasticity.lame(), opposite_local_vertex, opposite_local_vertex);
+      linear_stiffness_block(elasticity.rest(tet), elasticity.lame_of(elasticity.rest(tet)), opposite_local_vertex,
+                             opposite_local_vertex);
   return rotation * block * rotation.transpose();
 }
 
@@ -221,8 +222,19 @@ double mean_surface_edge_m(const DeformableBody& body, const SurfaceMesh& surfac
 }
 
 double contact_stiffness_scale_n_per_m(const DeformableBody& body, const SurfaceMesh& surface) {
-  const LameParameters& lame = body.elasticity().lame();
-  return (lame.lambda_pa + 2.0 * lame.mu_pa) * mean_surface_edge_m(body, surface);
+  // With regions, the stiffest material on the surface (P-wave modulus lambda + 2 mu): a probe must
+  // not sink into the stiffest part it can touch.
+  const CorotationalElasticity& elasticity = body.elasticity();
+  double modulus_pa = 0.0;
+  if (elasticity.lame().size() == 1) {
+    modulus_pa = elasticity.lame()[0].lambda_pa + 2.0 * elasticity.lame()[0].mu_pa;
+  } else {
+    for (const int tet : surface.triangle_tet) {
+      const LameParameters& lame = elasticity.lame_of(elasticity.rest(tet));
+      modulus_pa = std::max(modulus_pa, lame.lambda_pa + 2.0 * lame.mu_pa);
+    }
+  }
+  return modulus_pa * mean_surface_edge_m(body, surface);
 }
 
 ContactStiffnessRequest contact_stiffness_request(const ShiftedSystem& system, const DofMap& dofs,

@@ -1,7 +1,7 @@
 // The god-object point contact (see point_contact.hpp).
 #include "core/contact/point_contact.hpp"
 
-#include "core/fem/material.hpp"
+#include "core/material/material.hpp"
 
 #include <cmath>
 #include <stdexcept>

@@ -3,7 +3,7 @@
 
 #include "core/collide/geometry.hpp"
 #include "core/cut/cut_geometry.hpp"
-#include "core/fem/material.hpp"
+#include "core/material/material.hpp"
 
 #include <Eigen/Geometry>
 

@@ -24,18 +24,31 @@ TetPositions gather(const Eigen::VectorXd& positions_m, const Tet& tet) {
   return x;
 }
 
+std::vector<LameParameters> lame_table(const TetMesh& mesh, const std::vector<Material>& materials) {
+  if (materials.size() != static_cast<size_t>(mesh.region_count())) {
+    throw ParameterError("co-rotational elasticity: " + std::to_string(materials.size()) +
+                         " materials for a mesh of " + std::to_string(mesh.region_count()) + " regions");
+  }
+  std::vector<LameParameters> table;
+  for (const Material& material : materials) {
+    validate(material);
+    table.push_back(lame_parameters(material));
+  }
+  return table;
+}
+
 }  // namespace
 
-CorotationalElasticity::CorotationalElasticity(const TetMesh& mesh, const Material& material,
+CorotationalElasticity::CorotationalElasticity(const TetMesh& mesh, const std::vector<Material>& materials,
                                                const RotationSettings& rotation, const std::vector<int>& vertex_order)
-    : m_lame((validate(material), lame_parameters(material))),
-      m_rotation_settings((validate(rotation), rotation)) {
+    : m_lame(lame_table(mesh, materials)), m_rotation_settings((validate(rotation), rotation)) {
   partition(mesh, vertex_order);
   m_tets.reserve(m_tet_id.size());
   m_rest.reserve(m_tet_id.size());
   for (const int t : m_tet_id) {
     m_tets.push_back(mesh.tets[static_cast<size_t>(t)]);
     m_rest.push_back(precompute_tet(mesh.rest_corners(t)));
+    m_rest.back().material = mesh.region_of(t);
   }
   m_rotations.assign(m_tets.size(), Eigen::Matrix3d::Identity());
   m_warm_starts.assign(m_tets.size(), Eigen::Quaterniond::Identity());
@@ -239,7 +252,8 @@ TISSUE_HOT_KERNEL void CorotationalElasticity::add_tet(size_t k, const Eigen::Ma
   const Eigen::Matrix3d& r = m_rotations[k];
 
   // f_i = V R sigma g_i (equal to R K_e (R^T x - X), see DESIGN section 4).
-  const Eigen::Matrix<double, 3, 4> forces = corotated_forces(rest, r, f, m_lame);
+  const LameParameters& lame = lame_of(rest);
+  const Eigen::Matrix<double, 3, 4> forces = corotated_forces(rest, r, f, lame);
   for (int i = 0; i < 4; ++i) internal_forces_n.segment<3>(3 * tet[static_cast<size_t>(i)]) += forces.col(i);
 
   if (tangent == nullptr) return;
@@ -249,7 +263,7 @@ TISSUE_HOT_KERNEL void CorotationalElasticity::add_tet(size_t k, const Eigen::Ma
     for (int j = i; j < 4; ++j) {
       const int slot_ij = tet_slots[static_cast<size_t>(4 * i + j)];
       if (slot_ij < 0) continue;
-      const Eigen::Matrix3d block = rotated_stiffness_block(rest, m_lame, c, i, j);
+      const Eigen::Matrix3d block = rotated_stiffness_block(rest, lame, c, i, j);
       tangent->block(slot_ij) += block;
       if (i != j) tangent->block(tet_slots[static_cast<size_t>(4 * j + i)]) += block.transpose();
     }
@@ -264,7 +278,7 @@ TISSUE_HOT_KERNEL double CorotationalElasticity::energy_of_range(const Eigen::Ve
   in_rotation_batches(
       end - first, [first](size_t k) { return first + k; }, positions_m, nullptr, nullptr,
       [&](size_t t, const Eigen::Matrix3d& f, const Eigen::Matrix3d& rotation) {
-        energy += corotated_energy_j(m_rest[t], rotation, f, m_lame);
+        energy += corotated_energy_j(m_rest[t], rotation, f, lame_of(m_rest[t]));
       });
   return energy;
 }
@@ -279,10 +293,12 @@ double CorotationalElasticity::elastic_energy_j(const Eigen::VectorXd& positions
   return half[0] + half[1];
 }
 
-std::vector<double> lumped_vertex_masses(const TetMesh& mesh, double density_kg_per_m3) {
+std::vector<double> lumped_vertex_masses(const TetMesh& mesh, const std::vector<Material>& materials) {
   std::vector<double> masses(static_cast<size_t>(mesh.vertex_count()), 0.0);
-  for (const Tet& tet : mesh.tets) {
+  for (int t = 0; t < mesh.tet_count(); ++t) {
+    const Tet& tet = mesh.tets[static_cast<size_t>(t)];
     const auto& p = mesh.rest_positions_m;
+    const double density_kg_per_m3 = materials.at(static_cast<size_t>(mesh.region_of(t))).density_kg_per_m3;
     const double quarter_mass = 0.25 * density_kg_per_m3 *
                                 signed_tet_volume(p[static_cast<size_t>(tet[0])], p[static_cast<size_t>(tet[1])],
                                                   p[static_cast<size_t>(tet[2])], p[static_cast<size_t>(tet[3])]);

@@ -3,7 +3,7 @@
 // assembled into a BlockSparseMatrix through precomputed slots.
 #pragma once
 
-#include "core/fem/material.hpp"
+#include "core/material/material.hpp"
 #include "core/fem/rotation.hpp"
 #include "core/fem/tet_element.hpp"
 #include "core/mesh/tet_mesh.hpp"
@@ -21,16 +21,27 @@ namespace tissue {
 
 class CorotationalElasticity {
  public:
-  /// Precomputes shape gradients and volumes. Throws ParameterError for an invalid material or
-  /// rotation setting.
+  /// Precomputes shape gradients and volumes. `materials`: one per region of the mesh
+  /// (TetMesh::region_count(), see resolve_region_materials), each tet taking its region's. Throws
+  /// ParameterError for an invalid material, a count that does not match, or an invalid rotation
+  /// setting.
   /// `vertex_order` (a permutation of the vertices, such as locality_order(), or empty for vertex
   /// order): each assembly part visits its tets by the earliest of their vertices in it, so that
   /// consecutive tets write nearby blocks when the system's rows are numbered in the same order.
+  CorotationalElasticity(const TetMesh& mesh, const std::vector<Material>& materials,
+                         const RotationSettings& rotation = {}, const std::vector<int>& vertex_order = {});
+  /// One material for the whole mesh (every region).
   CorotationalElasticity(const TetMesh& mesh, const Material& material, const RotationSettings& rotation = {},
-                         const std::vector<int>& vertex_order = {});
+                         const std::vector<int>& vertex_order = {})
+      : CorotationalElasticity(mesh, std::vector<Material>(static_cast<size_t>(mesh.region_count()), material),
+                               rotation, vertex_order) {}
 
   [[nodiscard]] int tet_count() const { return static_cast<int>(m_tets.size()); }
-  [[nodiscard]] const LameParameters& lame() const { return m_lame; }
+  /// The Lame parameters of each material (TetRest::material indexes them).
+  [[nodiscard]] const std::vector<LameParameters>& lame() const { return m_lame; }
+  [[nodiscard]] const LameParameters& lame_of(const TetRest& rest) const {
+    return m_lame[static_cast<size_t>(rest.material)];
+  }
   [[nodiscard]] const TetRest& rest(int tet) const { return m_rest[stored(tet)]; }
   [[nodiscard]] const Eigen::Matrix3d& rotation(int tet) const { return m_rotations[stored(tet)]; }
 
@@ -130,11 +141,12 @@ class CorotationalElasticity {
   std::vector<Eigen::Matrix3d> m_rotations;
   std::vector<Eigen::Quaterniond> m_warm_starts;
   std::vector<char> m_excluded;  // 1 = modelled elsewhere (cut)
-  LameParameters m_lame;
+  std::vector<LameParameters> m_lame;  // per material
   RotationSettings m_rotation_settings;
 };
 
-/// Lumped mass (eq. 4.15): each tet gives rho V / 4 to each of its vertices. [kg], one per vertex.
-std::vector<double> lumped_vertex_masses(const TetMesh& mesh, double density_kg_per_m3);
+/// Lumped mass (eq. 4.15): each tet gives rho V / 4 to each of its vertices, rho its region's
+/// (`materials` as for CorotationalElasticity). [kg], one per vertex.
+std::vector<double> lumped_vertex_masses(const TetMesh& mesh, const std::vector<Material>& materials);
 
 }  // namespace tissue

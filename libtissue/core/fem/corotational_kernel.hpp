@@ -6,7 +6,7 @@
 // Inline: these are the innermost loop of every step.
 #pragma once
 
-#include "core/fem/material.hpp"
+#include "core/material/material.hpp"
 #include "core/fem/tet_element.hpp"
 
 #include <Eigen/Core>

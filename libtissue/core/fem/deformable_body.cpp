@@ -104,9 +104,10 @@ DeformableBody::DeformableBody(TetMesh mesh, BodySettings settings)
       m_adjacency(build_adjacency(m_mesh)),
       m_vertex_order(locality_order(m_adjacency, m_mesh.vertex_count())),
       m_settings(checked(std::move(settings), m_mesh.vertex_count())),
+      m_materials(resolve_region_materials(m_mesh.regions, m_settings.material, m_settings.region_materials)),
       m_dofs(make_dof_map(m_mesh.vertex_count(), m_settings.fixed_vertices, m_vertex_order)),
-      m_elasticity(m_mesh, m_settings.material, m_settings.rotation, m_vertex_order),
-      m_vertex_mass_kg(lumped_vertex_masses(m_mesh, m_settings.material.density_kg_per_m3)),
+      m_elasticity(m_mesh, m_materials, m_settings.rotation, m_vertex_order),
+      m_vertex_mass_kg(lumped_vertex_masses(m_mesh, m_materials)),
       m_tangent(stiffness_pattern(m_mesh, m_dofs), with_ghost_room(m_settings.reserve, m_mesh, m_dofs)),
       m_slots(make_tet_slots(m_mesh, m_dofs, m_tangent)),
       m_xfem(m_elasticity.lame(), m_settings.rotation),
@@ -414,7 +415,7 @@ EnrichmentResult DeformableBody::enrich(std::span<const TetCut> cuts,
 
 void DeformableBody::add_ghost_loads(int k, double sign) {
   const int u_rows = m_dofs.free_vertex_count();
-  const double tet_mass_kg = m_settings.material.density_kg_per_m3 * m_xfem.rest(k).volume_m3;
+  const double tet_mass_kg = density_kg_per_m3(m_xfem.rest(k)) * m_xfem.rest(k).volume_m3;
   for (size_t p = 0; p < m_xfem.piece_count(k); ++p) {
     const CutPiece& piece = m_xfem.piece(k, static_cast<int>(p));
     const double quarter_mass_kg = 0.25 * piece.weight * tet_mass_kg;
@@ -972,7 +973,7 @@ TetPositions DeformableBody::piece_positions(const Eigen::VectorXd& displacement
 }
 
 double DeformableBody::piece_mass_kg(int cut_tet_index, int piece) const {
-  return m_settings.material.density_kg_per_m3 * m_xfem.piece(cut_tet_index, piece).weight *
+  return density_kg_per_m3(m_xfem.rest(cut_tet_index)) * m_xfem.piece(cut_tet_index, piece).weight *
          m_xfem.rest(cut_tet_index).volume_m3;
 }
 

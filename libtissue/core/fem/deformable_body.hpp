@@ -13,7 +13,7 @@
 #include "core/fem/tet_pieces.hpp"
 #include "core/fem/tet_cut.hpp"
 #include "core/fem/corotational.hpp"
-#include "core/fem/material.hpp"
+#include "core/material/material.hpp"
 #include "core/fem/xfem_elasticity.hpp"
 #include "core/mesh/tet_mesh.hpp"
 #include "core/mesh/topology.hpp"
@@ -33,7 +33,10 @@
 namespace tissue {
 
 struct BodySettings {
+  /// The material of every region the mesh file gives none and `region_materials` does not set.
   Material material;
+  /// Materials set by region name (TetMesh::regions), replacing the file's (resolve_region_materials).
+  std::vector<RegionMaterial> region_materials;
   RayleighDamping damping;
   Eigen::Vector3d gravity_m_per_s2{0.0, -9.81, 0.0};
   std::vector<int> fixed_vertices;  ///< 0-based; they keep their rest positions
@@ -108,6 +111,8 @@ class DeformableBody final : public DynamicsModel {
   [[nodiscard]] const DofMap& dofs() const { return m_dofs; }
   [[nodiscard]] const BodySettings& settings() const { return m_settings; }
   [[nodiscard]] const CorotationalElasticity& elasticity() const { return m_elasticity; }
+  /// The material of each mesh region, resolved (TetRest::material indexes them).
+  [[nodiscard]] const std::vector<Material>& materials() const { return m_materials; }
   [[nodiscard]] const std::vector<double>& vertex_masses_kg() const { return m_vertex_mass_kg; }
   [[nodiscard]] double total_mass_kg() const;
 
@@ -219,6 +224,7 @@ class DeformableBody final : public DynamicsModel {
   TetAdjacency m_adjacency;  // faces and vertex stars, for grouping the pieces' ghosts
   std::vector<int> m_vertex_order;  // locality_order(): the block rows' and the assembly's sequence
   BodySettings m_settings;
+  std::vector<Material> m_materials;  // per region
   DofMap m_dofs;
   CorotationalElasticity m_elasticity;
   std::vector<double> m_vertex_mass_kg;
@@ -228,6 +234,10 @@ class DeformableBody final : public DynamicsModel {
   std::vector<TetSlots> m_slots;
   Eigen::VectorXd m_positions_m;      // all vertices
   Eigen::VectorXd m_vertex_forces_n;  // all vertices
+
+  [[nodiscard]] double density_kg_per_m3(const TetRest& rest) const {
+    return m_materials[static_cast<size_t>(rest.material)].density_kg_per_m3;
+  }
 
   // Looks up every slot held (uncut tets, cut tets, force terms) again: after a relayout.
   // All slots again after the tangent was re-laid out: by its slot map when it was re-laid out once

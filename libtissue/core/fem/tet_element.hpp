@@ -2,7 +2,7 @@
 // K_e = V B^T E B (eq. 3.12) and the deformation gradient. Shared by the co-rotational model and tests.
 #pragma once
 
-#include "core/fem/material.hpp"
+#include "core/material/material.hpp"
 
 #include <Eigen/Core>
 
@@ -20,7 +20,12 @@ struct TetRest {
   /// The columns sum to zero, and sum_i X_i grad(phi_i)^T = I for the rest positions X_i.
   Eigen::Matrix<double, 3, 4> shape_gradients_per_m;
   double volume_m3 = 0.0;
+  /// The tet's material: an index into the body's materials, one per mesh region (TetMesh::regions).
+  /// Cut pieces copy their tet's TetRest, so they keep it.
+  int material = 0;
 };
+// The index sits in what was padding: the per-tet data a step streams did not grow.
+static_assert(sizeof(TetRest) == 112, "TetRest grew: the co-rotational step streams it per tet");
 
 /// Requires a positively oriented tet (volume > 0); the mesh readers guarantee it.
 TetRest precompute_tet(const TetPositions& rest_positions_m);

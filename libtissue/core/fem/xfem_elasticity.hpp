@@ -18,7 +18,7 @@
 #pragma once
 
 #include "core/fem/tet_cut.hpp"
-#include "core/fem/material.hpp"
+#include "core/material/material.hpp"
 #include "core/fem/rotation.hpp"
 #include "core/fem/tet_element.hpp"
 #include "core/mesh/tet_mesh.hpp"
@@ -96,8 +96,9 @@ TetPositions piece_positions(const CutPiece& piece, const TetPositions& real_pos
 class XfemElasticity {
  public:
   /// `rotation`: when the parts' rotation extraction stops (validated by the caller's body settings).
-  XfemElasticity(const LameParameters& lame, const RotationSettings& rotation)
-      : m_lame(lame), m_rotation_settings(rotation) {}
+  /// `lame`: per material, as CorotationalElasticity::lame(); a cut tet's TetRest::material picks one.
+  XfemElasticity(std::vector<LameParameters> lame, const RotationSettings& rotation)
+      : m_lame(std::move(lame)), m_rotation_settings(rotation) {}
 
   /// Room for this many cut tets without reallocation.
   void reserve(int cut_tets);
@@ -177,7 +178,7 @@ class XfemElasticity {
 
   // Flat, cut tet after cut tet (one pass over contiguous memory): per cut tet, per piece, ghost
   // rows and slots with their begin offsets.
-  LameParameters m_lame;
+  std::vector<LameParameters> m_lame;  // per material
   RotationSettings m_rotation_settings;
   std::vector<CutTet> m_cut_tets;
   std::vector<TetRest> m_rest;

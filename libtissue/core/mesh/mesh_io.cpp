@@ -12,6 +12,7 @@
 #include <fstream>
 #include <limits>
 #include <map>
+#include <numeric>
 #include <optional>
 #include <sstream>
 #include <system_error>
@@ -232,7 +233,18 @@ struct RawMesh {
   std::vector<int> element_lines;
   std::vector<std::int64_t> element_numbers;  ///< the file's own element numbers, for messages
   std::int64_t vertex_base = 0;               ///< the file's number of vertex 0
+  std::vector<MeshRegion> regions;            ///< as the file declares them (issue 25)
+  std::vector<int> tet_regions;               ///< per tet, an index into regions, -1 none; empty: no regions
 };
+
+/// The index of the region of that name, appended (without a material) if new.
+int region_index(std::vector<MeshRegion>& regions, const std::string& name) {
+  for (std::size_t r = 0; r < regions.size(); ++r) {
+    if (regions[r].name == name) return static_cast<int>(r);
+  }
+  regions.push_back({name, std::nullopt});
+  return static_cast<int>(regions.size()) - 1;
+}
 
 std::string element_label(std::int64_t number) { return "element " + std::to_string(number) + ": "; }
 
@@ -254,6 +266,20 @@ void validate_impl(TetMesh& mesh, const std::string& vertex_source, const std::s
   }
   if (tet_count == 0) {
     fail(element_source, 0, -1, "the mesh has no tetrahedra");
+  }
+  if (mesh.regions.empty() != mesh.tet_regions.empty() ||
+      (!mesh.regions.empty() && mesh.tet_regions.size() != mesh.tets.size())) {
+    fail(element_source, 0, -1,
+         "regions: " + std::to_string(mesh.regions.size()) + " regions and " + std::to_string(mesh.tet_regions.size()) +
+             " tet region indices for " + std::to_string(tet_count) + " tets (one per tet, or none at all)");
+  }
+  for (int t = 0; t < static_cast<int>(mesh.tet_regions.size()); ++t) {
+    const int region = mesh.tet_regions[static_cast<std::size_t>(t)];
+    if (region < 0 || region >= static_cast<int>(mesh.regions.size())) {
+      fail(element_source, element_line(t), t,
+           element_label(element_number(t)) + "region index " + std::to_string(region) + " outside [0, " +
+               std::to_string(mesh.regions.size()) + ")");
+    }
   }
 
   Eigen::Vector3d lower = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());
@@ -376,6 +402,17 @@ TetMesh finish(RawMesh raw, const std::string& vertex_source, const std::string&
       mesh.tets[t][static_cast<std::size_t>(k)] = static_cast<int>(number - raw.vertex_base);
     }
   }
+  if (!raw.regions.empty()) {
+    for (std::size_t t = 0; t < raw.tets.size(); ++t) {
+      if (raw.tet_regions[t] < 0) {
+        fail(element_source, raw.element_lines[t], static_cast<int>(t),
+             element_label(raw.element_numbers[t]) + "is in no region, while the file gives others regions (" +
+                 quoted_region_names(raw.regions) + ")");
+      }
+    }
+    mesh.regions = std::move(raw.regions);
+    mesh.tet_regions = std::move(raw.tet_regions);
+  }
   validate_impl(mesh, vertex_source, element_source, raw.vertex_lines, raw.element_lines, &raw.element_numbers,
                 static_cast<int>(raw.vertex_base), warnings);
   return mesh;
@@ -486,6 +523,148 @@ void read_veg_elements(LineReader& reader, const std::string& source, RawMesh& r
   refuse_extra_veg_lines(reader, source, "*ELEMENTS", count);
 }
 
+/// What a .veg file says of materials and regions (Vega's grammar): `*MATERIAL name` then
+/// `ENU, density, E, nu`; `*SET name` then 1-based element numbers, comma separated, on any number
+/// of lines (`allElements` is predefined); `*REGION` then `set, material` lines.
+struct VegRegions {
+  struct NamedMaterial {
+    std::string name;
+    Material material;
+    int line = 0;
+  };
+  struct Set {
+    std::vector<std::int64_t> elements;
+    int line = 0;
+  };
+  struct Assignment {
+    std::string set, material;
+    int line = 0;
+  };
+  std::vector<NamedMaterial> materials;
+  std::map<std::string, Set> sets;
+  std::vector<Assignment> assignments;
+};
+
+std::string veg_section_name(const LineReader& reader, const std::string& source, const char* section) {
+  if (reader.size() != 2) {
+    fail(source, reader.line(), -1, std::string(section) + ": expected '" + section + " name'");
+  }
+  return std::string(reader[1]);
+}
+
+void read_veg_material(LineReader& reader, const std::string& source, VegRegions& regions) {
+  VegRegions::NamedMaterial named{veg_section_name(reader, source, "*MATERIAL"), {}, reader.line()};
+  for (const auto& other : regions.materials) {
+    if (other.name == named.name) {
+      fail(source, reader.line(), -1,
+           "*MATERIAL " + named.name + ": defined twice (first at line " + std::to_string(other.line) + ")");
+    }
+  }
+  const std::string prefix = "*MATERIAL " + named.name + ": ";
+  if (!next_veg_data(reader)) fail(source, reader.line(), -1, prefix + "missing the line 'ENU, density, E, nu'");
+  if (to_upper(reader[0]) != "ENU") {
+    fail(source, reader.line(), -1,
+         prefix + "material type '" + std::string(reader[0]) + "' is not supported (only ENU: density, E, nu)");
+  }
+  const Item item{source, reader.line(), -1, prefix};
+  expect_token_count(reader, 4, item, "ENU, density, E, nu");
+  named.material = {double_at(reader, 2, item), double_at(reader, 3, item), double_at(reader, 1, item)};
+  try {
+    validate(named.material);
+  } catch (const ParameterError& error) {
+    fail(source, reader.line(), -1, prefix + error.what());
+  }
+  if (next_veg_data(reader)) fail(source, reader.line(), -1, prefix + "one line 'ENU, density, E, nu' expected");
+  regions.materials.push_back(std::move(named));
+}
+
+void read_veg_set(LineReader& reader, const std::string& source, VegRegions& regions) {
+  const std::string name = veg_section_name(reader, source, "*SET");
+  VegRegions::Set set;
+  set.line = reader.line();
+  if (name == "allElements" || regions.sets.count(name) != 0) {
+    fail(source, reader.line(), -1, "*SET " + name + ": defined twice (allElements is predefined)");
+  }
+  while (next_veg_data(reader)) {
+    const Item item{source, reader.line(), -1, "*SET " + name + ": "};
+    for (std::size_t k = 0; k < reader.size(); ++k) set.elements.push_back(int_at(reader, k, item));
+  }
+  if (set.elements.empty() && reader.next()) {
+    if (to_upper(reader[0]) == "*INCLUDE") {
+      fail(source, reader.line(), -1,
+           "*SET " + name + ": its elements are in an *INCLUDE'd file, which is not read (write them in the .veg)");
+    }
+    reader.unread();
+  }
+  regions.sets.emplace(name, std::move(set));
+}
+
+void read_veg_region(LineReader& reader, const std::string& source, VegRegions& regions) {
+  if (reader.size() != 1) fail(source, reader.line(), -1, "*REGION: expected '*REGION' alone on its line");
+  bool any = false;
+  while (next_veg_data(reader)) {
+    if (reader.size() != 2) fail(source, reader.line(), -1, "*REGION: expected 'set, material'");
+    regions.assignments.push_back({std::string(reader[0]), std::string(reader[1]), reader.line()});
+    any = true;
+  }
+  if (!any) fail(source, reader.line(), -1, "*REGION: missing the line 'set, material'");
+}
+
+/// Gives each *REGION's set its material: the regions, named by their sets, and each tet's region.
+void resolve_veg_regions(const VegRegions& regions, const std::string& source, RawMesh& raw, MeshWarnings* warnings) {
+  const auto tet_count = static_cast<std::int64_t>(raw.tets.size());
+  if (regions.assignments.empty()) {
+    for (const auto& material : regions.materials) {
+      if (warnings != nullptr) {
+        warnings->messages.push_back(location(source, material.line) + ": *MATERIAL " + material.name +
+                                     " is given to no *REGION: not used");
+      }
+    }
+    return;
+  }
+  raw.tet_regions.assign(raw.tets.size(), -1);
+  std::vector<std::int64_t> all_elements;
+  for (const VegRegions::Assignment& assignment : regions.assignments) {
+    const std::string prefix = "*REGION " + assignment.set + ", " + assignment.material + ": ";
+    const VegRegions::Set* set = nullptr;
+    VegRegions::Set everything;
+    if (assignment.set == "allElements") {
+      everything.elements.resize(static_cast<std::size_t>(tet_count));
+      std::iota(everything.elements.begin(), everything.elements.end(), std::int64_t{1});
+      everything.line = assignment.line;
+      set = &everything;
+    } else if (const auto found = regions.sets.find(assignment.set); found != regions.sets.end()) {
+      set = &found->second;
+    } else {
+      fail(source, assignment.line, -1, prefix + "no *SET named " + assignment.set);
+    }
+    const VegRegions::NamedMaterial* material = nullptr;
+    for (const auto& named : regions.materials) {
+      if (named.name == assignment.material) material = &named;
+    }
+    if (material == nullptr) fail(source, assignment.line, -1, prefix + "no *MATERIAL named " + assignment.material);
+    for (const MeshRegion& region : raw.regions) {
+      if (region.name == assignment.set) fail(source, assignment.line, -1, prefix + "the set is given a region twice");
+    }
+    raw.regions.push_back({assignment.set, material->material});
+    const int index = static_cast<int>(raw.regions.size()) - 1;
+    for (const std::int64_t element : set->elements) {
+      if (element < 1 || element > tet_count) {
+        fail(source, set->line, -1,
+             "*SET " + assignment.set + ": element " + std::to_string(element) + " outside [1, " +
+                 std::to_string(tet_count) + "]");
+      }
+      int& region = raw.tet_regions[static_cast<std::size_t>(element - 1)];
+      if (region >= 0 && region != index) {
+        fail(source, assignment.line, static_cast<int>(element - 1),
+             prefix + "element " + std::to_string(element) + " is in two regions, " + raw.regions[static_cast<std::size_t>(region)].name +
+                 " and " + assignment.set);
+      }
+      region = index;
+    }
+  }
+}
+
 // ---------------------------------------------------------------------------------------------
 // TetGen .node / .ele
 
@@ -575,6 +754,16 @@ void read_tetgen_elements(std::string_view text, const std::string& source, RawM
     }
     for (std::size_t c = static_cast<std::size_t>(1 + nodes); c < columns; ++c) {
       double_at(reader, c, item);
+    }
+    if (attributes > 0) {
+      // The first attribute is the region (tetgen -A); its number, as written, names it.
+      const std::size_t c = static_cast<std::size_t>(1 + nodes);
+      const double attribute = double_at(reader, c, item);
+      if (attribute != std::floor(attribute) || std::abs(attribute) > 1e9) {
+        fail(source, reader.line(), static_cast<int>(k),
+             item.prefix + "region attribute " + std::string(reader[c]) + " is not a whole number (tetgen -A)");
+      }
+      raw.tet_regions.push_back(region_index(raw.regions, std::to_string(static_cast<std::int64_t>(attribute))));
     }
     raw.element_lines.push_back(reader.line());
     raw.element_numbers.push_back(id);
@@ -701,8 +890,83 @@ void read_gmsh_nodes(LineReader& reader, const std::string& source, RawMesh& raw
   expect_gmsh_end(reader, source, section);
 }
 
+/// The physical groups of a .msh file's volumes: their names ($PhysicalNames) and each volume
+/// entity's groups ($Entities), for the regions (issue 25).
+struct GmshGroups {
+  std::map<std::int64_t, std::string> volume_group_names;               // physical tag -> name
+  std::map<std::int64_t, std::vector<std::int64_t>> volume_groups;      // volume entity tag -> physical tags
+  std::vector<std::int64_t> tet_volume;                                 // per tet, its volume entity's tag
+};
+
+void read_gmsh_physical_names(LineReader& reader, const std::string& source, GmshGroups& groups) {
+  const std::string section = "$PhysicalNames";
+  const auto count = read_gmsh_ints(reader, source, "'numPhysicalNames'", 1, section)[0];
+  for (std::int64_t k = 0; k < count; ++k) {
+    if (!next_gmsh_data(reader)) fail(source, reader.line(), -1, section + ": truncated");
+    const Item item{source, reader.line(), -1, section + ": "};
+    if (reader.size() < 3) fail(source, reader.line(), -1, section + ": expected 'dimension physicalTag \"name\"'");
+    const std::int64_t dimension = int_at(reader, 0, item);
+    const std::int64_t tag = int_at(reader, 1, item);
+    std::string name;
+    for (std::size_t t = 2; t < reader.size(); ++t) {
+      if (t > 2) name.push_back(' ');
+      name.append(reader[t]);
+    }
+    if (name.size() >= 2 && name.front() == '"' && name.back() == '"') name = name.substr(1, name.size() - 2);
+    if (dimension == 3) groups.volume_group_names[tag] = name;
+  }
+  expect_gmsh_end(reader, source, section);
+}
+
+void read_gmsh_entities(LineReader& reader, const std::string& source, GmshGroups& groups) {
+  const std::string section = "$Entities";
+  const auto counts = read_gmsh_ints(reader, source, "header 'numPoints numCurves numSurfaces numVolumes'", 4, section);
+  for (std::size_t dimension = 0; dimension < 4; ++dimension) {
+    // A point's line has its coordinates (3), the others their bounding box (6), before the physical tags.
+    const std::size_t physical_count_at = 1 + (dimension == 0 ? 3 : 6);
+    for (std::int64_t k = 0; k < counts[dimension]; ++k) {
+      if (!next_gmsh_data(reader)) fail(source, reader.line(), -1, section + ": truncated");
+      const Item item{source, reader.line(), -1, section + ": "};
+      if (reader.size() <= physical_count_at) fail(source, reader.line(), -1, section + ": entity line too short");
+      const std::int64_t physical_count = int_at(reader, physical_count_at, item);
+      if (physical_count < 0 || reader.size() <= physical_count_at + static_cast<std::size_t>(physical_count)) {
+        fail(source, reader.line(), -1, section + ": entity line shorter than its physical tags");
+      }
+      if (dimension != 3) continue;
+      std::vector<std::int64_t>& tags = groups.volume_groups[int_at(reader, 0, item)];
+      for (std::int64_t p = 0; p < physical_count; ++p) {
+        tags.push_back(int_at(reader, physical_count_at + 1 + static_cast<std::size_t>(p), item));
+      }
+    }
+  }
+  expect_gmsh_end(reader, source, section);
+}
+
+/// Each tet's region: its volume's physical group, named by $PhysicalNames or else by its tag.
+void resolve_gmsh_regions(const GmshGroups& groups, const std::string& source, RawMesh& raw) {
+  bool any = false;
+  for (const auto& [volume, tags] : groups.volume_groups) any = any || !tags.empty();
+  if (!any) return;
+  raw.tet_regions.assign(raw.tets.size(), -1);
+  for (std::size_t t = 0; t < raw.tets.size(); ++t) {
+    const auto found = groups.volume_groups.find(groups.tet_volume[t]);
+    if (found == groups.volume_groups.end() || found->second.empty()) continue;  // in no region: finish() says
+    const auto name_of = [&](std::int64_t tag) {
+      const auto named = groups.volume_group_names.find(tag);
+      return named != groups.volume_group_names.end() ? named->second : std::to_string(tag);
+    };
+    if (found->second.size() > 1) {
+      fail(source, raw.element_lines[t], static_cast<int>(t),
+           element_label(raw.element_numbers[t]) + "is in two regions, " + name_of(found->second[0]) + " and " +
+               name_of(found->second[1]) + " (volume " + std::to_string(found->first) + " is in both physical groups)");
+    }
+    raw.tet_regions[t] = region_index(raw.regions, name_of(found->second[0]));
+  }
+}
+
 void read_gmsh_elements(LineReader& reader, const std::string& source, RawMesh& raw,
-                        const std::unordered_map<std::int64_t, int>& index_of_tag, std::size_t text_size) {
+                        const std::unordered_map<std::int64_t, int>& index_of_tag, std::size_t text_size,
+                        GmshGroups& groups) {
   constexpr std::int64_t k_tet4 = 4;  // Gmsh element type of the 4-node tetrahedron
   const std::string section = "$Elements";
   const auto header =
@@ -749,6 +1013,7 @@ void read_gmsh_elements(LineReader& reader, const std::string& source, RawMesh& 
       raw.tets.push_back(tet);
       raw.element_lines.push_back(reader.line());
       raw.element_numbers.push_back(tag);
+      groups.tet_volume.push_back(block[1]);
     }
   }
   if (seen != count) {
@@ -787,6 +1052,7 @@ TetMesh parse_veg(std::string_view text, const std::string& source_name, MeshWar
   raw.vertex_base = 1;
   bool have_vertices = false;
   bool have_elements = false;
+  VegRegions regions;
   while (reader.next()) {
     if (!is_veg_keyword(reader)) {
       fail(source_name, reader.line(), -1,
@@ -805,8 +1071,14 @@ TetMesh parse_veg(std::string_view text, const std::string& source_name, MeshWar
       }
       read_veg_elements(reader, source_name, raw, text.size());
       have_elements = true;
+    } else if (keyword == "*MATERIAL") {
+      read_veg_material(reader, source_name, regions);
+    } else if (keyword == "*SET") {
+      read_veg_set(reader, source_name, regions);
+    } else if (keyword == "*REGION") {
+      read_veg_region(reader, source_name, regions);
     } else {
-      // *MATERIAL, *REGION, *SET, *INCLUDE, ...: materials come from the FMU parameters.
+      // *INCLUDE, *CONSTRAINTS, ...: not read.
       while (next_veg_data(reader)) {
       }
     }
@@ -817,6 +1089,7 @@ TetMesh parse_veg(std::string_view text, const std::string& source_name, MeshWar
   if (!have_elements) {
     fail(source_name, 0, -1, "missing *ELEMENTS section");
   }
+  resolve_veg_regions(regions, source_name, raw, warnings);
   return finish(std::move(raw), source_name, source_name, warnings);
 }
 
@@ -846,6 +1119,7 @@ TetMesh parse_gmsh(std::string_view text, const std::string& source_name, MeshWa
   RawMesh raw;
   raw.vertex_base = 0;  // node tags are mapped to indices while reading
   std::unordered_map<std::int64_t, int> index_of_tag;
+  GmshGroups groups;
   bool have_format = false;
   bool have_nodes = false;
   bool have_elements = false;
@@ -873,8 +1147,12 @@ TetMesh parse_gmsh(std::string_view text, const std::string& source_name, MeshWa
       if (!have_nodes) {
         fail(source_name, reader.line(), -1, "$Elements before $Nodes");
       }
-      read_gmsh_elements(reader, source_name, raw, index_of_tag, text.size());
+      read_gmsh_elements(reader, source_name, raw, index_of_tag, text.size(), groups);
       have_elements = true;
+    } else if (section == "$PhysicalNames") {
+      read_gmsh_physical_names(reader, source_name, groups);
+    } else if (section == "$Entities") {
+      read_gmsh_entities(reader, source_name, groups);
     } else {
       skip_gmsh_section(reader, source_name, section);
     }
@@ -888,6 +1166,7 @@ TetMesh parse_gmsh(std::string_view text, const std::string& source_name, MeshWa
   if (!have_elements) {
     fail(source_name, 0, -1, "missing $Elements section");
   }
+  resolve_gmsh_regions(groups, source_name, raw);
   return finish(std::move(raw), source_name, source_name, warnings);
 }
 

@@ -21,17 +21,24 @@ struct MeshWarnings {
   std::vector<std::string> messages;
 };
 
-/// Vega .veg: *VERTICES / *ELEMENTS TET, 1-indexed, '#' comments; other sections (*MATERIAL, *REGION,
-/// *SET, *INCLUDE, ...) are skipped, so an *INCLUDE'd file is not read.
+/// Vega .veg: *VERTICES / *ELEMENTS TET, 1-indexed, '#' comments. Regions (issue 25): `*MATERIAL
+/// name` then `ENU, density, E, nu`; `*SET name` then element numbers; `*REGION` then `set,
+/// material` lines (the set `allElements` is predefined): each region is named by its set and has
+/// that material. Refused with the line: an unknown set or material, an element in two regions or
+/// (when there are regions) in none, a material out of range, a type other than ENU. Other sections
+/// (*INCLUDE, ...) are skipped, so an *INCLUDE'd file is not read.
 TetMesh read_veg(const std::filesystem::path& path, MeshWarnings* warnings = nullptr);
 /// Same, from text already in memory; `source_name` is used in messages in place of a file name.
 TetMesh parse_veg(std::string_view text, const std::string& source_name, MeshWarnings* warnings = nullptr);
 
 /// TetGen: `path` is the .node file (or the .ele file, or the common stem); the other is found beside it.
 /// Index base (0 or 1) is taken from the first vertex index in the .node file, as TetGen does.
+/// A .ele with attributes: the first is the tet's region (tetgen -A), named by its whole number.
 TetMesh read_tetgen(const std::filesystem::path& path, MeshWarnings* warnings = nullptr);
 
 /// Gmsh .msh 4.1 ASCII: $Nodes and $Elements (type 4 = 4-node tet); other element types are ignored.
+/// Regions: the physical groups of the tets' volumes ($Entities), named by $PhysicalNames or else by
+/// their tag; a volume in two groups, or (when there are groups) in none, is refused with the line.
 TetMesh read_gmsh(const std::filesystem::path& path, MeshWarnings* warnings = nullptr);
 TetMesh parse_gmsh(std::string_view text, const std::string& source_name, MeshWarnings* warnings = nullptr);
 

@@ -2,6 +2,8 @@
 // Produced by the readers (mesh_io.hpp); consumed by fem/ and the adjacency/surface tools.
 #pragma once
 
+#include "core/material/region_materials.hpp"
+
 #include <Eigen/Core>
 
 #include <array>
@@ -17,6 +19,13 @@ using Tet = std::array<int, 4>;  ///< four 0-based vertex indices, positively or
 struct TetMesh {
   std::vector<Eigen::Vector3d> rest_positions_m;  ///< one per vertex [m]
   std::vector<Tet> tets;                          ///< positive signed volume after loading
+  /// The named regions the file declares (issue 25); empty: the whole mesh is one region.
+  std::vector<MeshRegion> regions;
+  /// Per tet, its index in `regions`; empty when `regions` is.
+  std::vector<int> tet_regions;
+
+  [[nodiscard]] int region_count() const { return regions.empty() ? 1 : static_cast<int>(regions.size()); }
+  [[nodiscard]] int region_of(int t) const { return tet_regions.empty() ? 0 : tet_regions[static_cast<size_t>(t)]; }
 
   [[nodiscard]] int vertex_count() const { return static_cast<int>(rest_positions_m.size()); }
   [[nodiscard]] int tet_count() const { return static_cast<int>(tets.size()); }

@@ -149,7 +149,7 @@ TEST(EffectiveContactStiffness, APointOnFixedVerticesOnlyIsRigid) {
 
 TEST(ElementLocalContactStiffness, RepairsEq422AndIsMeasuredAgainstTheReference) {
   FrogAtRest frog;
-  const LameParameters lame = frog.body.elasticity().lame();
+  const LameParameters lame = frog.body.elasticity().lame()[0];
   for (const SurfacePoint& point : back_points(frog.surface, frog.rest)) {
     const int tet = frog.surface.triangle_tet[static_cast<size_t>(point.triangle)];
     const int opposite = frog.surface.triangle_local_face[static_cast<size_t>(point.triangle)];

@@ -67,7 +67,7 @@ TEST(Corotational, RigidRotationGivesZeroForceButLinearFemDoesNot) {
   // Force scale of a 1% strain: E * 0.01 * (edge ~1 cm)^2 = 1e-4 N. Round-off is ~1e-16 of the
   // stress times the area, so 1e-12 N is a generous bound for "zero".
   EXPECT_LT(f.norm(), 1e-12);
-  const Matrix12d k_linear = linear_stiffness_matrix(tet.model.rest(0), tet.model.lame());
+  const Matrix12d k_linear = linear_stiffness_matrix(tet.model.rest(0), tet.model.lame()[0]);
   const Eigen::VectorXd linear_force = k_linear * (x - flatten(tet.mesh.rest_positions_m));
   EXPECT_GT(linear_force.norm(), 1e-2);  // the ghost force of linear FEM under a 0.9 rad turn
 }
@@ -84,7 +84,7 @@ TEST(Corotational, ForceAndTangentEqualTheTextbookFormulas) {
   const Eigen::Matrix3d r = tet.model.rotation(0);
   Matrix12d block_rotation = Matrix12d::Zero();
   for (int i = 0; i < 4; ++i) block_rotation.block<3, 3>(3 * i, 3 * i) = r;
-  const Matrix12d k_e = linear_stiffness_matrix(tet.model.rest(0), tet.model.lame());
+  const Matrix12d k_e = linear_stiffness_matrix(tet.model.rest(0), tet.model.lame()[0]);
   const Eigen::VectorXd expected =
       block_rotation * k_e * (block_rotation.transpose() * x - flatten(tet.mesh.rest_positions_m));
   EXPECT_LT((f - expected).norm(), 1e-12 * expected.norm());
@@ -118,7 +118,7 @@ TEST(Corotational, ElasticEnergyIsHalfTheRotatedQuadraticForm) {
   x(3) += 0.0005;
   x(7) -= 0.0003;
   tet.force(x);
-  const Matrix12d k_e = linear_stiffness_matrix(tet.model.rest(0), tet.model.lame());
+  const Matrix12d k_e = linear_stiffness_matrix(tet.model.rest(0), tet.model.lame()[0]);
   Matrix12d block_rotation = Matrix12d::Zero();
   for (int i = 0; i < 4; ++i) block_rotation.block<3, 3>(3 * i, 3 * i) = tet.model.rotation(0);
   const Eigen::VectorXd u = block_rotation.transpose() * x - flatten(tet.mesh.rest_positions_m);
@@ -128,7 +128,7 @@ TEST(Corotational, ElasticEnergyIsHalfTheRotatedQuadraticForm) {
 
 TEST(Corotational, LumpedMassesSumToDensityTimesVolume) {
   const TetMesh mesh = make_box_mesh(6, 3, 2, 0.01);
-  const std::vector<double> masses = lumped_vertex_masses(mesh, 1000.0);
+  const std::vector<double> masses = lumped_vertex_masses(mesh, {Material{1.0e5, 0.4, 1000.0}});
   const double total = std::accumulate(masses.begin(), masses.end(), 0.0);
   const double volume_m3 = 6 * 3 * 2 * 1e-6;
   EXPECT_NEAR(total, 1000.0 * volume_m3, 1e-12 * total);

@@ -256,7 +256,6 @@ TEST(VegReader, ReadsVegaReferenceMeshes) {
   const Reference references[] = {
       {"simpleBridge/simpleBridge-ic_128_0.15_.1.veg", 4000, 12827},
       {"turtle/turtle-volumetric-homogeneous.veg", 347, 1185},
-      {"turtle/turtle-volumetric-heterogeneous.veg", 347, 1185},
       {"comb/comb.tet.veg", 1623, 5844},
       {"beam3/beam3_tet.veg", 208, 450},
   };
@@ -271,6 +270,16 @@ TEST(VegReader, ReadsVegaReferenceMeshes) {
       EXPECT_NE(message.find(reference.file), std::string::npos) << message;
     }
   }
+  // The heterogeneous turtle's two regions list their elements in *INCLUDE'd files, not shipped
+  // with it: refused, saying so, rather than read without its regions.
+  expect_refused([] { read_mesh(VEGA_DIR / "turtle/turtle-volumetric-heterogeneous.veg"); },
+                 (VEGA_DIR / "turtle/turtle-volumetric-heterogeneous.veg").string(), 1545, -1,
+                 {"*SET backshell: its elements are in an *INCLUDE'd file, which is not read"});
+  // The bridge's file gives every element its material (*REGION allElements): E = 1e7 Pa.
+  const TetMesh bridge_regions = read_veg(VEGA_DIR / "simpleBridge/simpleBridge-ic_128_0.15_.1.veg");
+  ASSERT_EQ(bridge_regions.regions.size(), 1u);
+  ASSERT_TRUE(bridge_regions.regions[0].material.has_value());
+  EXPECT_EQ(bridge_regions.regions[0].material->young_modulus_pa, 1e7);
   // The first vertex of the bridge, as written in the file.
   const TetMesh bridge = read_veg(VEGA_DIR / "simpleBridge/simpleBridge-ic_128_0.15_.1.veg");
   EXPECT_EQ(bridge.rest_positions_m[0], Eigen::Vector3d(-6.75193, 1.76055, 0.961333));
@@ -448,7 +457,7 @@ TEST(GmshReader, RefusesMissingSections) {
   expect_gmsh_refused(only_format, 0, -1, {"missing $Nodes section"});
   const std::string no_elements = TWO_TETS_MSH.substr(0, TWO_TETS_MSH.find("$Elements"));
   expect_gmsh_refused(no_elements, 0, -1, {"missing $Elements section"});
-  expect_gmsh_refused(TWO_TETS_MSH.substr(0, TWO_TETS_MSH.find("$EndPhysicalNames")), 4, -1,
+  expect_gmsh_refused(TWO_TETS_MSH.substr(0, TWO_TETS_MSH.find("$EndPhysicalNames")), 6, -1,
                       {"$PhysicalNames: missing $EndPhysicalNames"});
 }
 

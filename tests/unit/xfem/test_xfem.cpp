@@ -103,7 +103,7 @@ struct CutOneTet {
   // p_p = p0 + u + Psi_p a; R_p from the SVD (the reference, independent of the model's Newton).
   [[nodiscard]] Vector24d reference_force(const Vector24d& q) const {
     const TetRest& rest = body.elasticity().rest(0);
-    const Matrix12d k_e = linear_stiffness_matrix(rest, body.elasticity().lame());
+    const Matrix12d k_e = linear_stiffness_matrix(rest, body.elasticity().lame()[0]);
     TetPositions rest_x;
     for (size_t j = 0; j < 4; ++j) rest_x[j] = mesh.rest_positions_m[j];
     const Vector12d p0 = flatten(rest_x);
@@ -218,7 +218,7 @@ TEST(XfemCutTet, TangentAtRestIsTheLinearXfemStiffness) {
     const double w_b = 1.0 - w_a;
     CutOneTet tet(side, w_a);
     tet.force(Vector24d::Zero());
-    const Matrix12d k = linear_stiffness_matrix(tet.body.elasticity().rest(0), tet.body.elasticity().lame());
+    const Matrix12d k = linear_stiffness_matrix(tet.body.elasticity().rest(0), tet.body.elasticity().lame()[0]);
     Matrix24d expected = Matrix24d::Zero();
     const auto side_factor = [&](int h) { return h == 1 ? -w_b : w_a; };  // eq. 3.21-3.22
     for (int i = 0; i < 4; ++i) {
@@ -299,7 +299,7 @@ Eigen::VectorXd expected_enriched_forces(const DeformableBody& body, const Eigen
     }
     const Matrix12d r = block_diagonal(rotation_by_svd(deformation_gradient(rest, x)));
     const Vector12d tet_force =
-        r * linear_stiffness_matrix(rest, body.elasticity().lame()) * (r.transpose() * flatten(x) - flatten(x0));
+        r * linear_stiffness_matrix(rest, body.elasticity().lame()[0]) * (r.transpose() * flatten(x) - flatten(x0));
     for (int i = 0; i < 4; ++i) {
       const double factor = cut_tet.weight_above * cut_tet.shift(i, CutPart::above) +
                             cut_tet.weight_below * cut_tet.shift(i, CutPart::below);

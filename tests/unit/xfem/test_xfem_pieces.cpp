@@ -4,7 +4,7 @@
 // derivative of the force where it is exact (every piece moved rigidly, each its own way); pieces
 // that coincide with the tet give the uncut tet's forces, shared out by weight.
 #include "core/fem/corotational_kernel.hpp"
-#include "core/fem/material.hpp"
+#include "core/material/material.hpp"
 #include "core/fem/tet_element.hpp"
 #include "core/fem/xfem_elasticity.hpp"
 #include "core/system/block_sparse_matrix.hpp"
@@ -40,7 +40,7 @@ double ghost_sign(int j, int p) { return (j + p) % 2 == 0 ? 1.0 : -1.0; }
 struct FourPieces {
   LameParameters lame = lame_parameters(Material{1.0e5, 0.4, 1000.0});
   TetRest rest = precompute_tet(REST);
-  XfemElasticity xfem{lame, RotationSettings{.max_error_rad = 4e-18}};
+  XfemElasticity xfem{{lame}, RotationSettings{.max_error_rad = 4e-18}};
   BlockSparseMatrix tangent;
 
   FourPieces() {

@@ -1,5 +1,5 @@
 // Range checks and Lame parameters for Material.
-#include "core/fem/material.hpp"
+#include "core/material/material.hpp"
 
 #include <cmath>
 #include <string>
