@@ -3,6 +3,7 @@
 // CHOLMOD factorization + solve. Counters report DOFs and non-zeros.
 #include "core/collide/surface_bvh.hpp"
 #include "core/cut/volume_cutter.hpp"
+#include "core/fem/stable_neo_hookean.hpp"
 #include "core/fixed_region.hpp"
 #include "core/mesh/mesh_io.hpp"
 #include "core/mesh/topology.hpp"
@@ -65,6 +66,34 @@ void BM_ForcesAndTangent(benchmark::State& state) {
   f.count(state);
 }
 BENCHMARK(BM_ForcesAndTangent)->Arg(0)->Arg(1)->Unit(benchmark::kMicrosecond);
+
+// The stable Neo-Hookean kernel alone (issue 25): per tet F, forces and the 12 x 12 tangent with
+// (range(1) = 1) or without the per-element PSD projection (a 9 x 9 eigendecomposition), at the same
+// positions as BM_ForcesAndTangent, not assembled: what the hyperelastic option costs before any
+// assembly, against the whole co-rotational evaluate above.
+void BM_StableNeoHookeanKernel(benchmark::State& state) {
+  Fixture f(static_cast<int>(state.range(0)));
+  const bool project = state.range(1) != 0;
+  const TetMesh& mesh = f.body.mesh();
+  Eigen::VectorXd positions;
+  f.body.positions(f.displacement, positions);
+  std::vector<TetRest> rests;
+  for (int t = 0; t < mesh.tet_count(); ++t) rests.push_back(precompute_tet(mesh.rest_corners(t)));
+  const StableNeoHookean material = stable_neo_hookean(f.body.elasticity().lame()[0]);
+  for (auto _ : state) {
+    double sum = 0.0;
+    for (int t = 0; t < mesh.tet_count(); ++t) {
+      TetPositions x;
+      for (size_t i = 0; i < 4; ++i) x[i] = positions.segment<3>(3 * mesh.tets[static_cast<size_t>(t)][i]);
+      const Eigen::Matrix3d gradient = deformation_gradient(rests[static_cast<size_t>(t)], x);
+      sum += neo_hookean_forces(rests[static_cast<size_t>(t)], material, gradient)(0, 0);
+      sum += neo_hookean_stiffness(rests[static_cast<size_t>(t)], material, gradient, project)(0, 0);
+    }
+    benchmark::DoNotOptimize(sum);
+  }
+  f.count(state);
+}
+BENCHMARK(BM_StableNeoHookeanKernel)->Args({0, 0})->Args({0, 1})->Unit(benchmark::kMicrosecond);
 
 void BM_BlockMultiply(benchmark::State& state) {
   Fixture f(static_cast<int>(state.range(0)));
