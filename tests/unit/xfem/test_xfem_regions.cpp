@@ -1,0 +1,75 @@
+// Cuts across materials (issue 25): a cut tet's pieces keep its region's material, and the piece a
+// complete cut frees carries the mass of its regions' densities exactly.
+#include "core/mesh/box_mesh.hpp"
+#include "xfem/xfem_test_helpers.hpp"
+
+#include <gtest/gtest.h>
+
+namespace tissue {
+namespace {
+
+using xfem_test::Plane;
+
+constexpr double SOFT_DENSITY = 1000.0, STIFF_DENSITY = 2000.0, SIDE_M = 0.02;
+
+// A 0.1 x 0.02 x 0.02 m beam held at x = 0: "soft" for x < 0.05, "stiff" (E 10x, twice as dense)
+// beyond.
+struct TwoMaterialBeam {
+  TetMesh mesh = regions(make_box_mesh(10, 2, 2, 0.01));
+  DeformableBody body{mesh, settings(mesh)};
+
+  static TetMesh regions(TetMesh mesh) {
+    mesh.regions = {{"soft", Material{1.0e5, 0.3, SOFT_DENSITY}}, {"stiff", Material{1.0e6, 0.3, STIFF_DENSITY}}};
+    for (int t = 0; t < mesh.tet_count(); ++t) {
+      double x = 0.0;
+      for (const Eigen::Vector3d& corner : mesh.rest_corners(t)) x += 0.25 * corner.x();
+      mesh.tet_regions.push_back(x < 0.05 ? 0 : 1);
+    }
+    return mesh;
+  }
+  static BodySettings settings(const TetMesh& mesh) {
+    BodySettings s;
+    for (int v = 0; v < mesh.vertex_count(); ++v) {
+      if (mesh.rest_positions_m[static_cast<size_t>(v)].x() < 1e-9) s.fixed_vertices.push_back(v);
+    }
+    return s;
+  }
+  // The lumped mass of the free piece beyond a complete cut at x = cut_x (see
+  // XfemBeam.CompletelyCutPieceFallsFreely): the real vertices beyond, plus the ghosts of those
+  // before (side -1), minus the ghosts of those beyond (side +1).
+  double free_piece_mass(double cut_x) const {
+    const Eigen::VectorXd& mass = body.mass_kg();
+    double total = 0.0;
+    for (int row = 0; row < body.dofs().free_vertex_count(); ++row) {
+      const int vertex = body.dofs().row_vertex[static_cast<size_t>(row)];
+      if (mesh.rest_positions_m[static_cast<size_t>(vertex)].x() > cut_x) total += mass(3 * row);
+    }
+    for (const EnrichedDof& dof : body.enriched_dofs()) total -= dof.side * mass(3 * dof.row);
+    return total;
+  }
+};
+
+TEST(XfemRegions, CutPiecesKeepTheirTetsMaterialAndThePieceTheirDensities) {
+  for (const double cut_x : {0.075, 0.025}) {  // through the stiff part; through the soft part
+    SCOPED_TRACE(cut_x);
+    TwoMaterialBeam beam;
+    const double mass_before = beam.body.total_mass_kg();
+    const auto cuts = xfem_test::plane_cuts(beam.mesh, Plane{Eigen::Vector3d::UnitX(), cut_x});
+    ASSERT_EQ(cuts.size(), 20u);
+    beam.body.enrich(cuts);
+    ASSERT_EQ(beam.body.cut_tets().size(), 20u);
+    for (size_t k = 0; k < beam.body.cut_tets().size(); ++k) {
+      const int tet = beam.body.cut_tets()[k].cut.tet;
+      EXPECT_EQ(beam.body.xfem().rest(static_cast<int>(k)).material, beam.mesh.region_of(tet));
+      EXPECT_EQ(beam.mesh.region_of(tet), cut_x > 0.05 ? 1 : 0);
+    }
+    EXPECT_NEAR(beam.body.total_mass_kg(), mass_before, 1e-12 * mass_before);
+    const double area = SIDE_M * SIDE_M;
+    const double expected = cut_x > 0.05 ? STIFF_DENSITY * (0.1 - cut_x) * area
+                                         : SOFT_DENSITY * (0.05 - cut_x) * area + STIFF_DENSITY * 0.05 * area;
+    EXPECT_NEAR(beam.free_piece_mass(cut_x), expected, 1e-12 * expected);
+  }
+}
+
+}  // namespace
+}  // namespace tissue
