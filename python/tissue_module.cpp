@@ -25,6 +25,7 @@
 #include <algorithm>
 #include <array>
 #include <climits>
+#include <map>
 #include <cstdint>
 #include <variant>
 #include <memory>
@@ -90,7 +91,33 @@ struct Options {
   double blade_length_m = 0.03;
   double probe_radius_m = 0.0;
   std::string render_surface;  // "" none, "frog" the embedded frog's, else an OBJ file
+  /// Materials by region name (issue 25): {"tumour": {"young_modulus_pa": 1e6, ...}}; a key left out
+  /// keeps the body's value (young_modulus_pa, poisson_ratio, density_kg_per_m3).
+  std::map<std::string, std::map<std::string, double>> regions;
 };
+
+// The regions' materials the `regions` argument sets, on top of the body's material.
+std::vector<RegionMaterial> region_materials(const std::map<std::string, std::map<std::string, double>>& regions,
+                                             const Material& base) {
+  std::vector<RegionMaterial> materials;
+  for (const auto& [name, keys] : regions) {
+    RegionMaterial region{name, base};
+    for (const auto& [key, value] : keys) {
+      if (key == "young_modulus_pa") {
+        region.material.young_modulus_pa = value;
+      } else if (key == "poisson_ratio") {
+        region.material.poisson_ratio = value;
+      } else if (key == "density_kg_per_m3") {
+        region.material.density_kg_per_m3 = value;
+      } else {
+        throw ParameterError("regions[\"" + name + "\"]: unknown key \"" + key +
+                             "\" (young_modulus_pa, poisson_ratio, density_kg_per_m3)");
+      }
+    }
+    materials.push_back(std::move(region));
+  }
+  return materials;
+}
 
 // A Tissue behind a pointer: restoring a state with other cuts replaces it (restore_or_replay).
 class PyTissue {
@@ -103,6 +130,7 @@ class PyTissue {
     TissueSettings settings;
     BodySettings& body = settings.body;
     body.material = Material{options.young_modulus_pa, options.poisson_ratio, options.density_kg_per_m3};
+    body.region_materials = region_materials(options.regions, body.material);
     body.damping = RayleighDamping{options.damping_alpha_per_s, options.damping_beta_s};
     body.gravity_m_per_s2 = to_vector3(options.gravity_m_per_s2);
     if (options.fixed_vertices) {
@@ -156,6 +184,16 @@ class PyTissue {
   [[nodiscard]] const Tissue& core() const { return *m_tissue; }
   [[nodiscard]] int vertex_count() const { return m_tissue->body().mesh().vertex_count(); }
   [[nodiscard]] int tet_count() const { return m_tissue->body().mesh().tet_count(); }
+  /// The mesh's regions and their resolved materials: {name: (young_modulus_pa, poisson_ratio, density_kg_per_m3)}.
+  [[nodiscard]] std::map<std::string, std::array<double, 3>> regions() const {
+    std::map<std::string, std::array<double, 3>> out;
+    const DeformableBody& body = m_tissue->body();
+    for (size_t r = 0; r < body.mesh().regions.size(); ++r) {
+      const Material& m = body.materials()[r];
+      out[body.mesh().regions[r].name] = {m.young_modulus_pa, m.poisson_ratio, m.density_kg_per_m3};
+    }
+    return out;
+  }
   [[nodiscard]] int dof_count() const { return m_tissue->body().dof_count(); }
   [[nodiscard]] int cut_tets() const { return m_tissue->body().cut_tet_count(); }
   [[nodiscard]] int enriched_vertices() const { return m_tissue->body().enriched_dof_count(); }
@@ -399,7 +437,8 @@ PYBIND11_MODULE(tissue, m) {
                        double damping_alpha_per_s, double damping_beta_s, std::array<double, 3> gravity_m_per_s2,
                        double step_size_s, const std::string& integrator, const std::string& linear_solver,
                        double pcg_tolerance, int pcg_max_iterations, int threads, bool contact, bool cutting,
-                       double blade_length_m, double probe_radius_m, const std::string& render_surface) {
+                       double blade_length_m, double probe_radius_m, const std::string& render_surface,
+                       std::map<std::string, std::map<std::string, double>> regions) {
              Options o;
              o.mesh = mesh;
              o.box_cells = box;
@@ -424,6 +463,7 @@ PYBIND11_MODULE(tissue, m) {
              o.blade_length_m = blade_length_m;
              o.probe_radius_m = probe_radius_m;
              o.render_surface = render_surface;
+             o.regions = std::move(regions);
              return PyTissue(o);
            }),
            py::kw_only(), py::arg("mesh") = d.mesh, py::arg("box") = py::none(), py::arg("box_edge_m") = d.box_edge_m,
@@ -436,10 +476,12 @@ PYBIND11_MODULE(tissue, m) {
            py::arg("pcg_tolerance") = d.pcg_tolerance, py::arg("pcg_max_iterations") = d.pcg_max_iterations,
            py::arg("threads") = d.threads, py::arg("contact") = d.contact, py::arg("cutting") = d.cutting,
            py::arg("blade_length_m") = d.blade_length_m, py::arg("probe_radius_m") = d.probe_radius_m,
-           py::arg("render_surface") = d.render_surface,
+           py::arg("render_surface") = d.render_surface, py::arg("regions") = d.regions,
            "A tissue: mesh 'frog' (embedded) or a file path, or box=(nx, ny, nz) cubes of box_edge_m; fixed "
            "vertices by index, or those within fixed_fraction of the extent from the minimum along fixed_axis; "
-           "render_surface 'frog' (the embedded frog's fine surface) or an OBJ file to draw, riding on the tets")
+           "render_surface 'frog' (the embedded frog's fine surface) or an OBJ file to draw, riding on the tets; "
+           "regions {name: {young_modulus_pa, poisson_ratio, density_kg_per_m3}} sets the materials of the mesh "
+           "file's regions by name")
       .def("set_tool", &PyTissue::set_tool, py::arg("position_m"),
            py::arg("orientation_wxyz") = std::array<double, 4>{1.0, 0.0, 0.0, 0.0}, py::arg("mode") = "probe",
            "The tool pose for the next step: position [m], unit quaternion (w, x, y, z; the tool's axis is its "
@@ -448,6 +490,8 @@ PYBIND11_MODULE(tissue, m) {
       .def_property_readonly("time_s", &PyTissue::time_s)
       .def_property_readonly("vertex_count", &PyTissue::vertex_count)
       .def_property_readonly("tet_count", &PyTissue::tet_count)
+      .def_property_readonly("regions", &PyTissue::regions,
+                             "The mesh's regions: {name: (young_modulus_pa, poisson_ratio, density_kg_per_m3)}")
       .def_property_readonly("dof_count", &PyTissue::dof_count)
       .def_property_readonly("cut_tets", &PyTissue::cut_tets)
       .def_property_readonly("enriched_vertices", &PyTissue::enriched_vertices)

@@ -148,3 +148,23 @@ def test_bad_input_is_refused_with_the_cores_message():
         t.step(0)
     t.step()  # still usable
     assert t.time_s > 0.0
+
+
+def test_regions_take_their_materials_by_name_and_mistakes_are_refused(tmp_path):
+    # Two tets sharing a face, one per region (Vega *SET / *MATERIAL / *REGION): the file's material,
+    # then one set by name; a region the mesh does not have and an unknown key are refused.
+    mesh = tmp_path / "two.veg"
+    mesh.write_text("*VERTICES\n5 3 0 0\n1 0 0 0\n2 0.01 0 0\n3 0 0.01 0\n4 0 0 0.01\n5 0.01 0.01 0.01\n"
+                    "*ELEMENTS\nTET\n2 4 0\n1 1 2 3 4\n2 2 5 3 4\n"
+                    "*MATERIAL soft\nENU, 1000, 1e5, 0.4\n*MATERIAL stiff\nENU, 1100, 1e6, 0.45\n"
+                    "*SET skin\n1\n*SET tumour\n2\n*REGION\nskin, soft\ntumour, stiff\n")
+    from_file = tissue.Tissue(mesh=str(mesh), fixed_vertices=[0, 1, 2])
+    assert from_file.regions == {"skin": [1e5, 0.4, 1000.0], "tumour": [1e6, 0.45, 1100.0]}
+    set_by_name = tissue.Tissue(mesh=str(mesh), fixed_vertices=[0, 1, 2],
+                                regions={"tumour": {"young_modulus_pa": 3e6}})
+    # A key left out keeps the body's value (poisson_ratio 0.4, density 1000), not the file's.
+    assert set_by_name.regions["tumour"] == [3e6, 0.4, 1000.0]
+    with pytest.raises(ValueError, match='"liver", which the mesh does not have'):
+        tissue.Tissue(mesh=str(mesh), fixed_vertices=[0, 1, 2], regions={"liver": {"density_kg_per_m3": 1.0}})
+    with pytest.raises(ValueError, match="unknown key"):
+        tissue.Tissue(mesh=str(mesh), fixed_vertices=[0, 1, 2], regions={"tumour": {"stiffness": 1.0}})
