@@ -65,6 +65,7 @@ std::uint64_t model_fingerprint_of(const TetMesh& mesh, const TissueSettings& se
       f.add(material.density_kg_per_m3);
     }
   }
+  if (body.material_model != MaterialModel::corotational_linear) f.add(body.material_model);  // older fingerprints stay
   f.add(body.damping.mass_damping_per_s);
   f.add(body.damping.stiffness_damping_s);
   f.add(std::array<double, 3>{body.gravity_m_per_s2.x(), body.gravity_m_per_s2.y(), body.gravity_m_per_s2.z()});

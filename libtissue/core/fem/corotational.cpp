@@ -40,8 +40,9 @@ std::vector<LameParameters> lame_table(const TetMesh& mesh, const std::vector<Ma
 }  // namespace
 
 CorotationalElasticity::CorotationalElasticity(const TetMesh& mesh, const std::vector<Material>& materials,
-                                               const RotationSettings& rotation, const std::vector<int>& vertex_order)
-    : m_lame(lame_table(mesh, materials)), m_rotation_settings((validate(rotation), rotation)) {
+                                               const RotationSettings& rotation, const std::vector<int>& vertex_order,
+                                               MaterialModel model)
+    : m_elements(model, lame_table(mesh, materials)), m_rotation_settings((validate(rotation), rotation)) {
   partition(mesh, vertex_order);
   m_tets.reserve(m_tet_id.size());
   m_rest.reserve(m_tet_id.size());
@@ -252,6 +253,10 @@ TISSUE_HOT_KERNEL void CorotationalElasticity::add_tet(size_t k, const Eigen::Ma
   const Eigen::Matrix3d& r = m_rotations[k];
 
   // f_i = V R sigma g_i (equal to R K_e (R^T x - X), see DESIGN section 4).
+  if (m_elements.model != MaterialModel::corotational_linear) {
+    add_tet_of_model(k, f, internal_forces_n, tangent, slots);
+    return;
+  }
   const LameParameters& lame = lame_of(rest);
   const Eigen::Matrix<double, 3, 4> forces = corotated_forces(rest, r, f, lame);
   for (int i = 0; i < 4; ++i) internal_forces_n.segment<3>(3 * tet[static_cast<size_t>(i)]) += forces.col(i);
@@ -270,6 +275,26 @@ TISSUE_HOT_KERNEL void CorotationalElasticity::add_tet(size_t k, const Eigen::Ma
   }
 }
 
+void CorotationalElasticity::add_tet_of_model(size_t k, const Eigen::Matrix3d& f, Eigen::VectorXd& internal_forces_n,
+                                              BlockSparseMatrix* tangent, const std::vector<TetSlots>* slots) const {
+  const Tet& tet = m_tets[k];
+  const TetRest& rest = m_rest[k];
+  const Eigen::Matrix<double, 3, 4> forces = m_elements.forces(rest, m_rotations[k], f);
+  for (int i = 0; i < 4; ++i) internal_forces_n.segment<3>(3 * tet[static_cast<size_t>(i)]) += forces.col(i);
+  if (tangent == nullptr) return;
+  std::array<Eigen::Matrix3d, 16> blocks;
+  m_elements.blocks(rest, m_rotations[k], f, blocks);
+  const TetSlots& tet_slots = (*slots)[static_cast<size_t>(m_tet_id[k])];
+  for (int i = 0; i < 4; ++i) {
+    for (int j = i; j < 4; ++j) {
+      const int slot_ij = tet_slots[static_cast<size_t>(4 * i + j)];
+      if (slot_ij < 0) continue;
+      tangent->block(slot_ij) += blocks[static_cast<size_t>(4 * i + j)];
+      if (i != j) tangent->block(tet_slots[static_cast<size_t>(4 * j + i)]) += blocks[static_cast<size_t>(4 * i + j)].transpose();
+    }
+  }
+}
+
 TISSUE_HOT_KERNEL double CorotationalElasticity::energy_of_range(const Eigen::VectorXd& positions_m, size_t first,
                                                                    size_t end) const {
   // Rotations in SIMD lanes as in a step (the energy guard evaluates this twice on a step that
@@ -278,7 +303,7 @@ TISSUE_HOT_KERNEL double CorotationalElasticity::energy_of_range(const Eigen::Ve
   in_rotation_batches(
       end - first, [first](size_t k) { return first + k; }, positions_m, nullptr, nullptr,
       [&](size_t t, const Eigen::Matrix3d& f, const Eigen::Matrix3d& rotation) {
-        energy += corotated_energy_j(m_rest[t], rotation, f, lame_of(m_rest[t]));
+        energy += m_elements.energy_j(m_rest[t], rotation, f);
       });
   return energy;
 }

@@ -4,6 +4,7 @@
 #pragma once
 
 #include "core/material/material.hpp"
+#include "core/fem/element_model.hpp"
 #include "core/fem/rotation.hpp"
 #include "core/fem/tet_element.hpp"
 #include "core/mesh/tet_mesh.hpp"
@@ -28,8 +29,11 @@ class CorotationalElasticity {
   /// `vertex_order` (a permutation of the vertices, such as locality_order(), or empty for vertex
   /// order): each assembly part visits its tets by the earliest of their vertices in it, so that
   /// consecutive tets write nearby blocks when the system's rows are numbered in the same order.
+  /// `model`: how every tet answers (co-rotational linear, or stable Neo-Hookean: then the rotations
+  /// are still extracted, for the protections and the element-local contact stiffness).
   CorotationalElasticity(const TetMesh& mesh, const std::vector<Material>& materials,
-                         const RotationSettings& rotation = {}, const std::vector<int>& vertex_order = {});
+                         const RotationSettings& rotation = {}, const std::vector<int>& vertex_order = {},
+                         MaterialModel model = MaterialModel::corotational_linear);
   /// One material for the whole mesh (every region).
   CorotationalElasticity(const TetMesh& mesh, const Material& material, const RotationSettings& rotation = {},
                          const std::vector<int>& vertex_order = {})
@@ -38,10 +42,10 @@ class CorotationalElasticity {
 
   [[nodiscard]] int tet_count() const { return static_cast<int>(m_tets.size()); }
   /// The Lame parameters of each material (TetRest::material indexes them).
-  [[nodiscard]] const std::vector<LameParameters>& lame() const { return m_lame; }
-  [[nodiscard]] const LameParameters& lame_of(const TetRest& rest) const {
-    return m_lame[static_cast<size_t>(rest.material)];
-  }
+  [[nodiscard]] const std::vector<LameParameters>& lame() const { return m_elements.lame; }
+  [[nodiscard]] const LameParameters& lame_of(const TetRest& rest) const { return m_elements.lame_of(rest); }
+  /// The material model and its per-material constants (shared with the XFEM pieces).
+  [[nodiscard]] const ElementModel& elements() const { return m_elements; }
   [[nodiscard]] const TetRest& rest(int tet) const { return m_rest[stored(tet)]; }
   [[nodiscard]] const Eigen::Matrix3d& rotation(int tet) const { return m_rotations[stored(tet)]; }
 
@@ -106,6 +110,9 @@ class CorotationalElasticity {
   /// the rotation already extracted.
   void add_tet(size_t k, const Eigen::Matrix3d& f, Eigen::VectorXd& internal_forces_n, BlockSparseMatrix* tangent,
                const std::vector<TetSlots>* slots) const;
+  /// add_tet for a model other than co-rotational linear (ElementModel).
+  void add_tet_of_model(size_t k, const Eigen::Matrix3d& f, Eigen::VectorXd& internal_forces_n,
+                        BlockSparseMatrix* tangent, const std::vector<TetSlots>* slots) const;
 
   /// visit(t, F, R) for the tets tet_at(0) .. tet_at(count - 1) that are not excluded, in order, their
   /// rotations extracted ROTATION_BATCH at a time side by side (SIMD lanes). From and into the tets'
@@ -141,7 +148,7 @@ class CorotationalElasticity {
   std::vector<Eigen::Matrix3d> m_rotations;
   std::vector<Eigen::Quaterniond> m_warm_starts;
   std::vector<char> m_excluded;  // 1 = modelled elsewhere (cut)
-  std::vector<LameParameters> m_lame;  // per material
+  ElementModel m_elements;  // the model, Lame parameters per material
   RotationSettings m_rotation_settings;
 };
 

@@ -106,11 +106,11 @@ DeformableBody::DeformableBody(TetMesh mesh, BodySettings settings)
       m_settings(checked(std::move(settings), m_mesh.vertex_count())),
       m_materials(resolve_region_materials(m_mesh.regions, m_settings.material, m_settings.region_materials)),
       m_dofs(make_dof_map(m_mesh.vertex_count(), m_settings.fixed_vertices, m_vertex_order)),
-      m_elasticity(m_mesh, m_materials, m_settings.rotation, m_vertex_order),
+      m_elasticity(m_mesh, m_materials, m_settings.rotation, m_vertex_order, m_settings.material_model),
       m_vertex_mass_kg(lumped_vertex_masses(m_mesh, m_materials)),
       m_tangent(stiffness_pattern(m_mesh, m_dofs), with_ghost_room(m_settings.reserve, m_mesh, m_dofs)),
       m_slots(make_tet_slots(m_mesh, m_dofs, m_tangent)),
-      m_xfem(m_elasticity.lame(), m_settings.rotation),
+      m_xfem(m_elasticity.elements(), m_settings.rotation),
       m_enriched_row_capacity(enriched_row_capacities(m_mesh, m_dofs)),
       m_first_enriched_dof(static_cast<size_t>(m_mesh.vertex_count()), -1),
       m_cut_index(static_cast<size_t>(m_mesh.tet_count()), -1) {

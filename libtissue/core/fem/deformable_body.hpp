@@ -37,6 +37,8 @@ struct BodySettings {
   Material material;
   /// Materials set by region name (TetMesh::regions), replacing the file's (resolve_region_materials).
   std::vector<RegionMaterial> region_materials;
+  /// How the tets answer (issue 25): co-rotational linear (the default) or stable Neo-Hookean.
+  MaterialModel material_model = MaterialModel::corotational_linear;
   RayleighDamping damping;
   Eigen::Vector3d gravity_m_per_s2{0.0, -9.81, 0.0};
   std::vector<int> fixed_vertices;  ///< 0-based; they keep their rest positions

@@ -6,11 +6,11 @@
 // which is stress-free at F = I, agrees with linear elasticity of Lame parameters (lambda, mu) to
 // first order in the strain, and is defined for every F, inverted (J <= 0) or flat, so an inverted
 // element is pushed back (the J term's gradient dJ/dF never vanishes away from a collapsed F).
-// The constants mu'/2 log 4 - lambda'/2 (1 - alpha)^2 are added so that Psi(I) = 0. First Piola-Kirchhoff stress P = dPsi/dF and
-// its derivative dP/dF (9 x 9, column-major vec(F)), whose negative eigenvalues are clamped to zero
-// where a solver needs a positive semi-definite tangent. Per linear tet (shape gradients g_i, volume
-// V): the internal force on vertex i is V P g_i (the restoring force, as the co-rotational kernel's)
-// and the tangent block K_ij = V (g_i^T (x) I) dP/dF (g_j (x) I).
+// The constants mu'/2 log 4 - lambda'/2 (1 - alpha)^2 are added so that Psi(I) = 0. First Piola-Kirchhoff stress P =
+// dPsi/dF and its derivative dP/dF (9 x 9, column-major vec(F)), whose negative eigenvalues are clamped to zero where a
+// solver needs a positive semi-definite tangent. Per linear tet (shape gradients g_i, volume V): the internal force on
+// vertex i is V P g_i (the restoring force, as the co-rotational kernel's) and the tangent block K_ij = V (g_i^T (x) I)
+// dP/dF (g_j (x) I).
 #pragma once
 
 #include "core/fem/tet_element.hpp"

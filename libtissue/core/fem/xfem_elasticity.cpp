@@ -157,7 +157,6 @@ void XfemElasticity::evaluate(const Eigen::VectorXd& positions_m, const Eigen::V
     if (m_retired[k] != 0) continue;
     const CutTet& cut_tet = m_cut_tets[k];
     const TetRest& rest = m_rest[k];
-    const LameParameters& lame = m_lame[static_cast<size_t>(rest.material)];
     const std::size_t first = piece_begin(static_cast<int>(k));
     const std::size_t count = piece_count(static_cast<int>(k));
     gather(k, positions_m, real_m);
@@ -168,7 +167,7 @@ void XfemElasticity::evaluate(const Eigen::VectorXd& positions_m, const Eigen::V
       const CutPiece& piece = m_pieces[p];
       const Eigen::Matrix3d f = deformation_gradient(rest, piece_positions(piece, real_m, displacement_m));
       const Eigen::Matrix3d& r = m_rotations[p] = extract_rotation(f, m_warm_starts[p], m_rotation_settings);
-      const Eigen::Matrix<double, 3, 4> forces = corotated_forces(rest, r, f, lame);
+      const Eigen::Matrix<double, 3, 4> forces = m_elements.forces(rest, r, f);
       vertex_sum += piece.weight * forces;
       for (size_t i = 0; i < 4; ++i) {
         if (piece.ghost_row[i] < 0) continue;
@@ -204,11 +203,12 @@ void XfemElasticity::evaluate(const Eigen::VectorXd& positions_m, const Eigen::V
         vertex[to_size(n)] = i;
         coefficient[to_size(n++)] = piece.ghost_sign[to_size(i)];
       }
-      const Eigen::Matrix<double, 3, 4> c = m_rotations[p] * rest.shape_gradients_per_m;
+      // The co-rotational blocks need the piece's rotation only; other models its F.
+      const Eigen::Matrix3d f = m_elements.model == MaterialModel::corotational_linear
+                                    ? Eigen::Matrix3d::Identity()
+                                    : deformation_gradient(rest, piece_positions(piece, real_m, displacement_m));
       std::array<Eigen::Matrix3d, 16> blocks;
-      for (int i = 0; i < 4; ++i) {
-        for (int j = i; j < 4; ++j) blocks[to_size(4 * i + j)] = rotated_stiffness_block(rest, lame, c, i, j);
-      }
+      m_elements.blocks(rest, m_rotations[p], f, blocks);
       for (int i = 0; i < 4; ++i) {
         for (int j = i; j < 4; ++j) uu[to_size(4 * i + j)] += piece.weight * blocks[to_size(4 * i + j)];
       }
@@ -256,9 +256,7 @@ double XfemElasticity::elastic_energy_j(const Eigen::VectorXd& positions_m,
       const CutPiece& piece = m_pieces[p];
       const Eigen::Matrix3d f = deformation_gradient(m_rest[k], piece_positions(piece, real_m, displacement_m));
       Eigen::Quaterniond warm_start = m_warm_starts[p];  // a copy: reporting must not change the dynamics
-      energy += piece.weight *
-                corotated_energy_j(m_rest[k], extract_rotation(f, warm_start, m_rotation_settings), f,
-                                   m_lame[static_cast<size_t>(m_rest[k].material)]);
+      energy += piece.weight * m_elements.energy_j(m_rest[k], extract_rotation(f, warm_start, m_rotation_settings), f);
     }
   }
   return energy;

@@ -18,6 +18,7 @@
 #pragma once
 
 #include "core/fem/tet_cut.hpp"
+#include "core/fem/element_model.hpp"
 #include "core/material/material.hpp"
 #include "core/fem/rotation.hpp"
 #include "core/fem/tet_element.hpp"
@@ -96,9 +97,13 @@ TetPositions piece_positions(const CutPiece& piece, const TetPositions& real_pos
 class XfemElasticity {
  public:
   /// `rotation`: when the parts' rotation extraction stops (validated by the caller's body settings).
-  /// `lame`: per material, as CorotationalElasticity::lame(); a cut tet's TetRest::material picks one.
+  /// `elements`: the body's material model and constants per material, as
+  /// CorotationalElasticity::elements(); a cut tet's TetRest::material picks one.
+  XfemElasticity(ElementModel elements, const RotationSettings& rotation)
+      : m_elements(std::move(elements)), m_rotation_settings(rotation) {}
+  /// Co-rotational linear with these Lame parameters per material.
   XfemElasticity(std::vector<LameParameters> lame, const RotationSettings& rotation)
-      : m_lame(std::move(lame)), m_rotation_settings(rotation) {}
+      : XfemElasticity(ElementModel(MaterialModel::corotational_linear, std::move(lame)), rotation) {}
 
   /// Room for this many cut tets without reallocation.
   void reserve(int cut_tets);
@@ -178,7 +183,7 @@ class XfemElasticity {
 
   // Flat, cut tet after cut tet (one pass over contiguous memory): per cut tet, per piece, ghost
   // rows and slots with their begin offsets.
-  std::vector<LameParameters> m_lame;  // per material
+  ElementModel m_elements;  // the model, constants per material
   RotationSettings m_rotation_settings;
   std::vector<CutTet> m_cut_tets;
   std::vector<TetRest> m_rest;

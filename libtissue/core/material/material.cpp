@@ -19,6 +19,18 @@ void validate(const Material& material) {
   }
 }
 
+std::string_view to_string(MaterialModel model) {
+  return model == MaterialModel::stable_neo_hookean ? "stableNeoHookean" : "corotationalLinear";
+}
+
+MaterialModel parse_material_model(std::string_view name) {
+  for (const MaterialModel model : {MaterialModel::corotational_linear, MaterialModel::stable_neo_hookean}) {
+    if (name == to_string(model)) return model;
+  }
+  throw ParameterError("material model \"" + std::string(name) +
+                       "\" is not \"corotationalLinear\" or \"stableNeoHookean\"");
+}
+
 LameParameters lame_parameters(const Material& material) {
   const double e = material.young_modulus_pa;
   const double nu = material.poisson_ratio;

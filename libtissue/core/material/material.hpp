@@ -3,6 +3,8 @@
 
 #include "core/parameter_error.hpp"
 
+#include <string_view>
+
 namespace tissue {
 
 /// Homogeneous isotropic linear-elastic material.
@@ -22,5 +24,15 @@ void validate(const Material& material);
 
 /// lambda = E nu / ((1 + nu)(1 - 2 nu)), mu = E / (2 (1 + nu)).
 LameParameters lame_parameters(const Material& material);
+
+/// How the body's tets answer a deformation (issue 25; one for the whole body): co-rotational linear
+/// elasticity (the dissertation's, the default) or stable Neo-Hookean (core/fem/stable_neo_hookean.hpp),
+/// both with each region's (E, nu).
+enum class MaterialModel { corotational_linear, stable_neo_hookean };
+
+/// "corotationalLinear", "stableNeoHookean" (the FMU's and the host's spelling).
+std::string_view to_string(MaterialModel model);
+/// The inverse; throws ParameterError naming the accepted names.
+MaterialModel parse_material_model(std::string_view name);
 
 }  // namespace tissue

@@ -97,8 +97,9 @@ std::vector<Material> resolve_region_materials(const std::vector<MeshRegion>& re
       if (regions[r].name == set.region) found = r;
     }
     if (found == regions.size()) {
-      throw ParameterError("material set for region \"" + set.region + "\", which the mesh does not have (" +
-                           (regions.empty() ? std::string("it has no regions") : "its regions: " + quoted_region_names(regions)) + ")");
+      throw ParameterError(
+          "material set for region \"" + set.region + "\", which the mesh does not have (" +
+          (regions.empty() ? std::string("it has no regions") : "its regions: " + quoted_region_names(regions)) + ")");
     }
     materials[found] = set.material;
   }
@@ -106,8 +107,8 @@ std::vector<Material> resolve_region_materials(const std::vector<MeshRegion>& re
     try {
       validate(materials[r]);
     } catch (const ParameterError& error) {
-      throw ParameterError("region \"" + (regions.empty() ? std::string("all") : regions[r].name) + "\": " +
-                           error.what());
+      throw ParameterError("region \"" + (regions.empty() ? std::string("all") : regions[r].name) +
+                           "\": " + error.what());
     }
   }
   return materials;

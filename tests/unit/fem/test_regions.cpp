@@ -68,7 +68,8 @@ struct TwoRegionModel {
       const Tet& tet = mesh.tets[static_cast<size_t>(t)];
       for (int i = 0; i < 4; ++i) {
         for (int j = 0; j < 4; ++j) {
-          k.block<3, 3>(3 * tet[static_cast<size_t>(i)], 3 * tet[static_cast<size_t>(j)]) += k_e.block<3, 3>(3 * i, 3 * j);
+          k.block<3, 3>(3 * tet[static_cast<size_t>(i)], 3 * tet[static_cast<size_t>(j)]) +=
+              k_e.block<3, 3>(3 * i, 3 * j);
         }
       }
     }

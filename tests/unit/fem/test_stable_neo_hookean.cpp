@@ -142,7 +142,9 @@ TEST(StableNeoHookean, AnInvertedTetIsPushedBackToItsRestShape) {
   TetPositions x = rest_tet();
   x[3].z() = -x[3].z();
   ASSERT_LT(gradient_of(rest, x).determinant(), 0.0);
-  const auto energy = [&](const TetPositions& y) { return rest.volume_m3 * neo_hookean_energy_density(m, gradient_of(rest, y)); };
+  const auto energy = [&](const TetPositions& y) {
+    return rest.volume_m3 * neo_hookean_energy_density(m, gradient_of(rest, y));
+  };
   for (int iteration = 0; iteration < 100; ++iteration) {
     const Eigen::Matrix3d f = gradient_of(rest, x);
     const Eigen::Vector3d force = neo_hookean_forces(rest, m, f).col(3);
@@ -171,11 +173,12 @@ TEST(StableNeoHookean, SmallStrainsAgreeWithLinearElasticityToSecondOrder) {
   for (const double eps : {1e-2, 5e-3, 2.5e-3}) {
     const Eigen::Matrix3d grad = eps * h_dir;
     const Eigen::Matrix3d strain = 0.5 * (grad + grad.transpose());
-    const Eigen::Matrix3d linear = 2.0 * lame.mu_pa * strain + lame.lambda_pa * strain.trace() * Eigen::Matrix3d::Identity();
+    const Eigen::Matrix3d linear =
+        2.0 * lame.mu_pa * strain + lame.lambda_pa * strain.trace() * Eigen::Matrix3d::Identity();
     const Eigen::Matrix3d p = neo_hookean_stress(m, Eigen::Matrix3d::Identity() + grad);
     differences.push_back((p - linear).norm() / linear.norm());
   }
-  EXPECT_LT(differences[0], 0.05);  // 1% strain: a few percent
+  EXPECT_LT(differences[0], 0.05);                         // 1% strain: a few percent
   EXPECT_NEAR(differences[0] / differences[1], 2.0, 0.2);  // relative difference O(eps): the absolute O(eps^2)
   EXPECT_NEAR(differences[1] / differences[2], 2.0, 0.2);
 }

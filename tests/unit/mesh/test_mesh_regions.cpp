@@ -45,7 +45,8 @@ TEST(VegRegions, EachRegionIsNamedByItsSetAndHasItsMaterial) {
 }
 
 TEST(VegRegions, AllElementsIsPredefinedAndAFileWithoutRegionsHasNone) {
-  const TetMesh one = parse_veg(VEG_VERTICES + "*MATERIAL body\nENU, 1000, 2e5, 0.3\n*REGION\nallElements, body\n", "a.veg");
+  const TetMesh one =
+      parse_veg(VEG_VERTICES + "*MATERIAL body\nENU, 1000, 2e5, 0.3\n*REGION\nallElements, body\n", "a.veg");
   ASSERT_EQ(one.regions.size(), 1u);
   EXPECT_EQ(one.regions[0].name, "allElements");
   EXPECT_EQ(one.tet_regions, (std::vector<int>{0, 0}));
@@ -59,10 +60,13 @@ TEST(VegRegions, AllElementsIsPredefinedAndAFileWithoutRegionsHasNone) {
 
 TEST(VegRegions, MistakesAreRefusedWithTheFileAndLine) {
   const std::string materials = "*MATERIAL soft\nENU, 1000, 1e5, 0.4\n*MATERIAL stiff\nENU, 1100, 1e6, 0.45\n";
-  const auto refused = [&](const std::string& tail) { return message_of([&] { parse_veg(VEG_VERTICES + tail, "m.veg"); }); };
+  const auto refused = [&](const std::string& tail) {
+    return message_of([&] { parse_veg(VEG_VERTICES + tail, "m.veg"); });
+  };
   // Lines: 1-7 the vertices, 8-12 the elements, 13-16 the two materials.
   EXPECT_EQ(refused(materials + "*SET a\n1\n*REGION\nb, soft\n"), "m.veg:20: *REGION b, soft: no *SET named b");
-  EXPECT_EQ(refused(materials + "*SET a\n1, 2\n*REGION\na, bone\n"), "m.veg:20: *REGION a, bone: no *MATERIAL named bone");
+  EXPECT_EQ(refused(materials + "*SET a\n1, 2\n*REGION\na, bone\n"),
+            "m.veg:20: *REGION a, bone: no *MATERIAL named bone");
   EXPECT_EQ(refused(materials + "*SET a\n1, 2\n*SET b\n2\n*REGION\na, soft\nb, stiff\n"),
             "m.veg:23: *REGION b, stiff: element 2 is in two regions, a and b");
   EXPECT_EQ(refused(materials + "*SET a\n1\n*REGION\na, soft\n"),
@@ -74,24 +78,25 @@ TEST(VegRegions, MistakesAreRefusedWithTheFileAndLine) {
   EXPECT_EQ(refused("*MATERIAL bad\nMOONEYRIVLIN, 1000, 1e5, 0.4\n"),
             "m.veg:14: *MATERIAL bad: material type 'MOONEYRIVLIN' is not supported (only ENU: density, E, nu)");
   EXPECT_EQ(refused(materials + "*SET a\n1, 7\n*REGION\na, soft\n"), "m.veg:17: *SET a: element 7 outside [1, 2]");
-  EXPECT_EQ(refused(materials + "*MATERIAL soft\nENU, 1, 1, 0\n"), "m.veg:17: *MATERIAL soft: defined twice (first at line 13)");
+  EXPECT_EQ(refused(materials + "*MATERIAL soft\nENU, 1, 1, 0\n"),
+            "m.veg:17: *MATERIAL soft: defined twice (first at line 13)");
 }
 
 // Two tets in two volumes (entity tags 1 and 2); `volume_groups` is the physical-tag part of the
 // two volume lines of $Entities.
 std::string gmsh_text(const std::string& physical_names, const std::string& volume_1_groups,
                       const std::string& volume_2_groups) {
-  return "$MeshFormat\n4.1 0 8\n$EndMeshFormat\n" + physical_names +
-         "$Entities\n0 0 0 2\n1 0 0 0 1 1 1 " + volume_1_groups + " 0\n2 0 0 0 1 1 1 " + volume_2_groups +
+  return "$MeshFormat\n4.1 0 8\n$EndMeshFormat\n" + physical_names + "$Entities\n0 0 0 2\n1 0 0 0 1 1 1 " +
+         volume_1_groups + " 0\n2 0 0 0 1 1 1 " + volume_2_groups +
          " 0\n$EndEntities\n"
          "$Nodes\n1 5 1 5\n3 1 0 5\n1\n2\n3\n4\n5\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n1 1 1\n$EndNodes\n"
          "$Elements\n2 2 1 2\n3 1 4 1\n1 1 2 3 4\n3 2 4 1\n2 2 5 3 4\n$EndElements\n";
 }
 
 TEST(GmshRegions, PhysicalGroupsOfTheVolumesAreTheRegions) {
-  const TetMesh named =
-      parse_gmsh(gmsh_text("$PhysicalNames\n2\n3 7 \"liver tissue\"\n3 8 \"tumour\"\n$EndPhysicalNames\n", "1 7", "1 8"),
-                 "two.msh");
+  const TetMesh named = parse_gmsh(
+      gmsh_text("$PhysicalNames\n2\n3 7 \"liver tissue\"\n3 8 \"tumour\"\n$EndPhysicalNames\n", "1 7", "1 8"),
+      "two.msh");
   ASSERT_EQ(named.regions.size(), 2u);
   EXPECT_EQ(named.regions[0].name, "liver tissue");
   EXPECT_EQ(named.regions[1].name, "tumour");
@@ -121,13 +126,16 @@ TEST(TetgenRegions, TheFirstAttributeIsTheRegion) {
   EXPECT_EQ(mesh.regions[1].name, "2");
   EXPECT_EQ(mesh.tet_regions, (std::vector<int>{0, 1}));
   std::ofstream(dir / "two.ele") << "2 4 1\n1 1 2 3 4 1\n2 2 5 3 4 2.5\n";
-  EXPECT_NE(message_of([&] { read_tetgen(dir / "two.node"); }).find("two.ele:3: element 2: region attribute 2.5 is not a whole number"),
+  EXPECT_NE(message_of([&] {
+              read_tetgen(dir / "two.node");
+            }).find("two.ele:3: element 2: region attribute 2.5 is not a whole number"),
             std::string::npos);
 }
 
 TEST(RegionMaterials, SetByNameReplacesTheFilesAndTheRestKeepTheirs) {
   const Material body{1e5, 0.4, 1000.0};
-  const std::vector<MeshRegion> regions{{"skin", std::nullopt}, {"tumour", Material{1e6, 0.45, 1100.0}}, {"fat", std::nullopt}};
+  const std::vector<MeshRegion> regions{
+      {"skin", std::nullopt}, {"tumour", Material{1e6, 0.45, 1100.0}}, {"fat", std::nullopt}};
   const std::vector<Material> resolved =
       resolve_region_materials(regions, body, parse_region_materials("fat: youngModulus=3e4, density=900", body));
   ASSERT_EQ(resolved.size(), 3u);
@@ -155,16 +163,21 @@ TEST(RegionMaterials, TheTextFormRoundTripsAndMistakesNameTheRegion) {
   EXPECT_TRUE(parse_region_materials("  ", body).empty());
   EXPECT_TRUE(parse_region_materials("none", body).empty());
   const auto refused = [&](const std::string& text) { return message_of([&] { parse_region_materials(text, body); }); };
-  EXPECT_EQ(refused("tumour youngModulus=1e6"), "material.regions: \"tumour youngModulus=1e6\": expected 'name: key=value, ...'");
+  EXPECT_EQ(refused("tumour youngModulus=1e6"),
+            "material.regions: \"tumour youngModulus=1e6\": expected 'name: key=value, ...'");
   EXPECT_EQ(refused("tumour: stiffness=1e6"),
-            "material.regions: \"tumour: stiffness=1e6\": unknown key \"stiffness\" (youngModulus [Pa], poissonRatio, density [kg/m^3])");
+            "material.regions: \"tumour: stiffness=1e6\": unknown key \"stiffness\" (youngModulus [Pa], poissonRatio, "
+            "density [kg/m^3])");
   EXPECT_EQ(refused("tumour: youngModulus=-5"),
-            "material.regions: \"tumour: youngModulus=-5\": material: Young's modulus must be finite and > 0 Pa, got -5.000000");
-  EXPECT_EQ(refused("tumour: poissonRatio=nan"), "material.regions: \"tumour: poissonRatio=nan\": poissonRatio: \"nan\" is not a finite number");
+            "material.regions: \"tumour: youngModulus=-5\": material: Young's modulus must be finite and > 0 Pa, got "
+            "-5.000000");
+  EXPECT_EQ(refused("tumour: poissonRatio=nan"),
+            "material.regions: \"tumour: poissonRatio=nan\": poissonRatio: \"nan\" is not a finite number");
   EXPECT_EQ(refused("a: density=1; a: density=2"), "material.regions: region \"a\" given twice");
   const std::vector<MeshRegion> regions{{"skin", std::nullopt}, {"tumour", std::nullopt}};
-  EXPECT_EQ(message_of([&] { resolve_region_materials(regions, body, parse_region_materials("liver: density=1", body)); }),
-            "material set for region \"liver\", which the mesh does not have (its regions: \"skin\", \"tumour\")");
+  EXPECT_EQ(
+      message_of([&] { resolve_region_materials(regions, body, parse_region_materials("liver: density=1", body)); }),
+      "material set for region \"liver\", which the mesh does not have (its regions: \"skin\", \"tumour\")");
   EXPECT_EQ(message_of([&] { resolve_region_materials({}, body, parse_region_materials("liver: density=1", body)); }),
             "material set for region \"liver\", which the mesh does not have (it has no regions)");
 }
