@@ -185,3 +185,21 @@ TEST(StableNeoHookean, SmallStrainsAgreeWithLinearElasticityToSecondOrder) {
 
 }  // namespace
 }  // namespace tissue
+
+namespace tissue {
+namespace {
+
+TEST(MaterialModel, NamesRoundTripAndAnUnknownOneIsRefused) {
+  for (const MaterialModel model : {MaterialModel::corotational_linear, MaterialModel::stable_neo_hookean}) {
+    EXPECT_EQ(parse_material_model(to_string(model)), model);
+  }
+  try {
+    (void)parse_material_model("neoHookean");
+    ADD_FAILURE() << "an unknown model was taken";
+  } catch (const ParameterError& error) {
+    EXPECT_STREQ(error.what(), "material model \"neoHookean\" is not \"corotationalLinear\" or \"stableNeoHookean\"");
+  }
+}
+
+}  // namespace
+}  // namespace tissue
