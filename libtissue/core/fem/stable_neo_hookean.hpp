@@ -8,7 +8,8 @@
 // element is pushed back (the J term's gradient dJ/dF never vanishes away from a collapsed F).
 // The constants mu'/2 log 4 - lambda'/2 (1 - alpha)^2 are added so that Psi(I) = 0. First Piola-Kirchhoff stress P =
 // dPsi/dF and its derivative dP/dF (9 x 9, column-major vec(F)), whose negative eigenvalues are clamped to zero where a
-// solver needs a positive semi-definite tangent. Per linear tet (shape gradients g_i, volume V): the internal force on
+// solver needs a positive semi-definite tangent (skipped where a Cholesky factorization shows dP/dF positive
+// definite). Per linear tet (shape gradients g_i, volume V): the internal force on
 // vertex i is V P g_i (the restoring force, as the co-rotational kernel's) and the tangent block K_ij = V (g_i^T (x) I)
 // dP/dF (g_j (x) I).
 #pragma once
@@ -39,7 +40,8 @@ double neo_hookean_energy_density(const StableNeoHookean& material, const Eigen:
 Eigen::Matrix3d neo_hookean_stress(const StableNeoHookean& material, const Eigen::Matrix3d& f);
 
 /// dP/dF (9 x 9, vec(F) column-major: index 3 * column + row); `project`: negative eigenvalues set
-/// to zero (the projection onto the positive semi-definite cone, per element).
+/// to zero (the projection onto the positive semi-definite cone, per element; nothing to do, and not done,
+/// where dP/dF is positive definite).
 Matrix9d neo_hookean_stress_derivative(const StableNeoHookean& material, const Eigen::Matrix3d& f, bool project);
 
 /// Internal forces (3 x 4, column i acts on vertex i, the restoring force of M a + f_int = f_ext as
