@@ -226,13 +226,9 @@ double contact_stiffness_scale_n_per_m(const DeformableBody& body, const Surface
   // not sink into the stiffest part it can touch.
   const CorotationalElasticity& elasticity = body.elasticity();
   double modulus_pa = 0.0;
-  if (elasticity.lame().size() == 1) {
-    modulus_pa = elasticity.lame()[0].lambda_pa + 2.0 * elasticity.lame()[0].mu_pa;
-  } else {
-    for (const int tet : surface.triangle_tet) {
-      const LameParameters& lame = elasticity.lame_of(elasticity.rest(tet));
-      modulus_pa = std::max(modulus_pa, lame.lambda_pa + 2.0 * lame.mu_pa);
-    }
+  for (const int tet : surface.triangle_tet) {
+    const LameParameters& lame = elasticity.lame_of(elasticity.rest(tet));
+    modulus_pa = std::max(modulus_pa, lame.lambda_pa + 2.0 * lame.mu_pa);
   }
   return modulus_pa * mean_surface_edge_m(body, surface);
 }

@@ -246,53 +246,48 @@ TISSUE_HOT_KERNEL void CorotationalElasticity::add_tets(const std::vector<int>& 
       });
 }
 
+namespace {
+
+// Adds a tet's tangent blocks through its slots: block(i, j) for i <= j (and its transpose at
+// (j, i)), skipping blocks that touch a fixed vertex (slot -1), so a block is computed only where
+// it is stored.
+template <class Block>
+void add_tet_blocks(const TetSlots& tet_slots, BlockSparseMatrix& tangent, Block block) {
+  for (int i = 0; i < 4; ++i) {
+    for (int j = i; j < 4; ++j) {
+      const int slot_ij = tet_slots[static_cast<size_t>(4 * i + j)];
+      if (slot_ij < 0) continue;
+      const Eigen::Matrix3d b = block(i, j);
+      tangent.block(slot_ij) += b;
+      if (i != j) tangent.block(tet_slots[static_cast<size_t>(4 * j + i)]) += b.transpose();
+    }
+  }
+}
+
+}  // namespace
+
 TISSUE_HOT_KERNEL void CorotationalElasticity::add_tet(size_t k, const Eigen::Matrix3d& f, Eigen::VectorXd& internal_forces_n,
                                      BlockSparseMatrix* tangent, const std::vector<TetSlots>* slots) const {
   const Tet& tet = m_tets[k];
   const TetRest& rest = m_rest[k];
   const Eigen::Matrix3d& r = m_rotations[k];
 
-  // f_i = V R sigma g_i (equal to R K_e (R^T x - X), see DESIGN section 4).
-  if (m_elements.model != MaterialModel::corotational_linear) {
-    add_tet_of_model(k, f, internal_forces_n, tangent, slots);
+  // Co-rotational: f_i = V R sigma g_i (equal to R K_e (R^T x - X), see DESIGN section 4).
+  const Eigen::Matrix<double, 3, 4> forces = m_elements.forces(rest, r, f);
+  for (int i = 0; i < 4; ++i) internal_forces_n.segment<3>(3 * tet[static_cast<size_t>(i)]) += forces.col(i);
+
+  if (tangent == nullptr) return;
+  const TetSlots& tet_slots = (*slots)[static_cast<size_t>(m_tet_id[k])];
+  if (m_elements.model == MaterialModel::corotational_linear) {
+    // Each stored block straight from the rotated shape gradients (the hot path: no 12 x 12).
+    const LameParameters& lame = lame_of(rest);
+    const Eigen::Matrix<double, 3, 4> c = r * rest.shape_gradients_per_m;
+    add_tet_blocks(tet_slots, *tangent, [&](int i, int j) { return rotated_stiffness_block(rest, lame, c, i, j); });
     return;
   }
-  const LameParameters& lame = lame_of(rest);
-  const Eigen::Matrix<double, 3, 4> forces = corotated_forces(rest, r, f, lame);
-  for (int i = 0; i < 4; ++i) internal_forces_n.segment<3>(3 * tet[static_cast<size_t>(i)]) += forces.col(i);
-
-  if (tangent == nullptr) return;
-  const Eigen::Matrix<double, 3, 4> c = r * rest.shape_gradients_per_m;  // rotated shape gradients
-  const TetSlots& tet_slots = (*slots)[static_cast<size_t>(m_tet_id[k])];
-  for (int i = 0; i < 4; ++i) {
-    for (int j = i; j < 4; ++j) {
-      const int slot_ij = tet_slots[static_cast<size_t>(4 * i + j)];
-      if (slot_ij < 0) continue;
-      const Eigen::Matrix3d block = rotated_stiffness_block(rest, lame, c, i, j);
-      tangent->block(slot_ij) += block;
-      if (i != j) tangent->block(tet_slots[static_cast<size_t>(4 * j + i)]) += block.transpose();
-    }
-  }
-}
-
-void CorotationalElasticity::add_tet_of_model(size_t k, const Eigen::Matrix3d& f, Eigen::VectorXd& internal_forces_n,
-                                              BlockSparseMatrix* tangent, const std::vector<TetSlots>* slots) const {
-  const Tet& tet = m_tets[k];
-  const TetRest& rest = m_rest[k];
-  const Eigen::Matrix<double, 3, 4> forces = m_elements.forces(rest, m_rotations[k], f);
-  for (int i = 0; i < 4; ++i) internal_forces_n.segment<3>(3 * tet[static_cast<size_t>(i)]) += forces.col(i);
-  if (tangent == nullptr) return;
   std::array<Eigen::Matrix3d, 16> blocks;
-  m_elements.blocks(rest, m_rotations[k], f, blocks);
-  const TetSlots& tet_slots = (*slots)[static_cast<size_t>(m_tet_id[k])];
-  for (int i = 0; i < 4; ++i) {
-    for (int j = i; j < 4; ++j) {
-      const int slot_ij = tet_slots[static_cast<size_t>(4 * i + j)];
-      if (slot_ij < 0) continue;
-      tangent->block(slot_ij) += blocks[static_cast<size_t>(4 * i + j)];
-      if (i != j) tangent->block(tet_slots[static_cast<size_t>(4 * j + i)]) += blocks[static_cast<size_t>(4 * i + j)].transpose();
-    }
-  }
+  m_elements.blocks(rest, r, f, blocks);
+  add_tet_blocks(tet_slots, *tangent, [&](int i, int j) { return blocks[static_cast<size_t>(4 * i + j)]; });
 }
 
 TISSUE_HOT_KERNEL double CorotationalElasticity::energy_of_range(const Eigen::VectorXd& positions_m, size_t first,

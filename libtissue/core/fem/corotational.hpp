@@ -110,9 +110,6 @@ class CorotationalElasticity {
   /// the rotation already extracted.
   void add_tet(size_t k, const Eigen::Matrix3d& f, Eigen::VectorXd& internal_forces_n, BlockSparseMatrix* tangent,
                const std::vector<TetSlots>* slots) const;
-  /// add_tet for a model other than co-rotational linear (ElementModel).
-  void add_tet_of_model(size_t k, const Eigen::Matrix3d& f, Eigen::VectorXd& internal_forces_n,
-                        BlockSparseMatrix* tangent, const std::vector<TetSlots>* slots) const;
 
   /// visit(t, F, R) for the tets tet_at(0) .. tet_at(count - 1) that are not excluded, in order, their
   /// rotations extracted ROTATION_BATCH at a time side by side (SIMD lanes). From and into the tets'
