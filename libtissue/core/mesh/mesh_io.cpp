@@ -623,7 +623,6 @@ void resolve_veg_regions(const VegRegions& regions, const std::string& source, R
     return;
   }
   raw.tet_regions.assign(raw.tets.size(), -1);
-  std::vector<std::int64_t> all_elements;
   for (const VegRegions::Assignment& assignment : regions.assignments) {
     const std::string prefix = "*REGION " + assignment.set + ", " + assignment.material + ": ";
     const VegRegions::Set* set = nullptr;
@@ -947,14 +946,14 @@ void resolve_gmsh_regions(const GmshGroups& groups, const std::string& source, R
   bool any = false;
   for (const auto& [volume, tags] : groups.volume_groups) any = any || !tags.empty();
   if (!any) return;
+  const auto name_of = [&](std::int64_t tag) {
+    const auto named = groups.volume_group_names.find(tag);
+    return named != groups.volume_group_names.end() ? named->second : std::to_string(tag);
+  };
   raw.tet_regions.assign(raw.tets.size(), -1);
   for (std::size_t t = 0; t < raw.tets.size(); ++t) {
     const auto found = groups.volume_groups.find(groups.tet_volume[t]);
     if (found == groups.volume_groups.end() || found->second.empty()) continue;  // in no region: finish() says
-    const auto name_of = [&](std::int64_t tag) {
-      const auto named = groups.volume_group_names.find(tag);
-      return named != groups.volume_group_names.end() ? named->second : std::to_string(tag);
-    };
     if (found->second.size() > 1) {
       fail(source, raw.element_lines[t], static_cast<int>(t),
            element_label(raw.element_numbers[t]) + "is in two regions, " + name_of(found->second[0]) + " and " +
