@@ -9,6 +9,7 @@
 #include "core/fixed_region.hpp"
 #include "core/mesh/box_mesh.hpp"
 #include "core/mesh/mesh_io.hpp"
+#include "core/material/region_materials.hpp"
 #include "core/tissue.hpp"
 #include "core/tissue_snapshot_io.hpp"
 #include "device/scripted_device.hpp"
@@ -30,6 +31,7 @@
 #include <variant>
 #include <memory>
 #include <optional>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -103,16 +105,15 @@ std::vector<RegionMaterial> region_materials(const std::map<std::string, std::ma
   for (const auto& [name, keys] : regions) {
     RegionMaterial region{name, base};
     for (const auto& [key, value] : keys) {
-      if (key == "young_modulus_pa") {
-        region.material.young_modulus_pa = value;
-      } else if (key == "poisson_ratio") {
-        region.material.poisson_ratio = value;
-      } else if (key == "density_kg_per_m3") {
-        region.material.density_kg_per_m3 = value;
-      } else {
-        throw ParameterError("regions[\"" + name + "\"]: unknown key \"" + key +
-                             "\" (young_modulus_pa, poisson_ratio, density_kg_per_m3)");
+      const std::span<const MaterialProperty> properties = material_properties();
+      const auto property = std::find_if(properties.begin(), properties.end(),
+                                         [&](const MaterialProperty& p) { return p.si_name == key; });
+      if (property == properties.end()) {
+        std::string names;
+        for (const MaterialProperty& p : properties) names += (names.empty() ? "" : ", ") + std::string(p.si_name);
+        throw ParameterError("regions[\"" + name + "\"]: unknown key \"" + key + "\" (" + names + ")");
       }
+      region.material.*(property->value) = value;
     }
     materials.push_back(std::move(region));
   }

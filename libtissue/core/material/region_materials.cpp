@@ -1,6 +1,8 @@
 // Resolving the materials of a mesh's regions, and their text form.
 #include "core/material/region_materials.hpp"
 
+#include <algorithm>
+#include <array>
 #include <charconv>
 #include <cmath>
 #include <set>
@@ -32,6 +34,23 @@ std::string number_text(double value) {
   return {buffer, result.ptr};
 }
 
+constexpr std::array<MaterialProperty, 3> PROPERTIES{{
+    {"youngModulus", "young_modulus_pa", "Pa", &Material::young_modulus_pa},
+    {"poissonRatio", "poisson_ratio", "", &Material::poisson_ratio},
+    {"density", "density_kg_per_m3", "kg/m^3", &Material::density_kg_per_m3},
+}};
+
+// "youngModulus [Pa], poissonRatio, density [kg/m^3]".
+std::string property_keys_text() {
+  std::string text;
+  for (const MaterialProperty& property : PROPERTIES) {
+    if (!text.empty()) text += ", ";
+    text += std::string(property.key);
+    if (!property.unit.empty()) text += " [" + std::string(property.unit) + "]";
+  }
+  return text;
+}
+
 RegionMaterial parse_entry(std::string_view entry, const Material& base) {
   const auto fail = [&](const std::string& what) {
     throw ParameterError("material.regions: \"" + std::string(trimmed(entry)) + "\": " + what);
@@ -53,15 +72,10 @@ RegionMaterial parse_entry(std::string_view entry, const Material& base) {
       fail(key + ": \"" + std::string(value_text) + "\" is not a finite number");
     }
     if (!keys.insert(key).second) fail(key + " given twice");
-    if (key == "youngModulus") {
-      region.material.young_modulus_pa = value;
-    } else if (key == "poissonRatio") {
-      region.material.poisson_ratio = value;
-    } else if (key == "density") {
-      region.material.density_kg_per_m3 = value;
-    } else {
-      fail("unknown key \"" + key + "\" (youngModulus [Pa], poissonRatio, density [kg/m^3])");
-    }
+    const auto property =
+        std::find_if(PROPERTIES.begin(), PROPERTIES.end(), [&](const MaterialProperty& p) { return p.key == key; });
+    if (property == PROPERTIES.end()) fail("unknown key \"" + key + "\" (" + property_keys_text() + ")");
+    region.material.*(property->value) = value;
   }
   try {
     validate(region.material);
@@ -72,6 +86,8 @@ RegionMaterial parse_entry(std::string_view entry, const Material& base) {
 }
 
 }  // namespace
+
+std::span<const MaterialProperty> material_properties() { return PROPERTIES; }
 
 std::string quoted_region_names(const std::vector<MeshRegion>& regions) {
   std::string names;
@@ -133,9 +149,11 @@ std::string format_region_materials(const std::vector<RegionMaterial>& materials
   std::string text;
   for (const RegionMaterial& region : materials) {
     if (!text.empty()) text += "; ";
-    text += region.region + ": youngModulus=" + number_text(region.material.young_modulus_pa) +
-            ", poissonRatio=" + number_text(region.material.poisson_ratio) +
-            ", density=" + number_text(region.material.density_kg_per_m3);
+    text += region.region + ":";
+    for (const MaterialProperty& property : PROPERTIES) {
+      text += (&property == PROPERTIES.data() ? " " : ", ") + std::string(property.key) + "=" +
+              number_text(region.material.*(property.value));
+    }
   }
   return text;
 }

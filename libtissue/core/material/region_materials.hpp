@@ -8,6 +8,7 @@
 #include "core/material/material.hpp"
 
 #include <optional>
+#include <span>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -25,6 +26,18 @@ struct RegionMaterial {
   std::string region;
   Material material;
 };
+
+/// A material property a user sets by name: its key in the text form below (the FMU's), its SI name
+/// (the Python module's keyword), its unit for messages ("" for a ratio), and the member it sets.
+struct MaterialProperty {
+  std::string_view key;
+  std::string_view si_name;
+  std::string_view unit;
+  double Material::*value;
+};
+
+/// youngModulus [Pa], poissonRatio, density [kg/m^3]: the one list every front end sets them by.
+[[nodiscard]] std::span<const MaterialProperty> material_properties();
 
 /// The regions' names, quoted and comma separated, for messages: "skin", "tumour".
 std::string quoted_region_names(const std::vector<MeshRegion>& regions);
