@@ -13,6 +13,17 @@ target_compile_definitions(test_host_session PRIVATE TISSUE_SCENARIO_DIR="${PROJ
 add_dependencies(test_host_session tissue_fmu_package hapticloop_fmu_package)
 gtest_discover_tests(test_host_session PROPERTIES LABELS "host" DISCOVERY_TIMEOUT 60)
 
+# Palpation (issue 25): the palpation scenario's rendered force in its dwells against the full
+# model's quasi-static pokes of the same body (the test builds the tissue as the FMU does).
+add_executable(test_host_palpation ${CMAKE_CURRENT_LIST_DIR}/test_palpation.cpp)
+target_include_directories(test_host_palpation PRIVATE ${PROJECT_SOURCE_DIR}/tests)
+target_link_libraries(test_host_palpation PRIVATE tissue::host_session tissue_fmu_model GTest::gtest GTest::gtest_main
+                                                  tissue::warnings)
+target_compile_definitions(test_host_palpation PRIVATE TISSUE_SCENARIO_DIR="${PROJECT_SOURCE_DIR}/host/scenarios"
+                                                       TISSUE_FMU_DIR="${CMAKE_BINARY_DIR}/fmus")
+add_dependencies(test_host_palpation tissue_fmu_package hapticloop_fmu_package)
+gtest_discover_tests(test_host_palpation PROPERTIES LABELS "host" DISCOVERY_TIMEOUT 60 TIMEOUT 900)
+
 # The haptic thread allocates nothing (its own executable: it replaces operator new).
 add_executable(test_host_session_allocations ${CMAKE_CURRENT_LIST_DIR}/test_session_allocations.cpp)
 target_link_libraries(test_host_session_allocations PRIVATE tissue::host_session tissue_igtl_test_client GTest::gtest

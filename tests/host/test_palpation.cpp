@@ -1,0 +1,202 @@
+// Palpation (issue 25, part 2): host/scenarios/palpate_liver.toml's simulated hand presses a probe
+// 2 mm into the organ (meshes/liver_tumour.veg) straight down beside the stiff inclusion and holds,
+// then over it and holds, as a clinician palpates (the sweep that follows is for the figure). In each
+// dwell the normal force the haptic loop renders to the hand (the mean of the dwell's last 0.4 s in
+// log.csv) is compared with the full model's quasi-static poke (core/contact/quasi_static_poke.hpp)
+// of the same body, built as the Tissue FMU builds it (gravity included), to the same point: the
+// material point straight below at rest (what a press straight down holds: a bonded poke) pushed to
+// where the god-object holds it, the tool's position plus F / k (the contact spring's stretch). The
+// hand sags on its grip (F / 3000 N/m, 0.5-0.8 mm), which is why the target is where the tool was and
+// not where the script put it.
+//
+// What must hold: the normal force over the inclusion is larger than beside it by the ratio the
+// pokes predict (1.75 here), within 5 %, and each dwell's normal force is its poke's within 5 %.
+// Measured: 0.2 % beside, 2.4 % over, 2.2 % on the ratio. The 5 %: the god-object re-projects its
+// point to the closest one each step, so the held point slides part of the way towards the
+// frictionless equilibrium where the surface slopes (5-9 degrees at the two points), which the bonded
+// poke does not; the settled hand on the frog rests on the quasi-static force within 3.3 %
+// (test_session.cpp's HandDevice test); the dwells are 0.8 s. The frictionless poke is not used: on
+// this organ its slide did not converge in 60 iterations (13 minutes of CHOLMOD factorizations).
+#include "core/contact/quasi_static_poke.hpp"
+#include "core/tissue.hpp"
+#include "fmi3/value_store.hpp"
+#include "scenario/scenario.hpp"
+#include "session/session.hpp"
+#include "support/under_sanitizer.hpp"
+#include "tissue_fmu/tissue_model.hpp"
+#include "tissue_fmu/variables.hpp"
+
+#include <gtest/gtest.h>
+
+#include <Eigen/Core>
+
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <limits>
+#include <sstream>
+#include <string>
+#include <vector>
+
+namespace tissue::host {
+namespace {
+
+const std::filesystem::path SCENARIOS = TISSUE_SCENARIO_DIR;
+const std::filesystem::path FMUS = TISSUE_FMU_DIR;
+constexpr double SETTLED_WINDOW_S = 0.4;  // the end of each dwell the forces are averaged over
+constexpr double SHORTEST_DWELL_S = 0.6;
+
+struct LogRow {
+  double time_s = 0.0;
+  Eigen::Vector3d tool_m = Eigen::Vector3d::Zero();
+  Eigen::Vector3d force_n = Eigen::Vector3d::Zero();
+};
+
+std::vector<LogRow> read_log(const std::filesystem::path& file) {
+  std::ifstream log(file);
+  std::string line;
+  std::getline(log, line);  // header: time_s, device_xyz, tool_xyz, tool_mode, force_xyz, ...
+  std::vector<LogRow> rows;
+  while (std::getline(log, line)) {
+    std::vector<double> fields;
+    std::stringstream row(line);
+    for (std::string field; std::getline(row, field, ',');) fields.push_back(std::stod(field));
+    rows.push_back({fields.at(0), Eigen::Vector3d(fields.at(4), fields.at(5), fields.at(6)),
+                    Eigen::Vector3d(fields.at(8), fields.at(9), fields.at(10))});
+  }
+  return rows;
+}
+
+// Where the scripted path holds still in probe mode for SHORTEST_DWELL_S or longer: the end times.
+std::vector<double> dwell_ends_s(const DeviceConfig& device) {
+  std::vector<double> ends;
+  for (std::size_t k = 1; k < device.waypoints.size(); ++k) {
+    const Waypoint& a = device.waypoints[k - 1];
+    const Waypoint& b = device.waypoints[k];
+    if (a.mode == ToolMode::probe && b.mode == ToolMode::probe && a.position == b.position &&
+        b.time_s - a.time_s >= SHORTEST_DWELL_S) {
+      ends.push_back(b.time_s);
+    }
+  }
+  return ends;
+}
+
+struct Dwell {
+  Eigen::Vector3d tool_m = Eigen::Vector3d::Zero();
+  Eigen::Vector3d force_n = Eigen::Vector3d::Zero();
+};
+
+Dwell settled(const std::vector<LogRow>& rows, double end_s) {
+  Dwell mean;
+  int count = 0;
+  for (const LogRow& row : rows) {
+    if (row.time_s < end_s - SETTLED_WINDOW_S || row.time_s >= end_s) continue;
+    mean.tool_m += row.tool_m;
+    mean.force_n += row.force_n;
+    ++count;
+  }
+  EXPECT_GT(count, 0) << "no log rows before " << end_s << " s";
+  mean.tool_m /= std::max(count, 1);
+  mean.force_n /= std::max(count, 1);
+  return mean;
+}
+
+// The scenario's tissue as the Tissue FMU builds it. Only the mesh is taken from the scenario's
+// parameters: the test checks that the others cannot change the static equilibrium.
+std::unique_ptr<Tissue> scenario_tissue(const Scenario& scenario) {
+  const fmi3::ModelDescription& description = tissue_fmu::tissue_model_description();
+  fmi3::ValueStore values(description);
+  values.set_starts();
+  for (const ParameterSetting& p : scenario.tissue_parameters) {
+    if (p.name == "mesh") {
+      const char* path = std::get<std::string>(p.value).c_str();
+      values.write<const char*>(*description.find("mesh"), std::span<const char* const>(&path, 1));
+    } else {
+      EXPECT_TRUE(p.name == "stepSize" || p.name.starts_with("integrator.") ||
+                  p.name == "contact.stiffnessInBackground") << p.name << " may change the statics";
+    }
+  }
+  return tissue_fmu::make_tissue(values, scenario.file.parent_path().string());
+}
+
+// The material point of the top surface straight below `point_m` at rest (the vertical line through it
+// meets the upward-facing triangle there): the point a probe pressed straight down holds.
+SurfacePoint point_below(const Tissue& tissue, const Eigen::Vector3d& point_m) {
+  const Eigen::VectorXd& x = tissue.current_positions_m();
+  const SurfaceTriangles& triangles = tissue.surface().triangles;
+  SurfacePoint best;
+  double best_height_m = -std::numeric_limits<double>::infinity();
+  for (std::size_t t = 0; t < triangles.size(); ++t) {
+    const Eigen::Vector3d a = x.segment<3>(3 * triangles[t][0]);
+    const Eigen::Vector3d b = x.segment<3>(3 * triangles[t][1]);
+    const Eigen::Vector3d c = x.segment<3>(3 * triangles[t][2]);
+    if ((b - a).cross(c - a).z() <= 0.0) continue;  // facing down or vertical
+    // Barycentric coordinates of (x, y) in the triangle's projection on the horizontal plane.
+    Eigen::Matrix2d edges;
+    edges << (b - a).head<2>(), (c - a).head<2>();
+    const Eigen::Vector2d beta = edges.inverse() * (point_m - a).head<2>();
+    const Eigen::Vector3d barycentric(1.0 - beta.sum(), beta.x(), beta.y());
+    if (barycentric.minCoeff() < 0.0) continue;
+    const double height_m = barycentric.x() * a.z() + barycentric.y() * b.z() + barycentric.z() * c.z();
+    if (height_m > best_height_m) {
+      best_height_m = height_m;
+      best = SurfacePoint{static_cast<int>(t), barycentric};
+    }
+  }
+  EXPECT_GE(best.triangle, 0) << "no surface above or below (" << point_m.transpose() << ")";
+  return best;
+}
+
+TEST(Palpation, TheHandFeelsTheInclusionByTheRatioTheQuasiStaticPokesPredict) {
+  if (test::UNDER_SANITIZER) GTEST_SKIP() << "the 52k-tet organ takes minutes under a sanitizer";
+  Scenario scenario = load_scenario(SCENARIOS / "palpate_liver.toml");
+  const std::vector<double> ends = dwell_ends_s(scenario.device);
+  ASSERT_EQ(ends.size(), 2u) << "the scenario dwells beside the inclusion, then over it";
+  scenario.duration_s = ends.back() + 0.1;  // the sweep that follows is the figure's, not this test's
+
+  const std::filesystem::path dir = std::filesystem::temp_directory_path() / "tissue_host_test_palpation";
+  std::filesystem::remove_all(dir);
+  SessionOptions options;
+  options.offline = true;
+  options.output_dir = dir;
+  options.fmu_dir = FMUS;
+  const SessionSummary summary = run_session(scenario, options);
+  ASSERT_EQ(summary.tissue_errors, 0u) << summary.first_error;
+  ASSERT_FALSE(summary.nan_detected);
+  const std::vector<LogRow> rows = read_log(dir / "log.csv");
+
+  const std::unique_ptr<Tissue> tissue = scenario_tissue(scenario);
+  const double spring_n_per_m = tissue->contact_spring_stiffness_n_per_m();
+  std::vector<double> rendered, predicted;  // normal forces [N]
+  for (const double end_s : ends) {
+    const Dwell dwell = settled(rows, end_s);
+    const Eigen::Vector3d held_m = dwell.tool_m + dwell.force_n / spring_n_per_m;
+    DeformableBody body(tissue->body().mesh(), tissue->settings().body);
+    QuasiStaticPokeSettings poke_settings;
+    poke_settings.force_tolerance = 1e-8;
+    poke_settings.friction = PokeFriction::bonded;
+    const QuasiStaticPoke poke =
+        quasi_static_poke(body, tissue->surface().triangles, point_below(*tissue, held_m), held_m, poke_settings);
+    ASSERT_TRUE(poke.converged) << "the poke to (" << held_m.transpose() << ") m";
+    rendered.push_back(dwell.force_n.dot(poke.normal));
+    predicted.push_back(poke.force_on_tool_n.dot(poke.normal));
+    std::printf("  dwell ending %.2f s at (%.2f, %.2f, %.2f) mm: rendered (%.3f, %.3f, %.3f) N, poke (%.3f, %.3f, %.3f) N; "
+                "normal %.4f N against %.4f N\n",
+                end_s, 1e3 * held_m.x(), 1e3 * held_m.y(), 1e3 * held_m.z(), dwell.force_n.x(), dwell.force_n.y(),
+                dwell.force_n.z(), poke.force_on_tool_n.x(), poke.force_on_tool_n.y(), poke.force_on_tool_n.z(),
+                rendered.back(), predicted.back());
+  }
+  // [0] beside the inclusion, [1] over it.
+  const double rendered_ratio = rendered[1] / rendered[0];
+  const double predicted_ratio = predicted[1] / predicted[0];
+  std::printf("  over / beside: rendered %.3f, quasi-static pokes %.3f\n", rendered_ratio, predicted_ratio);
+  EXPECT_GT(predicted_ratio, 1.5) << "the inclusion is ten times stiffer: it must be felt";
+  EXPECT_NEAR(rendered_ratio, predicted_ratio, 0.05 * predicted_ratio);
+  for (std::size_t k = 0; k < rendered.size(); ++k) {
+    EXPECT_NEAR(rendered[k], predicted[k], 0.05 * predicted[k]) << (k == 0 ? "beside" : "over");
+  }
+}
+
+}  // namespace
+}  // namespace tissue::host
