@@ -114,7 +114,8 @@ std::unique_ptr<Tissue> scenario_tissue(const Scenario& scenario) {
       values.write<const char*>(*description.find("mesh"), std::span<const char* const>(&path, 1));
     } else {
       EXPECT_TRUE(p.name == "stepSize" || p.name.starts_with("integrator.") ||
-                  p.name == "contact.stiffnessInBackground") << p.name << " may change the statics";
+                  p.name == "contact.stiffnessInBackground")
+          << p.name << " may change the statics";
     }
   }
   return tissue_fmu::make_tissue(values, scenario.file.parent_path().string());
@@ -181,11 +182,12 @@ TEST(Palpation, TheHandFeelsTheInclusionByTheRatioTheQuasiStaticPokesPredict) {
     ASSERT_TRUE(poke.converged) << "the poke to (" << held_m.transpose() << ") m";
     rendered.push_back(dwell.force_n.dot(poke.normal));
     predicted.push_back(poke.force_on_tool_n.dot(poke.normal));
-    std::printf("  dwell ending %.2f s at (%.2f, %.2f, %.2f) mm: rendered (%.3f, %.3f, %.3f) N, poke (%.3f, %.3f, %.3f) N; "
-                "normal %.4f N against %.4f N\n",
-                end_s, 1e3 * held_m.x(), 1e3 * held_m.y(), 1e3 * held_m.z(), dwell.force_n.x(), dwell.force_n.y(),
-                dwell.force_n.z(), poke.force_on_tool_n.x(), poke.force_on_tool_n.y(), poke.force_on_tool_n.z(),
-                rendered.back(), predicted.back());
+    std::printf(
+        "  dwell ending %.2f s at (%.2f, %.2f, %.2f) mm: rendered (%.3f, %.3f, %.3f) N, poke (%.3f, %.3f, %.3f) N; "
+        "normal %.4f N against %.4f N\n",
+        end_s, 1e3 * held_m.x(), 1e3 * held_m.y(), 1e3 * held_m.z(), dwell.force_n.x(), dwell.force_n.y(),
+        dwell.force_n.z(), poke.force_on_tool_n.x(), poke.force_on_tool_n.y(), poke.force_on_tool_n.z(),
+        rendered.back(), predicted.back());
   }
   // [0] beside the inclusion, [1] over it.
   const double rendered_ratio = rendered[1] / rendered[0];
