@@ -79,6 +79,7 @@ struct Options {
   double young_modulus_pa = 1e5;
   double poisson_ratio = 0.4;
   double density_kg_per_m3 = 1000.0;
+  std::string material_model = "corotationalLinear";  // or "stableNeoHookean"
   double damping_alpha_per_s = 1.0;
   double damping_beta_s = 1e-3;
   std::array<double, 3> gravity_m_per_s2{0.0, 0.0, -9.81};
@@ -132,6 +133,7 @@ class PyTissue {
     BodySettings& body = settings.body;
     body.material = Material{options.young_modulus_pa, options.poisson_ratio, options.density_kg_per_m3};
     body.region_materials = region_materials(options.regions, body.material);
+    body.material_model = parse_material_model(options.material_model);
     body.damping = RayleighDamping{options.damping_alpha_per_s, options.damping_beta_s};
     body.gravity_m_per_s2 = to_vector3(options.gravity_m_per_s2);
     if (options.fixed_vertices) {
@@ -435,7 +437,8 @@ PYBIND11_MODULE(tissue, m) {
       .def(py::init([](const std::string& mesh, std::optional<std::array<int, 3>> box, double box_edge_m,
                        std::optional<std::vector<int>> fixed_vertices, int fixed_axis, double fixed_fraction,
                        double young_modulus_pa, double poisson_ratio, double density_kg_per_m3,
-                       double damping_alpha_per_s, double damping_beta_s, std::array<double, 3> gravity_m_per_s2,
+                       const std::string& material_model, double damping_alpha_per_s, double damping_beta_s,
+                       std::array<double, 3> gravity_m_per_s2,
                        double step_size_s, const std::string& integrator, const std::string& linear_solver,
                        double pcg_tolerance, int pcg_max_iterations, int threads, bool contact, bool cutting,
                        double blade_length_m, double probe_radius_m, const std::string& render_surface,
@@ -450,6 +453,7 @@ PYBIND11_MODULE(tissue, m) {
              o.young_modulus_pa = young_modulus_pa;
              o.poisson_ratio = poisson_ratio;
              o.density_kg_per_m3 = density_kg_per_m3;
+             o.material_model = material_model;
              o.damping_alpha_per_s = damping_alpha_per_s;
              o.damping_beta_s = damping_beta_s;
              o.gravity_m_per_s2 = gravity_m_per_s2;
@@ -471,6 +475,7 @@ PYBIND11_MODULE(tissue, m) {
            py::arg("fixed_vertices") = py::none(), py::arg("fixed_axis") = d.fixed_axis,
            py::arg("fixed_fraction") = d.fixed_fraction, py::arg("young_modulus_pa") = d.young_modulus_pa,
            py::arg("poisson_ratio") = d.poisson_ratio, py::arg("density_kg_per_m3") = d.density_kg_per_m3,
+           py::arg("material_model") = d.material_model,
            py::arg("damping_alpha_per_s") = d.damping_alpha_per_s, py::arg("damping_beta_s") = d.damping_beta_s,
            py::arg("gravity_m_per_s2") = d.gravity_m_per_s2, py::arg("step_size_s") = d.step_size_s,
            py::arg("integrator") = d.integrator, py::arg("linear_solver") = d.linear_solver,

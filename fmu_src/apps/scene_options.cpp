@@ -2,6 +2,7 @@
 #include "apps/scene_options.hpp"
 
 #include "core/fixed_region.hpp"
+#include "core/material/material.hpp"
 #include "core/mesh/mesh_io.hpp"
 #include "resources/default_mesh.hpp"
 
@@ -68,6 +69,9 @@ void add_scene_options(CLI::App& app, SceneOptions& options) {
   app.add_option("--young", options.material.young_modulus_pa, "Young's modulus [Pa]")->capture_default_str();
   app.add_option("--poisson", options.material.poisson_ratio, "Poisson's ratio")->capture_default_str();
   app.add_option("--density", options.material.density_kg_per_m3, "Density [kg/m^3]")->capture_default_str();
+  app.add_option("--material-model", options.material_model,
+                 "Elasticity: corotationalLinear or stableNeoHookean (Smith, de Goes and Kim 2018)")
+      ->capture_default_str();
   app.add_flag("--single-material", options.single_material,
                "Ignore the mesh file's regions and materials (Vega *REGION, Gmsh physical groups, TetGen region "
                "attributes): --young, --poisson, --density everywhere");
@@ -99,6 +103,7 @@ Scene make_scene(const SceneOptions& options) {
   settings.solver.refresh = options.refresh;
   settings.solver.warm_start = options.warm_start;
   settings.body.material = options.material;
+  settings.body.material_model = parse_material_model(options.material_model);
   settings.body.damping = options.damping;
   if (!options.large_turn_protection) {
     settings.integrator.newton.trigger_angle_rad = std::numeric_limits<double>::infinity();

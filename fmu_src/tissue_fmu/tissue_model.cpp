@@ -49,6 +49,10 @@ IdaLinearSolverKind ida_linear_solver(std::int64_t item) {
   return item == 1 ? IdaLinearSolverKind::klu : IdaLinearSolverKind::krylov;
 }
 
+MaterialModel material_model(std::int64_t item) {
+  return item == 1 ? MaterialModel::corotational_linear : MaterialModel::stable_neo_hookean;
+}
+
 ContactStiffnessModel stiffness_model(std::int64_t item) {
   return item == 1 ? ContactStiffnessModel::effective_static : ContactStiffnessModel::element_local;
 }
@@ -61,6 +65,7 @@ TissueSettings tissue_settings(const ValueStore& values, const TetMesh* mesh) {
   s.body.material.poisson_ratio = values.float64(vr(Vr::poisson_ratio));
   s.body.material.density_kg_per_m3 = values.float64(vr(Vr::density));
   s.body.region_materials = parse_region_materials(values.string(vr(Vr::material_regions)), s.body.material);
+  s.body.material_model = material_model(values.int64(vr(Vr::material_model)));
   s.body.damping.mass_damping_per_s = values.float64(vr(Vr::damping_alpha));
   s.body.damping.stiffness_damping_s = values.float64(vr(Vr::damping_beta));
   const std::span<const double> gravity = values.float64_array(vr(Vr::gravity));

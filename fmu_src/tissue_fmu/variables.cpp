@@ -33,9 +33,16 @@ constexpr auto CONTACT_STIFFNESS_ITEMS = std::to_array<EnumerationItem>({
      "Stiffness of the whole constrained body at the contact point (static condensation; the reference)"},
     {"elementLocal", 2, "Stiffness of the contacted tetrahedron alone (cheap, approximate)"},
 });
+constexpr auto MATERIAL_MODEL_ITEMS = std::to_array<EnumerationItem>({
+    {"corotationalLinear", 1, "Co-rotational linear elasticity (the dissertation's; one linear solve a step)"},
+    {"stableNeoHookean", 2,
+     "Stable Neo-Hookean hyperelasticity (Smith, de Goes and Kim 2018): inversion-safe, its tangent projected to "
+     "positive semi-definite per element"},
+});
 constexpr auto TOOL_MODE_ITEMS = ports::tool_mode_items();
 const auto ENUMERATIONS = std::to_array<EnumerationType>({
     {"LinearSolver", "Linear solver of the backward-Euler step", LINEAR_SOLVER_ITEMS},
+    {"MaterialModel", "Elasticity of the tissue", MATERIAL_MODEL_ITEMS},
     {"ContactStiffnessModel", "How the 3x3 contact stiffness K_c is computed", CONTACT_STIFFNESS_ITEMS},
     {"Integrator", "Time integrator of the tissue", INTEGRATOR_ITEMS},
     {"IdaLinearSolver", "Linear solver of IDA's Newton iteration", IDA_LINEAR_SOLVER_ITEMS},

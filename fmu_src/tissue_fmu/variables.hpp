@@ -92,6 +92,7 @@ enum class Vr : std::uint32_t {
   contact_stiffness_in_background = 80,  // issue 23
   sample_time = 81,                      // issue 24: for masters that cannot connect `time`
   material_regions = 82,                 // issue 25
+  material_model = 83,                   // issue 25
   tool_applied_position = ports::sample_field("tool.appliedPosition").tissue_vr
 };
 
@@ -99,7 +100,8 @@ namespace variables_detail {
 // The table in parts, one kind of variable each, in value-reference order within each; own_variables()
 // merges them (fmi3::merged: by value reference).
 
-/// The body: mesh, material, damping, gravity, the fixed region (value references 1-9), the regions' materials (82).
+/// The body: mesh, material, damping, gravity, the fixed region (value references 1-9), the regions'
+/// materials (82), the material model (83).
 constexpr auto body_parameters() {
   using namespace fmi3;  // NOLINT(google-build-using-namespace): the table reads as the XML
   using enum VariableType;
@@ -112,7 +114,7 @@ constexpr auto body_parameters() {
     parameter(Vr::young_modulus, "material.youngModulus", float64)
         .unit("Pa")
         .start("1e5")
-        .describe("Young's modulus E of the co-rotational linear material; must be > 0"),
+        .describe("Young's modulus E (of either material.model); must be > 0"),
     parameter(Vr::poisson_ratio, "material.poissonRatio", float64)
         .unit("1")
         .start("0.4")
@@ -155,6 +157,11 @@ constexpr auto body_parameters() {
                   "numbers), replacing the file's: \"name: youngModulus=1e6, poissonRatio=0.45, density=1050; "
                   "name2: ...\"; a key left out takes material.*. A region neither the file nor this gives a "
                   "material has material.*. \"none\": none"),
+    parameter(Vr::material_model, "material.model", enumeration)
+        .declared_type("MaterialModel")
+        .start("1")
+        .describe("Elasticity of every region: co-rotational linear (the default) or stable Neo-Hookean "
+                  "(hyperelastic, inversion-safe; Smith, de Goes and Kim 2018), with the same E and nu"),
 });
 }
 

@@ -84,6 +84,7 @@ CompareRow make_row(const RunSpec& run, const RunOutcome& outcome, const ModelDe
   row.setting = run.setting;
   row.integrator = d.integrator;
   row.linear_solver = d.linear_solver;
+  row.material_model = d.material_model;
   row.tolerance = d.tolerance;
   row.iteration_cap = d.iteration_cap;
   row.internal_step_s = run.step_s;

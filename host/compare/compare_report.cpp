@@ -56,6 +56,7 @@ std::string json_document(const CompareReport& report) {
     rows.push_back({{"setting", r.setting},
                     {"integrator", r.integrator},
                     {"linear_solver", r.linear_solver},
+                    {"material_model", r.material_model},
                     {"tolerance", json_value(r.tolerance)},
                     {"iteration_cap", json_value(r.iteration_cap)},
                     {"internal_step_s", r.internal_step_s},

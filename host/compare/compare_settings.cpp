@@ -1,6 +1,7 @@
 // The settings of tissue-host compare (see compare_settings.hpp).
 #include "compare/compare_settings.hpp"
 
+#include "compare/compare_table.hpp"
 #include "scenario/parameter_table.hpp"
 
 #include <algorithm>
@@ -215,7 +216,7 @@ std::optional<double> value_number(const std::vector<ParameterSetting>& paramete
 
 }  // namespace
 
-std::string SettingDescription::family() const { return integrator + "/" + linear_solver; }
+std::string SettingDescription::family() const { return setting_family(integrator, linear_solver, material_model); }
 
 CompareSettingsList default_settings() {
   CompareSettingsList list;
@@ -363,6 +364,7 @@ std::vector<RunSpec> plan_runs(const CompareSettingsList& list, const Scenario& 
 SettingDescription describe_setting(const std::vector<ParameterSetting>& parameters, const ModelDescription& tissue) {
   SettingDescription d;
   d.integrator = value_text(parameters, "integrator.method", tissue).value_or("backwardEuler");
+  d.material_model = value_text(parameters, "material.model", tissue).value_or("corotationalLinear");
   if (d.integrator == "ida") {
     d.linear_solver = value_text(parameters, "integrator.idaLinearSolver", tissue).value_or("klu");
     d.tolerance = value_number(parameters, "integrator.idaRelativeTolerance", tissue);

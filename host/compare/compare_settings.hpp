@@ -61,6 +61,7 @@ struct SettingDescription {
   std::string linear_solver;                  ///< item of integrator.linearSolver or integrator.idaLinearSolver
   std::optional<double> tolerance;            ///< PCG tolerance or IDA relative tolerance
   std::optional<std::int64_t> iteration_cap;  ///< PCG's iteration cap
+  std::string material_model = "corotationalLinear";  ///< item of material.model
   [[nodiscard]] std::string family() const;   ///< "backwardEuler/pcg", for the plot's colours
 };
 

@@ -9,7 +9,7 @@
 namespace tissue::host {
 namespace {
 
-constexpr std::size_t COLUMNS = 15;
+constexpr std::size_t COLUMNS = 16;
 
 void append_number(std::string& line, double value) {
   char buffer[32];
@@ -84,15 +84,24 @@ std::optional<T> parse_optional(const std::string& field, const char* column) {
 
 }  // namespace
 
+std::string setting_family(const std::string& integrator, const std::string& linear_solver,
+                           const std::string& material_model) {
+  std::string family = integrator + "/" + linear_solver;
+  if (!material_model.empty() && material_model != "corotationalLinear") family += "/" + material_model;
+  return family;
+}
+
 bool CompareRow::comparable() const { return rms_error_m && cpu_s_per_sim_s && failures == 0; }
 
 std::string csv_header() {
-  return "setting,integrator,linear_solver,tolerance,iteration_cap,internal_step_s,cpu_s_per_sim_s,rms_error_m,"
+  return "setting,integrator,linear_solver,material_model,tolerance,iteration_cap,internal_step_s,cpu_s_per_sim_s,rms_"
+         "error_m,"
          "max_error_m,force_error_n,energy_drift_j,iterations,failures,pareto,note";
 }
 
 std::string csv_row(const CompareRow& row) {
-  std::string line = quoted(row.setting) + ',' + quoted(row.integrator) + ',' + quoted(row.linear_solver);
+  std::string line = quoted(row.setting) + ',' + quoted(row.integrator) + ',' + quoted(row.linear_solver) + ',' +
+                     quoted(row.material_model);
   append_optional(line, row.tolerance);
   append_optional(line, row.iteration_cap);
   append_optional(line, std::optional<double>(row.internal_step_s));
@@ -118,18 +127,19 @@ CompareRow parse_csv_row(std::string_view line) {
   row.setting = f[0];
   row.integrator = f[1];
   row.linear_solver = f[2];
-  row.tolerance = parse_optional<double>(f[3], "tolerance");
-  row.iteration_cap = parse_optional<std::int64_t>(f[4], "iteration_cap");
-  row.internal_step_s = parse_number<double>(f[5], "internal_step_s");
-  row.cpu_s_per_sim_s = parse_optional<double>(f[6], "cpu_s_per_sim_s");
-  row.rms_error_m = parse_optional<double>(f[7], "rms_error_m");
-  row.max_error_m = parse_optional<double>(f[8], "max_error_m");
-  row.force_error_n = parse_optional<double>(f[9], "force_error_n");
-  row.energy_drift_j = parse_optional<double>(f[10], "energy_drift_j");
-  row.iterations = parse_optional<std::uint64_t>(f[11], "iterations");
-  row.failures = parse_number<std::uint64_t>(f[12], "failures");
-  row.pareto = f[13] == "1";
-  row.note = f[14];
+  row.material_model = f[3];
+  row.tolerance = parse_optional<double>(f[4], "tolerance");
+  row.iteration_cap = parse_optional<std::int64_t>(f[5], "iteration_cap");
+  row.internal_step_s = parse_number<double>(f[6], "internal_step_s");
+  row.cpu_s_per_sim_s = parse_optional<double>(f[7], "cpu_s_per_sim_s");
+  row.rms_error_m = parse_optional<double>(f[8], "rms_error_m");
+  row.max_error_m = parse_optional<double>(f[9], "max_error_m");
+  row.force_error_n = parse_optional<double>(f[10], "force_error_n");
+  row.energy_drift_j = parse_optional<double>(f[11], "energy_drift_j");
+  row.iterations = parse_optional<std::uint64_t>(f[12], "iterations");
+  row.failures = parse_number<std::uint64_t>(f[13], "failures");
+  row.pareto = f[14] == "1";
+  row.note = f[15];
   return row;
 }
 

@@ -14,9 +14,15 @@
 
 namespace tissue::host {
 
+/// The plot's series of a setting: "integrator/linear solver", and "/stableNeoHookean" when the
+/// material model is not the default co-rotational linear one.
+[[nodiscard]] std::string setting_family(const std::string& integrator, const std::string& linear_solver,
+                                         const std::string& material_model);
+
 struct CompareRow {
   std::string setting;  ///< "reference" for the reference run
   std::string integrator, linear_solver;
+  std::string material_model = "corotationalLinear";  ///< item of material.model
   std::optional<double> tolerance;
   std::optional<std::int64_t> iteration_cap;
   double internal_step_s = 0.0;
@@ -30,7 +36,7 @@ struct CompareRow {
   [[nodiscard]] bool is_reference() const { return setting == "reference"; }
   /// Has an error and a cost, and no failed step: a candidate for the front and the recommendations.
   [[nodiscard]] bool comparable() const;
-  [[nodiscard]] std::string family() const { return integrator + "/" + linear_solver; }
+  [[nodiscard]] std::string family() const { return setting_family(integrator, linear_solver, material_model); }
 };
 
 /// The header line of compare.csv (no newline).

@@ -172,13 +172,13 @@ TEST(CompareTable, MissingValuesAreEmptyFields) {
   row.linear_solver = "cholmod";
   row.internal_step_s = 0.01;
   const std::string line = csv_row(row);
-  EXPECT_EQ(line, "be-cholmod,backwardEuler,cholmod,,,0.01,,,,,,,0,0,");
+  EXPECT_EQ(line, "be-cholmod,backwardEuler,cholmod,corotationalLinear,,,0.01,,,,,,,0,0,");
   const CompareRow back = parse_csv_row(line);
   EXPECT_FALSE(back.tolerance);
   EXPECT_FALSE(back.rms_error_m);
   EXPECT_FALSE(back.comparable());
   EXPECT_THROW((void)parse_csv_row("a,b,c"), std::runtime_error);
-  EXPECT_THROW((void)parse_csv_row("a,b,c,x,,0.01,,,,,,,0,0,"), std::runtime_error);
+  EXPECT_THROW((void)parse_csv_row("a,b,c,d,x,,0.01,,,,,,,0,0,"), std::runtime_error);
 }
 
 // --- recommendations ---
@@ -342,6 +342,29 @@ steps = [0.005]
   EXPECT_EQ(runs[3].step_s, 0.005);
   EXPECT_EQ(describe_setting(runs[3].parameters, tissue_like(false)).linear_solver, "cholmod");  // 2 = cholmod
   EXPECT_EQ(describe_setting(runs[1].parameters, tissue_like(false)).iteration_cap, 5);
+}
+
+// A setting's material model (issue 25): read from material.model (co-rotational when not set), in
+// the row's family (the plot's series) only when it is Neo-Hookean, and kept by the CSV.
+TEST(CompareSettings, TheMaterialModelIsPartOfTheSettingsFamily) {
+  const std::vector<ParameterSetting> neo_hookean{{"material.model", std::string("stableNeoHookean")},
+                                                  {"integrator.linearSolver", std::string("cholmod")}};
+  const SettingDescription d = describe_setting(neo_hookean, tissue_like(true));
+  EXPECT_EQ(d.material_model, "stableNeoHookean");
+  EXPECT_EQ(d.family(), "backwardEuler/cholmod/stableNeoHookean");
+  const SettingDescription plain =
+      describe_setting({{"integrator.linearSolver", std::string("cholmod")}}, tissue_like(true));
+  EXPECT_EQ(plain.material_model, "corotationalLinear");
+  EXPECT_EQ(plain.family(), "backwardEuler/cholmod");
+  CompareRow row;
+  row.setting = "snh";
+  row.integrator = "backwardEuler";
+  row.linear_solver = "cholmod";
+  row.material_model = "stableNeoHookean";
+  row.internal_step_s = 0.01;
+  const CompareRow back = parse_csv_row(csv_row(row));
+  EXPECT_EQ(back.material_model, "stableNeoHookean");
+  EXPECT_EQ(back.family(), "backwardEuler/cholmod/stableNeoHookean");
 }
 
 void expect_refused(const std::string& compare_table, const Scenario& scenario, const std::string& says) {

@@ -30,10 +30,10 @@ const std::filesystem::path SCENARIOS = TISSUE_COMPARE_TEST_DIR;
 const std::filesystem::path FMUS = TISSUE_FMU_DIR;
 const std::filesystem::path TISSUE_HOST = TISSUE_HOST_EXECUTABLE;
 
-const std::vector<std::string> COLUMNS{
-    "setting",         "integrator",      "linear_solver", "tolerance",   "iteration_cap",
-    "internal_step_s", "cpu_s_per_sim_s", "rms_error_m",   "max_error_m", "force_error_n",
-    "energy_drift_j",  "iterations",      "failures",      "pareto",      "note"};
+const std::vector<std::string> COLUMNS{"setting",     "integrator",    "linear_solver",   "material_model",
+                                       "tolerance",   "iteration_cap", "internal_step_s", "cpu_s_per_sim_s",
+                                       "rms_error_m", "max_error_m",   "force_error_n",   "energy_drift_j",
+                                       "iterations",  "failures",      "pareto",          "note"};
 // The columns that must not depend on threads or processes (CPU time does).
 const std::vector<std::string> REPRODUCIBLE{"setting",       "internal_step_s", "rms_error_m", "max_error_m",
                                             "force_error_n", "energy_drift_j",  "iterations",  "failures"};

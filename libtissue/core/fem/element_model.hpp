@@ -19,6 +19,14 @@ namespace tissue {
 
 /// The body's material model and, per material, what it needs.
 struct ElementModel {
+  /// Stable Neo-Hookean's projected tangent at F = R is exactly the co-rotational one, R K_e R^T with
+  /// the same Lame parameters (its twist modes have eigenvalue 0, its flip and scaling modes are
+  /// linear elasticity's 2 mu and 2 mu I + lambda 1 1^T: docs/DESIGN.md). Where the stretch R^T F is
+  /// within this of I (Frobenius), the tangent is taken from there: off by O(strain) relatively, as the
+  /// co-rotational tangent omits dR/du, while the forces stay Neo-Hookean's (so do equilibria). It
+  /// halves the Neo-Hookean step on a body near rest (docs/BENCHMARKS.md).
+  static constexpr double NEAR_REST_STRAIN = 0.01;
+
   MaterialModel model = MaterialModel::corotational_linear;
   std::vector<LameParameters> lame;           // per material
   std::vector<StableNeoHookean> neo_hookean;  // per material
@@ -43,14 +51,13 @@ struct ElementModel {
     return corotated_forces(rest, rotation, f, lame_of(rest));
   }
 
-  /// The tangent's blocks (i, j), i <= j, at [4 i + j] (block (j, i) is its transpose). [N/m]
+  /// The tangent's blocks (i, j), i <= j, at [4 i + j] (block (j, i) is its transpose); Neo-Hookean's
+  /// near rest is the co-rotational one (NEAR_REST_STRAIN). [N/m]
   void blocks(const TetRest& rest, const Eigen::Matrix3d& rotation, const Eigen::Matrix3d& f,
               std::array<Eigen::Matrix3d, 16>& out) const {
-    if (model == MaterialModel::stable_neo_hookean) {
-      const Matrix12d k = neo_hookean_stiffness(rest, neo_hookean_of(rest), f, true);
-      for (int i = 0; i < 4; ++i) {
-        for (int j = i; j < 4; ++j) out[static_cast<size_t>(4 * i + j)] = k.block<3, 3>(3 * i, 3 * j);
-      }
+    if (model == MaterialModel::stable_neo_hookean &&
+        (rotation.transpose() * f - Eigen::Matrix3d::Identity()).norm() > NEAR_REST_STRAIN) {
+      neo_hookean_projected_blocks(rest, neo_hookean_of(rest), f, out);
       return;
     }
     const Eigen::Matrix<double, 3, 4> c = rotation * rest.shape_gradients_per_m;  // rotated shape gradients

@@ -19,6 +19,8 @@
 
 #include <Eigen/Core>
 
+#include <array>
+
 namespace tissue {
 
 using Matrix9d = Eigen::Matrix<double, 9, 9>;
@@ -40,9 +42,23 @@ double neo_hookean_energy_density(const StableNeoHookean& material, const Eigen:
 Eigen::Matrix3d neo_hookean_stress(const StableNeoHookean& material, const Eigen::Matrix3d& f);
 
 /// dP/dF (9 x 9, vec(F) column-major: index 3 * column + row); `project`: negative eigenvalues set
-/// to zero (the projection onto the positive semi-definite cone, per element; nothing to do, and not done,
-/// where dP/dF is positive definite).
+/// to zero (the projection onto the positive semi-definite cone, per element), as
+/// neo_hookean_projected_stress_derivative.
 Matrix9d neo_hookean_stress_derivative(const StableNeoHookean& material, const Eigen::Matrix3d& f, bool project);
+
+/// dP/dF projected onto the positive semi-definite cone from its eigensystem in closed form (Smith, de
+/// Goes and Kim 2018, section 4.2; derived in docs/DESIGN.md): with the rotation-variant SVD
+/// F = U diag(sigma) V^T, six twist and flip modes U (e_i e_k^T -/+ e_k e_i^T) V^T / sqrt 2 with
+/// eigenvalues a +/- lambda' (J - alpha) sigma_l (a = mu' (1 - 1/(I_C + 1)), l the third axis), and
+/// three scaling modes U diag(d) V^T, d the eigenvectors of a 3 x 3 matrix; negative ones dropped. One
+/// 3 x 3 SVD and a 3 x 3 eigensolve instead of a 9 x 9 one.
+Matrix9d neo_hookean_projected_stress_derivative(const StableNeoHookean& material, const Eigen::Matrix3d& f);
+
+/// The projected element tangent's blocks K_ij = d f_i / d x_j, i <= j, at [4 i + j] (block (j, i) is
+/// the transpose), straight from the closed-form modes applied to the shape gradients, without the
+/// 9 x 9 dP/dF: what the body's assembly takes. [N/m]
+void neo_hookean_projected_blocks(const TetRest& rest, const StableNeoHookean& material, const Eigen::Matrix3d& f,
+                                  std::array<Eigen::Matrix3d, 16>& out);
 
 /// Internal forces (3 x 4, column i acts on vertex i, the restoring force of M a + f_int = f_ext as
 /// the co-rotational kernel's): V P g_i. [N]
