@@ -220,7 +220,7 @@ PlotFrame plot_frame(const Drawing& d, const LogLogPlot& plot) {
   const std::array<Decades, 2> axes = axis_decades(plot);
   double legend_width = d.text_width(plot.front_name, LABEL_SIZE);
   for (const std::string& name : plot.series) legend_width = std::max(legend_width, d.text_width(name, LABEL_SIZE));
-  legend_width = std::min(legend_width + 40.0, plot.width / 3.0);
+  legend_width = std::min(legend_width + 40.0, 0.4 * plot.width);
   double y_labels = 0.0;
   for (int e = axes[1].first; e <= axes[1].last; ++e) y_labels = std::max(y_labels, d.text_width(decade_label(e), LABEL_SIZE));
   PlotFrame frame;
