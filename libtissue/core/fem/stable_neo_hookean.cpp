@@ -140,21 +140,22 @@ Eigensystem eigensystem(const StableNeoHookean& material, const Eigen::Matrix3d&
   return e;
 }
 
-// The projected dP/dF as Q Q^T: Q's columns are the modes with positive eigenvalues, as 3 x 3 matrices
-// E_m = U Ehat_m V^T times the roots of their eigenvalues, handed to `mode(m, root, ehat_coefficients)`
-// in the U/V frames: a twist or flip as (i, k, sign): (e_i e_k^T + sign e_k e_i^T) / sqrt 2; a
-// scaling mode as diag(d). The scaling block is factorized by Cholesky where it is positive definite
-// (nearly always: lambda' g g^T dominates it), its eigenvectors otherwise.
-template <class Twist, class Scaling>
-int for_each_positive_mode(const Eigensystem& e, Twist twist, Scaling scaling) {
+// The modes with positive eigenvalues, each m-th one E_m = U Ehat_m V^T scaled by the root of its
+// eigenvalue, so that the projected dP/dF is sum_m vec(E_m) vec(E_m)^T. Handed over in the U/V
+// frames: a twist (sign -1) or flip (+1) of axes i and k as pair(m, root, i, k, sign), Ehat =
+// (e_i e_k^T + sign e_k e_i^T) / sqrt 2; a scaling mode as scaling(m, d), Ehat = diag(d) with the root
+// folded into d. The scaling block is factorized by Cholesky where it is positive definite (nearly
+// always: lambda' g g^T dominates it), eigensolved otherwise. Returns the number of modes.
+template <class Pair, class Scaling>
+int for_each_positive_mode(const Eigensystem& e, Pair pair, Scaling scaling) {
   int modes = 0;
   for (int l = 0; l < 3; ++l) {
     const int i = (l + 1) % 3;
     const int k = (l + 2) % 3;
     const double twist_value = e.a + e.scale * e.svd.sigma(l);
     const double flip_value = e.a - e.scale * e.svd.sigma(l);
-    if (twist_value > 0.0) twist(modes++, std::sqrt(twist_value), i, k, -1.0);
-    if (flip_value > 0.0) twist(modes++, std::sqrt(flip_value), i, k, 1.0);
+    if (twist_value > 0.0) pair(modes++, std::sqrt(twist_value), i, k, -1.0);
+    if (flip_value > 0.0) pair(modes++, std::sqrt(flip_value), i, k, 1.0);
   }
   const Eigen::LLT<Eigen::Matrix3d> cholesky(e.scaling);
   if (cholesky.info() == Eigen::Success) {
