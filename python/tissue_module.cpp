@@ -79,7 +79,7 @@ struct Options {
   double young_modulus_pa = 1e5;
   double poisson_ratio = 0.4;
   double density_kg_per_m3 = 1000.0;
-  std::string material_model = "corotationalLinear";  // or "stableNeoHookean"
+  std::string material_model{to_string(MaterialModel::corotational_linear)};  // parse_material_model's names
   double damping_alpha_per_s = 1.0;
   double damping_beta_s = 1e-3;
   std::array<double, 3> gravity_m_per_s2{0.0, 0.0, -9.81};

@@ -31,7 +31,7 @@ struct SceneOptions {
   CholeskyPcgSolver::Refresh refresh = with_background_refactor();
   bool warm_start = false;
   Material material{1.0e5, 0.4, 1000.0};
-  std::string material_model = "corotationalLinear";  ///< or "stableNeoHookean" (parse_material_model)
+  std::string material_model{to_string(MaterialModel::corotational_linear)};  ///< parse_material_model's names
   /// Ignore the mesh file's regions and their materials (Vega *REGION, ...): `material` everywhere,
   /// as the benchmarks' side-by-side runs were measured before regions were read (issue 25).
   bool single_material = false;

@@ -364,7 +364,7 @@ std::vector<RunSpec> plan_runs(const CompareSettingsList& list, const Scenario& 
 SettingDescription describe_setting(const std::vector<ParameterSetting>& parameters, const ModelDescription& tissue) {
   SettingDescription d;
   d.integrator = value_text(parameters, "integrator.method", tissue).value_or("backwardEuler");
-  d.material_model = value_text(parameters, "material.model", tissue).value_or("corotationalLinear");
+  d.material_model = value_text(parameters, "material.model", tissue).value_or(DEFAULT_MATERIAL_MODEL);
   if (d.integrator == "ida") {
     d.linear_solver = value_text(parameters, "integrator.idaLinearSolver", tissue).value_or("klu");
     d.tolerance = value_number(parameters, "integrator.idaRelativeTolerance", tissue);

@@ -15,6 +15,7 @@
 //   steps = [0.01]                         # optional, this setting only
 #pragma once
 
+#include "compare/compare_table.hpp"
 #include "importer/model_description.hpp"
 #include "scenario/scenario.hpp"
 
@@ -61,7 +62,7 @@ struct SettingDescription {
   std::string linear_solver;                  ///< item of integrator.linearSolver or integrator.idaLinearSolver
   std::optional<double> tolerance;            ///< PCG tolerance or IDA relative tolerance
   std::optional<std::int64_t> iteration_cap;  ///< PCG's iteration cap
-  std::string material_model = "corotationalLinear";  ///< item of material.model
+  std::string material_model = DEFAULT_MATERIAL_MODEL;  ///< item of material.model
   [[nodiscard]] std::string family() const;   ///< "backwardEuler/pcg", for the plot's colours
 };
 

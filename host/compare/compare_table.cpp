@@ -87,16 +87,15 @@ std::optional<T> parse_optional(const std::string& field, const char* column) {
 std::string setting_family(const std::string& integrator, const std::string& linear_solver,
                            const std::string& material_model) {
   std::string family = integrator + "/" + linear_solver;
-  if (!material_model.empty() && material_model != "corotationalLinear") family += "/" + material_model;
+  if (!material_model.empty() && material_model != DEFAULT_MATERIAL_MODEL) family += "/" + material_model;
   return family;
 }
 
 bool CompareRow::comparable() const { return rms_error_m && cpu_s_per_sim_s && failures == 0; }
 
 std::string csv_header() {
-  return "setting,integrator,linear_solver,material_model,tolerance,iteration_cap,internal_step_s,cpu_s_per_sim_s,rms_"
-         "error_m,"
-         "max_error_m,force_error_n,energy_drift_j,iterations,failures,pareto,note";
+  return "setting,integrator,linear_solver,material_model,tolerance,iteration_cap,internal_step_s,cpu_s_per_sim_s,"
+         "rms_error_m,max_error_m,force_error_n,energy_drift_j,iterations,failures,pareto,note";
 }
 
 std::string csv_row(const CompareRow& row) {

@@ -14,15 +14,18 @@
 
 namespace tissue::host {
 
+/// material.model's item when a setting does not set it (the Tissue FMU's start).
+inline constexpr const char* DEFAULT_MATERIAL_MODEL = "corotationalLinear";
+
 /// The plot's series of a setting: "integrator/linear solver", and "/stableNeoHookean" when the
-/// material model is not the default co-rotational linear one.
+/// material model is not DEFAULT_MATERIAL_MODEL.
 [[nodiscard]] std::string setting_family(const std::string& integrator, const std::string& linear_solver,
                                          const std::string& material_model);
 
 struct CompareRow {
   std::string setting;  ///< "reference" for the reference run
   std::string integrator, linear_solver;
-  std::string material_model = "corotationalLinear";  ///< item of material.model
+  std::string material_model = DEFAULT_MATERIAL_MODEL;  ///< item of material.model
   std::optional<double> tolerance;
   std::optional<std::int64_t> iteration_cap;
   double internal_step_s = 0.0;

@@ -86,8 +86,7 @@ Eigen::Matrix3d neo_hookean_stress(const StableNeoHookean& material, const Eigen
   return material.mu_pa * (1.0 - 1.0 / (i_c + 1.0)) * f + material.lambda_pa * (j - material.alpha) * cofactor(f);
 }
 
-Matrix9d neo_hookean_stress_derivative(const StableNeoHookean& material, const Eigen::Matrix3d& f, bool project) {
-  if (project) return neo_hookean_projected_stress_derivative(material, f);
+Matrix9d neo_hookean_stress_derivative(const StableNeoHookean& material, const Eigen::Matrix3d& f) {
   const double i_c = f.squaredNorm();
   const double j = f.determinant();
   const Vector9d f_vec = vec(f);
@@ -145,9 +144,9 @@ Eigensystem eigensystem(const StableNeoHookean& material, const Eigen::Matrix3d&
 // frames: a twist (sign -1) or flip (+1) of axes i and k as pair(m, root, i, k, sign), Ehat =
 // (e_i e_k^T + sign e_k e_i^T) / sqrt 2; a scaling mode as scaling(m, d), Ehat = diag(d) with the root
 // folded into d. The scaling block is factorized by Cholesky where it is positive definite (nearly
-// always: lambda' g g^T dominates it), eigensolved otherwise. Returns the number of modes.
+// always: lambda' g g^T dominates it), eigensolved otherwise.
 template <class Pair, class Scaling>
-int for_each_positive_mode(const Eigensystem& e, Pair pair, Scaling scaling) {
+void for_each_positive_mode(const Eigensystem& e, Pair pair, Scaling scaling) {
   int modes = 0;
   for (int l = 0; l < 3; ++l) {
     const int i = (l + 1) % 3;
@@ -161,7 +160,7 @@ int for_each_positive_mode(const Eigensystem& e, Pair pair, Scaling scaling) {
   if (cholesky.info() == Eigen::Success) {
     const Eigen::Matrix3d l = cholesky.matrixL();
     for (int m = 0; m < 3; ++m) scaling(modes++, Eigen::Vector3d(l.col(m)));
-    return modes;
+    return;
   }
   Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eigen;
   eigen.computeDirect(e.scaling);
@@ -169,32 +168,9 @@ int for_each_positive_mode(const Eigensystem& e, Pair pair, Scaling scaling) {
     const double value = eigen.eigenvalues()(m);
     if (value > 0.0) scaling(modes++, Eigen::Vector3d(std::sqrt(value) * eigen.eigenvectors().col(m)));
   }
-  return modes;
 }
 
 }  // namespace
-
-Matrix9d neo_hookean_projected_stress_derivative(const StableNeoHookean& material, const Eigen::Matrix3d& f) {
-  const Eigensystem e = eigensystem(material, f);
-  const Eigen::Matrix3d& u = e.svd.u;
-  const Eigen::Matrix3d& v = e.svd.v;
-  Matrix9d q = Matrix9d::Zero();
-  const double root_half = std::sqrt(0.5);
-  (void)for_each_positive_mode(
-      e,
-      [&](int m, double root, int i, int k, double sign) {
-        const Eigen::Matrix3d mode =
-            root * root_half * (u.col(i) * v.col(k).transpose() + sign * u.col(k) * v.col(i).transpose());
-        q.col(m) = vec(mode);
-      },
-      [&](int m, const Eigen::Vector3d& d) {
-        const Eigen::Matrix3d mode = u * d.asDiagonal() * v.transpose();
-        q.col(m) = vec(mode);
-      });
-  Matrix9d h;
-  h.noalias() = q.lazyProduct(q.transpose());
-  return h;
-}
 
 void neo_hookean_projected_blocks(const TetRest& rest, const StableNeoHookean& material, const Eigen::Matrix3d& f,
                                   std::array<Eigen::Matrix3d, 16>& out) {
@@ -206,7 +182,7 @@ void neo_hookean_projected_blocks(const TetRest& rest, const StableNeoHookean& m
   const double root_volume = std::sqrt(rest.volume_m3);
   const double root_half_volume = std::sqrt(0.5 * rest.volume_m3);
   Eigen::Matrix<double, 12, 9> w = Eigen::Matrix<double, 12, 9>::Zero();
-  (void)for_each_positive_mode(
+  for_each_positive_mode(
       e,
       [&](int m, double root, int i, int k, double sign) {
         const double c = root * root_half_volume;
@@ -246,7 +222,7 @@ Matrix12d neo_hookean_stiffness(const TetRest& rest, const StableNeoHookean& mat
     }
     return k;
   }
-  const Matrix9d h = neo_hookean_stress_derivative(material, f, false);
+  const Matrix9d h = neo_hookean_stress_derivative(material, f);
   // K_ij = V sum_{c,d} g_i[c] g_j[d] H_cd (H_cd the 3 x 3 block of dP/dF at columns c, d of F):
   // first T_j = sum_d g_j[d] H_(:,d) (9 x 3), then K_ij = sum_c g_i[c] T_j(c), ~600 products
   // where the dense B^T H B (B 9 x 12, mostly zeros) took ~2300.

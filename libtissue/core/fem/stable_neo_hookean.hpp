@@ -8,10 +8,9 @@
 // element is pushed back (the J term's gradient dJ/dF never vanishes away from a collapsed F).
 // The constants mu'/2 log 4 - lambda'/2 (1 - alpha)^2 are added so that Psi(I) = 0. First Piola-Kirchhoff stress P =
 // dPsi/dF and its derivative dP/dF (9 x 9, column-major vec(F)), whose negative eigenvalues are clamped to zero where a
-// solver needs a positive semi-definite tangent (skipped where a Cholesky factorization shows dP/dF positive
-// definite). Per linear tet (shape gradients g_i, volume V): the internal force on
-// vertex i is V P g_i (the restoring force, as the co-rotational kernel's) and the tangent block K_ij = V (g_i^T (x) I)
-// dP/dF (g_j (x) I).
+// solver needs a positive semi-definite tangent (in closed form: neo_hookean_projected_blocks). Per linear tet (shape
+// gradients g_i, volume V): the internal force on vertex i is V P g_i (the restoring force, as the co-rotational
+// kernel's) and the tangent block K_ij = V (g_i^T (x) I) dP/dF (g_j (x) I).
 #pragma once
 
 #include "core/fem/tet_element.hpp"
@@ -41,22 +40,17 @@ double neo_hookean_energy_density(const StableNeoHookean& material, const Eigen:
 /// P(F) = mu' (1 - 1/(I_C + 1)) F + lambda' (J - alpha) dJ/dF [Pa], dJ/dF the cofactor matrix of F.
 Eigen::Matrix3d neo_hookean_stress(const StableNeoHookean& material, const Eigen::Matrix3d& f);
 
-/// dP/dF (9 x 9, vec(F) column-major: index 3 * column + row); `project`: negative eigenvalues set
-/// to zero (the projection onto the positive semi-definite cone, per element), as
-/// neo_hookean_projected_stress_derivative.
-Matrix9d neo_hookean_stress_derivative(const StableNeoHookean& material, const Eigen::Matrix3d& f, bool project);
+/// dP/dF, exact (9 x 9, vec(F) column-major: index 3 * column + row).
+Matrix9d neo_hookean_stress_derivative(const StableNeoHookean& material, const Eigen::Matrix3d& f);
 
-/// dP/dF projected onto the positive semi-definite cone from its eigensystem in closed form (Smith, de
-/// Goes and Kim 2018, section 4.2; derived in docs/DESIGN.md): with the rotation-variant SVD
-/// F = U diag(sigma) V^T, six twist and flip modes U (e_i e_k^T -/+ e_k e_i^T) V^T / sqrt 2 with
-/// eigenvalues a +/- lambda' (J - alpha) sigma_l (a = mu' (1 - 1/(I_C + 1)), l the third axis), and
-/// three scaling modes U diag(d) V^T, d the eigenvectors of a 3 x 3 matrix; negative ones dropped. One
-/// 3 x 3 SVD and a 3 x 3 eigensolve instead of a 9 x 9 one.
-Matrix9d neo_hookean_projected_stress_derivative(const StableNeoHookean& material, const Eigen::Matrix3d& f);
-
-/// The projected element tangent's blocks K_ij = d f_i / d x_j, i <= j, at [4 i + j] (block (j, i) is
-/// the transpose), straight from the closed-form modes applied to the shape gradients, without the
-/// 9 x 9 dP/dF: what the body's assembly takes. [N/m]
+/// The element tangent's blocks K_ij = d f_i / d x_j, i <= j, at [4 i + j] (block (j, i) is the
+/// transpose), with dP/dF projected onto the positive semi-definite cone from its eigensystem in closed
+/// form (Smith, de Goes and Kim 2018, section 4.2; derived in docs/DESIGN.md): with the
+/// rotation-variant SVD F = U diag(sigma) V^T, six twist and flip modes U (e_i e_k^T -/+ e_k e_i^T)
+/// V^T / sqrt 2 with eigenvalues a +/- lambda' (J - alpha) sigma_l (a = mu' (1 - 1/(I_C + 1)), l the
+/// third axis), and three scaling modes U diag(d) V^T from a 3 x 3 matrix; negative ones dropped. The
+/// modes are applied to the shape gradients straight away, without the 9 x 9 dP/dF: what the body's
+/// assembly takes. [N/m]
 void neo_hookean_projected_blocks(const TetRest& rest, const StableNeoHookean& material, const Eigen::Matrix3d& f,
                                   std::array<Eigen::Matrix3d, 16>& out);
 
