@@ -95,7 +95,7 @@ struct Options {
   double probe_radius_m = 0.0;
   std::string render_surface;  // "" none, "frog" the embedded frog's, else an OBJ file
   /// Materials by region name (issue 25): {"tumour": {"young_modulus_pa": 1e6, ...}}; a key left out
-  /// keeps the body's value (young_modulus_pa, poisson_ratio, density_kg_per_m3).
+  /// keeps the body's value (young_modulus_pa, poisson_ratio, density_kg_per_m3, damping_alpha_per_s).
   std::map<std::string, std::map<std::string, double>> regions;
 };
 
@@ -114,7 +114,7 @@ std::vector<RegionMaterial> region_materials(const std::map<std::string, std::ma
         for (const MaterialProperty& p : properties) names += (names.empty() ? "" : ", ") + std::string(p.si_name);
         throw ParameterError("regions[\"" + name + "\"]: unknown key \"" + key + "\" (" + names + ")");
       }
-      region.material.*(property->value) = value;
+      property->set(region.material, value);
     }
     materials.push_back(std::move(region));
   }
@@ -187,13 +187,15 @@ class PyTissue {
   [[nodiscard]] const Tissue& core() const { return *m_tissue; }
   [[nodiscard]] int vertex_count() const { return m_tissue->body().mesh().vertex_count(); }
   [[nodiscard]] int tet_count() const { return m_tissue->body().mesh().tet_count(); }
-  /// The mesh's regions and their resolved materials: {name: (young_modulus_pa, poisson_ratio, density_kg_per_m3)}.
-  [[nodiscard]] std::map<std::string, std::array<double, 3>> regions() const {
-    std::map<std::string, std::array<double, 3>> out;
+  /// The mesh's regions and their resolved materials:
+  /// {name: (young_modulus_pa, poisson_ratio, density_kg_per_m3, damping_alpha_per_s)}.
+  [[nodiscard]] std::map<std::string, std::array<double, 4>> regions() const {
+    std::map<std::string, std::array<double, 4>> out;
     const DeformableBody& body = m_tissue->body();
     for (size_t r = 0; r < body.mesh().regions.size(); ++r) {
       const Material& m = body.materials()[r];
-      out[body.mesh().regions[r].name] = {m.young_modulus_pa, m.poisson_ratio, m.density_kg_per_m3};
+      out[body.mesh().regions[r].name] = {m.young_modulus_pa, m.poisson_ratio, m.density_kg_per_m3,
+                                          body.region_mass_damping_per_s()[r]};
     }
     return out;
   }

@@ -185,8 +185,8 @@ std::string region_materials_text(const Reader& r, const toml::table& regions) {
   for (const auto& [name, node] : regions) {
     const std::string where = "tissue.regions." + std::string(name.str());
     const toml::table* region = node.as_table();
-    if (region == nullptr) r.fail(where, "must be a table (youngModulus, poissonRatio, density)");
-    r.only(*region, where, {"youngModulus", "poissonRatio", "density"});
+    if (region == nullptr) r.fail(where, "must be a table (youngModulus, poissonRatio, density, dampingAlpha)");
+    r.only(*region, where, {"youngModulus", "poissonRatio", "density", "dampingAlpha"});
     if (!text.empty()) text += "; ";
     text += std::string(name.str()) + ":";
     bool first = true;

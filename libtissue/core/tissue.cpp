@@ -63,6 +63,7 @@ std::uint64_t model_fingerprint_of(const TetMesh& mesh, const TissueSettings& se
       f.add(material.young_modulus_pa);
       f.add(material.poisson_ratio);
       f.add(material.density_kg_per_m3);
+      if (material.mass_damping_per_s) f.add(*material.mass_damping_per_s);  // older fingerprints stay
     }
   }
   if (body.material_model != MaterialModel::corotational_linear) f.add(body.material_model);  // older fingerprints stay

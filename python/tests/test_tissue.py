@@ -159,15 +159,19 @@ def test_regions_take_their_materials_by_name_and_mistakes_are_refused(tmp_path)
                     "*MATERIAL soft\nENU, 1000, 1e5, 0.4\n*MATERIAL stiff\nENU, 1100, 1e6, 0.45\n"
                     "*SET skin\n1\n*SET tumour\n2\n*REGION\nskin, soft\ntumour, stiff\n")
     from_file = tissue.Tissue(mesh=str(mesh), fixed_vertices=[0, 1, 2])
-    assert from_file.regions == {"skin": [1e5, 0.4, 1000.0], "tumour": [1e6, 0.45, 1100.0]}
-    set_by_name = tissue.Tissue(mesh=str(mesh), fixed_vertices=[0, 1, 2],
-                                regions={"tumour": {"young_modulus_pa": 3e6}})
-    # A key left out keeps the body's value (poisson_ratio 0.4, density 1000), not the file's.
-    assert set_by_name.regions["tumour"] == [3e6, 0.4, 1000.0]
+    assert from_file.regions == {"skin": [1e5, 0.4, 1000.0, 1.0], "tumour": [1e6, 0.45, 1100.0, 1.0]}
+    set_by_name = tissue.Tissue(mesh=str(mesh), fixed_vertices=[0, 1, 2], damping_alpha_per_s=2.0,
+                                regions={"tumour": {"young_modulus_pa": 3e6, "damping_alpha_per_s": 7.0}})
+    # A key left out keeps the body's value (poisson_ratio 0.4, density 1000), not the file's; the
+    # region without its own alpha takes the body's.
+    assert set_by_name.regions["tumour"] == [3e6, 0.4, 1000.0, 7.0]
+    assert set_by_name.regions["skin"] == [1e5, 0.4, 1000.0, 2.0]
     with pytest.raises(ValueError, match='"liver", which the mesh does not have'):
         tissue.Tissue(mesh=str(mesh), fixed_vertices=[0, 1, 2], regions={"liver": {"density_kg_per_m3": 1.0}})
     with pytest.raises(ValueError, match="unknown key"):
         tissue.Tissue(mesh=str(mesh), fixed_vertices=[0, 1, 2], regions={"tumour": {"stiffness": 1.0}})
+    with pytest.raises(ValueError, match='"tumour".*alpha'):
+        tissue.Tissue(mesh=str(mesh), fixed_vertices=[0, 1, 2], regions={"tumour": {"damping_alpha_per_s": -1.0}})
 
 
 def test_the_material_model_is_chosen_by_name_and_agrees_with_corotational_at_small_strain():

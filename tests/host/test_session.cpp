@@ -518,7 +518,8 @@ TEST(ScenarioRegions, ARegionsTableBecomesTheTissuesMaterialRegions) {
       "waypoints = [{ t = 0.0, position = [0, 0, 0.1], mode = \"none\" }]\n";
   const Scenario scenario = parse_scenario(
       head +
-          "[tissue.regions.tumour]\nyoungModulus = 1e6\ndensity = 1100\n[tissue.regions.skin]\npoissonRatio = 0.45\n",
+          "[tissue.regions.tumour]\nyoungModulus = 1e6\ndensity = 1100\n[tissue.regions.skin]\npoissonRatio = 0.45\n"
+          "dampingAlpha = 4\n",
       "regions.toml");
   const auto regions = std::find_if(scenario.tissue_parameters.begin(), scenario.tissue_parameters.end(),
                                     [](const ParameterSetting& p) { return p.name == "material.regions"; });
@@ -526,7 +527,7 @@ TEST(ScenarioRegions, ARegionsTableBecomesTheTissuesMaterialRegions) {
   // The FMU's grammar (parse_region_materials; BadUse.RegionMaterialsAreSetByName... reads it there),
   // tables and keys in TOML's (sorted) order.
   EXPECT_EQ(std::get<std::string>(regions->value),
-            "skin: poissonRatio=0.45; tumour: density=1100, youngModulus=1e+06");
+            "skin: dampingAlpha=4, poissonRatio=0.45; tumour: density=1100, youngModulus=1e+06");
   try {
     parse_scenario(head + "[tissue.regions.tumour]\nstiffness = 1e6\n", "regions.toml");
     ADD_FAILURE() << "an unknown key was taken";

@@ -313,18 +313,28 @@ double CorotationalElasticity::elastic_energy_j(const Eigen::VectorXd& positions
   return half[0] + half[1];
 }
 
-std::vector<double> lumped_vertex_masses(const TetMesh& mesh, const std::vector<Material>& materials) {
-  std::vector<double> masses(static_cast<size_t>(mesh.vertex_count()), 0.0);
+std::vector<double> lumped_vertex_sums(const TetMesh& mesh, std::span<const double> per_region_per_m3) {
+  std::vector<double> sums(static_cast<size_t>(mesh.vertex_count()), 0.0);
   for (int t = 0; t < mesh.tet_count(); ++t) {
     const Tet& tet = mesh.tets[static_cast<size_t>(t)];
     const auto& p = mesh.rest_positions_m;
-    const double density_kg_per_m3 = materials.at(static_cast<size_t>(mesh.region_of(t))).density_kg_per_m3;
-    const double quarter_mass = 0.25 * density_kg_per_m3 *
-                                signed_tet_volume(p[static_cast<size_t>(tet[0])], p[static_cast<size_t>(tet[1])],
-                                                  p[static_cast<size_t>(tet[2])], p[static_cast<size_t>(tet[3])]);
-    for (int v : tet) masses[static_cast<size_t>(v)] += quarter_mass;
+    const double per_m3 = per_region_per_m3[static_cast<size_t>(mesh.region_of(t))];
+    const double quarter = 0.25 * per_m3 *
+                           signed_tet_volume(p[static_cast<size_t>(tet[0])], p[static_cast<size_t>(tet[1])],
+                                             p[static_cast<size_t>(tet[2])], p[static_cast<size_t>(tet[3])]);
+    for (int v : tet) sums[static_cast<size_t>(v)] += quarter;
   }
-  return masses;
+  return sums;
+}
+
+std::vector<double> lumped_vertex_masses(const TetMesh& mesh, const std::vector<Material>& materials) {
+  std::vector<double> densities_kg_per_m3;
+  for (const Material& material : materials) densities_kg_per_m3.push_back(material.density_kg_per_m3);
+  if (densities_kg_per_m3.size() < static_cast<size_t>(mesh.region_count())) {
+    throw std::invalid_argument("lumped_vertex_masses: " + std::to_string(materials.size()) + " materials for " +
+                                std::to_string(mesh.region_count()) + " regions");
+  }
+  return lumped_vertex_sums(mesh, densities_kg_per_m3);
 }
 
 }  // namespace tissue

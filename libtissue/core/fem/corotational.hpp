@@ -16,6 +16,7 @@
 #include <Eigen/Geometry>
 
 #include <array>
+#include <span>
 #include <vector>
 
 namespace tissue {
@@ -149,8 +150,12 @@ class CorotationalElasticity {
   RotationSettings m_rotation_settings;
 };
 
-/// Lumped mass (eq. 4.15): each tet gives rho V / 4 to each of its vertices, rho its region's
-/// (`materials` as for CorotationalElasticity). [kg], one per vertex.
+/// Lumped per vertex as the mass is (eq. 4.15): each tet gives V / 4 times its region's
+/// `per_region_per_m3` to each of its vertices. One per vertex.
+std::vector<double> lumped_vertex_sums(const TetMesh& mesh, std::span<const double> per_region_per_m3);
+
+/// Lumped mass: lumped_vertex_sums of each region's density (`materials` as for
+/// CorotationalElasticity). [kg], one per vertex.
 std::vector<double> lumped_vertex_masses(const TetMesh& mesh, const std::vector<Material>& materials);
 
 }  // namespace tissue

@@ -97,6 +97,25 @@ MatrixReserve with_ghost_room(MatrixReserve reserve, const TetMesh& mesh, const 
   return reserve;
 }
 
+// Each region's mass damping alpha: its material's own, else the body's.
+std::vector<double> region_mass_damping(const std::vector<Material>& materials, const RayleighDamping& body) {
+  std::vector<double> alphas_per_s;
+  for (const Material& material : materials) {
+    alphas_per_s.push_back(material.mass_damping_per_s.value_or(body.mass_damping_per_s));
+  }
+  return alphas_per_s;
+}
+
+// alpha m per vertex, lumped as the mass is: each tet gives alpha rho V / 4 with its region's.
+std::vector<double> lumped_vertex_mass_damping(const TetMesh& mesh, const std::vector<Material>& materials,
+                                               const std::vector<double>& region_alpha_per_s) {
+  std::vector<double> per_m3;
+  for (size_t r = 0; r < materials.size(); ++r) {
+    per_m3.push_back(region_alpha_per_s[r] * materials[r].density_kg_per_m3);
+  }
+  return lumped_vertex_sums(mesh, per_m3);
+}
+
 }  // namespace
 
 DeformableBody::DeformableBody(TetMesh mesh, BodySettings settings)
@@ -105,9 +124,11 @@ DeformableBody::DeformableBody(TetMesh mesh, BodySettings settings)
       m_vertex_order(locality_order(m_adjacency, m_mesh.vertex_count())),
       m_settings(checked(std::move(settings), m_mesh.vertex_count())),
       m_materials(resolve_region_materials(m_mesh.regions, m_settings.material, m_settings.region_materials)),
+      m_region_mass_damping_per_s(region_mass_damping(m_materials, m_settings.damping)),
       m_dofs(make_dof_map(m_mesh.vertex_count(), m_settings.fixed_vertices, m_vertex_order)),
       m_elasticity(m_mesh, m_materials, m_settings.rotation, m_vertex_order, m_settings.material_model),
       m_vertex_mass_kg(lumped_vertex_masses(m_mesh, m_materials)),
+      m_vertex_mass_damping_kg_per_s(lumped_vertex_mass_damping(m_mesh, m_materials, m_region_mass_damping_per_s)),
       m_tangent(stiffness_pattern(m_mesh, m_dofs), with_ghost_room(m_settings.reserve, m_mesh, m_dofs)),
       m_slots(make_tet_slots(m_mesh, m_dofs, m_tangent)),
       m_xfem(m_elasticity.elements(), m_settings.rotation),
@@ -116,10 +137,13 @@ DeformableBody::DeformableBody(TetMesh mesh, BodySettings settings)
       m_cut_index(static_cast<size_t>(m_mesh.tet_count()), -1) {
   const int rows = m_dofs.free_vertex_count();
   m_mass_kg.resize(3 * rows);
+  m_mass_damping_kg_per_s.resize(3 * rows);
   m_external_force_n.resize(3 * rows);
   for (int row = 0; row < rows; ++row) {
-    const double mass = m_vertex_mass_kg[static_cast<size_t>(m_dofs.row_vertex[static_cast<size_t>(row)])];
+    const auto vertex = static_cast<size_t>(m_dofs.row_vertex[static_cast<size_t>(row)]);
+    const double mass = m_vertex_mass_kg[vertex];
     m_mass_kg.segment<3>(3 * row).setConstant(mass);
+    m_mass_damping_kg_per_s.segment<3>(3 * row).setConstant(m_vertex_mass_damping_kg_per_s[vertex]);
     m_external_force_n.segment<3>(3 * row) = mass * m_settings.gravity_m_per_s2;
   }
   m_positions_m.resize(3 * m_mesh.vertex_count());
@@ -416,6 +440,7 @@ EnrichmentResult DeformableBody::enrich(std::span<const TetCut> cuts,
 void DeformableBody::add_ghost_loads(int k, double sign) {
   const int u_rows = m_dofs.free_vertex_count();
   const double tet_mass_kg = density_kg_per_m3(m_xfem.rest(k)) * m_xfem.rest(k).volume_m3;
+  const double alpha_per_s = mass_damping_per_s(m_xfem.rest(k));
   for (size_t p = 0; p < m_xfem.piece_count(k); ++p) {
     const CutPiece& piece = m_xfem.piece(k, static_cast<int>(p));
     const double quarter_mass_kg = 0.25 * piece.weight * tet_mass_kg;
@@ -423,6 +448,7 @@ void DeformableBody::add_ghost_loads(int k, double sign) {
       const int row = piece.ghost_row[j];
       if (row < 0) continue;
       m_mass_kg.segment<3>(3 * row).array() += sign * quarter_mass_kg;
+      m_mass_damping_kg_per_s.segment<3>(3 * row).array() += sign * alpha_per_s * quarter_mass_kg;
       m_external_force_n.segment<3>(3 * row) +=
           sign * piece.ghost_sign[j] * quarter_mass_kg * m_settings.gravity_m_per_s2;
       m_ghost_users[static_cast<size_t>(row - u_rows)] += sign > 0.0 ? 1 : -1;
@@ -772,8 +798,10 @@ EnrichmentResult DeformableBody::enrich_pieces(std::span<const TetCut> cuts,
   };
   m_ghost_users.resize(static_cast<size_t>(enriched_dof_count()), 0);
   m_mass_kg.conservativeResize(dof_count());
+  m_mass_damping_kg_per_s.conservativeResize(dof_count());
   m_external_force_n.conservativeResize(dof_count());
   m_mass_kg.tail(3 * (enriched_dof_count() - old_dofs)).setZero();
+  m_mass_damping_kg_per_s.tail(3 * (enriched_dof_count() - old_dofs)).setZero();
   m_external_force_n.tail(3 * (enriched_dof_count() - old_dofs)).setZero();
 
   for (size_t c = 0; c < plans.size(); ++c) {
@@ -844,7 +872,9 @@ EnrichmentResult DeformableBody::enrich_pieces(std::span<const TetCut> cuts,
         if (m_ghost_users[dof] != 0 ||
             std::find(m_orphaned_rows.begin(), m_orphaned_rows.end(), row) != m_orphaned_rows.end())
           continue;
-        m_mass_kg.segment<3>(3 * row).setConstant(m_vertex_mass_kg[static_cast<size_t>(m_enriched_dofs[dof].vertex)]);
+        const auto vertex = static_cast<size_t>(m_enriched_dofs[dof].vertex);
+        m_mass_kg.segment<3>(3 * row).setConstant(m_vertex_mass_kg[vertex]);
+        m_mass_damping_kg_per_s.segment<3>(3 * row).setConstant(m_vertex_mass_damping_kg_per_s[vertex]);
         m_external_force_n.segment<3>(3 * row).setZero();
         m_orphaned_rows.push_back(row);
       }

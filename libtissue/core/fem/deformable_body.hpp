@@ -91,7 +91,8 @@ class DeformableBody final : public DynamicsModel {
 
   [[nodiscard]] int dof_count() const override { return 3 * (m_dofs.free_vertex_count() + enriched_dof_count()); }
   [[nodiscard]] const Eigen::VectorXd& mass_kg() const override { return m_mass_kg; }
-  [[nodiscard]] const RayleighDamping& damping() const override { return m_settings.damping; }
+  [[nodiscard]] const Eigen::VectorXd& mass_damping_kg_per_s() const override { return m_mass_damping_kg_per_s; }
+  [[nodiscard]] double stiffness_damping_s() const override { return m_settings.damping.stiffness_damping_s; }
   [[nodiscard]] const Eigen::VectorXd& external_force_n() const override { return m_external_force_n; }
   void evaluate(const Eigen::VectorXd& displacement_m, Eigen::VectorXd& internal_force_n, bool update_tangent) override;
   /// The uncut tets' forces and blocks are then assembled by the team (bitwise the same result).
@@ -115,6 +116,8 @@ class DeformableBody final : public DynamicsModel {
   [[nodiscard]] const CorotationalElasticity& elasticity() const { return m_elasticity; }
   /// The material of each mesh region, resolved (TetRest::material indexes them).
   [[nodiscard]] const std::vector<Material>& materials() const { return m_materials; }
+  /// Each region's mass damping alpha [1/s], resolved: its material's, else the body's (settings().damping).
+  [[nodiscard]] const std::vector<double>& region_mass_damping_per_s() const { return m_region_mass_damping_per_s; }
   [[nodiscard]] const std::vector<double>& vertex_masses_kg() const { return m_vertex_mass_kg; }
   [[nodiscard]] double total_mass_kg() const;
 
@@ -227,10 +230,13 @@ class DeformableBody final : public DynamicsModel {
   std::vector<int> m_vertex_order;  // locality_order(): the block rows' and the assembly's sequence
   BodySettings m_settings;
   std::vector<Material> m_materials;  // per region
+  std::vector<double> m_region_mass_damping_per_s;  // per region
   DofMap m_dofs;
   CorotationalElasticity m_elasticity;
   std::vector<double> m_vertex_mass_kg;
+  std::vector<double> m_vertex_mass_damping_kg_per_s;  // alpha m, lumped as the mass
   Eigen::VectorXd m_mass_kg;
+  Eigen::VectorXd m_mass_damping_kg_per_s;  // per unknown, as m_mass_kg
   Eigen::VectorXd m_external_force_n;
   BlockSparseMatrix m_tangent;
   std::vector<TetSlots> m_slots;
@@ -239,6 +245,9 @@ class DeformableBody final : public DynamicsModel {
 
   [[nodiscard]] double density_kg_per_m3(const TetRest& rest) const {
     return m_materials[static_cast<size_t>(rest.material)].density_kg_per_m3;
+  }
+  [[nodiscard]] double mass_damping_per_s(const TetRest& rest) const {
+    return m_region_mass_damping_per_s[static_cast<size_t>(rest.material)];
   }
 
   // Looks up every slot held (uncut tets, cut tets, force terms) again: after a relayout.

@@ -81,10 +81,9 @@ BackwardEuler::BackwardEuler(std::unique_ptr<LinearSolver> solver, Settings sett
 // (1 + h alpha) M + (h beta + h^2) K at the model's current tangent: the matrix of the step and of
 // its Newton corrections.
 ShiftedSystem BackwardEuler::step_system(const DynamicsModel& model, double h) {
-  const RayleighDamping& damping = model.damping();
   m_system_diagonal.resize(model.dof_count());
-  m_system_diagonal.noalias() = (1.0 + h * damping.mass_damping_per_s) * model.mass_kg();
-  return ShiftedSystem{&model.tangent(), h * damping.stiffness_damping_s + h * h, &m_system_diagonal,
+  m_system_diagonal.noalias() = model.mass_kg() + h * model.mass_damping_kg_per_s();
+  return ShiftedSystem{&model.tangent(), h * model.stiffness_damping_s() + h * h, &m_system_diagonal,
                        m_solver->follows_block_frames() ? model.block_frames() : nullptr};
 }
 
@@ -106,16 +105,14 @@ StepReport BackwardEuler::step(DynamicsModel& model, DynamicState& state, double
   const auto assembly_start = std::chrono::steady_clock::now();
   model.evaluate(state.displacement_m, m_internal_force_n, /*update_tangent=*/true);
   const BlockSparseMatrix& stiffness = model.tangent();
-  const RayleighDamping& damping = model.damping();
-  const Eigen::VectorXd& mass = model.mass_kg();
 
   // rhs = h (f_ext - f_int - alpha M v - (beta + h) K v)
   m_stiffness_times_velocity.resize(n);
   stiffness.multiply(state.velocity_m_per_s, m_stiffness_times_velocity, team ? &*team : nullptr);
   m_rhs.resize(n);
   m_rhs.noalias() = h * (model.external_force_n() - m_internal_force_n -
-                         damping.mass_damping_per_s * mass.cwiseProduct(state.velocity_m_per_s) -
-                         (damping.stiffness_damping_s + h) * m_stiffness_times_velocity);
+                         model.mass_damping_kg_per_s().cwiseProduct(state.velocity_m_per_s) -
+                         (model.stiffness_damping_s() + h) * m_stiffness_times_velocity);
   const ShiftedSystem system = step_system(model, h);
   report.assembly_s = seconds_since(assembly_start);
 
@@ -197,7 +194,6 @@ bool BackwardEuler::guard_energy(DynamicsModel& model, const DynamicState& state
 void BackwardEuler::correct(DynamicsModel& model, const DynamicState& state, double h, StepReport& report,
                             WorkTeam* team) {
   const int n = model.dof_count();
-  const RayleighDamping& damping = model.damping();
   const Eigen::VectorXd& mass = model.mass_kg();
   for (int iteration = 0; iteration < m_settings.newton.max_iterations; ++iteration) {
     const auto assembly_start = std::chrono::steady_clock::now();
@@ -206,8 +202,8 @@ void BackwardEuler::correct(DynamicsModel& model, const DynamicState& state, dou
     const BlockSparseMatrix& stiffness = model.tangent();
     stiffness.multiply(m_end_velocity, m_stiffness_times_velocity, team);
     m_rhs.noalias() = h * (model.external_force_n() - m_internal_force_n -
-                           damping.mass_damping_per_s * mass.cwiseProduct(m_end_velocity) -
-                           damping.stiffness_damping_s * m_stiffness_times_velocity) -
+                           model.mass_damping_kg_per_s().cwiseProduct(m_end_velocity) -
+                           model.stiffness_damping_s() * m_stiffness_times_velocity) -
                       mass.cwiseProduct(m_end_velocity - state.velocity_m_per_s);
     const ShiftedSystem system = step_system(model, h);
     report.assembly_s += seconds_since(assembly_start);

@@ -137,12 +137,10 @@ struct IdaIntegrator::Impl {
   void dynamic_residual(const Eigen::Map<Eigen::VectorXd>& u, const Eigen::Map<Eigen::VectorXd>& v,
                         const Eigen::Map<Eigen::VectorXd>& v_dot, Eigen::Map<Eigen::VectorXd>& out) {
     evaluate(u);
-    const RayleighDamping& damping = model->damping();
-    const Eigen::VectorXd& mass = model->mass_kg();
     stiffness_times_velocity.resize(n());
     model->tangent().multiply(v, stiffness_times_velocity);
-    out = mass.cwiseProduct(v_dot + damping.mass_damping_per_s * v) +
-          damping.stiffness_damping_s * stiffness_times_velocity + internal_force_n - model->external_force_n();
+    out = model->mass_kg().cwiseProduct(v_dot) + model->mass_damping_kg_per_s().cwiseProduct(v) +
+          model->stiffness_damping_s() * stiffness_times_velocity + internal_force_n - model->external_force_n();
   }
 
   static int residual(realtype /*t*/, N_Vector yy, N_Vector yyp, N_Vector rr, void* user_data) {
@@ -225,8 +223,9 @@ struct IdaIntegrator::Impl {
       std::copy(self.row_index.begin(), self.row_index.end(), SUNSparseMatrix_IndexValues(matrix));
       realtype* data = SUNSparseMatrix_Data(matrix);
       const double* k = stiffness.block(0).data();
-      const RayleighDamping& damping = self.model->damping();
+      const double beta_s = self.model->stiffness_damping_s();
       const Eigen::VectorXd& mass = self.model->mass_kg();
+      const Eigen::VectorXd& mass_damping = self.model->mass_damping_kg_per_s();
       const auto first_v_entry = self.column_start[static_cast<size_t>(count)];
       for (sunindextype e = 0; e < entries; ++e) {
         const int value = self.stiffness_value[static_cast<size_t>(e)];
@@ -234,11 +233,11 @@ struct IdaIntegrator::Impl {
         if (value < 0) {
           data[e] = u_column ? c_j : -1.0;
         } else {
-          data[e] = u_column ? k[value] : damping.stiffness_damping_s * k[value];
+          data[e] = u_column ? k[value] : beta_s * k[value];
         }
       }
       for (long j = 0; j < count; ++j) {
-        data[self.v_diagonal_entry[static_cast<size_t>(j)]] += (damping.mass_damping_per_s + c_j) * mass[j];
+        data[self.v_diagonal_entry[static_cast<size_t>(j)]] += mass_damping[j] + c_j * mass[j];
       }
       self.last_cj = c_j;
       return 0;
@@ -259,11 +258,10 @@ struct IdaIntegrator::Impl {
       const auto x_v = map(vector, count, count);
       auto out_u = map(result, 0, count);
       auto out_v = map(result, count, count);
-      const RayleighDamping& damping = self.model->damping();
       out_u = c_j * x_u - x_v;
       self.product.resize(count);
-      self.model->tangent().multiply(x_u + damping.stiffness_damping_s * x_v, self.product);
-      out_v = self.product + (damping.mass_damping_per_s + c_j) * self.model->mass_kg().cwiseProduct(x_v);
+      self.model->tangent().multiply(x_u + self.model->stiffness_damping_s() * x_v, self.product);
+      out_v = self.product + (self.model->mass_damping_kg_per_s() + c_j * self.model->mass_kg()).cwiseProduct(x_v);
       return 0;
     } catch (const std::exception& error) {
       self.last_error = error.what();
@@ -299,12 +297,11 @@ struct IdaIntegrator::Impl {
     const auto r_v = map(rvec, count, count);
     auto z_u = map(zvec, 0, count);
     auto z_v = map(zvec, count, count);
-    const RayleighDamping& damping = self.model->damping();
     self.product.resize(count);
     self.model->tangent().multiply(r_u, self.product);
     z_u = self.inverse_schur_diagonal.cwiseProduct(
-        r_v + (damping.mass_damping_per_s + c_j) * self.model->mass_kg().cwiseProduct(r_u) +
-        damping.stiffness_damping_s * self.product);
+        r_v + (self.model->mass_damping_kg_per_s() + c_j * self.model->mass_kg()).cwiseProduct(r_u) +
+        self.model->stiffness_damping_s() * self.product);
     z_v = c_j * z_u - r_u;
     return 0;
   }

@@ -13,9 +13,8 @@ ShiftedSystem newton_stiffness_system(const DynamicsModel& model, double leading
     throw ParameterError("Newton matrix: the leading coefficient must be finite and > 0 1/s, got " +
                          std::to_string(c));
   }
-  const RayleighDamping& damping = model.damping();
-  diagonal = (c * c + c * damping.mass_damping_per_s) * model.mass_kg();
-  return ShiftedSystem{&model.tangent(), 1.0 + c * damping.stiffness_damping_s, &diagonal};
+  diagonal = c * c * model.mass_kg() + c * model.mass_damping_kg_per_s();
+  return ShiftedSystem{&model.tangent(), 1.0 + c * model.stiffness_damping_s(), &diagonal};
 }
 
 }  // namespace tissue

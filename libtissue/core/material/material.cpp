@@ -17,6 +17,14 @@ void validate(const Material& material) {
   if (!std::isfinite(material.density_kg_per_m3) || material.density_kg_per_m3 <= 0.0) {
     fail("density must be finite and > 0 kg/m^3, got " + std::to_string(material.density_kg_per_m3));
   }
+  if (material.mass_damping_per_s) validate_mass_damping(*material.mass_damping_per_s);
+}
+
+void validate_mass_damping(double alpha_per_s) {
+  if (!std::isfinite(alpha_per_s) || alpha_per_s < 0.0) {
+    throw ParameterError("damping: mass damping alpha must be finite and >= 0 1/s, got " +
+                         std::to_string(alpha_per_s));
+  }
 }
 
 std::string_view to_string(MaterialModel model) {

@@ -3,6 +3,7 @@
 
 #include "core/parameter_error.hpp"
 
+#include <optional>
 #include <string_view>
 
 namespace tissue {
@@ -12,6 +13,9 @@ struct Material {
   double young_modulus_pa = 1.0e5;
   double poisson_ratio = 0.4;
   double density_kg_per_m3 = 1000.0;
+  /// Rayleigh mass damping alpha of this material [1/s] (a region's own, issue 25); none: the body's
+  /// (RayleighDamping::mass_damping_per_s). Stiffness damping beta is the body's alone.
+  std::optional<double> mass_damping_per_s = std::nullopt;
 };
 
 struct LameParameters {
@@ -19,8 +23,11 @@ struct LameParameters {
   double mu_pa = 0.0;  ///< shear modulus
 };
 
-/// Throws ParameterError unless E > 0, 0 <= nu < 0.5, rho > 0 (all finite).
+/// Throws ParameterError unless E > 0, 0 <= nu < 0.5, rho > 0 and alpha (if set) >= 0 (all finite).
 void validate(const Material& material);
+/// Throws ParameterError unless the mass damping alpha [1/s] is finite and >= 0 (a material's or a
+/// body's, RayleighDamping).
+void validate_mass_damping(double alpha_per_s);
 
 /// lambda = E nu / ((1 + nu)(1 - 2 nu)), mu = E / (2 (1 + nu)).
 LameParameters lame_parameters(const Material& material);

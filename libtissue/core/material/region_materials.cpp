@@ -34,10 +34,15 @@ std::string number_text(double value) {
   return {buffer, result.ptr};
 }
 
-constexpr std::array<MaterialProperty, 3> PROPERTIES{{
-    {"youngModulus", "young_modulus_pa", "Pa", &Material::young_modulus_pa},
-    {"poissonRatio", "poisson_ratio", "", &Material::poisson_ratio},
-    {"density", "density_kg_per_m3", "kg/m^3", &Material::density_kg_per_m3},
+constexpr std::array<MaterialProperty, 4> PROPERTIES{{
+    {"youngModulus", "young_modulus_pa", "Pa", [](Material& m, double value) { m.young_modulus_pa = value; },
+     [](const Material& m) -> std::optional<double> { return m.young_modulus_pa; }},
+    {"poissonRatio", "poisson_ratio", "", [](Material& m, double value) { m.poisson_ratio = value; },
+     [](const Material& m) -> std::optional<double> { return m.poisson_ratio; }},
+    {"density", "density_kg_per_m3", "kg/m^3", [](Material& m, double value) { m.density_kg_per_m3 = value; },
+     [](const Material& m) -> std::optional<double> { return m.density_kg_per_m3; }},
+    {"dampingAlpha", "damping_alpha_per_s", "1/s", [](Material& m, double value) { m.mass_damping_per_s = value; },
+     [](const Material& m) { return m.mass_damping_per_s; }},
 }};
 
 // "youngModulus [Pa], poissonRatio, density [kg/m^3]".
@@ -75,7 +80,7 @@ RegionMaterial parse_entry(std::string_view entry, const Material& base) {
     const auto property =
         std::find_if(PROPERTIES.begin(), PROPERTIES.end(), [&](const MaterialProperty& p) { return p.key == key; });
     if (property == PROPERTIES.end()) fail("unknown key \"" + key + "\" (" + property_keys_text() + ")");
-    region.material.*(property->value) = value;
+    property->set(region.material, value);
   }
   try {
     validate(region.material);
@@ -150,9 +155,12 @@ std::string format_region_materials(const std::vector<RegionMaterial>& materials
   for (const RegionMaterial& region : materials) {
     if (!text.empty()) text += "; ";
     text += region.region + ":";
+    const char* separator = " ";
     for (const MaterialProperty& property : PROPERTIES) {
-      text += (&property == PROPERTIES.data() ? " " : ", ") + std::string(property.key) + "=" +
-              number_text(region.material.*(property.value));
+      const std::optional<double> value = property.get(region.material);
+      if (!value) continue;
+      text += separator + std::string(property.key) + "=" + number_text(*value);
+      separator = ", ";
     }
   }
   return text;

@@ -28,15 +28,18 @@ struct RegionMaterial {
 };
 
 /// A material property a user sets by name: its key in the text form below (the FMU's), its SI name
-/// (the Python module's keyword), its unit for messages ("" for a ratio), and the member it sets.
+/// (the Python module's keyword), its unit for messages ("" for a ratio), how to set it and how to
+/// read it back (none: not set, the body's value applies).
 struct MaterialProperty {
   std::string_view key;
   std::string_view si_name;
   std::string_view unit;
-  double Material::*value;
+  void (*set)(Material& material, double value);
+  std::optional<double> (*get)(const Material& material);
 };
 
-/// youngModulus [Pa], poissonRatio, density [kg/m^3]: the one list every front end sets them by.
+/// youngModulus [Pa], poissonRatio, density [kg/m^3], dampingAlpha [1/s]: the one list every front
+/// end sets them by.
 [[nodiscard]] std::span<const MaterialProperty> material_properties();
 
 /// The regions' names, quoted and comma separated, for messages: "skin", "tumour".
@@ -50,14 +53,15 @@ std::vector<Material> resolve_region_materials(const std::vector<MeshRegion>& re
 
 /// The region materials as written in the FMU's `material.regions` and by the other front ends:
 /// entries separated by ';', each `name: key=value, key=value` with the keys youngModulus [Pa],
-/// poissonRatio [1] and density [kg/m^3]; a key left out keeps `base`'s value. Whitespace around
+/// poissonRatio [1], density [kg/m^3] and dampingAlpha [1/s] (material_properties()); a key left out
+/// keeps `base`'s value (for dampingAlpha, usually unset: the body's damping.alpha). Whitespace around
 /// names, keys and values is ignored; an empty text, or "none", sets none. Throws ParameterError quoting the
 /// entry for a missing ':', an unknown or repeated key, a value that is not a finite number, an empty
 /// or repeated name, or a material out of range.
 std::vector<RegionMaterial> parse_region_materials(std::string_view text, const Material& base);
 
 /// The inverse of parse_region_materials (shortest round-trip numbers): `name: youngModulus=..,
-/// poissonRatio=.., density=..; ...`.
+/// poissonRatio=.., density=..[, dampingAlpha=..]; ...` (a property not set is left out).
 std::string format_region_materials(const std::vector<RegionMaterial>& materials);
 
 }  // namespace tissue

@@ -21,8 +21,12 @@ class DynamicsModel {
   [[nodiscard]] virtual int dof_count() const = 0;
   /// Lumped (diagonal) mass per unknown [kg].
   [[nodiscard]] virtual const Eigen::VectorXd& mass_kg() const = 0;
-  /// D = alpha M + beta K.
-  [[nodiscard]] virtual const RayleighDamping& damping() const = 0;
+  /// Rayleigh damping D = diag(mass_damping_kg_per_s()) + beta K (eq. 4.21): its mass part per
+  /// unknown [kg/s], alpha m lumped like the mass with each material's alpha (a body of one
+  /// material: alpha M), ...
+  [[nodiscard]] virtual const Eigen::VectorXd& mass_damping_kg_per_s() const = 0;
+  /// ... and beta [s], one for the whole model.
+  [[nodiscard]] virtual double stiffness_damping_s() const = 0;
   /// External force per unknown [N] (gravity; contact later).
   [[nodiscard]] virtual const Eigen::VectorXd& external_force_n() const = 0;
 

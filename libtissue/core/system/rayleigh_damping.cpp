@@ -1,16 +1,15 @@
 // Range checks of the Rayleigh damping parameters.
 #include "core/system/rayleigh_damping.hpp"
 
+#include "core/material/material.hpp"
+
 #include <cmath>
 #include <string>
 
 namespace tissue {
 
 void validate(const RayleighDamping& damping) {
-  if (!std::isfinite(damping.mass_damping_per_s) || damping.mass_damping_per_s < 0.0) {
-    throw ParameterError("damping: mass damping alpha must be finite and >= 0 1/s, got " +
-                         std::to_string(damping.mass_damping_per_s));
-  }
+  validate_mass_damping(damping.mass_damping_per_s);
   if (!std::isfinite(damping.stiffness_damping_s) || damping.stiffness_damping_s < 0.0) {
     throw ParameterError("damping: stiffness damping beta must be finite and >= 0 s, got " +
                          std::to_string(damping.stiffness_damping_s));

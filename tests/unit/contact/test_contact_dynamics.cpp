@@ -36,7 +36,7 @@ SettledPress press_and_hold(DeformableBody& body, const SurfaceMesh& surface, do
   SurfaceBvh bvh(surface.triangles, x);
   const double step_size_s = 1e-2;
   PointContact contact(
-      PointContactSettings{spring_n_per_m, undamped_tangent_fraction(step_size_s, body.damping().stiffness_damping_s)});
+      PointContactSettings{spring_n_per_m, undamped_tangent_fraction(step_size_s, body.stiffness_damping_s())});
   PointSpringTerm spring_term;
   body.attach(spring_term);
   Eigen::Vector3d hip_previous = hip_outside;

@@ -18,12 +18,14 @@ class Oscillators final : public DynamicsModel {
         m_tangent_fraction(tangent_fraction),
         m_damping(damping),
         m_mass(Eigen::VectorXd::Constant(3 * count, mass_kg)),
+        m_mass_damping(damping.mass_damping_per_s * m_mass),
         m_external(Eigen::VectorXd::Zero(3 * count)),
         m_tangent(diagonal_pattern(count)) {}
 
   int dof_count() const override { return static_cast<int>(m_mass.size()); }
   const Eigen::VectorXd& mass_kg() const override { return m_mass; }
-  const RayleighDamping& damping() const override { return m_damping; }
+  const Eigen::VectorXd& mass_damping_kg_per_s() const override { return m_mass_damping; }
+  double stiffness_damping_s() const override { return m_damping.stiffness_damping_s; }
   const Eigen::VectorXd& external_force_n() const override { return m_external; }
   void evaluate(const Eigen::VectorXd& u, Eigen::VectorXd& f, bool update_tangent) override {
     f = m_stiffness_n_per_m * u;
@@ -44,7 +46,7 @@ class Oscillators final : public DynamicsModel {
   double m_stiffness_n_per_m;
   double m_tangent_fraction;
   RayleighDamping m_damping;
-  Eigen::VectorXd m_mass, m_external;
+  Eigen::VectorXd m_mass, m_mass_damping, m_external;
   BlockSparseMatrix m_tangent;
 };
 

@@ -43,10 +43,9 @@ double relative_residual(DeformableBody& body, const DynamicState& start, const 
   body.evaluate(end.displacement_m, force, true);
   Eigen::VectorXd stiffness_times_velocity(body.dof_count());
   body.tangent().multiply(end.velocity_m_per_s, stiffness_times_velocity);
-  const RayleighDamping& d = body.damping();
   const Eigen::VectorXd residual =
-      h * (body.external_force_n() - force - d.mass_damping_per_s * body.mass_kg().cwiseProduct(end.velocity_m_per_s) -
-           d.stiffness_damping_s * stiffness_times_velocity) -
+      h * (body.external_force_n() - force - body.mass_damping_kg_per_s().cwiseProduct(end.velocity_m_per_s) -
+           body.stiffness_damping_s() * stiffness_times_velocity) -
       body.mass_kg().cwiseProduct(end.velocity_m_per_s - start.velocity_m_per_s);
   return residual.norm() / (h * body.external_force_n().norm());
 }

@@ -149,9 +149,15 @@ TEST(RegionMaterials, SetByNameReplacesTheFilesAndTheRestKeepTheirs) {
 
 TEST(RegionMaterials, TheTextFormRoundTripsAndMistakesNameTheRegion) {
   const Material body{1e5, 0.4, 1000.0};
-  const std::vector<RegionMaterial> parsed =
-      parse_region_materials(" tumour : youngModulus = 1e6 , poissonRatio=0.45; skin: density=1050 ;", body);
+  const std::vector<RegionMaterial> parsed = parse_region_materials(
+      " tumour : youngModulus = 1e6 , poissonRatio=0.45; skin: density=1050, dampingAlpha=3 ;", body);
   ASSERT_EQ(parsed.size(), 2u);
+  EXPECT_EQ(parsed[0].material.mass_damping_per_s, std::nullopt);  // not given: the body's damping.alpha
+  EXPECT_EQ(parsed[1].material.mass_damping_per_s, 3.0);
+  // A property not set is left out of the text.
+  EXPECT_EQ(format_region_materials(parsed),
+            "tumour: youngModulus=1e+06, poissonRatio=0.45, density=1000; skin: youngModulus=1e+05, "
+            "poissonRatio=0.4, density=1050, dampingAlpha=3");
   const std::vector<RegionMaterial> again = parse_region_materials(format_region_materials(parsed), body);
   ASSERT_EQ(again.size(), 2u);
   for (size_t k = 0; k < 2; ++k) {
@@ -159,6 +165,7 @@ TEST(RegionMaterials, TheTextFormRoundTripsAndMistakesNameTheRegion) {
     EXPECT_EQ(again[k].material.young_modulus_pa, parsed[k].material.young_modulus_pa);
     EXPECT_EQ(again[k].material.poisson_ratio, parsed[k].material.poisson_ratio);
     EXPECT_EQ(again[k].material.density_kg_per_m3, parsed[k].material.density_kg_per_m3);
+    EXPECT_EQ(again[k].material.mass_damping_per_s, parsed[k].material.mass_damping_per_s);
   }
   EXPECT_TRUE(parse_region_materials("  ", body).empty());
   EXPECT_TRUE(parse_region_materials("none", body).empty());
@@ -167,12 +174,15 @@ TEST(RegionMaterials, TheTextFormRoundTripsAndMistakesNameTheRegion) {
             "material.regions: \"tumour youngModulus=1e6\": expected 'name: key=value, ...'");
   EXPECT_EQ(refused("tumour: stiffness=1e6"),
             "material.regions: \"tumour: stiffness=1e6\": unknown key \"stiffness\" (youngModulus [Pa], poissonRatio, "
-            "density [kg/m^3])");
+            "density [kg/m^3], dampingAlpha [1/s])");
   EXPECT_EQ(refused("tumour: youngModulus=-5"),
             "material.regions: \"tumour: youngModulus=-5\": material: Young's modulus must be finite and > 0 Pa, got "
             "-5.000000");
   EXPECT_EQ(refused("tumour: poissonRatio=nan"),
             "material.regions: \"tumour: poissonRatio=nan\": poissonRatio: \"nan\" is not a finite number");
+  EXPECT_EQ(refused("tumour: dampingAlpha=-1"),
+            "material.regions: \"tumour: dampingAlpha=-1\": damping: mass damping alpha must be finite and >= 0 1/s, "
+            "got -1.000000");
   EXPECT_EQ(refused("a: density=1; a: density=2"), "material.regions: region \"a\" given twice");
   const std::vector<MeshRegion> regions{{"skin", std::nullopt}, {"tumour", std::nullopt}};
   EXPECT_EQ(

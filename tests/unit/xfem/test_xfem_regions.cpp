@@ -1,5 +1,5 @@
 // Cuts across materials (issue 25): a cut tet's pieces keep its region's material, and the piece a
-// complete cut frees carries the mass of its regions' densities exactly.
+// complete cut frees carries the mass of its regions' densities exactly, and their mass damping.
 #include "core/mesh/box_mesh.hpp"
 #include "xfem/xfem_test_helpers.hpp"
 
@@ -11,15 +11,17 @@ namespace {
 using xfem_test::Plane;
 
 constexpr double SOFT_DENSITY = 1000.0, STIFF_DENSITY = 2000.0, SIDE_M = 0.02;
+constexpr double BODY_ALPHA_PER_S = 3.0, STIFF_ALPHA_PER_S = 7.0;  // the soft region takes the body's
 
-// A 0.1 x 0.02 x 0.02 m beam held at x = 0: "soft" for x < 0.05, "stiff" (E 10x, twice as dense)
-// beyond.
+// A 0.1 x 0.02 x 0.02 m beam held at x = 0: "soft" for x < 0.05, "stiff" (E 10x, twice as dense,
+// its own mass damping) beyond.
 struct TwoMaterialBeam {
   TetMesh mesh = regions(make_box_mesh(10, 2, 2, 0.01));
   DeformableBody body{mesh, settings(mesh)};
 
   static TetMesh regions(TetMesh mesh) {
-    mesh.regions = {{"soft", Material{1.0e5, 0.3, SOFT_DENSITY}}, {"stiff", Material{1.0e6, 0.3, STIFF_DENSITY}}};
+    mesh.regions = {{"soft", Material{1.0e5, 0.3, SOFT_DENSITY}},
+                    {"stiff", Material{1.0e6, 0.3, STIFF_DENSITY, STIFF_ALPHA_PER_S}}};
     for (int t = 0; t < mesh.tet_count(); ++t) {
       double x = 0.0;
       for (const Eigen::Vector3d& corner : mesh.rest_corners(t)) x += 0.25 * corner.x();
@@ -29,16 +31,16 @@ struct TwoMaterialBeam {
   }
   static BodySettings settings(const TetMesh& mesh) {
     BodySettings s;
+    s.damping.mass_damping_per_s = BODY_ALPHA_PER_S;
     for (int v = 0; v < mesh.vertex_count(); ++v) {
       if (mesh.rest_positions_m[static_cast<size_t>(v)].x() < 1e-9) s.fixed_vertices.push_back(v);
     }
     return s;
   }
-  // The lumped mass of the free piece beyond a complete cut at x = cut_x (see
+  // The lumped `mass` (or mass damping) of the free piece beyond a complete cut at x = cut_x (see
   // XfemBeam.CompletelyCutPieceFallsFreely): the real vertices beyond, plus the ghosts of those
   // before (side -1), minus the ghosts of those beyond (side +1).
-  double free_piece_mass(double cut_x) const {
-    const Eigen::VectorXd& mass = body.mass_kg();
+  double free_piece_sum(double cut_x, const Eigen::VectorXd& mass) const {
     double total = 0.0;
     for (int row = 0; row < body.dofs().free_vertex_count(); ++row) {
       const int vertex = body.dofs().row_vertex[static_cast<size_t>(row)];
@@ -67,7 +69,13 @@ TEST(XfemRegions, CutPiecesKeepTheirTetsMaterialAndThePieceTheirDensities) {
     const double area = SIDE_M * SIDE_M;
     const double expected = cut_x > 0.05 ? STIFF_DENSITY * (0.1 - cut_x) * area
                                          : SOFT_DENSITY * (0.05 - cut_x) * area + STIFF_DENSITY * 0.05 * area;
-    EXPECT_NEAR(beam.free_piece_mass(cut_x), expected, 1e-12 * expected);
+    EXPECT_NEAR(beam.free_piece_sum(cut_x, beam.body.mass_kg()), expected, 1e-12 * expected);
+    // Its mass damping: alpha rho V of each region's part.
+    const double expected_damping = cut_x > 0.05 ? STIFF_ALPHA_PER_S * STIFF_DENSITY * (0.1 - cut_x) * area
+                                                 : BODY_ALPHA_PER_S * SOFT_DENSITY * (0.05 - cut_x) * area +
+                                                       STIFF_ALPHA_PER_S * STIFF_DENSITY * 0.05 * area;
+    EXPECT_NEAR(beam.free_piece_sum(cut_x, beam.body.mass_damping_kg_per_s()), expected_damping,
+                1e-12 * expected_damping);
   }
 }
 
