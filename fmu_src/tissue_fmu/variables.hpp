@@ -155,8 +155,9 @@ constexpr auto body_parameters() {
         .start("none")
         .describe("Materials by region name (the mesh's Vega *REGION sets, Gmsh physical groups or TetGen region "
                   "numbers), replacing the file's: \"name: youngModulus=1e6, poissonRatio=0.45, density=1050; "
-                  "name2: ...\"; a key left out takes material.*. A region neither the file nor this gives a "
-                  "material has material.*. \"none\": none"),
+                  "name2: ...\" (keys youngModulus [Pa], poissonRatio, density [kg/m^3], dampingAlpha [1/s]); a key "
+                  "left out takes material.* (dampingAlpha: damping.alpha). A region neither the file nor this gives "
+                  "a material has material.*. \"none\": none"),
     parameter(Vr::material_model, "material.model", enumeration)
         .declared_type("MaterialModel")
         .start("1")

@@ -7,6 +7,7 @@
 #include "core/integrate/backward_euler.hpp"
 #include "core/integrate/ida_integrator.hpp"
 #include "core/mesh/box_mesh.hpp"
+#include "support/two_regions.hpp"
 
 #include <gtest/gtest.h>
 
@@ -56,13 +57,8 @@ TEST(Conservation, FreeBodyWithoutGravityConservesLinearMomentum) {
 // step; measured 1.4e-7 with KLU, 1.1e-5 with GMRES, whose linear tolerance is looser). With the
 // regions' alphas ignored the body would slow at the body's alpha, 1 1/s: V would end 80 % higher.
 TEST(Conservation, ABodyOfTwoDampingsSlowsAtTheirMassWeightedMeanAlpha) {
-  TetMesh mesh = make_box_mesh(4, 2, 2, 0.005);
-  mesh.regions = {{"skin", std::nullopt}, {"tumour", std::nullopt}};
-  for (int t = 0; t < mesh.tet_count(); ++t) {
-    Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
-    for (const Eigen::Vector3d& corner : mesh.rest_corners(t)) centroid += 0.25 * corner;
-    mesh.tet_regions.push_back(centroid.x() < 0.01 ? 0 : 1);
-  }
+  const TetMesh mesh =
+      test::split_at_x(make_box_mesh(4, 2, 2, 0.005), 0.01, {"skin", std::nullopt}, {"tumour", std::nullopt});
   BodySettings settings;
   settings.material = {1.0e7, 0.4, 1000.0};
   settings.damping = {1.0, 1.0e-5};

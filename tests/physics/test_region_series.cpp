@@ -7,6 +7,7 @@
 #include "core/fixed_region.hpp"
 #include "core/mesh/box_mesh.hpp"
 #include "core/tissue.hpp"
+#include "support/two_regions.hpp"
 
 #include <gtest/gtest.h>
 
@@ -28,13 +29,8 @@ struct Stretches {
 Stretches simulated_stretches(double edge_m) {
   const int along = static_cast<int>(std::lround(2.0 * HALF_LENGTH_M / edge_m));
   const int across = static_cast<int>(std::lround(SIDE_M / edge_m));
-  TetMesh mesh = make_box_mesh(along, across, across, edge_m);
-  mesh.regions = {{"soft", std::nullopt}, {"stiff", std::nullopt}};
-  for (int t = 0; t < mesh.tet_count(); ++t) {
-    double x = 0.0;
-    for (const Eigen::Vector3d& corner : mesh.rest_corners(t)) x += 0.25 * corner.x();
-    mesh.tet_regions.push_back(x < HALF_LENGTH_M ? 0 : 1);
-  }
+  TetMesh mesh = test::split_at_x(make_box_mesh(along, across, across, edge_m), HALF_LENGTH_M, {"soft", std::nullopt},
+                                  {"stiff", std::nullopt});
   TissueSettings settings;
   settings.body.material = SOFT;  // what the regions are given by name replaces it
   settings.body.region_materials = {{"soft", SOFT}, {"stiff", STIFF}};

@@ -5,6 +5,7 @@
 #include "core/fem/corotational.hpp"
 #include "core/mesh/box_mesh.hpp"
 #include "core/system/assembly.hpp"
+#include "support/two_regions.hpp"
 
 #include <gtest/gtest.h>
 
@@ -18,14 +19,7 @@ const Material STIFF{1.0e6, 0.45, 1100.0};  // a tumour in soft tissue: E 10x, a
 
 // 3 x 2 x 2 cubes of 5 mm; the cubes with x < 5 mm are "soft", the others "stiff".
 TetMesh two_region_box() {
-  TetMesh mesh = make_box_mesh(3, 2, 2, 0.005);
-  mesh.regions = {{"soft", std::nullopt}, {"stiff", std::nullopt}};
-  for (int t = 0; t < mesh.tet_count(); ++t) {
-    Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
-    for (const Eigen::Vector3d& corner : mesh.rest_corners(t)) centroid += 0.25 * corner;
-    mesh.tet_regions.push_back(centroid.x() < 0.005 ? 0 : 1);
-  }
-  return mesh;
+  return test::split_at_x(make_box_mesh(3, 2, 2, 0.005), 0.005, {"soft", std::nullopt}, {"stiff", std::nullopt});
 }
 
 Eigen::VectorXd flatten(const std::vector<Eigen::Vector3d>& points) {

@@ -1,6 +1,7 @@
 // Cuts across materials (issue 25): a cut tet's pieces keep its region's material, and the piece a
 // complete cut frees carries the mass of its regions' densities exactly, and their mass damping.
 #include "core/mesh/box_mesh.hpp"
+#include "support/two_regions.hpp"
 #include "xfem/xfem_test_helpers.hpp"
 
 #include <gtest/gtest.h>
@@ -16,19 +17,10 @@ constexpr double BODY_ALPHA_PER_S = 3.0, STIFF_ALPHA_PER_S = 7.0;  // the soft r
 // A 0.1 x 0.02 x 0.02 m beam held at x = 0: "soft" for x < 0.05, "stiff" (E 10x, twice as dense,
 // its own mass damping) beyond.
 struct TwoMaterialBeam {
-  TetMesh mesh = regions(make_box_mesh(10, 2, 2, 0.01));
+  TetMesh mesh = test::split_at_x(make_box_mesh(10, 2, 2, 0.01), 0.05, {"soft", Material{1.0e5, 0.3, SOFT_DENSITY}},
+                                  {"stiff", Material{1.0e6, 0.3, STIFF_DENSITY, STIFF_ALPHA_PER_S}});
   DeformableBody body{mesh, settings(mesh)};
 
-  static TetMesh regions(TetMesh mesh) {
-    mesh.regions = {{"soft", Material{1.0e5, 0.3, SOFT_DENSITY}},
-                    {"stiff", Material{1.0e6, 0.3, STIFF_DENSITY, STIFF_ALPHA_PER_S}}};
-    for (int t = 0; t < mesh.tet_count(); ++t) {
-      double x = 0.0;
-      for (const Eigen::Vector3d& corner : mesh.rest_corners(t)) x += 0.25 * corner.x();
-      mesh.tet_regions.push_back(x < 0.05 ? 0 : 1);
-    }
-    return mesh;
-  }
   static BodySettings settings(const TetMesh& mesh) {
     BodySettings s;
     s.damping.mass_damping_per_s = BODY_ALPHA_PER_S;
