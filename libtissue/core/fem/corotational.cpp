@@ -314,6 +314,10 @@ double CorotationalElasticity::elastic_energy_j(const Eigen::VectorXd& positions
 }
 
 std::vector<double> lumped_vertex_sums(const TetMesh& mesh, std::span<const double> per_region_per_m3) {
+  if (per_region_per_m3.size() < static_cast<size_t>(mesh.region_count())) {
+    throw std::invalid_argument("lumped_vertex_sums: " + std::to_string(per_region_per_m3.size()) + " values for " +
+                                std::to_string(mesh.region_count()) + " regions");
+  }
   std::vector<double> sums(static_cast<size_t>(mesh.vertex_count()), 0.0);
   for (int t = 0; t < mesh.tet_count(); ++t) {
     const Tet& tet = mesh.tets[static_cast<size_t>(t)];
@@ -330,10 +334,6 @@ std::vector<double> lumped_vertex_sums(const TetMesh& mesh, std::span<const doub
 std::vector<double> lumped_vertex_masses(const TetMesh& mesh, const std::vector<Material>& materials) {
   std::vector<double> densities_kg_per_m3;
   for (const Material& material : materials) densities_kg_per_m3.push_back(material.density_kg_per_m3);
-  if (densities_kg_per_m3.size() < static_cast<size_t>(mesh.region_count())) {
-    throw std::invalid_argument("lumped_vertex_masses: " + std::to_string(materials.size()) + " materials for " +
-                                std::to_string(mesh.region_count()) + " regions");
-  }
   return lumped_vertex_sums(mesh, densities_kg_per_m3);
 }
 

@@ -151,7 +151,8 @@ class CorotationalElasticity {
 };
 
 /// Lumped per vertex as the mass is (eq. 4.15): each tet gives V / 4 times its region's
-/// `per_region_per_m3` to each of its vertices. One per vertex.
+/// `per_region_per_m3` to each of its vertices. One per vertex. Throws std::invalid_argument for fewer
+/// values than the mesh has regions.
 std::vector<double> lumped_vertex_sums(const TetMesh& mesh, std::span<const double> per_region_per_m3);
 
 /// Lumped mass: lumped_vertex_sums of each region's density (`materials` as for

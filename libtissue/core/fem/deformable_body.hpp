@@ -20,6 +20,7 @@
 #include "core/system/assembly.hpp"
 #include "core/system/block_sparse_matrix.hpp"
 #include "core/system/dynamics_model.hpp"
+#include "core/system/rayleigh_damping.hpp"
 #include "core/system/force_term.hpp"
 
 #include <Eigen/Core>

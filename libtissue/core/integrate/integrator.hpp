@@ -15,6 +15,7 @@
 //   section 4), so the contact asks the integrator instead of re-deriving its matrix.
 #pragma once
 
+#include "core/parameter_error.hpp"
 #include "core/solve/linear_solver.hpp"
 #include "core/system/dynamics_model.hpp"
 

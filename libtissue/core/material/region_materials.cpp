@@ -45,7 +45,7 @@ constexpr std::array<MaterialProperty, 4> PROPERTIES{{
      [](const Material& m) { return m.mass_damping_per_s; }},
 }};
 
-// "youngModulus [Pa], poissonRatio, density [kg/m^3]".
+// "youngModulus [Pa], poissonRatio, density [kg/m^3], dampingAlpha [1/s]".
 std::string property_keys_text() {
   std::string text;
   for (const MaterialProperty& property : PROPERTIES) {

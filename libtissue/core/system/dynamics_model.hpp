@@ -4,7 +4,6 @@
 #pragma once
 
 #include "core/system/block_sparse_matrix.hpp"
-#include "core/system/rayleigh_damping.hpp"
 #include "core/system/work_team.hpp"
 
 #include <Eigen/Core>

@@ -10,6 +10,7 @@
 #include <gtest/gtest.h>
 
 #include <numeric>
+#include <stdexcept>
 
 namespace tissue {
 namespace {
@@ -145,6 +146,9 @@ TEST(Regions, AMaterialCountThatDoesNotMatchTheRegionsIsRefused) {
   const TetMesh mesh = two_region_box();
   EXPECT_THROW(CorotationalElasticity(mesh, std::vector<Material>{SOFT}), ParameterError);
   EXPECT_THROW(CorotationalElasticity(mesh, std::vector<Material>{SOFT, Material{-1.0, 0.3, 1000.0}}), ParameterError);
+  // The lumped masses and mass damping take one value per region too.
+  EXPECT_THROW(lumped_vertex_masses(mesh, {SOFT}), std::invalid_argument);
+  EXPECT_THROW(lumped_vertex_sums(mesh, std::vector<double>{1.0}), std::invalid_argument);
 }
 
 }  // namespace

@@ -1,6 +1,7 @@
 // Backward Euler through the Integrator/DynamicsModel contract, on a model with an exact solution:
 // independent undamped oscillators M a + k u = 0 (one 3x3 block per mass, K = k I).
 #include "core/integrate/backward_euler.hpp"
+#include "core/system/rayleigh_damping.hpp"
 
 #include <gtest/gtest.h>
 
