@@ -10,18 +10,18 @@
 // the cut must be free to move.
 #pragma once
 
-#include "core/fem/tet_pieces.hpp"
-#include "core/fem/tet_cut.hpp"
 #include "core/fem/corotational.hpp"
-#include "core/material/material.hpp"
+#include "core/fem/tet_cut.hpp"
+#include "core/fem/tet_pieces.hpp"
 #include "core/fem/xfem_elasticity.hpp"
+#include "core/material/material.hpp"
 #include "core/mesh/tet_mesh.hpp"
 #include "core/mesh/topology.hpp"
 #include "core/system/assembly.hpp"
 #include "core/system/block_sparse_matrix.hpp"
 #include "core/system/dynamics_model.hpp"
-#include "core/system/rayleigh_damping.hpp"
 #include "core/system/force_term.hpp"
+#include "core/system/rayleigh_damping.hpp"
 
 #include <Eigen/Core>
 
@@ -29,6 +29,7 @@
 #include <cstdint>
 #include <optional>
 #include <span>
+#include <utility>
 #include <vector>
 
 namespace tissue {
@@ -79,7 +80,7 @@ struct CutTetGeometry {
 
 /// What an enrichment changed.
 struct EnrichmentResult {
-  int new_cut_tets = 0;  ///< cut tets made (one per cut, and those remade with other ghosts)
+  int new_cut_tets = 0;          ///< cut tets made (one per cut, and those remade with other ghosts)
   int new_enriched_dofs = 0;     ///< new block rows (3 unknowns each), appended at the end
   bool matrix_relayout = false;  ///< the tangent's storage was re-laid out (layout_revision() changed)
 };
@@ -203,9 +204,7 @@ class DeformableBody final : public DynamicsModel {
   void detach(ForceTerm& term);
   [[nodiscard]] const std::vector<ForceTerm*>& force_terms() const { return m_force_terms; }
   /// Where the mesh vertices sit in the tangent, for a term's checks and slots.
-  [[nodiscard]] TermLayout term_layout() const {
-    return {m_mesh.vertex_count(), m_dofs.vertex_row, &m_tangent};
-  }
+  [[nodiscard]] TermLayout term_layout() const { return {m_mesh.vertex_count(), m_dofs.vertex_row, &m_tangent}; }
 
   /// Forgets the rotation warm starts of all tets and parts (e.g. after a state was restored).
   void reset_rotations();
@@ -227,10 +226,10 @@ class DeformableBody final : public DynamicsModel {
 
  private:
   TetMesh m_mesh;
-  TetAdjacency m_adjacency;  // faces and vertex stars, for grouping the pieces' ghosts
+  TetAdjacency m_adjacency;         // faces and vertex stars, for grouping the pieces' ghosts
   std::vector<int> m_vertex_order;  // locality_order(): the block rows' and the assembly's sequence
   BodySettings m_settings;
-  std::vector<Material> m_materials;  // per region
+  std::vector<Material> m_materials;                // per region
   std::vector<double> m_region_mass_damping_per_s;  // per region
   DofMap m_dofs;
   CorotationalElasticity m_elasticity;
@@ -262,6 +261,24 @@ class DeformableBody final : public DynamicsModel {
   void check_cuts(std::span<const TetCut> cuts) const;
   EnrichmentResult enrich_pieces(std::span<const TetCut> cuts, std::span<const std::vector<TetPositions>> offsets_m,
                                  const Eigen::VectorXd* displacement_m);
+  // enrich_pieces' stages, in order (deformable_body_enrich.cpp; the ghosts: deformable_body_ghosts.cpp),
+  // and what they share (deformable_body_enrich.hpp).
+  struct EnrichBatch;
+  void plan_cuts(std::span<const TetCut> cuts, EnrichBatch& batch) const;
+  void plan_ghosts(int v, EnrichBatch& batch) const;
+  void collect_star_nodes(int v, std::span<const int> star, EnrichBatch& batch) const;
+  void collect_star_faces(std::span<const int> star, EnrichBatch& batch) const;
+  void join_star_pieces(std::span<const int> star, const std::vector<size_t>& members, EnrichBatch& batch) const;
+  void assign_ghost_rows(int v, const std::vector<size_t>& members, EnrichBatch& batch) const;
+  static void check_offsets(std::span<const std::vector<TetPositions>> offsets_m, const EnrichBatch& batch);
+  void append_ghost_rows(const EnrichBatch& batch);
+  void start_pieces(const EnrichBatch& batch, size_t c, std::span<const std::vector<TetPositions>> offsets_m,
+                    const Eigen::VectorXd* displacement_m, std::vector<CutPiece>& pieces,
+                    std::vector<Eigen::Matrix3d>& rotations) const;
+  int replace_cut_tet(EnrichBatch& batch, size_t c, const std::vector<CutPiece>& pieces,
+                      const std::vector<Eigen::Matrix3d>& rotations);
+  void list_coupled_blocks(int k, std::vector<std::pair<int, int>>& new_blocks) const;
+  void insert_coupled_blocks(std::vector<std::pair<int, int>>& new_blocks, int first_new_cut_tet);
   // Adds (sign +1) or removes (-1) what cut tet k's ghosts carry: rho w_p V / 4 of mass and gravity.
   void add_ghost_loads(int k, double sign);
   void check_unknowns(const Eigen::VectorXd& displacement_m) const;
@@ -277,12 +294,12 @@ class DeformableBody final : public DynamicsModel {
   std::vector<int> m_orphaned_rows;            // rows the last enrich() left unused
   int m_tets_cut = 0;
   double m_largest_shape_gradient_per_m = 0.0;  // max |grad(phi_i)| over the mesh: 1 / the lowest altitude
-  std::vector<int> m_first_enriched_dof;  // per vertex: first of its enriched unknowns, or -1
-  std::vector<int> m_next_enriched_dof;   // per enriched unknown: next one of the same vertex, or -1
-  std::vector<int> m_cut_index;           // per tet: index into cut_tets(), or -1
+  std::vector<int> m_first_enriched_dof;        // per vertex: first of its enriched unknowns, or -1
+  std::vector<int> m_next_enriched_dof;         // per enriched unknown: next one of the same vertex, or -1
+  std::vector<int> m_cut_index;                 // per tet: index into cut_tets(), or -1
 
-  std::vector<ForceTerm*> m_force_terms;  // attached, not owned
-  WorkTeam* m_team = nullptr;  // lent for a step (lend_work_team)
+  std::vector<ForceTerm*> m_force_terms;                // attached, not owned
+  WorkTeam* m_team = nullptr;                           // lent for a step (lend_work_team)
   mutable std::vector<Eigen::Matrix3d> m_block_frames;  // block_frames(): made on request
   mutable std::vector<Eigen::Matrix3d> m_vertex_frames;
   mutable std::vector<int> m_vertex_first_tet;

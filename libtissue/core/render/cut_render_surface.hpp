@@ -96,6 +96,16 @@ class CutRenderSurface {
     int piece = -1;    // its piece holding the point
   };
   [[nodiscard]] Point locate(const DeformableBody& body, int tet, const Eigen::Vector3d& rest_m) const;
+  // rebuild's stages: which surface vertices to locate again, and where (cut_render_locate.cpp); the
+  // skin split along the cuts (cut_render_split.cpp); the caps (cut_render_caps.cpp).
+  /// Marks the surface vertices on tets whose cut changed (or their neighbours) dirty and gives the
+  /// others their material parts; whether to re-mesh from scratch (then `dirty` is incomplete).
+  [[nodiscard]] bool mark_dirty_points(const DeformableBody& body, std::vector<char>& dirty,
+                                       std::vector<int>& part) const;
+  void relocate_points(const DeformableBody& body, const std::vector<char>& dirty, std::vector<int>& part);
+  void drop_moved_splits(const std::vector<char>& dirty);
+  void split_skin(const DeformableBody& body, const std::vector<char>& dirty, const std::vector<int>& part);
+  const std::array<int, 2>* split_edge(const DeformableBody& body, const std::vector<int>& uncut_part, int u, int v);
   void cap_loops(const DeformableBody& body);
   void find_material_parts(const DeformableBody& body);
   /// The nodes of the points (after the points are final): all of them after a re-mesh from scratch,

@@ -1,0 +1,585 @@
+// CutRenderSurface: the caps that close the openings of the split surface (the border loops): a
+// single cut's opening ear-clipped, otherwise faces walked along the chains of each cut and closed
+// across junction lines and crack fronts (cut_render_surface.hpp).
+#include "core/render/cut_render_surface.hpp"
+
+#include "core/render/cut_render_detail.hpp"
+
+#include <Eigen/Dense>
+
+#include <algorithm>
+#include <climits>
+#include <cmath>
+#include <cstddef>
+#include <limits>
+#include <map>
+#include <unordered_map>
+#include <unordered_set>
+#include <utility>
+
+namespace tissue {
+
+using cut_render_detail::directed_key;
+using cut_render_detail::edge_key;
+
+namespace {
+
+// Triangulates the closed polygon `loop` (point indices, positions `x`) by ear clipping in its
+// best-fit plane, each triangle wound as the polygon (counter-clockwise about its Newell normal),
+// never cutting along an edge the mesh has already (edge_exists(u, v), either way: it would then
+// have four triangles).
+template <typename EdgeExists>
+void ear_clip(const std::vector<int>& loop, const std::vector<Eigen::Vector3d>& x,
+              std::vector<std::array<int, 3>>& triangles, const EdgeExists& edge_exists) {
+  const size_t n = loop.size();
+  if (n < 3) return;
+  Eigen::Vector3d normal = Eigen::Vector3d::Zero();
+  for (size_t i = 0; i < n; ++i) {
+    normal += x[static_cast<size_t>(loop[i])].cross(x[static_cast<size_t>(loop[(i + 1) % n])]);
+  }
+  std::vector<int> left = loop;
+  if (normal.norm() <= 0.0) {  // no area: a fan closes it
+    for (size_t i = 1; i + 1 < n; ++i) triangles.push_back({loop[0], loop[i], loop[i + 1]});
+    return;
+  }
+  normal.normalize();
+  const Eigen::Vector3d e1 = normal.unitOrthogonal();
+  const Eigen::Vector3d e2 = normal.cross(e1);
+  // The loop's points in the plane, once, beside `left`.
+  std::vector<Eigen::Vector2d> flat(n);
+  for (size_t i = 0; i < n; ++i) {
+    const Eigen::Vector3d& p = x[static_cast<size_t>(loop[i])];
+    flat[i] = Eigen::Vector2d(p.dot(e1), p.dot(e2));
+  }
+  const auto cross = [](const Eigen::Vector2d& a, const Eigen::Vector2d& b, const Eigen::Vector2d& c) {
+    return (b - a).x() * (c - a).y() - (b - a).y() * (c - a).x();
+  };
+  // Only a corner that is not convex can lie inside a convex corner's triangle: the test of an ear
+  // looks at those (flagged, kept up to date for the two corners next to each ear cut).
+  const auto convex_at = [&](size_t i, size_t m) {
+    const Eigen::Vector2d& a = flat[(i + m - 1) % m];
+    const Eigen::Vector2d& b = flat[i];
+    const Eigen::Vector2d& c = flat[(i + 1) % m];
+    return cross(a, b, c) > 1e-9 * (b - a).norm() * (c - b).norm();
+  };
+  std::vector<char> convex(n);
+  for (size_t i = 0; i < n; ++i) convex[i] = convex_at(i, n) ? 1 : 0;
+  size_t from = 0;  // the search goes on where the last ear was cut
+  while (left.size() > 3) {
+    const size_t m = left.size();
+    size_t ear = m;
+    for (size_t k = 0; k < m && ear == m; ++k) {
+      const size_t i = (from + k) % m;
+      if (convex[i] == 0) continue;  // reflex or flat
+      const Eigen::Vector2d& a = flat[(i + m - 1) % m];
+      const Eigen::Vector2d& b = flat[i];
+      const Eigen::Vector2d& c = flat[(i + 1) % m];
+      if (m > 3 && edge_exists(left[(i + 1) % m], left[(i + m - 1) % m])) continue;  // a diagonal the mesh has
+      bool empty = true;
+      for (size_t j = 0; j < m && empty; ++j) {
+        if (convex[j] != 0 || j == i || j == (i + m - 1) % m || j == (i + 1) % m) continue;
+        const Eigen::Vector2d& p = flat[j];
+        empty = !(cross(a, b, p) > 0.0 && cross(b, c, p) > 0.0 && cross(c, a, p) > 0.0);
+      }
+      if (empty) ear = i;
+    }
+    // No clean ear (a degenerate loop): cut one anyway, the topology stays closed; one whose
+    // diagonal the mesh lacks, so that no edge gets four triangles (cutting the first corner along a
+    // surface edge made the complete-cut frog non-manifold in 4 frames under baseline x86-64).
+    for (size_t i = 0; i < m && ear == m; ++i) {
+      if (!edge_exists(left[(i + 1) % m], left[(i + m - 1) % m])) ear = i;
+    }
+    if (ear == m) ear = 0;
+    triangles.push_back({left[(ear + m - 1) % m], left[ear], left[(ear + 1) % m]});
+    left.erase(left.begin() + static_cast<std::ptrdiff_t>(ear));
+    flat.erase(flat.begin() + static_cast<std::ptrdiff_t>(ear));
+    convex.erase(convex.begin() + static_cast<std::ptrdiff_t>(ear));
+    const size_t before = (ear + m - 2) % (m - 1), after = ear % (m - 1);
+    convex[before] = convex_at(before, m - 1) ? 1 : 0;
+    convex[after] = convex_at(after, m - 1) ? 1 : 0;
+    from = after;
+  }
+  triangles.push_back({left[0], left[1], left[2]});
+}
+
+// The border loops of a split surface from its directed edges at split points (a border edge has
+// no twin), each in the order its cap runs them (against the skin).
+std::vector<std::vector<int>> border_loops(const std::unordered_map<long long, int>& directed) {
+  std::vector<std::pair<int, int>> next;  // border edges u -> v, sorted
+  for (const auto& [edge, uses] : directed) {
+    const auto u = static_cast<int>(edge >> 32), v = static_cast<int>(edge & 0xffffffffLL);
+    if (!directed.contains(directed_key(v, u))) next.emplace_back(u, v);
+  }
+  std::sort(next.begin(), next.end());
+  std::vector<char> used(next.size(), 0);
+  // The first unused border edge from `at` (next.size(): none).
+  const auto from = [&](int at) {
+    for (auto i =
+             static_cast<size_t>(std::lower_bound(next.begin(), next.end(), std::pair{at, INT_MIN}) - next.begin());
+         i < next.size() && next[i].first == at; ++i) {
+      if (used[i] == 0) return i;
+    }
+    return next.size();
+  };
+  std::vector<std::vector<int>> loops;
+  for (size_t first = 0; first < next.size(); ++first) {
+    if (used[first] != 0) continue;
+    std::vector<int> loop;
+    const int start = next[first].first;
+    int at = start;
+    while (true) {
+      const size_t i = from(at);
+      if (i == next.size()) break;
+      loop.push_back(at);
+      at = next[i].second;
+      used[i] = 1;
+      if (at == start) break;
+    }
+    std::reverse(loop.begin(), loop.end());
+    loops.push_back(std::move(loop));
+  }
+  return loops;
+}
+
+// A loop's points' cuts (-1: a surface vertex, a crack tip). Where two cuts meet on the surface the
+// points next to the junction may be split by either, so a run shorter than JUNCTION_RUN points
+// between two other runs takes a neighbour's cut (the longer's); a tip between two runs of one cut
+// (a slit's) stays.
+std::vector<int> junction_smoothed(std::vector<int> label) {
+  constexpr size_t JUNCTION_RUN = 4;
+  const size_t n = label.size();
+  for (bool changed = true; changed;) {
+    changed = false;
+    for (size_t i = 0; i < n && !changed; ++i) {
+      if (label[(i + n - 1) % n] == label[i]) continue;  // not a run's start
+      size_t length = 1;
+      while (length < n && label[(i + length) % n] == label[i]) ++length;
+      if (length >= JUNCTION_RUN || length == n) continue;
+      const int before = label[(i + n - 1) % n], after = label[(i + length) % n];
+      if (label[i] < 0 && before == after) continue;  // a slit's tip
+      if (before < 0 && after < 0) continue;
+      size_t before_length = 1, after_length = 1;
+      while (before_length < n && label[(i + n - 1 - before_length) % n] == before) ++before_length;
+      while (after_length < n && label[(i + length + after_length) % n] == after) ++after_length;
+      const int into = after < 0 || (before >= 0 && before_length >= after_length) ? before : after;
+      for (size_t k = 0; k < length; ++k) label[(i + k) % n] = into;
+      changed = true;
+    }
+  }
+  return label;
+}
+
+// A maximal run of a loop's points split by one cut.
+struct Chain {
+  int loop, first, last;  // positions in the loop
+  int cut;
+  int facing;  // the side of the cut the chain's material lies on (majority of its points)
+};
+
+// How a chain's end continues to the next chain of its face: the points in between.
+struct Link {
+  std::vector<int> bridge;
+  int next_first = -1;  // first point of the next chain; -1: the face cannot be closed
+};
+
+// A crack tip (surface points between two chains of one cut, where a partial cut ends): usually one
+// unsplit surface vertex; with a run of split points no piece sides (the front meeting the surface
+// obliquely) more.
+struct Tip {
+  size_t chain;                  // the chain ending at the tip
+  std::vector<int> run;          // the points up to the next chain; the front starts at the last
+  int first_after;               // the next chain's first point
+  int part, cut, before, after;  // before, after: the facings of the chains either side
+  [[nodiscard]] int point() const { return run.back(); }
+};
+
+// The junctions' switch pairs (forward, backward): of the chains ending at a switch between two
+// cuts, keyed by (material part, cut lo, cut hi, facing on lo, facing on hi), the two whose switches
+// run opposite ways, forward leaving the lower cut. A key without exactly such a pair gets none.
+std::vector<std::pair<size_t, size_t>> paired_switches(
+    const std::map<std::array<int, 5>, std::vector<size_t>>& switches, const std::vector<Chain>& chains) {
+  std::vector<std::pair<size_t, size_t>> pairs;
+  for (const auto& [junction, ends] : switches) {
+    if (ends.size() != 2) continue;
+    size_t forward = ends[0], backward = ends[1];
+    if (chains[forward].cut != junction[1]) std::swap(forward, backward);
+    if (chains[forward].cut != junction[1] || chains[backward].cut != junction[2]) continue;
+    pairs.emplace_back(forward, backward);
+  }
+  return pairs;
+}
+
+// The crack fronts' tip pairs: each tip with the nearest unpaired tip of the same material part and
+// cut whose loop turns the other way (its facings swapped).
+std::vector<std::pair<size_t, size_t>> paired_tips(const std::vector<Tip>& tips,
+                                                   const std::vector<Eigen::Vector3d>& rest_m) {
+  std::vector<std::pair<size_t, size_t>> pairs;
+  std::vector<bool> paired(tips.size(), false);
+  for (size_t a = 0; a < tips.size(); ++a) {
+    if (paired[a]) continue;
+    size_t best = tips.size();
+    double nearest = std::numeric_limits<double>::infinity();
+    for (size_t b = 0; b < tips.size(); ++b) {
+      if (b == a || paired[b] || tips[b].part != tips[a].part || tips[b].cut != tips[a].cut ||
+          tips[b].before != tips[a].after || tips[b].after != tips[a].before)
+        continue;
+      const double distance =
+          (rest_m[static_cast<size_t>(tips[a].point())] - rest_m[static_cast<size_t>(tips[b].point())]).norm();
+      if (distance < nearest) {
+        nearest = distance;
+        best = b;
+      }
+    }
+    if (best == tips.size()) continue;
+    paired[a] = paired[best] = true;
+    pairs.emplace_back(a, best);
+  }
+  return pairs;
+}
+
+// The faces: chain, link, chain, ... back to the first. Returns how many walks did not close.
+int walk_faces(const std::vector<std::vector<int>>& loops, const std::vector<Chain>& chains,
+               const std::map<size_t, Link>& link, const std::map<int, size_t>& chain_starting_at,
+               std::vector<std::vector<int>>& faces) {
+  int open = 0;
+  std::vector<bool> used(chains.size(), false);
+  for (size_t first = 0; first < chains.size(); ++first) {
+    if (used[first]) continue;
+    std::vector<int> face;
+    size_t at = first;
+    bool closed = false;
+    for (size_t guard = 0; guard <= chains.size(); ++guard) {
+      used[at] = true;
+      const Chain& chain = chains[at];
+      const std::vector<int>& loop = loops[static_cast<size_t>(chain.loop)];
+      for (size_t i = static_cast<size_t>(chain.first);; i = (i + 1) % loop.size()) {
+        face.push_back(loop[i]);
+        if (i == static_cast<size_t>(chain.last)) break;
+      }
+      const auto out = link.find(at);
+      if (out == link.end() || out->second.next_first < 0) break;
+      face.insert(face.end(), out->second.bridge.begin(), out->second.bridge.end());
+      const auto following = chain_starting_at.find(out->second.next_first);
+      if (following == chain_starting_at.end()) break;
+      if (following->second == first) {
+        closed = true;
+        break;
+      }
+      at = following->second;
+      if (used[at]) break;
+    }
+    if (closed) {
+      faces.push_back(std::move(face));
+    } else {
+      ++open;
+    }
+  }
+  return open;
+}
+
+using SimpleCaps =
+    std::map<std::vector<int>, std::vector<std::array<int, 3>>>;  // loop (from its smallest point) -> cap
+
+// The edges a cap must not run along (ear_clip's edge_exists): the split surface's directed edges at
+// its split points (a border edge has no twin), the caps' edges so far and the surface's own.
+struct CapEdges {
+  std::unordered_map<long long, int> directed;   // (u, v) -> count
+  std::unordered_set<long long> caps;            // (lower, higher) of the caps' edges so far
+  const std::unordered_set<long long>& surface;  // the surface's own edges
+  int vertices;                                  // the surface's vertices: the points below
+
+  bool operator()(int u, int v) const {
+    const long long undirected = edge_key(u, v);
+    if (caps.contains(undirected)) return true;
+    if (u < vertices && v < vertices) return surface.contains(undirected);
+    return directed.contains(directed_key(u, v)) || directed.contains(directed_key(v, u));
+  }
+  void add(const std::array<int, 3>& triangle) {
+    for (size_t k = 0; k < 3; ++k) {
+      const int u = triangle[k], v = triangle[(k + 1) % 3];
+      caps.insert(edge_key(u, v));
+    }
+  }
+};
+
+// The directed edges of the split surface at its split points. (An edge between two of the surface's
+// own vertices keeps both its triangles: it is never a border.)
+void find_split_edges(const std::vector<std::array<int, 3>>& triangles, size_t point_count, CapEdges& edges) {
+  const int vertices = edges.vertices;
+  edges.directed.reserve(8 * (point_count - static_cast<size_t>(vertices)) + 64);
+  for (const auto& [a, b, c] : triangles) {
+    if (a < vertices && b < vertices && c < vertices) continue;
+    for (const auto& [u, v] : {std::pair{a, b}, std::pair{b, c}, std::pair{c, a}}) {
+      if (u >= vertices || v >= vertices) ++edges.directed[directed_key(u, v)];
+    }
+  }
+  edges.caps.reserve(edges.directed.size() + 64);
+}
+
+// Caps a polygon (ear_clip), its edges added to `edges`.
+void cap_polygon(const std::vector<int>& polygon, const std::vector<Eigen::Vector3d>& rest_m,
+                 std::vector<std::array<int, 3>>& triangles, CapEdges& edges) {
+  const size_t before = triangles.size();
+  ear_clip(polygon, rest_m, triangles, edges);
+  for (size_t t = before; t < triangles.size(); ++t) edges.add(triangles[t]);
+}
+
+// The cap of a loop on one cut, the opening of a piece cut free by one plane. The same loop as at the
+// last re-mesh (same points, which an incremental re-mesh keeps) gets its cap as it was (`last`,
+// unless from scratch); `caps` keeps it for the next.
+void cap_single_cut_loop(const std::vector<int>& loop, const SimpleCaps& last, bool from_scratch,
+                         const std::vector<Eigen::Vector3d>& rest_m, std::vector<std::array<int, 3>>& triangles,
+                         CapEdges& edges, SimpleCaps& caps) {
+  std::vector<int> key_points(loop);
+  std::rotate(key_points.begin(), std::min_element(key_points.begin(), key_points.end()), key_points.end());
+  const auto kept = from_scratch ? last.end() : last.find(key_points);
+  const size_t before = triangles.size();
+  if (kept != last.end()) {
+    for (const auto& triangle : kept->second) {
+      triangles.push_back(triangle);
+      edges.add(triangle);
+    }
+  } else {
+    cap_polygon(loop, rest_m, triangles, edges);
+  }
+  caps.emplace(std::move(key_points), std::vector<std::array<int, 3>>(
+                                          triangles.begin() + static_cast<std::ptrdiff_t>(before), triangles.end()));
+}
+
+// The loops' points' cuts (junction_smoothed). A run of one cut whose points lie on no side of it
+// (they ride on uncut tets: split only because their ends lie in two material parts) between two
+// unsplit points is where the crack front meets the surface obliquely: unlabelled, it becomes part of
+// the tip around it. facing(point, cut): as in cap_loops.
+template <typename Facing>
+std::vector<std::vector<int>> loop_labels(const std::vector<std::vector<int>>& loops, const std::vector<int>& point_cut,
+                                          const Facing& facing) {
+  std::vector<std::vector<int>> labels;
+  for (const std::vector<int>& loop : loops) {
+    std::vector<int> cuts;
+    for (const int point : loop) cuts.push_back(point_cut[static_cast<size_t>(point)]);
+    labels.push_back(junction_smoothed(std::move(cuts)));
+  }
+  for (size_t l = 0; l < loops.size(); ++l) {
+    std::vector<int>& label = labels[l];
+    const size_t n = label.size();
+    for (size_t i = 0; i < n; ++i) {
+      if (label[i] < 0 || label[(i + n - 1) % n] >= 0) continue;
+      size_t j = i;
+      int votes = 0;
+      while (label[(j + 1) % n] == label[i] && j + 1 < i + n) {
+        votes += std::abs(facing(loops[l][j % n], label[i]));
+        ++j;
+      }
+      votes += std::abs(facing(loops[l][j % n], label[i]));
+      if (votes == 0 && label[(j + 1) % n] < 0 && j + 1 < i + n) {
+        for (size_t k = i; k <= j; ++k) label[k % n] = -1;
+      }
+    }
+  }
+  return labels;
+}
+
+// Loop l's chains: maximal runs of points split by one cut, each facing the side of its cut where
+// the material of most of its points lies.
+template <typename Facing>
+void add_chains(size_t l, const std::vector<int>& loop, const std::vector<int>& label, const Facing& facing,
+                std::vector<Chain>& chains, std::map<int, size_t>& chain_starting_at) {
+  const size_t n = loop.size();
+  const auto cut_at = [&](size_t i) { return label[i % n]; };
+  for (size_t i = 0; i < n; ++i) {
+    if (cut_at(i) < 0 || cut_at(i + n - 1) == cut_at(i)) continue;
+    size_t j = i;
+    int votes = 0;
+    while (cut_at(j + 1) == cut_at(i) && j + 1 < i + n) {
+      votes += facing(loop[j % n], cut_at(i));
+      ++j;
+    }
+    votes += facing(loop[j % n], cut_at(i));
+    chains.push_back(Chain{static_cast<int>(l), static_cast<int>(i), static_cast<int>(j % n), cut_at(i),
+                           votes > 0 ? 1 : (votes < 0 ? -1 : 0)});
+    chain_starting_at[loop[i]] = chains.size() - 1;
+  }
+}
+
+// The point `steps` after a chain's last in its loop, and that point's label.
+int point_after(const std::vector<std::vector<int>>& loops, const Chain& chain, int steps) {
+  const std::vector<int>& loop = loops[static_cast<size_t>(chain.loop)];
+  return loop[(static_cast<size_t>(chain.last) + static_cast<size_t>(steps)) % loop.size()];
+}
+int label_after(const std::vector<std::vector<int>>& labels, const Chain& chain, int steps) {
+  const std::vector<int>& label = labels[static_cast<size_t>(chain.loop)];
+  return label[(static_cast<size_t>(chain.last) + static_cast<size_t>(steps)) % label.size()];
+}
+
+// How the chains' ends continue. Switches (two cuts meet: a junction line through the body between
+// the two switches of one part and cut pair that run opposite ways) and tips (a partial cut: a crack
+// front between two tips of one part and cut whose loops turn opposite ways, nearest first).
+struct ChainEnds {
+  std::map<size_t, Link> link;  // the points to add and the chain to go on with
+  // (part, cut lo, cut hi, facing on lo, facing on hi: the quadrant) -> the chains ending there
+  std::map<std::array<int, 5>, std::vector<size_t>> switches;
+  std::vector<Tip> tips;
+};
+
+// Each chain's end: at a switch, a tip, or (the material on one side before and after) going on
+// through the surface points between it and the next chain. part_of_point(point): its material part.
+template <typename PartOf>
+ChainEnds find_chain_ends(const std::vector<std::vector<int>>& loops, const std::vector<std::vector<int>>& labels,
+                          const std::vector<Chain>& chains, const std::map<int, size_t>& chain_starting_at,
+                          const PartOf& part_of_point) {
+  ChainEnds ends;
+  std::map<size_t, Link>& link = ends.link;
+  std::map<std::array<int, 5>, std::vector<size_t>>& switches = ends.switches;
+  std::vector<Tip>& tips = ends.tips;
+  for (size_t c = 0; c < chains.size(); ++c) {
+    const Chain& chain = chains[c];
+    const int beyond = point_after(loops, chain, 1);
+    const int beyond_cut = label_after(labels, chain, 1);
+    if (beyond_cut >= 0) {
+      const auto after = chain_starting_at.find(beyond);
+      if (after == chain_starting_at.end()) continue;
+      const int after_facing = chains[after->second].facing;
+      const bool up = chain.cut < beyond_cut;
+      switches[{part_of_point(beyond), std::min(chain.cut, beyond_cut), std::max(chain.cut, beyond_cut),
+                up ? chain.facing : after_facing, up ? after_facing : chain.facing}]
+          .push_back(c);
+    } else {
+      std::vector<int> run{beyond};  // the unsplit points up to the next chain
+      const auto length = static_cast<int>(loops[static_cast<size_t>(chain.loop)].size());
+      int steps = 2;
+      for (; steps <= length && label_after(labels, chain, steps) < 0; ++steps)
+        run.push_back(point_after(loops, chain, steps));
+      // (The next chain may be this one: a loop of one chain and its run.)
+      const auto after = chain_starting_at.find(point_after(loops, chain, steps));
+      if (steps > length || after == chain_starting_at.end() || chains[after->second].cut != chain.cut) continue;
+      const int after_facing = chains[after->second].facing;
+      if ((chain.facing != 0 && after_facing == chain.facing) || after->second == c) {
+        // Not where a cut ends: the material lies on one side before and after (or the loop is this
+        // chain and its run alone: a pocket), the loop only passes surface points the split left on
+        // the border (their edges' tests disagreed). The face goes on through them.
+        link[c] = Link{run, point_after(loops, chain, steps)};
+        continue;
+      }
+      tips.push_back(Tip{c, run, point_after(loops, chain, steps), part_of_point(run.back()), chain.cut, chain.facing,
+                         after_facing});
+    }
+  }
+  return ends;
+}
+
+// The lines between paired switches: the lower cut's face takes both switch edges and the line; the
+// higher cut's runs it back. line_points(from, to): new points between two.
+template <typename LinePoints>
+void bridge_switches(const std::vector<std::vector<int>>& loops, const std::vector<Chain>& chains,
+                     const LinePoints& line_points, ChainEnds& ends) {
+  std::map<size_t, Link>& link = ends.link;
+  for (const auto& [forward, backward] : paired_switches(ends.switches, chains)) {
+    const int line_start = point_after(loops, chains[forward], 1);  // on the higher cut
+    const int line_end = loops[static_cast<size_t>(chains[backward].loop)][static_cast<size_t>(chains[backward].last)];
+    const std::vector<int> line = line_points(line_start, line_end);
+    Link& out = link[forward];
+    out.bridge.push_back(line_start);
+    out.bridge.insert(out.bridge.end(), line.begin(), line.end());
+    out.bridge.push_back(line_end);
+    out.next_first = point_after(loops, chains[backward], 1);  // back on the lower cut
+    Link& back = link[backward];
+    back.bridge.assign(line.rbegin(), line.rend());
+    back.next_first = line_start;
+  }
+}
+
+// The crack fronts between paired tips.
+template <typename LinePoints>
+void bridge_tips(const std::vector<Eigen::Vector3d>& rest_m, const LinePoints& line_points, ChainEnds& ends) {
+  std::map<size_t, Link>& link = ends.link;
+  const std::vector<Tip>& tips = ends.tips;
+  for (const auto& [a, best] : paired_tips(tips, rest_m)) {
+    std::vector<int> front = line_points(tips[a].point(), tips[best].point());  // one crack front for both walls
+    for (const auto& [from, to] : {std::pair{a, best}, std::pair{best, a}}) {
+      // The wall's own tip run, the front, the other tip's front end; then the chain after it.
+      Link& out = link[tips[from].chain];
+      out.bridge = tips[from].run;
+      out.bridge.insert(out.bridge.end(), front.begin(), front.end());
+      out.bridge.push_back(tips[to].point());
+      out.next_first = tips[to].first_after;
+      std::reverse(front.begin(), front.end());
+    }
+  }
+}
+
+}  // namespace
+
+int CutRenderSurface::add_point_like(int model, const Eigen::Vector3d& rest_m) {
+  const Point& like = m_points[static_cast<size_t>(model)];
+  m_points.push_back(
+      Point{like.tet, barycentric_weights(m_mesh.rest_corners(like.tet), rest_m), like.cut_tet, like.piece});
+  m_rest_m.push_back(rest_m);
+  m_point_cut.push_back(-1);
+  return static_cast<int>(m_points.size()) - 1;
+}
+
+std::vector<int> CutRenderSurface::line_points(int from, int to) {
+  // Interior points about JOIN_SPACING_M apart on the straight rest segment; each half rides on the
+  // cell of its nearer end (exact under that piece's rigid motion).
+  constexpr double JOIN_SPACING_M = 0.0015;
+  const Eigen::Vector3d a = m_rest_m[static_cast<size_t>(from)];
+  const Eigen::Vector3d b = m_rest_m[static_cast<size_t>(to)];
+  // At least one point: the line must not coincide with an edge the skin may already have.
+  const int segments = std::max(2, static_cast<int>(std::ceil((b - a).norm() / JOIN_SPACING_M)));
+  std::vector<int> points;
+  for (int k = 1; k < segments; ++k) {
+    const double s = static_cast<double>(k) / segments;
+    points.push_back(add_point_like(s < 0.5 ? from : to, a + s * (b - a)));
+  }
+  return points;
+}
+
+void CutRenderSurface::cap_loops(const DeformableBody& body) {
+  CapEdges edges{{}, {}, m_surface_edges, static_cast<int>(m_surface.vertices_m.size())};
+  find_split_edges(m_triangles, m_points.size(), edges);
+  const std::vector<std::vector<int>> loops = border_loops(edges.directed);
+  SimpleCaps simple_caps;  // this re-mesh's, for the next
+  const size_t surface_triangles = m_triangles.size();
+  m_open_loops = 0;
+  const auto part_of_point = [&](int point) { return part_of(body, m_points[static_cast<size_t>(point)]); };
+  // Which side of cut `cut` the material of a point's piece lies on (+1 above, -1 below, 0 unknown:
+  // a point riding on an uncut tet).
+  const auto facing = [&](int point, int cut) {
+    const Point& at = m_points[static_cast<size_t>(point)];
+    if (at.cut_tet < 0) return 0;
+    const CutTetGeometry& geometry = body.cut_geometry(at.cut_tet);
+    for (size_t c = 0; c < geometry.cuts.size(); ++c) {
+      if (geometry.cuts[c].cut_id != cut) continue;
+      return (geometry.pieces[static_cast<size_t>(at.piece)].sides.above & (1u << c)) != 0 ? 1 : -1;
+    }
+    return 0;
+  };
+
+  // Chains: maximal runs of points split by one cut, in loops that are not a single plane's opening.
+  std::vector<Chain> chains;
+  std::map<int, size_t> chain_starting_at;  // first point -> chain
+  const std::vector<std::vector<int>> labels = loop_labels(loops, m_point_cut, facing);
+  for (size_t l = 0; l < loops.size(); ++l) {
+    const std::vector<int>& loop = loops[l];
+    const size_t n = loop.size();
+    const auto cut_at = [&](size_t i) { return labels[l][i % n]; };
+    bool simple = true;
+    for (size_t i = 0; i < n && simple; ++i) simple = cut_at(i) >= 0 && cut_at(i) == cut_at(0);
+    if (simple) {  // the opening of a piece cut free by one plane
+      cap_single_cut_loop(loop, m_simple_caps, m_from_scratch, m_rest_m, m_triangles, edges, simple_caps);
+      continue;
+    }
+    add_chains(l, loop, labels[l], facing, chains, chain_starting_at);
+  }
+  ChainEnds ends = find_chain_ends(loops, labels, chains, chain_starting_at, part_of_point);
+  const auto line = [&](int from, int to) { return line_points(from, to); };
+  bridge_switches(loops, chains, line, ends);
+  bridge_tips(m_rest_m, line, ends);
+  std::vector<std::vector<int>> faces;
+  m_open_loops += walk_faces(loops, chains, ends.link, chain_starting_at, faces);
+  for (const std::vector<int>& face : faces) cap_polygon(face, m_rest_m, m_triangles, edges);
+  m_cap_triangles = static_cast<int>(m_triangles.size() - surface_triangles);
+  m_simple_caps = std::move(simple_caps);
+}
+
+}  // namespace tissue

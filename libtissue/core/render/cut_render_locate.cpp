@@ -1,0 +1,133 @@
+// CutRenderSurface: which cell (tet, and piece of a cut tet) each surface point rides on, the
+// material parts the cells make, and which points a re-mesh must locate again.
+#include "core/render/cut_render_surface.hpp"
+
+#include <Eigen/Dense>
+
+#include <algorithm>
+#include <limits>
+#include <numeric>
+
+namespace tissue {
+
+namespace {
+
+// How far `p` lies outside piece `piece` of a cut tet (the largest distance beyond the planes that
+// bound it; <= 0 inside). [m]
+double outside_piece_m(const CutTetGeometry& geometry, size_t piece, const Eigen::Vector3d& p) {
+  const PieceSides& sides = geometry.pieces[piece].sides;
+  double outside = -std::numeric_limits<double>::infinity();
+  for (size_t c = 0; c < geometry.cuts.size(); ++c) {
+    if ((sides.bounded & (1u << c)) == 0) continue;
+    const double toward_inside = (sides.above & (1u << c)) != 0 ? 1.0 : -1.0;
+    outside = std::max(outside, -toward_inside * geometry.planes[c].signed_distance(p));
+  }
+  return outside;
+}
+
+}  // namespace
+
+CutRenderSurface::Point CutRenderSurface::locate(const DeformableBody& body, int tet,
+                                                 const Eigen::Vector3d& rest_m) const {
+  Point point{tet, barycentric_weights(m_mesh.rest_corners(tet), rest_m), body.cut_tet_index(tet), -1};
+  if (point.cut_tet < 0) return point;
+  const CutTetGeometry& geometry = body.cut_geometry(point.cut_tet);
+  double best = std::numeric_limits<double>::infinity();
+  for (size_t q = 0; q < geometry.pieces.size(); ++q) {
+    const double outside = outside_piece_m(geometry, q, rest_m);
+    if (outside < best) {
+      best = outside;
+      point.piece = static_cast<int>(q);
+    }
+  }
+  return point;
+}
+
+void CutRenderSurface::find_material_parts(const DeformableBody& body) {
+  // Union-find over the copies of the vertices (real: the vertex id; ghost: vertex count + its row),
+  // joined within each cell.
+  const int vertex_count = m_mesh.vertex_count();
+  m_copy_root.resize(static_cast<size_t>(vertex_count) + static_cast<size_t>(body.dof_count() / 3));
+  std::iota(m_copy_root.begin(), m_copy_root.end(), 0);
+  const auto find = [&](int i) {
+    while (m_copy_root[static_cast<size_t>(i)] != i) {
+      i = m_copy_root[static_cast<size_t>(i)] = m_copy_root[static_cast<size_t>(m_copy_root[static_cast<size_t>(i)])];
+    }
+    return i;
+  };
+  for (int t = 0; t < m_mesh.tet_count(); ++t) {
+    const int k = body.cut_tet_index(t);
+    const int pieces = k < 0 ? 1 : static_cast<int>(body.xfem().piece_count(k));
+    for (int p = 0; p < pieces; ++p) {
+      const int first = find(copy_of(body, t, k, p, 0));
+      for (size_t j = 1; j < 4; ++j) m_copy_root[static_cast<size_t>(find(copy_of(body, t, k, p, j)))] = first;
+    }
+  }
+  for (size_t i = 0; i < m_copy_root.size(); ++i) m_copy_root[i] = find(static_cast<int>(i));
+}
+
+int CutRenderSurface::copy_of(const DeformableBody& body, int tet, int cut_tet, int piece, size_t j) const {
+  const int vertex = m_mesh.tets[static_cast<size_t>(tet)][j];
+  if (cut_tet < 0) return vertex;
+  const int row = body.xfem().piece(cut_tet, piece).ghost_row[j];
+  return row < 0 ? vertex : m_mesh.vertex_count() + row;
+}
+
+int CutRenderSurface::part_of(const DeformableBody& body, const Point& point) const {
+  return m_copy_root[static_cast<size_t>(copy_of(body, point.tet, point.cut_tet, point.piece, 0))];
+}
+
+// Incremental: only what rides on a tet whose cut changed since the last re-mesh, or on one of its
+// face neighbours (whose cut planes an edge's split may use), is located and split again; every
+// other edge keeps its split points and every other triangle its pieces. From scratch the first
+// time, when the material parts of the unchanged points regrouped (a piece came free: an uncut
+// edge may now be cut anywhere), and when dropped split points pile up.
+bool CutRenderSurface::mark_dirty_points(const DeformableBody& body, std::vector<char>& dirty,
+                                         std::vector<int>& part) const {
+  const size_t vertices = m_surface.vertices_m.size();
+  const auto tet_count = static_cast<size_t>(m_mesh.tet_count());
+  bool scratch = m_tet_cut.size() != tet_count || m_orphan_points > static_cast<int>(vertices) / 4;
+  std::vector<char> dirty_tet(tet_count, scratch ? 1 : 0);
+  for (size_t t = 0; t < tet_count && !scratch; ++t) {
+    if (body.cut_tet_index(static_cast<int>(t)) == m_tet_cut[t]) continue;
+    dirty_tet[t] = 1;
+    for (const int n : body.adjacency().face_neighbor[t]) {
+      if (n >= 0) dirty_tet[static_cast<size_t>(n)] = 1;
+    }
+  }
+  if (!scratch) {
+    // The unchanged points' parts must group them as before: old and new part ids in one-to-one
+    // correspondence over them.
+    std::vector<int> old_to_new(m_part_ids, -1), new_to_old(m_copy_root.size(), -1);
+    for (size_t v = 0; v < vertices && !scratch; ++v) {
+      dirty[v] = dirty_tet[static_cast<size_t>(m_embedding[v].tet)];
+      if (dirty[v] != 0) continue;
+      part[v] = part_of(body, m_points[v]);
+      int& to_new = old_to_new[static_cast<size_t>(m_vertex_part[v])];
+      int& to_old = new_to_old[static_cast<size_t>(part[v])];
+      if (to_new < 0) to_new = part[v];
+      if (to_old < 0) to_old = m_vertex_part[v];
+      scratch = to_new != part[v] || to_old != m_vertex_part[v];
+    }
+  }
+  return scratch;
+}
+
+// Locates the dirty surface vertices again (their cells) and gives them their material parts.
+void CutRenderSurface::relocate_points(const DeformableBody& body, const std::vector<char>& dirty,
+                                       std::vector<int>& part) {
+  const size_t vertices = m_surface.vertices_m.size();
+  const auto locate_vertex = [&](size_t v) {
+    const SurfaceEmbedding& e = m_embedding[v];
+    m_points[v] =
+        body.cut_tet_index(e.tet) < 0 ? Point{e.tet, e.weights, -1, -1} : locate(body, e.tet, m_surface.vertices_m[v]);
+  };
+  for (size_t v = 0; v < vertices; ++v) {
+    if (dirty[v] != 0) {
+      locate_vertex(v);
+      part[v] = part_of(body, m_points[v]);
+    }
+  }
+}
+
+}  // namespace tissue
