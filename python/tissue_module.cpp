@@ -6,11 +6,11 @@
 // and restore the state as bytes. Errors come back as Python exceptions with the core's message:
 // ValueError for a bad setting or pose, RuntimeError for a failed step or a state that cannot be
 // restored. The core's arrays are copied out (numpy owns them), so nothing dangles after a step.
-#include "core/fixed_region.hpp"
 #include "core/mesh/box_mesh.hpp"
 #include "core/mesh/mesh_io.hpp"
 #include "core/material/region_materials.hpp"
 #include "core/tissue.hpp"
+#include "core/tissue_settings_schema.hpp"
 #include "core/tissue_snapshot_io.hpp"
 #include "device/scripted_device.hpp"
 #include "fmi3/value_store.hpp"
@@ -68,36 +68,67 @@ std::string tool_mode_name(ToolMode mode) {
   return mode == ToolMode::probe ? "probe" : mode == ToolMode::scalpel ? "scalpel" : "none";
 }
 
-// The keyword arguments of the constructor and their defaults (the one place they are written).
-struct Options {
-  std::string mesh = "frog";
+// The keyword arguments Python sets in its own way; the others are the settings schema's Python
+// keywords (core/tissue_settings_schema.hpp), with its defaults.
+struct PythonOnly {
   std::optional<std::array<int, 3>> box_cells;  // a box of cubes instead of a mesh
   double box_edge_m = 0.01;
-  std::optional<std::vector<int>> fixed_vertices;
-  int fixed_axis = 0;
-  double fixed_fraction = 0.01;
-  double young_modulus_pa = 1e5;
-  double poisson_ratio = 0.4;
-  double density_kg_per_m3 = 1000.0;
-  std::string material_model{to_string(MaterialModel::corotational_linear)};  // parse_material_model's names
-  double damping_alpha_per_s = 1.0;
-  double damping_beta_s = 1e-3;
-  std::array<double, 3> gravity_m_per_s2{0.0, 0.0, -9.81};
-  double step_size_s = 1e-3;
-  std::string integrator = "backward-euler";
-  std::string linear_solver = "pcg";
-  double pcg_tolerance = 1e-3;
-  int pcg_max_iterations = 10;
-  int threads = 1;
-  bool contact = true;
-  bool cutting = true;
-  double blade_length_m = 0.03;
-  double probe_radius_m = 0.0;
-  std::string render_surface;  // "" none, "frog" the embedded frog's, else an OBJ file
+  std::optional<std::vector<int>> fixed_vertices;  // instead of the fixed slab
   /// Materials by region name (issue 25): {"tumour": {"young_modulus_pa": 1e6, ...}}; a key left out
   /// keeps the body's value (young_modulus_pa, poisson_ratio, density_kg_per_m3, damping_alpha_per_s).
   std::map<std::string, std::map<std::string, double>> regions;
 };
+
+// A keyword's value as the schema's type, or TypeError.
+SettingValue python_value(const SettingInfo& setting, const py::handle& value) {
+  const auto wrong = [&]() -> py::type_error {
+    return py::type_error(std::string(setting.python_keyword) + " must be " +
+                          (setting.type == SettingType::vector3 ? "three numbers" : "of another type") + ", got " +
+                          std::string(py::str(py::type::of(value).attr("__name__"))));
+  };
+  try {
+    switch (setting.type) {
+      case SettingType::real:
+        if (py::isinstance<py::bool_>(value)) throw wrong();
+        return value.cast<double>();
+      case SettingType::integer:
+        if (py::isinstance<py::bool_>(value) || py::isinstance<py::float_>(value)) throw wrong();
+        return value.cast<std::int64_t>();
+      case SettingType::boolean:
+        if (!py::isinstance<py::bool_>(value)) throw wrong();
+        return value.cast<bool>();
+      case SettingType::vector3:
+        return value.cast<std::array<double, 3>>();
+      case SettingType::enumeration:
+      case SettingType::text:
+        if (!py::isinstance<py::str>(value)) throw wrong();
+        return value.cast<std::string>();
+    }
+  } catch (const py::cast_error&) {
+    throw wrong();
+  }
+  throw wrong();
+}
+
+// The constructor's documentation: the Python keywords and the schema's keywords with their types,
+// units, defaults and ranges.
+std::string tissue_doc() {
+  std::string doc =
+      "A tissue. Keyword arguments only (SI units), every one optional:\n"
+      "  box=(nx, ny, nz): a box of cubes of box_edge_m (default 0.01 m) instead of the mesh\n"
+      "  fixed_vertices=[...]: the fixed vertices by index, instead of fixed_axis and fixed_fraction\n"
+      "  regions={name: {young_modulus_pa, poisson_ratio, density_kg_per_m3, damping_alpha_per_s}}: the "
+      "materials of the mesh file's regions by name\n";
+  for (const SettingInfo& setting : TISSUE_SETTINGS) {
+    if (setting.python_keyword.empty()) continue;
+    doc += "  " + std::string(setting.python_keyword) + "=" + to_text(start_value(setting));
+    if (setting.type == SettingType::enumeration) doc += " (" + list_names(setting.items) + ")";
+    if (!setting.unit.empty() && setting.unit != "1") doc += " [" + std::string(setting.unit) + "]";
+    if (const std::string range = range_text(setting); !range.empty()) doc += " " + range;
+    doc += ": " + std::string(setting.description) + "\n";
+  }
+  return doc;
+}
 
 // The regions' materials the `regions` argument sets, on top of the body's material.
 std::vector<RegionMaterial> region_materials(const std::map<std::string, std::map<std::string, double>>& regions,
@@ -125,37 +156,46 @@ std::vector<RegionMaterial> region_materials(const std::map<std::string, std::ma
 class PyTissue {
  public:
   explicit PyTissue(std::unique_ptr<Tissue> tissue) : m_tissue(std::move(tissue)) {}
-  explicit PyTissue(const Options& options) {
-    TetMesh mesh = options.box_cells ? make_box_mesh((*options.box_cells)[0], (*options.box_cells)[1],
-                                                     (*options.box_cells)[2], options.box_edge_m)
-                                     : load_mesh(options.mesh);
-    TissueSettings settings;
-    BodySettings& body = settings.body;
-    body.material = Material{options.young_modulus_pa, options.poisson_ratio, options.density_kg_per_m3};
-    body.region_materials = region_materials(options.regions, body.material);
-    body.material_model = parse_material_model(options.material_model);
-    body.damping = RayleighDamping{options.damping_alpha_per_s, options.damping_beta_s};
-    body.gravity_m_per_s2 = to_vector3(options.gravity_m_per_s2);
-    if (options.fixed_vertices) {
-      body.fixed_vertices = *options.fixed_vertices;
-    } else {
-      if (options.fixed_axis < 0 || options.fixed_axis > 2) throw ParameterError("fixed_axis must be 0, 1 or 2");
-      body.fixed_vertices = vertices_at_minimum(mesh, options.fixed_axis, options.fixed_fraction);
-    }
-    settings.step_size_s = options.step_size_s;
-    settings.integrator.kind = parse_integrator_kind(options.integrator);
-    settings.integrator.threads = options.threads;
-    settings.solver.kind = parse_linear_solver_kind(options.linear_solver);
-    settings.solver.pcg = PcgSolver::Settings{options.pcg_tolerance, options.pcg_max_iterations};
-    InteractionSettings& interaction = settings.interaction;
-    interaction.contact_enabled = options.contact;
-    interaction.cutting_enabled = options.cutting;
-    interaction.blade_length_m = options.blade_length_m;
-    interaction.probe_radius_m = options.probe_radius_m;
-    if (!options.render_surface.empty()) {
-      settings.render_surface = std::make_shared<const TriangleSurface>(load_render_surface(options.render_surface));
+  PyTissue(const TissueParameters& parameters, const PythonOnly& extra) {
+    TetMesh mesh = extra.box_cells ? make_box_mesh((*extra.box_cells)[0], (*extra.box_cells)[1],
+                                                   (*extra.box_cells)[2], extra.box_edge_m)
+                                   : load_mesh(parameters.mesh);
+    TissueParameters resolved = parameters;
+    if (extra.fixed_vertices) resolved.fixed_axis = -1;
+    TissueSettings settings = resolve_settings(resolved, &mesh);
+    if (extra.fixed_vertices) settings.body.fixed_vertices = *extra.fixed_vertices;
+    if (!extra.regions.empty()) settings.body.region_materials = region_materials(extra.regions, settings.body.material);
+    if (parameters.render_surface != NO_RENDER_SURFACE) {
+      settings.render_surface = std::make_shared<const TriangleSurface>(load_render_surface(parameters.render_surface));
     }
     m_tissue = std::make_unique<Tissue>(std::move(mesh), settings);
+  }
+
+  // From keyword arguments: the Python-only ones, then the schema's.
+  static PyTissue from_keywords(const py::kwargs& keywords) {
+    PythonOnly extra;
+    TissueParameters parameters = default_parameters();
+    for (const auto& [key, value] : keywords) {
+      const std::string name = py::str(key);
+      if (name == "box") {
+        if (!value.is_none()) extra.box_cells = value.cast<std::array<int, 3>>();
+      } else if (name == "box_edge_m") {
+        extra.box_edge_m = value.cast<double>();
+      } else if (name == "fixed_vertices") {
+        if (!value.is_none()) extra.fixed_vertices = value.cast<std::vector<int>>();
+      } else if (name == "regions") {
+        extra.regions = value.cast<std::map<std::string, std::map<std::string, double>>>();
+      } else if (const SettingInfo* setting = find_python_setting(name)) {
+        try {
+          set_value(*setting, parameters, python_value(*setting, value));
+        } catch (const ParameterError& error) {  // named as Python names it, then as the FMU does
+          throw ParameterError(name + ": " + error.what());
+        }
+      } else {
+        throw py::type_error("Tissue() got an unexpected keyword argument '" + name + "' (help(tissue.Tissue) lists them)");
+      }
+    }
+    return {parameters, extra};
   }
 
   void set_tool(const std::array<double, 3>& position_m, const std::array<double, 4>& orientation_wxyz,
@@ -425,7 +465,6 @@ class PyScenario {
 
 PYBIND11_MODULE(tissue, m) {
   using namespace tissue;
-  using tissue::python::Options;
   using tissue::python::PyTissue;
   m.doc() = "Real-time deformable tissue: co-rotational FEM, XFEM cutting, probe contact (SI units)";
   py::register_exception<ParameterError>(m, "ParameterError", PyExc_ValueError);
@@ -434,62 +473,13 @@ PYBIND11_MODULE(tissue, m) {
   py::register_exception<host::ScenarioError>(m, "ScenarioError", PyExc_ValueError);
   py::register_exception<fmi3::VariableError>(m, "VariableError", PyExc_ValueError);
 
-  const Options d;  // the keyword arguments' defaults
+  static const std::string tissue_constructor_doc = python::tissue_doc();
   py::class_<PyTissue>(m, "Tissue")
-      .def(py::init([](const std::string& mesh, std::optional<std::array<int, 3>> box, double box_edge_m,
-                       std::optional<std::vector<int>> fixed_vertices, int fixed_axis, double fixed_fraction,
-                       double young_modulus_pa, double poisson_ratio, double density_kg_per_m3,
-                       const std::string& material_model, double damping_alpha_per_s, double damping_beta_s,
-                       std::array<double, 3> gravity_m_per_s2,
-                       double step_size_s, const std::string& integrator, const std::string& linear_solver,
-                       double pcg_tolerance, int pcg_max_iterations, int threads, bool contact, bool cutting,
-                       double blade_length_m, double probe_radius_m, const std::string& render_surface,
-                       std::map<std::string, std::map<std::string, double>> regions) {
-             Options o;
-             o.mesh = mesh;
-             o.box_cells = box;
-             o.box_edge_m = box_edge_m;
-             o.fixed_vertices = std::move(fixed_vertices);
-             o.fixed_axis = fixed_axis;
-             o.fixed_fraction = fixed_fraction;
-             o.young_modulus_pa = young_modulus_pa;
-             o.poisson_ratio = poisson_ratio;
-             o.density_kg_per_m3 = density_kg_per_m3;
-             o.material_model = material_model;
-             o.damping_alpha_per_s = damping_alpha_per_s;
-             o.damping_beta_s = damping_beta_s;
-             o.gravity_m_per_s2 = gravity_m_per_s2;
-             o.step_size_s = step_size_s;
-             o.integrator = integrator;
-             o.linear_solver = linear_solver;
-             o.pcg_tolerance = pcg_tolerance;
-             o.pcg_max_iterations = pcg_max_iterations;
-             o.threads = threads;
-             o.contact = contact;
-             o.cutting = cutting;
-             o.blade_length_m = blade_length_m;
-             o.probe_radius_m = probe_radius_m;
-             o.render_surface = render_surface;
-             o.regions = std::move(regions);
-             return PyTissue(o);
+      .def(py::init([](const py::args& args, const py::kwargs& keywords) {
+             if (!args.empty()) throw py::type_error("Tissue() takes keyword arguments only");
+             return PyTissue::from_keywords(keywords);
            }),
-           py::kw_only(), py::arg("mesh") = d.mesh, py::arg("box") = py::none(), py::arg("box_edge_m") = d.box_edge_m,
-           py::arg("fixed_vertices") = py::none(), py::arg("fixed_axis") = d.fixed_axis,
-           py::arg("fixed_fraction") = d.fixed_fraction, py::arg("young_modulus_pa") = d.young_modulus_pa,
-           py::arg("poisson_ratio") = d.poisson_ratio, py::arg("density_kg_per_m3") = d.density_kg_per_m3,
-           py::arg("material_model") = d.material_model,
-           py::arg("damping_alpha_per_s") = d.damping_alpha_per_s, py::arg("damping_beta_s") = d.damping_beta_s,
-           py::arg("gravity_m_per_s2") = d.gravity_m_per_s2, py::arg("step_size_s") = d.step_size_s,
-           py::arg("integrator") = d.integrator, py::arg("linear_solver") = d.linear_solver,
-           py::arg("pcg_tolerance") = d.pcg_tolerance, py::arg("pcg_max_iterations") = d.pcg_max_iterations,
-           py::arg("threads") = d.threads, py::arg("contact") = d.contact, py::arg("cutting") = d.cutting,
-           py::arg("blade_length_m") = d.blade_length_m, py::arg("probe_radius_m") = d.probe_radius_m,
-           py::arg("render_surface") = d.render_surface, py::arg("regions") = d.regions,
-           "A tissue: mesh 'frog' (embedded) or a file path, or box=(nx, ny, nz) cubes of box_edge_m; fixed "
-           "vertices by index, or those within fixed_fraction of the extent from the minimum along fixed_axis; "
-           "render_surface 'frog' (the embedded frog's fine surface) or an OBJ file to draw, riding on the tets; "
-           "regions {name: {young_modulus_pa, poisson_ratio, density_kg_per_m3}} sets the materials of the mesh "
-           "file's regions by name")
+           tissue_constructor_doc.c_str())
       .def("set_tool", &PyTissue::set_tool, py::arg("position_m"),
            py::arg("orientation_wxyz") = std::array<double, 4>{1.0, 0.0, 0.0, 0.0}, py::arg("mode") = "probe",
            "The tool pose for the next step: position [m], unit quaternion (w, x, y, z; the tool's axis is its "

@@ -44,26 +44,26 @@ void add_scene_options(CLI::App& app, SceneOptions& options) {
       ->capture_default_str();
   app.add_option("--steps", options.steps, "Number of time steps")->capture_default_str();
   app.add_option("--dt", options.step_size_s, "Time step [s]")->capture_default_str();
-  app.add_option("--solver", options.solver, "Linear solver: " + std::string(linear_solver_names()))
+  app.add_option("--solver", options.solver, "Linear solver: " + LINEAR_SOLVER_NAMES.names())
       ->capture_default_str();
-  app.add_option("--tolerance", options.tolerance, "PCG (and pcg-cholesky) relative residual tolerance")
+  app.add_option("--tolerance", options.tolerance, "PCG (and pcgCholesky) relative residual tolerance")
       ->capture_default_str();
   app.add_flag("--double-matrix", options.double_matrix,
                "PCG products stream A in double precision (default: single for tolerances >= 1e-5; sums in double)");
-  app.add_option("--max-iterations", options.max_iterations, "PCG (and pcg-cholesky) iteration cap")
+  app.add_option("--max-iterations", options.max_iterations, "PCG (and pcgCholesky) iteration cap")
       ->capture_default_str();
   app.add_option("--refresh-iterations", options.refresh.refresh_iterations,
-                 "pcg-cholesky: a solve needing more iterations starts a refactorization")
+                 "pcgCholesky: a solve needing more iterations starts a refactorization")
       ->capture_default_str();
   app.add_option("--pickup-setups", options.refresh.pickup_setups,
-                 "pcg-cholesky: a refactorization is used this many solver setups after it started")
+                 "pcgCholesky: a refactorization is used this many solver setups after it started")
       ->capture_default_str();
   app.add_flag("!--no-background-refactor", options.refresh.background_refactor,
-               "pcg-cholesky: refactorize at pick-up in the stepping thread instead of a worker thread");
+               "pcgCholesky: refactorize at pick-up in the stepping thread instead of a worker thread");
   app.add_flag("--follow-rotations", options.refresh.follow_rotations,
-               "pcg-cholesky: turn the lagged factor with the vertices' rotations since it was made");
+               "pcgCholesky: turn the lagged factor with the vertices' rotations since it was made");
   app.add_flag("!--no-refactor-on-growth", options.refresh.refactor_on_growth,
-               "pcg-cholesky: when a cut grows the system, Jacobi on the new rows until a refresh lands "
+               "pcgCholesky: when a cut grows the system, Jacobi on the new rows until a refresh lands "
                "(default: factorize at once)");
   app.add_flag("--warm-start", options.warm_start, "PCG starts from the previous step's velocity change");
   app.add_option("--young", options.material.young_modulus_pa, "Young's modulus [Pa]")->capture_default_str();

@@ -27,7 +27,7 @@ struct SceneOptions {
   double tolerance = 1e-6;
   int max_iterations = 10000;
   bool double_matrix = false;  ///< PCG products in double precision (MatrixPrecision)
-  /// pcg-cholesky's refresh rules; the benches ask for the worker thread unless told not to.
+  /// pcgCholesky's refresh rules; the benches ask for the worker thread unless told not to.
   CholeskyPcgSolver::Refresh refresh = with_background_refactor();
   bool warm_start = false;
   Material material{1.0e5, 0.4, 1000.0};

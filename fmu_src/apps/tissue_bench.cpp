@@ -18,7 +18,7 @@ nlohmann::ordered_json summary_json(const Summary& s) {
   return {{"median", s.median}, {"p90", s.p90}, {"max", s.max}};
 }
 
-// pcg-cholesky's counters (how often its lagged factor was rebuilt), when that is the solver.
+// pcgCholesky's counters (how often its lagged factor was rebuilt), when that is the solver.
 void add_lagged_factor(const tissue::Tissue& tissue, nlohmann::ordered_json& out) {
   const auto* integrator = dynamic_cast<const tissue::BackwardEuler*>(&tissue.integrator());
   const auto* solver =

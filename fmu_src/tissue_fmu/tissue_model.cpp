@@ -1,7 +1,7 @@
 // TissueModel (see tissue_model.hpp).
 #include "tissue_fmu/tissue_model.hpp"
 
-#include "core/fixed_region.hpp"
+#include "core/tissue_settings_schema.hpp"
 #include "core/tissue_snapshot_io.hpp"
 #include "resources/default_mesh.hpp"
 
@@ -30,81 +30,43 @@ struct TissueState final : fmi3::ModelState {
   std::uint64_t integrator_iterations = 0;
 };
 
-LinearSolverKind linear_solver(std::int64_t item) {
-  switch (item) {
-    case 1:
-      return LinearSolverKind::pcg;
-    case 3:
-      return LinearSolverKind::pcg_cholesky;
-    default:
-      return LinearSolverKind::cholmod;
+// A setting's value as the store holds it (an enumeration's item number as the item's name).
+SettingValue stored_value(const ValueStore& values, const SettingInfo& setting) {
+  const fmi3::ValueReference ref = setting.value_reference;
+  switch (setting.type) {
+    case SettingType::real:
+      return values.float64(ref);
+    case SettingType::integer:
+      return static_cast<std::int64_t>(values.int32(ref));
+    case SettingType::boolean:
+      return values.boolean(ref);
+    case SettingType::vector3: {
+      const std::span<const double> v = values.float64_array(ref);
+      return std::array<double, 3>{v[0], v[1], v[2]};
+    }
+    case SettingType::enumeration: {
+      const std::int64_t item = values.int64(ref);
+      if (item < 1 || static_cast<std::size_t>(item) > setting.items.size()) {
+        throw VariableError(std::string(setting.name) + " has no item " + std::to_string(item));
+      }
+      return std::string(setting.items[static_cast<std::size_t>(item - 1)].name);
+    }
+    case SettingType::text:
+      return values.string(ref);
   }
-}
-
-IntegratorKind integrator_kind(std::int64_t item) {
-  return item == 1 ? IntegratorKind::backward_euler : IntegratorKind::ida;
-}
-
-IdaLinearSolverKind ida_linear_solver(std::int64_t item) {
-  return item == 1 ? IdaLinearSolverKind::klu : IdaLinearSolverKind::krylov;
-}
-
-MaterialModel material_model(std::int64_t item) {
-  return item == 1 ? MaterialModel::corotational_linear : MaterialModel::stable_neo_hookean;
-}
-
-ContactStiffnessModel stiffness_model(std::int64_t item) {
-  return item == 1 ? ContactStiffnessModel::effective_static : ContactStiffnessModel::element_local;
+  return values.string(ref);
 }
 
 }  // namespace
 
+TissueParameters tissue_parameters(const ValueStore& values) {
+  TissueParameters parameters;
+  for (const SettingInfo& setting : TISSUE_SETTINGS) set_value(setting, parameters, stored_value(values, setting));
+  return parameters;
+}
+
 TissueSettings tissue_settings(const ValueStore& values, const TetMesh* mesh) {
-  TissueSettings s;
-  s.body.material.young_modulus_pa = values.float64(vr(Vr::young_modulus));
-  s.body.material.poisson_ratio = values.float64(vr(Vr::poisson_ratio));
-  s.body.material.density_kg_per_m3 = values.float64(vr(Vr::density));
-  s.body.region_materials = parse_region_materials(values.string(vr(Vr::material_regions)), s.body.material);
-  s.body.material_model = material_model(values.int64(vr(Vr::material_model)));
-  s.body.damping.mass_damping_per_s = values.float64(vr(Vr::damping_alpha));
-  s.body.damping.stiffness_damping_s = values.float64(vr(Vr::damping_beta));
-  const std::span<const double> gravity = values.float64_array(vr(Vr::gravity));
-  s.body.gravity_m_per_s2 = Eigen::Vector3d(gravity[0], gravity[1], gravity[2]);
-  const int axis = values.int32(vr(Vr::fixed_axis));
-  if (axis != -1) {
-    const MinimumSlab slab{axis, values.float64(vr(Vr::fixed_fraction))};
-    validate(slab);
-    if (mesh != nullptr) s.body.fixed_vertices = vertices_at_minimum(*mesh, slab.axis, slab.fraction);
-  }
-  s.integrator.kind = integrator_kind(values.int64(vr(Vr::integrator_method)));
-  IdaSettings& ida = s.integrator.ida;
-  ida.relative_tolerance = values.float64(vr(Vr::ida_relative_tolerance));
-  ida.absolute_tolerance = values.float64(vr(Vr::ida_absolute_tolerance));
-  ida.max_order = values.int32(vr(Vr::ida_max_order));
-  ida.max_step_s = values.float64(vr(Vr::ida_max_step));
-  ida.linear_solver = ida_linear_solver(values.int64(vr(Vr::ida_linear_solver)));
-  s.solver.kind = linear_solver(values.int64(vr(Vr::linear_solver)));
-  s.solver.pcg = PcgSolver::Settings{values.float64(vr(Vr::pcg_tolerance)), values.int32(vr(Vr::pcg_max_iterations))};
-  s.solver.warm_start = values.boolean(vr(Vr::warm_start));
-  // No FMI switch says an importer allows threads: none unless the user asks (integrator.threads; a
-  // step's team lives for the step only), and no refactorization worker (pcgCholesky refactorizes at
-  // pick-up in the calling thread, the same results; DESIGN "Threads"; the contact stiffness's worker
-  // only when contact.stiffnessInBackground asks for it).
-  s.integrator.threads = values.int32(vr(Vr::step_threads));
-  s.step_size_s = values.float64(vr(Vr::step_size));
-  InteractionSettings& i = s.interaction;
-  i.contact_enabled = values.boolean(vr(Vr::contact_enabled));
-  i.cutting_enabled = values.boolean(vr(Vr::cutting_enabled));
-  i.blade_length_m = values.float64(vr(Vr::blade_length));
-  i.cutter.min_volume_fraction = values.float64(vr(Vr::min_volume_fraction));
-  i.contact_spring_stiffness_n_per_m = values.float64(vr(Vr::contact_spring_stiffness));
-  i.contact_stiffness_model = stiffness_model(values.int64(vr(Vr::contact_stiffness_model)));
-  i.contact_stiffness_refresh_steps = values.int32(vr(Vr::contact_stiffness_refresh_steps));
-  i.contact_stiffness_in_background = values.boolean(vr(Vr::contact_stiffness_in_background));
-  i.max_tool_speed_m_per_s = values.float64(vr(Vr::tool_max_speed));
-  i.probe_radius_m = values.float64(vr(Vr::probe_radius));
-  validate(s);
-  return s;
+  return resolve_settings(tissue_parameters(values), mesh);
 }
 
 ToolPose tool_pose(const ValueStore& values) {
@@ -129,13 +91,10 @@ void TissueModel::validate_parameters(const ValueStore& values) const {
                           " must be in [1, 2^26], got " + std::to_string(rows));
     }
   }
-  if (!(values.float64(vr(Vr::contact_near_margin)) >= 0.0)) {
-    throw VariableError("contact.nearMargin must be >= 0 m, got " + std::to_string(values.float64(vr(Vr::contact_near_margin))));
-  }
 }
 
 void TissueModel::update_near_surface() {
-  m_near = near_surface(*m_tissue, m_values.float64(vr(Vr::contact_near_margin)), m_near_hits);
+  m_near = near_surface(*m_tissue, m_near_margin_m, m_near_hits);
 }
 
 // --- the model ---
@@ -156,7 +115,8 @@ std::string resolve_path(const std::string& name, const char* what, const std::s
 }  // namespace
 
 std::unique_ptr<Tissue> make_tissue(const ValueStore& values, const std::string& resource_path) {
-  const std::string& name = values.string(vr(Vr::mesh));
+  const TissueParameters parameters = tissue_parameters(values);
+  const std::string& name = parameters.mesh;
   if (name.empty()) throw VariableError("mesh must be a non-empty name or path");
   TetMesh mesh;
   if (name == DEFAULT_MESH_NAME) {
@@ -168,8 +128,8 @@ std::unique_ptr<Tissue> make_tissue(const ValueStore& values, const std::string&
       throw VariableError("mesh '" + name + "' cannot be loaded: " + error.what());
     }
   }
-  TissueSettings settings = tissue_settings(values, &mesh);
-  if (const std::string& render = values.string(vr(Vr::render_surface)); render != NO_RENDER_SURFACE) {
+  TissueSettings settings = resolve_settings(parameters, &mesh);
+  if (const std::string& render = parameters.render_surface; render != NO_RENDER_SURFACE) {
     try {
       TriangleSurface surface = load_render_surface(
           render == DEFAULT_MESH_NAME ? render : resolve_path(render, "surface.renderSurface", resource_path));
@@ -184,6 +144,7 @@ std::unique_ptr<Tissue> make_tissue(const ValueStore& values, const std::string&
 
 void TissueModel::build() {
   m_tissue = make_tissue(m_values, m_context.resource_path);
+  m_near_margin_m = tissue_parameters(m_values).contact_near_margin_m;
   m_tissue->set_tool(tool_pose(m_values));
   m_dirty = false;
   m_surface_revision = 0;
@@ -298,7 +259,7 @@ void TissueModel::exit_initialization_mode() { ensure_built(); }
 fmi3::StepOutcome TissueModel::do_step(double current_time_s, double step_s) {
   Tissue& tissue = *m_tissue;
   const double now = m_start_time_s + tissue.time_s();
-  const long count = fmi3::whole_internal_steps(now, current_time_s, step_s, m_values.float64(vr(Vr::step_size)));
+  const long count = fmi3::whole_internal_steps(now, current_time_s, step_s, tissue.settings().step_size_s);
   tissue.set_tool(tool_pose(m_values));  // the inputs' one check (Tissue::set_tool), where they are used
   const std::size_t cuts_before = tissue.body().cut_tets().size();
   const bool contact_before = tissue.contact().active;

@@ -18,6 +18,8 @@
 
 namespace tissue::tissue_fmu {
 
+/// The tissue's settings as the store holds them (core/tissue_settings_schema.hpp), each checked.
+TissueParameters tissue_parameters(const fmi3::ValueStore& values);
 /// The core's settings from the FMU's parameters; fixed vertices only if `mesh` is given. Throws
 /// ParameterError for values the core refuses.
 TissueSettings tissue_settings(const fmi3::ValueStore& values, const TetMesh* mesh);
@@ -84,6 +86,7 @@ class TissueModel final : public fmi3::Model {
   ports::SurfaceNodes m_nodes;             // scratch of get_binary
   std::vector<std::uint8_t> m_mesh_bytes, m_embedding_bytes, m_nodes_bytes;
   bool m_capacity_warned = false;
+  double m_near_margin_m = 0.0;                       ///< contact.nearMargin
   std::optional<NearSurface> m_near;                  ///< contact.near's surface, if near
   std::vector<SurfaceBvh::SphereHit> m_near_hits;     // scratch of update_near_surface()
 };

@@ -3,6 +3,7 @@
 #include "tissue_fmu/variables.hpp"
 
 #include <algorithm>
+#include <vector>
 
 namespace tissue::tissue_fmu {
 namespace {
@@ -13,41 +14,34 @@ using fmi3::EnumerationType;
 constexpr auto VARIABLES = tissue_variables(ports::TISSUE_SAMPLE);
 static_assert(fmi3::strictly_ordered(VARIABLES), "the variable table must be in increasing value-reference order");
 
-constexpr auto LINEAR_SOLVER_ITEMS = std::to_array<EnumerationItem>({
-    {"pcg", 1,
-     "Jacobi-preconditioned conjugate gradients (iterative; integrator.pcgTolerance, integrator.pcgMaxIterations)"},
-    {"cholmod", 2, "Sparse Cholesky factorization (CHOLMOD, direct, exact)"},
-    {"pcgCholesky", 3,
-     "CG preconditioned by a lagged CHOLMOD factor, refactorized when the iterations grow or a cut changes the pattern; in the FMU without a worker thread (integrator.pcgTolerance, integrator.pcgMaxIterations)"},
-});
-constexpr auto INTEGRATOR_ITEMS = std::to_array<EnumerationItem>({
-    {"backwardEuler", 1, "Semi-implicit backward Euler, one linear solve per internal step (integrator.linearSolver)"},
-    {"ida", 2, "SUNDIALS IDA: variable-order, variable-step BDF with error control (integrator.ida*)"},
-});
-constexpr auto IDA_LINEAR_SOLVER_ITEMS = std::to_array<EnumerationItem>({
-    {"klu", 1, "Sparse LU factorization of the Newton matrix (KLU, direct)"},
-    {"krylov", 2, "GMRES, preconditioned by eliminating the velocities and the diagonal of the rest (iterative)"},
-});
-constexpr auto CONTACT_STIFFNESS_ITEMS = std::to_array<EnumerationItem>({
-    {"effectiveStatic", 1,
-     "Stiffness of the whole constrained body at the contact point (static condensation; the reference)"},
-    {"elementLocal", 2, "Stiffness of the contacted tetrahedron alone (cheap, approximate)"},
-});
-constexpr auto MATERIAL_MODEL_ITEMS = std::to_array<EnumerationItem>({
-    {"corotationalLinear", 1, "Co-rotational linear elasticity (the dissertation's; one linear solve a step)"},
-    {"stableNeoHookean", 2,
-     "Stable Neo-Hookean hyperelasticity (Smith, de Goes and Kim 2018): inversion-safe, its tangent projected to "
-     "positive semi-definite per element"},
-});
 constexpr auto TOOL_MODE_ITEMS = ports::tool_mode_items();
-const auto ENUMERATIONS = std::to_array<EnumerationType>({
-    {"LinearSolver", "Linear solver of the backward-Euler step", LINEAR_SOLVER_ITEMS},
-    {"MaterialModel", "Elasticity of the tissue", MATERIAL_MODEL_ITEMS},
-    {"ContactStiffnessModel", "How the 3x3 contact stiffness K_c is computed", CONTACT_STIFFNESS_ITEMS},
-    {"Integrator", "Time integrator of the tissue", INTEGRATOR_ITEMS},
-    {"IdaLinearSolver", "Linear solver of IDA's Newton iteration", IDA_LINEAR_SOLVER_ITEMS},
-    {"ToolMode", ports::TOOL_MODE_DESCRIPTION, TOOL_MODE_ITEMS},
-});
+
+// The enumeration types: the settings' (from the schema, items numbered from 1), then the tool mode.
+struct Enumerations {
+  std::vector<std::vector<EnumerationItem>> items;
+  std::vector<EnumerationType> types;
+};
+
+const Enumerations& enumerations() {
+  static const Enumerations all = [] {
+    Enumerations e;
+    std::vector<const SettingInfo*> settings;
+    for (const SettingInfo& setting : TISSUE_SETTINGS) {
+      if (setting.type != SettingType::enumeration) continue;
+      settings.push_back(&setting);
+      std::vector<EnumerationItem>& items = e.items.emplace_back();
+      for (std::size_t k = 0; k < setting.items.size(); ++k) {
+        items.push_back({setting.items[k].name, static_cast<std::int64_t>(k + 1), setting.items[k].description});
+      }
+    }
+    for (std::size_t k = 0; k < settings.size(); ++k) {
+      e.types.push_back({settings[k]->enumeration_type, settings[k]->enumeration_description, e.items[k]});
+    }
+    e.types.push_back({"ToolMode", ports::TOOL_MODE_DESCRIPTION, TOOL_MODE_ITEMS});
+    return e;
+  }();
+  return all;
+}
 
 constexpr auto LOG_CATEGORIES = fmi3::layer_log_categories(
     "Calls that returned fmi3Warning, and recoverable problems such as a surface that outgrew its capacity",
@@ -59,7 +53,7 @@ fmi3::ModelDescription tissue_model_description(std::span<const fmi3::VariableIn
   return {MODEL_IDENTIFIER,
           INSTANTIATION_TOKEN,
           variables,
-          ENUMERATIONS,
+          enumerations().types,
           "Real-time XFEM soft-tissue simulation: a co-rotational tetrahedral body cut by a scalpel and touched by a "
           "probe, with the contact force, contact stiffness and deformed surface mesh as outputs",
           LOG_CATEGORIES,

@@ -1,6 +1,8 @@
 // The Tissue facade.
 #include "core/tissue.hpp"
 
+#include "core/tissue_settings_schema.hpp"
+
 #include <algorithm>
 #include <array>
 #include <Eigen/Eigenvalues>
@@ -9,6 +11,7 @@
 #include <cmath>
 #include <string>
 #include <type_traits>
+#include <variant>
 
 namespace tissue {
 
@@ -27,91 +30,6 @@ Eigen::VectorXd rest_positions(const DeformableBody& body) {
   Eigen::VectorXd positions_m;
   body.positions(Eigen::VectorXd::Zero(body.dof_count()), positions_m);
   return positions_m;
-}
-
-// FNV-1a (64 bit) over the bytes of trivially copyable values: the model fingerprint.
-class Fingerprint {
- public:
-  template <class T>
-  void add(const T& value) {
-    static_assert(std::is_trivially_copyable_v<T>);
-    const auto* bytes = reinterpret_cast<const unsigned char*>(&value);
-    for (size_t k = 0; k < sizeof(T); ++k) m_hash = (m_hash ^ bytes[k]) * 0x100000001b3ULL;
-  }
-  template <class T>
-  void add_all(const std::vector<T>& values) {
-    add(values.size());
-    for (const T& value : values) add(value);
-  }
-  [[nodiscard]] std::uint64_t value() const { return m_hash; }
-
- private:
-  std::uint64_t m_hash = 0xcbf29ce484222325ULL;
-};
-
-std::uint64_t model_fingerprint_of(const TetMesh& mesh, const TissueSettings& settings) {
-  Fingerprint f;
-  for (const Eigen::Vector3d& x : mesh.rest_positions_m) f.add(std::array<double, 3>{x.x(), x.y(), x.z()});
-  f.add_all(mesh.tets);
-  const BodySettings& body = settings.body;
-  f.add(body.material.young_modulus_pa);
-  f.add(body.material.poisson_ratio);
-  f.add(body.material.density_kg_per_m3);
-  if (!mesh.regions.empty()) {  // a mesh of one region keeps its older fingerprint
-    f.add_all(mesh.tet_regions);
-    for (const Material& material : resolve_region_materials(mesh.regions, body.material, body.region_materials)) {
-      f.add(material.young_modulus_pa);
-      f.add(material.poisson_ratio);
-      f.add(material.density_kg_per_m3);
-      if (material.mass_damping_per_s) f.add(*material.mass_damping_per_s);  // older fingerprints stay
-    }
-  }
-  if (body.material_model != MaterialModel::corotational_linear) f.add(body.material_model);  // older fingerprints stay
-  f.add(body.damping.mass_damping_per_s);
-  f.add(body.damping.stiffness_damping_s);
-  f.add(std::array<double, 3>{body.gravity_m_per_s2.x(), body.gravity_m_per_s2.y(), body.gravity_m_per_s2.z()});
-  f.add_all(body.fixed_vertices);
-  f.add(body.reserve.extra_row_fraction);  // field by field: a struct's padding bytes are not values
-  f.add(body.reserve.row_capacity_factor);
-  if (body.reserve.spare_row_capacity != 0) f.add(body.reserve.spare_row_capacity);  // older fingerprints stay
-  f.add(body.rotation.max_iterations);
-  f.add(body.rotation.max_error_rad);
-  f.add(settings.integrator.kind);
-  const IdaSettings& ida = settings.integrator.ida;
-  f.add(ida.relative_tolerance);
-  f.add(ida.absolute_tolerance);
-  f.add(ida.max_order);
-  f.add(ida.max_step_s);
-  f.add(ida.linear_solver);
-  f.add(ida.max_internal_steps);
-  f.add(settings.integrator.newton.trigger_angle_rad);
-  f.add(settings.integrator.newton.max_iterations);
-  f.add(settings.integrator.newton.energy_guard_angle_rad);
-  f.add(settings.solver.kind);
-  f.add(settings.solver.pcg.tolerance);
-  f.add(settings.solver.pcg.max_iterations);
-  f.add(settings.solver.warm_start);
-  if (settings.solver.pcg.matrix_precision != MatrixPrecision::automatic) f.add(settings.solver.pcg.matrix_precision);
-  if (settings.solver.kind == LinearSolverKind::pcg_cholesky) {  // so that older fingerprints stay as they were
-    f.add(settings.solver.refresh.refresh_iterations);          // background_refactor changes no result
-    f.add(settings.solver.refresh.pickup_setups);
-    f.add(settings.solver.refresh.follow_rotations);
-    f.add(settings.solver.refresh.refactor_on_growth);
-  }
-  const InteractionSettings& interaction = settings.interaction;
-  f.add(interaction.contact_enabled);
-  f.add(interaction.cutting_enabled);
-  f.add(interaction.blade_length_m);
-  f.add(interaction.cutter.vertex_snap_fraction);
-  f.add(interaction.cutter.min_volume_fraction);
-  f.add(interaction.contact_spring_stiffness_n_per_m);
-  f.add(interaction.contact_stiffness_model);
-  f.add(interaction.contact_stiffness_refresh_steps);
-  f.add(interaction.contact_stiffness_in_background);
-  f.add(interaction.max_tool_speed_m_per_s);
-  if (interaction.probe_radius_m != 0.0) f.add(interaction.probe_radius_m);  // older fingerprints unchanged
-  f.add(settings.step_size_s);
-  return f.value();
 }
 
 // CHOLMOD may factorize a singular K through rounding; the point of a free piece then comes out with
@@ -156,38 +74,12 @@ ToolMode parse_tool_mode(std::string_view name) {
 }
 
 void validate(const TissueSettings& settings) {
-  if (!(settings.step_size_s > 0.0) || !std::isfinite(settings.step_size_s)) {
-    throw ParameterError("step size must be finite and > 0 s, got " + std::to_string(settings.step_size_s));
-  }
+  check_setting_ranges(settings);  // the schema's ranges (tissue_settings_schema.hpp), named as users set them
   validate(settings.body.material);
   validate(settings.body.damping);
-  if (!settings.body.gravity_m_per_s2.allFinite()) throw ParameterError("gravity must be finite");
   validate(settings.integrator);
   validate(settings.solver);
-  validate(settings.interaction);
-}
-
-void validate(const InteractionSettings& settings) {
-  if (!(settings.blade_length_m > 0.0) || !std::isfinite(settings.blade_length_m)) {
-    throw ParameterError("blade length must be finite and > 0 m, got " + std::to_string(settings.blade_length_m));
-  }
-  if (!(settings.contact_spring_stiffness_n_per_m >= 0.0) ||
-      !std::isfinite(settings.contact_spring_stiffness_n_per_m)) {
-    throw ParameterError("contact spring stiffness must be finite and >= 0 N/m (0: automatic), got " +
-                         std::to_string(settings.contact_spring_stiffness_n_per_m));
-  }
-  if (!(settings.max_tool_speed_m_per_s > 0.0) || !std::isfinite(settings.max_tool_speed_m_per_s)) {
-    throw ParameterError("tool speed limit must be finite and > 0 m/s, got " +
-                         std::to_string(settings.max_tool_speed_m_per_s));
-  }
-  if (!(settings.probe_radius_m >= 0.0) || !std::isfinite(settings.probe_radius_m)) {
-    throw ParameterError("probe radius must be finite and >= 0 m, got " + std::to_string(settings.probe_radius_m));
-  }
-  if (settings.contact_stiffness_refresh_steps < 1) {
-    throw ParameterError("contact stiffness refresh must be >= 1 step, got " +
-                         std::to_string(settings.contact_stiffness_refresh_steps));
-  }
-  validate(settings.cutter);
+  validate(settings.interaction.cutter);
 }
 
 Tissue::Tissue(TetMesh mesh, TissueSettings settings)
@@ -206,7 +98,7 @@ Tissue::Tissue(TetMesh mesh, TissueSettings settings)
             m_positions_m),
       m_contact(contact_settings(m_settings, m_body, m_surface, *m_integrator)),
       m_contact_stiffness_scale_n_per_m(contact_stiffness_scale_n_per_m(m_body, m_surface)),
-      m_model_fingerprint(model_fingerprint_of(m_body.mesh(), m_settings)) {
+      m_model_fingerprint(tissue::model_fingerprint(m_body.mesh(), m_settings)) {
   m_state.displacement_m.setZero(m_body.dof_count());
   m_state.velocity_m_per_s.setZero(m_body.dof_count());
   m_body.attach(m_contact_spring);

@@ -71,11 +71,11 @@ struct InteractionSettings {
   double contact_spring_stiffness_n_per_m = 0.0;
   ContactStiffnessModel contact_stiffness_model = ContactStiffnessModel::effective_static;
   /// The effective (reference) K_c costs a factorization: it is recomputed when a contact starts and
-  /// then every this many steps (>= 1); the element-local model is recomputed every step.
+  /// then every this many steps (>= 1); the elementLocal model is recomputed every step.
   int contact_stiffness_refresh_steps = 10;
   /// The effective K_c's factorization runs in a worker thread beside the step
   /// (background_contact_stiffness.hpp) instead of in it: a refresh started at a step is rendered
-  /// from the next step on, the previous K_c standing until then; at a new contact, the element-local
+  /// from the next step on, the previous K_c standing until then; at a new contact, the elementLocal
   /// estimate (the one the near-surface report gave) stands for that first step. The results are
   /// the same with or without a thread to be had. Off: no thread unless asked (the FMU's rule).
   bool contact_stiffness_in_background = false;
@@ -86,9 +86,6 @@ struct InteractionSettings {
   /// with the ball's pole (0: a point tip, the pose is the touching point).
   double probe_radius_m = 0.0;
 };
-
-/// Throws ParameterError for an invalid setting.
-void validate(const InteractionSettings& settings);
 
 struct TissueSettings {
   BodySettings body;
@@ -102,9 +99,15 @@ struct TissueSettings {
   std::shared_ptr<const TriangleSurface> render_surface;
 };
 
-/// Throws ParameterError for an invalid setting (step size, material, damping, gravity, solver,
-/// interaction); fixed vertices and mesh-dependent settings are checked by DeformableBody.
+/// Throws ParameterError for an invalid setting: first any setting outside its schema range
+/// (tissue_settings_schema.hpp), then the parts' own checks (material, damping, integrator, solver,
+/// cutter); fixed vertices and mesh-dependent settings are checked by DeformableBody.
 void validate(const TissueSettings& settings);
+
+/// A hash of the mesh and every setting that changes the dynamics (FNV-1a over the rest positions, the
+/// tets, the schema's tissue settings in their order, the regions' materials, the fixed vertices and
+/// the core's own settings): a snapshot restores only into a Tissue of the same value.
+std::uint64_t model_fingerprint(const TetMesh& mesh, const TissueSettings& settings);
 
 /// The contact outputs of the last step (the haptic loop's input).
 struct ContactOutput {

@@ -57,7 +57,7 @@ inline constexpr auto TISSUE_SAMPLE = std::to_array<SampleField>({
      "The tissue's contact.force: f0, the force on the tool at tissue.toolPosition"},
     {"contact.stiffness", "tissue.contactStiffness", 44, 28, SampleType::float64, 3, 3, "N/m", "0 0 0 0 0 0 0 0 0", "",
      "Contact stiffness K_c (row-major 3x3) for rendering f = f0 + K_c (x - x0) between tissue updates (while "
-     "contact.near: the element-local model at contact.point)",
+     "contact.near: the elementLocal model at contact.point)",
      "The tissue's contact.stiffness K_c (row-major 3x3): the force on the tool is rendered as f0 - K_c (x - x0) "
      "against the contact plane"},
     {"contact.damping", "tissue.contactDamping", 46, 33, SampleType::float64, 3, 3, "N.s/m", "0 0 0 0 0 0 0 0 0", "",

@@ -49,7 +49,8 @@ def test_a_held_press_settles_at_springs_in_series():
 
 
 def test_a_scalpel_stroke_cuts_the_frog_and_opens_its_surface():
-    t = tissue.Tissue(mesh="frog", gravity_m_per_s2=(0.0, 0.0, 0.0), step_size_s=0.01, blade_length_m=0.1)
+    t = tissue.Tissue(mesh="frog", gravity_m_per_s2=(0.0, 0.0, 0.0), step_size_s=0.01, blade_length_m=0.1,
+                      fixed_axis=0, fixed_fraction=0.01)
     rest = t.rest_positions_m
     lower, upper = rest.min(axis=0), rest.max(axis=0)
     points_before, triangles_before = t.surface()
@@ -129,8 +130,14 @@ def test_a_restored_state_continues_bitwise():
 
 
 def test_bad_input_is_refused_with_the_cores_message():
-    with pytest.raises(ValueError, match="Poisson"):
+    with pytest.raises(ValueError, match=r"poisson_ratio: material.poissonRatio must be finite and in \[0, 0.5\)"):
         tissue.Tissue(box=(2, 2, 2), poisson_ratio=0.5)
+    with pytest.raises(TypeError, match="young_modulus"):
+        tissue.Tissue(box=(2, 2, 2), young_modulus=1e5)  # the keyword is young_modulus_pa
+    with pytest.raises(TypeError, match="pcg_max_iterations"):
+        tissue.Tissue(box=(2, 2, 2), pcg_max_iterations=2.5)
+    with pytest.raises(TypeError):
+        tissue.Tissue("frog")  # keywords only
     with pytest.raises(ValueError):
         tissue.Tissue(box=(2, 2, 2), step_size_s=-1.0)
     with pytest.raises(ValueError, match="linear solver|solver"):
@@ -193,5 +200,20 @@ def test_the_material_model_is_chosen_by_name_and_agrees_with_corotational_at_sm
     assert 1e-4 < corotational < 1e-3
     assert neo_hookean == pytest.approx(corotational, rel=1e-3)
     assert neo_hookean != corotational  # a different model, not the default again
-    with pytest.raises(ValueError, match='"corotationalLinear" or "stableNeoHookean"'):
+    with pytest.raises(ValueError, match="material.model must be corotationalLinear or stableNeoHookean"):
         tissue.Tissue(box=(2, 2, 2), material_model="neoHookean")
+
+
+def test_the_keywords_are_the_settings_schemas_with_the_fmus_defaults():
+    doc = tissue.Tissue.__init__.__doc__
+    # Every Tissue FMU setting Python sets, with the FMU's default (docs/FMU_VARIABLES.md).
+    for keyword in ("pcg_max_iterations=10", "gravity_m_per_s2=0 0 -9.81", "fixed_axis=2", "fixed_fraction=0.25",
+                    "linear_solver=pcg (pcg, cholmod or pcgCholesky)", "ida_relative_tolerance=0.0001",
+                    "contact_stiffness_in_background=false", "max_tool_speed_m_per_s=5"):
+        assert keyword in doc, keyword
+    # A setting Python did not have by hand before the schema reaches the core.
+    t = tissue.Tissue(box=(2, 2, 2), integrator="ida", ida_linear_solver="krylov", ida_max_order=2,
+                      contact_spring_stiffness_n_per_m=500.0)
+    assert t.contact_spring_stiffness_n_per_m == 500.0
+    t.step(2)
+    assert t.time_s == pytest.approx(0.002)

@@ -15,8 +15,8 @@ import subprocess
 ROOT = pathlib.Path(__file__).resolve().parents[2]
 
 
-# Each solver with its options: PCG at the bench's real-time defaults, pcg-cholesky near-exact.
-SOLVERS = {"pcg": [], "cholmod": [], "pcg-cholesky": ["--tolerance", "1e-6", "--max-iterations", "200"]}
+# Each solver with its options: PCG at the bench's real-time defaults, pcgCholesky near-exact.
+SOLVERS = {"pcg": [], "cholmod": [], "pcgCholesky": ["--tolerance", "1e-6", "--max-iterations", "200"]}
 
 
 def run(bench, solver):

@@ -45,3 +45,8 @@ target_compile_definitions(test_fmi2 PRIVATE TISSUE_FMU_DIR="${CMAKE_BINARY_DIR}
 add_dependencies(test_fmi2 tissue_fmu_package hapticloop_fmu_package tissue_fmi2_fmu_package hapticloop_fmi2_fmu_package
                  tissue_ssp_package)
 gtest_discover_tests(test_fmi2 PROPERTIES LABELS "fmu" DISCOVERY_TIMEOUT 60)
+
+# The settings' tables in docs/FMU_VARIABLES.md and docs/PYTHON.md are the ones the schema gives
+# (tissue-settings-doc docs rewrites them).
+add_test(NAME SettingsDoc.TheDocsHoldTheSchemasTables COMMAND tissue-settings-doc ${PROJECT_SOURCE_DIR}/docs --check)
+set_tests_properties(SettingsDoc.TheDocsHoldTheSchemasTables PROPERTIES LABELS "fmu")

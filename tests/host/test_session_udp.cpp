@@ -4,7 +4,10 @@
 // the session runs both FMUs on its two threads. Checked: the poses arrive and drive the probe into
 // contact, forces come back to the driver, every bad packet is dropped and counted by reason, and
 // after the driver goes silent the watchdog brings the force sent to zero within its timeout and
-// ramp (50 + 100 ms).
+// ramp (50 + 100 ms). What depends on the machine keeping time (the count of accepted poses, a
+// single watchdog trip, the contact) is asserted only when the driver and the haptic thread kept
+// their 1 ms periods: beside CPU-bound processes either may be held off for longer than the
+// watchdog's 50 ms, and then a trip mid-stream is the protection working, not a fault.
 #include "device/udp_packet.hpp"
 #include "scenario/scenario.hpp"
 #include "session/session.hpp"
@@ -36,20 +39,31 @@ TEST(UdpSession, PosesDriveTheProbeForcesComeBackBadPacketsAreCountedSilenceZero
   options.fmu_dir = TISSUE_FMU_DIR;
   options.realtime_priority = false;
   std::atomic<bool> session_started{false};
-  options.haptic_thread_started = [&] { session_started.store(true); };
+  std::chrono::steady_clock::time_point session_start;
+  options.haptic_thread_started = [&] {
+    session_start = std::chrono::steady_clock::now();
+    session_started.store(true);
+  };
 
   std::vector<udp::ForcePacket> forces;
+  double largest_send_gap_s = 0.0;  // the driver's longest time between two poses
+  double last_pose_s = 0.0;         // when the driver sent its last pose, from the session's start
   std::thread driver([&] {
     test::UdpSender sender("127.0.0.1", PORT);
     while (!session_started.load()) std::this_thread::sleep_for(std::chrono::milliseconds(1));
     // The frog's back is near (0, 0, 0.036) m (rest box of meshes/frog.veg): down from 1 cm above
     // to 3 mm inside in 0.5 s, held until 1.0 s; then silence.
     const auto start = std::chrono::steady_clock::now();
+    auto last_send = start;
     for (int n = 0; n < 1000; ++n) {
       const double t = n * 1e-3;
       DevicePose pose;
       pose.mode = ToolMode::probe;
       pose.position_m = {-0.007, 0.0, 0.046 - 0.013 * std::min(1.0, t / 0.5)};
+      const auto now = std::chrono::steady_clock::now();
+      if (n > 0)
+        largest_send_gap_s = std::max(largest_send_gap_s, std::chrono::duration<double>(now - last_send).count());
+      last_send = now;
       sender.send_pose(pose);
       if (n == 300) {
         std::vector<std::uint8_t> bad(20, 0xAB);  // malformed: too short, no magic
@@ -65,6 +79,7 @@ TEST(UdpSession, PosesDriveTheProbeForcesComeBackBadPacketsAreCountedSilenceZero
       sender.drain_forces(forces);
       std::this_thread::sleep_until(start + std::chrono::microseconds(1000 * (n + 1)));
     }
+    last_pose_s = std::chrono::duration<double>(last_send - session_start).count();
     const auto quiet_until = std::chrono::steady_clock::now() + std::chrono::milliseconds(700);
     while (std::chrono::steady_clock::now() < quiet_until) {
       sender.drain_forces(forces);
@@ -76,25 +91,30 @@ TEST(UdpSession, PosesDriveTheProbeForcesComeBackBadPacketsAreCountedSilenceZero
 
   EXPECT_FALSE(s.nan_detected);
   EXPECT_EQ(s.tissue_errors, 0u) << s.first_error;
-  // The poses reach the tissue and the probe touches the back (when the tissue keeps pace: a
-  // sanitizer build's steps overrun their slots many times over).
-  const bool kept_pace = s.sim_time_s > 0.9 * scenario.duration_s;
-  if (kept_pace) {
-    EXPECT_TRUE(s.contact_seen) << "the poses did not reach the tissue";
-  }
-  EXPECT_GE(s.device.accepted, 800u);  // of 1000 sent (a loaded machine may see some as stale)
+  // Whatever the load: every bad packet is dropped and counted by its reason, the final silence trips
+  // the watchdog, and forces come back.
   EXPECT_EQ(s.device.malformed, 1u);
   EXPECT_EQ(s.device.duplicate, 1u);
   EXPECT_EQ(s.device.out_of_order, 1u);
-  EXPECT_EQ(s.device.watchdog_trips, 1u);
-  // Forces came back to the driver, some of them pushing the probe out (+z).
+  EXPECT_GE(s.device.watchdog_trips, 1u);
+  EXPECT_GT(forces.size(), 100u);
+  // When the machine kept time (the driver never paused for half the watchdog's timeout, the haptic
+  // thread missed under 1 % of its deadlines, the tissue kept pace; a sanitizer build's steps
+  // overrun their slots many times over): the poses reach the tissue, the probe touches the back and
+  // is pushed out (+z), and only the final silence trips the watchdog.
+  const bool kept_time = largest_send_gap_s < 0.025 && s.deadline_misses * 100 < s.haptic_ticks &&
+                         s.sim_time_s > 0.9 * scenario.duration_s;
   double largest_up = 0.0;
   for (const udp::ForcePacket& f : forces) largest_up = std::max(largest_up, f.force_n[2]);
-  EXPECT_GT(forces.size(), 500u);
-  if (kept_pace) {
+  if (kept_time) {
+    EXPECT_TRUE(s.contact_seen) << "the poses did not reach the tissue";
+    EXPECT_GE(s.device.accepted, 800u);  // of 1000 sent (some may arrive stale)
+    EXPECT_EQ(s.device.watchdog_trips, 1u);
+    EXPECT_GT(forces.size(), 500u);
     EXPECT_GT(largest_up, 0.1);
   }
-  // The force sent to the device is exactly zero from 150 ms (+ a tick) after the last pose.
+  // The force sent to the device is exactly zero from 150 ms (+ a tick, and the 50 ms the session's
+  // clock may start after the haptic thread's first tick) after the last pose, whenever it was sent.
   std::ifstream log(options.output_dir / "log.csv");
   std::string line;
   std::getline(log, line);
@@ -105,7 +125,7 @@ TEST(UdpSession, PosesDriveTheProbeForcesComeBackBadPacketsAreCountedSilenceZero
     for (std::string field; std::getline(row, field, ',');) fields.push_back(std::stod(field));
     if (fields.at(8) != 0.0 || fields.at(9) != 0.0 || fields.at(10) != 0.0) last_nonzero_s = fields.at(0);
   }
-  EXPECT_LT(last_nonzero_s, 1.0 + 0.05 + 0.1 + 0.05) << "the watchdog did not zero the force in time";
+  EXPECT_LT(last_nonzero_s, last_pose_s + 0.05 + 0.1 + 0.05) << "the watchdog did not zero the force in time";
 }
 
 }  // namespace

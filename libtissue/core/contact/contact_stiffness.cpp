@@ -17,15 +17,10 @@
 namespace tissue {
 
 ContactStiffnessModel parse_contact_stiffness_model(std::string_view name) {
-  if (name == "effective-static") return ContactStiffnessModel::effective_static;
-  if (name == "element-local") return ContactStiffnessModel::element_local;
-  throw ParameterError("unknown contact stiffness model '" + std::string(name) +
-                       "' (expected effective-static or element-local)");
+  return CONTACT_STIFFNESS_MODEL_NAMES.parse(name);
 }
 
-std::string_view to_string(ContactStiffnessModel model) {
-  return model == ContactStiffnessModel::effective_static ? "effective-static" : "element-local";
-}
+std::string_view to_string(ContactStiffnessModel model) { return CONTACT_STIFFNESS_MODEL_NAMES.name(model); }
 
 ContactInterpolation contact_interpolation(const DofMap& dofs, const std::array<int, 3>& vertices,
                                            const Eigen::Vector3d& weights) {
@@ -168,11 +163,11 @@ std::optional<Eigen::Matrix3d> EffectiveContactStiffness::stiffness_n_per_m(cons
 Eigen::Matrix3d element_local_contact_stiffness(const CorotationalElasticity& elasticity, int tet,
                                                 int opposite_local_vertex) {
   if (tet < 0 || tet >= elasticity.tet_count()) {
-    throw std::invalid_argument("element-local contact stiffness: tet " + std::to_string(tet) + " outside [0, " +
+    throw std::invalid_argument("elementLocal contact stiffness: tet " + std::to_string(tet) + " outside [0, " +
                                 std::to_string(elasticity.tet_count()) + ")");
   }
   if (opposite_local_vertex < 0 || opposite_local_vertex > 3) {
-    throw std::invalid_argument("element-local contact stiffness: local vertex must be 0..3, got " +
+    throw std::invalid_argument("elementLocal contact stiffness: local vertex must be 0..3, got " +
                                 std::to_string(opposite_local_vertex));
   }
   const Eigen::Matrix3d& rotation = elasticity.rotation(tet);
@@ -185,7 +180,7 @@ Eigen::Matrix3d element_local_contact_stiffness(const CorotationalElasticity& el
 Eigen::Matrix3d element_local_contact_stiffness(const CorotationalElasticity& elasticity, const SurfaceMesh& surface,
                                                 int triangle) {
   if (triangle < 0 || triangle >= static_cast<int>(surface.triangle_tet.size())) {
-    throw std::invalid_argument("element-local contact stiffness: triangle " + std::to_string(triangle) +
+    throw std::invalid_argument("elementLocal contact stiffness: triangle " + std::to_string(triangle) +
                                 " is not a surface triangle");
   }
   return element_local_contact_stiffness(elasticity, surface.triangle_tet[static_cast<size_t>(triangle)],

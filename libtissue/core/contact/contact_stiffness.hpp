@@ -23,6 +23,7 @@
 #include "core/contact/point_spring.hpp"
 #include "core/fem/deformable_body.hpp"
 #include "core/mesh/topology.hpp"
+#include "core/named_items.hpp"
 #include "core/solve/linear_solver.hpp"
 #include "core/system/assembly.hpp"
 #include "core/system/dynamics_model.hpp"
@@ -40,7 +41,13 @@ class CholmodFactor;
 
 enum class ContactStiffnessModel { effective_static, element_local };
 
-/// Parses "effective-static" / "element-local"; throws ParameterError otherwise.
+inline constexpr ItemNames<ContactStiffnessModel, 2> CONTACT_STIFFNESS_MODEL_NAMES{
+    "contact stiffness model",
+    {{{"effectiveStatic",
+       "Stiffness of the whole constrained body at the contact point (static condensation; the reference)"},
+      {"elementLocal", "Stiffness of the contacted tetrahedron alone (cheap, approximate)"}}}};
+
+/// Parses "effectiveStatic" / "elementLocal" (CONTACT_STIFFNESS_MODEL_NAMES); throws ParameterError otherwise.
 ContactStiffnessModel parse_contact_stiffness_model(std::string_view name);
 [[nodiscard]] std::string_view to_string(ContactStiffnessModel model);
 
@@ -157,7 +164,7 @@ std::optional<Eigen::Matrix3d> condensed_contact_stiffness(EffectiveContactStiff
                                                           const std::optional<PointSpring>& spring,
                                                           double rigid_support_n_per_m, double floor_n_per_m);
 
-/// The element-local model (header): R K_oo R^T of tet `tet` with `opposite_local_vertex` (0..3) the
+/// The elementLocal model (header): R K_oo R^T of tet `tet` with `opposite_local_vertex` (0..3) the
 /// vertex not on the contacted face, at the rotation of the last evaluate(). [N/m], SPD.
 Eigen::Matrix3d element_local_contact_stiffness(const CorotationalElasticity& elasticity, int tet,
                                                 int opposite_local_vertex);

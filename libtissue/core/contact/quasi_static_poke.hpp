@@ -13,7 +13,7 @@
 //
 // Two kinds of contact:
 // * bonded: the material point s stays the one held (the reaction may have a tangential part);
-//   as d -> 0 the reaction tends to K_c d with the effective-static K_c;
+//   as d -> 0 the reaction tends to K_c d with the effectiveStatic K_c;
 // * frictionless: the point held slides until the reaction is normal to the deformed surface,
 //   which is the equilibrium the god-object contact (PointContact) settles to as its spring
 //   stiffness grows. Outer iterations: the bonded solution at s, then s moves to the material

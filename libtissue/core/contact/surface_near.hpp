@@ -1,7 +1,7 @@
 // The surface near a probe that does not touch it yet (issue 20): what a haptic loop needs to render
 // the surface from the tick the tool crosses it, instead of a tissue step (and a sample period)
 // later. The nearest point of the mesh's own surface within a margin of the probe's touching point,
-// the outward normal of its triangle, and the element-local contact stiffness there
+// the outward normal of its triangle, and the elementLocal contact stiffness there
 // (contact_stiffness.hpp: cheap, no factorization; the effective K_c follows once in contact).
 #pragma once
 

@@ -31,7 +31,7 @@ class CorotationalElasticity {
   /// order): each assembly part visits its tets by the earliest of their vertices in it, so that
   /// consecutive tets write nearby blocks when the system's rows are numbered in the same order.
   /// `model`: how every tet answers (co-rotational linear, or stable Neo-Hookean: then the rotations
-  /// are still extracted, for the protections and the element-local contact stiffness).
+  /// are still extracted, for the protections and the elementLocal contact stiffness).
   CorotationalElasticity(const TetMesh& mesh, const std::vector<Material>& materials,
                          const RotationSettings& rotation = {}, const std::vector<int>& vertex_order = {},
                          MaterialModel model = MaterialModel::corotational_linear);

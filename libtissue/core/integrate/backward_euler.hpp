@@ -46,7 +46,7 @@ class BackwardEuler final : public Integrator {
   BackwardEuler(std::unique_ptr<LinearSolver> solver, Settings settings);
   StepReport step(DynamicsModel& model, DynamicState& state, double step_size_s) override;
   [[nodiscard]] const Settings& settings() const { return m_settings; }
-  [[nodiscard]] std::string_view name() const override { return "backward-euler"; }
+  [[nodiscard]] std::string_view name() const override { return "backwardEuler"; }
   [[nodiscard]] const LinearSolver& solver() const { return *m_solver; }
   /// The last velocity change (the next solve's warm start when enabled).
   [[nodiscard]] Eigen::VectorXd internal_state() const override { return m_velocity_change; }

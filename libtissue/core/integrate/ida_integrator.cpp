@@ -29,13 +29,9 @@ constexpr int KRYLOV_RESTARTS = 2;
 
 }  // namespace
 
-IdaLinearSolverKind parse_ida_linear_solver_kind(std::string_view name) {
-  if (name == "klu") return IdaLinearSolverKind::klu;
-  if (name == "krylov") return IdaLinearSolverKind::krylov;
-  throw ParameterError("unknown IDA linear solver '" + std::string(name) + "' (expected klu or krylov)");
-}
+IdaLinearSolverKind parse_ida_linear_solver_kind(std::string_view name) { return IDA_LINEAR_SOLVER_NAMES.parse(name); }
 
-std::string_view to_string(IdaLinearSolverKind kind) { return kind == IdaLinearSolverKind::klu ? "klu" : "krylov"; }
+std::string_view to_string(IdaLinearSolverKind kind) { return IDA_LINEAR_SOLVER_NAMES.name(kind); }
 
 void validate(const IdaSettings& settings) {
   const auto positive = [](double value, const char* what) {

@@ -16,6 +16,7 @@
 #pragma once
 
 #include "core/integrate/integrator.hpp"
+#include "core/named_items.hpp"
 
 #include <memory>
 #include <string_view>
@@ -24,7 +25,12 @@ namespace tissue {
 
 enum class IdaLinearSolverKind { klu, krylov };
 
-/// Parses "klu" / "krylov"; throws ParameterError otherwise.
+inline constexpr ItemNames<IdaLinearSolverKind, 2> IDA_LINEAR_SOLVER_NAMES{
+    "IDA linear solver",
+    {{{"klu", "Sparse LU factorization of the Newton matrix (KLU, direct)"},
+      {"krylov", "GMRES, preconditioned by eliminating the velocities and the diagonal of the rest (iterative)"}}}};
+
+/// Parses "klu" / "krylov" (IDA_LINEAR_SOLVER_NAMES); throws ParameterError otherwise.
 IdaLinearSolverKind parse_ida_linear_solver_kind(std::string_view name);
 [[nodiscard]] std::string_view to_string(IdaLinearSolverKind kind);
 

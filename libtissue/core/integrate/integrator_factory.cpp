@@ -3,51 +3,14 @@
 
 #include "core/integrate/backward_euler.hpp"
 
-#include <array>
 #include <cmath>
 #include <string>
 
 namespace tissue {
 
-namespace {
+LinearSolverKind parse_linear_solver_kind(std::string_view name) { return LINEAR_SOLVER_NAMES.parse(name); }
 
-constexpr std::array LINEAR_SOLVER_KINDS{LinearSolverKind::pcg, LinearSolverKind::cholmod,
-                                         LinearSolverKind::pcg_cholesky};
-
-}  // namespace
-
-LinearSolverKind parse_linear_solver_kind(std::string_view name) {
-  for (const LinearSolverKind kind : LINEAR_SOLVER_KINDS) {
-    if (name == to_string(kind)) return kind;
-  }
-  throw ParameterError("unknown linear solver '" + std::string(name) + "' (expected " +
-                       std::string(linear_solver_names()) + ")");
-}
-
-std::string_view to_string(LinearSolverKind kind) {
-  switch (kind) {
-    case LinearSolverKind::pcg:
-      return "pcg";
-    case LinearSolverKind::cholmod:
-      return "cholmod";
-    case LinearSolverKind::pcg_cholesky:
-      return "pcg-cholesky";
-  }
-  return "unknown";
-}
-
-std::string_view linear_solver_names() {
-  // "a, b or c", from the list above.
-  static const std::string names = [] {
-    std::string text;
-    for (size_t k = 0; k < LINEAR_SOLVER_KINDS.size(); ++k) {
-      if (k > 0) text += k + 1 == LINEAR_SOLVER_KINDS.size() ? " or " : ", ";
-      text += to_string(LINEAR_SOLVER_KINDS[k]);
-    }
-    return text;
-  }();
-  return names;
-}
+std::string_view to_string(LinearSolverKind kind) { return LINEAR_SOLVER_NAMES.name(kind); }
 
 void validate(const SolverSettings& settings) {
   if (!(settings.pcg.tolerance > 0.0) || !std::isfinite(settings.pcg.tolerance)) {
@@ -72,15 +35,9 @@ std::unique_ptr<LinearSolver> make_linear_solver(const SolverSettings& settings)
   throw ParameterError("unknown linear solver kind");
 }
 
-IntegratorKind parse_integrator_kind(std::string_view name) {
-  if (name == "backward-euler") return IntegratorKind::backward_euler;
-  if (name == "ida") return IntegratorKind::ida;
-  throw ParameterError("unknown integrator '" + std::string(name) + "' (expected backward-euler or ida)");
-}
+IntegratorKind parse_integrator_kind(std::string_view name) { return INTEGRATOR_NAMES.parse(name); }
 
-std::string_view to_string(IntegratorKind kind) {
-  return kind == IntegratorKind::backward_euler ? "backward-euler" : "ida";
-}
+std::string_view to_string(IntegratorKind kind) { return INTEGRATOR_NAMES.name(kind); }
 
 void validate(const IntegratorSettings& settings) {
   if (settings.kind != IntegratorKind::backward_euler && settings.kind != IntegratorKind::ida) {

@@ -5,6 +5,7 @@
 #include "core/integrate/backward_euler.hpp"
 #include "core/integrate/ida_integrator.hpp"
 #include "core/integrate/integrator.hpp"
+#include "core/named_items.hpp"
 #include "core/solve/linear_solver.hpp"
 
 #include <memory>
@@ -14,17 +15,24 @@ namespace tissue {
 
 enum class LinearSolverKind { pcg, cholmod, pcg_cholesky };
 
-/// Parses "pcg" / "cholmod" / "pcg-cholesky" (linear_solver_names()); throws ParameterError otherwise.
+inline constexpr ItemNames<LinearSolverKind, 3> LINEAR_SOLVER_NAMES{
+    "linear solver",
+    {{{"pcg", "Jacobi-preconditioned conjugate gradients (iterative; integrator.pcgTolerance, "
+              "integrator.pcgMaxIterations)"},
+      {"cholmod", "Sparse Cholesky factorization (CHOLMOD, direct, exact)"},
+      {"pcgCholesky",
+       "CG preconditioned by a lagged CHOLMOD factor, refactorized when the iterations grow or a cut changes the "
+       "pattern; in the FMU without a worker thread (integrator.pcgTolerance, integrator.pcgMaxIterations)"}}}};
+
+/// Parses "pcg" / "cholmod" / "pcgCholesky" (LINEAR_SOLVER_NAMES); throws ParameterError otherwise.
 LinearSolverKind parse_linear_solver_kind(std::string_view name);
 [[nodiscard]] std::string_view to_string(LinearSolverKind kind);
-/// The accepted names, for help texts: "pcg, cholmod or pcg-cholesky".
-[[nodiscard]] std::string_view linear_solver_names();
 
 /// Backward Euler's linear solver.
 struct SolverSettings {
   LinearSolverKind kind = LinearSolverKind::pcg;
-  PcgSolver::Settings pcg;  ///< tolerance and iteration cap of pcg and pcg-cholesky
-  CholeskyPcgSolver::Refresh refresh;  ///< pcg-cholesky: when its lagged factor is rebuilt, and where
+  PcgSolver::Settings pcg;  ///< tolerance and iteration cap of pcg and pcgCholesky
+  CholeskyPcgSolver::Refresh refresh;  ///< pcgCholesky: when its lagged factor is rebuilt, and where
   bool warm_start = false;  ///< PCG starts from the previous step's velocity change (see BackwardEuler)
 };
 
@@ -35,7 +43,12 @@ std::unique_ptr<LinearSolver> make_linear_solver(const SolverSettings& settings)
 
 enum class IntegratorKind { backward_euler, ida };
 
-/// Parses "backward-euler" / "ida"; throws ParameterError otherwise.
+inline constexpr ItemNames<IntegratorKind, 2> INTEGRATOR_NAMES{
+    "integrator",
+    {{{"backwardEuler", "Semi-implicit backward Euler, one linear solve per internal step (integrator.linearSolver)"},
+      {"ida", "SUNDIALS IDA: variable-order, variable-step BDF with error control (integrator.ida*)"}}}};
+
+/// Parses "backwardEuler" / "ida" (INTEGRATOR_NAMES); throws ParameterError otherwise.
 IntegratorKind parse_integrator_kind(std::string_view name);
 [[nodiscard]] std::string_view to_string(IntegratorKind kind);
 

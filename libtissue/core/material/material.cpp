@@ -27,17 +27,9 @@ void validate_mass_damping(double alpha_per_s) {
   }
 }
 
-std::string_view to_string(MaterialModel model) {
-  return model == MaterialModel::stable_neo_hookean ? "stableNeoHookean" : "corotationalLinear";
-}
+std::string_view to_string(MaterialModel model) { return MATERIAL_MODEL_NAMES.name(model); }
 
-MaterialModel parse_material_model(std::string_view name) {
-  for (const MaterialModel model : {MaterialModel::corotational_linear, MaterialModel::stable_neo_hookean}) {
-    if (name == to_string(model)) return model;
-  }
-  throw ParameterError("material model \"" + std::string(name) +
-                       "\" is not \"corotationalLinear\" or \"stableNeoHookean\"");
-}
+MaterialModel parse_material_model(std::string_view name) { return MATERIAL_MODEL_NAMES.parse(name); }
 
 LameParameters lame_parameters(const Material& material) {
   const double e = material.young_modulus_pa;

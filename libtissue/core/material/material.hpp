@@ -1,6 +1,7 @@
 // Material parameters of a specimen, in SI units, with their range checks.
 #pragma once
 
+#include "core/named_items.hpp"
 #include "core/parameter_error.hpp"
 
 #include <optional>
@@ -37,7 +38,14 @@ LameParameters lame_parameters(const Material& material);
 /// both with each region's (E, nu).
 enum class MaterialModel { corotational_linear, stable_neo_hookean };
 
-/// "corotationalLinear", "stableNeoHookean" (the FMU's and the host's spelling).
+inline constexpr ItemNames<MaterialModel, 2> MATERIAL_MODEL_NAMES{
+    "material model",
+    {{{"corotationalLinear", "Co-rotational linear elasticity (the dissertation's; one linear solve a step)"},
+      {"stableNeoHookean",
+       "Stable Neo-Hookean hyperelasticity (Smith, de Goes and Kim 2018): inversion-safe, its tangent projected to "
+       "positive semi-definite per element"}}}};
+
+/// "corotationalLinear", "stableNeoHookean" (MATERIAL_MODEL_NAMES).
 std::string_view to_string(MaterialModel model);
 /// The inverse; throws ParameterError naming the accepted names.
 MaterialModel parse_material_model(std::string_view name);

@@ -164,8 +164,8 @@ struct CholeskyPcgSolver::Impl {
 };
 
 std::string CholeskyPcgSolver::Refresh::problem() const {
-  if (refresh_iterations < 0) return "pcg-cholesky refresh iterations must be >= 0, got " + std::to_string(refresh_iterations);
-  if (pickup_setups < 1) return "pcg-cholesky pick-up setups must be >= 1, got " + std::to_string(pickup_setups);
+  if (refresh_iterations < 0) return "pcgCholesky refresh iterations must be >= 0, got " + std::to_string(refresh_iterations);
+  if (pickup_setups < 1) return "pcgCholesky pick-up setups must be >= 1, got " + std::to_string(pickup_setups);
   return "";
 }
 

@@ -196,7 +196,7 @@ class CholeskyPcgSolver final : public LinearSolver {
   void setup(const ShiftedSystem& system) override;
   SolveReport solve(const Eigen::VectorXd& b, Eigen::VectorXd& x) override;
   [[nodiscard]] bool is_set_up() const override;
-  [[nodiscard]] std::string_view name() const override { return "pcg-cholesky"; }
+  [[nodiscard]] std::string_view name() const override { return "pcgCholesky"; }
   void lend_work_team(WorkTeam* team) override;
   /// Refresh::follow_rotations.
   [[nodiscard]] bool follows_block_frames() const override;

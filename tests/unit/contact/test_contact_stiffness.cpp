@@ -1,6 +1,6 @@
-// Tests of the contact stiffness models on the frog: the effective-static K_c is the slope of the
+// Tests of the contact stiffness models on the frog: the effectiveStatic K_c is the slope of the
 // quasi-static reaction of the full model (finite differences of a bonded poke), symmetric positive
-// definite; the element-local model is the repaired eq. 4.23 (the printed one gives zero force),
+// definite; the elementLocal model is the repaired eq. 4.23 (the printed one gives zero force),
 // and its ratio to the reference is measured; the step-matrix variant for an unsupported body;
 // CHOLMOD's factor-once/solve-many.
 #include "core/integrate/integrator.hpp"
@@ -184,7 +184,7 @@ TEST(ElementLocalContactStiffness, RepairsEq422AndIsMeasuredAgainstTheReference)
 
     const Eigen::Matrix3d k_c = *frog.effective.stiffness_n_per_m(frog.interpolation(point));
     std::printf(
-        "  triangle %d: normal stiffness element-local %.4g N/m, effective %.4g N/m (ratio %.3g); "
+        "  triangle %d: normal stiffness elementLocal %.4g N/m, effective %.4g N/m (ratio %.3g); "
         "frictionless %.4g vs %.4g N/m\n",
         point.triangle, normal_stiffness_n_per_m(k_local, n), normal_stiffness_n_per_m(k_c, n),
         normal_stiffness_n_per_m(k_local, n) / normal_stiffness_n_per_m(k_c, n),
@@ -220,7 +220,7 @@ TEST(ContactSpringStiffness, ScaleBracketsTheEffectiveNormalStiffnessOverTheSurf
   }
   std::printf(
       "  scale %.4g N/m; effective normal stiffness / scale in [%.3g, %.3g] (%.3g on triangles with no "
-      "fixed vertex); element-local / effective in [%.3g, %.3g]\n",
+      "fixed vertex); elementLocal / effective in [%.3g, %.3g]\n",
       scale, lowest, highest, highest_away, local_lowest, local_highest);
   EXPECT_GE(lowest, 1e-3);
   EXPECT_LE(highest, 15.0);
@@ -292,9 +292,9 @@ TEST(CholmodSolver, SetUpOnceSolveManyAgreesWithSolve) {
 }
 
 TEST(ContactStiffnessModel, ParsesItsNames) {
-  EXPECT_EQ(parse_contact_stiffness_model("effective-static"), ContactStiffnessModel::effective_static);
-  EXPECT_EQ(parse_contact_stiffness_model("element-local"), ContactStiffnessModel::element_local);
-  EXPECT_EQ(to_string(ContactStiffnessModel::element_local), "element-local");
+  EXPECT_EQ(parse_contact_stiffness_model("effectiveStatic"), ContactStiffnessModel::effective_static);
+  EXPECT_EQ(parse_contact_stiffness_model("elementLocal"), ContactStiffnessModel::element_local);
+  EXPECT_EQ(to_string(ContactStiffnessModel::element_local), "elementLocal");
   EXPECT_THROW(parse_contact_stiffness_model("local"), ParameterError);
 }
 

@@ -269,7 +269,7 @@ TEST(MaterialModel, NamesRoundTripAndAnUnknownOneIsRefused) {
     (void)parse_material_model("neoHookean");
     ADD_FAILURE() << "an unknown model was taken";
   } catch (const ParameterError& error) {
-    EXPECT_STREQ(error.what(), "material model \"neoHookean\" is not \"corotationalLinear\" or \"stableNeoHookean\"");
+    EXPECT_STREQ(error.what(), "unknown material model 'neoHookean' (expected corotationalLinear or stableNeoHookean)");
   }
 }
 

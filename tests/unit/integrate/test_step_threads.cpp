@@ -125,7 +125,7 @@ DynamicState run(int threads, LinearSolverKind solver = LinearSolverKind::pcg) {
   return tissue.state();
 }
 
-// Jacobi PCG splits its products, updates and preconditioning; pcg-cholesky its products and
+// Jacobi PCG splits its products, updates and preconditioning; pcgCholesky its products and
 // updates around the factor's solve (and its refresh runs beside them: the same factor is picked up
 // at the same setup, bitwise, which failed while its solves and the refresh shared OpenBLAS);
 // CHOLMOD keeps one thread for the solve.

@@ -39,7 +39,7 @@ TEST(CholeskyPcg, ReachesTheToleranceAndAgreesWithCholmod) {
   std::mt19937 rng(42);
   const double tolerance = 1e-10;
   CholeskyPcgSolver solver({tolerance, 100}, refresh_rule(10, 4, true));
-  EXPECT_EQ(solver.name(), "pcg-cholesky");
+  EXPECT_EQ(solver.name(), "pcgCholesky");
   CholmodSolver cholmod;
   for (const double scale : {1.0, 1.3, 0.7}) {  // the factor is of scale 1: later solves use it lagged
     const ShiftedSystem shifted = system.shifted(scale);
@@ -324,12 +324,12 @@ TEST(CholeskyPcg, DestroyedWithARefreshInFlight) {
 }
 
 TEST(CholeskyPcg, SettingsAndNameThroughTheFactory) {
-  EXPECT_EQ(parse_linear_solver_kind("pcg-cholesky"), LinearSolverKind::pcg_cholesky);
-  EXPECT_EQ(to_string(LinearSolverKind::pcg_cholesky), "pcg-cholesky");
+  EXPECT_EQ(parse_linear_solver_kind("pcgCholesky"), LinearSolverKind::pcg_cholesky);
+  EXPECT_EQ(to_string(LinearSolverKind::pcg_cholesky), "pcgCholesky");
   EXPECT_THROW(parse_linear_solver_kind("cholesky"), ParameterError);
   SolverSettings settings;
   settings.kind = LinearSolverKind::pcg_cholesky;
-  EXPECT_EQ(make_linear_solver(settings)->name(), "pcg-cholesky");
+  EXPECT_EQ(make_linear_solver(settings)->name(), "pcgCholesky");
   settings.refresh.pickup_setups = 0;
   EXPECT_THROW(validate(settings), ParameterError);
   settings.refresh.pickup_setups = 1;

@@ -185,7 +185,7 @@ namespace {
 
 // CHOLMOD's supernodal factorization and solves call BLAS, and Debian's serial OpenBLAS is not
 // safe to call from two threads at once: two solvers on two threads (tissue-host compare --jobs 2,
-// or pcg-cholesky's refresh beside its solves) got each other's work buffers and results that
+// or pcgCholesky's refresh beside its solves) got each other's work buffers and results that
 // changed from run to run. Two supernodal factors on two threads must give bitwise what each gives
 // alone. (CholmodFactor goes supernodal by itself only for dense factors; forced here.)
 TEST(Cholmod, TwoSupernodalFactorsOnTwoThreadsGiveBitwiseTheirSerialResults) {

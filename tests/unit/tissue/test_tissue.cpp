@@ -214,7 +214,7 @@ TEST(Tissue, FreeBodyContactStiffnessLeavesTheSpringOut) {
 
 // In the background (contact_stiffness_in_background), a refresh started at a step is what the next
 // step renders: the K_c the caller's thread condenses from the static K and the proxy as they were
-// when the step that started it ended. A new contact's first step renders the element-local
+// when the step that started it ended. A new contact's first step renders the elementLocal
 // estimate (what the near-surface report gives before the touch).
 TEST(Tissue, ABackgroundContactStiffnessIsRenderedOneStepLate) {
   const TetMesh mesh = make_box_mesh(6, 4, 2, 0.01);

@@ -1,0 +1,352 @@
+// The tissue's settings, each declared once (setting_schema.hpp): the Tissue FMU's parameters and
+// enumeration types, the scenario files' [tissue.parameters] keys, the Python module's keywords and
+// their defaults, the range checks, the model fingerprint and docs/FMU_VARIABLES.md's parameter table
+// all come from TISSUE_SETTINGS. A new setting is one entry here plus the code that uses it.
+#pragma once
+
+#include "core/setting_schema.hpp"
+
+#include <array>
+#include <optional>
+#include <string_view>
+
+namespace tissue {
+
+namespace settings_detail {
+using enum SettingType;
+// A member of TissueParameters, for Setting::member.
+#define TISSUE_MEMBER(path) [](TissueParameters& p) -> SettingMember { return &p.path; }
+#define TISSUE_ENUM_MEMBER(path) [](TissueParameters& p) -> SettingMember { return enum_member(p.path); }
+
+/// The body: its mesh, material, damping, gravity and fixed region.
+constexpr auto body_settings() {
+  return std::to_array<SettingInfo>({
+      Setting("mesh", 1, text)
+          .python("mesh")
+          .scene()
+          .start("frog")
+          .describe("The specimen's tetrahedral mesh: frog = the embedded default frog (also shipped as "
+                    "resources/frog.veg); otherwise a file name in the FMU's resources folder or an absolute path "
+                    "(.veg, .node/.ele, Gmsh .msh 4.1)")
+          .member(TISSUE_MEMBER(mesh)),
+      Setting("material.youngModulus", 2, real)
+          .python("young_modulus_pa")
+          .unit("Pa")
+          .start("1e5")
+          .above("0")
+          .describe("Young's modulus E (of either material.model)")
+          .member(TISSUE_MEMBER(settings.body.material.young_modulus_pa)),
+      Setting("material.poissonRatio", 3, real)
+          .python("poisson_ratio")
+          .unit("1")
+          .start("0.4")
+          .at_least("0")
+          .below("0.5")
+          .describe("Poisson's ratio nu")
+          .member(TISSUE_MEMBER(settings.body.material.poisson_ratio)),
+      Setting("material.density", 4, real)
+          .python("density_kg_per_m3")
+          .unit("kg/m3")
+          .start("1000")
+          .above("0")
+          .describe("Mass density rho")
+          .member(TISSUE_MEMBER(settings.body.material.density_kg_per_m3)),
+      Setting("material.regions", 82, text)
+          .scene()
+          .start("none")
+          .describe("Materials by region name (the mesh's Vega *REGION sets, Gmsh physical groups, TetGen region "
+                    "numbers), replacing the file's: \"tumour: youngModulus=1e6, poissonRatio=0.45, density=1050, "
+                    "dampingAlpha=20; skin: youngModulus=3e5\"; the keys youngModulus [Pa], poissonRatio, density "
+                    "[kg/m^3] and dampingAlpha [1/s] (the region's own Rayleigh alpha; damping.beta stays one for the "
+                    "body); a key left out takes material.* (dampingAlpha: damping.alpha); a region neither the file "
+                    "nor this gives a material has material.*; a name the mesh does not have is refused, naming the "
+                    "mesh's regions. none: none. (Python: the regions keyword, a dict by region)")
+          .member(TISSUE_MEMBER(material_regions)),
+      Setting("material.model", 83, enumeration)
+          .python("material_model")
+          .start("corotationalLinear")
+          .items("MaterialModel", "Elasticity of the tissue", MATERIAL_MODEL_NAMES.all())
+          .describe("Elasticity of every region, with the same E and nu: co-rotational linear (one linear solve a "
+                    "step) or stable Neo-Hookean (Smith, de Goes and Kim 2018: hyperelastic, inversion-safe, its "
+                    "tangent projected to positive semi-definite per element); docs/BENCHMARKS.md weighs them")
+          .member(TISSUE_ENUM_MEMBER(settings.body.material_model)),
+      Setting("damping.alpha", 5, real)
+          .python("damping_alpha_per_s")
+          .unit("1/s")
+          .start("1")
+          .at_least("0")
+          .core_default("the core's bodies are undamped unless a test or bench asks; a product's tissue settles")
+          .describe("Rayleigh damping D = alpha M + beta K, mass-proportional part (a region's dampingAlpha "
+                    "replaces it there)")
+          .member(TISSUE_MEMBER(settings.body.damping.mass_damping_per_s)),
+      Setting("damping.beta", 6, real)
+          .python("damping_beta_s")
+          .unit("s")
+          .start("0.001")
+          .at_least("0")
+          .core_default("the core's bodies are undamped unless a test or bench asks; a product's tissue settles")
+          .describe("Rayleigh damping, stiffness-proportional part")
+          .member(TISSUE_MEMBER(settings.body.damping.stiffness_damping_s)),
+      Setting("gravity", 7, vector3)
+          .python("gravity_m_per_s2")
+          .unit("m/s2")
+          .start("0 0 -9.81")
+          .core_default("the core's tests and benches are written with y up; the products' scenes, the frog's "
+                        "tray and the organ's ligament, with z up")
+          .describe("Gravitational acceleration (x y z)")
+          .member(TISSUE_MEMBER(settings.body.gravity_m_per_s2)),
+      Setting("fixedRegion.axis", 8, integer)
+          .python("fixed_axis")
+          .scene()
+          .start("2")
+          .at_least("-1")
+          .at_most("2")
+          .describe("-1: nothing fixed; 0, 1, 2: the vertices within fixedRegion.fraction of the extent from the "
+                    "minimum along x, y, z keep their rest positions (Python: fixed_vertices lists them instead)")
+          .member(TISSUE_MEMBER(fixed_axis)),
+      Setting("fixedRegion.fraction", 9, real)
+          .python("fixed_fraction")
+          .scene()
+          .unit("1")
+          .start("0.25")
+          .at_least("0")
+          .at_most("1")
+          .describe("Thickness of that slab as a fraction of the mesh's extent")
+          .member(TISSUE_MEMBER(fixed_fraction)),
+  });
+}
+
+/// The time integration: the integrator, backward Euler's linear solver and PCG, IDA's settings.
+constexpr auto integrator_settings() {
+  return std::to_array<SettingInfo>({
+      Setting("integrator.linearSolver", 10, enumeration)
+          .python("linear_solver")
+          .start("pcg")
+          .items("LinearSolver", "Linear solver of the backward-Euler step", LINEAR_SOLVER_NAMES.all())
+          .describe("Linear solver of the backward-Euler step")
+          .member(TISSUE_ENUM_MEMBER(settings.solver.kind)),
+      Setting("integrator.pcgTolerance", 11, real)
+          .python("pcg_tolerance")
+          .unit("1")
+          .start("0.001")
+          .above("0")
+          .core_default("the core solves to 1e-6 unless a caller asks for the real-time setting")
+          .describe("PCG stopping tolerance on the relative residual")
+          .member(TISSUE_MEMBER(settings.solver.pcg.tolerance)),
+      Setting("integrator.pcgMaxIterations", 12, integer)
+          .python("pcg_max_iterations")
+          .start("10")
+          .at_least("1")
+          .core_default("the core's PCG runs to its tolerance (10000) unless a caller caps it for a real-time slot")
+          .describe("PCG iteration cap per step")
+          .member(TISSUE_MEMBER(settings.solver.pcg.max_iterations)),
+      Setting("integrator.warmStart", 13, boolean)
+          .python("warm_start")
+          .start("false")
+          .describe("PCG starts from the previous step's velocity change instead of zero")
+          .member(TISSUE_MEMBER(settings.solver.warm_start)),
+      Setting("stepSize", 14, real)
+          .python("step_size_s")
+          .unit("s")
+          .start("0.001")
+          .above("0")
+          .describe("Internal step (IDA: the interval of one step, which IDA covers in as many steps as its "
+                    "tolerances need). A communication step must be a whole multiple of it")
+          .member(TISSUE_MEMBER(settings.step_size_s)),
+      Setting("integrator.threads", 79, integer)
+          .python("threads")
+          .start("1")
+          .at_least("1")
+          .at_most("2")
+          .describe("Threads of a backward-Euler step: 2 lets a step run a second thread for its own duration "
+                    "(made and joined by each step); the results are bitwise the same as with 1")
+          .member(TISSUE_MEMBER(settings.integrator.threads)),
+      Setting("integrator.method", 70, enumeration)
+          .python("integrator")
+          .start("backwardEuler")
+          .items("Integrator", "Time integrator of the tissue", INTEGRATOR_NAMES.all())
+          .describe("Time integrator: backward Euler (one linear solve per internal step) or SUNDIALS IDA "
+                    "(variable-order BDF with error control)")
+          .member(TISSUE_ENUM_MEMBER(settings.integrator.kind)),
+      Setting("integrator.idaRelativeTolerance", 71, real)
+          .python("ida_relative_tolerance")
+          .unit("1")
+          .start("0.0001")
+          .above("0")
+          .describe("IDA's relative error tolerance")
+          .member(TISSUE_MEMBER(settings.integrator.ida.relative_tolerance)),
+      Setting("integrator.idaAbsoluteTolerance", 72, real)
+          .python("ida_absolute_tolerance")
+          .start("1e-08")
+          .above("0")
+          .describe("IDA's absolute error tolerance, in m on displacements and m/s on velocities")
+          .member(TISSUE_MEMBER(settings.integrator.ida.absolute_tolerance)),
+      Setting("integrator.idaMaxOrder", 73, integer)
+          .python("ida_max_order")
+          .start("5")
+          .at_least("1")
+          .at_most("5")
+          .describe("Highest BDF order IDA may use")
+          .member(TISSUE_MEMBER(settings.integrator.ida.max_order)),
+      Setting("integrator.idaMaxStep", 74, real)
+          .python("ida_max_step_s")
+          .unit("s")
+          .start("0")
+          .at_least("0")
+          .describe("Largest internal step IDA may take; 0: no limit below stepSize")
+          .member(TISSUE_MEMBER(settings.integrator.ida.max_step_s)),
+      Setting("integrator.idaLinearSolver", 75, enumeration)
+          .python("ida_linear_solver")
+          .start("klu")
+          .items("IdaLinearSolver", "Linear solver of IDA's Newton iteration", IDA_LINEAR_SOLVER_NAMES.all())
+          .describe("Linear solver of IDA's Newton iteration: KLU (sparse LU) or GMRES preconditioned by "
+                    "eliminating the velocities")
+          .member(TISSUE_ENUM_MEMBER(settings.integrator.ida.linear_solver)),
+  });
+}
+
+/// What the scene builds, the tool, the contact and the cutter, and what is drawn.
+constexpr auto interaction_settings() {
+  return std::to_array<SettingInfo>({
+      Setting("scene.contact", 15, boolean)
+          .python("contact")
+          .start("true")
+          .describe("Probe contact; off: the probe touches nothing, and the surface BVH is built only if cutting "
+                    "is on")
+          .member(TISSUE_MEMBER(settings.interaction.contact_enabled)),
+      Setting("scene.cutting", 16, boolean)
+          .python("cutting")
+          .start("true")
+          .describe("Cutting; off: the scalpel does not cut; the cutter and the edge adjacency are not built")
+          .member(TISSUE_MEMBER(settings.interaction.cutting_enabled)),
+      Setting("tool.probeRadius", 18, real)
+          .python("probe_radius_m")
+          .unit("m")
+          .start("0")
+          .at_least("0")
+          .describe("Radius of a ball-ended probe: tool.position is then the ball's centre and the ball's pole "
+                    "along the tool axis (position - r x axis) touches; exact for pushes along the axis; 0 = a "
+                    "point probe")
+          .member(TISSUE_MEMBER(settings.interaction.probe_radius_m)),
+      Setting("tool.bladeLength", 19, real)
+          .python("blade_length_m")
+          .unit("m")
+          .start("0.03")
+          .above("0")
+          .describe("Length of the scalpel's cutting edge, from the tip along the tool axis")
+          .member(TISSUE_MEMBER(settings.interaction.blade_length_m)),
+      Setting("tool.maxSpeed", 76, real)
+          .python("max_tool_speed_m_per_s")
+          .unit("m/s")
+          .start("5")
+          .above("0")
+          .describe("Fastest a hand moves the tool: a pose farther than this times stepSize from the last is "
+                    "approached at this speed (the tool is clamped; a scalpel sweeps its path in sub-sweeps)")
+          .member(TISSUE_MEMBER(settings.interaction.max_tool_speed_m_per_s)),
+      Setting("contact.nearMargin", 77, real)
+          .scene()
+          .unit("m")
+          .start("0.01")
+          .at_least("0")
+          .describe("A probe not in contact but this close to the surface reports it (contact.near): the nearest "
+                    "surface point, its normal and stiffness, so that a haptic loop feels the surface from the tick "
+                    "the tool crosses it; 0: never")
+          .member(TISSUE_MEMBER(contact_near_margin_m)),
+      Setting("contact.springStiffness", 20, real)
+          .python("contact_spring_stiffness_n_per_m")
+          .unit("N/m")
+          .start("0")
+          .at_least("0")
+          .describe("Spring tying the god-object to the probe tip; 0 = automatic (100 x the body's contact "
+                    "stiffness scale)")
+          .member(TISSUE_MEMBER(settings.interaction.contact_spring_stiffness_n_per_m)),
+      Setting("contact.stiffnessModel", 21, enumeration)
+          .python("contact_stiffness_model")
+          .start("effectiveStatic")
+          .items("ContactStiffnessModel", "How the 3x3 contact stiffness K_c is computed",
+                 CONTACT_STIFFNESS_MODEL_NAMES.all())
+          .describe("How contact.stiffness is computed")
+          .member(TISSUE_ENUM_MEMBER(settings.interaction.contact_stiffness_model)),
+      Setting("contact.stiffnessRefreshSteps", 22, integer)
+          .python("contact_stiffness_refresh_steps")
+          .start("10")
+          .at_least("1")
+          .describe("effectiveStatic K_c is recomputed when a contact starts, then every this many internal steps")
+          .member(TISSUE_MEMBER(settings.interaction.contact_stiffness_refresh_steps)),
+      Setting("contact.stiffnessInBackground", 80, boolean)
+          .python("contact_stiffness_in_background")
+          .start("false")
+          .describe("The effectiveStatic K_c's factorization runs in a worker thread beside the step (started by a "
+                    "step, joined and rendered by the next) instead of in it: a refresh reaches contact.stiffness "
+                    "one internal step later, and a new contact's first step renders the elementLocal estimate. The "
+                    "results are the same with or without the thread. Off: no thread unless asked (an importer "
+                    "has no FMI switch that allows threads); tissue-host turns it on for its own Tissue.fmu, whose "
+                    "step shares its slot with nothing else")
+          .member(TISSUE_MEMBER(settings.interaction.contact_stiffness_in_background)),
+      Setting("cutter.minVolumeFraction", 23, real)
+          .python("min_volume_fraction")
+          .unit("1")
+          .start("0.001")
+          .at_least("1e-12")
+          .below("0.5")
+          .describe("Smallest volume fraction either side of a cut tet is given (keeps slivers stiff and massive "
+                    "enough)")
+          .member(TISSUE_MEMBER(settings.interaction.cutter.min_volume_fraction)),
+      Setting("surface.renderSurface", 78, text)
+          .python("render_surface")
+          .scene()
+          .start("none")
+          .describe("What is drawn: none the tet mesh's own skin; frog the embedded frog's fine render surface "
+                    "(meshes/frog_surface.obj, 23 240 triangles); otherwise an OBJ file (in the FMU: in its "
+                    "resources folder, or an absolute path). It rides on the tets and is cut with them (closed "
+                    "pieces, capped openings). A surface outside the mesh, not closed, not manifold or with a NaN is "
+                    "refused, naming the file and the element")
+          .member(TISSUE_MEMBER(render_surface)),
+  });
+}
+
+#undef TISSUE_MEMBER
+#undef TISSUE_ENUM_MEMBER
+
+template <class T, std::size_t A, std::size_t B>
+constexpr std::array<T, A + B> joined(const std::array<T, A>& a, const std::array<T, B>& b) {
+  std::array<T, A + B> out{};
+  for (std::size_t k = 0; k < A; ++k) out[k] = a[k];
+  for (std::size_t k = 0; k < B; ++k) out[A + k] = b[k];
+  return out;
+}
+}  // namespace settings_detail
+
+/// Every setting of the tissue, in the docs' order.
+inline constexpr auto TISSUE_SETTINGS = settings_detail::joined(
+    settings_detail::joined(settings_detail::body_settings(), settings_detail::integrator_settings()),
+    settings_detail::interaction_settings());
+
+/// The setting of an FMU / scenario name, or nullptr.
+const SettingInfo* find_setting(std::string_view name);
+/// The setting of a Python keyword, or nullptr.
+const SettingInfo* find_python_setting(std::string_view keyword);
+
+/// Every setting at its default (the schema's start values).
+TissueParameters default_parameters();
+
+/// The tissue's settings for `mesh` (nullptr: only checked, the fixed vertices left empty): the fixed
+/// slab's vertices and the regions' materials resolved, everything validated. Throws ParameterError.
+TissueSettings resolve_settings(const TissueParameters& parameters, const TetMesh* mesh);
+
+/// Throws ParameterError, naming the setting, for a member of `settings` outside its schema range (the
+/// settings' one range check; validate(TissueSettings) calls it).
+void check_setting_ranges(const TissueSettings& settings);
+
+/// Calls visit(setting, value) for each tissue-scope setting (those TissueSettings holds), in the
+/// table's order: the model fingerprint's share of the settings.
+template <class Visit>
+void for_each_tissue_setting(const TissueSettings& settings, Visit&& visit) {
+  TissueParameters parameters;
+  parameters.settings = settings;
+  for (const SettingInfo& setting : TISSUE_SETTINGS) {
+    if (setting.scope == SettingScope::tissue) visit(setting, value_of(setting, parameters));
+  }
+}
+
+}  // namespace tissue
