@@ -81,8 +81,6 @@ std::uint64_t model_fingerprint(const TetMesh& mesh, const TissueSettings& setti
     f.add(settings.solver.refresh.follow_rotations);
     f.add(settings.solver.refresh.refactor_on_growth);
   }
-  const InteractionSettings& interaction = settings.interaction;
-  f.add(interaction.cutter.vertex_snap_fraction);
   return f.value();
 }
 

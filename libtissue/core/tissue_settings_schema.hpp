@@ -292,6 +292,16 @@ constexpr auto interaction_settings() {
           .describe("Smallest volume fraction either side of a cut tet is given (keeps slivers stiff and massive "
                     "enough)")
           .member(TISSUE_MEMBER(settings.interaction.cutter.min_volume_fraction)),
+      Setting("cutter.vertexSnapFraction", 84, real)
+          .python("vertex_snap_fraction")
+          .unit("1")
+          .start("0.001")
+          .at_least("0")
+          .below("0.5")
+          .describe("An edge the blade crosses within this fraction of its length from an end is cut through that "
+                    "vertex (DESIGN.md 4: a cut within eps of a vertex passes through it); 0 takes the crossings as "
+                    "computed")
+          .member(TISSUE_MEMBER(settings.interaction.cutter.vertex_snap_fraction)),
       Setting("surface.renderSurface", 78, text)
           .python("render_surface")
           .scene()

@@ -212,6 +212,8 @@ def test_the_keywords_are_the_settings_schemas_with_the_fmus_defaults():
                     "contact_stiffness_in_background=false", "max_tool_speed_m_per_s=5"):
         assert keyword in doc, keyword
     # A setting Python did not have by hand before the schema reaches the core.
+    with pytest.raises(ValueError, match=r"cutter.vertexSnapFraction must be finite and in \[0, 0.5\)"):
+        tissue.Tissue(box=(2, 2, 2), vertex_snap_fraction=0.5)  # added to the schema alone
     t = tissue.Tissue(box=(2, 2, 2), integrator="ida", ida_linear_solver="krylov", ida_max_order=2,
                       contact_spring_stiffness_n_per_m=500.0)
     assert t.contact_spring_stiffness_n_per_m == 500.0
