@@ -205,7 +205,7 @@ constexpr auto integrator_settings() {
   });
 }
 
-/// What the scene builds, the tool, the contact and the cutter, and what is drawn.
+/// What the scene builds, the tool and the contact.
 constexpr auto interaction_settings() {
   return std::to_array<SettingInfo>({
       Setting("scene.contact", 15, boolean)
@@ -283,6 +283,12 @@ constexpr auto interaction_settings() {
                     "has no FMI switch that allows threads); tissue-host turns it on for its own Tissue.fmu, whose "
                     "step shares its slot with nothing else")
           .member(TISSUE_MEMBER(settings.interaction.contact_stiffness_in_background)),
+  });
+}
+
+/// The cutter, and what is drawn.
+constexpr auto cutter_and_surface_settings() {
+  return std::to_array<SettingInfo>({
       Setting("cutter.minVolumeFraction", 23, real)
           .python("min_volume_fraction")
           .unit("1")
@@ -330,7 +336,7 @@ constexpr std::array<T, A + B> joined(const std::array<T, A>& a, const std::arra
 /// Every setting of the tissue, in the docs' order.
 inline constexpr auto TISSUE_SETTINGS = settings_detail::joined(
     settings_detail::joined(settings_detail::body_settings(), settings_detail::integrator_settings()),
-    settings_detail::interaction_settings());
+    settings_detail::joined(settings_detail::interaction_settings(), settings_detail::cutter_and_surface_settings()));
 
 /// The setting of an FMU / scenario name, or nullptr.
 const SettingInfo* find_setting(std::string_view name);
