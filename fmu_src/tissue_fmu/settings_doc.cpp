@@ -25,10 +25,12 @@ std::string fmi_type(const fmi3::VariableInfo& variable) {
   return type;
 }
 
-// The setting's default as the FMU starts it: an enumeration's item number and name.
-std::string fmu_start(const SettingInfo& setting) {
-  if (setting.type != SettingType::enumeration) return std::string(setting.start);
-  return std::to_string(start_item(setting) + 1).append(" (").append(setting.start).append(")");
+// The setting's default as the FMU starts it (`variable`'s start): an enumeration's item number, with
+// the item's name.
+std::string fmu_start(const SettingInfo& setting, const fmi3::VariableInfo& variable) {
+  std::string start(variable.start);
+  if (setting.type == SettingType::enumeration) start.append(" (").append(setting.start).append(")");
+  return start;
 }
 
 std::string setting_range(const SettingInfo& setting) {
@@ -51,7 +53,7 @@ std::string fmu_parameter_table() {
     const fmi3::VariableInfo& variable = *description.find(setting.value_reference);
     table +=
         row({code(setting.name), std::to_string(setting.value_reference), fmi_type(variable), std::string(setting.unit),
-             fmu_start(setting), setting_range(setting), std::string(setting.description)});
+             fmu_start(setting, variable), setting_range(setting), std::string(setting.description)});
   }
   for (const fmi3::VariableInfo& variable : description.variables) {
     if (variable.causality != fmi3::Causality::parameter || find_setting(variable.name) != nullptr) continue;

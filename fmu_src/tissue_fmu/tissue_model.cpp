@@ -115,7 +115,10 @@ std::string resolve_path(const std::string& name, const char* what, const std::s
 }  // namespace
 
 std::unique_ptr<Tissue> make_tissue(const ValueStore& values, const std::string& resource_path) {
-  const TissueParameters parameters = tissue_parameters(values);
+  return make_tissue(tissue_parameters(values), resource_path);
+}
+
+std::unique_ptr<Tissue> make_tissue(const TissueParameters& parameters, const std::string& resource_path) {
   const std::string& name = parameters.mesh;
   if (name.empty()) throw VariableError("mesh must be a non-empty name or path");
   TetMesh mesh;
@@ -143,8 +146,9 @@ std::unique_ptr<Tissue> make_tissue(const ValueStore& values, const std::string&
 }
 
 void TissueModel::build() {
-  m_tissue = make_tissue(m_values, m_context.resource_path);
-  m_near_margin_m = tissue_parameters(m_values).contact_near_margin_m;
+  const TissueParameters parameters = tissue_parameters(m_values);
+  m_tissue = make_tissue(parameters, m_context.resource_path);
+  m_near_margin_m = parameters.contact_near_margin_m;
   m_tissue->set_tool(tool_pose(m_values));
   m_dirty = false;
   m_surface_revision = 0;

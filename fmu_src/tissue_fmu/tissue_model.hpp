@@ -30,6 +30,8 @@ ToolPose tool_pose(const fmi3::ValueStore& values);
 /// its tissue with it, the Python module a scenario's. Throws VariableError naming the parameter
 /// (a mesh or surface that cannot be loaded), ParameterError for values the core refuses.
 std::unique_ptr<Tissue> make_tissue(const fmi3::ValueStore& values, const std::string& resource_path);
+/// The same from parameters already read (tissue_parameters()).
+std::unique_ptr<Tissue> make_tissue(const TissueParameters& parameters, const std::string& resource_path);
 
 class TissueModel final : public fmi3::Model {
  public:

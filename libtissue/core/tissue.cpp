@@ -10,8 +10,6 @@
 #include <chrono>
 #include <cmath>
 #include <string>
-#include <type_traits>
-#include <variant>
 
 namespace tissue {
 

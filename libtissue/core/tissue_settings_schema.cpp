@@ -229,7 +229,10 @@ TissueParameters default_parameters() {
 }
 
 TissueSettings resolve_settings(const TissueParameters& parameters, const TetMesh* mesh) {
-  for (const SettingInfo& setting : TISSUE_SETTINGS) check_value(setting, value_of(setting, parameters));
+  // The scene's settings here; the tissue's are validate()'s (check_setting_ranges), below.
+  for (const SettingInfo& setting : TISSUE_SETTINGS) {
+    if (setting.scope == SettingScope::scene) check_value(setting, value_of(setting, parameters));
+  }
   TissueSettings settings = parameters.settings;
   settings.body.region_materials = parse_region_materials(parameters.material_regions, settings.body.material);
   if (parameters.fixed_axis != -1 && mesh != nullptr) {

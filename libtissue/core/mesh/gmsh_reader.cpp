@@ -73,16 +73,19 @@ void read_gmsh_format(LineReader& reader, const std::string& source) {
   expect_gmsh_end(reader, source, "$MeshFormat");
 }
 
+// A $Nodes or $Elements header: its block and item counts, refused when negative.
+std::pair<std::int64_t, std::int64_t> read_gmsh_section_header(LineReader& reader, const std::string& source,
+                                                               const std::string& what, const std::string& section) {
+  const auto header = read_gmsh_ints(reader, source, what, 4, section);
+  if (header[0] < 0 || header[1] < 0) fail(source, reader.line(), -1, section + ": negative count in the header");
+  return {header[0], header[1]};
+}
+
 void read_gmsh_nodes(LineReader& reader, const std::string& source, RawMesh& raw,
                      std::unordered_map<std::int64_t, int>& index_of_tag, std::size_t text_size) {
   const std::string section = "$Nodes";
-  const auto header =
-      read_gmsh_ints(reader, source, "header 'numEntityBlocks numNodes minNodeTag maxNodeTag'", 4, section);
-  const std::int64_t blocks = header[0];
-  const std::int64_t count = header[1];
-  if (blocks < 0 || count < 0) {
-    fail(source, reader.line(), -1, section + ": negative count in the header");
-  }
+  const auto [blocks, count] =
+      read_gmsh_section_header(reader, source, "header 'numEntityBlocks numNodes minNodeTag maxNodeTag'", section);
   raw.positions.reserve(plausible_reserve(count, text_size));
   raw.vertex_lines.reserve(plausible_reserve(count, text_size));
   index_of_tag.reserve(plausible_reserve(count, text_size));
@@ -209,13 +212,8 @@ void read_gmsh_elements(LineReader& reader, const std::string& source, RawMesh& 
                         GmshGroups& groups) {
   constexpr std::int64_t k_tet4 = 4;  // Gmsh element type of the 4-node tetrahedron
   const std::string section = "$Elements";
-  const auto header =
-      read_gmsh_ints(reader, source, "header 'numEntityBlocks numElements minElementTag maxElementTag'", 4, section);
-  const std::int64_t blocks = header[0];
-  const std::int64_t count = header[1];
-  if (blocks < 0 || count < 0) {
-    fail(source, reader.line(), -1, section + ": negative count in the header");
-  }
+  const auto [blocks, count] = read_gmsh_section_header(
+      reader, source, "header 'numEntityBlocks numElements minElementTag maxElementTag'", section);
   raw.tets.reserve(plausible_reserve(count, text_size));
   std::int64_t seen = 0;
   for (std::int64_t b = 0; b < blocks; ++b) {
