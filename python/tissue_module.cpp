@@ -321,6 +321,21 @@ class PyTissue {
     out["depth_m"] = c.penetration_depth_m;
     return out;
   }
+  [[nodiscard]] py::dict tool_contact() const {
+    const ToolContact c = m_tissue->tool_contact();
+    py::dict out;
+    out["active"] = c.active;
+    out["near"] = c.near;
+    out["point_m"] = vector3(c.point_m);
+    out["normal"] = vector3(c.normal);
+    out["force_on_tool_n"] = vector3(c.force_on_tool_n);
+    const Eigen::Matrix<double, 3, 3, Eigen::RowMajor> k = c.stiffness_n_per_m;
+    out["stiffness_n_per_m"] = matrix(k.data(), 3, 3);
+    const Eigen::Matrix<double, 3, 3, Eigen::RowMajor> d = c.damping_n_s_per_m;
+    out["damping_n_s_per_m"] = matrix(d.data(), 3, 3);
+    out["depth_m"] = c.penetration_depth_m;
+    return out;
+  }
   [[nodiscard]] double contact_spring_stiffness_n_per_m() const { return m_tissue->contact_spring_stiffness_n_per_m(); }
   [[nodiscard]] py::dict tool() const {
     const ToolPose& pose = m_tissue->applied_tool();
@@ -498,6 +513,10 @@ PYBIND11_MODULE(tissue, m) {
       .def_property_readonly("positions_m", &PyTissue::positions_m, "Vertex positions (n x 3) [m]")
       .def_property_readonly("rest_positions_m", &PyTissue::rest_positions_m, "Vertex rest positions (n x 3) [m]")
       .def_property_readonly("contact", &PyTissue::contact, "The last step's contact (force on the tool, K_c)")
+      .def_property_readonly("tool_contact", &PyTissue::tool_contact,
+                             "What a haptic loop renders after the last step, as the Tissue FMU's contact outputs: "
+                             "in contact or near the surface (near_surface_margin_m), the point in the tool "
+                             "position's terms (a ball probe's centre), K_c and the damping D_c = beta K_c")
       .def_property_readonly("contact_spring_stiffness_n_per_m", &PyTissue::contact_spring_stiffness_n_per_m)
       .def_property_readonly("tool", &PyTissue::tool, "The pose the last step applied")
       .def("surface", &PyTissue::surface, "The drawn surface: (points (m x 3) [m], triangles (k x 3))")

@@ -93,10 +93,6 @@ void TissueModel::validate_parameters(const ValueStore& values) const {
   }
 }
 
-void TissueModel::update_near_surface() {
-  m_near = near_surface(*m_tissue, m_near_margin_m, m_near_hits);
-}
-
 // --- the model ---
 
 namespace {
@@ -148,7 +144,6 @@ std::unique_ptr<Tissue> make_tissue(const TissueParameters& parameters, const st
 void TissueModel::build() {
   const TissueParameters parameters = tissue_parameters(m_values);
   m_tissue = make_tissue(parameters, m_context.resource_path);
-  m_near_margin_m = parameters.contact_near_margin_m;
   m_tissue->set_tool(tool_pose(m_values));
   m_dirty = false;
   m_surface_revision = 0;
@@ -157,7 +152,6 @@ void TissueModel::build() {
   m_surface_cut_tets = 0;
   m_drawn_current = false;
   m_capacity_warned = false;
-  update_near_surface();
 }
 
 const ports::SurfaceMesh& TissueModel::drawn_mesh() {
@@ -288,14 +282,12 @@ fmi3::StepOutcome TissueModel::do_step(double current_time_s, double step_s) {
                                  static_cast<std::uint64_t>(report.dynamics.linear_iterations);
     } catch (const std::exception& error) {
       update_surface_counters();
-      update_near_surface();
       log_events();
       m_context.log(fmi3::LogLevel::warning, std::string("doStep: an internal step failed: ") + error.what());
       return {false, m_start_time_s + tissue.time_s()};
     }
   }
   update_surface_counters();
-  update_near_surface();
   log_events();
   return {true, m_start_time_s + tissue.time_s()};
 }
@@ -303,7 +295,6 @@ fmi3::StepOutcome TissueModel::do_step(double current_time_s, double step_s) {
 void TissueModel::reset() {
   m_start_time_s = 0.0;
   m_tissue.reset();
-  m_near.reset();
   m_dirty = true;
   m_surface_revision = 0;
 }
@@ -313,43 +304,36 @@ void TissueModel::reset() {
 void TissueModel::get_float64(const VariableInfo& info, std::span<double> out) {
   ensure_built();
   Tissue& tissue = *m_tissue;
-  const ContactOutput& contact = tissue.contact();
   const auto put3 = [&](const Eigen::Vector3d& v) {
     for (int k = 0; k < 3; ++k) out[static_cast<std::size_t>(k)] = v(k);
+  };
+  const auto put33 = [&](const Eigen::Matrix3d& m) {
+    for (int r = 0; r < 3; ++r) {
+      for (int c = 0; c < 3; ++c) out[static_cast<std::size_t>(3 * r + c)] = m(r, c);
+    }
   };
   switch (static_cast<Vr>(info.vr)) {
     case Vr::time:
     case Vr::sample_time:
       out[0] = m_start_time_s + tissue.time_s();
       return;
-    case Vr::contact_point: {
-      // In the tool position's terms, as x0 (tool.appliedPosition): a ball probe touches with its pole
-      // and is posed by its centre, so the point is offset from the surface by the same centre - pole.
-      const Eigen::Vector3d ball_offset_m = tissue.applied_tool_position_m() - tissue.applied_tool().tip_position_m;
-      put3((!contact.active && m_near ? m_near->point_m : contact.point_m) + ball_offset_m);
+    case Vr::contact_point:
+      put3(tissue.tool_contact().point_m);
       return;
-    }
     case Vr::contact_normal:
-      put3(!contact.active && m_near ? m_near->normal : contact.normal);
+      put3(tissue.tool_contact().normal);
       return;
     case Vr::contact_force:
-      put3(contact.force_on_tool_n);
+      put3(tissue.tool_contact().force_on_tool_n);
       return;
     case Vr::contact_stiffness:
-    case Vr::contact_damping: {
-      const Eigen::Matrix3d& k = !contact.active && m_near ? m_near->stiffness_n_per_m : contact.stiffness_n_per_m;
-      // D_c = beta K_c: pressed at a speed v, the tool feels the quasi-static force plus beta K_n v
-      // (point_contact.hpp; tests/physics/test_contact_press.cpp).
-      const double scale = static_cast<Vr>(info.vr) == Vr::contact_damping
-                               ? tissue.settings().body.damping.stiffness_damping_s
-                               : 1.0;
-      for (int r = 0; r < 3; ++r) {
-        for (int c = 0; c < 3; ++c) out[static_cast<std::size_t>(3 * r + c)] = scale * k(r, c);
-      }
+      put33(tissue.tool_contact().stiffness_n_per_m);
       return;
-    }
+    case Vr::contact_damping:
+      put33(tissue.tool_contact().damping_n_s_per_m);
+      return;
     case Vr::contact_depth:
-      out[0] = contact.penetration_depth_m;
+      out[0] = tissue.tool_contact().penetration_depth_m;
       return;
     case Vr::kinetic_energy:
       out[0] = tissue.kinetic_energy_j();
@@ -429,7 +413,8 @@ void TissueModel::get_boolean(const VariableInfo& info, std::span<bool> out) {
   const auto which = static_cast<Vr>(info.vr);
   if (which != Vr::contact_active && which != Vr::contact_near) Model::get_boolean(info, out);
   ensure_built();
-  out[0] = which == Vr::contact_active ? m_tissue->contact().active : m_near.has_value();
+  const ToolContact contact = m_tissue->tool_contact();
+  out[0] = which == Vr::contact_active ? contact.active : contact.near;
 }
 
 std::span<const std::uint8_t> TissueModel::get_binary(const VariableInfo& info) {
@@ -489,7 +474,6 @@ void TissueModel::restore(const fmi3::ModelState& model_state) {
   m_surface_triangles = m_tissue->drawn_triangle_count();
   m_surface_cut_tets = m_tissue->body().cut_tets().size();
   m_drawn_current = false;
-  update_near_surface();
 }
 
 void TissueModel::serialize(const fmi3::ModelState& model_state, serial::ByteWriter& writer) const {

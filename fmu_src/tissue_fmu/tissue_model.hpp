@@ -4,7 +4,6 @@
 #pragma once
 
 #include "core/mesh/tet_mesh.hpp"
-#include "core/contact/surface_near.hpp"
 #include "core/tissue.hpp"
 #include "fmi3/model.hpp"
 #include "ports/surface_binary.hpp"
@@ -70,8 +69,6 @@ class TissueModel final : public fmi3::Model {
   const ports::SurfaceMesh& drawn_mesh();
   void drawn_embedding(ports::SurfaceEmbedding& embedding);
   void drawn_nodes(ports::SurfaceNodes& nodes);
-  /// contact.near and the surface it reports, after a build, a step or a restore.
-  void update_near_surface();
 
   fmi3::ModelContext m_context;
   const fmi3::ValueStore& m_values;
@@ -88,9 +85,6 @@ class TissueModel final : public fmi3::Model {
   ports::SurfaceNodes m_nodes;             // scratch of get_binary
   std::vector<std::uint8_t> m_mesh_bytes, m_embedding_bytes, m_nodes_bytes;
   bool m_capacity_warned = false;
-  double m_near_margin_m = 0.0;                       ///< contact.nearMargin
-  std::optional<NearSurface> m_near;                  ///< contact.near's surface, if near
-  std::vector<SurfaceBvh::SphereHit> m_near_hits;     // scratch of update_near_surface()
 };
 
 }  // namespace tissue::tissue_fmu

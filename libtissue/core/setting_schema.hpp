@@ -21,7 +21,7 @@
 namespace tissue {
 
 /// What a product sets by name: the tissue's settings, and the scene's choices that need the mesh (the
-/// fixed slab, the regions' materials by name) or the product (the files, the near-surface report).
+/// fixed slab, the regions' materials by name) or the product (the files).
 /// default_parameters() gives every setting its schema default.
 struct TissueParameters {
   TissueSettings settings;
@@ -30,7 +30,6 @@ struct TissueParameters {
   double fixed_fraction = 0.0;   ///< the slab's thickness, a fraction of the mesh's extent
   std::string material_regions;  ///< the regions' materials as text (parse_region_materials)
   std::string render_surface;    ///< "none", "frog" (the embedded frog's) or an OBJ file
-  double contact_near_margin_m = 0.0;
 };
 
 enum class SettingType { real, integer, boolean, enumeration, vector3, text };

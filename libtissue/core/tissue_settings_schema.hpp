@@ -244,14 +244,14 @@ constexpr auto interaction_settings() {
                     "approached at this speed (the tool is clamped; a scalpel sweeps its path in sub-sweeps)")
           .member(TISSUE_MEMBER(settings.interaction.max_tool_speed_m_per_s)),
       Setting("contact.nearMargin", 77, real)
-          .scene()
+          .python("near_surface_margin_m")
           .unit("m")
           .start("0.01")
           .at_least("0")
           .describe("A probe not in contact but this close to the surface reports it (contact.near): the nearest "
                     "surface point, its normal and stiffness, so that a haptic loop feels the surface from the tick "
                     "the tool crosses it; 0: never")
-          .member(TISSUE_MEMBER(contact_near_margin_m)),
+          .member(TISSUE_MEMBER(settings.interaction.contact.near_surface_margin_m)),
       Setting("contact.springStiffness", 20, real)
           .python("contact_spring_stiffness_n_per_m")
           .unit("N/m")
@@ -259,20 +259,20 @@ constexpr auto interaction_settings() {
           .at_least("0")
           .describe("Spring tying the god-object to the probe tip; 0 = automatic (100 x the body's contact "
                     "stiffness scale)")
-          .member(TISSUE_MEMBER(settings.interaction.contact_spring_stiffness_n_per_m)),
+          .member(TISSUE_MEMBER(settings.interaction.contact.spring_stiffness_n_per_m)),
       Setting("contact.stiffnessModel", 21, enumeration)
           .python("contact_stiffness_model")
           .start("effectiveStatic")
           .items("ContactStiffnessModel", "How the 3x3 contact stiffness K_c is computed",
                  CONTACT_STIFFNESS_MODEL_NAMES.all())
           .describe("How contact.stiffness is computed")
-          .member(TISSUE_ENUM_MEMBER(settings.interaction.contact_stiffness_model)),
+          .member(TISSUE_ENUM_MEMBER(settings.interaction.contact.stiffness_model)),
       Setting("contact.stiffnessRefreshSteps", 22, integer)
           .python("contact_stiffness_refresh_steps")
           .start("10")
           .at_least("1")
           .describe("effectiveStatic K_c is recomputed when a contact starts, then every this many internal steps")
-          .member(TISSUE_MEMBER(settings.interaction.contact_stiffness_refresh_steps)),
+          .member(TISSUE_MEMBER(settings.interaction.contact.stiffness_refresh_steps)),
       Setting("contact.stiffnessInBackground", 80, boolean)
           .python("contact_stiffness_in_background")
           .start("false")
@@ -282,7 +282,7 @@ constexpr auto interaction_settings() {
                     "results are the same with or without the thread. Off: no thread unless asked (an importer "
                     "has no FMI switch that allows threads); tissue-host turns it on for its own Tissue.fmu, whose "
                     "step shares its slot with nothing else")
-          .member(TISSUE_MEMBER(settings.interaction.contact_stiffness_in_background)),
+          .member(TISSUE_MEMBER(settings.interaction.contact.stiffness_in_background)),
   });
 }
 

@@ -5,7 +5,9 @@
 // (contact_stiffness.hpp: cheap, no factorization; the effective K_c follows once in contact).
 #pragma once
 
-#include "core/tissue.hpp"
+#include "core/collide/surface_bvh.hpp"
+#include "core/fem/corotational.hpp"
+#include "core/mesh/topology.hpp"
 
 #include <Eigen/Core>
 
@@ -21,9 +23,12 @@ struct NearSurface {
   double distance_m = 0.0;  ///< from the touching point to `point_m`
 };
 
-/// Nothing unless the tool is a probe with contact on, not in contact, and a triangle of the mesh's
-/// surface (not a cut face) lies within `margin_m` (> 0) of its touching point; `hits` is scratch.
-std::optional<NearSurface> near_surface(const Tissue& tissue, double margin_m,
+/// The nearest triangle of the mesh's surface `surface` (not a cut face: the BVH's ids from
+/// surface.triangles.size() on) within `margin_m` (> 0) of `touching_point_m`, in `bvh` fitted to
+/// `positions_m`; nothing when there is none. `hits` is scratch.
+std::optional<NearSurface> near_surface(const Eigen::Vector3d& touching_point_m, double margin_m, const SurfaceBvh& bvh,
+                                        const Eigen::VectorXd& positions_m, const SurfaceMesh& surface,
+                                        const CorotationalElasticity& elasticity,
                                         std::vector<SurfaceBvh::SphereHit>& hits);
 
 }  // namespace tissue

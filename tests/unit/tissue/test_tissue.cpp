@@ -44,8 +44,8 @@ TEST(Tissue, RefusesInvalidSettingsWhenGiven) {
   EXPECT_THROW(make([](TissueSettings& s) { s.body.fixed_vertices = {-1}; }), ParameterError);
   EXPECT_THROW(parse_linear_solver_kind("gauss-seidel"), ParameterError);
   EXPECT_THROW(make([](TissueSettings& s) { s.interaction.blade_length_m = 0.0; }), ParameterError);
-  EXPECT_THROW(make([](TissueSettings& s) { s.interaction.contact_spring_stiffness_n_per_m = -1.0; }), ParameterError);
-  EXPECT_THROW(make([](TissueSettings& s) { s.interaction.contact_stiffness_refresh_steps = 0; }), ParameterError);
+  EXPECT_THROW(make([](TissueSettings& s) { s.interaction.contact.spring_stiffness_n_per_m = -1.0; }), ParameterError);
+  EXPECT_THROW(make([](TissueSettings& s) { s.interaction.contact.stiffness_refresh_steps = 0; }), ParameterError);
   EXPECT_THROW(make([](TissueSettings& s) { s.interaction.cutter.min_volume_fraction = 0.5; }), ParameterError);
   EXPECT_THROW(make([](TissueSettings& s) { s.interaction.cutter.min_volume_fraction = 0.0; }), ParameterError);
   EXPECT_THROW(parse_tool_mode("laser"), ParameterError);
@@ -180,6 +180,65 @@ TEST(Tissue, ABallProbeTouchesWithItsPole) {
   EXPECT_THROW(Tissue(mesh, settings), ParameterError);
 }
 
+// The complete contact output a haptic loop renders (Tissue::tool_contact, the Tissue FMU's contact
+// outputs) for a ball probe of radius r over the flat top (z = 0.02 m) of a clamped block, no gravity:
+// hovering 3 mm above it (within the 1 cm margin) it reports the surface below, the point offset by
+// the ball's centre - pole (r along the axis) and the outward normal; pressed, the contact's own point
+// with the same offset; in both, the damping is beta K_c. The report is the sample's: of the pose the
+// last step took (or the pose set before the first step), not of a pose set since.
+TEST(Tissue, TheToolContactIsWhatAHapticLoopRenders) {
+  const TetMesh mesh = make_box_mesh(4, 4, 2, 0.01);
+  TissueSettings settings;
+  settings.body.fixed_vertices = vertices_at_minimum(mesh, 2, 0.0);
+  settings.body.gravity_m_per_s2.setZero();
+  settings.body.damping = RayleighDamping{0.0, 0.01};
+  settings.solver.kind = LinearSolverKind::cholmod;
+  settings.step_size_s = 0.01;
+  settings.interaction.probe_radius_m = 0.002;
+  settings.interaction.contact.near_surface_margin_m = 0.01;
+  Tissue tissue(mesh, settings);
+  const Eigen::Vector3d ball_offset(0.0, 0.0, 0.002);  // identity orientation: the axis is +z
+  const Eigen::Vector3d hover_pole(0.0213, 0.0187, 0.023);
+  tissue.set_tool({hover_pole + ball_offset, Eigen::Quaterniond::Identity(), ToolMode::probe});
+  const auto expect_near_top = [&](const ToolContact& near, const char* when) {
+    SCOPED_TRACE(when);
+    EXPECT_FALSE(near.active);
+    ASSERT_TRUE(near.near);
+    const Eigen::Vector3d expected = Eigen::Vector3d(hover_pole.x(), hover_pole.y(), 0.02) + ball_offset;
+    EXPECT_NEAR((near.point_m - expected).norm(), 0.0, 1e-12) << near.point_m.transpose();
+    EXPECT_NEAR((near.normal - Eigen::Vector3d::UnitZ()).norm(), 0.0, 1e-12);
+    EXPECT_GT(near.stiffness_n_per_m(2, 2), 0.0);
+    EXPECT_EQ(near.damping_n_s_per_m, 0.01 * near.stiffness_n_per_m);
+    EXPECT_EQ(near.force_on_tool_n, Eigen::Vector3d::Zero());
+  };
+  expect_near_top(tissue.tool_contact(), "before the first step: of the pose set");
+  tissue.step();
+  expect_near_top(tissue.tool_contact(), "after a step");
+  const Eigen::Vector3d far_pole(0.0213, 0.0187, 0.05);
+  tissue.set_tool({far_pole + ball_offset, Eigen::Quaterniond::Identity(), ToolMode::probe});
+  expect_near_top(tissue.tool_contact(), "a pose set since is the next step's");
+  tissue.step();
+  EXPECT_FALSE(tissue.tool_contact().near);  // 3 cm above: beyond the margin
+
+  const Eigen::Vector3d pressed_pole(0.0213, 0.0187, 0.02 - 1e-4);
+  tissue.set_tool({pressed_pole + ball_offset, Eigen::Quaterniond::Identity(), ToolMode::probe});
+  for (int n = 0; n < 50; ++n) tissue.step();
+  const ToolContact pressed = tissue.tool_contact();
+  ASSERT_TRUE(pressed.active);
+  EXPECT_FALSE(pressed.near);
+  EXPECT_NEAR((pressed.point_m - (tissue.contact().point_m + ball_offset)).norm(), 0.0, 1e-15);  // rounding
+  EXPECT_EQ(pressed.force_on_tool_n, tissue.contact().force_on_tool_n);
+  EXPECT_GT(pressed.force_on_tool_n.z(), 0.0);
+  EXPECT_EQ(pressed.stiffness_n_per_m, tissue.contact().stiffness_n_per_m);
+  EXPECT_EQ(pressed.damping_n_s_per_m, 0.01 * tissue.contact().stiffness_n_per_m);
+
+  settings.interaction.contact.near_surface_margin_m = 0.0;  // never reported
+  Tissue no_margin(mesh, settings);
+  no_margin.set_tool({hover_pole + ball_offset, Eigen::Quaterniond::Identity(), ToolMode::probe});
+  no_margin.step();
+  EXPECT_FALSE(no_margin.tool_contact().near);
+}
+
 // A body with nothing fixed condenses its contact stiffness from the step matrix
 // M/h^2 + D/h + K, which holds the contact spring while the probe touches, scaled like K; the
 // spring is taken out exactly, whatever share of it the tangent holds (issue 9: it enters the
@@ -222,8 +281,8 @@ TEST(Tissue, ABackgroundContactStiffnessIsRenderedOneStepLate) {
   settings.body.gravity_m_per_s2.setZero();
   settings.body.fixed_vertices = vertices_at_minimum(mesh, 0, 0.0);
   settings.step_size_s = 0.01;
-  settings.interaction.contact_stiffness_in_background = true;
-  settings.interaction.contact_stiffness_refresh_steps = 1;
+  settings.interaction.contact.stiffness_in_background = true;
+  settings.interaction.contact.stiffness_refresh_steps = 1;
   Tissue tissue(mesh, settings);
   const Eigen::Vector3d above(0.0413, 0.0187, 0.025);
   tissue.set_tool({above, Eigen::Quaterniond::Identity(), ToolMode::probe});

@@ -144,8 +144,8 @@ TEST(TissueState, ABackgroundStiffnessRefreshUnderWayIsSavedWithTheState) {
   const TetMesh mesh = frog();
   Session session(mesh);
   TissueSettings settings = frog_settings(mesh);
-  settings.interaction.contact_stiffness_in_background = true;
-  settings.interaction.contact_stiffness_refresh_steps = 1;
+  settings.interaction.contact.stiffness_in_background = true;
+  settings.interaction.contact.stiffness_refresh_steps = 1;
   Tissue original(mesh, settings);
   session.set_top(top_of_back(original, session));
   constexpr int SAVED_AT = 8;

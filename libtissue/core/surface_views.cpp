@@ -1,0 +1,66 @@
+// SurfaceViews (see surface_views.hpp).
+#include "core/surface_views.hpp"
+
+#include "core/parameter_error.hpp"
+
+#include <span>
+
+namespace tissue {
+
+namespace {
+
+Eigen::VectorXd rest_positions(const DeformableBody& body) {
+  Eigen::VectorXd positions_m;
+  body.positions(Eigen::VectorXd::Zero(body.dof_count()), positions_m);
+  return positions_m;
+}
+
+std::unique_ptr<CutRenderSurface> embedded(const TetMesh& mesh, const TriangleSurface* surface) {
+  if (surface == nullptr) return nullptr;
+  try {
+    return std::make_unique<CutRenderSurface>(mesh, *surface, default_max_outside_m(mesh), surface->source_name);
+  } catch (const MeshError& error) {
+    throw ParameterError(error.what());
+  }
+}
+
+}  // namespace
+
+SurfaceViews::SurfaceViews(const DeformableBody& body, bool with_bvh, const TriangleSurface* render_surface)
+    : m_surface(extract_surface(body.mesh())),
+      m_vertex_positions_m(rest_positions(body)),
+      m_positions_m(m_vertex_positions_m),
+      m_cut_surface(body.mesh().vertex_count()),
+      m_bvh(with_bvh ? m_surface.triangles : std::vector<std::array<int, 3>>{}, m_positions_m),
+      m_render(embedded(body.mesh(), render_surface)) {}
+
+void SurfaceViews::update_positions(const DeformableBody& body, const Eigen::VectorXd& displacement_m) {
+  m_render_mapped = false;
+  body.positions(displacement_m, m_vertex_positions_m);
+  m_positions_m.head(m_vertex_positions_m.size()) = m_vertex_positions_m;
+  m_cut_surface.update_points(body, displacement_m, m_positions_m);
+}
+
+void SurfaceViews::add_cut_tets(const DeformableBody& body, const Eigen::VectorXd& displacement_m, int first_cut_tet) {
+  const int new_faces = m_cut_surface.add_cut_tets(body, first_cut_tet, m_surface);
+  update_positions(body, displacement_m);
+  const auto& faces = m_cut_surface.triangles();
+  m_bvh.add_triangles(std::span(faces).last(static_cast<size_t>(new_faces)));
+}
+
+const CutRenderSurface* SurfaceViews::render_surface(const DeformableBody& body,
+                                                     const Eigen::VectorXd& displacement_m) const {
+  if (!m_render) return nullptr;
+  if (m_render_cut_tets != body.cut_tets().size()) {
+    m_render->rebuild(body);
+    m_render_cut_tets = body.cut_tets().size();
+    m_render_mapped = false;
+  }
+  if (!m_render_mapped) {
+    m_render->update(body, displacement_m);
+    m_render_mapped = true;
+  }
+  return m_render.get();
+}
+
+}  // namespace tissue

@@ -1,0 +1,90 @@
+// SurfaceViews: the tissue's surfaces at the current state, each for its reader. The mesh's surface
+// and the faces the cuts opened, at the current positions (3 per mesh vertex, then the cut faces'
+// corners); the surface BVH over both, refitted when a query needs it (contact, cutting); the
+// triangles to draw (the tet skin); and the finer render surface riding on the tets, re-meshed and
+// mapped only when asked for.
+#pragma once
+
+#include "core/collide/lazy_surface_bvh.hpp"
+#include "core/cut/cut_surface.hpp"
+#include "core/fem/deformable_body.hpp"
+#include "core/mesh/topology.hpp"
+#include "core/render/cut_render_surface.hpp"
+
+#include <Eigen/Core>
+
+#include <array>
+#include <cstddef>
+#include <memory>
+#include <optional>
+#include <vector>
+
+namespace tissue {
+
+class SurfaceViews {
+ public:
+  /// At the rest state of `body`; a BVH over the surface only `with_bvh` (contact or cutting on);
+  /// `render_surface` (or none) embedded in the tets. Throws ParameterError for a render surface
+  /// that cannot be embedded.
+  SurfaceViews(const DeformableBody& body, bool with_bvh, const TriangleSurface* render_surface);
+  SurfaceViews(const SurfaceViews&) = delete;
+  SurfaceViews& operator=(const SurfaceViews&) = delete;
+
+  /// The positions at `displacement_m` (the BVH is marked stale by moved(), not here).
+  void update_positions(const DeformableBody& body, const Eigen::VectorXd& displacement_m);
+  /// The positions moved: the BVH refits at its next query.
+  void moved() { m_bvh.positions_moved(); }
+  /// The cut tets from `first_cut_tet` on were just made: their opened faces join the surface and
+  /// the BVH, at `displacement_m` (both parts still coincide).
+  void add_cut_tets(const DeformableBody& body, const Eigen::VectorXd& displacement_m, int first_cut_tet);
+
+  [[nodiscard]] const SurfaceMesh& surface() const { return m_surface; }
+  [[nodiscard]] const CutSurface& cut_surface() const { return m_cut_surface; }
+  /// The mesh vertices (3 each), then the corners of the cut faces.
+  [[nodiscard]] const Eigen::VectorXd& positions_m() const { return m_positions_m; }
+  [[nodiscard]] const LazySurfaceBvh& bvh() const { return m_bvh; }
+  [[nodiscard]] int mesh_triangle_count() const { return static_cast<int>(m_surface.triangles.size()); }
+
+  /// The render surface at `displacement_m`, re-meshed for the cuts made since it was last asked for
+  /// and mapped when the state changed; nullptr when the scene has none.
+  [[nodiscard]] const CutRenderSurface* render_surface(const DeformableBody& body,
+                                                       const Eigen::VectorXd& displacement_m) const;
+
+  /// The surface to draw, with corners indexing positions_m(): the mesh's surface without the
+  /// triangles of cut tets, their pieces either side of the cut (the skin), then the cut faces.
+  template <class Visit>
+  void for_each_drawn_triangle(Visit&& visit) const;
+  [[nodiscard]] std::size_t drawn_triangle_count() const {
+    return m_surface.triangles.size() - m_cut_surface.replaced_triangles().size() +
+           m_cut_surface.skin_triangles().size() + m_cut_surface.drawn_triangles().size();
+  }
+
+ private:
+  SurfaceMesh m_surface;
+  Eigen::VectorXd m_vertex_positions_m;
+  Eigen::VectorXd m_positions_m;
+  CutSurface m_cut_surface;
+  LazySurfaceBvh m_bvh;
+  // The render surface, brought up to date by render_surface() (re-meshed when the cut tets changed,
+  // mapped when the state changed).
+  mutable std::unique_ptr<CutRenderSurface> m_render;
+  mutable std::optional<std::size_t> m_render_cut_tets;  // the cut tets it was meshed for (none: not yet)
+  mutable bool m_render_mapped = false;
+};
+
+template <class Visit>
+void SurfaceViews::for_each_drawn_triangle(Visit&& visit) const {
+  const std::vector<int>& replaced = m_cut_surface.replaced_triangles();  // ascending
+  auto next_replaced = replaced.begin();
+  for (std::size_t t = 0; t < m_surface.triangles.size(); ++t) {
+    if (next_replaced != replaced.end() && *next_replaced == static_cast<int>(t)) {
+      ++next_replaced;
+      continue;
+    }
+    visit(m_surface.triangles[t]);
+  }
+  for (const auto& triangle : m_cut_surface.skin_triangles()) visit(triangle);
+  for (const auto& triangle : m_cut_surface.drawn_triangles()) visit(triangle);
+}
+
+}  // namespace tissue
