@@ -1,4 +1,4 @@
-// tissue-host: drives the Tissue FMU next to the HapticLoop FMU (DESIGN section 5), loading both
+// tissue-host: drives the Tissue FMU next to the HapticLoop FMU (docs/DESIGN.md, "Host"), loading both
 // through host/importer like any FMI importer would (it never links libtissue).
 //   tissue-host run SCENARIO.toml [--offline] [--output DIR] [--record FILE.csv] ...
 //   tissue-host info FILE.fmu

@@ -1,5 +1,5 @@
 // tissue-host compare: one scenario run offline under a list of integrator settings, each against
-// a tight reference, for speed against accuracy (DESIGN: "tissue-host compare"). The reference
+// a tight reference, for speed against accuracy (docs/DESIGN.md, "tissue-host compare"). The reference
 // runs first (rank 0); the other runs are dealt over the processes (RunDistribution: one, or the
 // ranks of an MPI job) and, inside each, over `jobs` threads; rank 0 gathers the rows and writes
 // compare.csv, compare.png, recommendation.txt and compare.json.

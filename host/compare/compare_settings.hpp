@@ -66,7 +66,7 @@ struct SettingDescription {
   [[nodiscard]] std::string family() const;   ///< "backwardEuler/pcg", for the plot's colours
 };
 
-/// The built-in list (DESIGN: "tissue-host compare"): backward Euler with PCG at 1e-3 (caps 10,
+/// The built-in list (docs/DESIGN.md, "tissue-host compare"): backward Euler with PCG at 1e-3 (caps 10,
 /// 50) and 1e-6 (cap 1000), with CHOLMOD; IDA at rtol 1e-3 and 1e-5 with KLU, 1e-3 with Krylov;
 /// reference IDA rtol 1e-7, atol 1e-10, max step 1 ms, KLU.
 [[nodiscard]] CompareSettingsList default_settings();

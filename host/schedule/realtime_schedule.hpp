@@ -1,4 +1,4 @@
-// The real-time scheduler (DESIGN section 5, dissertation 5.1.3): a haptic thread ticking on
+// The real-time scheduler (docs/DESIGN.md, "Host"; dissertation 5.1.3): a haptic thread ticking on
 // absolute deadlines of the haptic period (SCHED_FIFO 80 when permitted), a dynamics thread stepping
 // the tissue once per slot (SCHED_FIFO 70) under the scenario's overrun policy, and the calling
 // thread writing the surface frames the dynamics thread hands over (FramePipe) and the progress lines.

@@ -1,4 +1,4 @@
-// A session's timeline (DESIGN section 5): the haptic loop ticks every haptic period, the tissue
+// A session's timeline (docs/DESIGN.md, "Host"): the haptic loop ticks every haptic period, the tissue
 // steps once per slot (its communication step, a whole number of ticks), and a session runs whole
 // slots. Both schedulers (offline_schedule.hpp, realtime_schedule.hpp) and the session's log use it.
 #pragma once

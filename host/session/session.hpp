@@ -1,4 +1,4 @@
-// One haptic session (DESIGN section 5, dissertation 5.1.3): the HapticLoop FMU ticked at 1 kHz
+// One haptic session (docs/DESIGN.md, "Host"; dissertation 5.1.3): the HapticLoop FMU ticked at 1 kHz
 // on a haptic thread with absolute deadlines, the Tissue FMU stepped on a dynamics thread, the two
 // exchanging snapshots (LatestValue) at the start and end of each tissue step; a device in, forces
 // out; frames, a log and a summary written to one folder. `offline` runs the same schedule on one

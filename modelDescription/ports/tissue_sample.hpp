@@ -1,5 +1,5 @@
 // The tissue sample: what the Tissue FMU outputs after a step and the HapticLoop FMU takes as its
-// tissue.* inputs (the contact's intermediate representation, DESIGN "Haptic loop"), written once.
+// tissue.* inputs (the contact's intermediate representation, docs/DESIGN.md, "Haptic loop"), written once.
 // Each field is one Tissue output and one HapticLoop input: both FMUs' variable tables make their
 // entries from this list (fmu_src/<fmu>/variables.cpp), and the host forwards the sample field by
 // field by these names (host/links/sample_relay.hpp). A field added here appears in both

@@ -1,4 +1,4 @@
-// What the scene switches save ("model only what the scene requires", DESIGN section 1): building
+// What the scene switches save (docs/DESIGN.md, "One Tissue step": only what the scene requires): building
 // a Tissue on the embedded frog and stepping it with the tool away, with contact and cutting on or
 // off. Counters: the bytes allocated while building (global operator new of this executable) and
 // the surface BVH's triangles. Arguments: /contact/cutting (1 = on).

@@ -221,7 +221,7 @@ TEST(ModelDescription, IdentifiesTheFmuAsTheCodeDoes) {
   ASSERT_FALSE(co_simulation.empty()) << "no CoSimulation element";
   EXPECT_EQ(std::string_view(co_simulation.attribute("modelIdentifier").value()), fmi3::description().model_identifier)
       << "modelIdentifier differs from the code's";
-  // Rollback is part of the product (DESIGN section 5).
+  // Rollback is part of the product (docs/DESIGN.md, "FMI layer": FMU states).
   EXPECT_TRUE(co_simulation.attribute("canGetAndSetFMUState").as_bool());
   EXPECT_TRUE(co_simulation.attribute("canSerializeFMUState").as_bool());
   EXPECT_TRUE(description.child("ModelExchange").empty());

@@ -26,7 +26,7 @@ Eigen::Vector3d intermediate_force(const TissueSample& sample, const Eigen::Vect
 ///   force and chattered at 23 Hz). The same rule holds the Tissue's contact (PointContact::update);
 /// * a force whose normal component is negative (it would pull the tool into the surface) is
 ///   dropped altogether, tangential part included: a frictionless contact (the tissue's contact is,
-///   docs/DESIGN.md) that carries no normal load carries no tangential load either. The step this
+///   docs/DESIGN.md, "Haptic loop") that carries no normal load carries no tangential load either. The step this
 ///   makes where f . n crosses 0 is at most the tangential part, and the rate limiter smooths it.
 /// Otherwise `force_n` is returned unchanged. The result r satisfies r . n >= 0.
 Eigen::Vector3d unilateral_force(const Eigen::Vector3d& force_n, const TissueSample& sample,

@@ -1,4 +1,4 @@
-// The haptic rendering core of the HapticLoop FMU (DESIGN section 5): every 1 ms tick it turns the
+// The haptic rendering core of the HapticLoop FMU (docs/DESIGN.md, "Haptic loop"): every 1 ms tick it turns the
 // device position, the tool mode and the tissue's latest sample into the force to command on the
 // device. The pieces, each in its own file with one job, in the order a tick applies them:
 //   1. contact_force.hpp: intermediate representation f0 - K_c (x - x0), then the unilateral
@@ -129,7 +129,7 @@ class HapticRenderer {
   /// A sample in contact without stiffness (K_c = 0) gets k n n^T, k the secant of its normal force
   /// over the tool's normal motion since the previous sample in contact (clamped to [0,
   /// max_estimated_stiffness_n_per_m]; the previous k while the tool moved less than 1 um): held
-  /// force alone renders a delayed, active spring (issue 20, docs/DESIGN.md).
+  /// force alone renders a delayed, active spring (issue 20; docs/DESIGN.md, "Haptic loop").
   void set_sample(const TissueSample& sample);
 
   /// One haptic tick: the device (hand) position now, the tool mode, the tick length. Returns the

@@ -5,9 +5,9 @@
 // hand), in N. K_c is the stiffness of the tissue at the contact point as the tool sees it:
 // moving the tool by dx changes the force on it by -K_c dx. K_c is symmetric positive
 // semi-definite, so pushing deeper (dx = -d n, d > 0, n the outward normal) adds d K_c n, whose
-// normal part d n^T K_c n >= 0 pushes the tool out harder. (DESIGN section 5 writes
-// f = f0 + K_c (x - x0): the same model with K_c seen from the tissue's side, i.e. as the
-// stiffness of the force the tool exerts on the tissue.)
+// normal part d n^T K_c n >= 0 pushes the tool out harder. (docs/DESIGN.md, "Haptic loop": the
+// architecture writes f = f0 + K_c (x - x0), the same model with K_c seen from the tissue's side,
+// i.e. as the stiffness of the force the tool exerts on the tissue.)
 #pragma once
 
 #include "ports/tool.hpp"

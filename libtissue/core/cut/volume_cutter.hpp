@@ -70,8 +70,8 @@ inline constexpr double SMALLEST_MIN_VOLUME_FRACTION = 1e-12;
 
 struct CutterSettings {
   /// An edge crossing within this fraction of the edge length from an end passes through that
-  /// vertex (DESIGN.md 4: "a cut that passes within eps of a vertex is treated as passing
-  /// through it"). In [0, 0.5); 0 takes crossings as computed.
+  /// vertex (docs/DESIGN.md, "Cutting": a cut that passes within eps of a vertex is treated as
+  /// passing through it). In [0, 0.5); 0 takes crossings as computed.
   double vertex_snap_fraction = 1e-3;
   /// V_a/V is clamped to [this, 1 - this], so that neither part of a cut tet has (almost) no
   /// stiffness and mass (eq. 3.21-3.23, 4.16). In [SMALLEST_MIN_VOLUME_FRACTION, 0.5).

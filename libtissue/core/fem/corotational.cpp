@@ -272,7 +272,7 @@ TISSUE_HOT_KERNEL void CorotationalElasticity::add_tet(size_t k, const Eigen::Ma
   const TetRest& rest = m_rest[k];
   const Eigen::Matrix3d& r = m_rotations[k];
 
-  // Co-rotational: f_i = V R sigma g_i (equal to R K_e (R^T x - X), see DESIGN section 4).
+  // Co-rotational: f_i = V R sigma g_i (equal to R K_e (R^T x - X), see docs/DESIGN.md, "Elasticity").
   const Eigen::Matrix<double, 3, 4> forces = m_elements.forces(rest, r, f);
   for (int i = 0; i < 4; ++i) internal_forces_n.segment<3>(3 * tet[static_cast<size_t>(i)]) += forces.col(i);
 

@@ -1,6 +1,6 @@
 // The co-rotational kernel of one tet (or one part of a cut tet), shared by the uncut model
 // (corotational.cpp) and the XFEM parts (xfem_elasticity.cpp): strain, stress, nodal forces,
-// energy and the rotated stiffness blocks, all in the rotated-gradient form (docs/DESIGN.md):
+// energy and the rotated stiffness blocks, all in the rotated-gradient form (docs/DESIGN.md, "Elasticity"):
 //   f_i = V R sigma(sym(R^T F) - I) g_i = [R K_e (R^T x - X)]_i,
 //   R K_ij R^T = V [lambda c_i c_j^T + mu c_j c_i^T + mu (g_i . g_j) I],   c = R g.
 // Inline: these are the innermost loop of every step.

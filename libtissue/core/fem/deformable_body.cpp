@@ -55,11 +55,12 @@ Neighbourhoods neighbourhoods(const TetMesh& mesh, const DofMap& dofs) {
   return counts;
 }
 
-// Room cuts need, so that cutting does not overflow a row (DESIGN section 3: the matrix grows in
-// place). A u row holds its free neighbours and gains a u-a block for every ghost of a neighbour,
-// fixed ones included: one per neighbour for a single cut, up to three where two cuts cross (the
-// ghosts behind the first, the second and both): free + GHOSTS_PER_NEIGHBOUR all. An enriched row
-// holds a-u blocks with the free neighbours and a-a blocks with their ghosts, as many.
+// Room cuts need, so that cutting does not overflow a row (docs/DESIGN.md, "Linear solvers and
+// system": room made where a cut goes). A u row holds its free neighbours and gains a u-a block for
+// every ghost of a neighbour, fixed ones included: one per neighbour for a single cut, up to three
+// where two cuts cross (the ghosts behind the first, the second and both): free +
+// GHOSTS_PER_NEIGHBOUR all. An enriched row holds a-u blocks with the free neighbours and a-a blocks
+// with their ghosts, as many.
 constexpr int GHOSTS_PER_NEIGHBOUR = 3;
 
 std::vector<int> enriched_row_capacities(const TetMesh& mesh, const DofMap& dofs) {

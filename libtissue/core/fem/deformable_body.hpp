@@ -126,7 +126,7 @@ class DeformableBody final : public DynamicsModel {
   /// Current (real) positions of all vertices (3 per vertex) for a displacement of the unknowns.
   void positions(const Eigen::VectorXd& displacement_m, Eigen::VectorXd& positions_m) const;
 
-  // --- XFEM cuts (dissertation 3.3, 4.2; DESIGN section 4) ---
+  // --- XFEM cuts (dissertation 3.3, 4.2; docs/DESIGN.md, "Cutting") ---
 
   /// Enriches completely cut tets and grows the system in place: enriched unknowns are appended
   /// (listed once per ghost key), their blocks inserted into the tangent's reserved room (the u-u

@@ -1,8 +1,8 @@
 // DeformableBody's XFEM enrichment (deformable_body.hpp: enrich): the cut tets' pieces and the system
 // grown in place; which ghost each piece uses is in deformable_body_ghosts.cpp.
 //
-// Enriched lumped mass and gravity (DESIGN section 4; eq. 4.16 is garbled). Lumping each part of a
-// cut tet as a full tet of mass w_p m gives the kinetic energy
+// Enriched lumped mass and gravity (docs/DESIGN.md, "Equations and errata": eq. 4.16 is garbled).
+// Lumping each part of a cut tet as a full tet of mass w_p m gives the kinetic energy
 //   (m/4) sum_j [w_a |v_j + Psi_aj da_j|^2 + w_b |v_j + Psi_bj da_j|^2]
 // and, for a vertex with H_j = +1 (Psi_aj = 0, Psi_bj = -1), the mass blocks M^uu = m/4,
 // M^ua = -w_b m/4, M^aa = w_b m/4 (for H_j = -1: m/4, +w_a m/4, w_a m/4). The diagonal lumping

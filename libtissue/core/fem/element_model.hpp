@@ -21,7 +21,7 @@ namespace tissue {
 struct ElementModel {
   /// Stable Neo-Hookean's projected tangent at F = R is exactly the co-rotational one, R K_e R^T with
   /// the same Lame parameters (its twist modes have eigenvalue 0, its flip and scaling modes are
-  /// linear elasticity's 2 mu and 2 mu I + lambda 1 1^T: docs/DESIGN.md). Where the stretch R^T F is
+  /// linear elasticity's 2 mu and 2 mu I + lambda 1 1^T: docs/DESIGN.md, "Elasticity"). Where the stretch R^T F is
   /// within this of I (Frobenius), the tangent is taken from there: off by O(strain) relatively, as the
   /// co-rotational tangent omits dR/du, while the forces stay Neo-Hookean's (so do equilibria). It
   /// halves the Neo-Hookean step on a body near rest (docs/BENCHMARKS.md).

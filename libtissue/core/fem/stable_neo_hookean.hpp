@@ -45,7 +45,7 @@ Matrix9d neo_hookean_stress_derivative(const StableNeoHookean& material, const E
 
 /// The element tangent's blocks K_ij = d f_i / d x_j, i <= j, at [4 i + j] (block (j, i) is the
 /// transpose), with dP/dF projected onto the positive semi-definite cone from its eigensystem in closed
-/// form (Smith, de Goes and Kim 2018, section 4.2; derived in docs/DESIGN.md): with the
+/// form (Smith, de Goes and Kim 2018, section 4.2; derived in docs/DESIGN.md, "Elasticity"): with the
 /// rotation-variant SVD F = U diag(sigma) V^T, six twist and flip modes U (e_i e_k^T -/+ e_k e_i^T)
 /// V^T / sqrt 2 with eigenvalues a +/- lambda' (J - alpha) sigma_l (a = mu' (1 - 1/(I_C + 1)), l the
 /// third axis), and three scaling modes U diag(d) V^T from a 3 x 3 matrix; negative ones dropped. The

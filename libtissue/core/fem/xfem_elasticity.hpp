@@ -1,4 +1,4 @@
-// XFEM elasticity of completely cut tets (dissertation 3.3 and 4.2.1, DESIGN section 4): a cut tet
+// XFEM elasticity of completely cut tets (dissertation 3.3 and 4.2.1; docs/DESIGN.md, "Cutting"): a cut tet
 // behaves as two full-shape co-rotational tets, part a above the cut (H = +1) and part b below
 // (H = -1), weighted by their rest volume fractions w_a = V_a / V and w_b = 1 - w_a. Part p places
 // local vertex j at p_pj = x_j + Psi_pj a_j with the shifted enrichment Psi_pj = (H_p - H_j) / 2

@@ -1,5 +1,5 @@
 // Semi-implicit backward Euler (Baraff and Witkin 1998; dissertation section 4.2.4, with the
-// erratum of DESIGN section 4: the left side of eq. 4.20 holds the tangent K):
+// erratum in docs/DESIGN.md, "Equations and errata": the left side of eq. 4.20 holds the tangent K):
 //   (M + h D + h^2 K) dv = h (f_ext - f_int(u) - D v - h K v),   v += dv,   u += h v.
 // One linear solve per step; with D = alpha M + beta K the matrix is (1 + h alpha) M + (h beta + h^2) K.
 // A step that turns some element far (a free piece tumbling, a 0.1 s step) is corrected by Newton

@@ -69,7 +69,7 @@ class IdaIntegrator final : public Integrator {
   /// With IDA's c_j of its last internal step (1/h before the first).
   [[nodiscard]] ShiftedSystem newton_stiffness(const DynamicsModel& model, double step_size_s,
                                                Eigen::VectorXd& diagonal) const override;
-  /// 1: the spring enters the tangent whole (IDA's residual damps it by beta k; see DESIGN).
+  /// 1: the spring enters the tangent whole (IDA's residual damps it by beta k; docs/DESIGN.md, "Integrators").
   [[nodiscard]] double undamped_tangent_share(double /*step_size_s*/, double /*stiffness_damping_s*/) const override {
     return 1.0;
   }

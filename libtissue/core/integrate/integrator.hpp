@@ -11,8 +11,8 @@
 //   restored state continues exactly as a restart at the restored point would (tests/unit/integrate).
 // * newton_stiffness(): the matrix of the step's Newton iteration in the unknowns u, scaled to a
 //   stiffness [N/m]: the stiffness a point of the body meets within one step (inertia and damping
-//   hold the rest). The contact's K_c of a body that nothing holds is condensed from it (DESIGN
-//   section 4), so the contact asks the integrator instead of re-deriving its matrix.
+//   hold the rest). The contact's K_c of a body that nothing holds is condensed from it
+//   (docs/DESIGN.md, "Contact"), so the contact asks the integrator instead of re-deriving its matrix.
 #pragma once
 
 #include "core/parameter_error.hpp"
