@@ -3,7 +3,7 @@
 // the probe's contact model (ContactModel) and the surfaces at the current state (SurfaceViews).
 // Each step takes the tool pose, sweeps the scalpel through the volume cutter and enriches the
 // completed tets, or moves the probe's god-object, then integrates and reports the contact outputs
-// (docs/DESIGN.md, "Overview"). This is what the benches, the Python module and the Tissue FMU call.
+// (docs/DESIGN.md, "One Tissue step"). This is what the benches, the Python module and the Tissue FMU call.
 #pragma once
 
 #include "core/contact/contact_model.hpp"
@@ -38,7 +38,7 @@ struct InteractionSettings {
   CutterSettings cutter;
   ContactSettings contact;
   /// The fastest a hand moves the tool (tip or blade end) [m/s]: a pose farther than this times the
-  /// step from the last pose the tissue applied is approached at this speed (docs/DESIGN.md, "Overview").
+  /// step from the last pose the tissue applied is approached at this speed (docs/DESIGN.md, "One Tissue step").
   double max_tool_speed_m_per_s = 5.0;
   /// Radius of a ball-ended probe [m], >= 0: the probe's pose is its ball's centre, and it touches
   /// with the ball's pole (0: a point tip, the pose is the touching point).

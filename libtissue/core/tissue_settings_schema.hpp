@@ -305,7 +305,8 @@ constexpr auto cutter_and_surface_settings() {
           .at_least("0")
           .below("0.5")
           .describe("An edge the blade crosses within this fraction of its length from an end is cut through that "
-                    "vertex (DESIGN.md 4: a cut within eps of a vertex passes through it); 0 takes the crossings as "
+                    "vertex (a cut within eps of a vertex passes through it: docs/DESIGN.md, \"Cutting\"); 0 takes the "
+                    "crossings as "
                     "computed")
           .member(TISSUE_MEMBER(settings.interaction.cutter.vertex_snap_fraction)),
       Setting("surface.renderSurface", 78, text)

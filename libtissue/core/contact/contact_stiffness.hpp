@@ -1,5 +1,5 @@
 // The 3x3 contact stiffness K_c the haptic loop renders with (f = f0 + K_c (x - x0)) between
-// two tissue updates, in two models (DESIGN section 4, erratum on eq. 4.22):
+// two tissue updates, in two models (docs/DESIGN.md, "Equations and errata": eq. 4.22):
 //
 // * effective_static (the reference): the stiffness of the whole constrained body at the
 //   contact point, K_c = (P^T K^-1 P)^-1, P (3n x 3) interpolating the contact point from the

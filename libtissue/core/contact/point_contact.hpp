@@ -1,4 +1,4 @@
-// Point contact of the probe (dissertation 4.4.1; DESIGN section 4): a god-object proxy
+// Point contact of the probe (dissertation 4.4.1; docs/DESIGN.md, "Contact"): a god-object proxy
 // (Zilles and Salisbury 1995) held on the deforming surface as a material point (triangle,
 // barycentric), and the implicit spring that applies the contact to the tissue.
 //

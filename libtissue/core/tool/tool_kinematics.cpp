@@ -28,7 +28,7 @@ ToolPose ToolKinematics::touching() const {
 
 ToolKinematics::Move ToolKinematics::next_move() const {
   // A pose farther than a hand can move in one step is approached at the hand's top speed; the tool
-  // catches up with it over the next steps (docs/DESIGN.md, "Overview").
+  // catches up with it over the next steps (docs/DESIGN.md, "One Tissue step").
   Move move{m_applied, touching(), {}};
   move.current = reachable_pose(move.previous, move.target, m_blade_length_m, m_max_step_m);
   return move;
