@@ -1,12 +1,12 @@
 // The HapticLoop FMU's model behind the FMI layer (fmi3/model.hpp): the haptic renderer
-// (haptic_loop/core) ticked every stepSize; the device pose in, the tool pose for the tissue and the
+// (libtissue/haptic) ticked every stepSize; the device pose in, the tool pose for the tissue and the
 // device force out. A new tissue.time marks a new tissue sample. Range checks are the renderer's
 // own validate(). No allocation in doStep or in setting inputs (the host's haptic thread calls them
 // at 1 kHz).
 #pragma once
 
 #include "fmi3/model.hpp"
-#include "haptic_loop/core/haptic_renderer.hpp"
+#include "haptic/haptic_renderer.hpp"
 #include "haptic_loop/variables.hpp"
 
 #include <Eigen/Core>
@@ -17,7 +17,7 @@
 
 namespace tissue::haptic_fmu {
 
-/// The renderer's settings from the FMU's parameters (throws haptic::ParameterError when refused).
+/// The renderer's settings from the FMU's parameters (throws tissue::ParameterError when refused).
 haptic::RendererSettings renderer_settings(const fmi3::ValueStore& values);
 
 class HapticModel final : public fmi3::Model {

@@ -1,6 +1,6 @@
 // The HapticLoop FMU's description: its variable table (variables.hpp) with the tissue sample's
 // inputs, its enumeration types, log categories and default experiment. Start values are the
-// renderer's defaults (haptic_loop/core/haptic_renderer.hpp, where their sources are given).
+// renderer's defaults (libtissue/haptic/haptic_renderer.hpp, where their sources are given).
 #include "haptic_loop/variables.hpp"
 
 #include <array>

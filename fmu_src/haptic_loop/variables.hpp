@@ -5,7 +5,7 @@
 #pragma once
 
 #include "fmi3/variable_table.hpp"
-#include "ports/sample_entries.hpp"
+#include "port_variables/port_variables.hpp"
 #include "ports/tissue_sample.hpp"
 #include "ports/tool.hpp"
 

@@ -8,7 +8,7 @@
 
 #include "core/tissue_settings_schema.hpp"
 #include "fmi3/variable_table.hpp"
-#include "ports/sample_entries.hpp"
+#include "port_variables/port_variables.hpp"
 #include "ports/tissue_sample.hpp"
 #include "ports/tool.hpp"
 

@@ -128,7 +128,7 @@ void TissueLink::set_tool(const ToolCommand& tool) {
 
 DoStepResult TissueLink::step(double time_s, double step_s) { return m_instance.do_step(time_s, step_s); }
 
-void TissueLink::read_counters(TissueSample& sample) {
+void TissueLink::read_counters(RelaySample& sample) {
   std::array<fmi3UInt64, 2> counters{};
   const std::array<fmi3ValueReference, 2> counter_vrs{m_cut_tets, m_enriched};
   (void)m_instance.get_uint64(counter_vrs, counters);

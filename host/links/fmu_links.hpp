@@ -49,7 +49,7 @@ class TissueLink {
   void set_tool(const ToolCommand& tool);
   DoStepResult step(double time_s, double step_s);
   /// The cut counters into `sample` (the relay reads the sample's fields).
-  void read_counters(TissueSample& sample);
+  void read_counters(RelaySample& sample);
   /// The surface into `frame` from surface.embedding (re-read when surface.revision changes: a cut)
   /// and surface.nodes: its points mapped, its nodes and embedding for a viewer. Its vectors keep
   /// their capacity: between cuts no allocation after the first. Throws FmuError for outputs that do

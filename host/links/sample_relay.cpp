@@ -53,9 +53,9 @@ SampleLayout::SampleLayout(std::span<const ports::SampleField> fields, const Mod
     }
     m_slots.push_back(slot);
   }
-  if (m_flags > TissueSample::MAX_FLAGS) {
+  if (m_flags > RelaySample::MAX_FLAGS) {
     throw FmuError("the tissue sample has " + std::to_string(m_flags) + " Boolean values, more than the host carries (" +
-                   std::to_string(TissueSample::MAX_FLAGS) + ")");
+                   std::to_string(RelaySample::MAX_FLAGS) + ")");
   }
   m_haptic_time = checked_variable(haptic, ports::SAMPLE_TIME_INPUT, ports::SampleType::float64, "input", 1)
                       .value_reference;
@@ -75,19 +75,19 @@ SampleRelay::SampleRelay(SampleLayout layout) : m_layout(std::move(layout)) {
   m_haptic_values.assign(1 + m_layout.number_count(), 0.0);
 }
 
-TissueSample SampleRelay::make_sample() const {
-  TissueSample sample;
+RelaySample SampleRelay::make_sample() const {
+  RelaySample sample;
   sample.numbers.assign(m_layout.number_count(), 0.0);
   return sample;
 }
 
-void SampleRelay::read(Fmu3Instance& tissue, TissueSample& sample) const {
+void SampleRelay::read(Fmu3Instance& tissue, RelaySample& sample) const {
   (void)tissue.get_float64(m_layout.tissue_numbers(), sample.numbers);
   (void)tissue.get_boolean(m_layout.tissue_flags(), std::span(sample.flags).first(m_layout.flag_count()));
   sample.finite = std::all_of(sample.numbers.begin(), sample.numbers.end(), [](double v) { return std::isfinite(v); });
 }
 
-fmi3Status SampleRelay::write(const TissueSample& sample, Fmu3Instance& haptic) const {
+fmi3Status SampleRelay::write(const RelaySample& sample, Fmu3Instance& haptic) const {
   // The time and the numbers in one call (the FMU takes or refuses them together), then the flags.
   m_haptic_values[0] = sample.time_s;
   std::copy(sample.numbers.begin(), sample.numbers.end(), m_haptic_values.begin() + 1);

@@ -19,10 +19,10 @@
 
 namespace tissue::host {
 
-/// Where one field's values are in a TissueSample.
+/// Where one field's values are in a RelaySample.
 struct SampleSlot {
   ports::SampleType type = ports::SampleType::float64;
-  std::size_t offset = 0;  ///< into TissueSample::numbers or ::flags
+  std::size_t offset = 0;  ///< into RelaySample::numbers or ::flags
   std::size_t size = 0;
 };
 
@@ -56,7 +56,7 @@ class SampleLayout {
 
 /// One tissue sample as the host carries it between its threads (copying one into another of the same
 /// layout allocates nothing), with the host's own readings of the step.
-struct TissueSample {
+struct RelaySample {
   static constexpr std::size_t MAX_FLAGS = 16;
   double time_s = 0.0;                    ///< the tissue time the sample is for (the step's end)
   std::vector<double> numbers;            ///< the Float64 fields' values, in slot order
@@ -81,12 +81,12 @@ class SampleRelay {
 
   [[nodiscard]] const SampleLayout& layout() const { return m_layout; }
   /// A record of this layout (sized once; later copies allocate nothing).
-  [[nodiscard]] TissueSample make_sample() const;
+  [[nodiscard]] RelaySample make_sample() const;
   /// The sample fields of `tissue`'s outputs into `sample` (time_s and the counters are the caller's).
-  void read(Fmu3Instance& tissue, TissueSample& sample) const;
+  void read(Fmu3Instance& tissue, RelaySample& sample) const;
   /// `sample` to `haptic`'s tissue inputs, stamped with sample.time_s. Returns the first failing status.
   /// One thread's (it fills a buffer of the relay's): no allocation.
-  fmi3Status write(const TissueSample& sample, Fmu3Instance& haptic) const;
+  fmi3Status write(const RelaySample& sample, Fmu3Instance& haptic) const;
 
  private:
   SampleLayout m_layout;

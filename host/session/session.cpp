@@ -141,7 +141,7 @@ class Session final : public SessionSteps {
     const double t = static_cast<double>(n) * m_schedule.haptic_period_s;
     const DevicePose pose = m_device->read(t);
     if (m_tissue_sample.update()) {
-      const TissueSample& sample = m_tissue_sample.read_buffer();
+      const RelaySample& sample = m_tissue_sample.read_buffer();
       if (sample.finite) {
         (void)m_relay.write(sample, m_haptic.instance());
         m_last_tissue_time_s = sample.time_s;
@@ -184,7 +184,7 @@ class Session final : public SessionSteps {
 
   // One tissue step from tissue time `time_s` over `slots` slots, into m_step_sample. Dynamics thread.
   double tissue_step(double time_s, int slots) override {
-    TissueSample& out = m_step_sample;
+    RelaySample& out = m_step_sample;
     m_tool_command.update();
     m_tissue.set_tool(m_tool_command.read_buffer());
     const bool scalpel = m_tool_command.read_buffer().mode == static_cast<std::int64_t>(ToolMode::scalpel);
@@ -343,15 +343,15 @@ class Session final : public SessionSteps {
   HapticLink m_haptic;
   SampleRelay m_relay;  // the tissue sample from m_tissue to m_haptic, and its fields' slots
   SampleSlot m_contact_slot, m_point_slot, m_force_slot, m_blade_depth_slot;
-  TissueSample m_step_sample;   // dynamics thread's: the step's sample, until published
-  TissueSample m_last_outputs;  // dynamics thread's: the last step's sample
+  RelaySample m_step_sample;   // dynamics thread's: the step's sample, until published
+  RelaySample m_last_outputs;  // dynamics thread's: the last step's sample
   std::shared_ptr<IgtlServer> m_igtl;  // [openigtlink]: the device's and the surface stream's
   std::unique_ptr<Device> m_device;
   std::unique_ptr<LiveView> m_view;          // --view
   Schedule m_schedule;
   // Exchanged between the threads (dissertation 5.1.3).
   LatestValue<ToolCommand> m_tool_command;
-  LatestValue<TissueSample> m_tissue_sample;
+  LatestValue<RelaySample> m_tissue_sample;
   // Haptic thread's own.
   HapticOutputs m_haptic_out;
   std::vector<LogRow> m_rows;

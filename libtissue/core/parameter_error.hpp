@@ -1,4 +1,5 @@
-// The one error type for a parameter outside its range, shared by every folder of the core.
+// The one error type for a parameter outside its range, shared by every folder of the core and by the
+// haptic core (libtissue/haptic, which includes this leaf and links nothing of the core).
 #pragma once
 
 #include <stdexcept>

@@ -60,7 +60,7 @@ TOOL_NONE, TOOL_PROBE, TOOL_SCALPEL = 0, 1, 2
 STATUS = ["OK", "WARNING", "DISCARD", "ERROR", "FATAL"]
 
 
-# ---- The Binary surface outputs (modelDescription/ports/surface_binary.hpp) ----------------------
+# ---- The Binary surface outputs (libports/ports/surface_binary.hpp) ------------------------------
 
 class DecodeError(Exception):
     pass

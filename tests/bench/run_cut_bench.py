@@ -3,7 +3,7 @@
 setting), CHOLMOD and CG with a lagged Cholesky factor (at 1e-6, near-exact), several times each, and prints Markdown tables of the per-field medians over
 the runs, for docs/BENCHMARKS.md.
 
-Usage: tests/bench/run_cut_bench.py [--bench build/release/fmu_src/apps/tissue-cut-bench] [--runs 5]
+Usage: tests/bench/run_cut_bench.py [--bench build/release/apps/tissue-cut-bench] [--runs 5]
 Uses only the Python standard library.
 """
 import argparse
@@ -41,7 +41,7 @@ def median_worst_over_after(runs, scenario):
 
 def main():
     parser = argparse.ArgumentParser()
-    parser.add_argument("--bench", default=str(ROOT / "build" / "release" / "fmu_src" / "apps" / "tissue-cut-bench"))
+    parser.add_argument("--bench", default=str(ROOT / "build" / "release" / "apps" / "tissue-cut-bench"))
     parser.add_argument("--runs", type=int, default=5)
     args = parser.parse_args()
     for solver in SOLVERS:

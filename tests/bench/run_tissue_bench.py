@@ -3,7 +3,7 @@
 two settings (strict: eps 1e-6, <= 10000 PCG iterations; real-time: eps 1e-3, 10 iterations) and
 prints a Markdown table of the medians, for docs/BENCHMARKS.md.
 
-Usage: tests/bench/run_tissue_bench.py [--bench build/release/fmu_src/apps/tissue-bench] [--quick]
+Usage: tests/bench/run_tissue_bench.py [--bench build/release/apps/tissue-bench] [--quick]
 Uses only the Python standard library.
 """
 import argparse
@@ -45,7 +45,7 @@ def run(bench, mesh, bou, dt, material, tolerance, iterations, steps, solver="pc
 
 def main():
     parser = argparse.ArgumentParser()
-    parser.add_argument("--bench", default=str(ROOT / "build" / "release" / "fmu_src" / "apps" / "tissue-bench"))
+    parser.add_argument("--bench", default=str(ROOT / "build" / "release" / "apps" / "tissue-bench"))
     parser.add_argument("--quick", action="store_true", help="fewer steps (a smoke run, not for the docs)")
     args = parser.parse_args()
     print("| mesh | vertices | tets | dofs | nonzeros | dt [s] | setting | ms/step median | p90 | max "

@@ -3,7 +3,7 @@
 
 Vega FEM 4.0's own semi-implicit backward-Euler step, driven by ../shared/peers' `vega_bench`
 (build it with ../shared/peers/build-vega.sh; a tool, never a dependency of the project), and
-`tissue-bench` (build/release/fmu_src/apps/): the same mesh, fixed vertices (Vega's .bou, or the
+`tissue-bench` (build/release/apps/): the same mesh, fixed vertices (Vega's .bou, or the
 vertices within 1% of the x extent of the minimum x), material, gravity (0, -9.81, 0), no damping,
 time step and PCG setting (Jacobi-preconditioned, relative residual eps, at most K iterations).
 One thread each (OMP/OpenBLAS limited to 1, both pinned to the same core when taskset exists).
@@ -93,7 +93,7 @@ def cpu_model():
 def main():
     parser = argparse.ArgumentParser()
     parser.add_argument("--vega", default=str(PEERS / "vega" / "bench" / "build" / "vega_bench"))
-    parser.add_argument("--bench", default=str(ROOT / "build" / "release" / "fmu_src" / "apps" / "tissue-bench"))
+    parser.add_argument("--bench", default=str(ROOT / "build" / "release" / "apps" / "tissue-bench"))
     parser.add_argument("--rounds", type=int, default=5)
     parser.add_argument("--steps", type=int, default=200)
     parser.add_argument("--only", default="", help="run only the cases whose name contains this")

@@ -19,10 +19,10 @@ add_custom_command(OUTPUT ${TISSUE_HOST_CMAKE_PACKED_FMU}
   COMMAND ${CMAKE_COMMAND} -E rm -rf cmake_packed ${TISSUE_HOST_CMAKE_PACKED_FMU}
   COMMAND ${CMAKE_COMMAND} -E make_directory cmake_packed/resources cmake_packed/binaries/x86_64-linux
   COMMAND ${CMAKE_COMMAND} -E copy ${TISSUE_TISSUE_XML_PATH} cmake_packed/modelDescription.xml
-  COMMAND ${CMAKE_COMMAND} -E copy ${PROJECT_SOURCE_DIR}/modelDescription/README.md cmake_packed/resources/README.md
+  COMMAND ${CMAKE_COMMAND} -E copy ${PROJECT_SOURCE_DIR}/libports/README.md cmake_packed/resources/README.md
   COMMAND ${CMAKE_COMMAND} -E chdir cmake_packed
           ${CMAKE_COMMAND} -E tar cf ${TISSUE_HOST_CMAKE_PACKED_FMU} --format=zip modelDescription.xml resources binaries
-  DEPENDS ${TISSUE_TISSUE_XML_PATH} ${PROJECT_SOURCE_DIR}/modelDescription/README.md
+  DEPENDS ${TISSUE_TISSUE_XML_PATH} ${PROJECT_SOURCE_DIR}/libports/README.md
   WORKING_DIRECTORY ${CMAKE_CURRENT_BINARY_DIR}
   COMMENT "Packing cmake_packed.fmu for the host tests"
   VERBATIM)

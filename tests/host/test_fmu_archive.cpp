@@ -116,7 +116,7 @@ TEST_F(FmuArchiveTest, ReadsAnArchivePackedByCmakeTar) {
   EXPECT_EQ(test::read_file(archive.model_description_path()),
             test::read_file(TISSUE_TISSUE_XML));
   EXPECT_EQ(test::read_file(archive.resources_directory() / "README.md"),
-            test::read_file(TISSUE_SOURCE_DIR "/modelDescription/README.md"));
+            test::read_file(TISSUE_SOURCE_DIR "/libports/README.md"));
   EXPECT_TRUE(std::filesystem::is_directory(archive.directory() / "binaries" / "x86_64-linux"));
 }
 

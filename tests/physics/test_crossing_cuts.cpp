@@ -16,7 +16,7 @@
 //   relative; the total mass is unchanged;
 // * each free region falls: its momentum along its translation, c_R^T M v, obeys backward Euler's
 //   damped free fall of its mass exactly (c_R^T f_int = 0 for a detached region, c_R^T f_ext =
-//   -M_R g; tests/unit/xfem/test_xfem_beam.cpp), to 1e-8; the held region stays.
+//   -M_R g; tests/unit/fem/test_xfem_beam.cpp), to 1e-8; the held region stays.
 #include "core/collide/surface_bvh.hpp"
 #include "core/cut/volume_cutter.hpp"
 #include "core/fem/deformable_body.hpp"

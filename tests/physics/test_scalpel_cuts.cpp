@@ -2,7 +2,7 @@
 // across a cantilever beam, through the surface BVH, the volume cutter and the XFEM growth.
 // * A complete cut: the free piece's translational momentum c^T M v obeys the damped free-fall
 //   law exactly (c^T f_int = 0 for a detached piece, c^T f_ext = M_free g; see
-//   tests/unit/xfem/test_xfem_beam.cpp), the clamped piece stays, mass and tets unchanged.
+//   tests/unit/fem/test_xfem_beam.cpp), the clamped piece stays, mass and tets unchanged.
 // * A partial cut leaves the piece attached; two and three separate cuts each separate a piece.
 #include "core/fixed_region.hpp"
 #include "core/mesh/box_mesh.hpp"

@@ -14,7 +14,8 @@
 // (which belongs to the other part, at x_j + Psi_opposite a_j) down. With it the statics are exact
 // (the load of each part sits on that part). The dropped M^ua makes the dynamics of a piece cut
 // free inexact: translating the piece moves both u_j and a_j of its real vertices next to the cut,
-// so it carries an extra inertia 2 sum M^aa over those vertices (quantified in tests/unit/xfem).
+// so it carries an extra inertia 2 sum M^aa over those vertices (quantified in
+// tests/unit/fem/test_xfem_beam.cpp).
 #include "core/fem/deformable_body.hpp"
 
 #include "core/fem/deformable_body_enrich.hpp"

@@ -1,8 +1,8 @@
 // The intermediate representation and the unilateral constraint (contact_force.hpp): the rendered
 // force is f0 - K_c (x - x0) inside the contact plane and as far out as the pressed surface rebounds,
 // nothing beyond, and never a pull inward.
-#include "haptic_loop/core/contact_force.hpp"
-#include "haptic_loop/core/haptic_renderer.hpp"
+#include "haptic/contact_force.hpp"
+#include "haptic/haptic_renderer.hpp"
 
 #include <gtest/gtest.h>
 

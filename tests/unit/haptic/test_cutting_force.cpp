@@ -1,8 +1,8 @@
 // The cutting force (cutting_force.hpp): J_c x depth (with blade friction, after the tanh
 // smoothing) against the hand's velocity, only in scalpel mode with the blade in the tissue, never
 // along the hand's own motion; and the work the hand does is the fracture work J_c x crack area.
-#include "haptic_loop/core/cutting_force.hpp"
-#include "haptic_loop/core/haptic_renderer.hpp"
+#include "haptic/cutting_force.hpp"
+#include "haptic/haptic_renderer.hpp"
 
 #include <gtest/gtest.h>
 

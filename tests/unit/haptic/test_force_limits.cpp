@@ -1,8 +1,8 @@
 // The clamp and the rate limiter (force_limits.hpp), alone and in the renderer: a cut that releases
 // the tissue's tension (3 N to 0 at once) and a contact appearing at 3 N under a resting tool reach
 // the hand at no more than max_force_rate_n_per_s, and nothing ever exceeds max_force_n.
-#include "haptic_loop/core/force_limits.hpp"
-#include "haptic_loop/core/haptic_renderer.hpp"
+#include "haptic/force_limits.hpp"
+#include "haptic/haptic_renderer.hpp"
 
 #include <gtest/gtest.h>
 

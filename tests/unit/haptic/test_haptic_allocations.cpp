@@ -1,7 +1,7 @@
 // Real-time discipline (STYLE.md principle 6): a haptic tick and a new tissue sample allocate
 // nothing, over contact, cutting, the clamp, the rate limiter, the passivity controller, a repaired
 // K_c and non-finite device positions. Counts every global operator new in this executable.
-#include "haptic_loop/core/haptic_renderer.hpp"
+#include "haptic/haptic_renderer.hpp"
 #include "support/counting_new.hpp"
 
 #include <gtest/gtest.h>

@@ -1,7 +1,7 @@
 // The renderer as the FMU layer sees it: settings refused by validate() with the setting's name,
 // samples and device positions with NaN/Inf that never reach the output, K_c repaired to symmetric
 // PSD, the tool put away, and a saved state that continues bitwise.
-#include "haptic_loop/core/haptic_renderer.hpp"
+#include "haptic/haptic_renderer.hpp"
 
 #include <gtest/gtest.h>
 

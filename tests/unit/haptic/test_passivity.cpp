@@ -2,10 +2,10 @@
 // tissue samples arrive at 30 Hz (zero-order hold of f0 and x0 from the true wall), and a scripted
 // hand pushing in and out sinusoidally for 10 s at 1 kHz. The hand is position-driven (it absorbs
 // nothing), so any energy the loop gives it is the loop's own.
-#include "haptic_loop/core/contact_force.hpp"
-#include "haptic_loop/core/force_limits.hpp"
-#include "haptic_loop/core/haptic_renderer.hpp"
-#include "haptic_loop/core/passivity.hpp"
+#include "haptic/contact_force.hpp"
+#include "haptic/force_limits.hpp"
+#include "haptic/haptic_renderer.hpp"
+#include "haptic/passivity.hpp"
 
 #include <gtest/gtest.h>
 

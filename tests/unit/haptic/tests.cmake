@@ -1,4 +1,4 @@
-# The haptic rendering core (fmu_src/haptic_loop/core). Not tissue_add_test: that links the FEM core,
+# The haptic rendering core (libtissue/haptic). Not tissue_add_test: that links the FEM core,
 # and the haptic core must build and test without it.
 add_executable(test_haptic
   ${CMAKE_CURRENT_LIST_DIR}/test_contact_force.cpp ${CMAKE_CURRENT_LIST_DIR}/test_force_limits.cpp

@@ -1,8 +1,8 @@
-#include "haptic_loop/core/haptic_renderer.hpp"
+#include "haptic/haptic_renderer.hpp"
 
-#include "haptic_loop/core/contact_force.hpp"
-#include "haptic_loop/core/force_limits.hpp"
-#include "haptic_loop/core/velocity_filter.hpp"
+#include "haptic/contact_force.hpp"
+#include "haptic/force_limits.hpp"
+#include "haptic/velocity_filter.hpp"
 
 #include <algorithm>
 #include <cmath>

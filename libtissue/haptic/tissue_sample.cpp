@@ -1,4 +1,4 @@
-#include "haptic_loop/core/tissue_sample.hpp"
+#include "haptic/tissue_sample.hpp"
 
 #include <Eigen/Eigenvalues>
 

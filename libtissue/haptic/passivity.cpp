@@ -1,4 +1,4 @@
-#include "haptic_loop/core/passivity.hpp"
+#include "haptic/passivity.hpp"
 
 #include <algorithm>
 

@@ -2,7 +2,7 @@
 // complete cut frees carries the mass of its regions' densities exactly, and their mass damping.
 #include "core/mesh/box_mesh.hpp"
 #include "support/two_regions.hpp"
-#include "xfem/xfem_test_helpers.hpp"
+#include "fem/xfem_test_helpers.hpp"
 
 #include <gtest/gtest.h>
 

@@ -1,4 +1,4 @@
-#include "haptic_loop/core/force_limits.hpp"
+#include "haptic/force_limits.hpp"
 
 namespace tissue::haptic {
 

@@ -1,6 +1,6 @@
-#include "haptic_loop/core/cutting_force.hpp"
+#include "haptic/cutting_force.hpp"
 
-#include "haptic_loop/core/parameter_error.hpp"
+#include "core/parameter_error.hpp"
 
 #include <cmath>
 #include <string>

@@ -17,10 +17,10 @@
 // Real-time: tick() and set_sample() allocate nothing (except on the throwing paths) and do no I/O.
 #pragma once
 
-#include "haptic_loop/core/cutting_force.hpp"
-#include "haptic_loop/core/parameter_error.hpp"
-#include "haptic_loop/core/passivity.hpp"
-#include "haptic_loop/core/tissue_sample.hpp"
+#include "core/parameter_error.hpp"
+#include "haptic/cutting_force.hpp"
+#include "haptic/passivity.hpp"
+#include "haptic/tissue_sample.hpp"
 
 #include <Eigen/Core>
 

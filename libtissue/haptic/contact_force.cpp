@@ -1,4 +1,4 @@
-#include "haptic_loop/core/contact_force.hpp"
+#include "haptic/contact_force.hpp"
 
 namespace tissue::haptic {
 

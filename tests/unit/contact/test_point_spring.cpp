@@ -4,7 +4,7 @@
 #include "core/contact/point_spring.hpp"
 #include "core/fem/deformable_body.hpp"
 #include "core/mesh/box_mesh.hpp"
-#include "xfem/xfem_test_helpers.hpp"
+#include "fem/xfem_test_helpers.hpp"
 
 #include <gtest/gtest.h>
 

@@ -9,7 +9,7 @@
 #include "core/integrate/backward_euler.hpp"
 #include "core/mesh/box_mesh.hpp"
 #include "core/mesh/mesh_io.hpp"
-#include "xfem/xfem_test_helpers.hpp"
+#include "fem/xfem_test_helpers.hpp"
 
 #include <gtest/gtest.h>
 

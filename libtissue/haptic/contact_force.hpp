@@ -5,7 +5,7 @@
 // one job each; the sign convention is the one in tissue_sample.hpp (force on the tool).
 #pragma once
 
-#include "haptic_loop/core/tissue_sample.hpp"
+#include "haptic/tissue_sample.hpp"
 
 #include <Eigen/Core>
 

@@ -5,7 +5,7 @@
 // vertices get one too; the enriched mass is the mass across the cut; bad cuts are refused.
 #include "core/fem/deformable_body.hpp"
 #include "core/mesh/box_mesh.hpp"
-#include "xfem/xfem_test_helpers.hpp"
+#include "fem/xfem_test_helpers.hpp"
 
 #include <gtest/gtest.h>
 
