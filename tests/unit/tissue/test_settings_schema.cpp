@@ -117,6 +117,36 @@ TEST(SettingsSchema, RangesAreCheckedWhereTheyAreSet) {
 }
 
 // The core's check of a TissueSettings is the schema's range, named as the products name it.
+// The parts keep range checks of their own (validate(Material), validate(SolverSettings), ...: the
+// core's direct users and the regions' materials pass through them without the schema), so a range
+// is written there and in the schema. The schema is the one users read: no part may refuse a value
+// at the edge of the schema's range, inside it (a part looser than the schema is harmless: the
+// schema's check comes first).
+TEST(SettingsSchema, ThePartsOwnChecksAcceptEveryValueTheSchemaAccepts) {
+  int edges = 0;
+  for (const SettingInfo& setting : TISSUE_SETTINGS) {
+    if (setting.scope != SettingScope::tissue) continue;
+    if (setting.type != SettingType::real && setting.type != SettingType::integer) continue;
+    for (const auto& [bound, toward] : {std::pair{setting.min, std::numeric_limits<double>::infinity()},
+                                        std::pair{setting.max, -std::numeric_limits<double>::infinity()}}) {
+      if (!bound) continue;
+      const double edge = std::stod(std::string(bound->value));
+      TissueParameters parameters = default_parameters();
+      if (setting.type == SettingType::real) {
+        set_value(setting, parameters, SettingValue(bound->inclusive ? edge : std::nextafter(edge, toward)));
+      } else {
+        const auto step = static_cast<std::int64_t>(toward > 0 ? 1 : -1);
+        set_value(setting, parameters,
+                  SettingValue(static_cast<std::int64_t>(edge) + (bound->inclusive ? 0 : step)));
+      }
+      EXPECT_NO_THROW(validate(parameters.settings))
+          << setting.name << " at the edge of its range " << range_text(setting);
+      ++edges;
+    }
+  }
+  EXPECT_GT(edges, 20);
+}
+
 TEST(SettingsSchema, TheCoresValidationNamesTheSetting) {
   TissueSettings settings;
   settings.interaction.probe_radius_m = -0.001;
