@@ -1,5 +1,5 @@
 // Frog cut scenarios (see cut_scenarios.hpp).
-#include "apps/cut_scenarios.hpp"
+#include "cut_scenarios.hpp"
 
 #include <algorithm>
 #include <cmath>

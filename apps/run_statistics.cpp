@@ -1,5 +1,5 @@
 // Order statistics for the apps' reports.
-#include "apps/run_statistics.hpp"
+#include "run_statistics.hpp"
 
 #include <algorithm>
 #include <cmath>

@@ -1,5 +1,5 @@
 // Shared command-line options of the apps.
-#include "apps/scene_options.hpp"
+#include "scene_options.hpp"
 
 #include "core/fixed_region.hpp"
 #include "core/material/material.hpp"

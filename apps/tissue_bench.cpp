@@ -1,7 +1,7 @@
 // tissue-bench: runs N backward-Euler steps of one mesh on one thread and prints one JSON object
 // with the sizes and the per-step timings (medians), for users and for scripts.
-#include "apps/run_statistics.hpp"
-#include "apps/scene_options.hpp"
+#include "run_statistics.hpp"
+#include "scene_options.hpp"
 
 #include <chrono>
 #include <cstdio>

@@ -2,9 +2,9 @@
 // scripted scalpel strokes): the system before and after (size, enriched vertices, non-zeros,
 // median step time), the volume cutter's time and newly cut tets per cutting step, and the worst
 // step during the cuts against a normal step. Prints a JSON array.
-#include "apps/cut_scenarios.hpp"
-#include "apps/run_statistics.hpp"
-#include "apps/scene_options.hpp"
+#include "cut_scenarios.hpp"
+#include "run_statistics.hpp"
+#include "scene_options.hpp"
 #include "core/fixed_region.hpp"
 
 #include <algorithm>

@@ -3,9 +3,9 @@
 // presses its back (god-object contact: force and contact stiffness printed), then a scalpel makes
 // the strokes of one of the cut scenarios (tissue-cut-bench's), and the pieces settle. Prints one
 // line per phase and every --print-every steps, and can write the final surface as OBJ.
-#include "apps/cut_scenarios.hpp"
-#include "apps/run_statistics.hpp"
-#include "apps/scene_options.hpp"
+#include "cut_scenarios.hpp"
+#include "run_statistics.hpp"
+#include "scene_options.hpp"
 #include "core/fixed_region.hpp"
 #include "core/mesh/topology.hpp"
 
