@@ -69,11 +69,7 @@ TissueStepReport Tissue::step() {
 
   // Cut: the blade's sweep since the last step, the tets it completed enriched.
   if (current.mode == ToolMode::scalpel && interaction.cutting_enabled && previous.mode == ToolMode::scalpel) {
-    const CutSweepReport sweep = m_cuts.sweep(previous, current, m_surfaces.bvh(),
-                                              [this](std::span<const TetCut> cuts,
-                                                     std::span<const std::vector<TetPositions>> offsets_m) {
-                                                return apply_cuts(cuts, offsets_m);
-                                              });
+    const CutSweepReport sweep = m_cuts.sweep(previous, current, m_surfaces.bvh(), cut_applier());
     report.cut = sweep.cut;
     report.enrichment = sweep.enrichment;
     report.cut_s = sweep.cut_s;
@@ -175,10 +171,7 @@ void Tissue::restore(const TissueSnapshot& snapshot) {
     throw StateError("the state has other cuts than this instance; restore it into a fresh instance");
   }
   if (!has_cuts_of(snapshot)) {
-    m_cuts.replay(snapshot.cuts, snapshot.cut_batch_ends, snapshot.cut_offsets,
-                  [this](std::span<const TetCut> cuts, std::span<const std::vector<TetPositions>> offsets_m) {
-                    return apply_cuts(cuts, offsets_m);
-                  });
+    m_cuts.replay(snapshot.cuts, snapshot.cut_batch_ends, snapshot.cut_offsets, cut_applier());
   }
   // Check everything before changing anything.
   const Eigen::Index dofs = m_body.dof_count();

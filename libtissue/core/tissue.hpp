@@ -209,6 +209,12 @@ class Tissue {
   /// Enriches one batch of cuts, grows the state, adds the opened faces to the surfaces: live
   /// (offsets empty: taken from the state) or replayed from a snapshot (its recorded offsets).
   EnrichmentResult apply_cuts(std::span<const TetCut> cuts, std::span<const std::vector<TetPositions>> offsets_m);
+  /// apply_cuts as the cut session calls it (a live sweep or a replay).
+  [[nodiscard]] ApplyCuts cut_applier() {
+    return [this](std::span<const TetCut> cuts, std::span<const std::vector<TetPositions>> offsets_m) {
+      return apply_cuts(cuts, offsets_m);
+    };
+  }
   /// Per cut tet, its pieces' offsets (what a replay needs besides the cuts).
   [[nodiscard]] std::vector<std::vector<TetPositions>> cut_offsets() const;
   /// The near-surface report of the pose set, at the current positions (the tissue's sample).

@@ -73,16 +73,23 @@ TEST(Tissue, RefusesABadToolPoseAndKeepsTheLastOne) {
 // the surface, the tool is pushed back out (force along +z), the contact stiffness is SPD and, in
 // the linear regime, the settled force is K_c d to the spring's share of the compliance; lifting
 // the tip ends the contact.
-/// A 0.04 x 0.04 x 0.02 m block clamped at its bottom, no gravity, CHOLMOD, 10 ms steps.
-Tissue clamped_block() {
-  const TetMesh mesh = make_box_mesh(4, 4, 2, 0.01);
+/// A 0.04 x 0.04 x 0.02 m block (top at z = 0.02 m) clamped at its bottom, no gravity, CHOLMOD,
+/// 10 ms steps, with `damping`.
+TissueSettings clamped_block_settings(const TetMesh& mesh, RayleighDamping damping) {
   TissueSettings settings;
   settings.body.fixed_vertices = vertices_at_minimum(mesh, 2, 0.0);
   settings.body.gravity_m_per_s2.setZero();
-  settings.body.damping = RayleighDamping{20.0, 0.0};
+  settings.body.damping = damping;
   settings.solver.kind = LinearSolverKind::cholmod;
   settings.step_size_s = 0.01;
-  return Tissue(mesh, settings);
+  return settings;
+}
+
+TetMesh clamped_block_mesh() { return make_box_mesh(4, 4, 2, 0.01); }
+
+Tissue clamped_block() {
+  const TetMesh mesh = clamped_block_mesh();
+  return Tissue(mesh, clamped_block_settings(mesh, RayleighDamping{20.0, 0.0}));
 }
 
 TEST(Tissue, ProbeTouchesPushesBackAndLetsGo) {
@@ -150,12 +157,8 @@ TEST(Tissue, APressedSurfaceFollowsATipDrawnBackALittle) {
 // tool axis toward the tip: the two tissues step bitwise alike, and each reports as applied the
 // position it was given. A refused radius is refused when given.
 TEST(Tissue, ABallProbeTouchesWithItsPole) {
-  const TetMesh mesh = make_box_mesh(4, 4, 2, 0.01);
-  TissueSettings settings;
-  settings.body.fixed_vertices = vertices_at_minimum(mesh, 2, 0.0);
-  settings.body.gravity_m_per_s2.setZero();
-  settings.solver.kind = LinearSolverKind::cholmod;
-  settings.step_size_s = 0.01;
+  const TetMesh mesh = clamped_block_mesh();
+  TissueSettings settings = clamped_block_settings(mesh, RayleighDamping{});
   Tissue point_probe(mesh, settings);
   settings.interaction.probe_radius_m = 0.002;
   Tissue ball_probe(mesh, settings);
@@ -187,13 +190,8 @@ TEST(Tissue, ABallProbeTouchesWithItsPole) {
 // with the same offset; in both, the damping is beta K_c. The report is the sample's: of the pose the
 // last step took (or the pose set before the first step), not of a pose set since.
 TEST(Tissue, TheToolContactIsWhatAHapticLoopRenders) {
-  const TetMesh mesh = make_box_mesh(4, 4, 2, 0.01);
-  TissueSettings settings;
-  settings.body.fixed_vertices = vertices_at_minimum(mesh, 2, 0.0);
-  settings.body.gravity_m_per_s2.setZero();
-  settings.body.damping = RayleighDamping{0.0, 0.01};
-  settings.solver.kind = LinearSolverKind::cholmod;
-  settings.step_size_s = 0.01;
+  const TetMesh mesh = clamped_block_mesh();
+  TissueSettings settings = clamped_block_settings(mesh, RayleighDamping{0.0, 0.01});
   settings.interaction.probe_radius_m = 0.002;
   settings.interaction.contact.near_surface_margin_m = 0.01;
   Tissue tissue(mesh, settings);
