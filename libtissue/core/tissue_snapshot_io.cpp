@@ -11,8 +11,10 @@ namespace {
 
 constexpr std::uint64_t MAGIC = 0x31305353'49535354ULL;  // "TSSISS01" read as little-endian bytes
 // 2: PointSpring::tangent_fraction; 3: the cuts' enrichment offsets; 4: the applied tool position;
-// 5: several cuts per tet (pieces' offsets and rotations, the cuts' smallest fraction, cut counts)
-constexpr std::uint32_t VERSION = 6;
+// 5: several cuts per tet (pieces' offsets and rotations, the cuts' smallest fraction, cut counts);
+// 7: a ghost's unknown is its copy's displacement, not a difference from u (issue 40): the same
+// fields, other meanings
+constexpr std::uint32_t VERSION = 7;
 
 // The core's Eigen types and cut records on top of the shared byte stream.
 class Writer : public serial::ByteWriter {

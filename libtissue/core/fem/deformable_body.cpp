@@ -198,8 +198,9 @@ double DeformableBody::largest_turn_rad(const Eigen::VectorXd& increment_m, doub
   for (Eigen::Index row = 0; row < increment_m.size() / 3; ++row) {
     largest_block_m = std::max(largest_block_m, increment_m.segment<3>(3 * row).norm());
   }
-  // G = sum_{i>0} (dp_i - dp_0) grad(phi_i)^T with |dp_i - dp_0| <= 4 max|block| (a part's vertex
-  // moves by du + Psi da), so the angle is at most |G| <= 12 max|block| max|grad(phi)|.
+  // G = sum_{i>0} (dp_i - dp_0) grad(phi_i)^T with |dp_i - dp_0| <= 2 max|block| (a piece's vertex
+  // moves by one block, du or dc), so the angle is at most |G| <= 6 max|block| max|grad(phi)|; the
+  // bound below keeps the factor 12 of the shifted enrichment (du + Psi da), which is safe.
   const double bound_rad = 12.0 * largest_block_m * m_largest_shape_gradient_per_m;
   if (bound_rad <= resolution_rad) return bound_rad;
   return largest_element_turn_rad(increment_m);
@@ -235,10 +236,8 @@ TISSUE_HOT_KERNEL double DeformableBody::largest_element_turn_rad(const Eigen::V
     for (int p = 0; p < static_cast<int>(m_xfem.piece_count(k)); ++p) {
       const CutPiece& piece = m_xfem.piece(k, p);
       for (size_t j = 0; j < 4; ++j) {
-        increment[j] = vertex_increment(cut_tet.vertices[j]);
-        if (piece.ghost_row[j] >= 0) {
-          increment[j] += piece.ghost_sign[j] * Eigen::Vector3d(increment_m.segment<3>(3 * piece.ghost_row[j]));
-        }
+        increment[j] = piece.ghost_row[j] < 0 ? vertex_increment(cut_tet.vertices[j])
+                                              : Eigen::Vector3d(increment_m.segment<3>(3 * piece.ghost_row[j]));
       }
       largest_rad = std::max(largest_rad, turn_angle_rad(m_xfem.rest(k), m_xfem.rotation(k, p), increment));
     }
@@ -414,7 +413,7 @@ TetPositions DeformableBody::piece_positions(const Eigen::VectorXd& displacement
     real_m[j] = m_mesh.rest_positions_m[static_cast<size_t>(vertex)];
     if (row >= 0) real_m[j] += displacement_m.segment<3>(3 * row);
   }
-  return tissue::piece_positions(m_xfem.piece(cut_tet_index, piece), real_m, displacement_m);
+  return tissue::piece_positions(m_xfem.piece(cut_tet_index, piece), real_m, cut_tet.rest_m, displacement_m);
 }
 
 double DeformableBody::piece_mass_kg(int cut_tet_index, int piece) const {

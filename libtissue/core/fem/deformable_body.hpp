@@ -128,39 +128,39 @@ class DeformableBody final : public DynamicsModel {
 
   // --- XFEM cuts (dissertation 3.3, 4.2; docs/DESIGN.md, "Cutting") ---
 
-  /// Enriches completely cut tets and grows the system in place: enriched unknowns are appended
+  /// Enriches completely cut tets and grows the system in place: ghost unknowns are appended
   /// (listed once per ghost key), their blocks inserted into the tangent's reserved room (the u-u
-  /// blocks and their slots are kept), mass and external force extended. A tet cut before is cut
-  /// again (issue 21): its pieces are split by the new cut (split_pieces), the old cut tet is retired
-  /// and a new one of the new pieces appended, each starting where its parent piece was. New
-  /// enriched unknowns start at a = 0, da/dt = 0 (grow_state()): each piece then coincides with the
-  /// deformed tet (or its parent) and the forces do not change. Throws ParameterError, with nothing
-  /// changed, if a cut names a tet out of range, twice in the batch, already cut by the same cut id
-  /// or by MAX_PIECE_CUTS cuts, lacks a sign or has a sign other than +-1, has a volume fraction
-  /// outside (0, 1) or not finite, or (cutting a cut tet) lacks the edge crossings of a plane.
+  /// blocks and their slots are kept), mass and external force moved to the rows that carry them. A
+  /// tet cut before is cut again (issue 21): its pieces are split by the new cut (split_pieces), the
+  /// old cut tet is retired and a new one of the new pieces appended, each starting where its parent
+  /// piece was. A ghost is a copy of a vertex with a displacement of its own (xfem_elasticity.hpp).
+  /// Throws ParameterError, with nothing changed, if a cut names a tet out of range, twice in the
+  /// batch, already cut by the same cut id or by MAX_PIECE_CUTS cuts, lacks a sign or has a sign
+  /// other than +-1, has a volume fraction outside (0, 1) or not finite, or (cutting a cut tet) lacks
+  /// the edge crossings of a plane.
   ///
   /// Around each vertex of the cut tets, the pieces that the same cuts separate from it and that
   /// touch across faces share one ghost (the virtual-node algorithm's copies): a cut tet whose
   /// pieces move to other ghosts is made again too (EnrichmentResult::new_cut_tets counts every cut
   /// tet made: the cuts' first, in order, then those).
   ///
-  /// This form is for a body whose existing enriched unknowns are still at a = 0 (no step taken
-  /// since they were made, as in tests), or to replay recorded cuts: `offsets_m`, empty or at least
-  /// one list per cut tet made, are the offsets of its pieces (CutPiece::offset_m) when it was made.
+  /// This form is for a body at rest (u = 0: new ghosts start at zero, grow_state()), or to replay
+  /// recorded cuts: `offsets_m`, empty or at least one list per cut tet made, are the offsets of its
+  /// pieces (CutPiece::offset_m) when it was made, and the recorded state replaces the grown one.
   EnrichmentResult enrich(std::span<const TetCut> cuts, std::span<const std::vector<TetPositions>> offsets_m = {});
   EnrichmentResult enrich(const TetCut& cut) { return enrich(std::span<const TetCut>(&cut, 1)); }
 
-  /// The form for a running body (a cut completed in the middle of a simulation): a piece that joins
-  /// an enriched unknown which exists already (made by a tet completed at an earlier step, and moved
-  /// since) records an offset so that it starts where the tet (or its parent piece) was; the join
-  /// is inelastic: an unknown's velocity is scaled by old mass / new mass where its mass grew (its
-  /// momentum kept, kinetic energy not gained). `state` is grown as by grow_state(). Throws
-  /// ParameterError for bad cuts and std::invalid_argument for a state of the wrong size, with
-  /// nothing changed.
+  /// The form for a running body (a cut in the middle of a simulation): `state` is grown, each new
+  /// ghost starting as a copy of the copy it splits from (its displacement and velocity), so the
+  /// cut moves nothing and keeps the momentum. A piece that joins a ghost which exists already (made
+  /// by a tet completed at an earlier step, and moved since) records an offset so that it starts
+  /// where the tet (or its parent piece) was, and brings its momentum (an inelastic join: momentum
+  /// kept, kinetic energy not gained). Throws ParameterError for bad cuts and std::invalid_argument
+  /// for a state of the wrong size, with nothing changed.
   EnrichmentResult enrich(std::span<const TetCut> cuts, DynamicState& state);
 
-  /// Grows a state to dof_count() in place: existing entries unchanged, new ones (enriched a and
-  /// da/dt) zero. Call after enrich().
+  /// Grows a state to dof_count() in place: existing entries unchanged, new ones (the ghosts'
+  /// displacements and velocities) zero. Call after enrich() without a state.
   void grow_state(DynamicState& state) const;
 
   [[nodiscard]] int enriched_dof_count() const { return static_cast<int>(m_enriched_dofs.size()); }
@@ -186,7 +186,7 @@ class DeformableBody final : public DynamicsModel {
   [[nodiscard]] TetPositions piece_positions(const Eigen::VectorXd& displacement_m, int cut_tet_index, int piece) const;
   /// Rest mass of a piece, rho w_p V. [kg]
   [[nodiscard]] double piece_mass_kg(int cut_tet_index, int piece) const;
-  /// The same for a tet cut once: part a is piece 0, part b piece 1, p_j = x_j + Psi_j a_j.
+  /// The same for a tet cut once: part a is piece 0, part b piece 1 (p_j = x_j, or the ghost X_j + c_j).
   [[nodiscard]] TetPositions part_positions(const Eigen::VectorXd& displacement_m, int cut_tet_index,
                                             CutPart part) const {
     return piece_positions(displacement_m, cut_tet_index, part == CutPart::above ? 0 : 1);
@@ -274,13 +274,16 @@ class DeformableBody final : public DynamicsModel {
   void append_ghost_rows(const EnrichBatch& batch);
   void start_pieces(const EnrichBatch& batch, size_t c, std::span<const std::vector<TetPositions>> offsets_m,
                     const Eigen::VectorXd* displacement_m, std::vector<CutPiece>& pieces,
-                    std::vector<Eigen::Matrix3d>& rotations) const;
+                    std::vector<Eigen::Matrix3d>& rotations);
   int replace_cut_tet(EnrichBatch& batch, size_t c, const std::vector<CutPiece>& pieces,
                       const std::vector<Eigen::Matrix3d>& rotations);
   void list_coupled_blocks(int k, std::vector<std::pair<int, int>>& new_blocks) const;
   void insert_coupled_blocks(std::vector<std::pair<int, int>>& new_blocks, int first_new_cut_tet);
-  // Adds (sign +1) or removes (-1) what cut tet k's ghosts carry: rho w_p V / 4 of mass and gravity.
-  void add_ghost_loads(int k, double sign);
+  // Adds (sign +1) or removes (-1) what cut tet k's pieces put on the rows they use: rho w_p V / 4
+  // of mass, its mass damping and its weight.
+  void add_piece_loads(int k, double sign);
+  // Adds a mass (negative: removes it) to a row with its mass damping alpha m and its weight m g.
+  void add_row_load(int row, double mass_kg, double alpha_per_s);
   void check_unknowns(const Eigen::VectorXd& displacement_m) const;
   // largest_turn_rad past its bound: every uncut tet and cut part.
   [[nodiscard]] double largest_element_turn_rad(const Eigen::VectorXd& increment_m) const;
@@ -292,6 +295,16 @@ class DeformableBody final : public DynamicsModel {
   std::vector<CutTetGeometry> m_cut_geometry;  // per cut tet
   std::vector<int> m_ghost_users;              // per enriched unknown: pieces of live cut tets using it
   std::vector<int> m_orphaned_rows;            // rows the last enrich() left unused
+  // A piece's share at a vertex that the last enrich() moved to another copy (from_row -1: a fixed
+  // vertex, at rest): its momentum goes with it.
+  struct CopyArrival {
+    int row;
+    int from_row;
+    double mass_kg;
+  };
+  std::vector<CopyArrival> m_arrivals;
+  std::vector<Eigen::Vector3d> m_new_row_start_m;  // per ghost the last enrich() made: its start
+  std::vector<std::uint8_t> m_new_row_started;
   int m_tets_cut = 0;
   double m_largest_shape_gradient_per_m = 0.0;  // max |grad(phi_i)| over the mesh: 1 / the lowest altitude
   std::vector<int> m_first_enriched_dof;        // per vertex: first of its enriched unknowns, or -1

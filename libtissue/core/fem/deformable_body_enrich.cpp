@@ -1,21 +1,16 @@
 // DeformableBody's XFEM enrichment (deformable_body.hpp: enrich): the cut tets' pieces and the system
 // grown in place; which ghost each piece uses is in deformable_body_ghosts.cpp.
 //
-// Enriched lumped mass and gravity (docs/DESIGN.md, "Equations and errata": eq. 4.16 is garbled).
-// Lumping each part of a cut tet as a full tet of mass w_p m gives the kinetic energy
-//   (m/4) sum_j [w_a |v_j + Psi_aj da_j|^2 + w_b |v_j + Psi_bj da_j|^2]
-// and, for a vertex with H_j = +1 (Psi_aj = 0, Psi_bj = -1), the mass blocks M^uu = m/4,
-// M^ua = -w_b m/4, M^aa = w_b m/4 (for H_j = -1: m/4, +w_a m/4, w_a m/4). The diagonal lumping
-// keeps M^uu (unchanged by the cut: total mass conserved) and M^aa = rho V_opposite(j) / 4, the mass
-// of the part on the other side of the cut, and drops M^ua. Gravity is the derivative of the same
-// lumped potential -sum_p (w_p m/4) g . p_pj: on u_j it stays m/4 g, on a_j it is
-//   Psi_opposite(j) rho V_opposite(j) / 4 g,   Psi_opposite(j) = -H_j,
-// i.e. -w_b m/4 g for a vertex above the cut and +w_a m/4 g for one below: pulling the ghost copy
-// (which belongs to the other part, at x_j + Psi_opposite a_j) down. With it the statics are exact
-// (the load of each part sits on that part). The dropped M^ua makes the dynamics of a piece cut
-// free inexact: translating the piece moves both u_j and a_j of its real vertices next to the cut,
-// so it carries an extra inertia 2 sum M^aa over those vertices (quantified in
-// tests/unit/fem/test_xfem_beam.cpp).
+// Lumped mass and gravity of the pieces (docs/DESIGN.md, "Equations and errata": eq. 4.16 is
+// garbled). Each piece p of a cut tet is lumped as a full tet of mass w_p m: it puts w_p m / 4 and
+// its weight w_p m / 4 g on each of the 4 rows it uses (a real vertex's u or a ghost's c), and the
+// uncut tet's m / 4 leaves the real vertices' rows. The rows are the copies' own displacements, so
+// this lumping is diagonal and exact for rigid motion: a piece cut free carries exactly its mass and
+// its weight and falls at g (issue 40; the dissertation's shifted enrichment a = u - c couples u and
+// a by an off-diagonal block M^ua that a diagonal lumping drops, which made a freed beam end fall at
+// 8.5 m/s^2). A new ghost starts as a copy of the copy it splits from (its displacement and
+// velocity), so a cut moves nothing and keeps the momentum; a piece that joins a ghost that has
+// moved keeps its place by an offset and brings its momentum (an inelastic join).
 #include "core/fem/deformable_body.hpp"
 
 #include "core/fem/deformable_body_enrich.hpp"
@@ -87,14 +82,30 @@ EnrichmentResult DeformableBody::enrich(std::span<const TetCut> cuts, DynamicSta
                                 " displacements and " + std::to_string(state.velocity_m_per_s.size()) +
                                 " velocities, the body " + std::to_string(size) + " unknowns");
   }
-  const Eigen::VectorXd mass_before_kg = m_mass_kg;
+  const Eigen::VectorXd velocity_before_m_per_s = state.velocity_m_per_s;
   const EnrichmentResult result = enrich_pieces(cuts, {}, &state.displacement_m);
   grow_state(state);
-  for (const int row : m_orphaned_rows) state.velocity_m_per_s.segment<3>(3 * row).setZero();
-  // An existing unknown that gained mass keeps its momentum (an inelastic join of the new piece).
-  for (Eigen::Index r = 0; r < mass_before_kg.size(); ++r) {
-    if (m_mass_kg(r) > mass_before_kg(r)) state.velocity_m_per_s(r) *= mass_before_kg(r) / m_mass_kg(r);
+  const int first_new_row = static_cast<int>(size / 3);
+  for (size_t n = 0; n < m_new_row_start_m.size(); ++n) {
+    state.displacement_m.segment<3>(3 * (first_new_row + static_cast<int>(n))) = m_new_row_start_m[n];
   }
+  // Momentum: a row keeps its own (of the mass that stayed) and gains what arrives with the pieces
+  // that came from other copies.
+  std::map<int, std::pair<double, Eigen::Vector3d>> arrived;  // row: mass, momentum
+  for (const CopyArrival& arrival : m_arrivals) {
+    auto& [mass_kg, momentum] = arrived.try_emplace(arrival.row, 0.0, Eigen::Vector3d::Zero()).first->second;
+    mass_kg += arrival.mass_kg;
+    if (arrival.from_row >= 0) momentum += arrival.mass_kg * velocity_before_m_per_s.segment<3>(3 * arrival.from_row);
+  }
+  for (const auto& [row, arrival] : arrived) {
+    const double mass_kg = m_mass_kg(3 * row);
+    const Eigen::Vector3d stayed = row < first_new_row
+                                       ? Eigen::Vector3d(std::max(mass_kg - arrival.first, 0.0) *
+                                                         velocity_before_m_per_s.segment<3>(3 * row))
+                                       : Eigen::Vector3d::Zero();
+    state.velocity_m_per_s.segment<3>(3 * row) = (stayed + arrival.second) / mass_kg;
+  }
+  for (const int row : m_orphaned_rows) state.velocity_m_per_s.segment<3>(3 * row).setZero();
   return result;
 }
 
@@ -103,23 +114,27 @@ EnrichmentResult DeformableBody::enrich(std::span<const TetCut> cuts,
   return enrich_pieces(cuts, offsets_m, nullptr);
 }
 
-void DeformableBody::add_ghost_loads(int k, double sign) {
+void DeformableBody::add_piece_loads(int k, double sign) {
   const int u_rows = m_dofs.free_vertex_count();
   const double tet_mass_kg = density_kg_per_m3(m_xfem.rest(k)) * m_xfem.rest(k).volume_m3;
   const double alpha_per_s = mass_damping_per_s(m_xfem.rest(k));
+  const Tet& vertices = m_xfem.cut_tets()[static_cast<size_t>(k)].vertices;
   for (size_t p = 0; p < m_xfem.piece_count(k); ++p) {
     const CutPiece& piece = m_xfem.piece(k, static_cast<int>(p));
     const double quarter_mass_kg = 0.25 * piece.weight * tet_mass_kg;
     for (size_t j = 0; j < 4; ++j) {
-      const int row = piece.ghost_row[j];
-      if (row < 0) continue;
-      m_mass_kg.segment<3>(3 * row).array() += sign * quarter_mass_kg;
-      m_mass_damping_kg_per_s.segment<3>(3 * row).array() += sign * alpha_per_s * quarter_mass_kg;
-      m_external_force_n.segment<3>(3 * row) +=
-          sign * piece.ghost_sign[j] * quarter_mass_kg * m_settings.gravity_m_per_s2;
-      m_ghost_users[static_cast<size_t>(row - u_rows)] += sign > 0.0 ? 1 : -1;
+      const int row = piece.ghost_row[j] >= 0 ? piece.ghost_row[j] : vertex_block_row(vertices[j]);
+      if (row < 0) continue;  // a fixed vertex
+      add_row_load(row, sign * quarter_mass_kg, alpha_per_s);
+      if (piece.ghost_row[j] >= 0) m_ghost_users[static_cast<size_t>(row - u_rows)] += sign > 0.0 ? 1 : -1;
     }
   }
+}
+
+void DeformableBody::add_row_load(int row, double mass_kg, double alpha_per_s) {
+  m_mass_kg.segment<3>(3 * row).array() += mass_kg;
+  m_mass_damping_kg_per_s.segment<3>(3 * row).array() += alpha_per_s * mass_kg;
+  m_external_force_n.segment<3>(3 * row) += mass_kg * m_settings.gravity_m_per_s2;
 }
 
 namespace {
@@ -170,7 +185,10 @@ EnrichmentResult DeformableBody::enrich_pieces(std::span<const TetCut> cuts,
   const int first_new_cut_tet = m_xfem.cut_tet_count();
   std::vector<std::pair<int, int>> new_blocks;  // (row, column) the new cut tets couple
   m_orphaned_rows.clear();
+  m_arrivals.clear();
   append_ghost_rows(batch);
+  m_new_row_start_m.assign(batch.new_rows.size(), Eigen::Vector3d::Zero());
+  m_new_row_started.assign(batch.new_rows.size(), 0);
   for (size_t c = 0; c < batch.plans.size(); ++c) {
     const size_t piece_count = batch.plans[c].geometry.pieces.size();
     std::vector<CutPiece> pieces(piece_count);
@@ -269,27 +287,27 @@ void DeformableBody::append_ghost_rows(const EnrichBatch& batch) {
   m_external_force_n.tail(3 * (enriched_dof_count() - old_dofs)).setZero();
 }
 
-// 2. The pieces of plan c: rows and signs, and where each starts: where its parent had the vertex. A
-// new row's sign is -H of the vertex for its first separating cut (a single cut: Psi = (H_p - H_j) / 2
-// = -H_j).
+// 2. The pieces of plan c: their rows, and where each starts: where its parent had the vertex. A new
+// ghost starts as a copy of the copy the first piece using it comes from (m_new_row_start_m); a
+// piece that comes from another copy than the row it uses is listed in m_arrivals (its momentum).
 void DeformableBody::start_pieces(const EnrichBatch& batch, size_t c,
                                   std::span<const std::vector<TetPositions>> offsets_m,
                                   const Eigen::VectorXd* displacement_m, std::vector<CutPiece>& pieces,
-                                  std::vector<Eigen::Matrix3d>& rotations) const {
+                                  std::vector<Eigen::Matrix3d>& rotations) {
   const EnrichBatch::Plan& plan = batch.plans[c];
   const int old = plan.old;
   const CutTetGeometry& geometry = plan.geometry;
   const int u_rows = m_dofs.free_vertex_count();
-  const int old_dofs = batch.old_dofs;
-  // The current a of an unknown (new ones, and every one without a running state, are zero).
-  const auto current_a = [&](int row) -> Eigen::Vector3d {
+  const int first_new_row = u_rows + batch.old_dofs;
+  const Tet& tet = m_mesh.tets[static_cast<size_t>(plan.tet)];
+  const double tet_mass_kg = density_kg_per_m3(m_elasticity.rest(plan.tet)) * m_elasticity.rest(plan.tet).volume_m3;
+  // The current value of an existing row (zero without a running state), or a new row's start.
+  const auto current = [&](int row) -> Eigen::Vector3d {
+    if (row >= first_new_row) return m_new_row_start_m[static_cast<size_t>(row - first_new_row)];
     if (displacement_m == nullptr || 3 * row >= displacement_m->size()) return Eigen::Vector3d::Zero();
     return displacement_m->segment<3>(3 * row);
   };
-  const auto row_of = [&](int planned) { return planned >= -1 ? planned : u_rows + old_dofs + (-2 - planned); };
-  const auto sign_of = [&](int row) {
-    return -static_cast<double>(m_enriched_dofs[static_cast<size_t>(row - u_rows)].separated_by.side[0]);
-  };
+  const auto row_of = [&](int planned) { return planned >= -1 ? planned : first_new_row + (-2 - planned); };
   for (size_t q = 0; q < pieces.size(); ++q) {
     CutPiece& piece = pieces[q];
     piece.weight = geometry.pieces[q].volume_fraction;
@@ -297,20 +315,21 @@ void DeformableBody::start_pieces(const EnrichBatch& batch, size_t c,
     const CutPiece* parent = old >= 0 ? &m_xfem.piece(old, parent_index) : nullptr;
     if (old >= 0) rotations[q] = m_xfem.rotation(old, parent_index);
     for (size_t j = 0; j < 4; ++j) {
-      const int row = row_of(plan.rows[q][j]);
-      if (row < 0) continue;
-      const double sign = sign_of(row);
-      piece.ghost_row[j] = row;
-      piece.ghost_sign[j] = sign;
-      if (!offsets_m.empty()) {
-        piece.offset_m[j] = offsets_m[c][q][j];
-      } else {
-        Eigen::Vector3d from_real_m = Eigen::Vector3d::Zero();
-        if (parent != nullptr && parent->ghost_row[j] >= 0) {
-          from_real_m = parent->ghost_sign[j] * (current_a(parent->ghost_row[j]) - parent->offset_m[j]);
-        }
-        piece.offset_m[j] = current_a(row) - sign * from_real_m;
+      // The copy the piece's material at vertex j comes from, and its displacement there.
+      const bool from_ghost = parent != nullptr && parent->ghost_row[j] >= 0;
+      const int from_row = from_ghost ? parent->ghost_row[j] : vertex_block_row(tet[j]);
+      Eigen::Vector3d from_m = from_row >= 0 ? current(from_row) : Eigen::Vector3d::Zero();
+      if (from_ghost) from_m -= parent->offset_m[j];
+      const int planned = row_of(plan.rows[q][j]);
+      const int row = planned >= 0 ? planned : vertex_block_row(tet[j]);
+      if (row >= first_new_row && !m_new_row_started[static_cast<size_t>(row - first_new_row)]) {
+        m_new_row_start_m[static_cast<size_t>(row - first_new_row)] = from_m;
+        m_new_row_started[static_cast<size_t>(row - first_new_row)] = 1;
       }
+      if (row >= 0 && row != from_row) m_arrivals.push_back({row, from_row, 0.25 * piece.weight * tet_mass_kg});
+      if (planned < 0) continue;  // the real vertex
+      piece.ghost_row[j] = planned;
+      piece.offset_m[j] = offsets_m.empty() ? Eigen::Vector3d(current(planned) - from_m) : offsets_m[c][q][j];
     }
   }
 }
@@ -325,15 +344,22 @@ int DeformableBody::replace_cut_tet(EnrichBatch& batch, size_t c, const std::vec
   const Tet& tet = m_mesh.tets[static_cast<size_t>(plan.tet)];
   const int u_rows = m_dofs.free_vertex_count();
   if (old >= 0) {
-    add_ghost_loads(old, -1.0);
+    add_piece_loads(old, -1.0);
     m_xfem.retire(old);
   } else {
+    // The uncut tet's share leaves its vertices (its pieces bring theirs back below).
+    const TetRest& rest = m_elasticity.rest(plan.tet);
+    for (const int v : tet) {
+      const int row = vertex_block_row(v);
+      if (row >= 0) add_row_load(row, -0.25 * density_kg_per_m3(rest) * rest.volume_m3, mass_damping_per_s(rest));
+    }
     m_elasticity.exclude(plan.tet);
     ++m_tets_cut;
   }
   CutTet cut_tet;
   cut_tet.cut = geometry.cuts.front();
   cut_tet.vertices = tet;
+  cut_tet.rest_m = m_mesh.rest_corners(plan.tet);
   if (pieces.size() == 2 && geometry.cuts.size() == 1) {
     cut_tet.weight_above = pieces[0].weight;
     cut_tet.weight_below = pieces[1].weight;
@@ -349,7 +375,7 @@ int DeformableBody::replace_cut_tet(EnrichBatch& batch, size_t c, const std::vec
   m_cut_index[static_cast<size_t>(plan.tet)] = k;
   m_xfem.add(cut_tet, pieces, m_elasticity.rest(plan.tet), rotations);
   m_cut_geometry.push_back(std::move(geometry));
-  add_ghost_loads(k, 1.0);
+  add_piece_loads(k, 1.0);
   // A ghost no piece uses any more (its pieces moved to other ghosts): it keeps a mass so the
   // system stays regular, and loses its load; nothing moves it.
   if (old >= 0) {

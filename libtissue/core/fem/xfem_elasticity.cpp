@@ -1,6 +1,6 @@
 // XFEM cut-tet forces and tangent (see xfem_elasticity.hpp), in the rotated-gradient form of the
-// uncut model: each part costs one deformation gradient, one rotation and one stress; the 8x8
-// blocks of eq. 4.3-4.6 are sums of the two parts' rotated blocks with coefficients 0 or +-w_p.
+// uncut model: each piece costs one deformation gradient, one rotation and one stress, and is a
+// tet element over its own 4 DOFs (a real vertex's u or a ghost's c), weighted by w_p.
 #include "core/fem/xfem_elasticity.hpp"
 
 #include "core/fem/corotational_kernel.hpp"
@@ -29,7 +29,6 @@ std::array<CutPiece, 2> pieces_of(const CutTet& cut_tet) {
       const double shift = cut_tet.shift(j, PARTS[p]);
       if (shift == 0.0) continue;  // the real vertex
       piece.ghost_row[to_size(j)] = cut_tet.enriched_row[to_size(j)];
-      piece.ghost_sign[to_size(j)] = shift;
       piece.offset_m[to_size(j)] = cut_tet.enrichment_offset_m[to_size(j)];
     }
   }
@@ -68,11 +67,6 @@ void XfemElasticity::add(const CutTet& cut_tet, std::span<const CutPiece> pieces
   for (const CutPiece& piece : pieces) {
     if (!(piece.weight > 0.0)) throw std::invalid_argument("XFEM: a piece's weight is not positive");
     total += piece.weight;
-    for (size_t j = 0; j < 4; ++j) {
-      if (piece.ghost_row[j] >= 0 && std::abs(piece.ghost_sign[j]) != 1.0) {
-        throw std::invalid_argument("XFEM: a ghost's sign is not +-1");
-      }
-    }
   }
   if (std::abs(total - 1.0) > 1e-12) {
     throw std::invalid_argument("XFEM: the pieces' weights add up to " + std::to_string(total) + ", not 1");
@@ -108,11 +102,13 @@ void XfemElasticity::add(const CutTet& cut_tet, std::span<const CutPiece> pieces
 }
 
 bool XfemElasticity::couples(int k, int dof_i, int dof_j) const {
-  if (dof_i < 4 && dof_j < 4) return true;
+  if (dof_i < 4 && dof_j < 4) return true;  // the uncut tet's blocks (kept)
   const std::size_t begin = piece_begin(k);
   for (std::size_t p = begin; p < begin + piece_count(k); ++p) {
     const std::array<int, 4>& dofs = m_ghost_dofs[p];
-    const auto uses = [&](int dof) { return dof < 4 || std::find(dofs.begin(), dofs.end(), dof) != dofs.end(); };
+    const auto uses = [&](int dof) {
+      return dof < 4 ? dofs[to_size(dof)] < 0 : std::find(dofs.begin(), dofs.end(), dof) != dofs.end();
+    };
     if (uses(dof_i) && uses(dof_j)) return true;
   }
   return false;
@@ -140,11 +136,11 @@ void XfemElasticity::gather(size_t k, const Eigen::VectorXd& positions_m, TetPos
 }
 
 TetPositions piece_positions(const CutPiece& piece, const TetPositions& real_positions_m,
-                             const Eigen::VectorXd& displacement_m) {
+                             const TetPositions& rest_positions_m, const Eigen::VectorXd& displacement_m) {
   TetPositions p = real_positions_m;
   for (size_t j = 0; j < 4; ++j) {
     if (piece.ghost_row[j] < 0) continue;
-    p[j] += piece.ghost_sign[j] * (displacement_m.segment<3>(3 * piece.ghost_row[j]) - piece.offset_m[j]);
+    p[j] = rest_positions_m[j] + (displacement_m.segment<3>(3 * piece.ghost_row[j]) - piece.offset_m[j]);
   }
   return p;
 }
@@ -165,13 +161,16 @@ void XfemElasticity::evaluate(const Eigen::VectorXd& positions_m, const Eigen::V
     Eigen::Matrix<double, 3, 4> vertex_sum = Eigen::Matrix<double, 3, 4>::Zero();
     for (size_t p = first; p < first + count; ++p) {
       const CutPiece& piece = m_pieces[p];
-      const Eigen::Matrix3d f = deformation_gradient(rest, piece_positions(piece, real_m, displacement_m));
+      const Eigen::Matrix3d f =
+          deformation_gradient(rest, piece_positions(piece, real_m, cut_tet.rest_m, displacement_m));
       const Eigen::Matrix3d& r = m_rotations[p] = extract_rotation(f, m_warm_starts[p], m_rotation_settings);
       const Eigen::Matrix<double, 3, 4> forces = m_elements.forces(rest, r, f);
-      vertex_sum += piece.weight * forces;
       for (size_t i = 0; i < 4; ++i) {
-        if (piece.ghost_row[i] < 0) continue;
-        internal_force_n.segment<3>(3 * piece.ghost_row[i]) += piece.weight * piece.ghost_sign[i] * forces.col(to_int(i));
+        if (piece.ghost_row[i] < 0) {
+          vertex_sum.col(to_int(i)) += piece.weight * forces.col(to_int(i));
+        } else {
+          internal_force_n.segment<3>(3 * piece.ghost_row[i]) += piece.weight * forces.col(to_int(i));
+        }
       }
     }
     for (int i = 0; i < 4; ++i) vertex_forces_n.segment<3>(3 * cut_tet.vertices[to_size(i)]) += vertex_sum.col(i);
@@ -179,57 +178,40 @@ void XfemElasticity::evaluate(const Eigen::VectorXd& positions_m, const Eigen::V
     if (tangent == nullptr) continue;
     const int dofs = dof_count(static_cast<int>(k));
     const int* const slots = m_slots.data() + m_slot_begin[k];
-    // The u-u blocks are summed over the pieces first (every piece has them), then written once.
+    // The u-u blocks are summed over the pieces first (written once), the blocks with a ghost
+    // directly.
     std::array<Eigen::Matrix3d, 16> uu;
     for (int i = 0; i < 4; ++i) {
       for (int j = i; j < 4; ++j) uu[to_size(4 * i + j)].setZero();
     }
     for (size_t p = first; p < first + count; ++p) {
       const CutPiece& piece = m_pieces[p];
-      // The piece's DOFs: u of each local vertex (coefficient 1), its ghosts (coefficient sign).
-      std::array<int, 8> dof{};
-      std::array<int, 8> vertex{};
-      std::array<double, 8> coefficient{};
-      int n = 0;
-      for (int i = 0; i < 4; ++i) {
-        dof[to_size(n)] = i;
-        vertex[to_size(n)] = i;
-        coefficient[to_size(n++)] = 1.0;
-      }
+      // The piece's DOF at each local vertex: u of the vertex (i) or its ghost (>= 4).
+      std::array<int, 4> dof{};
       for (int i = 0; i < 4; ++i) {
         const int ghost = m_ghost_dofs[p][to_size(i)];
-        if (ghost < 0) continue;
-        dof[to_size(n)] = ghost;
-        vertex[to_size(n)] = i;
-        coefficient[to_size(n++)] = piece.ghost_sign[to_size(i)];
+        dof[to_size(i)] = ghost < 0 ? i : ghost;
       }
       // The co-rotational blocks need the piece's rotation only; other models its F.
-      const Eigen::Matrix3d f = m_elements.model == MaterialModel::corotational_linear
-                                    ? Eigen::Matrix3d::Identity()
-                                    : deformation_gradient(rest, piece_positions(piece, real_m, displacement_m));
+      const Eigen::Matrix3d f =
+          m_elements.model == MaterialModel::corotational_linear
+              ? Eigen::Matrix3d::Identity()
+              : deformation_gradient(rest, piece_positions(piece, real_m, cut_tet.rest_m, displacement_m));
       std::array<Eigen::Matrix3d, 16> blocks;
       m_elements.blocks(rest, m_rotations[p], f, blocks);
       for (int i = 0; i < 4; ++i) {
-        for (int j = i; j < 4; ++j) uu[to_size(4 * i + j)] += piece.weight * blocks[to_size(4 * i + j)];
-      }
-      // Blocks (a, b) with a ghost, a <= b, and their transposes into (b, a).
-      for (int a = 0; a < n; ++a) {
-        for (int b = std::max(a, 4); b < n; ++b) {
-          const int slot = slots[dofs * dof[to_size(a)] + dof[to_size(b)]];
-          if (slot < 0) continue;
-          const int i = vertex[to_size(a)];
-          const int j = vertex[to_size(b)];
-          const double w = piece.weight * coefficient[to_size(a)] * coefficient[to_size(b)];
-          Eigen::Matrix3d block;
-          if (i <= j) {
-            block.noalias() = w * blocks[to_size(4 * i + j)];
-          } else {
-            block.noalias() = w * blocks[to_size(4 * j + i)].transpose();
+        for (int j = i; j < 4; ++j) {
+          const int a = dof[to_size(i)];
+          const int b = dof[to_size(j)];
+          if (a < 4 && b < 4) {
+            uu[to_size(4 * i + j)] += piece.weight * blocks[to_size(4 * i + j)];
+            continue;
           }
+          const int slot = slots[dofs * a + b];
+          if (slot < 0) continue;  // with a fixed vertex's u
+          const Eigen::Matrix3d block = piece.weight * blocks[to_size(4 * i + j)];
           tangent->block(slot) += block;
-          if (dof[to_size(a)] != dof[to_size(b)]) {
-            tangent->block(slots[dofs * dof[to_size(b)] + dof[to_size(a)]]) += block.transpose();
-          }
+          if (a != b) tangent->block(slots[dofs * b + a]) += block.transpose();
         }
       }
     }
@@ -254,7 +236,8 @@ double XfemElasticity::elastic_energy_j(const Eigen::VectorXd& positions_m,
     const std::size_t first = piece_begin(static_cast<int>(k));
     for (size_t p = first; p < first + piece_count(static_cast<int>(k)); ++p) {
       const CutPiece& piece = m_pieces[p];
-      const Eigen::Matrix3d f = deformation_gradient(m_rest[k], piece_positions(piece, real_m, displacement_m));
+      const Eigen::Matrix3d f =
+          deformation_gradient(m_rest[k], piece_positions(piece, real_m, m_cut_tets[k].rest_m, displacement_m));
       Eigen::Quaterniond warm_start = m_warm_starts[p];  // a copy: reporting must not change the dynamics
       energy += piece.weight * m_elements.energy_j(m_rest[k], extract_rotation(f, warm_start, m_rotation_settings), f);
     }

@@ -9,12 +9,17 @@
 // with the tangent blocks of eq. 4.3-4.6, w_p s_p(I) s_p(J) R_p K_ij R_p^T, where s_p = 1 for a
 // u unknown and Psi_pi for an enriched one.
 //
-// Internally a cut tet is a list of pieces (issue 21, the virtual-node algorithm): piece p is a
-// full-shape copy weighted by w_p whose local vertex j is the real x_j, or a ghost x_j + s (a_g -
-// offset) with its own enriched row g and sign s. A single cut is the two pieces above; the forces
-// and blocks below are then exactly eq. 3.31-3.32 and 4.3-4.6. For N pieces: u_j gets
-// sum_p w_p Fp_j, a ghost row w_p s Fp_j, and block (I, J) sum_p w_p s_p(I) s_p(J) R_p K_ij R_p^T
-// over the DOFs each piece uses (its 4 u rows and its ghost rows).
+// Internally a cut tet is a list of pieces (issue 21, the virtual-node algorithm of Molino et al.
+// 2004): piece p is a full-shape copy weighted by w_p whose local vertex j is the real x_j, or a
+// copy of it with its own unknown, the ghost row g: p_j = X_j + c_g - offset_j (X_j the rest
+// position). A ghost is a displacement of its own, not a difference from u_j (issue 40): so a
+// piece's lumped mass w_p m / 4 sits on exactly the rows that move it, and a piece cut free carries
+// its own mass and its own weight, no more (the shifted enrichment a_j = u_j - c_g couples the two
+// by an off-diagonal mass block that a diagonal lumping drops: a freed beam end fell at 8.5 m/s^2).
+// A single cut is the two pieces above, and the forces and blocks below are eq. 3.31-3.32 and
+// 4.3-4.6 in those variables. For N pieces: u_j gets w_p Fp_j of the pieces that use the real x_j,
+// a ghost row w_p Fp_j of the pieces that use it, and block (I, J) sum_p w_p R_p K_ij R_p^T over the
+// pieces that use both DOFs.
 #pragma once
 
 #include "core/fem/tet_cut.hpp"
@@ -53,28 +58,32 @@ struct CutTet {
   Tet vertices{};                     ///< mesh vertex of each local vertex
   double weight_above = 0.5;          ///< w_a = V_a / V
   double weight_below = 0.5;          ///< w_b = 1 - w_a
-  std::array<int, 4> enriched_row{};  ///< block row of the enriched unknown a_i of each local vertex
-  /// a_i when this tet joined an enriched unknown that existed already (a tet completed at a later
-  /// step of the same stroke; zero for an unknown it created). The parts place their vertices at
-  /// x_j + Psi_pj (a_j - offset_j), so they start as the tet was and the join adds no energy; from
-  /// then on they move with the shared unknown (a seam the size of the offset stays).
+  /// Rest positions X_j of the local vertices (a ghost's position is X_j + c_g - offset_j).
+  TetPositions rest_m{Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero(),
+                      Eigen::Vector3d::Zero()};
+  /// Block row of the ghost of each local vertex: the copy of x_i that the part across the cut uses.
+  std::array<int, 4> enriched_row{};
+  /// The ghost's offset (CutPiece::offset_m) in the part that uses it: zero for a ghost this tet
+  /// created (it starts as a copy of the vertex it splits from); for a tet that joined a ghost that
+  /// had moved already (a tet completed at a later step of the same stroke), c_g minus where the
+  /// part had the vertex, so the part starts as the tet was and the join adds no energy; from then on
+  /// it moves with the shared ghost (a seam the size of the offset stays).
   TetPositions enrichment_offset_m{Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero(),
                                    Eigen::Vector3d::Zero()};
   /// The weight of a part (w_a or w_b).
   [[nodiscard]] double weight(CutPart part) const { return part == CutPart::above ? weight_above : weight_below; }
-  /// Psi of local vertex i in part p.
+  /// Psi of local vertex i in part p: 0 where the part uses the real vertex, +-1 where its ghost.
   [[nodiscard]] double shift(int i, CutPart part) const {
     return enrichment_shift(cut.side[static_cast<size_t>(i)], part);
   }
 };
 
 /// A piece of a cut tet as an element copy: its rest volume fraction and, per local vertex, the
-/// enriched row of its ghost there (-1: the real vertex), the ghost's sign and offset:
-/// p_j = x_j + sign_j (a_{row_j} - offset_j).
+/// row of its ghost there (-1: the real vertex) and the ghost's offset: p_j = X_j + c_{row_j} -
+/// offset_j, so that a piece joining a ghost that has moved starts where its material was.
 struct CutPiece {
   double weight = 0.0;
   std::array<int, 4> ghost_row{-1, -1, -1, -1};
-  std::array<double, 4> ghost_sign{};
   TetPositions offset_m{Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero(),
                         Eigen::Vector3d::Zero()};
 };
@@ -88,11 +97,11 @@ std::array<CutPiece, 2> pieces_of(const CutTet& cut_tet);
 /// single cut: the a-a blocks of two vertices on opposite sides, eq. 4.6).
 using CutTetSlots = std::span<int>;
 
-/// Positions of the 4 vertices of `piece`: x_j, or x_j + sign_j (a_j - offset_j) for a ghost (for a
-/// single cut eq. 3.26-3.27 with Psi = sign), from the real positions x of the tet's local vertices
-/// and the unknowns (the ghosts' a are read from their rows). [m]
+/// Positions of the 4 vertices of `piece`: x_j, or X_j + c_g - offset_j for a ghost, from the real
+/// positions x and rest positions X of the tet's local vertices and the unknowns (the ghosts' c are
+/// read from their rows). [m]
 TetPositions piece_positions(const CutPiece& piece, const TetPositions& real_positions_m,
-                             const Eigen::VectorXd& displacement_m);
+                             const TetPositions& rest_positions_m, const Eigen::VectorXd& displacement_m);
 
 class XfemElasticity {
  public:
@@ -109,7 +118,7 @@ class XfemElasticity {
   void reserve(int cut_tets);
 
   /// Adds a cut tet with its rest data. Both parts' rotations start from `rotation` (the tet's
-  /// rotation before the cut: with a = 0 both parts coincide with the tet). Slots start at -1 (set
+  /// rotation before the cut: with each ghost a copy of its vertex both parts coincide with the tet). Slots start at -1 (set
   /// them with slots() before the first evaluate with a tangent).
   void add(const CutTet& cut_tet, const TetRest& rest, const Eigen::Matrix3d& rotation);
   /// The same for a tet cut into any number of pieces (>= 2; `cut_tet` keeps its vertices and its
@@ -153,9 +162,9 @@ class XfemElasticity {
   }
 
   /// One pass over the cut tets. `positions_m`: real positions of all vertices (3 per vertex);
-  /// `displacement_m`: the unknowns (the enriched a are read from the enriched rows). Adds f_i into
-  /// `vertex_forces_n` (3 per vertex), f^a_i into the enriched rows of `internal_force_n` (3 per
-  /// unknown) and, when `tangent` is given, the blocks of eq. 4.3-4.6 through the slots.
+  /// `displacement_m`: the unknowns (the ghosts' c are read from their rows). Adds the forces on the
+  /// real vertices into `vertex_forces_n` (3 per vertex), those on the ghosts into their rows of
+  /// `internal_force_n` (3 per unknown) and, when `tangent` is given, the blocks through the slots.
   void evaluate(const Eigen::VectorXd& positions_m, const Eigen::VectorXd& displacement_m,
                 Eigen::VectorXd& vertex_forces_n, Eigen::VectorXd& internal_force_n, BlockSparseMatrix* tangent);
 

@@ -1,6 +1,6 @@
 // A tet cut into four pieces (issue 21, the virtual-node form of XfemElasticity): each piece a
-// full-shape copy weighted by its volume fraction, its own vertex real and the others ghosts with
-// rows and signs of their own. The force is the gradient of the weighted energy; the tangent is the
+// full-shape copy weighted by its volume fraction, its own vertex real and the others ghosts: copies
+// with displacements of their own. The force is the gradient of the weighted energy; the tangent is the
 // derivative of the force where it is exact (every piece moved rigidly, each its own way); pieces
 // that coincide with the tet give the uncut tet's forces, shared out by weight.
 #include "core/fem/corotational_kernel.hpp"
@@ -34,8 +34,6 @@ const std::array<double, PIECES> WEIGHTS{0.1, 0.2, 0.3, 0.4};
 
 /// The ghost row of vertex j in piece p (p != j).
 int ghost_row(int j, int p) { return 4 + 3 * j + (p < j ? p : p - 1); }
-/// Alternating signs, so that a wrong sign shows.
-double ghost_sign(int j, int p) { return (j + p) % 2 == 0 ? 1.0 : -1.0; }
 
 struct FourPieces {
   LameParameters lame = lame_parameters(Material{1.0e5, 0.4, 1000.0});
@@ -50,11 +48,11 @@ struct FourPieces {
       for (int j = 0; j < 4; ++j) {
         if (j == p) continue;
         pieces[static_cast<size_t>(p)].ghost_row[static_cast<size_t>(j)] = ghost_row(j, p);
-        pieces[static_cast<size_t>(p)].ghost_sign[static_cast<size_t>(j)] = ghost_sign(j, p);
       }
     }
     CutTet cut_tet;
     cut_tet.vertices = Tet{0, 1, 2, 3};
+    cut_tet.rest_m = REST;
     xfem.add(cut_tet, pieces, rest, std::vector<Eigen::Matrix3d>(pieces.size(), Eigen::Matrix3d::Identity()));
     std::vector<std::vector<int>> pattern(BLOCK_ROWS);
     for (int r = 0; r < BLOCK_ROWS; ++r) {
@@ -118,26 +116,36 @@ Eigen::MatrixXd central_differences(const Vector& q, Value value) {
   return columns;
 }
 
-// Every ghost on its real vertex (a = 0): the four pieces are the tet itself, so the u forces are the
-// uncut tet's (the weights add up to 1) and a ghost row gets w_p s times the tet's force there.
+// Every ghost on its real vertex (its displacement the vertex's): the four pieces are the tet itself,
+// so each copy of vertex j gets w_p times the uncut tet's force there (vertex j's own u: w_j), and
+// the copies' forces add up to the uncut tet's (the weights add up to 1).
 TEST(XfemPieces, PiecesThatCoincideWithTheTetShareItsForcesByWeight) {
   FourPieces tet;
   Vector q = Vector::Zero();
   std::mt19937 rng(3);
   std::uniform_real_distribution<double> jitter(-0.001, 0.001);
   for (int k = 0; k < 12; ++k) q(k) = jitter(rng);
+  for (int j = 0; j < 4; ++j) {
+    for (int p = 0; p < PIECES; ++p) {
+      if (p != j) q.segment<3>(3 * ghost_row(j, p)) = q.segment<3>(3 * j);
+    }
+  }
   const Vector f = tet.force(q);
   TetPositions x;
   for (int j = 0; j < 4; ++j) x[static_cast<size_t>(j)] = REST[static_cast<size_t>(j)] + q.segment<3>(3 * j);
   const Eigen::Matrix3d deformation = deformation_gradient(tet.rest, x);
   const Eigen::Matrix<double, 3, 4> uncut = corotated_forces(tet.rest, rotation_by_svd(deformation), deformation, tet.lame);
   for (int j = 0; j < 4; ++j) {
-    EXPECT_LT((f.segment<3>(3 * j) - uncut.col(j)).norm(), 1e-9 * uncut.norm()) << "vertex " << j;
+    const Eigen::Vector3d own = WEIGHTS[static_cast<size_t>(j)] * uncut.col(j);
+    EXPECT_LT((f.segment<3>(3 * j) - own).norm(), 1e-9 * uncut.norm()) << "vertex " << j;
+    Eigen::Vector3d copies = f.segment<3>(3 * j);
     for (int p = 0; p < PIECES; ++p) {
       if (p == j) continue;
-      const Eigen::Vector3d expected = WEIGHTS[static_cast<size_t>(p)] * ghost_sign(j, p) * uncut.col(j);
+      const Eigen::Vector3d expected = WEIGHTS[static_cast<size_t>(p)] * uncut.col(j);
       EXPECT_LT((f.segment<3>(3 * ghost_row(j, p)) - expected).norm(), 1e-9 * uncut.norm()) << j << " in " << p;
+      copies += f.segment<3>(3 * ghost_row(j, p));
     }
+    EXPECT_LT((copies - uncut.col(j)).norm(), 1e-9 * uncut.norm()) << "vertex " << j;
   }
 }
 
@@ -175,7 +183,7 @@ TEST(XfemPieces, TangentMatchesFiniteDifferencesWhenEveryPieceMovesRigidly) {
   for (int j = 0; j < 4; ++j) {
     for (int p = 0; p < PIECES; ++p) {
       if (p == j) continue;
-      q.segment<3>(3 * ghost_row(j, p)) = ghost_sign(j, p) * (placed(p, j) - placed(j, j));
+      q.segment<3>(3 * ghost_row(j, p)) = placed(p, j) - REST[static_cast<size_t>(j)];
     }
   }
   EXPECT_LT(tet.force(q).norm(), 1e-9);  // rigid pieces: no force
@@ -191,6 +199,10 @@ TEST(XfemPieces, TangentMatchesFiniteDifferencesWhenEveryPieceMovesRigidly) {
   };
   EXPECT_FALSE(tet.xfem.couples(0, dof_of(ghost_row(1, 0)), dof_of(ghost_row(2, 1))));
   EXPECT_TRUE(tet.xfem.couples(0, dof_of(ghost_row(1, 0)), dof_of(ghost_row(2, 0))));
+  // A piece uses a vertex's u or its ghost, never both: piece 0 holds u of vertex 0 and ghosts of
+  // the others, so u of vertex 1 meets no ghost of piece 0.
+  EXPECT_TRUE(tet.xfem.couples(0, 0, dof_of(ghost_row(1, 0))));
+  EXPECT_FALSE(tet.xfem.couples(0, 1, dof_of(ghost_row(2, 0))));
   EXPECT_EQ(tet.xfem.dof_count(0), BLOCK_ROWS);
 }
 
@@ -208,9 +220,6 @@ TEST(XfemPieces, BadPiecesAreRefused) {
   EXPECT_THROW(tet.xfem.add(cut_tet, two, tet.rest, identities), std::invalid_argument);
   two[1].weight = 0.5;
   two[1].ghost_row[0] = 7;
-  two[1].ghost_sign[0] = 0.5;
-  EXPECT_THROW(tet.xfem.add(cut_tet, two, tet.rest, identities), std::invalid_argument);
-  two[1].ghost_sign[0] = 1.0;
   EXPECT_THROW(tet.xfem.add(cut_tet, two, tet.rest, std::span(identities).first(1)), std::invalid_argument);
   EXPECT_EQ(tet.xfem.cut_tet_count(), 1);
 }

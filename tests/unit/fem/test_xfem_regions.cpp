@@ -30,15 +30,17 @@ struct TwoMaterialBeam {
     return s;
   }
   // The lumped `mass` (or mass damping) of the free piece beyond a complete cut at x = cut_x (see
-  // XfemBeam.CompletelyCutPieceFallsFreely): the real vertices beyond, plus the ghosts of those
-  // before (side -1), minus the ghosts of those beyond (side +1).
+  // XfemBeam.CompletelyCutPieceFallsFreely): the real vertices beyond, and the ghosts of those
+  // before (side -1), which the parts beyond use.
   double free_piece_sum(double cut_x, const Eigen::VectorXd& mass) const {
     double total = 0.0;
     for (int row = 0; row < body.dofs().free_vertex_count(); ++row) {
       const int vertex = body.dofs().row_vertex[static_cast<size_t>(row)];
       if (mesh.rest_positions_m[static_cast<size_t>(vertex)].x() > cut_x) total += mass(3 * row);
     }
-    for (const EnrichedDof& dof : body.enriched_dofs()) total -= dof.side * mass(3 * dof.row);
+    for (const EnrichedDof& dof : body.enriched_dofs()) {
+      if (dof.side == -1) total += mass(3 * dof.row);
+    }
     return total;
   }
 };

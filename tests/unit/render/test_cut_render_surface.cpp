@@ -502,10 +502,11 @@ TEST(TissueRenderSurface, TheScalpelsCutIsDrawnOnTheRenderSurfaceAndSurvivesARes
   (void)parts_of(render->triangles(), parts);
   EXPECT_EQ(parts, 2);
   EXPECT_EQ(render->open_loop_count(), 0);
-  // The free end fell: its render points moved down with it.
-  double lowest_z = 0.0;
-  for (const auto& p : render->positions_m()) lowest_z = std::min(lowest_z, p.z());
-  EXPECT_LT(lowest_z, -1e-4);
+  // The free end fell (the core's gravity is along -y): its render points moved down with it.
+  ASSERT_EQ(settings.body.gravity_m_per_s2, Eigen::Vector3d(0.0, -9.81, 0.0));
+  double lowest_y = 0.0;
+  for (const auto& p : render->positions_m()) lowest_y = std::min(lowest_y, p.y());
+  EXPECT_LT(lowest_y, -1e-4);
 
   TissueSnapshot snapshot;
   tissue->save(snapshot);
