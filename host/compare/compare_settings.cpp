@@ -229,6 +229,8 @@ CompareSettingsList default_settings() {
                                          number("integrator.idaRelativeTolerance", relative_tolerance)};
   };
   list.settings = {
+      // The real-time default (Jacobi PCG capped at 10 iterations) and its relatives, then the
+      // converged real-time setting of issue 40 (CG on the lagged Cholesky factor, warm-started).
       setting("be-pcg-tol1e-3-cap10",
               be({text("integrator.linearSolver", "pcg"), number("integrator.pcgTolerance", 1e-3),
                   integer("integrator.pcgMaxIterations", 10)})),
@@ -238,6 +240,9 @@ CompareSettingsList default_settings() {
       setting("be-pcg-tol1e-6-cap1000",
               be({text("integrator.linearSolver", "pcg"), number("integrator.pcgTolerance", 1e-6),
                   integer("integrator.pcgMaxIterations", 1000)})),
+      setting("be-pcgCholesky-tol1e-5-cap25",
+              be({text("integrator.linearSolver", "pcgCholesky"), number("integrator.pcgTolerance", 1e-5),
+                  integer("integrator.pcgMaxIterations", 25), ParameterSetting{"integrator.warmStart", true}})),
       setting("be-cholmod", be({text("integrator.linearSolver", "cholmod")})),
       setting("ida-klu-rtol1e-3", ida("klu", 1e-3)),
       setting("ida-klu-rtol1e-5", ida("klu", 1e-5)),

@@ -233,8 +233,12 @@ void read_tissue(const Reader& r, const toml::table& root, const std::filesystem
   // The host runs beside the tissue's threads anyway: our Tissue.fmu refreshes its contact stiffness
   // in a worker, off the step's 10 ms slot (a CHOLMOD factorization: ~7 ms on the frog), unless the
   // scenario says otherwise. Another tissue FMU is given only what the scenario says.
-  if (s.tissue_fmu.empty())
+  // The same for the lagged factor of the default solver, pcgCholesky (a refactorization: ~5 ms on
+  // the frog, issue 40).
+  if (s.tissue_fmu.empty()) {
     add_unless_set(s.tissue_parameters, ParameterSetting{"contact.stiffnessInBackground", true});
+    add_unless_set(s.tissue_parameters, ParameterSetting{"integrator.refactorInBackground", true});
+  }
 }
 
 // [haptic] (optional): the FMU, the period, the parameters; the tissue step a whole number of periods.

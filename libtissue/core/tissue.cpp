@@ -136,7 +136,10 @@ std::vector<std::vector<TetPositions>> Tissue::cut_offsets() const {
   return offsets;
 }
 
-void Tissue::save(TissueSnapshot& snapshot) const {
+void Tissue::save(TissueSnapshot& snapshot) {
+  // A save point is a restart point: the integrator's solver forgets its lagged factor here as the
+  // restore does, so that the run after the save and the run after a restore continue alike.
+  m_integrator->restart(Restart::state_saved);
   snapshot.model_fingerprint = m_model_fingerprint;
   snapshot.cuts = m_cuts.history();
   snapshot.cut_batch_ends = m_cuts.batch_ends();

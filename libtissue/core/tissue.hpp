@@ -184,7 +184,9 @@ class Tissue {
   }
   /// A hash of the mesh and every setting: a snapshot restores only into a Tissue of the same value.
   [[nodiscard]] std::uint64_t model_fingerprint() const { return m_model_fingerprint; }
-  void save(TissueSnapshot& snapshot) const;
+  /// Saves the state. A save point is a restart point of the linear solver (its lagged factor is
+  /// dropped, as at a restore), so that the run after it and a run restored to it continue alike.
+  void save(TissueSnapshot& snapshot);
   /// True when the snapshot's cuts are exactly the cuts made here, so restore() works in place.
   [[nodiscard]] bool has_cuts_of(const TissueSnapshot& snapshot) const;
   /// True when restore() can take the snapshot here: it has the same cuts, or nothing was cut here

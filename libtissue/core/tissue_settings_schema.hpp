@@ -116,14 +116,18 @@ constexpr auto body_settings() {
   });
 }
 
-/// The time integration: the integrator, backward Euler's linear solver and PCG, IDA's settings.
+/// The time integration: the integrator, backward Euler's linear solver and PCG (IDA's: below).
 constexpr auto integrator_settings() {
   return std::to_array<SettingInfo>({
       Setting("integrator.linearSolver", 10, enumeration)
           .python("linear_solver")
           .start("pcg")
           .items("LinearSolver", "Linear solver of the backward-Euler step", LINEAR_SOLVER_NAMES.all())
-          .describe("Linear solver of the backward-Euler step")
+          .describe("Linear solver of the backward-Euler step. pcg capped at 10 iterations (the default) "
+                    "leaves the slow motions unconverged: a piece cut free sinks in slow motion, a cantilever "
+                    "swings at a third of its frequency. pcgCholesky (CG preconditioned by a lagged Cholesky "
+                    "factor) with pcgTolerance 1e-5, pcgMaxIterations 25 and warmStart follows the exact "
+                    "solve to 1e-5, at 2-10x the frog's step cost (docs/BENCHMARKS.md, issue 40)")
           .member(TISSUE_ENUM_MEMBER(settings.solver.kind)),
       Setting("integrator.pcgTolerance", 11, real)
           .python("pcg_tolerance")
@@ -145,6 +149,14 @@ constexpr auto integrator_settings() {
           .start("false")
           .describe("PCG starts from the previous step's velocity change instead of zero")
           .member(TISSUE_MEMBER(settings.solver.warm_start)),
+      Setting("integrator.refactorInBackground", 85, boolean)
+          .python("refactor_in_background")
+          .start("false")
+          .describe("pcgCholesky: its lagged factor is refactorized in a worker thread beside the steps (started "
+                    "by a solver setup, installed two setups later) instead of in the setup that installs it. The results "
+                    "are the same with or without the thread. Off: no thread unless asked (an importer has no "
+                    "FMI switch that allows threads); tissue-host turns it on for its own Tissue.fmu")
+          .member(TISSUE_MEMBER(settings.solver.refresh.background_refactor)),
       Setting("stepSize", 14, real)
           .python("step_size_s")
           .unit("s")
@@ -168,6 +180,12 @@ constexpr auto integrator_settings() {
           .describe("Time integrator: backward Euler (one linear solve per internal step) or SUNDIALS IDA "
                     "(variable-order BDF with error control)")
           .member(TISSUE_ENUM_MEMBER(settings.integrator.kind)),
+  });
+}
+
+/// SUNDIALS IDA's settings.
+constexpr auto ida_settings() {
+  return std::to_array<SettingInfo>({
       Setting("integrator.idaRelativeTolerance", 71, real)
           .python("ida_relative_tolerance")
           .unit("1")
@@ -336,7 +354,8 @@ constexpr std::array<T, A + B> joined(const std::array<T, A>& a, const std::arra
 
 /// Every setting of the tissue, in the docs' order.
 inline constexpr auto TISSUE_SETTINGS = settings_detail::joined(
-    settings_detail::joined(settings_detail::body_settings(), settings_detail::integrator_settings()),
+    settings_detail::joined(settings_detail::joined(settings_detail::body_settings(), settings_detail::integrator_settings()),
+                            settings_detail::ida_settings()),
     settings_detail::joined(settings_detail::interaction_settings(), settings_detail::cutter_and_surface_settings()));
 
 /// The setting of an FMU / scenario name, or nullptr.

@@ -12,7 +12,10 @@ large-turn protections), each first in turn; a run's figure is its median ms per
 gives the median over rounds and the ratios Vega / ours. Prints a Markdown table with the machine.
 
 Usage: tests/bench/side_by_side_vega.py [--vega PATH] [--bench PATH] [--rounds 5] [--steps 200] [--only TEXT]
-                                       [--scaling [--plot PNG]]
+                                       [--scaling [--plot PNG]] [--converged]
+--converged (issue 40): converged steps instead, one thread, no protections, no damping: Vega's strict
+PCG (eps 1e-6) against ours converged to a relative residual of 1e-6 three ways: Jacobi PCG, PCG
+preconditioned by the lagged Cholesky factor (warm-started; the real-time default's solver), CHOLMOD.
 Ours is also run with two threads (defaults), unpinned. --scaling adds the organ at two sizes between the
 bridge and it (meshes/make_liver.py and Gmsh) and prints ms per step against tet count with the fitted
 exponent (and a log-log plot with matplotlib). Uses only the Python standard library otherwise.
@@ -54,9 +57,9 @@ def pinned(command):
     return (["taskset", "-c", "0"] if shutil.which("taskset") else []) + command
 
 
-def run_vega(vega, case, steps):
+def run_vega(vega, case, steps, setting=SETTING):
     name, mesh, bou, dt, material = case
-    eps, cap = SETTING
+    eps, cap = setting
     command = [str(vega), "--mesh", str(mesh), "--E", str(material["young"]), "--nu", str(material["poisson"]),
                "--rho", str(material["density"]), "--dt", str(dt), "--steps", str(steps), "--cg-eps", str(eps),
                "--cg-max", str(cap), "--alpha", "0", "--beta", "0"]
@@ -80,6 +83,56 @@ def run_ours(bench, case, steps, protection, threads=1):
     return result["ms_per_step"]["median"], result
 
 
+# --converged: ours three ways, each to a relative residual of 1e-6: name, solver, more tissue-bench
+# options (the lagged factor is refactorized in the stepping thread: one core each).
+CONVERGED = (("pcg", "pcg", []),
+             ("pcgCholesky", "pcgCholesky", ["--warm-start", "--no-background-refactor"]),
+             ("cholmod", "cholmod", []))
+STRICT = (1e-6, 10000)
+
+
+def run_converged(bench, case, steps, solver, options):
+    name, mesh, bou, dt, material = case
+    extra = ["--mass-damping", "0", "--stiffness-damping", "0", "--no-large-turn-protection"] + options
+    result = run_tissue_bench(bench, mesh, bou, dt, material, STRICT[0], STRICT[1], steps, solver=solver,
+                              extra=extra, prefix=pinned([]), env=environment())
+    return result["ms_per_step"]["median"], result
+
+
+def converged_table(args, cases):
+    rows = []
+    for case in cases:
+        times = {who: [] for who in ["vega"] + [name for name, _, _ in CONVERGED]}
+        details = {}
+        for k in range(args.rounds):
+            order = list(times)
+            order = order[k % len(order):] + order[:k % len(order)]
+            for who in order:
+                if who == "vega":
+                    times[who].append(run_vega(args.vega, case, args.steps, STRICT))
+                else:
+                    _, solver, options = next(c for c in CONVERGED if c[0] == who)
+                    ms, details[who] = run_converged(args.bench, case, args.steps, solver, options)
+                    times[who].append(ms)
+            print("  %s: round %d/%d: %s" % (case[0], k + 1, args.rounds,
+                                             ", ".join("%s %.3f ms" % (w, t[-1]) for w, t in times.items())),
+                  file=sys.stderr)
+        rows.append((case, {who: statistics.median(t) for who, t in times.items()}, details))
+    print("Machine: %d cores (`nproc`), %s; one thread each (pinned); %d rounds of %d steps, each first in turn; "
+          "converged steps: Vega's PCG to eps %g, ours to a relative residual of %g; no damping, no protections; "
+          "medians over rounds of each run's median step.\n" % (os.cpu_count(), cpu_model(), args.rounds, args.steps,
+                                                                 STRICT[0], STRICT[0]))
+    print("| mesh | dt | Vega, strict PCG (ms/step) | ours, PCG | ours, pcgCholesky (warm) | ours, CHOLMOD | "
+          "Vega / best of ours | CHOLMOD / pcgCholesky | pcgCholesky: CG iterations mean / max |")
+    print("|---|---|---:|---:|---:|---:|---:|---:|---|")
+    for case, median, details in rows:
+        best = min(median["pcg"], median["pcgCholesky"], median["cholmod"])
+        it = details["pcgCholesky"]["cg_iterations"]
+        print("| %s | %g s | %.2f | %.2f | %.2f | %.2f | %.1f | %.2f | %.1f / %d |"
+              % (case[0], case[3], median["vega"], median["pcg"], median["pcgCholesky"], median["cholmod"],
+                 median["vega"] / best, median["cholmod"] / median["pcgCholesky"], it["mean"], it["max"]))
+
+
 def cpu_model():
     try:
         for line in subprocess.run(["lscpu"], capture_output=True, text=True).stdout.splitlines():
@@ -101,12 +154,17 @@ def main():
                         help="also the organ at two sizes between the bridge and it (needs gmsh); print the "
                              "scaling table and the fitted exponents")
     parser.add_argument("--plot", default="", help="with --scaling: write the log-log plot here (needs matplotlib)")
+    parser.add_argument("--converged", action="store_true",
+                        help="converged steps (issue 40): Vega strict PCG against ours three ways, to 1e-6")
     args = parser.parse_args()
     for path in (args.vega, args.bench):
         if not pathlib.Path(path).exists():
             sys.exit("missing " + path + " (Vega: ../shared/peers/build-vega.sh; ours: cmake --build --preset release)")
 
     cases = [case for case in CASES if args.only in case[0]]
+    if args.converged:
+        converged_table(args, cases)
+        return
     if args.scaling:
         cases += scaling_cases()
     two_threads = (os.cpu_count() or 1) >= 2

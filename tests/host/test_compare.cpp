@@ -229,7 +229,7 @@ TEST(Recommendation, SaysWhenNoSettingQualifies) {
 // A Tissue-like description: the PCG/CHOLMOD parameters, and with_ida also integrator.method.
 ModelDescription tissue_like(bool with_ida) {
   const std::string types = R"(<TypeDefinitions>
-    <EnumerationType name="LinearSolver"><Item name="pcg" value="1"/><Item name="cholmod" value="2"/></EnumerationType>
+    <EnumerationType name="LinearSolver"><Item name="pcg" value="1"/><Item name="cholmod" value="2"/><Item name="pcgCholesky" value="3"/></EnumerationType>
     <EnumerationType name="Integrator"><Item name="backwardEuler" value="1"/><Item name="ida" value="2"/></EnumerationType>
     <EnumerationType name="IdaLinearSolver"><Item name="klu" value="1"/><Item name="krylov" value="2"/></EnumerationType>
   </TypeDefinitions>)";
@@ -237,6 +237,7 @@ ModelDescription tissue_like(bool with_ida) {
     <Enumeration name="integrator.linearSolver" valueReference="10" causality="parameter" variability="fixed" declaredType="LinearSolver" start="1"/>
     <Float64 name="integrator.pcgTolerance" valueReference="11" causality="parameter" variability="fixed" start="0.001"/>
     <Int32 name="integrator.pcgMaxIterations" valueReference="12" causality="parameter" variability="fixed" start="10"/>
+    <Boolean name="integrator.warmStart" valueReference="13" causality="parameter" variability="fixed" start="false"/>
     <Float64 name="stepSize" valueReference="14" causality="parameter" variability="fixed" start="0.001"/>
     <Float64 name="contact.force" valueReference="43" causality="output" variability="continuous"/>)";
   if (with_ida) {
@@ -263,7 +264,8 @@ TEST(CompareSettings, TheDefaultListAndSteps) {
   for (const CompareSetting& s : list.settings) names.push_back(s.name);
   EXPECT_EQ(names,
             (std::vector<std::string>{"be-pcg-tol1e-3-cap10", "be-pcg-tol1e-3-cap50", "be-pcg-tol1e-6-cap1000",
-                                      "be-cholmod", "ida-klu-rtol1e-3", "ida-klu-rtol1e-5", "ida-krylov-rtol1e-3"}));
+                                      "be-pcgCholesky-tol1e-5-cap25", "be-cholmod", "ida-klu-rtol1e-3",
+                                      "ida-klu-rtol1e-5", "ida-krylov-rtol1e-3"}));
   EXPECT_EQ(default_steps(0.01), (std::vector<double>{0.001, 0.01}));
   EXPECT_EQ(default_steps(0.005), (std::vector<double>{0.001, 0.005}));
   EXPECT_EQ(default_steps(0.001), (std::vector<double>{0.001}));
@@ -273,7 +275,7 @@ TEST(CompareSettings, TheDefaultListAndSteps) {
 TEST(CompareSettings, WithIdaEveryRunIsPlannedAndTheReferenceIsIda) {
   std::string note;
   const std::vector<RunSpec> runs = plan_runs(default_settings(), scenario_with_step(0.01), tissue_like(true), note);
-  ASSERT_EQ(runs.size(), 1u + 7u * 2u);
+  ASSERT_EQ(runs.size(), 1u + 8u * 2u);
   EXPECT_TRUE(note.empty()) << note;
   EXPECT_TRUE(runs[0].is_reference);
   EXPECT_EQ(runs[0].step_s, 0.001);
@@ -285,8 +287,13 @@ TEST(CompareSettings, WithIdaEveryRunIsPlannedAndTheReferenceIsIda) {
   EXPECT_EQ(runs[1].setting, "be-pcg-tol1e-3-cap10");
   EXPECT_EQ(runs[1].step_s, 0.001);
   EXPECT_EQ(runs[2].step_s, 0.01);
-  const SettingDescription cholmod = describe_setting(runs[7].parameters, tissue_like(true));
-  EXPECT_EQ(runs[7].setting, "be-cholmod");
+  const SettingDescription lagged = describe_setting(runs[7].parameters, tissue_like(true));
+  EXPECT_EQ(runs[7].setting, "be-pcgCholesky-tol1e-5-cap25");
+  EXPECT_EQ(lagged.family(), "backwardEuler/pcgCholesky");
+  EXPECT_EQ(lagged.tolerance, 1e-5);
+  EXPECT_EQ(lagged.iteration_cap, 25);
+  const SettingDescription cholmod = describe_setting(runs[9].parameters, tissue_like(true));
+  EXPECT_EQ(runs[9].setting, "be-cholmod");
   EXPECT_EQ(cholmod.family(), "backwardEuler/cholmod");
   EXPECT_FALSE(cholmod.tolerance);
   EXPECT_FALSE(cholmod.iteration_cap);
@@ -296,7 +303,7 @@ TEST(CompareSettings, WithoutIdaTheIdaRowsAreSkippedAndTheReferenceFallsBack) {
   const ModelDescription old_tissue = tissue_like(false);
   std::string note;
   const std::vector<RunSpec> runs = plan_runs(default_settings(), scenario_with_step(0.01), old_tissue, note);
-  ASSERT_EQ(runs.size(), 15u);
+  ASSERT_EQ(runs.size(), 17u);
   EXPECT_NE(note.find("integrator.method"), std::string::npos) << note;
   EXPECT_EQ(describe_setting(runs[0].parameters, old_tissue).family(), "backwardEuler/cholmod");
   for (const RunSpec& run : runs) {

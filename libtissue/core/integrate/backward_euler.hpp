@@ -53,8 +53,11 @@ class BackwardEuler final : public Integrator {
   void restore_internal_state(const Eigen::VectorXd& internal_state) override {
     m_velocity_change = internal_state;
   }
-  /// One step depends on the state alone: nothing to forget (a grown system drops the warm start).
-  void restart(Restart /*why*/) override {}
+  /// One step depends on the state alone (a grown system drops the warm start); a save or a restore
+  /// makes the solver forget its lagged factor (LinearSolver::forget_earlier_setups).
+  void restart(Restart why) override {
+    if (why == Restart::state_saved || why == Restart::state_restored) m_solver->forget_earlier_setups();
+  }
   /// (1/h^2) times this step's matrix: newton_stiffness_system with c = 1/h.
   [[nodiscard]] ShiftedSystem newton_stiffness(const DynamicsModel& model, double step_size_s,
                                                Eigen::VectorXd& diagonal) const override;

@@ -402,6 +402,7 @@ void IdaIntegrator::restore_internal_state(const Eigen::VectorXd& internal_state
 }
 
 void IdaIntegrator::restart(Restart why) {
+  if (why == Restart::state_saved) return;  // the history continues; a restore restarts it
   Impl& impl = *m_impl;
   impl.restart_pending = true;
   if (why == Restart::system_grown) impl.free_memory();

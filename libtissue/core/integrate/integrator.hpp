@@ -2,10 +2,12 @@
 // IDA implement it; make_integrator() (integrator_factory.hpp) picks one from the settings.
 //
 // The contract, beyond step():
-// * restart(why): the system grew (a cut), a saved state was restored, or a contact began or
-//   ended. A one-step method has nothing to forget; a multistep method (IDA) drops its history and
-//   starts afresh (order 1, a new step size, new memory when the size changed) from the state it
-//   is given at the next step().
+// * restart(why): the system grew (a cut), a state was saved or a saved state restored, or a
+//   contact began or ended. A multistep method (IDA) drops its history and starts afresh (order 1,
+//   a new step size, new memory when the size changed) from the state it is given at the next
+//   step() (not for a save). A one-step method has no history; where a state is saved or restored
+//   it lets its linear solver forget what earlier setups left (a lagged factor), so that the run
+//   after a save and the run after its restore continue alike, bitwise.
 // * internal_state(): what carries over between steps and can be saved with an FMU state (backward
 //   Euler's warm start). A multistep history cannot be exported: internal_state() is empty, and a
 //   restored state continues exactly as a restart at the restored point would (tests/unit/integrate).
@@ -41,7 +43,7 @@ struct StepReport {
 };
 
 /// Why an integrator must start afresh at its next step.
-enum class Restart { system_grown, state_restored, contact_changed };
+enum class Restart { system_grown, state_saved, state_restored, contact_changed };
 
 class Integrator {
  public:

@@ -40,6 +40,7 @@ struct CholeskyPcgSolver::Impl {
   bool in_flight = false;
   int setups_since_start = 0;
   bool refresh_wanted = false;  // the last solve asked for a new factor
+  bool forgotten = false;       // forget_earlier_setups(): the factor is not used again
 
   ShiftedSystem system{nullptr, 1.0, nullptr};  // of the last setup()
   PcgWorkspace work;
@@ -65,7 +66,7 @@ struct CholeskyPcgSolver::Impl {
 
   // The factor in use can precondition A (or its leading block): same matrix, not more rows.
   [[nodiscard]] bool usable(const BlockSparseMatrix& stiffness) const {
-    return active->factored() && active->source() == &stiffness && active->rows() <= stiffness.rows();
+    return !forgotten && active->factored() && active->source() == &stiffness && active->rows() <= stiffness.rows();
   }
   [[nodiscard]] bool stale(const BlockSparseMatrix& stiffness) const {
     return active->pattern_revision() != stiffness.pattern_revision() || active->rows() != stiffness.rows();
@@ -193,6 +194,14 @@ int CholeskyPcgSolver::symbolic_analysis_count() const {
   return impl.active->analysis_count() + (impl.worker.joinable() ? 0 : impl.spare->analysis_count());
 }
 
+void CholeskyPcgSolver::forget_earlier_setups() {
+  Impl& impl = *m_impl;
+  impl.discard_refresh();
+  impl.forgotten = true;
+  impl.refresh_wanted = false;
+  impl.setups_since_start = 0;
+}
+
 void CholeskyPcgSolver::setup(const ShiftedSystem& system) {
   Impl& impl = *m_impl;
   impl.system = ShiftedSystem{nullptr, 1.0, nullptr};
@@ -204,6 +213,7 @@ void CholeskyPcgSolver::setup(const ShiftedSystem& system) {
   jacobi_inverse_diagonal(system, impl.inverse_diagonal, WHO);  // also refuses a diagonal <= 0
   if (!impl.usable(*system.stiffness) || (impl.refresh.refactor_on_growth && impl.stale(*system.stiffness))) {
     impl.discard_refresh();  // older than what we factorize now
+    impl.forgotten = false;
     impl.active->load(system);
     Impl::copy_frames(system, impl.active_frames);
     ++impl.counters.factorizations;

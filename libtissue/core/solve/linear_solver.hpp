@@ -75,6 +75,11 @@ class LinearSolver {
   /// step's team for the step only). The CG solvers split their products and vector updates over
   /// it, with bitwise the results of one thread; CHOLMOD ignores it.
   virtual void lend_work_team(WorkTeam* /*team*/) {}
+  /// Drops what earlier setups left for later ones (CholeskyPcgSolver: its lagged factor and a
+  /// refresh in flight), so that the next setup starts as a fresh solver's would. Called where a
+  /// state is saved and where it is restored (Integrator::restart), so that a restored run
+  /// continues bitwise as the saved one did. The other solvers keep nothing: no-op.
+  virtual void forget_earlier_setups() {}
   /// Whether the solver uses ShiftedSystem::block_frames (an integrator asks the model for them
   /// only then: they cost a pass over the mesh).
   [[nodiscard]] virtual bool follows_block_frames() const { return false; }
@@ -200,6 +205,8 @@ class CholeskyPcgSolver final : public LinearSolver {
   void lend_work_team(WorkTeam* team) override;
   /// Refresh::follow_rotations.
   [[nodiscard]] bool follows_block_frames() const override;
+  /// The next setup factorizes at once (the refresh in flight is discarded).
+  void forget_earlier_setups() override;
 
   [[nodiscard]] const Counters& counters() const;
   /// Why the last refresh failed ("" if none did).

@@ -192,6 +192,33 @@ TEST(TissueState, RestoredInPlaceRepeatsTheSameSteps) {
   EXPECT_TRUE(bitwise_equal(tissue.state().velocity_m_per_s, first.velocity_m_per_s));
 }
 
+// With the lagged Cholesky preconditioner (pcgCholesky, the converged setting of issue 40) the
+// steps after a save depend on the factor the solver carries, which a snapshot does not hold: a save
+// and a restore both drop it (Integrator::restart), so the saved run and a fresh instance restored
+// from its snapshot go on bitwise alike, through the probe's press and both strokes. Before, they
+// differed at the solver's tolerance.
+TEST(TissueState, WithTheLaggedFactorRestoredRepeatsTheSameSteps) {
+  const TetMesh mesh = frog();
+  Session session(mesh);
+  TissueSettings settings = frog_settings(mesh);
+  settings.solver.kind = LinearSolverKind::pcg_cholesky;
+  settings.solver.pcg = PcgSolver::Settings{1e-5, 25};
+  settings.solver.warm_start = true;
+  for (const int saved_at : {10, 40, 85}) {
+    Tissue original(mesh, settings);
+    session.set_top(top_of_back(original, session));
+    run(original, session, 0, saved_at);
+    TissueSnapshot snapshot;
+    original.save(snapshot);
+    Tissue fresh(mesh, settings);
+    fresh.restore(snapshot);
+    run(original, session, saved_at, LAST_STEP);
+    run(fresh, session, saved_at, LAST_STEP);
+    EXPECT_TRUE(bitwise_equal(fresh.state().displacement_m, original.state().displacement_m)) << "saved at " << saved_at;
+    EXPECT_TRUE(bitwise_equal(fresh.state().velocity_m_per_s, original.state().velocity_m_per_s)) << "saved at " << saved_at;
+  }
+}
+
 TEST(TissueState, RefusesWhatItCannotRestoreAndKeepsItsState) {
   const TetMesh mesh = frog();
   Session session(mesh);
