@@ -204,7 +204,7 @@ TEST(TissueState, WithTheLaggedFactorRestoredRepeatsTheSameSteps) {
   settings.solver.kind = LinearSolverKind::pcg_cholesky;
   settings.solver.pcg = PcgSolver::Settings{1e-5, 25};
   settings.solver.warm_start = true;
-  for (const int saved_at : {10, 40, 85}) {
+  for (const int saved_at : {10, 40}) {  // pressing; mid-stroke
     Tissue original(mesh, settings);
     session.set_top(top_of_back(original, session));
     run(original, session, 0, saved_at);
