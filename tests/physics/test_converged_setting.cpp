@@ -46,6 +46,17 @@ TissueSettings exact(TissueSettings settings) {
   return settings;
 }
 
+// The lowest and highest rest coordinates of the mesh. [m]
+std::pair<Eigen::Vector3d, Eigen::Vector3d> rest_box(const TetMesh& mesh) {
+  Eigen::Vector3d low = mesh.rest_positions_m.front();
+  Eigen::Vector3d high = low;
+  for (const Eigen::Vector3d& p : mesh.rest_positions_m) {
+    low = low.cwiseMin(p);
+    high = high.cwiseMax(p);
+  }
+  return {low, high};
+}
+
 // Mean position of the vertices whose rest x is beyond `x_m`. [m]
 Eigen::Vector3d mean_beyond(const Tissue& tissue, double x_m) {
   const TetMesh& mesh = tissue.body().mesh();
@@ -73,12 +84,7 @@ Eigen::Vector3d freed_end_motion(const TetMesh& mesh, const TissueSettings& sett
   Tissue tissue(mesh, settings);
   const double h = settings.step_size_s;
   for (int n = 0; n < static_cast<int>(std::lround(0.2 / h)); ++n) tissue.step();
-  Eigen::Vector3d low = mesh.rest_positions_m.front();
-  Eigen::Vector3d high = low;
-  for (const Eigen::Vector3d& p : mesh.rest_positions_m) {
-    low = low.cwiseMin(p);
-    high = high.cwiseMax(p);
-  }
+  const auto [low, high] = rest_box(mesh);
   const double y_from = low.y() - 0.01;
   const double y_to = high.y() + 0.01;
   const int steps = static_cast<int>(std::ceil((y_to - y_from) / (stroke.speed_m_per_s * h)));
@@ -125,11 +131,9 @@ TEST(ConvergedSetting, AFreedFrogEndFollowsTheExactSolve) {
   settings.body.material.young_modulus_pa = 3.0e5;
   settings.step_size_s = 0.01;
   settings.interaction.blade_length_m = 0.3;
-  double low_x = 1e9, high_x = -1e9;
-  for (const Eigen::Vector3d& p : mesh.rest_positions_m) {
-    low_x = std::min(low_x, p.x());
-    high_x = std::max(high_x, p.x());
-  }
+  const auto [low, high] = rest_box(mesh);
+  const double low_x = low.x();
+  const double high_x = high.x();
   expect_follows_exact(mesh, settings, Stroke{low_x + 0.55 * (high_x - low_x), 0.5, 0.15},
                        low_x + 0.85 * (high_x - low_x), "frog");
 }

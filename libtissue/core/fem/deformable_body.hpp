@@ -246,6 +246,8 @@ class DeformableBody final : public DynamicsModel {
   [[nodiscard]] double density_kg_per_m3(const TetRest& rest) const {
     return m_materials[static_cast<size_t>(rest.material)].density_kg_per_m3;
   }
+  // rho V of a tet (its material's density).
+  [[nodiscard]] double tet_mass_kg(const TetRest& rest) const { return density_kg_per_m3(rest) * rest.volume_m3; }
   [[nodiscard]] double mass_damping_per_s(const TetRest& rest) const {
     return m_region_mass_damping_per_s[static_cast<size_t>(rest.material)];
   }
@@ -303,8 +305,8 @@ class DeformableBody final : public DynamicsModel {
     double mass_kg;
   };
   std::vector<CopyArrival> m_arrivals;
-  std::vector<Eigen::Vector3d> m_new_row_start_m;  // per ghost the last enrich() made: its start
-  std::vector<std::uint8_t> m_new_row_started;
+  // Per ghost the last enrich() made: its start (set by the first piece that uses it).
+  std::vector<std::optional<Eigen::Vector3d>> m_new_row_start_m;
   int m_tets_cut = 0;
   double m_largest_shape_gradient_per_m = 0.0;  // max |grad(phi_i)| over the mesh: 1 / the lowest altitude
   std::vector<int> m_first_enriched_dof;        // per vertex: first of its enriched unknowns, or -1

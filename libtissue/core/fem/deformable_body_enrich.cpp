@@ -87,7 +87,8 @@ EnrichmentResult DeformableBody::enrich(std::span<const TetCut> cuts, DynamicSta
   grow_state(state);
   const int first_new_row = static_cast<int>(size / 3);
   for (size_t n = 0; n < m_new_row_start_m.size(); ++n) {
-    state.displacement_m.segment<3>(3 * (first_new_row + static_cast<int>(n))) = m_new_row_start_m[n];
+    state.displacement_m.segment<3>(3 * (first_new_row + static_cast<int>(n))) =
+        m_new_row_start_m[n].value_or(Eigen::Vector3d::Zero());
   }
   // Momentum: a row keeps its own (of the mass that stayed) and gains what arrives with the pieces
   // that came from other copies.
@@ -116,12 +117,12 @@ EnrichmentResult DeformableBody::enrich(std::span<const TetCut> cuts,
 
 void DeformableBody::add_piece_loads(int k, double sign) {
   const int u_rows = m_dofs.free_vertex_count();
-  const double tet_mass_kg = density_kg_per_m3(m_xfem.rest(k)) * m_xfem.rest(k).volume_m3;
+  const double mass_kg = tet_mass_kg(m_xfem.rest(k));
   const double alpha_per_s = mass_damping_per_s(m_xfem.rest(k));
   const Tet& vertices = m_xfem.cut_tets()[static_cast<size_t>(k)].vertices;
   for (size_t p = 0; p < m_xfem.piece_count(k); ++p) {
     const CutPiece& piece = m_xfem.piece(k, static_cast<int>(p));
-    const double quarter_mass_kg = 0.25 * piece.weight * tet_mass_kg;
+    const double quarter_mass_kg = 0.25 * piece.weight * mass_kg;
     for (size_t j = 0; j < 4; ++j) {
       const int row = piece.ghost_row[j] >= 0 ? piece.ghost_row[j] : vertex_block_row(vertices[j]);
       if (row < 0) continue;  // a fixed vertex
@@ -187,8 +188,7 @@ EnrichmentResult DeformableBody::enrich_pieces(std::span<const TetCut> cuts,
   m_orphaned_rows.clear();
   m_arrivals.clear();
   append_ghost_rows(batch);
-  m_new_row_start_m.assign(batch.new_rows.size(), Eigen::Vector3d::Zero());
-  m_new_row_started.assign(batch.new_rows.size(), 0);
+  m_new_row_start_m.assign(batch.new_rows.size(), std::nullopt);
   for (size_t c = 0; c < batch.plans.size(); ++c) {
     const size_t piece_count = batch.plans[c].geometry.pieces.size();
     std::vector<CutPiece> pieces(piece_count);
@@ -300,10 +300,12 @@ void DeformableBody::start_pieces(const EnrichBatch& batch, size_t c,
   const int u_rows = m_dofs.free_vertex_count();
   const int first_new_row = u_rows + batch.old_dofs;
   const Tet& tet = m_mesh.tets[static_cast<size_t>(plan.tet)];
-  const double tet_mass_kg = density_kg_per_m3(m_elasticity.rest(plan.tet)) * m_elasticity.rest(plan.tet).volume_m3;
+  const double mass_kg = tet_mass_kg(m_elasticity.rest(plan.tet));
   // The current value of an existing row (zero without a running state), or a new row's start.
   const auto current = [&](int row) -> Eigen::Vector3d {
-    if (row >= first_new_row) return m_new_row_start_m[static_cast<size_t>(row - first_new_row)];
+    if (row >= first_new_row) {
+      return m_new_row_start_m[static_cast<size_t>(row - first_new_row)].value_or(Eigen::Vector3d::Zero());
+    }
     if (displacement_m == nullptr || 3 * row >= displacement_m->size()) return Eigen::Vector3d::Zero();
     return displacement_m->segment<3>(3 * row);
   };
@@ -322,11 +324,11 @@ void DeformableBody::start_pieces(const EnrichBatch& batch, size_t c,
       if (from_ghost) from_m -= parent->offset_m[j];
       const int planned = row_of(plan.rows[q][j]);
       const int row = planned >= 0 ? planned : vertex_block_row(tet[j]);
-      if (row >= first_new_row && !m_new_row_started[static_cast<size_t>(row - first_new_row)]) {
-        m_new_row_start_m[static_cast<size_t>(row - first_new_row)] = from_m;
-        m_new_row_started[static_cast<size_t>(row - first_new_row)] = 1;
+      if (row >= first_new_row) {
+        std::optional<Eigen::Vector3d>& start = m_new_row_start_m[static_cast<size_t>(row - first_new_row)];
+        if (!start) start = from_m;
       }
-      if (row >= 0 && row != from_row) m_arrivals.push_back({row, from_row, 0.25 * piece.weight * tet_mass_kg});
+      if (row >= 0 && row != from_row) m_arrivals.push_back({row, from_row, 0.25 * piece.weight * mass_kg});
       if (planned < 0) continue;  // the real vertex
       piece.ghost_row[j] = planned;
       piece.offset_m[j] = offsets_m.empty() ? Eigen::Vector3d(current(planned) - from_m) : offsets_m[c][q][j];
@@ -351,7 +353,7 @@ int DeformableBody::replace_cut_tet(EnrichBatch& batch, size_t c, const std::vec
     const TetRest& rest = m_elasticity.rest(plan.tet);
     for (const int v : tet) {
       const int row = vertex_block_row(v);
-      if (row >= 0) add_row_load(row, -0.25 * density_kg_per_m3(rest) * rest.volume_m3, mass_damping_per_s(rest));
+      if (row >= 0) add_row_load(row, -0.25 * tet_mass_kg(rest), mass_damping_per_s(rest));
     }
     m_elasticity.exclude(plan.tet);
     ++m_tets_cut;
