@@ -74,6 +74,7 @@ std::uint64_t model_fingerprint(const TetMesh& mesh, const TissueSettings& setti
   f.add(settings.integrator.newton.trigger_angle_rad);
   f.add(settings.integrator.newton.max_iterations);
   f.add(settings.integrator.newton.energy_guard_angle_rad);
+  f.add(settings.integrator.newton.line_search);
   if (settings.solver.pcg.matrix_precision != MatrixPrecision::automatic) f.add(settings.solver.pcg.matrix_precision);
   if (settings.solver.kind == LinearSolverKind::pcg_cholesky) {  // so that older fingerprints stay as they were
     f.add(settings.solver.refresh.refresh_iterations);           // background_refactor changes no result

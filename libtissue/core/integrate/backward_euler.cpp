@@ -218,12 +218,52 @@ void BackwardEuler::correct(DynamicsModel& model, const DynamicState& state, dou
     report.solve_s += seconds_since(solve_start);
     report.linear_iterations += report.solve.iterations;
     if (!m_correction.allFinite()) throw IntegrationError("backward Euler: a Newton correction is not finite; state kept");
-    m_end_velocity += m_correction;
     ++report.newton_iterations;
+    if (m_settings.newton.line_search) {
+      const double share = line_search(model, state, h, team);
+      if (share == 0.0) break;
+      m_correction *= share;
+    }
+    m_end_velocity += m_correction;
     m_end_displacement.noalias() = h * m_correction;
     const double converged_rad = 0.01 * m_settings.newton.trigger_angle_rad;
     if (model.largest_turn_rad(m_end_displacement, converged_rad) <= converged_rad) break;
   }
+}
+
+// Backward Euler's step minimizes, over the end velocity v1 (u1 = u0 + h v1),
+//   Phi(v1) = 1/2 |v1 - v0|^2_M + h alpha/2 |v1|^2_M + h beta/2 v1^T K v1 + E(u1),
+// E the potential (elastic, the loads', the force terms'), K frozen at the iterate the correction
+// was solved at: grad Phi = -r(v1) of correct() there. The matrix is positive definite, so a
+// correction descends Phi; the line search keeps the iterates from overshooting it.
+double BackwardEuler::incremental_potential_j(DynamicsModel& model, const DynamicState& state, double h,
+                                              const BlockSparseMatrix& stiffness, const Eigen::VectorXd& v1,
+                                              WorkTeam* team) {
+  m_trial_displacement.noalias() = state.displacement_m + h * v1;
+  stiffness.multiply(v1, m_trial_product, team);
+  const Eigen::VectorXd& mass = model.mass_kg();
+  double kinetic_j = 0.0;
+  double damping_j = 0.0;
+  for (Eigen::Index i = 0; i < v1.size(); ++i) {
+    const double change = v1[i] - state.velocity_m_per_s[i];
+    kinetic_j += mass[i] * change * change;
+    damping_j += model.mass_damping_kg_per_s()[i] * v1[i] * v1[i];
+  }
+  damping_j += model.stiffness_damping_s() * v1.dot(m_trial_product);
+  return 0.5 * kinetic_j + 0.5 * h * damping_j + model.potential_energy_j(m_trial_displacement);
+}
+
+double BackwardEuler::line_search(DynamicsModel& model, const DynamicState& state, double h, WorkTeam* team) {
+  const BlockSparseMatrix& stiffness = model.tangent();
+  m_trial_product.resize(m_correction.size());
+  const double start_j = incremental_potential_j(model, state, h, stiffness, m_end_velocity, team);
+  if (!std::isfinite(start_j)) return 1.0;  // the model cannot say: the full correction, as without the search
+  double share = 1.0;
+  for (int halving = 0; halving <= LINE_SEARCH_HALVINGS; ++halving, share *= 0.5) {
+    m_trial_velocity.noalias() = m_end_velocity + share * m_correction;
+    if (incremental_potential_j(model, state, h, stiffness, m_trial_velocity, team) <= start_j) return share;
+  }
+  return 0.0;
 }
 
 }  // namespace tissue

@@ -34,7 +34,14 @@ class BackwardEuler final : public Integrator {
     /// (kinetic + DynamicsModel::potential_energy_j) ends above where it began, the velocity is
     /// scaled down until it does not (energy projection, Dinev et al. 2018). Infinity: never.
     double energy_guard_angle_rad = 0.005;
+    /// Take of each correction only as much as lowers the step's incremental potential (halving it
+    /// up to LINE_SEARCH_HALVINGS times; none lowers it: the iterations stop). The co-rotational
+    /// tangent lacks the rotation's derivative, so a full correction can overshoot a fast-turning
+    /// piece and the iterates swing (docs/DESIGN.md, "Newton corrections"). false: full corrections.
+    bool line_search = true;
   };
+  /// Halvings of a correction before the line search gives up on it.
+  static constexpr int LINE_SEARCH_HALVINGS = 6;
   struct Settings {
     /// Start each solve from the previous step's dv instead of zero (matters for iterative solvers).
     bool warm_start = false;
@@ -70,6 +77,11 @@ class BackwardEuler final : public Integrator {
   ShiftedSystem step_system(const DynamicsModel& model, double h);
   // Scales v1 (m_end_velocity) so that the step's energy does not rise; true if it did.
   bool guard_energy(DynamicsModel& model, const DynamicState& state, double h);
+  // The step's incremental potential at v1 (backward_euler.cpp); `stiffness` is the damping's K.
+  double incremental_potential_j(DynamicsModel& model, const DynamicState& state, double h,
+                                 const BlockSparseMatrix& stiffness, const Eigen::VectorXd& v1, WorkTeam* team);
+  // The share t of m_correction to take (0: none lowers the incremental potential).
+  double line_search(DynamicsModel& model, const DynamicState& state, double h, WorkTeam* team);
 
   std::unique_ptr<LinearSolver> m_solver;
   Settings m_settings;
@@ -81,6 +93,9 @@ class BackwardEuler final : public Integrator {
   Eigen::VectorXd m_end_displacement;  // the Newton iterate u0 + h v1
   Eigen::VectorXd m_end_velocity;      // v1
   Eigen::VectorXd m_correction;        // a Newton correction of v1
+  Eigen::VectorXd m_trial_velocity;    // v1 + t correction, in the line search
+  Eigen::VectorXd m_trial_displacement;
+  Eigen::VectorXd m_trial_product;     // K v of a trial
 };
 
 /// Throws ParameterError unless the trigger angle is > 0 (infinity: off) and 1 to 100 iterations.
