@@ -211,7 +211,8 @@ void BackwardEuler::correct(DynamicsModel& model, const DynamicState& state, dou
     const auto solve_start = std::chrono::steady_clock::now();
     m_correction.setZero(n);
     try {
-      report.solve = m_solver->solve(system, m_rhs, m_correction);
+      m_solver->setup_nearby(system);  // the step's matrix moved a little
+      report.solve = m_solver->solve(m_rhs, m_correction);
     } catch (const SolverError& error) {
       throw IntegrationError(std::string("backward Euler: a Newton correction's solve failed: ") + error.what());
     }

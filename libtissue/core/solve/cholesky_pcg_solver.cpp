@@ -182,6 +182,8 @@ void CholeskyPcgSolver::lend_work_team(WorkTeam* team) { m_impl->team = team; }
 
 bool CholeskyPcgSolver::follows_block_frames() const { return m_impl->refresh.follow_rotations; }
 
+void CholeskyPcgSolver::record_residuals(std::vector<double>* history) { m_impl->work.residual_history = history; }
+
 bool CholeskyPcgSolver::is_set_up() const { return m_impl->system.stiffness != nullptr; }
 
 const CholeskyPcgSolver::Counters& CholeskyPcgSolver::counters() const { return m_impl->counters; }

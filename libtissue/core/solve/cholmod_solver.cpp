@@ -1,8 +1,10 @@
 // CholmodSolver: sparse Cholesky of A = s K + diag(d) with SuiteSparse CHOLMOD, the accurate
 // (reference) solver: every setup refactorizes (CholmodFactor, whose header and source give the
-// CHOLMOD choices), every solve back-substitutes and checks the true residual.
+// CHOLMOD choices), every solve back-substitutes and checks the true residual. A setup_nearby (a
+// Newton correction's matrix) keeps the factor and iterates on the new A with it.
 #include "core/solve/cholmod_factor.hpp"
 #include "core/solve/linear_solver.hpp"
+#include "core/solve/pcg_iteration.hpp"
 
 #include <cmath>
 #include <span>
@@ -14,6 +16,20 @@ struct CholmodSolver::Impl {
   CholmodFactor factor;
   Eigen::VectorXd product;                               // A x for the residual check
   ShiftedSystem factored_system{nullptr, 1.0, nullptr};  // of the valid factor, stiffness == nullptr without one
+  // setup_nearby(): the A the solves iterate on with the factor of factored_system (stiffness ==
+  // nullptr: solve with the factor directly).
+  ShiftedSystem nearby_system{nullptr, 1.0, nullptr};
+  PcgWorkspace work;
+  WorkTeam* team = nullptr;
+
+  void factorize(const ShiftedSystem& system) {
+    const ShiftedSystem a = system;  // a copy: it may be nearby_system, cleared here
+    factored_system = ShiftedSystem{nullptr, 1.0, nullptr};
+    nearby_system = ShiftedSystem{nullptr, 1.0, nullptr};
+    factor.load(a);
+    if (factor.factorize() != CholmodFactor::Status::ok) throw SolverError(factor.failure_message("CholmodSolver"));
+    factored_system = a;
+  }
 };
 
 CholmodSolver::CholmodSolver() : m_impl(std::make_unique<Impl>()) {}
@@ -24,20 +40,46 @@ int CholmodSolver::symbolic_analysis_count() const { return m_impl->factor.analy
 
 bool CholmodSolver::is_set_up() const { return m_impl->factored_system.stiffness != nullptr; }
 
+void CholmodSolver::lend_work_team(WorkTeam* team) { m_impl->team = team; }
+
 void CholmodSolver::setup(const ShiftedSystem& system) {
   Impl& impl = *m_impl;
   impl.factored_system = ShiftedSystem{nullptr, 1.0, nullptr};
+  impl.nearby_system = ShiftedSystem{nullptr, 1.0, nullptr};
   system.check("CholmodSolver");
-  impl.factor.load(system);
-  if (impl.factor.factorize() != CholmodFactor::Status::ok) {
-    throw SolverError(impl.factor.failure_message("CholmodSolver"));
+  impl.factorize(system);
+}
+
+void CholmodSolver::setup_nearby(const ShiftedSystem& system) {
+  Impl& impl = *m_impl;
+  system.check("CholmodSolver");
+  const ShiftedSystem& factored = impl.factored_system;
+  if (factored.stiffness != system.stiffness || factored.rows() != system.rows() ||
+      impl.factor.pattern_revision() != system.stiffness->pattern_revision()) {
+    setup(system);
+    return;
   }
-  impl.factored_system = system;
+  impl.nearby_system = ShiftedSystem{nullptr, 1.0, nullptr};
+  impl.work.resize(system.rows());
+  impl.work.matrix.assign(system, impl.team);
+  impl.nearby_system = system;
 }
 
 SolveReport CholmodSolver::solve(const Eigen::VectorXd& b, Eigen::VectorXd& x) {
   Impl& impl = *m_impl;
   if (!is_set_up()) throw SolverError("CholmodSolver: solve() without a factor (call setup())");
+  if (impl.nearby_system.stiffness != nullptr) {
+    x.setZero(impl.nearby_system.rows());
+    impl.nearby_system.check_sizes(b, x);
+    const SolveReport report = preconditioned_cg</*ROW_WISE=*/false>(
+        impl.nearby_system, b, x, NEARBY_TOLERANCE, NEARBY_ITERATIONS, impl.work, impl.team,
+        [&impl](const Eigen::VectorXd& r, Eigen::VectorXd& z, long, long) {
+          impl.factor.solve(std::span<const double>(r.data(), static_cast<size_t>(r.size())),
+                            std::span<double>(z.data(), static_cast<size_t>(z.size())));
+        });
+    if (report.converged && x.allFinite()) return report;
+    impl.factorize(impl.nearby_system);  // too far after all: the exact solve below
+  }
   const long n = impl.factor.rows();
   if (b.size() != n) {
     throw SolverError("CholmodSolver: the right-hand side b has length " + std::to_string(b.size()) +

@@ -15,6 +15,7 @@
 #include <stdexcept>
 #include <string>
 #include <string_view>
+#include <vector>
 
 namespace tissue {
 
@@ -59,6 +60,11 @@ class LinearSolver {
   /// unchanged until the next setup(). Throws SolverError (A not positive definite, sizes wrong);
   /// nothing is set up then.
   virtual void setup(const ShiftedSystem& system) = 0;
+  /// setup() for an A close to the last setup's (a Newton correction's matrix within the step that
+  /// set up): same K object, pattern and size, values moved a little. A direct solver may keep its
+  /// factor and iterate on A with it as the preconditioner (CholmodSolver: to a relative residual
+  /// of 1e-6, which a Newton iteration's own stopping rule is far above); the others set up as usual.
+  virtual void setup_nearby(const ShiftedSystem& system) { setup(system); }
   /// Solves A x = b with the A of the last setup(). On entry x holds the initial guess (iterative
   /// solvers warm-start from it and need length A.rows(); a direct solver resizes it). Work buffers
   /// are kept between calls: no allocation while the size stays the same. Throws SolverError
@@ -90,6 +96,9 @@ class LinearSolver {
 struct PcgWorkspace {
   Eigen::VectorXd residual, direction, preconditioned, product;
   HalfMatrix matrix;  ///< A as the products stream it, made at each setup
+  /// Where each solve appends its relative residual after every iteration (iteration 0 first); the
+  /// solvers' record_residuals(). For plots and benchmarks: nullptr (the default) records nothing.
+  std::vector<double>* residual_history = nullptr;
 
   void resize(long n) {
     if (residual.size() == n) return;
@@ -120,6 +129,9 @@ class PcgSolver final : public LinearSolver {
   [[nodiscard]] std::string_view name() const override { return "pcg"; }
   void lend_work_team(WorkTeam* team) override { m_team = team; }
   [[nodiscard]] const Settings& settings() const { return m_settings; }
+  /// Appends the relative residual ||r_k|| / ||b|| of every iteration k >= 0 of the solves that
+  /// follow to `history` (kept by the caller; nullptr stops). For convergence plots.
+  void record_residuals(std::vector<double>* history) { m_work.residual_history = history; }
 
  private:
   Settings m_settings;
@@ -205,6 +217,8 @@ class CholeskyPcgSolver final : public LinearSolver {
   void lend_work_team(WorkTeam* team) override;
   /// Refresh::follow_rotations.
   [[nodiscard]] bool follows_block_frames() const override;
+  /// As PcgSolver::record_residuals.
+  void record_residuals(std::vector<double>* history);
   /// The next setup factorizes at once (the refresh in flight is discarded).
   void forget_earlier_setups() override;
 
@@ -232,8 +246,16 @@ class CholmodSolver final : public LinearSolver {
   using LinearSolver::solve;
   /// Factorizes A; the previous factor is gone even when this throws.
   void setup(const ShiftedSystem& system) override;
+  /// Keeps the factor when it is of the same K's pattern and size (else setup()): the solves that
+  /// follow run CG on A preconditioned by it, to NEARBY_TOLERANCE, and factorize A after all if CG
+  /// has not got there in NEARBY_ITERATIONS. A Newton correction then costs back-substitutions
+  /// instead of a factorization (docs/DESIGN.md, "Newton corrections"). Reports CG's residual.
+  void setup_nearby(const ShiftedSystem& system) override;
   /// x = A^-1 b with the factor; reports the true relative residual (one product with A).
   SolveReport solve(const Eigen::VectorXd& b, Eigen::VectorXd& x) override;
+  void lend_work_team(WorkTeam* team) override;
+  static constexpr double NEARBY_TOLERANCE = 1e-6;
+  static constexpr int NEARBY_ITERATIONS = 40;
   [[nodiscard]] bool is_set_up() const override;
   [[nodiscard]] std::string_view name() const override { return "cholmod"; }
 

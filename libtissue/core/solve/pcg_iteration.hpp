@@ -109,6 +109,7 @@ SolveReport preconditioned_cg(const ShiftedSystem& system, const Eigen::VectorXd
   }
   const double threshold = tolerance * b_norm;
   report.relative_residual = r_norm / b_norm;
+  if (work.residual_history != nullptr) work.residual_history->push_back(report.relative_residual);
   if (r_norm <= threshold) {
     report.converged = true;
     return report;
@@ -149,6 +150,7 @@ SolveReport preconditioned_cg(const ShiftedSystem& system, const Eigen::VectorXd
     r_norm = std::sqrt(r_squared.total());
     report.iterations = k;
     report.relative_residual = r_norm / b_norm;
+    if (work.residual_history != nullptr) work.residual_history->push_back(report.relative_residual);
     if (r_norm <= threshold) {
       report.converged = true;
       break;

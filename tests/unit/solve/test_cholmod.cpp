@@ -10,6 +10,7 @@
 
 #include <Eigen/Dense>
 
+#include <cstdio>
 #include <limits>
 #include <random>
 #include <span>
@@ -33,6 +34,47 @@ void expect_matches_dense(CholmodSolver& solver, const test::TestSystem& system,
   const double true_residual = (b - system.dense(scale) * x).norm() / b.norm();
   EXPECT_NEAR(report.relative_residual, true_residual, 0.2 * true_residual + 1e-15);
   EXPECT_LE((x - expected).norm(), 1e-10 * expected.norm());
+}
+
+TEST(Cholmod, ANearbySetupIteratesWithTheFactorAndFactorizesWhenTooFar) {
+  // A Newton correction's matrix is the step's moved a little (setup_nearby): the solve iterates on
+  // it with the step's factor, to NEARBY_TOLERANCE, and so lands within that of the exact solution
+  // but not on it (it did not refactorize). A matrix far from the factor's (stiff random springs
+  // added along the grid's rows, the same pattern) is not reached in NEARBY_ITERATIONS, so the
+  // solver factorizes it and solves exactly.
+  std::mt19937 rng(5);
+  for (const bool far : {false, true}) {
+    test::TestSystem system = test::make_grid_system(5, 5, 5, 21);
+    const Eigen::VectorXd b = test::random_vector(system.shifted(1.0).rows(), rng);
+    CholmodSolver solver;
+    solver.setup(system.shifted(1.0));
+    const double scale = far ? 1.0 : 1.05;
+    if (far) {
+      for (int i = 0; i + 1 < system.stiffness.block_rows(); i += 2) {
+        if (i % 5 == 4) continue;  // the last vertex of a grid row has no neighbour i + 1
+        system.add_edge(i, i + 1, 1e4 * test::random_spd_block(rng, 0.1, 10.0));
+      }
+    }
+    solver.setup_nearby(system.shifted(scale));
+    Eigen::VectorXd x = Eigen::VectorXd::Zero(b.size());
+    const SolveReport report = solver.solve(b, x);
+    const Eigen::VectorXd exact = system.dense(scale).llt().solve(b);
+    const double true_residual = (b - system.dense(scale) * x).norm() / b.norm();
+    const double error = (x - exact).norm() / exact.norm();
+    std::printf("  %s: %d iterations, true residual %.2e, error %.2e\n", far ? "far" : "nearby", report.iterations,
+                true_residual, error);
+    EXPECT_TRUE(report.converged);
+    if (!far) {
+      EXPECT_GE(report.iterations, 1);
+      EXPECT_LE(true_residual, 2.0 * CholmodSolver::NEARBY_TOLERANCE);
+      EXPECT_GT(error, 1e-13);  // iterated, not refactorized
+      EXPECT_LE(error, 1e-4);
+    } else {
+      EXPECT_EQ(report.iterations, 0);  // the direct solve of a new factor: round-off only (the
+      EXPECT_LE(true_residual, 1e-9);   // stiff springs make A ill-conditioned)
+      EXPECT_LE(error, 1e-8);
+    }
+  }
 }
 
 TEST(Cholmod, AgreesWithDenseLlt) {

@@ -9,6 +9,7 @@
 #include <Eigen/Dense>
 
 #include <random>
+#include <vector>
 
 namespace tissue {
 namespace {
@@ -146,6 +147,41 @@ TEST(Pcg, FollowsTheSystemWhenItGrows) {
     EXPECT_TRUE(report.converged);
     EXPECT_LE((x - system->dense(1.0).llt().solve(b)).norm(), 1e-6 * x.norm());
   }
+}
+
+TEST(Pcg, RecordsTheResidualOfEveryIterate) {
+  // The history of one solve (tissue-convergence's plots): entry k is the relative residual of
+  // iterate k, which a solve capped at k iterations reports (CG from the same start is the same
+  // sequence); entry 0 is 1 from a zero start. And the lagged-factor solver records its own.
+  const test::TestSystem system = test::make_grid_system(5, 5, 5, 1);
+  const ShiftedSystem shifted = system.shifted(1.0);
+  std::mt19937 rng(4);
+  const Eigen::VectorXd b = test::random_vector(shifted.rows(), rng);
+  std::vector<double> history;
+  PcgSolver recorded({1e-10, 10000});
+  recorded.record_residuals(&history);
+  Eigen::VectorXd x = Eigen::VectorXd::Zero(shifted.rows());
+  const SolveReport full = recorded.solve(shifted, b, x);
+  ASSERT_EQ(history.size(), static_cast<size_t>(full.iterations) + 1);
+  EXPECT_EQ(history.front(), 1.0);
+  EXPECT_EQ(history.back(), full.relative_residual);
+  for (const int cap : {1, 5, 20}) {
+    PcgSolver capped({1e-10, cap});
+    x.setZero();
+    EXPECT_EQ(capped.solve(shifted, b, x).relative_residual, history[static_cast<size_t>(cap)]) << cap;
+  }
+  recorded.record_residuals(nullptr);  // stops recording
+  x.setZero();
+  recorded.solve(shifted, b, x);
+  EXPECT_EQ(history.size(), static_cast<size_t>(full.iterations) + 1);
+
+  std::vector<double> lagged_history;
+  CholeskyPcgSolver lagged({1e-10, 100}, CholeskyPcgSolver::Refresh{});
+  lagged.record_residuals(&lagged_history);
+  x.setZero();
+  const SolveReport lagged_report = lagged.solve(shifted, b, x);
+  ASSERT_EQ(lagged_history.size(), static_cast<size_t>(lagged_report.iterations) + 1);
+  EXPECT_EQ(lagged_history.back(), lagged_report.relative_residual);
 }
 
 TEST(ShiftedSystem, MultiplyIsScaledStiffnessPlusDiagonal) {
