@@ -1,5 +1,6 @@
 // tissue-bench: runs N backward-Euler steps of one mesh on one thread and prints one JSON object
 // with the sizes and the per-step timings (medians), for users and for scripts.
+#include "app_main.hpp"
 #include "run_statistics.hpp"
 #include "scene_options.hpp"
 
@@ -90,18 +91,5 @@ int main(int argc, char** argv) {
   CLI::App app{"tissue-bench: time backward-Euler steps of a co-rotational FEM mesh (one thread, JSON out)"};
   tissue::apps::SceneOptions options;
   tissue::apps::add_scene_options(app, options);
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::ParseError& error) {
-    return app.exit(error);
-  }
-  try {
-    return run(options);
-  } catch (const tissue::IntegrationError& error) {
-    std::cerr << "tissue-bench: step failed: " << error.what() << '\n';
-    return 1;
-  } catch (const std::exception& error) {
-    std::cerr << "tissue-bench: " << error.what() << '\n';
-    return 2;
-  }
+  return tissue::apps::parse_and_run(app, argc, argv, "tissue-bench", [&] { return run(options); });
 }

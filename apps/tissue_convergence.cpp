@@ -4,6 +4,7 @@
 // falls from rest under gravity with exact (CHOLMOD) steps; the measured solve is the one of the
 // step after --lag-steps. CSV out (preconditioner, iteration, relative residual), a summary with
 // the cost per iteration on stderr; tests/bench/solver_convergence.py plots it.
+#include "app_main.hpp"
 #include "scene_options.hpp"
 
 #include "core/fem/deformable_body.hpp"
@@ -17,6 +18,7 @@
 #include <iostream>
 #include <limits>
 #include <memory>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -75,6 +77,8 @@ void solve(Solver& solver, const StepSystem& step, Run& run, bool set_up) {
 }
 
 int run(const Options& options) {
+  std::ofstream csv(options.output);  // first: a file that cannot be written is said before the work
+  if (!csv) throw std::runtime_error("cannot write " + options.output);
   tissue::apps::Scene scene = tissue::apps::make_scene(options.scene);
   tissue::DeformableBody body(scene.mesh, scene.settings.body);
   const double h = options.scene.step_size_s;
@@ -108,7 +112,6 @@ int run(const Options& options) {
   tissue::CholeskyPcgSolver fresh(strict, never_refresh);
   solve(fresh, step, runs[2], true);
 
-  std::ofstream csv(options.output);
   csv << "preconditioner,iteration,relative_residual,ms_per_iteration,setup_ms\n";
   for (const Run& r : runs) {
     const double iterations = static_cast<double>(r.history.size() > 1 ? r.history.size() - 1 : 1);
@@ -119,10 +122,7 @@ int run(const Options& options) {
     std::fprintf(stderr, "  %-40s %5zu iterations to %.2e, %.3f ms per iteration, setup %.1f ms\n", r.name.c_str(),
                  r.history.size() - 1, r.history.back(), r.solve_ms / iterations, r.setup_ms);
   }
-  if (!csv) {
-    std::fprintf(stderr, "tissue-convergence: cannot write %s\n", options.output.c_str());
-    return 1;
-  }
+  if (!csv) throw std::runtime_error("cannot write " + options.output);
   std::fprintf(stderr, "  %d unknowns, %d tets; wrote %s\n", body.dof_count(), body.mesh().tet_count(),
                options.output.c_str());
   return 0;
@@ -145,15 +145,5 @@ int main(int argc, char** argv) {
       ->check(CLI::PositiveNumber)
       ->capture_default_str();
   app.add_option("-o,--output", options.output, "CSV file")->capture_default_str();
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::ParseError& error) {
-    return app.exit(error);
-  }
-  try {
-    return run(options);
-  } catch (const std::exception& error) {
-    std::fprintf(stderr, "tissue-convergence: %s\n", error.what());
-    return 1;
-  }
+  return tissue::apps::parse_and_run(app, argc, argv, "tissue-convergence", [&] { return run(options); });
 }

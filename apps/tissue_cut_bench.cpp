@@ -2,6 +2,7 @@
 // scripted scalpel strokes): the system before and after (size, enriched vertices, non-zeros,
 // median step time), the volume cutter's time and newly cut tets per cutting step, and the worst
 // step during the cuts against a normal step. Prints a JSON array.
+#include "app_main.hpp"
 #include "cut_scenarios.hpp"
 #include "run_statistics.hpp"
 #include "scene_options.hpp"
@@ -131,12 +132,7 @@ int main(int argc, char** argv) {
   app.add_option("--pinned-fraction", options.pinned_fraction, "of the z extent pinned at the bottom")
       ->check(CLI::Range(1e-6, 1.0));
   app.add_option("--only", options.only, "run only the scenario of this name");
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::ParseError& error) {
-    return app.exit(error);
-  }
-  try {
+  return tissue::apps::parse_and_run(app, argc, argv, "tissue-cut-bench", [&] {
     std::vector<tissue::apps::CutScenario> scenarios = tissue::apps::frog_cut_scenarios();
     if (!options.only.empty()) {
       std::erase_if(scenarios, [&](const auto& s) { return s.name != options.only; });
@@ -146,11 +142,5 @@ int main(int argc, char** argv) {
     for (size_t k = 0; k < scenarios.size(); ++k) run_scenario(options, scenarios[k], k + 1 == scenarios.size());
     std::printf("]\n");
     return 0;
-  } catch (const tissue::IntegrationError& error) {
-    std::cerr << "tissue-cut-bench: step failed: " << error.what() << '\n';
-    return 1;
-  } catch (const std::exception& error) {
-    std::cerr << "tissue-cut-bench: " << error.what() << '\n';
-    return 2;
-  }
+  });
 }

@@ -3,6 +3,7 @@
 // presses its back (god-object contact: force and contact stiffness printed), then a scalpel makes
 // the strokes of one of the cut scenarios (tissue-cut-bench's), and the pieces settle. Prints one
 // line per phase and every --print-every steps, and can write the final surface as OBJ.
+#include "app_main.hpp"
 #include "cut_scenarios.hpp"
 #include "run_statistics.hpp"
 #include "scene_options.hpp"
@@ -146,19 +147,8 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(1e-6, 1.0));
   app.add_option("--print-every", options.print_every, "Print one line every this many steps")->capture_default_str();
   app.add_option("--surface-obj", options.surface_obj, "Write the final surface as Wavefront OBJ to this file");
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::ParseError& error) {
-    return app.exit(error);
-  }
-  try {
+  return tissue::apps::parse_and_run(app, argc, argv, "tissue-demo", [&] {
     if (options.print_every < 1) throw tissue::ParameterError("--print-every must be >= 1");
     return run(options);
-  } catch (const tissue::IntegrationError& error) {
-    std::cerr << "tissue-demo: step failed: " << error.what() << '\n';
-    return 1;
-  } catch (const std::exception& error) {
-    std::cerr << "tissue-demo: " << error.what() << '\n';
-    return 2;
-  }
+  });
 }
