@@ -64,10 +64,10 @@ double ms_since(std::chrono::steady_clock::time_point start) {
 }
 
 template <class Solver>
-void solve(Solver& solver, const StepSystem& step, Run& run, bool set_up) {
+void solve(Solver& solver, const StepSystem& step, Run& run) {
   solver.record_residuals(&run.history);
   auto start = std::chrono::steady_clock::now();
-  if (set_up) solver.setup(step.system);
+  solver.setup(step.system);
   run.setup_ms = ms_since(start);
   Eigen::VectorXd x = Eigen::VectorXd::Zero(step.rhs.size());
   start = std::chrono::steady_clock::now();
@@ -105,12 +105,12 @@ int run(const Options& options) {
   std::vector<Run> runs(3);
   runs[0].name = "pcg (Jacobi)";
   tissue::PcgSolver jacobi(strict);
-  solve(jacobi, step, runs[0], true);
+  solve(jacobi, step, runs[0]);
   runs[1].name = "pcgCholesky, factor " + std::to_string(options.lag_steps) + " steps old";
-  solve(lagged, step, runs[1], true);  // keeps its factor: same pattern, no refresh asked for
+  solve(lagged, step, runs[1]);  // keeps its factor: same pattern, no refresh asked for
   runs[2].name = "pcgCholesky, factor of this step";
   tissue::CholeskyPcgSolver fresh(strict, never_refresh);
-  solve(fresh, step, runs[2], true);
+  solve(fresh, step, runs[2]);
 
   csv << "preconditioner,iteration,relative_residual,ms_per_iteration,setup_ms\n";
   for (const Run& r : runs) {

@@ -44,7 +44,7 @@ void CholmodSolver::lend_work_team(WorkTeam* team) { m_impl->team = team; }
 
 void CholmodSolver::setup(const ShiftedSystem& system) {
   Impl& impl = *m_impl;
-  impl.factored_system = ShiftedSystem{nullptr, 1.0, nullptr};
+  impl.factored_system = ShiftedSystem{nullptr, 1.0, nullptr};  // no factor if the check throws
   impl.nearby_system = ShiftedSystem{nullptr, 1.0, nullptr};
   system.check("CholmodSolver");
   impl.factorize(system);
