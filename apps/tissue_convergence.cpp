@@ -1,6 +1,7 @@
-// tissue-convergence: how the step's CG solve converges, iteration by iteration, under the two
-// preconditioners a real-time setting can use: Jacobi (pcg) and the lagged Cholesky factor
-// (pcgCholesky) made --lag-steps steps earlier, beside a factor of the step's own matrix. The body
+// tissue-convergence: how the step's CG solve converges, iteration by iteration, under the
+// preconditioners a real-time setting can use: Jacobi (pcg), the lagged Cholesky factor
+// (pcgCholesky) made --lag-steps steps earlier, beside a factor of the step's own matrix, and the
+// two-level one (pcgTwoLevel). The body
 // falls from rest under gravity with exact (CHOLMOD) steps; the measured solve is the one of the
 // step after --lag-steps. CSV out (preconditioner, iteration, relative residual), a summary with
 // the cost per iteration on stderr; tests/bench/solver_convergence.py plots it.
@@ -49,7 +50,8 @@ struct StepSystem {
                body.mass_damping_kg_per_s().cwiseProduct(state.velocity_m_per_s) -
                (body.stiffness_damping_s() + h) * stiffness_times_velocity);
     diagonal = body.mass_kg() + h * body.mass_damping_kg_per_s();
-    system = ShiftedSystem{&body.tangent(), h * body.stiffness_damping_s() + h * h, &diagonal};
+    system = ShiftedSystem{&body.tangent(), h * body.stiffness_damping_s() + h * h, &diagonal, nullptr,
+                           body.block_positions(state.displacement_m)};
   }
 };
 
@@ -102,7 +104,7 @@ int run(const Options& options) {
   std::fprintf(stderr, "\n");
   const StepSystem step(body, state, h);
 
-  std::vector<Run> runs(3);
+  std::vector<Run> runs(4);
   runs[0].name = "pcg (Jacobi)";
   tissue::PcgSolver jacobi(strict);
   solve(jacobi, step, runs[0]);
@@ -111,6 +113,9 @@ int run(const Options& options) {
   runs[2].name = "pcgCholesky, factor of this step";
   tissue::CholeskyPcgSolver fresh(strict, never_refresh);
   solve(fresh, step, runs[2]);
+  runs[3].name = "pcgTwoLevel (Jacobi + rigid aggregates)";
+  tissue::TwoLevelPcgSolver two_level(strict);
+  solve(two_level, step, runs[3]);
 
   csv << "preconditioner,iteration,relative_residual,ms_per_iteration,setup_ms\n";
   for (const Run& r : runs) {

@@ -229,14 +229,15 @@ CompareSettingsList default_settings() {
                                          number("integrator.idaRelativeTolerance", relative_tolerance)};
   };
   list.settings = {
-      // The real-time default (Jacobi PCG capped at 10 iterations) and its relatives, then the
-      // converged real-time setting of issue 40 (CG on the lagged Cholesky factor, warm-started).
+      // The real-time default (issue 40: the two-level preconditioner, capped at 10 iterations, one
+      // Newton correction), the default before it (Jacobi PCG capped at 10, up to 5 corrections),
+      // Jacobi PCG converged, CG on the lagged Cholesky factor (warm-started, converged).
+      setting("be-pcgTwoLevel-tol1e-3-cap10",
+              be({text("integrator.linearSolver", "pcgTwoLevel"), number("integrator.pcgTolerance", 1e-3),
+                  integer("integrator.pcgMaxIterations", 10), integer("integrator.newtonMaxIterations", 1)})),
       setting("be-pcg-tol1e-3-cap10",
               be({text("integrator.linearSolver", "pcg"), number("integrator.pcgTolerance", 1e-3),
-                  integer("integrator.pcgMaxIterations", 10)})),
-      setting("be-pcg-tol1e-3-cap50",
-              be({text("integrator.linearSolver", "pcg"), number("integrator.pcgTolerance", 1e-3),
-                  integer("integrator.pcgMaxIterations", 50)})),
+                  integer("integrator.pcgMaxIterations", 10), integer("integrator.newtonMaxIterations", 5)})),
       setting("be-pcg-tol1e-6-cap1000",
               be({text("integrator.linearSolver", "pcg"), number("integrator.pcgTolerance", 1e-6),
                   integer("integrator.pcgMaxIterations", 1000)})),
@@ -375,7 +376,7 @@ SettingDescription describe_setting(const std::vector<ParameterSetting>& paramet
     d.tolerance = value_number(parameters, "integrator.idaRelativeTolerance", tissue);
   } else {
     d.linear_solver = value_text(parameters, "integrator.linearSolver", tissue).value_or("pcg");
-    if (d.linear_solver == "pcg" || d.linear_solver == "pcgCholesky") {
+    if (d.linear_solver != "cholmod") {  // every other backward-Euler solver is CG with a tolerance and a cap
       d.tolerance = value_number(parameters, "integrator.pcgTolerance", tissue);
       if (const std::optional<double> cap = value_number(parameters, "integrator.pcgMaxIterations", tissue)) {
         d.iteration_cap = static_cast<std::int64_t>(*cap);

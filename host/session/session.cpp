@@ -330,9 +330,24 @@ class Session final : public SessionSteps {
       SurfaceFrame frame;
       m_next_frame_s = 0.0;
       capture_frame(frame, m_summary.sim_time_s);
-      render_png(dir / "final.png", frame);
+      render_png(dir / "final.png", frame, operating_field());
     }
     std::ofstream(dir / "summary.json") << m_summary.to_json();
+  }
+
+  // The picture's camera frames the body's rest box grown by half its size on every side (the
+  // operating field), not all of the surface: a piece cut free falls out of the picture, as out of
+  // a fixed camera's, instead of shrinking the body to a speck (issue 40: freed pieces now fall).
+  [[nodiscard]] RenderSettings operating_field() const {
+    RenderSettings settings;
+    std::array<double, 6> box{};
+    for (size_t axis = 0; axis < 3; ++axis) {
+      const double half = 0.5 * (m_tissue.rest_upper()[axis] - m_tissue.rest_lower()[axis]);
+      box[axis] = m_tissue.rest_lower()[axis] - half;
+      box[3 + axis] = m_tissue.rest_upper()[axis] + half;
+    }
+    settings.fit_box_m = box;
+    return settings;
   }
 
   const Scenario& m_scenario;

@@ -121,13 +121,16 @@ constexpr auto integrator_settings() {
   return std::to_array<SettingInfo>({
       Setting("integrator.linearSolver", 10, enumeration)
           .python("linear_solver")
-          .start("pcg")
+          .start("pcgTwoLevel")
           .items("LinearSolver", "Linear solver of the backward-Euler step", LINEAR_SOLVER_NAMES.all())
-          .describe("Linear solver of the backward-Euler step. pcg capped at 10 iterations (the default) "
-                    "leaves the slow motions unconverged: a piece cut free sinks in slow motion, a cantilever "
-                    "swings at a third of its frequency. pcgCholesky (CG preconditioned by a lagged Cholesky "
-                    "factor) with pcgTolerance 1e-5, pcgMaxIterations 25 and warmStart follows the exact "
-                    "solve to 1e-5, at 2-10x the frog's step cost (docs/BENCHMARKS.md, issue 40)")
+          .core_default("the core's solver is Jacobi PCG (pcg) to its tolerance unless a caller picks one")
+          .describe("Linear solver of the backward-Euler step. pcgTwoLevel (the default; issue 40) adds to Jacobi an "
+                    "exact solve on the rigid motions of small aggregates of vertices, so that the slow motions "
+                    "converge within the 10-iteration cap: a piece cut free falls, a cantilever sags and swings, a "
+                    "held probe's force is steady, as with exact solves. pcg (Jacobi alone, the default before) "
+                    "capped at 10 iterations leaves them unconverged: a freed piece sinks in slow motion, a "
+                    "cantilever swings at a third of its frequency. pcgCholesky (CG preconditioned by a lagged "
+                    "Cholesky factor) converges too, at a large factorization per cut (docs/BENCHMARKS.md)")
           .member(TISSUE_ENUM_MEMBER(settings.solver.kind)),
       Setting("integrator.pcgTolerance", 11, real)
           .python("pcg_tolerance")
@@ -173,6 +176,17 @@ constexpr auto integrator_settings() {
           .describe("Threads of a backward-Euler step: 2 lets a step run a second thread for its own duration "
                     "(made and joined by each step); the results are bitwise the same as with 1")
           .member(TISSUE_MEMBER(settings.integrator.threads)),
+      Setting("integrator.newtonMaxIterations", 86, integer)
+          .python("newton_max_iterations")
+          .start("1")
+          .at_least("1")
+          .at_most("100")
+          .core_default("the core takes up to 5 corrections unless a caller bounds them for a real-time slot")
+          .describe("Backward Euler: Newton corrections at most in a step whose linearized solve turns some element "
+                    "further than 0.05 rad (each halved until the step's incremental potential falls; the energy "
+                    "guard still keeps the step from gaining energy). 1 (the default) bounds a tumbling piece's step "
+                    "to about twice a plain one; more converge the turn further at a solve each")
+          .member(TISSUE_MEMBER(settings.integrator.newton.max_iterations)),
       Setting("integrator.method", 70, enumeration)
           .python("integrator")
           .start("backwardEuler")

@@ -208,7 +208,8 @@ def test_the_keywords_are_the_settings_schemas_with_the_fmus_defaults():
     doc = tissue.Tissue.__init__.__doc__
     # Every Tissue FMU setting Python sets, with the FMU's default (docs/FMU_VARIABLES.md).
     for keyword in ("pcg_max_iterations=10", "gravity_m_per_s2=0 0 -9.81", "fixed_axis=2", "fixed_fraction=0.25",
-                    "linear_solver=pcg (pcg, cholmod or pcgCholesky)", "ida_relative_tolerance=0.0001",
+                    "linear_solver=pcgTwoLevel (pcg, cholmod, pcgCholesky or pcgTwoLevel)",
+                    "newton_max_iterations=1", "ida_relative_tolerance=0.0001",
                     "contact_stiffness_in_background=false", "max_tool_speed_m_per_s=5"):
         assert keyword in doc, keyword
     # A setting Python did not have by hand before the schema reaches the core.

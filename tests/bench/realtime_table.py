@@ -5,6 +5,11 @@ Markdown table with the machine. Real time needs the cores to itself: run nothin
 (as root the host's threads get SCHED_FIFO).
 
 Usage: tests/bench/realtime_table.py [--host build/release/host/tissue-host] [--runs 5] [--only NAME,NAME]
+                                    [--set PARAMETER=VALUE ...] [--alternate PARAMETER=VALUE ...]
+--set overrides Tissue parameters in every scenario (e.g. the default before issue 40:
+--set integrator.linearSolver=pcg --set integrator.newtonMaxIterations=5); --alternate runs each
+scenario's runs twice over, interleaved, without and with these overrides, and prints both tables
+(the same machine state for both: the way to compare two settings on a shared machine).
 A scenario driven by the browser's mouse runs 5 s with the live view up and no one at it.
 Uses only the Python standard library.
 """
@@ -25,29 +30,79 @@ def main():
     parser.add_argument("--host", default=str(ROOT / "build" / "release" / "host" / "tissue-host"))
     parser.add_argument("--runs", type=int, default=5)
     parser.add_argument("--only", default="", help="only these scenarios (comma-separated parts of file names)")
+    parser.add_argument("--set", action="append", default=[], metavar="PARAMETER=VALUE",
+                        help="a Tissue parameter set in every scenario")
+    parser.add_argument("--alternate", action="append", default=[], metavar="PARAMETER=VALUE",
+                        help="also run every scenario with these, interleaved run by run, and print both tables")
     args = parser.parse_args()
     wanted = args.only.split(",")
-    scenarios = sorted(p for p in (ROOT / "host" / "scenarios").glob("*.toml") if any(w in p.stem for w in wanted))
-    rows = []
+    scenarios = sorted(p for p in (ROOT / "host" / "scenarios").glob("*.toml")
+                       if not p.name.startswith(".") and any(w in p.stem for w in wanted))
+    variants = [("", args.set)] + ([("with " + " ".join(args.alternate), args.set + args.alternate)] if args.alternate else [])
+    rows = {label: [] for label, _ in variants}
     for scenario in scenarios:
-        runs = []
+        runs = {label: [] for label, _ in variants}
         for k in range(args.runs):
-            with tempfile.TemporaryDirectory(prefix="tissue-rt-") as out:
-                command = [args.host, "run", str(scenario), "-o", out, "-q"]
-                if 'kind = "browser"' in scenario.read_text():
-                    command += ["--mouse", "--duration", "5"]  # the live view's mouse, no one at it: 5 s idle
-                if 'kind = "openigtlink"' in scenario.read_text():
-                    command += ["--duration", "5"]  # the OpenIGTLink server, no client: 5 s idle
-                subprocess.run(command, check=True, capture_output=True, text=True)
-                runs.append(json.loads((pathlib.Path(out) / "summary.json").read_text()))
-            r = runs[-1]
-            print("  %s run %d/%d: overruns %d, misses %d of %d, step p99 %.2f ms, SCHED_FIFO %s"
-                  % (scenario.stem, k + 1, args.runs, r["tissue_overruns"], r["deadline_misses"], r["haptic_ticks"],
-                     r["tissue_step_ms"]["p99"], r["realtime_priority"]), file=sys.stderr)
-        rows.append((scenario.stem, runs))
+            for label, overrides in variants:
+                runs[label].append(run_once(args.host, scenario, overrides))
+                r = runs[label][-1]
+                print("  %s%s run %d/%d: overruns %d, misses %d of %d, step p99 %.2f ms, SCHED_FIFO %s"
+                      % (scenario.stem, " (" + label + ")" if label else "", k + 1, args.runs, r["tissue_overruns"],
+                         r["deadline_misses"], r["haptic_ticks"], r["tissue_step_ms"]["p99"], r["realtime_priority"]),
+                      file=sys.stderr)
+        for label, _ in variants:
+            rows[label].append((scenario.stem, runs[label]))
 
     print("Machine: %d cores (`nproc`); %d real-time runs of each scenario (`tissue-host run`, not offline); "
-          "figures per run, listed run by run where they differ.\n" % (os.cpu_count(), args.runs))
+          "figures per run, listed run by run where they differ.%s\n"
+          % (os.cpu_count(), args.runs, " Parameters set: " + " ".join(args.set) + "." if args.set else ""))
+    for label, _ in variants:
+        if label:
+            print("\n%s (runs interleaved with the table above):\n" % label)
+        print_table(rows[label])
+
+
+def toml_value(text):
+    """A parameter's value as TOML: numbers and booleans as they are, anything else quoted."""
+    if text in ("true", "false"):
+        return text
+    try:
+        float(text)
+        return text
+    except ValueError:
+        return json.dumps(text)
+
+
+def run_once(host, scenario, overrides):
+    """One real-time run of `scenario` with Tissue parameters `overrides` (PARAMETER=VALUE); its summary."""
+    source = scenario
+    if overrides:  # a copy beside the original, so that its relative paths still hold
+        lines = scenario.read_text().splitlines()
+        names = [o.split("=", 1)[0] for o in overrides]
+        lines = [l for l in lines if not any(l.strip().startswith('"%s"' % n) for n in names)]
+        if "[tissue.parameters]" not in lines:
+            lines.append("[tissue.parameters]")
+        at = lines.index("[tissue.parameters]") + 1
+        for o in overrides:
+            name, value = o.split("=", 1)
+            lines.insert(at, '"%s" = %s' % (name, toml_value(value)))
+        source = scenario.with_name(".realtime-table-" + scenario.name)
+        source.write_text("\n".join(lines) + "\n")
+    try:
+        with tempfile.TemporaryDirectory(prefix="tissue-rt-") as out:
+            command = [host, "run", str(source), "-o", out, "-q"]
+            if 'kind = "browser"' in scenario.read_text():
+                command += ["--mouse", "--duration", "5"]  # the live view's mouse, no one at it: 5 s idle
+            if 'kind = "openigtlink"' in scenario.read_text():
+                command += ["--duration", "5"]  # the OpenIGTLink server, no client: 5 s idle
+            subprocess.run(command, check=True, capture_output=True, text=True)
+            return json.loads((pathlib.Path(out) / "summary.json").read_text())
+    finally:
+        if source != scenario:
+            source.unlink()
+
+
+def print_table(rows):
     print("| scenario | tissue overruns | haptic misses (of ticks) | misses % | tissue step p50 / p99 / max (ms), "
           "median run | cut steps p50 / before the cut p50 |")
     print("|---|---|---|---:|---|---|")

@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
 """The relative residual per CG iteration of a step's solve on the organ (and the frog), Jacobi
-against the lagged Cholesky factor: runs build/release/apps/tissue-convergence and plots
+against the lagged Cholesky factor and the two-level preconditioner (the default since issue 40): runs build/release/apps/tissue-convergence and plots
 docs/solver_convergence.png (residual per iteration and per millisecond). Needs Debian's
 python3-matplotlib. Usage: tests/bench/solver_convergence.py [--lag-steps N] [--out PNG]."""
 import argparse
@@ -60,7 +60,7 @@ def main():
             ax.set_ylabel("relative residual |r| / |b|")
             ax.set_title(mesh)
         axes[row][0].axvline(10, color="red", lw=0.8, ls="--")
-        axes[row][0].text(11, 0.5, "old default: 10 iterations", color="red", fontsize=8)
+        axes[row][0].text(11, 0.5, "real-time cap: 10 iterations", color="red", fontsize=8)
         axes[row][0].set_xlabel("CG iteration")
         axes[row][0].set_xscale("symlog", linthresh=10)
         axes[row][1].set_xlabel("solve time [ms] (one core, setup not counted)")
@@ -69,7 +69,7 @@ def main():
             ax.set_xlim(left=0)
         axes[row][1].legend(fontsize=8)
     figure.suptitle("A backward-Euler step's solve (10 ms step, %d steps of fall from rest): "
-                    "Jacobi PCG against the lagged Cholesky factor" % options.lag_steps)
+                    "Jacobi, the lagged Cholesky factor, the two-level preconditioner" % options.lag_steps)
     figure.tight_layout()
     figure.savefig(options.out, dpi=90)
     print("wrote", options.out)

@@ -229,7 +229,7 @@ TEST(Recommendation, SaysWhenNoSettingQualifies) {
 // A Tissue-like description: the PCG/CHOLMOD parameters, and with_ida also integrator.method.
 ModelDescription tissue_like(bool with_ida) {
   const std::string types = R"(<TypeDefinitions>
-    <EnumerationType name="LinearSolver"><Item name="pcg" value="1"/><Item name="cholmod" value="2"/><Item name="pcgCholesky" value="3"/></EnumerationType>
+    <EnumerationType name="LinearSolver"><Item name="pcg" value="1"/><Item name="cholmod" value="2"/><Item name="pcgCholesky" value="3"/><Item name="pcgTwoLevel" value="4"/></EnumerationType>
     <EnumerationType name="Integrator"><Item name="backwardEuler" value="1"/><Item name="ida" value="2"/></EnumerationType>
     <EnumerationType name="IdaLinearSolver"><Item name="klu" value="1"/><Item name="krylov" value="2"/></EnumerationType>
   </TypeDefinitions>)";
@@ -238,6 +238,7 @@ ModelDescription tissue_like(bool with_ida) {
     <Float64 name="integrator.pcgTolerance" valueReference="11" causality="parameter" variability="fixed" start="0.001"/>
     <Int32 name="integrator.pcgMaxIterations" valueReference="12" causality="parameter" variability="fixed" start="10"/>
     <Boolean name="integrator.warmStart" valueReference="13" causality="parameter" variability="fixed" start="false"/>
+    <Int32 name="integrator.newtonMaxIterations" valueReference="86" causality="parameter" variability="fixed" start="1"/>
     <Float64 name="stepSize" valueReference="14" causality="parameter" variability="fixed" start="0.001"/>
     <Float64 name="contact.force" valueReference="43" causality="output" variability="continuous"/>)";
   if (with_ida) {
@@ -263,7 +264,7 @@ TEST(CompareSettings, TheDefaultListAndSteps) {
   std::vector<std::string> names;
   for (const CompareSetting& s : list.settings) names.push_back(s.name);
   EXPECT_EQ(names,
-            (std::vector<std::string>{"be-pcg-tol1e-3-cap10", "be-pcg-tol1e-3-cap50", "be-pcg-tol1e-6-cap1000",
+            (std::vector<std::string>{"be-pcgTwoLevel-tol1e-3-cap10", "be-pcg-tol1e-3-cap10", "be-pcg-tol1e-6-cap1000",
                                       "be-pcgCholesky-tol1e-5-cap25", "be-cholmod", "ida-klu-rtol1e-3",
                                       "ida-klu-rtol1e-5", "ida-krylov-rtol1e-3"}));
   EXPECT_EQ(default_steps(0.01), (std::vector<double>{0.001, 0.01}));
@@ -284,7 +285,7 @@ TEST(CompareSettings, WithIdaEveryRunIsPlannedAndTheReferenceIsIda) {
   EXPECT_EQ(reference.linear_solver, "klu");
   EXPECT_EQ(reference.tolerance, 1e-7);
   for (const RunSpec& run : runs) EXPECT_TRUE(run.skipped.empty()) << run.setting << ": " << run.skipped;
-  EXPECT_EQ(runs[1].setting, "be-pcg-tol1e-3-cap10");
+  EXPECT_EQ(runs[1].setting, "be-pcgTwoLevel-tol1e-3-cap10");
   EXPECT_EQ(runs[1].step_s, 0.001);
   EXPECT_EQ(runs[2].step_s, 0.01);
   const SettingDescription lagged = describe_setting(runs[7].parameters, tissue_like(true));

@@ -160,7 +160,7 @@ TEST(CompareRuns, TheDefaultListOnTheBeam) {
     EXPECT_EQ(number(rows[0], column), 0.0) << column;
   }
   EXPECT_EQ(rows[0].at("pareto"), "0");
-  const std::vector<std::string> settings{"be-pcg-tol1e-3-cap10",         "be-pcg-tol1e-3-cap50",
+  const std::vector<std::string> settings{"be-pcgTwoLevel-tol1e-3-cap10", "be-pcg-tol1e-3-cap10",
                                           "be-pcg-tol1e-6-cap1000",       "be-pcgCholesky-tol1e-5-cap25",
                                           "be-cholmod",                   "ida-klu-rtol1e-3",
                                           "ida-klu-rtol1e-5",             "ida-krylov-rtol1e-3"};
@@ -186,7 +186,7 @@ TEST(CompareRuns, TheDefaultListOnTheBeam) {
   }
   EXPECT_GE(on_front, 2);
   EXPECT_EQ(rows[1].at("integrator"), "backwardEuler");
-  EXPECT_EQ(rows[1].at("linear_solver"), "pcg");
+  EXPECT_EQ(rows[1].at("linear_solver"), "pcgTwoLevel");
   EXPECT_EQ(rows[1].at("iteration_cap"), "10");
   EXPECT_EQ(std::stod(rows[1].at("tolerance")), 1e-3);
   EXPECT_EQ(rows[7].at("linear_solver"), "pcgCholesky");
@@ -200,8 +200,11 @@ TEST(CompareRuns, TheDefaultListOnTheBeam) {
   EXPECT_LT(rms("be-cholmod", "0.001"), 0.5 * rms("be-cholmod", "0.01"));
   // Ten PCG iterations do not solve the 10 ms step: further off than the exact solve.
   EXPECT_GT(rms("be-pcg-tol1e-3-cap10", "0.01"), 1.5 * rms("be-cholmod", "0.01"));
-  // A converged PCG solves the same equations as CHOLMOD; so does the converged real-time setting
-  // (issue 40) at the real-time step, where the ten Jacobi iterations above do not.
+  // The default's ten two-level iterations do (issue 40): the slow motions converge.
+  std::printf("rms error at 10 ms: two-level %.4g m, Jacobi %.4g m, CHOLMOD %.4g m\n",
+              rms("be-pcgTwoLevel-tol1e-3-cap10", "0.01"), rms("be-pcg-tol1e-3-cap10", "0.01"), rms("be-cholmod", "0.01"));
+  EXPECT_NEAR(rms("be-pcgTwoLevel-tol1e-3-cap10", "0.01"), rms("be-cholmod", "0.01"), 0.05 * rms("be-cholmod", "0.01"));
+  // A converged PCG solves the same equations as CHOLMOD; so does CG on the lagged factor at 1e-5.
   EXPECT_NEAR(rms("be-pcg-tol1e-6-cap1000", "0.001"), rms("be-cholmod", "0.001"), 1e-3 * rms("be-cholmod", "0.001"));
   EXPECT_NEAR(rms("be-pcgCholesky-tol1e-5-cap25", "0.01"), rms("be-cholmod", "0.01"), 1e-3 * rms("be-cholmod", "0.01"));
   // IDA's error control: a tighter tolerance is closer to the (tighter still) reference.

@@ -201,7 +201,10 @@ TEST(ScenarioFile, TheSlicerScenarioListensForOpenIgtlinkInMillimetres) {
   EXPECT_EQ(scenario.openigtlink->probe_transform, "ProbeToTissue");
 }
 
-TEST(RenderSurface, TheCompleteCutDrawsTheFrogClosedInEveryFrameAndInTwoPiecesAtTheEnd) {
+// Whether the stroke separates the sagging frog is issue 41's: under the converged defaults (issue
+// 40) the front sags as the blade passes and hangs by the last uncut tets at the back, as it does
+// with exact solves; the Jacobi step of before left the body nearly still, so it fell in two.
+TEST(RenderSurface, TheCompleteCutDrawsTheFrogClosedInEveryFrame) {
   const Scenario scenario = load_scenario(SCENARIOS / "cut_frog_complete.toml");
   const std::filesystem::path dir = fresh_dir("render_complete");
   const SessionSummary s = run_offline(scenario, dir);
@@ -216,8 +219,7 @@ TEST(RenderSurface, TheCompleteCutDrawsTheFrogClosedInEveryFrameAndInTwoPiecesAt
     EXPECT_EQ(shape.repeated, 0u) << frame.filename();
   }
   const std::vector<std::uint32_t> triangles = vtu_triangles(frames.back());
-  EXPECT_GT(triangles.size(), 3u * 23240u);
-  EXPECT_EQ(shape_of(triangles).pieces, 2);
+  EXPECT_GT(triangles.size(), 3u * 23240u);  // the uncut frog's triangles and the cut faces'
 
   // What is drawn changes nothing else: with the tet skin the session's log (tool, forces, tissue
   // state per tick) is the same bytes. (The scripted path once followed the drawn surface's box.)

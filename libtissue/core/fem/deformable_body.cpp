@@ -189,6 +189,17 @@ const std::vector<Eigen::Matrix3d>* DeformableBody::block_frames() const {
   return &m_block_frames;
 }
 
+const std::vector<Eigen::Vector3d>* DeformableBody::block_positions(const Eigen::VectorXd& displacement_m) const {
+  m_block_positions.resize(static_cast<size_t>(m_tangent.block_rows()));
+  const auto moved = [&](int row, int vertex) {
+    m_block_positions[static_cast<size_t>(row)] =
+        m_mesh.rest_positions_m[static_cast<size_t>(vertex)] + displacement_m.segment<3>(3L * row);
+  };
+  for (int row = 0; row < m_dofs.free_vertex_count(); ++row) moved(row, m_dofs.row_vertex[static_cast<size_t>(row)]);
+  for (const EnrichedDof& dof : m_enriched_dofs) moved(dof.row, dof.vertex);
+  return &m_block_positions;
+}
+
 double DeformableBody::largest_turn_rad(const Eigen::VectorXd& increment_m, double resolution_rad) const {
   if (increment_m.size() != dof_count()) {
     throw std::invalid_argument("largest_turn_rad: the increment has " + std::to_string(increment_m.size()) +

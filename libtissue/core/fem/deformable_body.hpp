@@ -103,6 +103,8 @@ class DeformableBody final : public DynamicsModel {
   /// A vertex's frame is the rotation nearest the sum of the rotations of its tets not modelled by
   /// XFEM (identity if it has none); an enriched unknown takes its vertex's. O(tets), on request.
   [[nodiscard]] const std::vector<Eigen::Matrix3d>* block_frames() const override;
+  /// A free vertex's row: X + u; an enriched unknown's: its vertex's X plus the unknown. O(unknowns).
+  [[nodiscard]] const std::vector<Eigen::Vector3d>* block_positions(const Eigen::VectorXd& displacement_m) const override;
   /// First a bound, O(unknowns): no element (or cut part) turns further than 12 max|block of the
   /// increment| max|grad(phi)|; past `resolution_rad`, each tet and part: |axial(skew(R^T G))| with
   /// G the gradient of the increment and R its rotation at the last evaluate().
@@ -316,6 +318,7 @@ class DeformableBody final : public DynamicsModel {
   std::vector<ForceTerm*> m_force_terms;                // attached, not owned
   WorkTeam* m_team = nullptr;                           // lent for a step (lend_work_team)
   mutable std::vector<Eigen::Matrix3d> m_block_frames;  // block_frames(): made on request
+  mutable std::vector<Eigen::Vector3d> m_block_positions;  // block_positions(): made on request
   mutable std::vector<Eigen::Matrix3d> m_vertex_frames;
   mutable std::vector<int> m_vertex_first_tet;
 };

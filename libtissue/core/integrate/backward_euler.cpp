@@ -80,11 +80,12 @@ BackwardEuler::BackwardEuler(std::unique_ptr<LinearSolver> solver, Settings sett
 
 // (1 + h alpha) M + (h beta + h^2) K at the model's current tangent: the matrix of the step and of
 // its Newton corrections.
-ShiftedSystem BackwardEuler::step_system(const DynamicsModel& model, double h) {
+ShiftedSystem BackwardEuler::step_system(const DynamicsModel& model, double h, const Eigen::VectorXd& displacement_m) {
   m_system_diagonal.resize(model.dof_count());
   m_system_diagonal.noalias() = model.mass_kg() + h * model.mass_damping_kg_per_s();
   return ShiftedSystem{&model.tangent(), h * model.stiffness_damping_s() + h * h, &m_system_diagonal,
-                       m_solver->follows_block_frames() ? model.block_frames() : nullptr};
+                       m_solver->follows_block_frames() ? model.block_frames() : nullptr,
+                       m_solver->uses_block_positions() ? model.block_positions(displacement_m) : nullptr};
 }
 
 StepReport BackwardEuler::step(DynamicsModel& model, DynamicState& state, double step_size_s) {
@@ -113,7 +114,7 @@ StepReport BackwardEuler::step(DynamicsModel& model, DynamicState& state, double
   m_rhs.noalias() = h * (model.external_force_n() - m_internal_force_n -
                          model.mass_damping_kg_per_s().cwiseProduct(state.velocity_m_per_s) -
                          (model.stiffness_damping_s() + h) * m_stiffness_times_velocity);
-  const ShiftedSystem system = step_system(model, h);
+  const ShiftedSystem system = step_system(model, h, state.displacement_m);
   report.assembly_s = seconds_since(assembly_start);
 
   const auto solve_start = std::chrono::steady_clock::now();
@@ -205,7 +206,7 @@ void BackwardEuler::correct(DynamicsModel& model, const DynamicState& state, dou
                            model.mass_damping_kg_per_s().cwiseProduct(m_end_velocity) -
                            model.stiffness_damping_s() * m_stiffness_times_velocity) -
                       mass.cwiseProduct(m_end_velocity - state.velocity_m_per_s);
-    const ShiftedSystem system = step_system(model, h);
+    const ShiftedSystem system = step_system(model, h, m_end_displacement);
     report.assembly_s += seconds_since(assembly_start);
 
     const auto solve_start = std::chrono::steady_clock::now();
@@ -226,6 +227,7 @@ void BackwardEuler::correct(DynamicsModel& model, const DynamicState& state, dou
       m_correction *= share;
     }
     m_end_velocity += m_correction;
+    if (iteration + 1 == m_settings.newton.max_iterations) break;  // no later iteration to stop
     m_end_displacement.noalias() = h * m_correction;
     const double converged_rad = 0.01 * m_settings.newton.trigger_angle_rad;
     if (model.largest_turn_rad(m_end_displacement, converged_rad) <= converged_rad) break;

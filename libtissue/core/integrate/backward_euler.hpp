@@ -74,7 +74,7 @@ class BackwardEuler final : public Integrator {
 
  private:
   void correct(DynamicsModel& model, const DynamicState& state, double h, StepReport& report, WorkTeam* team);
-  ShiftedSystem step_system(const DynamicsModel& model, double h);
+  ShiftedSystem step_system(const DynamicsModel& model, double h, const Eigen::VectorXd& displacement_m);
   // Scales v1 (m_end_velocity) so that the step's energy does not rise; true if it did.
   bool guard_energy(DynamicsModel& model, const DynamicState& state, double h);
   // The step's incremental potential at v1 (backward_euler.cpp); `stiffness` is the damping's K.

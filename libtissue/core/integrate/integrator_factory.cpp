@@ -31,6 +31,8 @@ std::unique_ptr<LinearSolver> make_linear_solver(const SolverSettings& settings)
       return std::make_unique<CholmodSolver>();
     case LinearSolverKind::pcg_cholesky:
       return std::make_unique<CholeskyPcgSolver>(settings.pcg, settings.refresh);
+    case LinearSolverKind::pcg_two_level:
+      return std::make_unique<TwoLevelPcgSolver>(settings.pcg);
   }
   throw ParameterError("unknown linear solver kind");
 }

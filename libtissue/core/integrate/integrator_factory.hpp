@@ -13,25 +13,29 @@
 
 namespace tissue {
 
-enum class LinearSolverKind { pcg, cholmod, pcg_cholesky };
+enum class LinearSolverKind { pcg, cholmod, pcg_cholesky, pcg_two_level };
 
-inline constexpr ItemNames<LinearSolverKind, 3> LINEAR_SOLVER_NAMES{
+inline constexpr ItemNames<LinearSolverKind, 4> LINEAR_SOLVER_NAMES{
     "linear solver",
     {{{"pcg", "Jacobi-preconditioned conjugate gradients (iterative; integrator.pcgTolerance, "
               "integrator.pcgMaxIterations)"},
       {"cholmod", "Sparse Cholesky factorization (CHOLMOD, direct, exact)"},
       {"pcgCholesky",
        "CG preconditioned by a lagged CHOLMOD factor, refactorized when the iterations grow or a cut changes the "
-       "pattern; in the FMU without a worker thread (integrator.pcgTolerance, integrator.pcgMaxIterations)"}}}};
+       "pattern; in the FMU without a worker thread (integrator.pcgTolerance, integrator.pcgMaxIterations)"},
+      {"pcgTwoLevel",
+       "CG preconditioned by Jacobi plus an exact solve on the rigid motions of small aggregates of vertices (a "
+       "two-level method: the slow motions converge in every iteration, no large factorization) "
+       "(integrator.pcgTolerance, integrator.pcgMaxIterations)"}}}};
 
-/// Parses "pcg" / "cholmod" / "pcgCholesky" (LINEAR_SOLVER_NAMES); throws ParameterError otherwise.
+/// Parses "pcg" / "cholmod" / "pcgCholesky" / "pcgTwoLevel" (LINEAR_SOLVER_NAMES); throws ParameterError otherwise.
 LinearSolverKind parse_linear_solver_kind(std::string_view name);
 [[nodiscard]] std::string_view to_string(LinearSolverKind kind);
 
 /// Backward Euler's linear solver.
 struct SolverSettings {
   LinearSolverKind kind = LinearSolverKind::pcg;
-  PcgSolver::Settings pcg;  ///< tolerance and iteration cap of pcg and pcgCholesky
+  PcgSolver::Settings pcg;  ///< tolerance and iteration cap of pcg, pcgCholesky and pcgTwoLevel
   CholeskyPcgSolver::Refresh refresh;  ///< pcgCholesky: when its lagged factor is rebuilt, and where
   bool warm_start = false;  ///< PCG starts from the previous step's velocity change (see BackwardEuler)
 };

@@ -11,6 +11,7 @@
 
 #include <Eigen/Core>
 
+#include <cstdint>
 #include <memory>
 #include <stdexcept>
 #include <string>
@@ -26,6 +27,9 @@ struct ShiftedSystem {
   /// Optional (nullptr: none): per block row, the rotation K's rows have turned through since the
   /// rest state (DynamicsModel::block_frames); given to solvers that follow_block_frames().
   const std::vector<Eigen::Matrix3d>* block_frames = nullptr;
+  /// Optional (nullptr: none): per block row, the point its unknowns move [m] (DynamicsModel::
+  /// block_positions); given to solvers that use_block_positions().
+  const std::vector<Eigen::Vector3d>* block_positions = nullptr;
 
   [[nodiscard]] int rows() const { return stiffness->rows(); }
   /// y = A x. No allocation. x and y must be different vectors.
@@ -89,6 +93,8 @@ class LinearSolver {
   /// Whether the solver uses ShiftedSystem::block_frames (an integrator asks the model for them
   /// only then: they cost a pass over the mesh).
   [[nodiscard]] virtual bool follows_block_frames() const { return false; }
+  /// Whether the solver uses ShiftedSystem::block_positions (asked of the model only then).
+  [[nodiscard]] virtual bool uses_block_positions() const { return false; }
   [[nodiscard]] virtual std::string_view name() const = 0;
 };
 
@@ -139,6 +145,53 @@ class PcgSolver final : public LinearSolver {
   PcgWorkspace m_work;
   Eigen::VectorXd m_inverse_diagonal;
   WorkTeam* m_team = nullptr;  // lent for a step
+};
+
+class TwoLevelPreconditioner;
+
+/// Conjugate gradients with a two-level preconditioner: Jacobi plus an exact solve on the rigid
+/// motions (translations and rotations) of small aggregates of block rows
+/// (two_level_preconditioner.hpp). Each iteration resolves the slow motions that Jacobi alone
+/// leaves for hundreds of iterations (a freed piece's fall, a cantilever's sag), and nothing is
+/// factorized but the small coarse matrix, so a cut costs no large factorization. The aggregates
+/// are made at the first setup and again when K's pattern changes (a cut); the coarse matrix at
+/// every setup. Uses ShiftedSystem::block_positions (translations only without them). Stopping rule
+/// and reported residual as PcgSolver's.
+class TwoLevelPcgSolver final : public LinearSolver {
+ public:
+  explicit TwoLevelPcgSolver(PcgSolver::Settings settings);
+  ~TwoLevelPcgSolver() override;
+  TwoLevelPcgSolver(const TwoLevelPcgSolver&) = delete;
+  TwoLevelPcgSolver& operator=(const TwoLevelPcgSolver&) = delete;
+  using LinearSolver::solve;
+  void setup(const ShiftedSystem& system) override;
+  /// Keeps the last setup's coarse level (a Newton correction's matrix is the step's, moved a
+  /// little): only the Jacobi diagonal and A's copy are taken anew.
+  void setup_nearby(const ShiftedSystem& system) override;
+  SolveReport solve(const Eigen::VectorXd& b, Eigen::VectorXd& x) override;
+  [[nodiscard]] bool is_set_up() const override { return m_system.stiffness != nullptr; }
+  [[nodiscard]] std::string_view name() const override { return "pcgTwoLevel"; }
+  void lend_work_team(WorkTeam* team) override { m_team = team; }
+  /// The aggregates are made anew at the next setup, as in a fresh solver.
+  void forget_earlier_setups() override;
+  [[nodiscard]] bool uses_block_positions() const override { return true; }
+  [[nodiscard]] const PcgSolver::Settings& settings() const { return m_settings; }
+  /// As PcgSolver::record_residuals.
+  void record_residuals(std::vector<double>* history) { m_work.residual_history = history; }
+  /// Of the last setup: aggregates and columns of the coarse space (0 if its factorization failed).
+  [[nodiscard]] int aggregate_count() const;
+  [[nodiscard]] int coarse_size() const;
+
+ private:
+  PcgSolver::Settings m_settings;
+  ShiftedSystem m_system{nullptr, 1.0, nullptr};  // of the last setup()
+  PcgWorkspace m_work;
+  Eigen::VectorXd m_inverse_diagonal;
+  std::unique_ptr<TwoLevelPreconditioner> m_preconditioner;
+  std::uint64_t m_pattern_revision = 0, m_layout_revision = 0;  // of K at the last setup
+  WorkTeam* m_team = nullptr;  // lent for a step
+
+  void set_up(const ShiftedSystem& system, bool nearby);
 };
 
 /// Conjugate gradients preconditioned by the Cholesky factor of an earlier A (a lagged factor).

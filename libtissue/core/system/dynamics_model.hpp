@@ -44,6 +44,14 @@ class DynamicsModel {
   /// A lagged preconditioner turns with it (CholeskyPcgSolver). Valid until the next evaluate() or
   /// growth of the model.
   [[nodiscard]] virtual const std::vector<Eigen::Matrix3d>* block_frames() const { return nullptr; }
+  /// Per block row of tangent(), the point its unknowns move at displacement `displacement_m` [m]
+  /// (a vertex's position; an enriched unknown's, its vertex's rest position moved by it), or
+  /// nullptr for a model without points. A two-level preconditioner takes the rigid motions of
+  /// groups of them (TwoLevelPcgSolver). Valid until the next call or growth of the model.
+  [[nodiscard]] virtual const std::vector<Eigen::Vector3d>* block_positions(
+      const Eigen::VectorXd& /*displacement_m*/) const {
+    return nullptr;
+  }
   /// The largest angle [rad] the displacement increment `increment_m` (from the state of the last
   /// evaluate()) turns an element: a step linearized there strays from the nonlinear model by about
   /// its square. Where a cheap bound shows every element below `resolution_rad`, that bound may be

@@ -1,0 +1,61 @@
+// TwoLevelPcgSolver: CG (pcg_iteration.hpp) with the two-level preconditioner
+// (two_level_preconditioner.hpp).
+#include "core/solve/linear_solver.hpp"
+#include "core/solve/pcg_iteration.hpp"
+#include "core/solve/two_level_preconditioner.hpp"
+
+namespace tissue {
+namespace {
+constexpr const char* WHO = "TwoLevelPcgSolver";
+}  // namespace
+
+TwoLevelPcgSolver::TwoLevelPcgSolver(PcgSolver::Settings settings)
+    : m_settings(settings), m_preconditioner(std::make_unique<TwoLevelPreconditioner>()) {
+  validate_pcg_settings(settings, WHO);
+  m_work.matrix = HalfMatrix(resolved_precision(settings.matrix_precision, settings.tolerance));
+}
+
+TwoLevelPcgSolver::~TwoLevelPcgSolver() = default;
+
+void TwoLevelPcgSolver::setup(const ShiftedSystem& system) { set_up(system, /*nearby=*/false); }
+
+void TwoLevelPcgSolver::setup_nearby(const ShiftedSystem& system) { set_up(system, /*nearby=*/true); }
+
+void TwoLevelPcgSolver::set_up(const ShiftedSystem& system, bool nearby) {
+  const bool coarse_fits = is_set_up() && system.stiffness == m_system.stiffness && system.rows() == m_system.rows() &&
+                           system.stiffness->pattern_revision() == m_pattern_revision &&
+                           system.stiffness->layout_revision() == m_layout_revision;
+  m_system = ShiftedSystem{nullptr, 1.0, nullptr};
+  system.check(WHO);
+  if (system.block_positions != nullptr &&
+      system.block_positions->size() < static_cast<size_t>(system.stiffness->block_rows())) {
+    throw SolverError(std::string(WHO) + ": fewer block positions than block rows");
+  }
+  m_work.resize(system.rows());
+  jacobi_inverse_diagonal(system, m_inverse_diagonal, WHO);  // also refuses a diagonal <= 0
+  if (nearby && coarse_fits) {
+    m_preconditioner->setup_nearby(m_inverse_diagonal);
+  } else {
+    m_preconditioner->setup(system, m_inverse_diagonal);
+  }
+  m_work.matrix.assign(system, m_team);
+  m_pattern_revision = system.stiffness->pattern_revision();
+  m_layout_revision = system.stiffness->layout_revision();
+  m_system = system;
+}
+
+SolveReport TwoLevelPcgSolver::solve(const Eigen::VectorXd& b, Eigen::VectorXd& x) {
+  if (!is_set_up()) throw SolverError(std::string(WHO) + ": solve() without a setup()");
+  m_system.check_sizes(b, x);
+  return preconditioned_cg</*ROW_WISE=*/false>(
+      m_system, b, x, m_settings.tolerance, m_settings.max_iterations, m_work, m_team,
+      [this](const Eigen::VectorXd& r, Eigen::VectorXd& z, long, long) { m_preconditioner->apply(r, z); });
+}
+
+void TwoLevelPcgSolver::forget_earlier_setups() { m_preconditioner->forget(); }
+
+int TwoLevelPcgSolver::aggregate_count() const { return m_preconditioner->aggregate_count(); }
+
+int TwoLevelPcgSolver::coarse_size() const { return m_preconditioner->coarse_size(); }
+
+}  // namespace tissue

@@ -1,0 +1,352 @@
+// TwoLevelPreconditioner: aggregates, their rigid-motion coarse space, the coarse matrix and its
+// factor, and the additive two-level application (two_level_preconditioner.hpp).
+#include "core/solve/two_level_preconditioner.hpp"
+
+#include <Eigen/Eigenvalues>
+#include <Eigen/Geometry>
+
+#include <algorithm>
+#include <cmath>
+
+namespace tissue {
+namespace {
+
+double frobenius(const ShiftedSystem& system, int slot, int row, int column) {
+  Eigen::Matrix3d block = system.stiffness_scale * system.stiffness->block(slot);
+  if (row == column) block.diagonal() += system.diagonal->segment<3>(3L * row);
+  return block.norm();
+}
+
+Eigen::Matrix3d cross_matrix(const Eigen::Vector3d& v) {
+  Eigen::Matrix3d m;
+  m << 0.0, -v.z(), v.y(), v.z(), 0.0, -v.x(), -v.y(), v.x(), 0.0;
+  return m;
+}
+
+}  // namespace
+
+void TwoLevelPreconditioner::setup(const ShiftedSystem& system, const Eigen::VectorXd& inverse_diagonal) {
+  m_inverse_diagonal = &inverse_diagonal;
+  const BlockSparseMatrix& k = *system.stiffness;
+  const bool with_rotations = system.block_positions != nullptr;
+  if (k.pattern_revision() != m_pattern_revision || k.layout_revision() != m_layout_revision ||
+      k.block_rows() != m_rows || with_rotations != m_with_rotations) {
+    m_with_rotations = with_rotations;
+    aggregate(system);
+    m_setups_since_coarse = COARSE_REFRESH_SETUPS;  // a coarse level now
+  }
+  if (++m_setups_since_coarse < COARSE_REFRESH_SETUPS) return;
+  m_setups_since_coarse = 0;
+  make_basis(system, /*count_rotations=*/false);
+  assemble_and_factorize(system);
+}
+
+// Phase 1: in row order, a row whose rows within `reach` strong edges are all free becomes a root
+// and takes them. Phase 2: a row left over joins the phase-1 aggregate of its strongest strong
+// neighbour that has one (else the aggregate of a neighbour taken in this phase, else its own).
+int TwoLevelPreconditioner::aggregate_within(int reach, int rows, const std::vector<int>& strong_begin,
+                                             const std::vector<int>& strong_column,
+                                             const std::vector<double>& strong_weight) {
+  m_aggregate_of_row.assign(static_cast<size_t>(rows), -1);
+  std::vector<int> reached;
+  std::vector<int> mark(static_cast<size_t>(rows), -1);
+  int count = 0;
+  for (int root = 0; root < rows; ++root) {
+    if (m_aggregate_of_row[static_cast<size_t>(root)] >= 0) continue;
+    reached.assign(1, root);
+    mark[static_cast<size_t>(root)] = root;
+    bool free = true;
+    size_t level_begin = 0;
+    for (int level = 0; level < reach && free; ++level) {
+      const size_t level_end = reached.size();
+      for (size_t front = level_begin; front < level_end && free; ++front) {
+        const int i = reached[front];
+        for (int e = strong_begin[static_cast<size_t>(i)]; e < strong_begin[static_cast<size_t>(i) + 1]; ++e) {
+          const int j = strong_column[static_cast<size_t>(e)];
+          if (mark[static_cast<size_t>(j)] == root) continue;
+          if (m_aggregate_of_row[static_cast<size_t>(j)] >= 0) {
+            free = false;
+            break;
+          }
+          mark[static_cast<size_t>(j)] = root;
+          reached.push_back(j);
+        }
+      }
+      level_begin = level_end;
+    }
+    if (!free) continue;
+    for (const int i : reached) m_aggregate_of_row[static_cast<size_t>(i)] = count;
+    ++count;
+  }
+  const std::vector<int> phase_one = m_aggregate_of_row;
+  for (int i = 0; i < rows; ++i) {
+    if (phase_one[static_cast<size_t>(i)] >= 0) continue;
+    double strongest = -1.0;
+    for (int e = strong_begin[static_cast<size_t>(i)]; e < strong_begin[static_cast<size_t>(i) + 1]; ++e) {
+      const int j = strong_column[static_cast<size_t>(e)];
+      const int a = phase_one[static_cast<size_t>(j)] >= 0 ? phase_one[static_cast<size_t>(j)] : -1;
+      if (a >= 0 && strong_weight[static_cast<size_t>(e)] > strongest) {
+        strongest = strong_weight[static_cast<size_t>(e)];
+        m_aggregate_of_row[static_cast<size_t>(i)] = a;
+      }
+    }
+    if (m_aggregate_of_row[static_cast<size_t>(i)] >= 0) continue;
+    for (int e = strong_begin[static_cast<size_t>(i)]; e < strong_begin[static_cast<size_t>(i) + 1]; ++e) {
+      const int a = m_aggregate_of_row[static_cast<size_t>(strong_column[static_cast<size_t>(e)])];
+      if (a >= 0) {
+        m_aggregate_of_row[static_cast<size_t>(i)] = a;
+        break;
+      }
+    }
+    if (m_aggregate_of_row[static_cast<size_t>(i)] < 0) m_aggregate_of_row[static_cast<size_t>(i)] = count++;
+  }
+  return count;
+}
+
+void TwoLevelPreconditioner::aggregate(const ShiftedSystem& system) {
+  const BlockSparseMatrix& k = *system.stiffness;
+  const int rows = k.block_rows();
+  std::vector<double> diagonal_norm(static_cast<size_t>(rows));
+  for (int i = 0; i < rows; ++i) {
+    const int slot = k.find_slot(i, i);
+    diagonal_norm[static_cast<size_t>(i)] = frobenius(system, slot, i, i);
+  }
+  // The strong neighbours of each row (CSR).
+  std::vector<int> strong_begin(static_cast<size_t>(rows) + 1, 0);
+  std::vector<int> strong_column;
+  std::vector<double> strong_weight;
+  for (int i = 0; i < rows; ++i) {
+    for (int s = k.row_begin(i); s < k.row_begin(i) + k.row_size(i); ++s) {
+      const int j = k.slot_column(s);
+      if (j < 0 || j == i) continue;
+      const double coupling = frobenius(system, s, i, j);
+      if (coupling > STRENGTH * std::sqrt(diagonal_norm[static_cast<size_t>(i)] * diagonal_norm[static_cast<size_t>(j)])) {
+        strong_column.push_back(j);
+        strong_weight.push_back(coupling);
+      }
+    }
+    strong_begin[static_cast<size_t>(i) + 1] = static_cast<int>(strong_column.size());
+  }
+  // Aggregates of the rows within `reach` strong edges of a root; the coarse solve must stay cheap
+  // beside a fine mat-vec, so a larger reach when the first gives too many coarse columns.
+  int count = 0;
+  for (const int reach : {1, 2}) {
+    count = aggregate_within(reach, rows, strong_begin, strong_column, strong_weight);
+    if (reach == 1 && 6L * count <= MAX_COARSE_COLUMNS) break;
+  }
+  // Rows of each aggregate, in row order.
+  m_aggregate_rows_begin.assign(static_cast<size_t>(count) + 1, 0);
+  for (const int a : m_aggregate_of_row) ++m_aggregate_rows_begin[static_cast<size_t>(a) + 1];
+  for (int a = 0; a < count; ++a) m_aggregate_rows_begin[static_cast<size_t>(a) + 1] += m_aggregate_rows_begin[static_cast<size_t>(a)];
+  m_aggregate_rows.resize(static_cast<size_t>(rows));
+  std::vector<int> fill(m_aggregate_rows_begin.begin(), m_aggregate_rows_begin.end() - 1);
+  for (int i = 0; i < rows; ++i) m_aggregate_rows[static_cast<size_t>(fill[static_cast<size_t>(m_aggregate_of_row[static_cast<size_t>(i)])]++)] = i;
+
+  // Columns per aggregate: 3 translations, and the rotations the points then span.
+  m_centroid.assign(static_cast<size_t>(count), Eigen::Vector3d::Zero());
+  m_translation_scale.assign(static_cast<size_t>(count), 0.0);
+  m_rotation_axes.assign(static_cast<size_t>(count), Eigen::Matrix3d::Zero());
+  m_rotation_count.assign(static_cast<size_t>(count), 0);
+  m_offset.assign(static_cast<size_t>(rows), Eigen::Vector3d::Zero());
+  m_column_begin.assign(static_cast<size_t>(count) + 1, 0);
+  make_basis(system, /*count_rotations=*/true);
+  for (int a = 0; a < count; ++a) {
+    m_column_begin[static_cast<size_t>(a) + 1] = m_column_begin[static_cast<size_t>(a)] + 3 + m_rotation_count[static_cast<size_t>(a)];
+  }
+  m_coarse_size = m_column_begin.back();
+
+  make_coarse_pattern(k);
+  m_pattern_revision = k.pattern_revision();
+  m_layout_revision = k.layout_revision();
+  m_rows = rows;
+}
+
+// The coarse block pattern (aggregate pairs that share a fine block), each fine slot's block and
+// each block's mirror, and the scalar lower triangle of the coarse matrix with its symbolic analysis.
+void TwoLevelPreconditioner::make_coarse_pattern(const BlockSparseMatrix& k) {
+  const int rows = k.block_rows();
+  const int count = aggregate_count();
+  std::vector<std::vector<int>> neighbours(static_cast<size_t>(count));
+  for (int i = 0; i < rows; ++i) {
+    const int a = m_aggregate_of_row[static_cast<size_t>(i)];
+    for (int s = k.row_begin(i); s < k.row_begin(i) + k.row_size(i); ++s) {
+      const int j = k.slot_column(s);
+      if (j >= 0) neighbours[static_cast<size_t>(a)].push_back(m_aggregate_of_row[static_cast<size_t>(j)]);
+    }
+  }
+  m_coarse_row_begin.assign(static_cast<size_t>(count) + 1, 0);
+  m_coarse_column.clear();
+  for (int a = 0; a < count; ++a) {
+    std::vector<int>& list = neighbours[static_cast<size_t>(a)];
+    std::sort(list.begin(), list.end());
+    list.erase(std::unique(list.begin(), list.end()), list.end());
+    m_coarse_column.insert(m_coarse_column.end(), list.begin(), list.end());
+    m_coarse_row_begin[static_cast<size_t>(a) + 1] = static_cast<int>(m_coarse_column.size());
+  }
+  m_coarse_block_of_slot.assign(static_cast<size_t>(k.slot_capacity()), -1);
+  for (int i = 0; i < rows; ++i) {
+    const int a = m_aggregate_of_row[static_cast<size_t>(i)];
+    const auto first = m_coarse_column.begin() + m_coarse_row_begin[static_cast<size_t>(a)];
+    const auto last = m_coarse_column.begin() + m_coarse_row_begin[static_cast<size_t>(a) + 1];
+    for (int s = k.row_begin(i); s < k.row_begin(i) + k.row_size(i); ++s) {
+      const int j = k.slot_column(s);
+      if (j < 0) continue;
+      const auto at = std::lower_bound(first, last, m_aggregate_of_row[static_cast<size_t>(j)]);
+      m_coarse_block_of_slot[static_cast<size_t>(s)] = static_cast<int>(at - m_coarse_column.begin());
+    }
+  }
+  m_coarse_blocks.assign(m_coarse_column.size(), {});
+  m_coarse_mirror.resize(m_coarse_column.size());
+  for (int a = 0; a < count; ++a) {
+    for (int p = m_coarse_row_begin[static_cast<size_t>(a)]; p < m_coarse_row_begin[static_cast<size_t>(a) + 1]; ++p) {
+      const int b = m_coarse_column[static_cast<size_t>(p)];
+      const auto first = m_coarse_column.begin() + m_coarse_row_begin[static_cast<size_t>(b)];
+      const auto last = m_coarse_column.begin() + m_coarse_row_begin[static_cast<size_t>(b) + 1];
+      m_coarse_mirror[static_cast<size_t>(p)] = static_cast<int>(std::lower_bound(first, last, a) - m_coarse_column.begin());
+    }
+  }
+
+  // The scalar lower triangle of the coarse matrix (compressed columns), made in the order
+  // for_each_lower_entry visits it.
+  long entries = 0;
+  for_each_lower_entry([&](int, int, int, int, int) { ++entries; });
+  m_coarse_matrix = Eigen::SparseMatrix<double>(m_coarse_size, m_coarse_size);
+  m_coarse_matrix.makeCompressed();
+  m_coarse_matrix.resizeNonZeros(entries);
+  int* column_start = m_coarse_matrix.outerIndexPtr();
+  int* row = m_coarse_matrix.innerIndexPtr();
+  long next = 0;
+  for_each_lower_entry([&](int column, int entry_row, int, int, int) {
+    column_start[column + 1] = static_cast<int>(++next);
+    row[next - 1] = entry_row;
+  });
+  for (int column = 0; column < m_coarse_size; ++column) {  // a column without entries (none here) keeps its start
+    column_start[column + 1] = std::max(column_start[column + 1], column_start[column]);
+  }
+  m_coarse_factor.analyzePattern(m_coarse_matrix);
+  m_coarse_rhs.resize(m_coarse_size);
+  m_coarse_solution.resize(m_coarse_size);
+}
+
+// Per aggregate: the centroid of its points, 1/sqrt(rows) for the translations, and the rotation
+// axes (principal axes of the points' second moment J = sum |r|^2 I - r r^T, scaled by 1/sqrt of
+// the moment so that each column has unit norm). The number of rotations is fixed at aggregation
+// (the coarse matrix's pattern); later setups keep the largest ones.
+void TwoLevelPreconditioner::make_basis(const ShiftedSystem& system, bool count_rotations) {
+  const int count = static_cast<int>(m_centroid.size());
+  for (int a = 0; a < count; ++a) {
+    const int begin = m_aggregate_rows_begin[static_cast<size_t>(a)];
+    const int end = m_aggregate_rows_begin[static_cast<size_t>(a) + 1];
+    m_translation_scale[static_cast<size_t>(a)] = 1.0 / std::sqrt(static_cast<double>(end - begin));
+    if (!m_with_rotations) continue;
+    const std::vector<Eigen::Vector3d>& points = *system.block_positions;
+    Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
+    for (int p = begin; p < end; ++p) centroid += points[static_cast<size_t>(m_aggregate_rows[static_cast<size_t>(p)])];
+    centroid /= static_cast<double>(end - begin);
+    Eigen::Matrix3d moment = Eigen::Matrix3d::Zero();
+    for (int p = begin; p < end; ++p) {
+      const int row = m_aggregate_rows[static_cast<size_t>(p)];
+      const Eigen::Vector3d r = points[static_cast<size_t>(row)] - centroid;
+      m_offset[static_cast<size_t>(row)] = r;
+      moment += r.squaredNorm() * Eigen::Matrix3d::Identity() - r * r.transpose();
+    }
+    m_centroid[static_cast<size_t>(a)] = centroid;
+    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eigen(moment);
+    const Eigen::Vector3d moments = eigen.eigenvalues();  // increasing
+    const double largest = moments[2];
+    int& rotations = m_rotation_count[static_cast<size_t>(a)];
+    if (count_rotations) {
+      rotations = 0;
+      for (int c = 0; c < 3; ++c) {
+        if (largest > 0.0 && moments[c] > ROTATION_RANK_TOLERANCE * largest) ++rotations;
+      }
+    }
+    Eigen::Matrix3d& axes = m_rotation_axes[static_cast<size_t>(a)];
+    axes.setZero();
+    for (int c = 0; c < rotations; ++c) {
+      const int e = 2 - c;  // the largest moments first
+      const double moment_e = std::max(moments[e], ROTATION_RANK_TOLERANCE * largest);
+      axes.col(c) = eigen.eigenvectors().col(e) / std::sqrt(moment_e);
+    }
+  }
+}
+
+void TwoLevelPreconditioner::assemble_and_factorize(const ShiftedSystem& system) {
+  const BlockSparseMatrix& k = *system.stiffness;
+  for (auto& block : m_coarse_blocks) block.fill(0.0);
+  // P_i = [t_a I, -[r_i]x W_a] (3 x the columns of a, zero beyond them), once per row.
+  m_row_basis.resize(static_cast<size_t>(m_rows));
+  for (int i = 0; i < m_rows; ++i) {
+    const int a = m_aggregate_of_row[static_cast<size_t>(i)];
+    RowBasis& p = m_row_basis[static_cast<size_t>(i)];
+    p.setZero();
+    p.leftCols<3>().diagonal().setConstant(m_translation_scale[static_cast<size_t>(a)]);
+    if (m_with_rotations) {
+      p.rightCols<3>() = -cross_matrix(m_offset[static_cast<size_t>(i)]) * m_rotation_axes[static_cast<size_t>(a)];
+    }
+  }
+  // P_i^T A_ij P_j into block (a, b), and its transpose into (b, a), for the blocks with j >= i
+  // (A is symmetric; K's rows hold both halves).
+  for (int i = 0; i < m_rows; ++i) {
+    const RowBasis& p_i = m_row_basis[static_cast<size_t>(i)];
+    for (int s = k.row_begin(i); s < k.row_begin(i) + k.row_size(i); ++s) {
+      const int j = k.slot_column(s);
+      if (j < i) continue;
+      Eigen::Matrix3d block = system.stiffness_scale * k.block(s);
+      if (j == i) block.diagonal() += system.diagonal->segment<3>(3L * i);
+      const Eigen::Matrix<double, 3, 6> block_p_j = block * m_row_basis[static_cast<size_t>(j)];
+      const Eigen::Matrix<double, 6, 6> coarse = p_i.transpose() * block_p_j;
+      Eigen::Map<Eigen::Matrix<double, 6, 6>>(m_coarse_blocks[static_cast<size_t>(m_coarse_block_of_slot[static_cast<size_t>(s)])].data()) += coarse;
+      if (j != i) {
+        const int mirror = m_coarse_mirror[static_cast<size_t>(m_coarse_block_of_slot[static_cast<size_t>(s)])];
+        Eigen::Map<Eigen::Matrix<double, 6, 6>>(m_coarse_blocks[static_cast<size_t>(mirror)].data()) += coarse.transpose();
+      }
+    }
+  }
+  double* values = m_coarse_matrix.valuePtr();
+  long next = 0;
+  for_each_lower_entry([&](int, int, int block, int column_in_block, int row_in_block) {
+    // Entry (row, column) of block (a, b) is entry (column, row) of its mirror (b, a), the one visited.
+    values[next++] = m_coarse_blocks[static_cast<size_t>(block)][static_cast<size_t>(6 * row_in_block + column_in_block)];
+  });
+  m_coarse_factor.factorize(m_coarse_matrix);
+  m_coarse_ok = m_coarse_factor.info() == Eigen::Success && m_coarse_factor.vectorD().minCoeff() > 0.0;
+}
+
+void TwoLevelPreconditioner::apply(const Eigen::VectorXd& r, Eigen::VectorXd& z) {
+  z = m_inverse_diagonal->cwiseProduct(r);
+  if (!m_coarse_ok) return;
+  const int count = aggregate_count();
+  for (int a = 0; a < count; ++a) {
+    Eigen::Vector3d force = Eigen::Vector3d::Zero();
+    Eigen::Vector3d moment = Eigen::Vector3d::Zero();
+    for (int p = m_aggregate_rows_begin[static_cast<size_t>(a)]; p < m_aggregate_rows_begin[static_cast<size_t>(a) + 1]; ++p) {
+      const int row = m_aggregate_rows[static_cast<size_t>(p)];
+      const Eigen::Vector3d r_i = r.segment<3>(3L * row);
+      force += r_i;
+      if (m_with_rotations) moment += m_offset[static_cast<size_t>(row)].cross(r_i);
+    }
+    const int first = m_column_begin[static_cast<size_t>(a)];
+    m_coarse_rhs.segment<3>(first) = m_translation_scale[static_cast<size_t>(a)] * force;
+    const int rotations = m_column_begin[static_cast<size_t>(a) + 1] - first - 3;
+    // (-[r]x W)^T v = W^T (r x v)
+    for (int c = 0; c < rotations; ++c) {
+      m_coarse_rhs[first + 3 + c] = m_rotation_axes[static_cast<size_t>(a)].col(c).dot(moment);
+    }
+  }
+  m_coarse_solution = m_coarse_factor.solve(m_coarse_rhs);
+  for (int a = 0; a < count; ++a) {
+    const int first = m_column_begin[static_cast<size_t>(a)];
+    const int rotations = m_column_begin[static_cast<size_t>(a) + 1] - first - 3;
+    const Eigen::Vector3d translation = m_translation_scale[static_cast<size_t>(a)] * m_coarse_solution.segment<3>(first);
+    Eigen::Vector3d spin = Eigen::Vector3d::Zero();
+    for (int c = 0; c < rotations; ++c) spin += m_coarse_solution[first + 3 + c] * m_rotation_axes[static_cast<size_t>(a)].col(c);
+    for (int p = m_aggregate_rows_begin[static_cast<size_t>(a)]; p < m_aggregate_rows_begin[static_cast<size_t>(a) + 1]; ++p) {
+      const int row = m_aggregate_rows[static_cast<size_t>(p)];
+      // -[r]x w = w x r
+      z.segment<3>(3L * row) += translation + spin.cross(m_offset[static_cast<size_t>(row)]);
+    }
+  }
+}
+
+}  // namespace tissue

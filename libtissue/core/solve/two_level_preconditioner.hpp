@@ -1,0 +1,134 @@
+// A two-level preconditioner for A = s K + diag(d) (internal to core/solve): Jacobi on the fine
+// rows plus an exact solve on a coarse space of the rigid motions of small aggregates of block rows,
+//   P^-1 r = D^-1 r + Pc (Pc^T A Pc)^-1 Pc^T r     (additive two-level Schwarz),
+// so that CG resolves the slow motions (a piece falling, a body swinging or sagging as a whole),
+// which Jacobi alone reaches only after hundreds of iterations, in every iteration.
+//
+// Aggregates (Vanek, Mandel and Brezina 1996, "Algebraic multigrid by smoothed aggregation",
+// phases 1 and 2): in row order, a row whose strong neighbours (within MAX reach) are all
+// unassigned becomes a root and takes them; a row left over joins the aggregate of its strongest
+// assigned neighbour (or becomes one of its own). A coupling is strong when ||A_ij||_F > STRENGTH sqrt(||A_ii||_F ||A_jj||_F):
+// the blocks a cut left in the pattern at zero never join the two sides of a cut. Made at the
+// first setup and again whenever K's pattern or layout changes (a cut), from that setup's values.
+//
+// Coarse space: per aggregate, the translations and the rotations about its centroid of the rows'
+// points (ShiftedSystem::block_positions at each setup; translations only without them),
+// orthonormal over the aggregate (rotations along the principal axes of its points, those about
+// which the points do not all lie: a two-row aggregate keeps two), so at most 6 columns per
+// aggregate. The coarse matrix Pc^T A Pc is assembled and factorized (sparse LDL^T) at each setup.
+#pragma once
+
+#include "core/solve/linear_solver.hpp"
+
+#include <Eigen/Core>
+#include <Eigen/SparseCholesky>
+#include <Eigen/SparseCore>
+
+#include <array>
+#include <cstdint>
+#include <vector>
+
+namespace tissue {
+
+class TwoLevelPreconditioner {
+ public:
+  /// A coupling weaker than this (relative, Frobenius norms) does not join two rows in an aggregate.
+  static constexpr double STRENGTH = 0.08;
+  /// Rotations about an axis whose moment of the aggregate's points is below this share of the
+  /// largest are left out (the points lie (nearly) on a line through the centroid along it).
+  static constexpr double ROTATION_RANK_TOLERANCE = 1e-6;
+  /// Aggregates reach one strong edge from their root (~10-16 rows on a tet mesh) unless that gives
+  /// more coarse columns than this; then two. The coarse factor's fill grows faster than its size:
+  /// on the 52k-tet organ reach 1 gives 3828 columns whose factor (4.7M entries) costs 4x a fine
+  /// mat-vec per solve, reach 2 gives 906 (0.27M) for 83 instead of 59 iterations to 1e-6.
+  static constexpr long MAX_COARSE_COLUMNS = 1500;
+  /// The coarse level (its points and matrix, assembled and factorized) is made anew every this many
+  /// setups, and at once after aggregating; in between the last one serves (Pc and Pc^T A Pc of
+  /// the same earlier setup: still a positive definite P). Translations do not depend on the points,
+  /// and A changes little in a few steps.
+  static constexpr int COARSE_REFRESH_SETUPS = 4;
+
+  /// Takes the Jacobi diagonal `inverse_diagonal` (1 / diag A, the caller's, kept until the next
+  /// setup) and makes the coarse level of `system` (aggregating anew when K's pattern or layout
+  /// changed). Never throws for a positive definite A; if the coarse factorization fails all the
+  /// same (rounding), the preconditioner is Jacobi alone until the next setup.
+  void setup(const ShiftedSystem& system, const Eigen::VectorXd& inverse_diagonal);
+  /// For an A near the last setup's (same pattern and size): takes the new Jacobi diagonal and keeps
+  /// the coarse level (its space and factor are the last setup's; still a positive definite P).
+  void setup_nearby(const Eigen::VectorXd& inverse_diagonal) { m_inverse_diagonal = &inverse_diagonal; }
+  /// z = P^-1 r (lengths rows() of the last setup). No allocation.
+  void apply(const Eigen::VectorXd& r, Eigen::VectorXd& z);
+  /// Aggregate anew at the next setup (a saved or restored run continues bitwise).
+  void forget() {
+    m_pattern_revision = UINT64_MAX;
+    m_setups_since_coarse = 0;
+  }
+
+  [[nodiscard]] int aggregate_count() const { return static_cast<int>(m_aggregate_rows_begin.size()) - 1; }
+  /// Columns of the coarse space (0 after a failed coarse factorization).
+  [[nodiscard]] int coarse_size() const { return m_coarse_ok ? m_coarse_size : 0; }
+  /// Aggregate of each block row of the last setup's A.
+  [[nodiscard]] const std::vector<int>& aggregate_of_row() const { return m_aggregate_of_row; }
+
+ private:
+  void aggregate(const ShiftedSystem& system);
+  int aggregate_within(int reach, int rows, const std::vector<int>& strong_begin, const std::vector<int>& strong_column,
+                       const std::vector<double>& strong_weight);
+  void make_coarse_pattern(const BlockSparseMatrix& k);
+  void make_basis(const ShiftedSystem& system, bool count_rotations);
+  void assemble_and_factorize(const ShiftedSystem& system);
+  /// visit(column, row, block, column in block, row in block) for each entry of the coarse matrix's
+  /// lower triangle in compressed-column order: column j of aggregate b, then the blocks (b, a) of
+  /// b's block row with a >= b (rows ascending), `block` being (b, a), whose entry (j, row) it is.
+  template <class Visit>
+  void for_each_lower_entry(Visit&& visit) const {
+    const int count = aggregate_count();
+    for (int b = 0; b < count; ++b) {
+      const int b_first = m_column_begin[static_cast<size_t>(b)];
+      for (int column = b_first; column < m_column_begin[static_cast<size_t>(b) + 1]; ++column) {
+        for (int p = m_coarse_row_begin[static_cast<size_t>(b)]; p < m_coarse_row_begin[static_cast<size_t>(b) + 1]; ++p) {
+          const int a = m_coarse_column[static_cast<size_t>(p)];
+          if (a < b) continue;
+          const int a_first = m_column_begin[static_cast<size_t>(a)];
+          for (int row = a == b ? column : a_first; row < m_column_begin[static_cast<size_t>(a) + 1]; ++row) {
+            visit(column, row, p, column - b_first, row - a_first);
+          }
+        }
+      }
+    }
+  }
+
+  // Aggregates: rows of aggregate a are m_aggregate_rows[m_aggregate_rows_begin[a] ...].
+  std::vector<int> m_aggregate_of_row;
+  std::vector<int> m_aggregate_rows_begin;
+  std::vector<int> m_aggregate_rows;
+  // Coarse space: per aggregate its first coarse column, translation columns (3) then rotations.
+  std::vector<int> m_column_begin;  // size aggregates + 1
+  std::vector<Eigen::Vector3d> m_centroid;
+  std::vector<double> m_translation_scale;      // 1 / sqrt(rows)
+  std::vector<Eigen::Matrix3d> m_rotation_axes;  // columns: axis / sqrt(moment), as many as used
+  std::vector<int> m_rotation_count;
+  std::vector<Eigen::Vector3d> m_offset;  // per block row: its point minus its aggregate's centroid
+  int m_coarse_size = 0;
+  // Coarse matrix: dense blocks of (aggregate, aggregate) pairs, CSR by aggregate; each fine slot's
+  // coarse block.
+  std::vector<int> m_coarse_row_begin;
+  std::vector<int> m_coarse_column;
+  std::vector<int> m_coarse_block_of_slot;  // per fine slot (-1: unused slot)
+  std::vector<std::array<double, 36>> m_coarse_blocks;  // 6x6 column-major, used up to the columns
+  std::vector<int> m_coarse_mirror;                     // per coarse block (a, b): the block (b, a)
+  using RowBasis = Eigen::Matrix<double, 3, 6>;
+  std::vector<RowBasis> m_row_basis;  // per block row, its rows of the coarse basis (this setup)
+  Eigen::SparseMatrix<double> m_coarse_matrix;           // lower triangle, pattern fixed per aggregation
+  Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> m_coarse_factor;
+  bool m_coarse_ok = false;
+  Eigen::VectorXd m_coarse_rhs, m_coarse_solution;
+  const Eigen::VectorXd* m_inverse_diagonal = nullptr;
+  std::uint64_t m_pattern_revision = UINT64_MAX;
+  std::uint64_t m_layout_revision = UINT64_MAX;
+  int m_rows = -1;
+  int m_setups_since_coarse = 0;
+  bool m_with_rotations = false;
+};
+
+}  // namespace tissue
