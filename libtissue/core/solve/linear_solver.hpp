@@ -154,9 +154,9 @@ class TwoLevelPreconditioner;
 /// (two_level_preconditioner.hpp). Each iteration resolves the slow motions that Jacobi alone
 /// leaves for hundreds of iterations (a freed piece's fall, a cantilever's sag), and nothing is
 /// factorized but the small coarse matrix, so a cut costs no large factorization. The aggregates
-/// are made at the first setup and again when K's pattern changes (a cut); the coarse matrix at
-/// every setup. Uses ShiftedSystem::block_positions (translations only without them). Stopping rule
-/// and reported residual as PcgSolver's.
+/// are made at the first setup and again when K's pattern changes (a cut); the coarse matrix then
+/// and every few setups. Uses ShiftedSystem::block_positions (translations only without them).
+/// Stopping rule and reported residual as PcgSolver's.
 class TwoLevelPcgSolver final : public LinearSolver {
  public:
   explicit TwoLevelPcgSolver(PcgSolver::Settings settings);

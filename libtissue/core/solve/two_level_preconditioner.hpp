@@ -15,7 +15,8 @@
 // points (ShiftedSystem::block_positions at each setup; translations only without them),
 // orthonormal over the aggregate (rotations along the principal axes of its points, those about
 // which the points do not all lie: a two-row aggregate keeps two), so at most 6 columns per
-// aggregate. The coarse matrix Pc^T A Pc is assembled and factorized (sparse LDL^T) at each setup.
+// aggregate. The coarse matrix Pc^T A Pc is assembled and factorized (sparse LDL^T) after aggregating
+// and every COARSE_REFRESH_SETUPS setups.
 #pragma once
 
 #include "core/solve/linear_solver.hpp"
@@ -49,9 +50,9 @@ class TwoLevelPreconditioner {
   static constexpr int COARSE_REFRESH_SETUPS = 4;
 
   /// Takes the Jacobi diagonal `inverse_diagonal` (1 / diag A, the caller's, kept until the next
-  /// setup) and makes the coarse level of `system` (aggregating anew when K's pattern or layout
-  /// changed). Never throws for a positive definite A; if the coarse factorization fails all the
-  /// same (rounding), the preconditioner is Jacobi alone until the next setup.
+  /// setup) and, when due, makes the coarse level of `system` (aggregating anew when K's pattern,
+  /// layout or size changed). Never throws for a positive definite A; if the coarse factorization
+  /// fails all the same (rounding), the preconditioner is Jacobi alone until the next coarse level.
   void setup(const ShiftedSystem& system, const Eigen::VectorXd& inverse_diagonal);
   /// For an A near the last setup's (same pattern and size): takes the new Jacobi diagonal and keeps
   /// the coarse level (its space and factor are the last setup's; still a positive definite P).
