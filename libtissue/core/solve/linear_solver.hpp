@@ -11,7 +11,6 @@
 
 #include <Eigen/Core>
 
-#include <cstdint>
 #include <memory>
 #include <stdexcept>
 #include <string>
@@ -188,7 +187,6 @@ class TwoLevelPcgSolver final : public LinearSolver {
   PcgWorkspace m_work;
   Eigen::VectorXd m_inverse_diagonal;
   std::unique_ptr<TwoLevelPreconditioner> m_preconditioner;
-  std::uint64_t m_pattern_revision = 0, m_layout_revision = 0;  // of K at the last setup
   WorkTeam* m_team = nullptr;  // lent for a step
 
   void set_up(const ShiftedSystem& system, bool nearby);

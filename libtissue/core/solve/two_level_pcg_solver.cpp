@@ -22,9 +22,6 @@ void TwoLevelPcgSolver::setup(const ShiftedSystem& system) { set_up(system, /*ne
 void TwoLevelPcgSolver::setup_nearby(const ShiftedSystem& system) { set_up(system, /*nearby=*/true); }
 
 void TwoLevelPcgSolver::set_up(const ShiftedSystem& system, bool nearby) {
-  const bool coarse_fits = is_set_up() && system.stiffness == m_system.stiffness && system.rows() == m_system.rows() &&
-                           system.stiffness->pattern_revision() == m_pattern_revision &&
-                           system.stiffness->layout_revision() == m_layout_revision;
   m_system = ShiftedSystem{nullptr, 1.0, nullptr};
   system.check(WHO);
   if (system.block_positions != nullptr &&
@@ -33,14 +30,12 @@ void TwoLevelPcgSolver::set_up(const ShiftedSystem& system, bool nearby) {
   }
   m_work.resize(system.rows());
   jacobi_inverse_diagonal(system, m_inverse_diagonal, WHO);  // also refuses a diagonal <= 0
-  if (nearby && coarse_fits) {
-    m_preconditioner->setup_nearby(m_inverse_diagonal);
+  if (nearby) {
+    m_preconditioner->setup_nearby(system, m_inverse_diagonal);
   } else {
     m_preconditioner->setup(system, m_inverse_diagonal);
   }
   m_work.matrix.assign(system, m_team);
-  m_pattern_revision = system.stiffness->pattern_revision();
-  m_layout_revision = system.stiffness->layout_revision();
   m_system = system;
 }
 

@@ -27,11 +27,8 @@ Eigen::Matrix3d cross_matrix(const Eigen::Vector3d& v) {
 
 void TwoLevelPreconditioner::setup(const ShiftedSystem& system, const Eigen::VectorXd& inverse_diagonal) {
   m_inverse_diagonal = &inverse_diagonal;
-  const BlockSparseMatrix& k = *system.stiffness;
-  const bool with_rotations = system.block_positions != nullptr;
-  if (k.pattern_revision() != m_pattern_revision || k.layout_revision() != m_layout_revision ||
-      k.block_rows() != m_rows || with_rotations != m_with_rotations) {
-    m_with_rotations = with_rotations;
+  if (!aggregates_fit(system)) {
+    m_with_rotations = system.block_positions != nullptr;
     aggregate(system);
     m_setups_since_coarse = COARSE_REFRESH_SETUPS;  // a coarse level now
   }
@@ -39,6 +36,20 @@ void TwoLevelPreconditioner::setup(const ShiftedSystem& system, const Eigen::Vec
   m_setups_since_coarse = 0;
   make_basis(system, /*count_rotations=*/false);
   assemble_and_factorize(system);
+}
+
+void TwoLevelPreconditioner::setup_nearby(const ShiftedSystem& system, const Eigen::VectorXd& inverse_diagonal) {
+  if (!aggregates_fit(system)) {
+    setup(system, inverse_diagonal);
+    return;
+  }
+  m_inverse_diagonal = &inverse_diagonal;
+}
+
+bool TwoLevelPreconditioner::aggregates_fit(const ShiftedSystem& system) const {
+  const BlockSparseMatrix& k = *system.stiffness;
+  return &k == m_matrix && k.pattern_revision() == m_pattern_revision && k.layout_revision() == m_layout_revision &&
+         k.block_rows() == m_rows && (system.block_positions != nullptr) == m_with_rotations;
 }
 
 // Phase 1: in row order, a row whose rows within `reach` strong edges are all free becomes a root
@@ -108,8 +119,7 @@ void TwoLevelPreconditioner::aggregate(const ShiftedSystem& system) {
   const int rows = k.block_rows();
   std::vector<double> diagonal_norm(static_cast<size_t>(rows));
   for (int i = 0; i < rows; ++i) {
-    const int slot = k.find_slot(i, i);
-    diagonal_norm[static_cast<size_t>(i)] = frobenius(system, slot, i, i);
+    diagonal_norm[static_cast<size_t>(i)] = frobenius(system, k.diagonal_slot(i), i, i);
   }
   // The strong neighbours of each row (CSR).
   std::vector<int> strong_begin(static_cast<size_t>(rows) + 1, 0);
@@ -156,6 +166,7 @@ void TwoLevelPreconditioner::aggregate(const ShiftedSystem& system) {
   m_coarse_size = m_column_begin.back();
 
   make_coarse_pattern(k);
+  m_matrix = &k;
   m_pattern_revision = k.pattern_revision();
   m_layout_revision = k.layout_revision();
   m_rows = rows;
@@ -285,10 +296,15 @@ void TwoLevelPreconditioner::assemble_and_factorize(const ShiftedSystem& system)
       p.rightCols<3>() = -cross_matrix(m_offset[static_cast<size_t>(i)]) * m_rotation_axes[static_cast<size_t>(a)];
     }
   }
-  // P_i^T A_ij P_j into block (a, b), and its transpose into (b, a), for the blocks with j >= i
-  // (A is symmetric; K's rows hold both halves).
+  // For the blocks with j >= i (A is symmetric; K's rows hold both halves), P_i^T A_ij P_j goes
+  // into the coarse block that for_each_lower_entry reads: (a, b) when a <= b, else the transpose
+  // into (b, a); a diagonal coarse block takes both.
+  const auto add = [&](int coarse_block, const Eigen::Matrix<double, 6, 6>& term) {
+    Eigen::Map<Eigen::Matrix<double, 6, 6>>(m_coarse_blocks[static_cast<size_t>(coarse_block)].data()) += term;
+  };
   for (int i = 0; i < m_rows; ++i) {
     const RowBasis& p_i = m_row_basis[static_cast<size_t>(i)];
+    const int a = m_aggregate_of_row[static_cast<size_t>(i)];
     for (int s = k.row_begin(i); s < k.row_begin(i) + k.row_size(i); ++s) {
       const int j = k.slot_column(s);
       if (j < i) continue;
@@ -296,11 +312,10 @@ void TwoLevelPreconditioner::assemble_and_factorize(const ShiftedSystem& system)
       if (j == i) block.diagonal() += system.diagonal->segment<3>(3L * i);
       const Eigen::Matrix<double, 3, 6> block_p_j = block * m_row_basis[static_cast<size_t>(j)];
       const Eigen::Matrix<double, 6, 6> coarse = p_i.transpose() * block_p_j;
-      Eigen::Map<Eigen::Matrix<double, 6, 6>>(m_coarse_blocks[static_cast<size_t>(m_coarse_block_of_slot[static_cast<size_t>(s)])].data()) += coarse;
-      if (j != i) {
-        const int mirror = m_coarse_mirror[static_cast<size_t>(m_coarse_block_of_slot[static_cast<size_t>(s)])];
-        Eigen::Map<Eigen::Matrix<double, 6, 6>>(m_coarse_blocks[static_cast<size_t>(mirror)].data()) += coarse.transpose();
-      }
+      const int b = m_aggregate_of_row[static_cast<size_t>(j)];
+      const int coarse_block = m_coarse_block_of_slot[static_cast<size_t>(s)];
+      if (a <= b) add(coarse_block, coarse);
+      if (a >= b && j != i) add(a == b ? coarse_block : m_coarse_mirror[static_cast<size_t>(coarse_block)], coarse.transpose());
     }
   }
   double* values = m_coarse_matrix.valuePtr();

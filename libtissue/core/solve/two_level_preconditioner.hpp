@@ -54,9 +54,10 @@ class TwoLevelPreconditioner {
   /// layout or size changed). Never throws for a positive definite A; if the coarse factorization
   /// fails all the same (rounding), the preconditioner is Jacobi alone until the next coarse level.
   void setup(const ShiftedSystem& system, const Eigen::VectorXd& inverse_diagonal);
-  /// For an A near the last setup's (same pattern and size): takes the new Jacobi diagonal and keeps
-  /// the coarse level (its space and factor are the last setup's; still a positive definite P).
-  void setup_nearby(const Eigen::VectorXd& inverse_diagonal) { m_inverse_diagonal = &inverse_diagonal; }
+  /// For an A near the last setup's (a Newton correction's): when it is of the same K object,
+  /// pattern, layout and size, takes the new Jacobi diagonal and keeps the coarse level (its space
+  /// and factor are the last setup's; still a positive definite P); else setup().
+  void setup_nearby(const ShiftedSystem& system, const Eigen::VectorXd& inverse_diagonal);
   /// z = P^-1 r (lengths rows() of the last setup). No allocation.
   void apply(const Eigen::VectorXd& r, Eigen::VectorXd& z);
   /// Aggregate anew at the next setup (a saved or restored run continues bitwise).
@@ -72,6 +73,9 @@ class TwoLevelPreconditioner {
   [[nodiscard]] const std::vector<int>& aggregate_of_row() const { return m_aggregate_of_row; }
 
  private:
+  /// Whether the aggregates are of `system`'s K: the same object, pattern, layout and size, and
+  /// points given as when they were made.
+  [[nodiscard]] bool aggregates_fit(const ShiftedSystem& system) const;
   void aggregate(const ShiftedSystem& system);
   int aggregate_within(int reach, int rows, const std::vector<int>& strong_begin, const std::vector<int>& strong_column,
                        const std::vector<double>& strong_weight);
@@ -125,6 +129,7 @@ class TwoLevelPreconditioner {
   bool m_coarse_ok = false;
   Eigen::VectorXd m_coarse_rhs, m_coarse_solution;
   const Eigen::VectorXd* m_inverse_diagonal = nullptr;
+  const BlockSparseMatrix* m_matrix = nullptr;  // the K aggregated
   std::uint64_t m_pattern_revision = UINT64_MAX;
   std::uint64_t m_layout_revision = UINT64_MAX;
   int m_rows = -1;

@@ -44,6 +44,8 @@ class BlockSparseMatrix {
 
   /// Slot of block (row, col), or -1 if absent. Searches: for set-up code, not for a step.
   [[nodiscard]] int find_slot(int row, int col) const;
+  /// Slot of the diagonal block of `row` (always present). No search.
+  [[nodiscard]] int diagonal_slot(int row) const { return m_diagonal_slot[static_cast<size_t>(row)]; }
 
   [[nodiscard]] Eigen::Map<Eigen::Matrix3d> block(int slot) {
     return Eigen::Map<Eigen::Matrix3d>(&m_values[9 * static_cast<size_t>(slot)]);
