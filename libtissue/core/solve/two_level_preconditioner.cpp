@@ -137,13 +137,7 @@ void TwoLevelPreconditioner::aggregate(const ShiftedSystem& system) {
     }
     strong_begin[static_cast<size_t>(i) + 1] = static_cast<int>(strong_column.size());
   }
-  // Aggregates of the rows within `reach` strong edges of a root; the coarse solve must stay cheap
-  // beside a fine mat-vec, so a larger reach when the first gives too many coarse columns.
-  int count = 0;
-  for (const int reach : {1, 2}) {
-    count = aggregate_within(reach, rows, strong_begin, strong_column, strong_weight);
-    if (reach == 1 && 6L * count <= MAX_COARSE_COLUMNS) break;
-  }
+  const int count = aggregate_within(AGGREGATE_REACH, rows, strong_begin, strong_column, strong_weight);
   // Rows of each aggregate, in row order.
   m_aggregate_rows_begin.assign(static_cast<size_t>(count) + 1, 0);
   for (const int a : m_aggregate_of_row) ++m_aggregate_rows_begin[static_cast<size_t>(a) + 1];
@@ -175,36 +169,38 @@ void TwoLevelPreconditioner::aggregate(const ShiftedSystem& system) {
 // The coarse block pattern (aggregate pairs that share a fine block), each fine slot's block and
 // each block's mirror, and the scalar lower triangle of the coarse matrix with its symbolic analysis.
 void TwoLevelPreconditioner::make_coarse_pattern(const BlockSparseMatrix& k) {
-  const int rows = k.block_rows();
   const int count = aggregate_count();
-  std::vector<std::vector<int>> neighbours(static_cast<size_t>(count));
-  for (int i = 0; i < rows; ++i) {
-    const int a = m_aggregate_of_row[static_cast<size_t>(i)];
-    for (int s = k.row_begin(i); s < k.row_begin(i) + k.row_size(i); ++s) {
-      const int j = k.slot_column(s);
-      if (j >= 0) neighbours[static_cast<size_t>(a)].push_back(m_aggregate_of_row[static_cast<size_t>(j)]);
-    }
-  }
+  // Per aggregate a (its rows in m_aggregate_rows): the aggregates its rows' blocks reach, in
+  // ascending order, and each of those slots' coarse block; `position[b]` is b's block in a's row
+  // while `seen[b] == a`.
+  std::vector<int> seen(static_cast<size_t>(count), -1);
+  std::vector<int> position(static_cast<size_t>(count), -1);
   m_coarse_row_begin.assign(static_cast<size_t>(count) + 1, 0);
   m_coarse_column.clear();
-  for (int a = 0; a < count; ++a) {
-    std::vector<int>& list = neighbours[static_cast<size_t>(a)];
-    std::sort(list.begin(), list.end());
-    list.erase(std::unique(list.begin(), list.end()), list.end());
-    m_coarse_column.insert(m_coarse_column.end(), list.begin(), list.end());
-    m_coarse_row_begin[static_cast<size_t>(a) + 1] = static_cast<int>(m_coarse_column.size());
-  }
   m_coarse_block_of_slot.assign(static_cast<size_t>(k.slot_capacity()), -1);
-  for (int i = 0; i < rows; ++i) {
-    const int a = m_aggregate_of_row[static_cast<size_t>(i)];
-    const auto first = m_coarse_column.begin() + m_coarse_row_begin[static_cast<size_t>(a)];
-    const auto last = m_coarse_column.begin() + m_coarse_row_begin[static_cast<size_t>(a) + 1];
-    for (int s = k.row_begin(i); s < k.row_begin(i) + k.row_size(i); ++s) {
-      const int j = k.slot_column(s);
-      if (j < 0) continue;
-      const auto at = std::lower_bound(first, last, m_aggregate_of_row[static_cast<size_t>(j)]);
-      m_coarse_block_of_slot[static_cast<size_t>(s)] = static_cast<int>(at - m_coarse_column.begin());
+  for (int a = 0; a < count; ++a) {
+    const size_t first = m_coarse_column.size();
+    for (int p = m_aggregate_rows_begin[static_cast<size_t>(a)]; p < m_aggregate_rows_begin[static_cast<size_t>(a) + 1]; ++p) {
+      const int i = m_aggregate_rows[static_cast<size_t>(p)];
+      for (int s = k.row_begin(i); s < k.row_begin(i) + k.row_size(i); ++s) {
+        const int j = k.slot_column(s);
+        if (j < 0) continue;
+        const int b = m_aggregate_of_row[static_cast<size_t>(j)];
+        if (seen[static_cast<size_t>(b)] == a) continue;
+        seen[static_cast<size_t>(b)] = a;
+        m_coarse_column.push_back(b);
+      }
     }
+    std::sort(m_coarse_column.begin() + static_cast<long>(first), m_coarse_column.end());
+    for (size_t q = first; q < m_coarse_column.size(); ++q) position[static_cast<size_t>(m_coarse_column[q])] = static_cast<int>(q);
+    for (int p = m_aggregate_rows_begin[static_cast<size_t>(a)]; p < m_aggregate_rows_begin[static_cast<size_t>(a) + 1]; ++p) {
+      const int i = m_aggregate_rows[static_cast<size_t>(p)];
+      for (int s = k.row_begin(i); s < k.row_begin(i) + k.row_size(i); ++s) {
+        const int j = k.slot_column(s);
+        if (j >= 0) m_coarse_block_of_slot[static_cast<size_t>(s)] = position[static_cast<size_t>(m_aggregate_of_row[static_cast<size_t>(j)])];
+      }
+    }
+    m_coarse_row_begin[static_cast<size_t>(a) + 1] = static_cast<int>(m_coarse_column.size());
   }
   m_coarse_blocks.assign(m_coarse_column.size(), {});
   m_coarse_mirror.resize(m_coarse_column.size());

@@ -5,7 +5,7 @@
 // which Jacobi alone reaches only after hundreds of iterations, in every iteration.
 //
 // Aggregates (Vanek, Mandel and Brezina 1996, "Algebraic multigrid by smoothed aggregation",
-// phases 1 and 2): in row order, a row whose strong neighbours (within MAX reach) are all
+// phases 1 and 2): in row order, a row whose strong neighbours (within AGGREGATE_REACH edges) are all
 // unassigned becomes a root and takes them; a row left over joins the aggregate of its strongest
 // assigned neighbour (or becomes one of its own). A coupling is strong when ||A_ij||_F > STRENGTH sqrt(||A_ii||_F ||A_jj||_F):
 // the blocks a cut left in the pattern at zero never join the two sides of a cut. Made at the
@@ -38,11 +38,13 @@ class TwoLevelPreconditioner {
   /// Rotations about an axis whose moment of the aggregate's points is below this share of the
   /// largest are left out (the points lie (nearly) on a line through the centroid along it).
   static constexpr double ROTATION_RANK_TOLERANCE = 1e-6;
-  /// Aggregates reach one strong edge from their root (~10-16 rows on a tet mesh) unless that gives
-  /// more coarse columns than this; then two. The coarse factor's fill grows faster than its size:
-  /// on the 52k-tet organ reach 1 gives 3828 columns whose factor (4.7M entries) costs 4x a fine
-  /// mat-vec per solve, reach 2 gives 906 (0.27M) for 83 instead of 59 iterations to 1e-6.
-  static constexpr long MAX_COARSE_COLUMNS = 1500;
+  /// Aggregates take the rows within this many strong edges of their root (~40-60 rows on a tet
+  /// mesh). The coarse solve (a scalar sparse triangular pair) costs ~10x a fine mat-vec's time per
+  /// entry, and its factor fills faster than it grows: one edge gave the 2.4k-tet frog 408 columns
+  /// whose solve took 16% of a step (two: 132 columns, 1950 factor entries, 30% off a cut-heavy
+  /// session), the 52k-tet organ 3828 columns and a 4.7M-entry factor (two: 950, 87k); three
+  /// saves no more on the organ and needs 1.6x the iterations on the frog.
+  static constexpr int AGGREGATE_REACH = 2;
   /// The coarse level (its points and matrix, assembled and factorized) is made anew every this many
   /// setups, and at once after aggregating; in between the last one serves (Pc and Pc^T A Pc of
   /// the same earlier setup: still a positive definite P). Translations do not depend on the points,

@@ -229,8 +229,16 @@ void BlockSparseMatrix::relayout(const std::vector<std::pair<int, int>>& min_cap
     throw std::length_error("BlockSparseMatrix: too many blocks for int slot indices");
 
   std::vector<int> row_begin(to_size(n));
-  std::vector<int> column(static_cast<size_t>(slot_count), -1);
-  std::vector<double> values(9 * static_cast<size_t>(slot_count), 0.0);
+  // Written into the storage of the re-layout before, with a quarter to spare when it must grow:
+  // each cut re-lays out a little larger, and fresh pages cost more than the copy.
+  std::vector<int>& column = m_spare_column;
+  std::vector<double>& values = m_spare_values;
+  if (column.capacity() < static_cast<size_t>(slot_count)) {
+    column.reserve(static_cast<size_t>(slot_count) + static_cast<size_t>(slot_count) / 4);
+    values.reserve(9 * column.capacity());
+  }
+  column.assign(static_cast<size_t>(slot_count), -1);
+  values.assign(9 * static_cast<size_t>(slot_count), 0.0);
   std::vector<std::pair<int, int>> order;  // (column, old slot) of one row
   m_relayout_slot_map.assign(m_column.size(), -1);
   int begin = 0;
@@ -253,8 +261,8 @@ void BlockSparseMatrix::relayout(const std::vector<std::pair<int, int>>& min_cap
 
   m_row_begin = std::move(row_begin);
   m_row_capacity = std::move(capacity);
-  m_column = std::move(column);
-  m_values = std::move(values);
+  m_column.swap(column);
+  m_values.swap(values);
   m_block_row_capacity = n + spare_rows;
   ++m_layout_revision;
   ++m_pattern_revision;
