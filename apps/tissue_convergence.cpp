@@ -128,7 +128,8 @@ int run(const Options& options) {
                  r.history.size() - 1, r.history.back(), r.solve_ms / iterations, r.setup_ms);
   }
   if (!csv) throw std::runtime_error("cannot write " + options.output);
-  std::fprintf(stderr, "  %d unknowns, %d tets; wrote %s\n", body.dof_count(), body.mesh().tet_count(),
+  std::fprintf(stderr, "  %d unknowns, %d tets, two-level: %d aggregates, %d coarse columns; wrote %s\n",
+               body.dof_count(), body.mesh().tet_count(), two_level.aggregate_count(), two_level.coarse_size(),
                options.output.c_str());
   return 0;
 }
