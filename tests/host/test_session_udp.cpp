@@ -94,8 +94,16 @@ TEST(UdpSession, PosesDriveTheProbeForcesComeBackBadPacketsAreCountedSilenceZero
   // Whatever the load: every bad packet is dropped and counted by its reason, the final silence trips
   // the watchdog, and forces come back.
   EXPECT_EQ(s.device.malformed, 1u);
-  EXPECT_EQ(s.device.duplicate, 1u);
   EXPECT_EQ(s.device.out_of_order, 1u);
+  EXPECT_EQ(s.device.received, s.device.accepted + s.device.malformed + s.device.oversized + s.device.out_of_order +
+                                   s.device.duplicate + s.device.stale + s.device.ignored);
+  // The replay repeats the sequence of the pose sent just before it: a duplicate when that pose was
+  // accepted. A haptic thread held off past the stale window (20 ms) drops that pose as stale, or a
+  // watchdog trip mid-stream reopens the stream, and the replay is then a fresh pose, not a duplicate.
+  if (s.device.stale == 0 && s.device.watchdog_trips == 1)
+    EXPECT_EQ(s.device.duplicate, 1u);
+  else
+    EXPECT_LE(s.device.duplicate, 1u);
   EXPECT_GE(s.device.watchdog_trips, 1u);
   EXPECT_GT(forces.size(), 100u);
   // When the machine kept time (the driver never paused for half the watchdog's timeout, the haptic
