@@ -13,8 +13,9 @@ constexpr std::uint64_t MAGIC = 0x31305353'49535354ULL;  // "TSSISS01" read as l
 // 2: PointSpring::tangent_fraction; 3: the cuts' enrichment offsets; 4: the applied tool position;
 // 5: several cuts per tet (pieces' offsets and rotations, the cuts' smallest fraction, cut counts);
 // 7: a ghost's unknown is its copy's displacement, not a difference from u (issue 40): the same
-// fields, other meanings
-constexpr std::uint32_t VERSION = 7;
+// fields, other meanings; 8: the cutter's per-vertex sides, distances and the blade's plane of the
+// open session (issue 41)
+constexpr std::uint32_t VERSION = 8;
 
 // The core's Eigen types and cut records on top of the shared byte stream.
 class Writer : public serial::ByteWriter {
@@ -142,9 +143,21 @@ std::vector<std::uint8_t> serialize_snapshot(const TissueSnapshot& s) {
   w.put_all(c.tet_cut_session);
   w.put_all(c.tet_ignored_session);
   w.put_all(c.tet_cut_count);
+  w.put_all(c.tet_cut_above);
   w.put_all(c.edge_session);
   w.put_all(c.edge_ratio);
   w.put_all(c.edge_upper_end);
+  w.put_all(c.vertex_session);
+  w.put_all(c.vertex_side);
+  w.put_all(c.vertex_distance_m);
+  w.put_all(c.vertex_turn_rad);
+  w.put_all(c.watched);
+  w.put(c.idle_steps);
+  w.put(c.record_epoch);
+  w.put(c.turn_rad);
+  w.put_all(c.session_vertices);
+  for (const Eigen::Vector3d& p : c.plane) w.put(p);
+  w.put(static_cast<std::uint8_t>(c.plane_valid));
   w.put_all(c.active);
   w.put(static_cast<std::uint8_t>(s.contact.in_contact));
   w.put(s.contact.proxy.triangle);
@@ -204,9 +217,21 @@ TissueSnapshot read_snapshot(std::span<const std::uint8_t> bytes) {
   r.get_all(c.tet_cut_session, 4);
   r.get_all(c.tet_ignored_session, 4);
   r.get_all(c.tet_cut_count, 1);
+  r.get_all(c.tet_cut_above, 1);
   r.get_all(c.edge_session, 4);
   r.get_all(c.edge_ratio, 8);
   r.get_all(c.edge_upper_end, 1);
+  r.get_all(c.vertex_session, 4);
+  r.get_all(c.vertex_side, 1);
+  r.get_all(c.vertex_distance_m, 8);
+  r.get_all(c.vertex_turn_rad, 8);
+  r.get_all(c.watched, 4);
+  r.get(c.idle_steps);
+  r.get(c.record_epoch);
+  r.get(c.turn_rad);
+  r.get_all(c.session_vertices, 4);
+  for (Eigen::Vector3d& p : c.plane) r.get(p);
+  c.plane_valid = r.get_bool();
   r.get_all(c.active, 4);
   s.contact.in_contact = r.get_bool();
   r.get(s.contact.proxy.triangle);

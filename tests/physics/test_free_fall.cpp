@@ -172,7 +172,8 @@ TEST(FreeFall, APieceFreedByAStrokeOverManyStepsFallsAtG) {
   }
   tissue.set_tool(ToolPose{Eigen::Vector3d(0.075, 0.2, -0.05), Eigen::Quaterniond::Identity(), ToolMode::none});
   tissue.step();
-  EXPECT_GE(steps_that_cut, 3);  // tets complete as the blade leaves them: at several steps, not at once
+  // Tets complete as the blade passes their vertices: the beam's two layers at two steps, not at once.
+  EXPECT_GE(steps_that_cut, 2);
 
   const std::vector<BodyPiece> free = free_pieces_of(tissue.body());
   ASSERT_EQ(free.size(), 1u);

@@ -221,4 +221,29 @@ std::optional<TetCut> classify_tet_cut(const std::array<Eigen::Vector3d, 4>& res
   return cut;
 }
 
+TetCut cut_from_sides(const std::array<Eigen::Vector3d, 4>& rest_m, const std::array<std::int8_t, 4>& side,
+                      const std::array<double, 6>& ratio, double end_margin, double min_volume_fraction) {
+  TetCut cut;
+  cut.side = side;
+  unsigned above = 0u;
+  for (int v = 0; v < 4; ++v) {
+    if (side[static_cast<std::size_t>(v)] > 0) above |= 1u << static_cast<unsigned>(v);
+  }
+  std::array<Eigen::Vector3d, 6> cut_points;
+  for (std::size_t k = 0; k < 6; ++k) {
+    if (in_group(above, TET_EDGES[k][0]) == in_group(above, TET_EDGES[k][1])) continue;
+    // The volume from where the blade passed (a vertex on the blade leaves its part no volume);
+    // the cut points held end_margin off the ends, so that they are distinct.
+    const double exact = std::clamp(ratio[k], 0.0, 1.0);
+    cut_points[k] = (1.0 - exact) * rest_m[static_cast<std::size_t>(TET_EDGES[k][0])] +
+                    exact * rest_m[static_cast<std::size_t>(TET_EDGES[k][1])];
+    cut.edge_ratio[k] = std::clamp(ratio[k], end_margin, 1.0 - end_margin);
+  }
+  const double volume_m3 = signed_tet_volume(rest_m[0], rest_m[1], rest_m[2], rest_m[3]);
+  double fraction_above = part_volume(rest_m, above, cut_points) / volume_m3;
+  if (!std::isfinite(fraction_above)) fraction_above = 0.5;  // a degenerate rest tet (never after loading)
+  cut.volume_fraction_above = std::clamp(fraction_above, min_volume_fraction, 1.0 - min_volume_fraction);
+  return cut;
+}
+
 }  // namespace tissue

@@ -44,6 +44,14 @@ struct TetEdgeCrossings {
 std::optional<TetCut> classify_tet_cut(const std::array<Eigen::Vector3d, 4>& rest_m, const TetEdgeCrossings& crossings,
                                        double vertex_snap_fraction, double min_volume_fraction);
 
+/// The cut of a tet whose vertices' sides were decided (the cutter's per-vertex decisions, issue 41):
+/// `side` +1 above, -1 below, both present; `ratio[k]` where the blade passed local edge k (along
+/// TET_EDGES[k], in [0, 1]), read only for the edges between the sides and held at least
+/// `end_margin` from either end there, so the cut points are distinct. The volume fraction is exact
+/// for the cut surface through them (part_volume), clamped as classify_tet_cut clamps it.
+TetCut cut_from_sides(const std::array<Eigen::Vector3d, 4>& rest_m, const std::array<std::int8_t, 4>& side,
+                      const std::array<double, 6>& ratio, double end_margin, double min_volume_fraction);
+
 /// Signed volume of the part of tet x (positive orientation: positive result) that holds the local
 /// vertices in `group` (bit i set = vertex i; neither 0 nor 15), bounded by the tet's faces and the
 /// cut surface through cut_points_m[k] on each local edge k between the group and the other vertices

@@ -83,7 +83,7 @@ CutSweepReport CutSession::sweep(const ToolPose& previous, const ToolPose& curre
 }
 
 void CutSession::stop() {
-  if (m_cutter && m_cutter->cutting()) m_cutter->end_cut();
+  if (m_cutter) m_cutter->end_cut();  // also after a session that ended itself: the next is a new stroke
 }
 
 double CutSession::blade_depth_m(const ToolPose& tool, const LazySurfaceBvh& bvh, int mesh_triangles) const {

@@ -10,6 +10,8 @@
 #include <algorithm>
 #include <array>
 #include <chrono>
+#include <limits>
+#include <cmath>
 #include <stdexcept>
 #include <sstream>
 #include <string>
@@ -18,6 +20,15 @@ namespace tissue {
 namespace {
 
 std::size_t at(int index) { return static_cast<std::size_t>(index); }
+
+/// The local vertices a cut puts above, as bits.
+std::uint8_t above_mask(const TetCut& cut) {
+  unsigned mask = 0u;
+  for (unsigned v = 0; v < 4; ++v) {
+    if (cut.side[v] > 0) mask |= 1u << v;
+  }
+  return static_cast<std::uint8_t>(mask);
+}
 
 Eigen::Vector3d vertex_position(const Eigen::VectorXd& positions_m, int vertex) {
   return positions_m.segment<3>(3 * static_cast<Eigen::Index>(vertex));
@@ -142,17 +153,42 @@ VolumeCutter::VolumeCutter(const TetMesh& mesh, const TetAdjacency& adjacency, c
   m_tet_cut_session.assign(tets, -1);
   m_tet_ignored_session.assign(tets, -1);
   m_tet_cut_count.assign(tets, 0);
+  m_tet_cut_above.assign(tets, 0);
   m_edge_stamp.assign(edges, 0);
   m_edge_session.assign(edges, -1);
   m_edge_ratio.assign(edges, 0.0);
   m_edge_upper_end.assign(edges, 0);
+  m_active_stamp.assign(tets, 0);
+  const std::size_t vertices = static_cast<std::size_t>(mesh.vertex_count());
+  m_vertex_session.assign(vertices, -1);
+  m_vertex_side.assign(vertices, 0);
+  m_vertex_distance_m.assign(vertices, 0.0);
+  m_vertex_turn_rad.assign(vertices, 0.0);
+  m_vertex_edge_m.assign(vertices, std::numeric_limits<double>::infinity());
+  m_vertex_reach_m.assign(vertices, 0.0);
+  for (const auto& ends : adjacency.edges) {
+    const double length_m = (mesh.rest_positions_m[at(ends[1])] - mesh.rest_positions_m[at(ends[0])]).norm();
+    for (const int v : ends) {
+      m_vertex_edge_m[at(v)] = std::min(m_vertex_edge_m[at(v)], length_m);
+      m_vertex_reach_m[at(v)] = std::max(m_vertex_reach_m[at(v)], length_m);
+    }
+  }
+  m_vertex_snap_m.resize(vertices);
+  for (std::size_t v = 0; v < vertices; ++v) {
+    if (!std::isfinite(m_vertex_edge_m[v])) m_vertex_edge_m[v] = 0.0;  // a vertex on no edge
+    m_vertex_snap_m[v] = settings.vertex_snap_fraction * m_vertex_edge_m[v];
+  }
+  m_new_vertices.reserve(vertices);
+  m_watched.reserve(vertices);
+  m_watched_flag.assign(vertices, 0);
+  m_session_vertices.reserve(vertices);
+  m_closing.reserve(4 * tets);
   // Each tet (edge) enters a list at most once per step: these capacities are never exceeded.
   m_active.reserve(tets);
   m_visited.reserve(tets);
   m_stack.reserve(tets);
   m_candidates.reserve(tets);
   m_new_cuts.reserve(tets);
-  m_new_edges.reserve(edges);
   m_seeds.reserve(surface.triangles.size());
   // The BVH also holds the cut faces added later: room for as many again.
   m_hits.reserve(2 * surface.triangles.size());
@@ -160,13 +196,14 @@ VolumeCutter::VolumeCutter(const TetMesh& mesh, const TetAdjacency& adjacency, c
 }
 
 std::optional<double> VolumeCutter::edge_crossing(int edge) const {
-  if (m_cut_id < 0 || m_edge_session[at(edge)] != m_cut_id) return std::nullopt;
+  if (m_cut_id < 0 || m_edge_session[at(edge)] != m_record_epoch) return std::nullopt;
   return m_edge_ratio[at(edge)];
 }
 
 void VolumeCutter::end_cut() {
   m_cutting = false;
   m_active.clear();
+  m_idle_steps = 2;  // ended on purpose: the next session is a new stroke
 }
 
 void VolumeCutter::save(SessionState& state) const {
@@ -175,9 +212,21 @@ void VolumeCutter::save(SessionState& state) const {
   state.tet_cut_session = m_tet_cut_session;
   state.tet_ignored_session = m_tet_ignored_session;
   state.tet_cut_count = m_tet_cut_count;
+  state.tet_cut_above = m_tet_cut_above;
   state.edge_session = m_edge_session;
   state.edge_ratio = m_edge_ratio;
   state.edge_upper_end = m_edge_upper_end;
+  state.vertex_session = m_vertex_session;
+  state.vertex_side = m_vertex_side;
+  state.vertex_distance_m = m_vertex_distance_m;
+  state.vertex_turn_rad = m_vertex_turn_rad;
+  state.watched = m_watched;
+  state.idle_steps = m_idle_steps;
+  state.record_epoch = m_record_epoch;
+  state.turn_rad = m_turn_rad;
+  state.session_vertices = m_session_vertices;
+  state.plane = {m_plane.tip_m, m_plane.blade_m, m_plane.normal, m_plane.ahead, m_plane.anchor_m, m_last_stroke_normal};
+  state.plane_valid = m_plane.valid;
   state.active = m_active;
 }
 
@@ -185,8 +234,38 @@ void VolumeCutter::restore(const SessionState& state) {
   const auto fail = [](const std::string& what) { throw std::invalid_argument("VolumeCutter::restore: " + what); };
   const size_t tets = m_tet_cut_session.size();
   const size_t edges = m_edge_session.size();
+  const size_t vertices = m_vertex_session.size();
+  if (state.vertex_session.size() != vertices || state.vertex_side.size() != vertices) {
+    fail("the state's vertex sides are of another mesh (" + std::to_string(state.vertex_session.size()) +
+         " vertices; this one has " + std::to_string(vertices) + ")");
+  }
+  if (!std::all_of(state.vertex_side.begin(), state.vertex_side.end(),
+                   [](std::int8_t side) { return side >= -1 && side <= 1; })) {
+    fail("a vertex's side is not -1, 0 or +1");
+  }
+  if (state.vertex_turn_rad.size() != vertices || !std::isfinite(state.turn_rad) ||
+      !std::all_of(state.vertex_turn_rad.begin(), state.vertex_turn_rad.end(), [](double a) { return std::isfinite(a); })) {
+    fail("the state's blade turning is of another mesh or not finite");
+  }
+  if (state.vertex_distance_m.size() != vertices ||
+      !std::all_of(state.vertex_distance_m.begin(), state.vertex_distance_m.end(), [](double d) { return std::isfinite(d); })) {
+    fail("the state's vertex distances are of another mesh or not finite");
+  }
+  if (state.watched.size() > vertices ||
+      !std::all_of(state.watched.begin(), state.watched.end(),
+                   [&](int v) { return v >= 0 && static_cast<size_t>(v) < vertices; })) {
+    fail("a watched vertex is out of range");
+  }
+  if (state.session_vertices.size() > vertices ||
+      !std::all_of(state.session_vertices.begin(), state.session_vertices.end(),
+                   [&](int v) { return v >= 0 && static_cast<size_t>(v) < vertices; })) {
+    fail("a session vertex is out of range");
+  }
+  if (!std::all_of(state.plane.begin(), state.plane.end(), [](const Eigen::Vector3d& p) { return p.allFinite(); })) {
+    fail("the blade's plane is not finite");
+  }
   if (state.tet_cut_session.size() != tets || state.tet_ignored_session.size() != tets ||
-      state.tet_cut_count.size() != tets ||
+      state.tet_cut_count.size() != tets || state.tet_cut_above.size() != tets ||
       state.edge_session.size() != edges || state.edge_ratio.size() != edges || state.edge_upper_end.size() != edges) {
     fail("the state is of another mesh (" + std::to_string(state.tet_cut_session.size()) + " tets, " +
          std::to_string(state.edge_session.size()) + " edges; this one has " + std::to_string(tets) + " and " +
@@ -196,7 +275,9 @@ void VolumeCutter::restore(const SessionState& state) {
   const auto session_ok = [&](int session) { return session >= -1 && session <= state.cut_id; };
   if (!std::all_of(state.tet_cut_session.begin(), state.tet_cut_session.end(), session_ok) ||
       !std::all_of(state.tet_ignored_session.begin(), state.tet_ignored_session.end(), session_ok) ||
-      !std::all_of(state.edge_session.begin(), state.edge_session.end(), session_ok)) {
+      !std::all_of(state.edge_session.begin(), state.edge_session.end(),
+                   [&](int epoch) { return epoch >= -1 && epoch <= state.record_epoch; }) ||
+      !std::all_of(state.vertex_session.begin(), state.vertex_session.end(), session_ok)) {
     fail("a tet or edge names a session after " + std::to_string(state.cut_id));
   }
   if (!std::all_of(state.tet_cut_count.begin(), state.tet_cut_count.end(),
@@ -213,9 +294,23 @@ void VolumeCutter::restore(const SessionState& state) {
   std::copy(state.tet_cut_session.begin(), state.tet_cut_session.end(), m_tet_cut_session.begin());
   std::copy(state.tet_ignored_session.begin(), state.tet_ignored_session.end(), m_tet_ignored_session.begin());
   std::copy(state.tet_cut_count.begin(), state.tet_cut_count.end(), m_tet_cut_count.begin());
+  std::copy(state.tet_cut_above.begin(), state.tet_cut_above.end(), m_tet_cut_above.begin());
   std::copy(state.edge_session.begin(), state.edge_session.end(), m_edge_session.begin());
   std::copy(state.edge_ratio.begin(), state.edge_ratio.end(), m_edge_ratio.begin());
   std::copy(state.edge_upper_end.begin(), state.edge_upper_end.end(), m_edge_upper_end.begin());
+  std::copy(state.vertex_session.begin(), state.vertex_session.end(), m_vertex_session.begin());
+  std::copy(state.vertex_side.begin(), state.vertex_side.end(), m_vertex_side.begin());
+  std::copy(state.vertex_distance_m.begin(), state.vertex_distance_m.end(), m_vertex_distance_m.begin());
+  std::copy(state.vertex_turn_rad.begin(), state.vertex_turn_rad.end(), m_vertex_turn_rad.begin());
+  m_turn_rad = state.turn_rad;
+  m_idle_steps = std::clamp(state.idle_steps, 0, 2);
+  m_record_epoch = state.record_epoch;
+  std::fill(m_watched_flag.begin(), m_watched_flag.end(), std::uint8_t{0});
+  m_watched.assign(state.watched.begin(), state.watched.end());
+  for (const int vertex : m_watched) m_watched_flag[at(vertex)] = 1;
+  m_session_vertices.assign(state.session_vertices.begin(), state.session_vertices.end());
+  m_plane = BladePlane{state.plane[0], state.plane[1], state.plane[2], state.plane[3], state.plane[4], state.plane_valid};
+  m_last_stroke_normal = state.plane[5];
   m_active.assign(state.active.begin(), state.active.end());
 }
 
@@ -240,41 +335,71 @@ CutStepReport VolumeCutter::step(const Blade& previous, const Blade& current, co
   const auto start = std::chrono::steady_clock::now();
   m_new_cuts.clear();
   m_visited.clear();
-  m_new_edges.clear();
+  m_new_vertices.clear();
+  m_new_crossings = 0;
   m_candidates.clear();
   m_seeds.clear();
   CutStepReport report;
-  const Sweep sweep(swept_from(previous, current), current);
+  const Blade sweep_start = swept_from(previous, current);
+  const Sweep sweep(sweep_start, current);
   const bool was_cutting = m_cutting;
   if (!was_cutting) {
     // Algorithm 5, first part: the blade (or, added, its sweep) meets the surface.
     ++m_stamp;
     find_initial_tets(current, positions_m, bvh);
     ++m_stamp;
-    collect_surface_seeds(sweep, positions_m, bvh);
+    // From the previous blade itself: the sweep's overlap behind it would start a session again
+    // just after one ended, where the blade left the body, and cut the tets there twice.
+    collect_surface_seeds(Sweep(previous, current), positions_m, bvh);
     if (m_active.empty() && m_seeds.empty()) {
+      m_idle_steps = std::min(m_idle_steps + 1, 2);
       report.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
       return report;
     }
+    m_seeds.clear();
+    collect_surface_seeds(sweep, positions_m, bvh);
     m_cutting = true;
-    ++m_cut_id;
-  } else {
-    ++m_stamp;
   }
+  // A session that ended in the last step (a blade through a vertex or along an edge exactly may
+  // touch no tet for a step) goes on when the blade moves on in its plane: one stroke, one session.
+  const bool new_session = !was_cutting && !(m_idle_steps == 0 && continues_plane(previous, current));
+  if (!was_cutting) ++m_record_epoch;  // edge crossings are recorded afresh (algorithm 3) at every start
+  if (new_session) {
+    ++m_cut_id;
+    m_session_vertices.clear();
+    for (const int vertex : m_watched) m_watched_flag[at(vertex)] = 0;
+    m_watched.clear();
+  }
+  if (was_cutting) ++m_stamp;
+  if (!was_cutting && !new_session) m_plane.anchor_m = 0.5 * (previous.tip_m + previous.handle_m);  // going on
+  update_plane(previous, current, new_session);
+  // How far behind the blade the sweep starts, in the plane's direction of motion (<= 0).
+  m_strip_back_m = std::min({0.0, (sweep_start.tip_m - current.tip_m).dot(m_plane.ahead),
+                             (sweep_start.handle_m - current.tip_m).dot(m_plane.ahead)});
   // Algorithm 2 from every active tet, then from where the sweep crosses the surface elsewhere.
   for (const int tet : m_active) search_from(tet, sweep, positions_m);
   if (was_cutting) collect_surface_seeds(sweep, positions_m, bvh);
   for (const int tet : m_seeds) search_from(tet, sweep, positions_m);
 
   find_next_active(current, positions_m);
-  complete_touched_tets(report);
-  if (m_active.empty()) m_cutting = false;
+  if (m_active.empty()) {
+    // A blade through a vertex or along an edge exactly may touch none of the tets the sweep
+    // reached while it is still in the body: the session goes on from where it enters the surface.
+    ++m_stamp;
+    find_initial_tets(current, positions_m, bvh);
+  }
+  complete_touched_tets(report, positions_m);
+  if (m_active.empty()) {
+    close_session(report, positions_m);
+    m_cutting = false;
+    m_idle_steps = 0;
+  }
 
   report.cutting = m_cutting;
   report.cut_id = m_cut_id;
   report.intersected_tets = static_cast<int>(m_visited.size());
   report.active_tets = static_cast<int>(m_active.size());
-  report.new_edge_crossings = static_cast<int>(m_new_edges.size());
+  report.new_edge_crossings = m_new_crossings;
   report.newly_cut_tets = static_cast<int>(m_new_cuts.size());
   report.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return report;
@@ -350,8 +475,14 @@ void VolumeCutter::search_from(int seed, const Sweep& sweep, const Eigen::Vector
 
 void VolumeCutter::visit(int tet, const Sweep& sweep, const Eigen::VectorXd& positions_m) {
   for (const int edge : m_adjacency.tet_edges[at(tet)]) process_edge(edge, sweep, positions_m);
-  // Added: step across faces the sweep's boundary crosses (no edge need be crossed there).
   const Tet& vertices = m_mesh.tets[at(tet)];
+  // A vertex of a tet the sweep touches that the blade passed in this step (behind the blade, not
+  // behind the sweep's start) gets its side now, for the session and every tet around it; one still
+  // ahead of the blade is watched until it is passed (pass_watched).
+  for (const int vertex : vertices) {
+    decide_if_passed(vertex, positions_m);
+  }
+  // Added: step across faces the sweep's boundary crosses (no edge need be crossed there).
   for (std::size_t k = 0; k < 4; ++k) {
     const int next = m_adjacency.face_neighbor[at(tet)][k];
     if (next < 0 || m_tet_stamp[at(next)] == m_stamp) continue;
@@ -364,19 +495,19 @@ void VolumeCutter::visit(int tet, const Sweep& sweep, const Eigen::VectorXd& pos
   }
 }
 
-// Each edge is tested once per step; a crossed edge is recorded once per session (algorithm 3:
-// the first crossing wins) and the tets around it are searched next.
+// Each edge is tested once per step; the first crossing in a session is recorded (algorithm 3) and
+// the tets around it are searched next.
 void VolumeCutter::process_edge(int edge, const Sweep& sweep, const Eigen::VectorXd& positions_m) {
   if (m_edge_stamp[at(edge)] == m_stamp) return;
   m_edge_stamp[at(edge)] = m_stamp;
   const auto& ends = m_adjacency.edges[at(edge)];
   const auto crossing = sweep.cross_edge(vertex_position(positions_m, ends[0]), vertex_position(positions_m, ends[1]));
   if (!crossing) return;
-  if (m_edge_session[at(edge)] != m_cut_id) {
-    m_edge_session[at(edge)] = m_cut_id;
+  if (m_edge_session[at(edge)] != m_record_epoch) {
+    m_edge_session[at(edge)] = m_record_epoch;
     m_edge_ratio[at(edge)] = crossing->ratio;
     m_edge_upper_end[at(edge)] = crossing->upper_end;
-    m_new_edges.push_back(edge);
+    ++m_new_crossings;
   }
   const int end = m_adjacency.edge_tets_begin[at(edge) + 1];
   for (int k = m_adjacency.edge_tets_begin[at(edge)]; k < end; ++k) push_unvisited(m_adjacency.edge_tets[at(k)]);
@@ -395,33 +526,31 @@ void VolumeCutter::find_next_active(const Blade& blade, const Eigen::VectorXd& p
   }
 }
 
-// A tet can only become completely cut when one of its edges gets a crossing: test the tets
-// around this step's new crossings.
-void VolumeCutter::complete_touched_tets(CutStepReport& report) {
-  for (const int edge : m_new_edges) {
-    const int end = m_adjacency.edge_tets_begin[at(edge) + 1];
-    for (int k = m_adjacency.edge_tets_begin[at(edge)]; k < end; ++k) {
-      const int tet = m_adjacency.edge_tets[at(k)];
+// A tet is cut when the sides of all its vertices are decided in this session and differ. Decisions
+// are made only here and in visit: the candidates are the tets around this step's decisions.
+void VolumeCutter::complete_touched_tets(CutStepReport& report, const Eigen::VectorXd& positions_m) {
+  // The vertices seen ahead of the blade that it has passed since, whether or not a tet of theirs
+  // is touched now (off the blade's plane, beyond the part of a tet it crossed; or carried past a
+  // step's sweep by the body).
+  pass_watched(positions_m);
+  cut_around_new_vertices(report);
+}
+
+void VolumeCutter::cut_around_new_vertices(CutStepReport& report) {
+  for (const int vertex : m_new_vertices) {
+    const int end = m_adjacency.vertex_tets_begin[at(vertex) + 1];
+    for (int k = m_adjacency.vertex_tets_begin[at(vertex)]; k < end; ++k) {
+      const int tet = m_adjacency.vertex_tets[at(k)];
       if (m_candidate_stamp[at(tet)] == m_stamp) continue;
       m_candidate_stamp[at(tet)] = m_stamp;
       m_candidates.push_back(tet);
     }
   }
+  m_new_vertices.clear();
+  const double end_margin = MIN_CUT_POINT_MARGIN;  // the classification is snapped, never the geometry
   for (const int tet : m_candidates) {
     if (m_tet_cut_session[at(tet)] == m_cut_id) continue;
-    const Tet& vertices = m_mesh.tets[at(tet)];
-    TetEdgeCrossings crossings;
-    for (std::size_t k = 0; k < 6; ++k) {
-      const int edge = m_adjacency.tet_edges[at(tet)][k];
-      if (m_edge_session[at(edge)] != m_cut_id) continue;
-      // Stored along {v0, v1} with v0 < v1; the tet's local edge may run the other way.
-      const bool same_direction = vertices[at(TET_EDGES[k][0])] == m_adjacency.edges[at(edge)][0];
-      crossings.ratio[k] = same_direction ? m_edge_ratio[at(edge)] : 1.0 - m_edge_ratio[at(edge)];
-      crossings.upper_end[k] =
-          static_cast<std::int8_t>(same_direction ? m_edge_upper_end[at(edge)] : -m_edge_upper_end[at(edge)]);
-    }
-    const std::array<Eigen::Vector3d, 4> rest = m_mesh.rest_corners(tet);
-    auto cut = classify_tet_cut(rest, crossings, m_settings.vertex_snap_fraction, m_settings.min_volume_fraction);
+    const auto cut = cut_of(tet, end_margin);
     if (!cut) continue;
     if (m_tet_cut_count[at(tet)] >= MAX_PIECE_CUTS) {  // the pieces' capacity (convex_piece.hpp)
       if (m_tet_ignored_session[at(tet)] != m_cut_id) {
@@ -430,13 +559,21 @@ void VolumeCutter::complete_touched_tets(CutStepReport& report) {
       }
       continue;
     }
-    cut->tet = tet;
-    cut->cut_id = m_cut_id;
-    cut->min_volume_fraction = m_settings.min_volume_fraction;
+    // A session that continues the last one's stroke (a session started again where a blade moving
+    // through a vertex or an edge touched no tet for a step: the same plane) and gives the tet's
+    // vertices the sides the last one gave them makes no new cut: the pieces are those it has.
+    const std::uint8_t above = above_mask(*cut);
+    const std::uint8_t last = m_tet_cut_above[at(tet)];
+    if (m_tet_cut_count[at(tet)] > 0 && m_tet_cut_session[at(tet)] == m_cut_id - 1 && continues_last_stroke() &&
+        (last == above || last == (~above & 0xFu))) {
+      continue;
+    }
     m_tet_cut_session[at(tet)] = m_cut_id;
+    m_tet_cut_above[at(tet)] = above;
     ++m_tet_cut_count[at(tet)];
     m_new_cuts.push_back(*cut);
   }
+  m_candidates.clear();
 }
 
 }  // namespace tissue

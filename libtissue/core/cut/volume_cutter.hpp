@@ -1,9 +1,15 @@
 // VolumeCutter: semi-progressive cutting by volume collision detection (dissertation 4.3.2,
 // algorithms 1-5). The blade is the segment tip-handle; between two steps it sweeps two
-// triangles. A local neighbour search from the tets the blade touches records where the sweep
-// crosses mesh edges (once per cutting session), and every tet whose recorded crossings separate
-// its vertices is handed to the XFEM as a TetCut as soon as it is cut completely (once per session;
-// a tet may be cut by up to MAX_PIECE_CUTS sessions, issue 21).
+// triangles. A local neighbour search from the tets the blade touches finds the tets the sweep
+// touches and records where it crosses mesh edges (once per cutting session).
+//
+// Which tets are cut is decided by their vertices (issue 41, vertex_sides.cpp): each vertex gets one
+// side of the blade's plane per session (per passage of a spiral), when the blade passes it, shared
+// by every tet around it; a tet is cut as soon as the blade has passed all its vertices and they lie
+// on both sides (a vertex within its snap distance of the blade counts above, in every tet). So
+// the cut tets always separate the decided vertices: no tet holds the two sides together, however
+// the body moves while the blade passes. Each cut goes to the XFEM as a TetCut; a tet may be cut by
+// up to MAX_PIECE_CUTS sessions (issue 21).
 //
 // Additions to the dissertation's algorithms, for robustness:
 //  * A session also starts when the sweep (not only the current blade) crosses the surface, so a
@@ -17,12 +23,11 @@
 //  * Each edge test is guarded against round-off at the edge's ends (EDGE_ROUND_OFF_EXTENSION).
 //
 // A session (one cut_id) runs from the step in which the blade or its sweep meets the surface to
-// the step after which the blade touches no tet, or to end_cut(). When a tet is complete, and how
-// its TetCut is computed, is decided by classify_tet_cut (cut_geometry.hpp) on this session's
-// crossings of the tet's edges: a later session that crosses a cut tet completely cuts it again (the
-// XFEM splits the pieces it passes through, split_pieces). A tet that carries MAX_PIECE_CUTS cuts
-// already is not cut again: counted once per session in CutStepReport::ignored_cuts. The search
-// starts from the previous step's active tets: if the
+// the step after which the blade touches no tet (then close_session), or to end_cut(); one that
+// ended in the last step goes on if the blade moves on in its plane. A later session that passes a
+// cut tet cuts it again (the XFEM splits the pieces it passes through, split_pieces). A tet that
+// carries MAX_PIECE_CUTS cuts already is not cut again: counted once per session in
+// CutStepReport::ignored_cuts. The search starts from the previous step's active tets: if the
 // body moves so far in one step that the blade has left all of them, only the parts of the sweep
 // that reach the surface are found.
 #pragma once
@@ -35,6 +40,7 @@
 
 #include <Eigen/Core>
 
+#include <array>
 #include <cstdint>
 #include <optional>
 #include <vector>
@@ -45,6 +51,35 @@ namespace tissue {
 /// both ends, and the crossing is clamped to the edge: a sweep exactly through a vertex is then
 /// seen, at that vertex, from every edge there, whatever the round-off.
 inline constexpr double EDGE_ROUND_OFF_EXTENSION = 1e-9;
+
+/// The blade's plane, in which a vertex's side is decided, turns with the blade's direction of
+/// motion measured over at least this distance of the blade's middle (and over the first step of a
+/// session): a hand's tremor over a fraction of a millimetre does not tilt it.
+inline constexpr double BLADE_PLANE_BASELINE_M = 1e-3;
+/// A blade moving within this sine of its own direction (a plunge) keeps the plane it had.
+inline constexpr double BLADE_PLANE_SINE_FLOOR = 1e-6;
+
+/// A vertex is passed again, and decided again, when the blade comes back to it after its plane
+/// turned through more than this (the next turn of a spiral); a tet is cut from decisions made
+/// within half of it.
+inline constexpr double PASSAGE_TURN_RAD = 3.14159265358979323846;
+
+/// Two sessions whose blade planes agree to this cosine (5 degrees), the second's blade within
+/// SAME_STROKE_OFFSET_M of the first's plane, are one stroke continued.
+inline constexpr double SAME_STROKE_COSINE = 0.996;
+inline constexpr double SAME_STROKE_OFFSET_M = 1e-4;
+
+/// close_session decides vertices in at most this many rounds (each round around the last).
+inline constexpr int MAX_CLOSING_ROUNDS = 8;
+
+/// The fit of close_session over a vertex's decided neighbours (rest positions scaled to the star's
+/// size) counts only pivots above this fraction of the largest: neighbours near one plane through
+/// the vertex do not determine its distance.
+inline constexpr double FIT_PIVOT_FLOOR = 1e-3;
+
+/// A cut point stays at least this fraction of its edge from either end (with vertex_snap_fraction
+/// 0 too), so that a tet's cut points are distinct and its cut plane defined.
+inline constexpr double MIN_CUT_POINT_MARGIN = 1e-6;
 
 /// Each step's sweep starts this fraction of the tip's and of the handle's travel behind the
 /// previous blade. Blade and body both move between two steps, and an edge is tested at its
@@ -119,11 +154,23 @@ class VolumeCutter {
   /// The tets the blade touches after the last step (the seeds of the next search).
   [[nodiscard]] const std::vector<int>& active_tets() const { return m_active; }
   [[nodiscard]] bool is_cut(int tet) const { return m_tet_cut_session[static_cast<std::size_t>(tet)] >= 0; }
+  /// The last session that cut `tet`, -1 if none did.
+  [[nodiscard]] int cut_session(int tet) const { return m_tet_cut_session[static_cast<std::size_t>(tet)]; }
   /// How many sessions cut `tet`.
   [[nodiscard]] int cut_count(int tet) const { return m_tet_cut_count[static_cast<std::size_t>(tet)]; }
   /// Where the current (or last) session crossed `edge` (an id of TetAdjacency::edges {v0, v1}):
   /// the ratio r of the point (1 - r) x_v0 + r x_v1, or nothing if it did not cross it.
   [[nodiscard]] std::optional<double> edge_crossing(int edge) const;
+
+  /// The side of the blade the current (or last) session gave `vertex`: +1 above, -1 below, 0 on
+  /// the blade (within its snap distance); nothing if the blade has not passed it.
+  /// True when the blade's plane turned through at most half PASSAGE_TURN_RAD between the decisions
+  /// of the tet's vertices' sides: a tet is cut only from such decisions.
+  [[nodiscard]] bool decided_in_one_passage(int tet) const { return one_passage(tet); }
+  [[nodiscard]] std::optional<int> vertex_side(int vertex) const {
+    if (m_cut_id < 0 || !side_decided(vertex)) return std::nullopt;
+    return m_vertex_side[static_cast<std::size_t>(vertex)];
+  }
 
   /// Ends the session (the tool changed mode): tets cut partially stay uncut.
   void end_cut();
@@ -136,9 +183,23 @@ class VolumeCutter {
     std::vector<int> tet_cut_session;
     std::vector<int> tet_ignored_session;
     std::vector<std::int8_t> tet_cut_count;
+    std::vector<std::uint8_t> tet_cut_above;
     std::vector<int> edge_session;
     std::vector<double> edge_ratio;
     std::vector<std::int8_t> edge_upper_end;
+    std::vector<int> vertex_session;
+    std::vector<std::int8_t> vertex_side;
+    std::vector<double> vertex_distance_m;
+    std::vector<double> vertex_turn_rad;
+    std::vector<int> watched;
+    int idle_steps = 2;
+    int record_epoch = -1;
+    double turn_rad = 0.0;
+    std::vector<int> session_vertices;
+    /// The blade's plane: tip, blade, normal, ahead, anchor (VolumeCutter::BladePlane); the last
+    /// session's normal.
+    std::array<Eigen::Vector3d, 6> plane{};
+    bool plane_valid = false;
     std::vector<int> active;
   };
   void save(SessionState& state) const;
@@ -156,9 +217,50 @@ class VolumeCutter {
   void search_from(int seed, const Sweep& sweep, const Eigen::VectorXd& positions_m);
   void visit(int tet, const Sweep& sweep, const Eigen::VectorXd& positions_m);
   void process_edge(int edge, const Sweep& sweep, const Eigen::VectorXd& positions_m);
+  /// True when the blade moving from `previous` to `current` moves in the last session's plane.
+  [[nodiscard]] bool continues_plane(const Blade& previous, const Blade& current) const;
+  /// The blade's plane for this step (BladePlane), from the blade's motion since its anchor.
+  void update_plane(const Blade& previous, const Blade& current, bool new_session);
+  /// A vertex's place relative to the blade's plane now: along the blade (0 at the tip, 1 at the
+  /// handle), ahead of it in its direction of motion [m], and above it [m].
+  struct PlaneOffset {
+    double along_blade = 0.0;
+    double ahead_m = 0.0;
+    double distance_m = 0.0;
+    [[nodiscard]] bool within_span() const { return along_blade >= 0.0 && along_blade <= 1.0; }
+  };
+  [[nodiscard]] PlaneOffset plane_offset(int vertex, const Eigen::VectorXd& positions_m) const;
+  /// Decides the vertex's side by its distance from the plane if the blade passed it in this step:
+  /// within the blade's span, behind it and not behind the sweep's start; watches it while ahead.
+  void decide_if_passed(int vertex, const Eigen::VectorXd& positions_m);
+  /// Decides the watched vertices the blade has passed since they were seen ahead of it.
+  void pass_watched(const Eigen::VectorXd& positions_m);
+  /// Decides the vertex's side by the cut around it: the linear fit, over the rest positions of the
+  /// decided vertices of its tets, of their distances from the blade, taken at its rest position.
+  void decide_from_neighbours(int vertex, const Eigen::VectorXd& positions_m);
+  void record_side(int vertex, double distance_m);
+  /// True when the tet's decided vertices lie on both sides (on the blade counts above), decided in
+  /// one passage.
+  [[nodiscard]] bool has_both_sides(int tet) const;
+  /// True when the blade turned through at most half PASSAGE_TURN_RAD between the decisions of the
+  /// tet's vertices.
+  [[nodiscard]] bool one_passage(int tet) const;
+  /// Cuts the tets around this step's decisions that are complete (cut_of).
+  void cut_around_new_vertices(CutStepReport& report);
+  /// At a session's end: decides, by the cut around them, the vertices of tets with vertices on both
+  /// sides that the blade went past (within its span, not ahead of it) without passing them.
+  void close_session(CutStepReport& report, const Eigen::VectorXd& positions_m);
+  /// The tet's cut from its vertices' sides, if all are decided in this session and they differ.
+  [[nodiscard]] std::optional<TetCut> cut_of(int tet, double end_margin) const;
+  [[nodiscard]] bool side_decided(int vertex) const { return m_vertex_session[static_cast<std::size_t>(vertex)] == m_cut_id; }
+  /// Decided in this session and in this passage: the blade's plane has not turned through
+  /// PASSAGE_TURN_RAD since (a spiral's earlier turn decided it for the tets there, not for these).
+  [[nodiscard]] bool decided_now(int vertex) const {
+    return side_decided(vertex) && m_turn_rad - m_vertex_turn_rad[static_cast<std::size_t>(vertex)] <= PASSAGE_TURN_RAD;
+  }
   void push_unvisited(int tet);
   void find_next_active(const Blade& blade, const Eigen::VectorXd& positions_m);
-  void complete_touched_tets(CutStepReport& report);
+  void complete_touched_tets(CutStepReport& report, const Eigen::VectorXd& positions_m);
 
   const TetMesh& m_mesh;
   const TetAdjacency& m_adjacency;
@@ -173,19 +275,58 @@ class VolumeCutter {
 
   std::vector<std::int64_t> m_tet_stamp;        ///< visited (algorithms 1, 2)
   std::vector<std::int64_t> m_candidate_stamp;  ///< already queued for the completion test
+  std::vector<std::int64_t> m_active_stamp;     ///< the blade touches it after this step
   std::vector<int> m_tet_cut_session;           ///< last session that cut the tet, -1 if uncut
   std::vector<std::int8_t> m_tet_cut_count;     ///< sessions that cut the tet
+  std::vector<std::uint8_t> m_tet_cut_above;    ///< the local vertices the last cut put above (bits)
   std::vector<int> m_tet_ignored_session;       ///< last session that reported an ignored cut
   std::vector<std::int64_t> m_edge_stamp;       ///< tested against the current sweep
-  std::vector<int> m_edge_session;              ///< session whose crossing is recorded, -1 if none
+  std::vector<int> m_edge_session;              ///< record epoch whose crossing is recorded, -1 if none
   std::vector<double> m_edge_ratio;             ///< along {v0, v1}
   std::vector<std::int8_t> m_edge_upper_end;    ///< +1: v1 above the sweep, -1: v0, 0: unknown
+  int m_new_crossings = 0;
+  /// Each vertex's side of the blade's plane (+1 above, -1 below, 0 on it: within its snap distance,
+  /// vertex_snap_fraction of its shortest edge), decided once per session when the blade has passed
+  /// it and shared by every tet around it; the session that decided it (-1: none), and its signed
+  /// distance from the plane then.
+  std::vector<int> m_vertex_session;
+  std::vector<std::int8_t> m_vertex_side;
+  std::vector<double> m_vertex_distance_m;
+  std::vector<double> m_vertex_edge_m;  ///< the shortest rest edge at each vertex
+  std::vector<double> m_vertex_reach_m;  ///< the longest
+  std::vector<double> m_vertex_turn_rad;  ///< how far the blade's plane had turned when it was decided
+  double m_turn_rad = 0.0;                ///< how far the blade's plane turned in this session
+  std::vector<double> m_vertex_snap_m;  ///< vertex_snap_fraction of it
+  std::vector<int> m_new_vertices;      ///< decided this step
+  std::vector<int> m_session_vertices;  ///< decided in this session
+  std::vector<int> m_closing;           ///< close_session's vertices to decide
+  std::vector<int> m_watched;           ///< seen ahead of the blade in a tet it touched, not yet passed
+  std::vector<std::uint8_t> m_watched_flag;
+  /// The plane of the blade's motion: through the current blade, its normal `normal` ("above"), and
+  /// `ahead` the direction in which the blade moves within it; measured from `anchor_m`, where the
+  /// blade's middle was when it was last turned. Not valid until the blade has moved in a session.
+  struct BladePlane {
+    Eigen::Vector3d tip_m = Eigen::Vector3d::Zero();
+    Eigen::Vector3d blade_m = Eigen::Vector3d::Zero();
+    Eigen::Vector3d normal = Eigen::Vector3d::Zero();
+    Eigen::Vector3d ahead = Eigen::Vector3d::Zero();
+    Eigen::Vector3d anchor_m = Eigen::Vector3d::Zero();
+    bool valid = false;
+  };
+  BladePlane m_plane;
+  Eigen::Vector3d m_last_stroke_normal = Eigen::Vector3d::Zero();  ///< the last session's plane (zero: none)
+  /// True when this session's plane is the last session's (within SAME_STROKE_COSINE).
+  [[nodiscard]] bool continues_last_stroke() const {
+    return m_plane.valid && std::abs(m_plane.normal.dot(m_last_stroke_normal)) >= SAME_STROKE_COSINE;
+  }
+  double m_strip_back_m = 0.0;  ///< where this step's sweep starts, behind the blade (<= 0)
+  int m_idle_steps = 2;         ///< steps without a session since the last ended (at most 2)
+  int m_record_epoch = -1;      ///< counts session starts, reopened ones too: the edge records' key
 
   std::vector<int> m_active;
   std::vector<int> m_visited;     ///< algorithm 2's intersected list of this step
   std::vector<int> m_stack;       ///< explicit stack of the searches (no recursion)
   std::vector<int> m_seeds;       ///< tets of surface triangles the sweep crosses
-  std::vector<int> m_new_edges;   ///< edges recorded this step
   std::vector<int> m_candidates;  ///< tets around them
   std::vector<TetCut> m_new_cuts;
   std::vector<SurfaceBvh::SegmentHit> m_hits;

@@ -173,7 +173,7 @@ class ReferenceCutter {
     const SweepQuad sweep(previous, current);
     Step result;
     if (!m_cutting) {
-      if (!meets_surface(sweep, current)) return result;
+      if (!meets_surface(SweepQuad(previous_blade, current), current)) return result;  // without the overlap
       ++m_session;
       m_cutting = true;
       std::fill(m_records.begin(), m_records.end(), -1.0);

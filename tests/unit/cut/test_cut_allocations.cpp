@@ -24,17 +24,19 @@ TEST(CutAllocations, CutterStepsAllocateNothing) {
   VolumeCutter cutter(mesh, adjacency, surface);
 
   // A long blade swept across the frog in 30 steps (fast enough to cut many tets per step), then
-  // back through the cut tets (second cuts, cutting them again), then out.
-  const auto blade_at = [](double x) {
-    return Blade{Eigen::Vector3d(x, 0.004, -0.2), Eigen::Vector3d(x + 0.003, -0.002, 0.2)};
+  // back, turned 8.5 degrees out of the first plane, through the cut tets (second cuts, cutting them
+  // again), then out.
+  const auto blade_at = [](double x, double tilt_m) {
+    return Blade{Eigen::Vector3d(x, 0.004 - tilt_m, -0.2), Eigen::Vector3d(x + 0.003, -0.002 + tilt_m, 0.2)};
   };
   const long before = g_allocations.load();
   int cut_tets = 0;
   for (const double direction : {1.0, -1.0}) {
+    const double tilt_m = direction > 0.0 ? 0.0 : 0.03;  // turned about the blade's middle
     for (int i = 0; i < 30; ++i) {
       const double x0 = direction * (-0.1 + 0.2 * i / 30.0);
       const double x1 = direction * (-0.1 + 0.2 * (i + 1) / 30.0);
-      const CutStepReport report = cutter.step(blade_at(x0), blade_at(x1), positions, bvh);
+      const CutStepReport report = cutter.step(blade_at(x0, tilt_m), blade_at(x1, tilt_m), positions, bvh);
       cut_tets += report.newly_cut_tets;
     }
   }
