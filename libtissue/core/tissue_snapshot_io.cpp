@@ -146,7 +146,6 @@ std::vector<std::uint8_t> serialize_snapshot(const TissueSnapshot& s) {
   w.put_all(c.tet_cut_above);
   w.put_all(c.edge_session);
   w.put_all(c.edge_ratio);
-  w.put_all(c.edge_upper_end);
   w.put_all(c.vertex_session);
   w.put_all(c.vertex_side);
   w.put_all(c.vertex_distance_m);
@@ -220,7 +219,6 @@ TissueSnapshot read_snapshot(std::span<const std::uint8_t> bytes) {
   r.get_all(c.tet_cut_above, 1);
   r.get_all(c.edge_session, 4);
   r.get_all(c.edge_ratio, 8);
-  r.get_all(c.edge_upper_end, 1);
   r.get_all(c.vertex_session, 4);
   r.get_all(c.vertex_side, 1);
   r.get_all(c.vertex_distance_m, 8);

@@ -10,8 +10,8 @@
 #include <algorithm>
 #include <array>
 #include <chrono>
-#include <limits>
 #include <cmath>
+#include <limits>
 #include <stdexcept>
 #include <sstream>
 #include <string>
@@ -80,23 +80,17 @@ struct VolumeCutter::Sweep {
     upper = previous.tip_m.cwiseMax(previous.handle_m).cwiseMax(current.tip_m).cwiseMax(current.handle_m);
   }
 
-  struct EdgeCrossing {
-    double ratio = 0.0;         ///< along a -> b, in [0, 1]
-    std::int8_t upper_end = 0;  ///< +1: b above, -1: a above, 0: unknown
-  };
-  /// Where the edge a-b (lengthened by EDGE_ROUND_OFF_EXTENSION) crosses the sweep; the first triangle wins
-  /// when it crosses both.
-  [[nodiscard]] std::optional<EdgeCrossing> cross_edge(const Eigen::Vector3d& a, const Eigen::Vector3d& b) const {
+  /// Where the edge a-b (lengthened by EDGE_ROUND_OFF_EXTENSION) crosses the sweep: the ratio along
+  /// a -> b, in [0, 1]; the first triangle wins when it crosses both.
+  [[nodiscard]] std::optional<double> cross_edge(const Eigen::Vector3d& a, const Eigen::Vector3d& b) const {
     const Eigen::Vector3d direction = b - a;
     const Eigen::Vector3d from = a - EDGE_ROUND_OFF_EXTENSION * direction;
     const Eigen::Vector3d to = b + EDGE_ROUND_OFF_EXTENSION * direction;
     for (std::size_t m = 0; m < 2; ++m) {
       const auto hit = intersect_segment_triangle(from, to, triangles[m][0], triangles[m][1], triangles[m][2]);
       if (!hit) continue;
-      const double ratio = std::clamp(
-          hit->segment_parameter * (1.0 + 2.0 * EDGE_ROUND_OFF_EXTENSION) - EDGE_ROUND_OFF_EXTENSION, 0.0, 1.0);
-      const double lift = direction.dot(normals[m]);
-      return EdgeCrossing{ratio, static_cast<std::int8_t>(lift > 0.0 ? 1 : (lift < 0.0 ? -1 : 0))};
+      return std::clamp(hit->segment_parameter * (1.0 + 2.0 * EDGE_ROUND_OFF_EXTENSION) - EDGE_ROUND_OFF_EXTENSION,
+                        0.0, 1.0);
     }
     return std::nullopt;
   }
@@ -157,26 +151,23 @@ VolumeCutter::VolumeCutter(const TetMesh& mesh, const TetAdjacency& adjacency, c
   m_edge_stamp.assign(edges, 0);
   m_edge_session.assign(edges, -1);
   m_edge_ratio.assign(edges, 0.0);
-  m_edge_upper_end.assign(edges, 0);
-  m_active_stamp.assign(tets, 0);
   const std::size_t vertices = static_cast<std::size_t>(mesh.vertex_count());
   m_vertex_session.assign(vertices, -1);
   m_vertex_side.assign(vertices, 0);
   m_vertex_distance_m.assign(vertices, 0.0);
   m_vertex_turn_rad.assign(vertices, 0.0);
-  m_vertex_edge_m.assign(vertices, std::numeric_limits<double>::infinity());
+  // Each vertex's snap distance from its shortest rest edge, its reach from its longest.
+  m_vertex_snap_m.assign(vertices, std::numeric_limits<double>::infinity());
   m_vertex_reach_m.assign(vertices, 0.0);
   for (const auto& ends : adjacency.edges) {
     const double length_m = (mesh.rest_positions_m[at(ends[1])] - mesh.rest_positions_m[at(ends[0])]).norm();
     for (const int v : ends) {
-      m_vertex_edge_m[at(v)] = std::min(m_vertex_edge_m[at(v)], length_m);
+      m_vertex_snap_m[at(v)] = std::min(m_vertex_snap_m[at(v)], settings.vertex_snap_fraction * length_m);
       m_vertex_reach_m[at(v)] = std::max(m_vertex_reach_m[at(v)], length_m);
     }
   }
-  m_vertex_snap_m.resize(vertices);
-  for (std::size_t v = 0; v < vertices; ++v) {
-    if (!std::isfinite(m_vertex_edge_m[v])) m_vertex_edge_m[v] = 0.0;  // a vertex on no edge
-    m_vertex_snap_m[v] = settings.vertex_snap_fraction * m_vertex_edge_m[v];
+  for (double& snap_m : m_vertex_snap_m) {
+    if (!std::isfinite(snap_m)) snap_m = 0.0;  // a vertex on no edge
   }
   m_new_vertices.reserve(vertices);
   m_watched.reserve(vertices);
@@ -215,7 +206,6 @@ void VolumeCutter::save(SessionState& state) const {
   state.tet_cut_above = m_tet_cut_above;
   state.edge_session = m_edge_session;
   state.edge_ratio = m_edge_ratio;
-  state.edge_upper_end = m_edge_upper_end;
   state.vertex_session = m_vertex_session;
   state.vertex_side = m_vertex_side;
   state.vertex_distance_m = m_vertex_distance_m;
@@ -266,7 +256,7 @@ void VolumeCutter::restore(const SessionState& state) {
   }
   if (state.tet_cut_session.size() != tets || state.tet_ignored_session.size() != tets ||
       state.tet_cut_count.size() != tets || state.tet_cut_above.size() != tets ||
-      state.edge_session.size() != edges || state.edge_ratio.size() != edges || state.edge_upper_end.size() != edges) {
+      state.edge_session.size() != edges || state.edge_ratio.size() != edges) {
     fail("the state is of another mesh (" + std::to_string(state.tet_cut_session.size()) + " tets, " +
          std::to_string(state.edge_session.size()) + " edges; this one has " + std::to_string(tets) + " and " +
          std::to_string(edges) + ")");
@@ -297,7 +287,6 @@ void VolumeCutter::restore(const SessionState& state) {
   std::copy(state.tet_cut_above.begin(), state.tet_cut_above.end(), m_tet_cut_above.begin());
   std::copy(state.edge_session.begin(), state.edge_session.end(), m_edge_session.begin());
   std::copy(state.edge_ratio.begin(), state.edge_ratio.end(), m_edge_ratio.begin());
-  std::copy(state.edge_upper_end.begin(), state.edge_upper_end.end(), m_edge_upper_end.begin());
   std::copy(state.vertex_session.begin(), state.vertex_session.end(), m_vertex_session.begin());
   std::copy(state.vertex_side.begin(), state.vertex_side.end(), m_vertex_side.begin());
   std::copy(state.vertex_distance_m.begin(), state.vertex_distance_m.end(), m_vertex_distance_m.begin());
@@ -505,8 +494,7 @@ void VolumeCutter::process_edge(int edge, const Sweep& sweep, const Eigen::Vecto
   if (!crossing) return;
   if (m_edge_session[at(edge)] != m_record_epoch) {
     m_edge_session[at(edge)] = m_record_epoch;
-    m_edge_ratio[at(edge)] = crossing->ratio;
-    m_edge_upper_end[at(edge)] = crossing->upper_end;
+    m_edge_ratio[at(edge)] = *crossing;
     ++m_new_crossings;
   }
   const int end = m_adjacency.edge_tets_begin[at(edge) + 1];

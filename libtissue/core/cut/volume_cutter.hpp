@@ -186,7 +186,6 @@ class VolumeCutter {
     std::vector<std::uint8_t> tet_cut_above;
     std::vector<int> edge_session;
     std::vector<double> edge_ratio;
-    std::vector<std::int8_t> edge_upper_end;
     std::vector<int> vertex_session;
     std::vector<std::int8_t> vertex_side;
     std::vector<double> vertex_distance_m;
@@ -275,7 +274,6 @@ class VolumeCutter {
 
   std::vector<std::int64_t> m_tet_stamp;        ///< visited (algorithms 1, 2)
   std::vector<std::int64_t> m_candidate_stamp;  ///< already queued for the completion test
-  std::vector<std::int64_t> m_active_stamp;     ///< the blade touches it after this step
   std::vector<int> m_tet_cut_session;           ///< last session that cut the tet, -1 if uncut
   std::vector<std::int8_t> m_tet_cut_count;     ///< sessions that cut the tet
   std::vector<std::uint8_t> m_tet_cut_above;    ///< the local vertices the last cut put above (bits)
@@ -283,7 +281,6 @@ class VolumeCutter {
   std::vector<std::int64_t> m_edge_stamp;       ///< tested against the current sweep
   std::vector<int> m_edge_session;              ///< record epoch whose crossing is recorded, -1 if none
   std::vector<double> m_edge_ratio;             ///< along {v0, v1}
-  std::vector<std::int8_t> m_edge_upper_end;    ///< +1: v1 above the sweep, -1: v0, 0: unknown
   int m_new_crossings = 0;
   /// Each vertex's side of the blade's plane (+1 above, -1 below, 0 on it: within its snap distance,
   /// vertex_snap_fraction of its shortest edge), decided once per session when the blade has passed
@@ -292,11 +289,10 @@ class VolumeCutter {
   std::vector<int> m_vertex_session;
   std::vector<std::int8_t> m_vertex_side;
   std::vector<double> m_vertex_distance_m;
-  std::vector<double> m_vertex_edge_m;  ///< the shortest rest edge at each vertex
-  std::vector<double> m_vertex_reach_m;  ///< the longest
+  std::vector<double> m_vertex_reach_m;  ///< the longest rest edge at each vertex
   std::vector<double> m_vertex_turn_rad;  ///< how far the blade's plane had turned when it was decided
   double m_turn_rad = 0.0;                ///< how far the blade's plane turned in this session
-  std::vector<double> m_vertex_snap_m;  ///< vertex_snap_fraction of it
+  std::vector<double> m_vertex_snap_m;  ///< vertex_snap_fraction of its shortest rest edge
   std::vector<int> m_new_vertices;      ///< decided this step
   std::vector<int> m_session_vertices;  ///< decided in this session
   std::vector<int> m_closing;           ///< close_session's vertices to decide
