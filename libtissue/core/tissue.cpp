@@ -67,16 +67,15 @@ TissueStepReport Tissue::step() {
   const ToolPose& previous = move.previous;
   const ToolPose& current = move.current;
 
-  // Cut: the blade's sweep since the last step, the tets it completed enriched.
-  if (current.mode == ToolMode::scalpel && interaction.cutting_enabled && previous.mode == ToolMode::scalpel) {
-    const CutSweepReport sweep = m_cuts.sweep(previous, current, m_surfaces.bvh(), cut_applier());
-    report.cut = sweep.cut;
-    report.enrichment = sweep.enrichment;
-    report.cut_s = sweep.cut_s;
-    report.enrich_s = sweep.enrich_s;
-  } else {
-    m_cuts.stop();
-  }
+  // Cut: the blade's sweep since the last step, the tets it completed enriched; when the scalpel
+  // stops cutting, the stroke ends where the blade is.
+  const bool cutting = current.mode == ToolMode::scalpel && interaction.cutting_enabled && previous.mode == ToolMode::scalpel;
+  const CutSweepReport sweep = cutting ? m_cuts.sweep(previous, current, m_surfaces.bvh(), cut_applier())
+                                       : m_cuts.stop(m_surfaces.bvh(), cut_applier());
+  report.cut = sweep.cut;
+  report.enrichment = sweep.enrichment;
+  report.cut_s = sweep.cut_s;
+  report.enrich_s = sweep.enrich_s;
 
   // Touch: the probe's god-object and spring.
   const auto contact_start = std::chrono::steady_clock::now();

@@ -209,7 +209,10 @@ struct FrogStrokes {
         body->enrich(cutter.new_cuts(), dynamics);
         if (after_cut) after_cut();
       }
-      cutter.end_cut();
+      cutter.end_cut(rest);  // the stroke ends where the blade is
+      if (cutter.new_cuts().empty()) continue;
+      body->enrich(cutter.new_cuts(), dynamics);
+      if (after_cut) after_cut();
     }
   }
   [[nodiscard]] CutRenderSurface render() const { return {mesh, render_surface, default_max_outside_m(mesh)}; }

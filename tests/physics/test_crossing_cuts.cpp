@@ -111,7 +111,9 @@ struct CutSpecimen {
         for (const TetCut& cut : cutter.new_cuts()) recut_tets += body.cut_tet_index(cut.tet) >= 0 ? 1 : 0;
         if (!cutter.new_cuts().empty()) body.enrich(cutter.new_cuts(), state);
       }
-      cutter.end_cut();  // the scalpel is lifted: the next stroke is a new session
+      cutter.end_cut(rest);  // the scalpel is lifted where it is: the next stroke is a new session
+      for (const TetCut& cut : cutter.new_cuts()) recut_tets += body.cut_tet_index(cut.tet) >= 0 ? 1 : 0;
+      if (!cutter.new_cuts().empty()) body.enrich(cutter.new_cuts(), state);
     }
   }
 
@@ -293,11 +295,10 @@ TEST(CrossingCuts, AnXCutLeavesFourPiecesOfTheExactVolumesAndTheThreeFreeOnesFal
 
 // --- the flap out of the frog's back -------------------------------------------------------------
 
-TEST(CrossingCuts, ThreeStrokesCutATriangularFlapOutOfTheFrogThatFallsWithThePrismsMass) {
+/// Three strokes along the sides of a triangle on the frog's back, each running past the corners at
+/// its ends by `overshoot_m` (0: from corner to corner, the strokes meeting at the corners).
+void expect_triangular_flap_falls(double overshoot_m) {
   TetMesh mesh = read_mesh(std::string(TISSUE_MESH_DIR) + "/frog.veg");
-  // The triangle's corners (x, y) on the back, and strokes along its sides that overshoot each
-  // corner by 2 cm (about two tets: where a stroke starts or ends inside the body, the tets around
-  // the blade are not cut through).
   const std::array<Eigen::Vector2d, 3> corner{Eigen::Vector2d(-0.0213, -0.0117), Eigen::Vector2d(0.0161, -0.0129),
                                               Eigen::Vector2d(-0.0019, 0.0147)};
   std::vector<Stroke> strokes;
@@ -307,7 +308,7 @@ TEST(CrossingCuts, ThreeStrokesCutATriangularFlapOutOfTheFrogThatFallsWithThePri
     const Eigen::Vector2d& a = corner[k];
     const Eigen::Vector2d& b = corner[(k + 1) % 3];
     const Eigen::Vector2d along = (b - a).normalized();
-    strokes.push_back(Stroke{a - 0.02 * along, b + 0.02 * along});
+    strokes.push_back(Stroke{a - overshoot_m * along, b + overshoot_m * along});
     inside[k] = stroke_plane(strokes.back());
     if (inside[k].signed_distance(Eigen::Vector3d(centre.x(), centre.y(), 0.0)) < 0.0) {
       inside[k] = CutPlane{-inside[k].normal, -inside[k].offset};
@@ -345,6 +346,51 @@ TEST(CrossingCuts, ThreeStrokesCutATriangularFlapOutOfTheFrogThatFallsWithThePri
   expect_pieces_fall_as_regions(frog, flap_region, {frog_m3 - prism_m3, prism_m3}, 0, 40, 5e-3);
 }
 
+TEST(CrossingCuts, ThreeStrokesOvershootingTheCornersCutATriangularFlapThatFallsWithThePrismsMass) {
+  expect_triangular_flap_falls(0.02);  // about two tets past each corner
+}
+
+// Where a stroke ends at an earlier cut inside a tet (a T junction) or starts at its end (the
+// corner), the tets up to the blade are cut: a flap needs no overshoot.
+TEST(CrossingCuts, ThreeStrokesMeetingAtTheCornersCutATriangularFlapThatFallsWithThePrismsMass) {
+  expect_triangular_flap_falls(0.0);
+}
+
+// --- a T junction in a slab ----------------------------------------------------------------------
+
+constexpr double SLAB_EDGE_M = 0.005;  // the slabs' cubes
+
+// A 10 x 10 x 1 cm slab of 5 mm cubes held along two edges (x = 0 and y = 0). The first stroke runs
+// along y = T_FIRST_Y from inside the slab out through its edge x = 0.1; the second comes in
+// through the edge y = 0.1 along x = T_SECOND_X and ends at the first (a T junction): on it, or as
+// a hand would, past it by less than a tet (into the tets beyond it, whose extra cut joins no two
+// regions). The corner beyond both (x > T_SECOND_X, y > T_FIRST_Y) is then cut free on both its
+// inner sides and falls. (A stroke that stops short of the earlier cut leaves the material between
+// attached where it lies in tets the blade did not go into: a bridge that is there.)
+constexpr double T_FIRST_Y = 0.0512;
+constexpr double T_SECOND_X = 0.0613;
+
+int t_region(const Eigen::Vector3d& p) { return p.x() > T_SECOND_X && p.y() > T_FIRST_Y ? 1 : 0; }
+
+TEST(CrossingCuts, AStrokeEndingAtAnEarlierCutCutsTheTetsUpToItAndFreesTheCornerBeyond) {
+  for (const double end_past_m : {0.0, 1e-3, 3e-3}) {
+    SCOPED_TRACE("the second stroke ends " + std::to_string(1e3 * end_past_m) + " mm past the first");
+    TetMesh mesh = make_box_mesh(20, 20, 2, SLAB_EDGE_M);
+    std::vector<int> fixed = vertices_at_minimum(mesh, 0, 1e-6);
+    for (const int v : vertices_at_minimum(mesh, 1, 1e-6)) {
+      if (std::find(fixed.begin(), fixed.end(), v) == fixed.end()) fixed.push_back(v);
+    }
+    const std::vector<Stroke> strokes{Stroke{{0.0313, T_FIRST_Y}, {0.105, T_FIRST_Y}},
+                                      Stroke{{T_SECOND_X, 0.105}, {T_SECOND_X, T_FIRST_Y - end_past_m}}};
+    CutSpecimen slab(std::move(mesh), std::move(fixed), straight_paths(strokes), -0.01, 0.02);
+    ASSERT_GT(slab.recut_tets, 0);  // the junction's tets were cut by both strokes
+    const double slab_m3 = 0.1 * 0.1 * 0.01;
+    const double corner_m3 = (0.1 - T_SECOND_X) * (0.1 - T_FIRST_Y) * 0.01;
+    // The slab held along two edges sags by less than a millimetre on average in 40 ms.
+    expect_pieces_fall_as_regions(slab, t_region, {slab_m3 - corner_m3, corner_m3}, 0, 40, 1e-3);
+  }
+}
+
 // --- the spiral through a slab --------------------------------------------------------------------
 
 // The dissertation's figure 7.1: a spiral stroke, where one global Heaviside leaves a vertex between
@@ -352,7 +398,6 @@ TEST(CrossingCuts, ThreeStrokesCutATriangularFlapOutOfTheFrogThatFallsWithThePri
 // two turns from theta = 2 pi + SPIRAL_ENDS to 6 pi + SPIRAL_ENDS (both ends on one ray), with a
 // pitch 2 pi b of 2 cube edges: no tet (longest edge, a face diagonal: sqrt 2 cube edges) meets
 // both turns; the stars of some vertices between the turns meet both.
-constexpr double SLAB_EDGE_M = 0.005;
 const Eigen::Vector2d SPIRAL_CENTRE(0.0501, 0.0502);
 constexpr double SPIRAL_PITCH_M = 2.0 * SLAB_EDGE_M;
 constexpr double SPIRAL_ENDS = 0.3;

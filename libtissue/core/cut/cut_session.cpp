@@ -70,20 +70,31 @@ CutSweepReport CutSession::sweep(const ToolPose& previous, const ToolPose& curre
     report.cut.newly_cut_tets = newly_cut;
     report.cut_s += seconds_since(cut_start);
     from = to;
-    if (m_cutter->new_cuts().empty()) continue;
-    const auto enrich_start = std::chrono::steady_clock::now();
-    const EnrichmentResult enriched = apply(m_cutter->new_cuts(), {});
-    record(m_cutter->new_cuts());
-    report.enrichment.new_cut_tets += enriched.new_cut_tets;
-    report.enrichment.new_enriched_dofs += enriched.new_enriched_dofs;
-    report.enrichment.matrix_relayout = report.enrichment.matrix_relayout || enriched.matrix_relayout;
-    report.enrich_s += seconds_since(enrich_start);
+    apply_new_cuts(apply, report);
   }
   return report;
 }
 
-void CutSession::stop() {
-  if (m_cutter) m_cutter->end_cut();  // also after a session that ended itself: the next is a new stroke
+CutSweepReport CutSession::stop(const LazySurfaceBvh& bvh, const ApplyCuts& apply) {
+  CutSweepReport report;
+  if (!m_cutter) return report;
+  // Also after a session that ended itself (then nothing is cut): the next is a new stroke.
+  const auto cut_start = std::chrono::steady_clock::now();
+  report.cut = m_cutter->end_cut(bvh.positions_m());
+  report.cut_s = seconds_since(cut_start);
+  apply_new_cuts(apply, report);
+  return report;
+}
+
+void CutSession::apply_new_cuts(const ApplyCuts& apply, CutSweepReport& report) {
+  if (m_cutter->new_cuts().empty()) return;
+  const auto enrich_start = std::chrono::steady_clock::now();
+  const EnrichmentResult enriched = apply(m_cutter->new_cuts(), {});
+  record(m_cutter->new_cuts());
+  report.enrichment.new_cut_tets += enriched.new_cut_tets;
+  report.enrichment.new_enriched_dofs += enriched.new_enriched_dofs;
+  report.enrichment.matrix_relayout = report.enrichment.matrix_relayout || enriched.matrix_relayout;
+  report.enrich_s += seconds_since(enrich_start);
 }
 
 double CutSession::blade_depth_m(const ToolPose& tool, const LazySurfaceBvh& bvh, int mesh_triangles) const {

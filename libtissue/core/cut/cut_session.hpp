@@ -46,8 +46,10 @@ class CutSession {
   /// completed tets has them enriched by `apply` (live) and recorded.
   CutSweepReport sweep(const ToolPose& previous, const ToolPose& current, const LazySurfaceBvh& bvh,
                        const ApplyCuts& apply);
-  /// The scalpel stopped cutting (its mode changed): a session in progress ends.
-  void stop();
+  /// The scalpel stopped cutting (its mode changed, or cutting was switched off): a session in
+  /// progress ends where the blade is (VolumeCutter::end_cut), and the tets it went into are
+  /// enriched by `apply` and recorded as a sweep's are.
+  CutSweepReport stop(const LazySurfaceBvh& bvh, const ApplyCuts& apply);
   /// Length of the blade of `tool` inside the tissue while it cuts [m] (0 otherwise): from the handle
   /// end of the edge, the first crossing of the mesh's surface (ids below `mesh_triangles`).
   [[nodiscard]] double blade_depth_m(const ToolPose& tool, const LazySurfaceBvh& bvh, int mesh_triangles) const;
@@ -72,6 +74,9 @@ class CutSession {
   void restore(const VolumeCutter::SessionState& state);
 
  private:
+  /// Enriches the cutter's new cuts (if any) through `apply`, records them, adds to `report`.
+  void apply_new_cuts(const ApplyCuts& apply, CutSweepReport& report);
+
   std::optional<VolumeCutter> m_cutter;
   double m_blade_length_m;
   std::vector<TetCut> m_history;

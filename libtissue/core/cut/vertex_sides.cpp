@@ -114,15 +114,27 @@ void VolumeCutter::record_side(int vertex, double distance_m) {
   m_new_vertices.push_back(vertex);
 }
 
-bool VolumeCutter::has_both_sides(int tet) const {
+bool VolumeCutter::has_both_sides_passed(int tet) const {
   bool below = false;
   bool above = false;
   for (const int v : m_mesh.tets[at(tet)]) {
-    if (!decided_now(v)) continue;
+    if (!decided_now(v) || m_fitted_close[at(v)] == m_close_count) continue;
     below |= m_vertex_side[at(v)] < 0;
     above |= m_vertex_side[at(v)] >= 0;
   }
   return below && above && one_passage(tet);
+}
+
+bool VolumeCutter::stopped_in(int tet) const {
+  bool passed = false;
+  for (const int v : m_mesh.tets[at(tet)]) {
+    if (!decided_now(v)) {
+      if (m_watched_flag[at(v)] == 0) return false;
+    } else if (m_fitted_close[at(v)] != m_close_count) {
+      passed = true;
+    }
+  }
+  return passed;
 }
 
 bool VolumeCutter::one_passage(int tet) const {
@@ -136,13 +148,22 @@ bool VolumeCutter::one_passage(int tet) const {
   return last_rad - first_rad <= 0.5 * PASSAGE_TURN_RAD;
 }
 
-// When the blade has left the body, a tet with vertices on both sides whose other vertices the
-// blade never passed (a piece that swung about its last bridge while the blade cut it, carrying
-// them off the blade's path) would hold the sides together: those vertices are decided by the cut
-// around them, the linear fit over the rest positions of the decided vertices next to them of their
-// distances from the blade, repeated until no such tet is left.
+// When the stroke ends (the blade left the body, or the scalpel was taken away inside it), two kinds
+// of tet would hold the sides together, and their vertices the blade did not pass are decided by
+// the cut around them, the linear fit over the rest positions of the decided vertices next to them
+// of their distances from the blade, repeated until no such tet is left:
+//  * a tet the blade went into and stopped in: it passed some of its vertices and saw the others
+//    ahead of it, within its span (watched). So a stroke ends at the far faces of the tets it reached:
+//    one that ends at an earlier cut (a T junction) or at another stroke's start (a flap's corner)
+//    cuts the tets up to it (the virtual node algorithm's resolution: a crack ends at a tet's face);
+//  * a tet with vertices the blade passed on both sides whose other vertices it never passed (a
+//    piece that swung about its last bridge while the blade cut it, carrying them off the blade's
+//    path). Vertices the closing decided do not count: the cut does not creep on from them.
+// Vertices below the tip are never seen within the span: a blade that does not reach through the
+// body cuts only the tets it passed whole.
 void VolumeCutter::close_session(CutStepReport& report, const Eigen::VectorXd& positions_m) {
   if (!m_plane.valid) return;
+  ++m_close_count;  // the vertices this closing decides by the fit do not make a tet two-sided
   for (int round = 0; round < MAX_CLOSING_ROUNDS; ++round) {
     ++m_stamp;
     m_closing.clear();
@@ -150,15 +171,21 @@ void VolumeCutter::close_session(CutStepReport& report, const Eigen::VectorXd& p
       const int end = m_adjacency.vertex_tets_begin[at(vertex) + 1];
       for (int k = m_adjacency.vertex_tets_begin[at(vertex)]; k < end; ++k) {
         const int tet = m_adjacency.vertex_tets[at(k)];
-        if (m_tet_stamp[at(tet)] == m_stamp) continue;
+        if (m_tet_stamp[at(tet)] == m_stamp || m_tet_cut_session[at(tet)] == m_cut_id) continue;
         m_tet_stamp[at(tet)] = m_stamp;
-        if (!has_both_sides(tet)) continue;
+        const bool stopped = stopped_in(tet);
+        const bool both_sides = has_both_sides_passed(tet);
+        if (!stopped && !both_sides) continue;
         for (const int v : m_mesh.tets[at(tet)]) {
           if (decided_now(v)) continue;
+          if (stopped) {
+            m_closing.push_back(v);
+            continue;
+          }
           // Only where the blade went: between tip and handle, not more than an edge ahead of where
           // it stopped (a tet it crossed whole whose vertex lies ahead, off its plane).
           const PlaneOffset o = plane_offset(v, positions_m);
-          if (o.within_span() && o.ahead_m <= m_vertex_reach_m[at(v)]) m_closing.push_back(v);
+          if (both_sides && o.within_span() && o.ahead_m <= m_vertex_reach_m[at(v)]) m_closing.push_back(v);
         }
       }
     }
@@ -198,6 +225,7 @@ void VolumeCutter::decide_from_neighbours(int vertex, const Eigen::VectorXd& pos
   Eigen::FullPivLU<Eigen::Matrix4d> fit(normal_matrix);
   fit.setThreshold(FIT_PIVOT_FLOOR);
   record_side(vertex, reach_m > 0.0 && fit.rank() == 4 ? fit.solve(right)[3] : plane_offset(vertex, positions_m).distance_m);
+  m_fitted_close[at(vertex)] = m_close_count;
 }
 
 std::optional<TetCut> VolumeCutter::cut_of(int tet, double end_margin) const {

@@ -172,6 +172,7 @@ VolumeCutter::VolumeCutter(const TetMesh& mesh, const TetAdjacency& adjacency, c
   m_new_vertices.reserve(vertices);
   m_watched.reserve(vertices);
   m_watched_flag.assign(vertices, 0);
+  m_fitted_close.assign(vertices, -1);
   m_session_vertices.reserve(vertices);
   m_closing.reserve(4 * tets);
   // Each tet (edge) enters a list at most once per step: these capacities are never exceeded.
@@ -191,10 +192,23 @@ std::optional<double> VolumeCutter::edge_crossing(int edge) const {
   return m_edge_ratio[at(edge)];
 }
 
-void VolumeCutter::end_cut() {
+CutStepReport VolumeCutter::end_cut(const Eigen::VectorXd& positions_m) {
+  if (m_cutting) validate_positions(positions_m, "VolumeCutter::end_cut");
+  const auto start = std::chrono::steady_clock::now();
+  m_new_cuts.clear();
+  m_candidates.clear();
+  m_new_vertices.clear();
+  CutStepReport report;
+  if (m_cutting) {
+    report.cut_id = m_cut_id;
+    close_session(report, positions_m);
+  }
   m_cutting = false;
   m_active.clear();
   m_idle_steps = 2;  // ended on purpose: the next session is a new stroke
+  report.newly_cut_tets = static_cast<int>(m_new_cuts.size());
+  report.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return report;
 }
 
 void VolumeCutter::save(SessionState& state) const {
@@ -308,14 +322,18 @@ void VolumeCutter::validate(const Blade& previous, const Blade& current, const E
   if (!is_finite(previous) || !is_finite(current)) {
     throw std::invalid_argument("VolumeCutter::step: blade position is not finite");
   }
-  if (positions_m.size() < 3 * static_cast<Eigen::Index>(m_mesh.vertex_count())) {
-    throw std::invalid_argument("VolumeCutter::step: " + std::to_string(positions_m.size()) + " position entries for " +
-                                std::to_string(m_mesh.vertex_count()) + " vertices");
-  }
-  if (!positions_m.allFinite()) throw std::invalid_argument("VolumeCutter::step: a vertex position is not finite");
+  validate_positions(positions_m, "VolumeCutter::step");
   if (bvh.triangle_count() < static_cast<int>(m_surface.triangles.size())) {
     throw std::invalid_argument("VolumeCutter::step: the BVH has fewer triangles than the surface");
   }
+}
+
+void VolumeCutter::validate_positions(const Eigen::VectorXd& positions_m, const char* call) const {
+  if (positions_m.size() < 3 * static_cast<Eigen::Index>(m_mesh.vertex_count())) {
+    throw std::invalid_argument(std::string(call) + ": " + std::to_string(positions_m.size()) +
+                                " position entries for " + std::to_string(m_mesh.vertex_count()) + " vertices");
+  }
+  if (!positions_m.allFinite()) throw std::invalid_argument(std::string(call) + ": a vertex position is not finite");
 }
 
 CutStepReport VolumeCutter::step(const Blade& previous, const Blade& current, const Eigen::VectorXd& positions_m,

@@ -172,8 +172,12 @@ class VolumeCutter {
     return m_vertex_side[static_cast<std::size_t>(vertex)];
   }
 
-  /// Ends the session (the tool changed mode): tets cut partially stay uncut.
-  void end_cut();
+  /// Ends the session where the blade is (the scalpel was taken away inside the body, or its mode
+  /// changed): as when the blade leaves the body, the tets it went into are cut up to their far
+  /// faces (close_session); those cuts are in new_cuts() (cleared by the next step or end_cut).
+  /// `positions_m` as for step() (read only when a session is open). Throws std::invalid_argument,
+  /// before changing any state, for positions that are not finite or do not match the mesh.
+  CutStepReport end_cut(const Eigen::VectorXd& positions_m);
 
   /// What the cutter carries from step to step: the open session and every session's record of the
   /// tets and edges it cut. (The search stamps are per step and not part of it.)
@@ -211,6 +215,7 @@ class VolumeCutter {
 
   void validate(const Blade& previous, const Blade& current, const Eigen::VectorXd& positions_m,
                 const SurfaceBvh& bvh) const;
+  void validate_positions(const Eigen::VectorXd& positions_m, const char* call) const;
   void find_initial_tets(const Blade& blade, const Eigen::VectorXd& positions_m, const SurfaceBvh& bvh);
   void collect_surface_seeds(const Sweep& sweep, const Eigen::VectorXd& positions_m, const SurfaceBvh& bvh);
   void search_from(int seed, const Sweep& sweep, const Eigen::VectorXd& positions_m);
@@ -238,16 +243,20 @@ class VolumeCutter {
   /// decided vertices of its tets, of their distances from the blade, taken at its rest position.
   void decide_from_neighbours(int vertex, const Eigen::VectorXd& positions_m);
   void record_side(int vertex, double distance_m);
-  /// True when the tet's decided vertices lie on both sides (on the blade counts above), decided in
-  /// one passage.
-  [[nodiscard]] bool has_both_sides(int tet) const;
+  /// True when the tet's vertices decided by the blade's passage (not by this closing's fit) lie on
+  /// both sides (on the blade counts above), decided in one passage.
+  [[nodiscard]] bool has_both_sides_passed(int tet) const;
   /// True when the blade turned through at most half PASSAGE_TURN_RAD between the decisions of the
   /// tet's vertices.
   [[nodiscard]] bool one_passage(int tet) const;
+  /// True when the blade stopped in the tet: it passed some of its vertices (not decided by this
+  /// closing's fit) and saw the others ahead of it (watched).
+  [[nodiscard]] bool stopped_in(int tet) const;
   /// Cuts the tets around this step's decisions that are complete (cut_of).
   void cut_around_new_vertices(CutStepReport& report);
-  /// At a session's end: decides, by the cut around them, the vertices of tets with vertices on both
-  /// sides that the blade went past (within its span, not ahead of it) without passing them.
+  /// At a session's end: decides, by the cut around them, the vertices the blade did not pass of the
+  /// tets it went into (those seen ahead of it within its span) and of tets with vertices on both
+  /// sides (within its span, not more than an edge ahead of it).
   void close_session(CutStepReport& report, const Eigen::VectorXd& positions_m);
   /// The tet's cut from its vertices' sides, if all are decided in this session and they differ.
   [[nodiscard]] std::optional<TetCut> cut_of(int tet, double end_margin) const;
@@ -296,6 +305,8 @@ class VolumeCutter {
   std::vector<int> m_new_vertices;      ///< decided this step
   std::vector<int> m_session_vertices;  ///< decided in this session
   std::vector<int> m_closing;           ///< close_session's vertices to decide
+  std::int64_t m_close_count = 0;       ///< counts close_session calls
+  std::vector<std::int64_t> m_fitted_close;  ///< the close_session call that decided the vertex by the fit
   std::vector<int> m_watched;           ///< seen ahead of the blade in a tet it touched, not yet passed
   std::vector<std::uint8_t> m_watched_flag;
   /// The plane of the blade's motion: through the current blade, its normal `normal` ("above"), and

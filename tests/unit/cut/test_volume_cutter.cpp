@@ -199,7 +199,9 @@ void compare_random_sweeps(Body& body, unsigned seed, RunTotals& totals) {
       if (kind == SweepKind::handle_ends_inside) {
         EXPECT_TRUE(cutter.cutting()) << "the handle ends inside";
       }
-      cutter.end_cut();
+      cutter.end_cut(body.positions_m);
+      for (const TetCut& cut : cutter.new_cuts()) expect_valid_cut(cut, body, settings);
+      expect_cut_is_the_sides_partition(body, cutter, path.size());
       reference.end_cut();
     }
   }
@@ -405,23 +407,48 @@ TEST(VolumeCutter, StraightCutThroughABeamSeparatesItExactly) {
   }
 }
 
-TEST(VolumeCutter, CutStoppedHalfWayDoesNotSeparateTheBeam) {
+TEST(VolumeCutter, ACutStoppedInsideEndsAtTheFarFacesOfTheTetsTheBladeWentInto) {
   Body body(make_box_mesh(10, 2, 2, 0.01));
   const SurfaceBvh bvh = body.make_bvh();
   VolumeCutter cutter(body.mesh, body.adjacency, body.surface, exact_settings());
-  // The blade enters from one side and stops 4 mm past the middle of the beam (its middle row of
-  // vertices; 0.014 m of its 0.02 m): the tets whose vertices it passed are cut, the others not.
-  const auto cuts = cut_along(body, cutter, bvh, planar_path(PLANE_NORMAL, PLANE_POINT, -0.04, 0.004, 8));
+  // The blade enters the beam's side y = 0.02 (it moves along -y) and stops at y = 0.014, in the
+  // first layer of cubes (y in [0.01, 0.02]): it passed no vertex but those it entered at.
+  const auto passed = cut_along(body, cutter, bvh, planar_path(PLANE_NORMAL, PLANE_POINT, -0.04, -0.004, 8));
   EXPECT_TRUE(cutter.cutting());  // the blade is still in the beam
-  cutter.end_cut();
+  const CutStepReport ended = cutter.end_cut(body.positions_m);
   EXPECT_FALSE(cutter.cutting());
-  const std::set<int> crossed = tets_crossed_by_plane(body, PLANE_NORMAL, PLANE_POINT);
-  const std::set<int> cut_tets = tet_set(cuts);
-  EXPECT_GT(cut_tets.size(), 4u);
-  EXPECT_LT(cut_tets.size(), crossed.size());
-  EXPECT_TRUE(std::includes(crossed.begin(), crossed.end(), cut_tets.begin(), cut_tets.end()));
+  EXPECT_EQ(ended.newly_cut_tets, static_cast<int>(cutter.new_cuts().size()));
+  std::vector<TetCut> cuts = passed;
+  cuts.insert(cuts.end(), cutter.new_cuts().begin(), cutter.new_cuts().end());
+  // The stroke ends where the blade stopped, at the far faces of the tets it went into: exactly the
+  // tets whose section by the plane reaches behind the blade's last position (some crossing of an
+  // edge by the plane lies behind it, along the blade's motion) are cut.
+  const Eigen::Vector3d n = PLANE_NORMAL.normalized();
+  const Eigen::Vector3d motion = n.cross((Eigen::Vector3d::UnitZ() - n.z() * n).normalized());
+  const Eigen::Vector3d stopped_at = PLANE_POINT - 0.004 * motion;
+  std::set<int> went_into;
+  for (const int t : tets_crossed_by_plane(body, PLANE_NORMAL, PLANE_POINT)) {
+    const auto x = body.tet_points(t);
+    for (const auto& edge : TET_EDGES) {
+      const double da = n.dot(x[at(edge[0])] - PLANE_POINT);
+      const double db = n.dot(x[at(edge[1])] - PLANE_POINT);
+      if ((da < 0.0) == (db < 0.0)) continue;
+      const Eigen::Vector3d crossing = x[at(edge[0])] + da / (da - db) * (x[at(edge[1])] - x[at(edge[0])]);
+      if ((crossing - stopped_at).dot(motion) < -1e-9) went_into.insert(t);
+    }
+    // All in the first row of cubes (y in [0.01, 0.02]): the second holds the beam together.
+    if (went_into.contains(t)) {
+      EXPECT_TRUE(std::all_of(x.begin(), x.end(), [](const Eigen::Vector3d& p) { return p.y() > 0.01 - 1e-9; }));
+    }
+  }
+  EXPECT_GT(went_into.size(), 4u);
+  EXPECT_EQ(tet_set(cuts), went_into);
+  EXPECT_EQ(cuts.size(), tet_set(cuts).size());  // each once
   std::vector<int> label;
-  EXPECT_EQ(count_components(body, removed_tets(body, cut_tets), label), 1);
+  EXPECT_EQ(count_components(body, removed_tets(body, tet_set(cuts)), label), 1);  // still one body
+  // Ending again, or a session never started, cuts nothing.
+  EXPECT_EQ(cutter.end_cut(body.positions_m).newly_cut_tets, 0);
+  EXPECT_TRUE(cutter.new_cuts().empty());
 }
 
 TEST(VolumeCutter, ASecondCutCutsTheTetsOfTheFirstAgain) {

@@ -68,7 +68,11 @@ struct CutFrog {
           if (after_cuts) after_cuts(body);
         }
       }
-      cutter.end_cut();
+      cutter.end_cut(rest);  // the stroke ends where the blade is
+      if (!cutter.new_cuts().empty()) {
+        body.enrich(cutter.new_cuts(), state);
+        if (after_cuts) after_cuts(body);
+      }
     }
   }
   /// The frog's render surface (meshes/frog_surface.obj).
