@@ -86,6 +86,20 @@ void VolumeCutter::decide_if_passed(int vertex, const Eigen::VectorXd& positions
   }
 }
 
+// A vertex on the blade counts above in every tet around it: a tet that touches the sweep only
+// there, its other vertices below, is cut, though the search, which goes from tet to tet where the
+// sweep crosses, need not visit it. Its other vertices are decided (or watched) as if it had been.
+void VolumeCutter::decide_around_vertices_on_blade(const Eigen::VectorXd& positions_m) {
+  while (!m_on_blade.empty()) {
+    const int vertex = m_on_blade.back();
+    m_on_blade.pop_back();
+    const int end = m_adjacency.vertex_tets_begin[at(vertex) + 1];
+    for (int k = m_adjacency.vertex_tets_begin[at(vertex)]; k < end; ++k) {
+      for (const int v : m_mesh.tets[at(m_adjacency.vertex_tets[at(k)])]) decide_if_passed(v, positions_m);
+    }
+  }
+}
+
 void VolumeCutter::pass_watched(const Eigen::VectorXd& positions_m) {
   std::size_t kept = 0;
   for (const int vertex : m_watched) {
@@ -112,6 +126,7 @@ void VolumeCutter::record_side(int vertex, double distance_m) {
   m_vertex_turn_rad[at(vertex)] = m_turn_rad;
   m_vertex_side[at(vertex)] = distance_m > snap_m ? std::int8_t{1} : (distance_m < -snap_m ? std::int8_t{-1} : std::int8_t{0});
   m_new_vertices.push_back(vertex);
+  if (m_vertex_side[at(vertex)] == 0) m_on_blade.push_back(vertex);
 }
 
 bool VolumeCutter::has_both_sides_passed(int tet) const {
@@ -189,6 +204,7 @@ void VolumeCutter::close_session(CutStepReport& report, const Eigen::VectorXd& p
         }
       }
     }
+    m_on_blade.clear();  // a closing decides by the fit, not by the blade: no star to go on to
     if (m_closing.empty()) return;
     for (const int vertex : m_closing) {
       if (!decided_now(vertex)) decide_from_neighbours(vertex, positions_m);

@@ -173,6 +173,7 @@ VolumeCutter::VolumeCutter(const TetMesh& mesh, const TetAdjacency& adjacency, c
   m_watched.reserve(vertices);
   m_watched_flag.assign(vertices, 0);
   m_fitted_close.assign(vertices, -1);
+  m_on_blade.reserve(vertices);
   m_session_vertices.reserve(vertices);
   m_closing.reserve(4 * tets);
   // Each tet (edge) enters a list at most once per step: these capacities are never exceeded.
@@ -343,6 +344,7 @@ CutStepReport VolumeCutter::step(const Blade& previous, const Blade& current, co
   m_new_cuts.clear();
   m_visited.clear();
   m_new_vertices.clear();
+  m_on_blade.clear();
   m_new_crossings = 0;
   m_candidates.clear();
   m_seeds.clear();
@@ -539,6 +541,7 @@ void VolumeCutter::complete_touched_tets(CutStepReport& report, const Eigen::Vec
   // is touched now (off the blade's plane, beyond the part of a tet it crossed; or carried past a
   // step's sweep by the body).
   pass_watched(positions_m);
+  decide_around_vertices_on_blade(positions_m);
   cut_around_new_vertices(report);
 }
 

@@ -237,6 +237,8 @@ class VolumeCutter {
   /// Decides the vertex's side by its distance from the plane if the blade passed it in this step:
   /// within the blade's span, behind it and not behind the sweep's start; watches it while ahead.
   void decide_if_passed(int vertex, const Eigen::VectorXd& positions_m);
+  /// Decides (or watches) the vertices of the tets around the vertices decided on the blade.
+  void decide_around_vertices_on_blade(const Eigen::VectorXd& positions_m);
   /// Decides the watched vertices the blade has passed since they were seen ahead of it.
   void pass_watched(const Eigen::VectorXd& positions_m);
   /// Decides the vertex's side by the cut around it: the linear fit, over the rest positions of the
@@ -305,6 +307,7 @@ class VolumeCutter {
   std::vector<int> m_new_vertices;      ///< decided this step
   std::vector<int> m_session_vertices;  ///< decided in this session
   std::vector<int> m_closing;           ///< close_session's vertices to decide
+  std::vector<int> m_on_blade;          ///< decided on the blade, their stars not yet decided
   std::int64_t m_close_count = 0;       ///< counts close_session calls
   std::vector<std::int64_t> m_fitted_close;  ///< the close_session call that decided the vertex by the fit
   std::vector<int> m_watched;           ///< seen ahead of the blade in a tet it touched, not yet passed

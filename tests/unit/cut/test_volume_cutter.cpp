@@ -451,6 +451,35 @@ TEST(VolumeCutter, ACutStoppedInsideEndsAtTheFarFacesOfTheTetsTheBladeWentInto) 
   EXPECT_TRUE(cutter.new_cuts().empty());
 }
 
+// A stroke parallel to a layer of vertices, on it or just past it within the vertices' snap
+// distance (vertex_snap_fraction of a 1 cm edge: 10 um): the layer counts above (the -z side here:
+// the sweep's normal is blade x motion = y x x = -z), so the cut runs along the layer, through the
+// cubes on its +z side, whose tets touch the blade's plane only at their vertices in the layer. The
+// search from tet to tet where the sweep crosses an edge need not visit them (with the plane 1 um
+// below the layer, no edge of theirs crosses it); before their vertices were decided from the
+// vertices on the blade, that stroke cut nothing and left the body whole.
+TEST(VolumeCutter, AStrokeJustPastALayerOfVerticesWithinTheirSnapCutsTheLayerOfCubesBeyond) {
+  Body body(make_box_mesh(4, 3, 3, 0.01));
+  const SurfaceBvh bvh = body.make_bvh();
+  for (const double offset_m : {-1e-6, 0.0, 1e-6}) {
+    SCOPED_TRACE("plane " + std::to_string(offset_m) + " m above the layer z = 0.02");
+    VolumeCutter cutter(body.mesh, body.adjacency, body.surface, CutterSettings{});
+    const double z = 0.02 + offset_m;
+    const auto blade_at = [&](double x) { return Blade{{x, -0.025, z}, {x, 0.055, z}}; };
+    const auto cuts = cut_along(body, cutter, bvh, linear_path(blade_at(-0.02), blade_at(0.06), 16));
+    EXPECT_FALSE(cutter.cutting());
+    // Cut: exactly the 60 tets of the cubes between z = 0.02 and 0.03 (a vertex in the top layer,
+    // below, and one in the layer, on the blade).
+    std::set<int> beyond;
+    for (int t = 0; t < body.mesh.tet_count(); ++t) {
+      const auto x = body.tet_points(t);
+      if (std::all_of(x.begin(), x.end(), [](const Eigen::Vector3d& p) { return p.z() > 0.02 - 1e-9; })) beyond.insert(t);
+    }
+    ASSERT_EQ(beyond.size(), 60u);
+    EXPECT_EQ(tet_set(cuts), beyond);
+  }
+}
+
 TEST(VolumeCutter, ASecondCutCutsTheTetsOfTheFirstAgain) {
   Body body(make_box_mesh(10, 2, 2, 0.01));
   const SurfaceBvh bvh = body.make_bvh();
