@@ -2,12 +2,14 @@
 // volume fractions (planes at known positions, a non-planar 2-2 split against a hand-made
 // decomposition into tets, parts adding up to the whole, clamping near a vertex, degenerate cuts).
 #include "core/cut/cut_geometry.hpp"
+#include "core/fem/convex_piece.hpp"
 #include "core/mesh/tet_mesh.hpp"
 #include "core/mesh/topology.hpp"
 
 #include <gtest/gtest.h>
 #include <Eigen/Geometry>
 
+#include <algorithm>
 #include <cmath>
 #include <random>
 
@@ -301,6 +303,77 @@ TEST(CutGeometry, TouchingAnEdgeOrAVertexOrACrossingInsideAPartDoesNotCut) {
   EXPECT_FALSE(classify_tet_cut(unit_tet(), folded, 1e-3, MIN_FRACTION));
 
   EXPECT_FALSE(classify_tet_cut(unit_tet(), TetEdgeCrossings{}, 1e-3, MIN_FRACTION));
+}
+
+// --- cut_from_sides: the cut of a tet whose vertices' sides were decided (issue 41) ---------------
+
+// Random tets cut by random planes through them: with the sides of the vertices and the plane's
+// crossings of the edges between them, the volume fraction above is the plane's clip of the tet
+// (ConvexPiece, an independent computation) to round-off, the sides are kept, and every edge
+// between the sides carries its crossing (-1 elsewhere): 1-3 and 2-2 splits alike.
+TEST(CutFromSides, ThePlanesCrossingsGiveTheClippedVolumeForOneThreeAndTwoTwoSplits) {
+  std::mt19937 rng(4141);
+  std::uniform_real_distribution<double> coordinate(-1.0, 1.0);
+  std::normal_distribution<double> normal;
+  int splits[2] = {0, 0};  // 1-3, 2-2
+  for (int trial = 0; trial < 2000; ++trial) {
+    std::array<Eigen::Vector3d, 4> x;
+    for (auto& p : x) p = 0.01 * Eigen::Vector3d(coordinate(rng), coordinate(rng), coordinate(rng));
+    if (std::abs((x[1] - x[0]).cross(x[2] - x[0]).dot(x[3] - x[0])) < 1e-8) continue;  // a flat tet
+    const Eigen::Vector3d n = Eigen::Vector3d(normal(rng), normal(rng), normal(rng)).normalized();
+    const Eigen::Vector3d through = 0.25 * (x[0] + x[1] + x[2] + x[3]) + 0.002 * Eigen::Vector3d(coordinate(rng), coordinate(rng), coordinate(rng));
+    const CutPlane plane{n, n.dot(through)};
+    std::array<std::int8_t, 4> side{};
+    int above = 0;
+    for (size_t j = 0; j < 4; ++j) {
+      side[j] = plane.signed_distance(x[j]) > 0.0 ? std::int8_t{1} : std::int8_t{-1};
+      above += side[j] > 0 ? 1 : 0;
+    }
+    if (above == 0 || above == 4) continue;
+    ++splits[above == 2 ? 1 : 0];
+    std::array<double, 6> ratio{};
+    for (size_t k = 0; k < 6; ++k) {
+      const double d0 = plane.signed_distance(x[static_cast<size_t>(TET_EDGES[k][0])]);
+      const double d1 = plane.signed_distance(x[static_cast<size_t>(TET_EDGES[k][1])]);
+      ratio[k] = d0 / (d0 - d1);  // read only where the ends differ
+    }
+    const TetCut cut = cut_from_sides(x, side, ratio, 0.0, MIN_FRACTION);
+    const double tet_m3 = ConvexPiece::tet(x).volume_m3();
+    const double above_m3 = ConvexPiece::tet(x).clipped(plane, true, 0.0).volume_m3();
+    const double exact = std::clamp(above_m3 / tet_m3, MIN_FRACTION, 1.0 - MIN_FRACTION);
+    ASSERT_NEAR(cut.volume_fraction_above, exact, 1e-9) << "trial " << trial;
+    EXPECT_EQ(cut.side, side);
+    for (size_t k = 0; k < 6; ++k) {
+      const bool between = side[static_cast<size_t>(TET_EDGES[k][0])] != side[static_cast<size_t>(TET_EDGES[k][1])];
+      EXPECT_EQ(cut.edge_ratio[k], between ? ratio[k] : -1.0) << "edge " << k << ", trial " << trial;
+    }
+  }
+  EXPECT_GT(splits[0], 200);
+  EXPECT_GT(splits[1], 200);
+}
+
+// A plane through a vertex: its crossings there are held `end_margin` from the ends (distinct cut
+// points), while the volume fraction is the clamped fraction of the clip (the geometry is not
+// snapped): the sliver below, under the plane, is held at the smallest part.
+TEST(CutFromSides, CrossingsAtAVertexAreHeldOffTheEndsAndTheSliverIsClamped) {
+  const std::array<Eigen::Vector3d, 4> x = unit_tet();
+  // The plane z = 1e-14 (vertex 3 of the unit tet at z = 1 above, the base's three below): the
+  // crossings lie at 1e-14 of the edges from the base.
+  const std::array<std::int8_t, 4> side{-1, -1, -1, 1};
+  std::array<double, 6> ratio{};
+  for (size_t k = 0; k < 6; ++k) {
+    const double z0 = x[static_cast<size_t>(TET_EDGES[k][0])].z() - 1e-14;
+    const double z1 = x[static_cast<size_t>(TET_EDGES[k][1])].z() - 1e-14;
+    ratio[k] = z0 / (z0 - z1);
+  }
+  const double margin = 1e-6;
+  const TetCut cut = cut_from_sides(x, side, ratio, margin, MIN_FRACTION);
+  for (size_t k = 0; k < 6; ++k) {
+    if (cut.edge_ratio[k] < 0.0) continue;
+    EXPECT_GE(cut.edge_ratio[k], margin);
+    EXPECT_LE(cut.edge_ratio[k], 1.0 - margin);
+  }
+  EXPECT_NEAR(cut.volume_fraction_above, 1.0 - MIN_FRACTION, 1e-15);  // all but the sliver below z = 1e-14
 }
 
 }  // namespace
