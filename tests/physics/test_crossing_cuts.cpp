@@ -88,8 +88,12 @@ struct CutSpecimen {
   DynamicState state;
   int recut_tets = 0;  ///< cuts of tets an earlier stroke cut
 
+  /// Each stroke: the vertical blade from z_below to z_above stands at the path's points. With
+  /// `plunge`, it is first lowered into the body at the path's start from above it (its tip from
+  /// z_above down to z_below in 10 steps) and lifted out at its end the same way, instead of standing
+  /// in it at the start and being taken away where it ends (end_cut).
   CutSpecimen(TetMesh tet_mesh, std::vector<int> fixed, const std::vector<BladePath>& strokes, double z_below,
-              double z_above)
+              double z_above, bool plunge = false)
       : mesh(std::move(tet_mesh)), body(mesh, settings(std::move(fixed))) {
     state.displacement_m = Eigen::VectorXd::Zero(body.dof_count());
     state.velocity_m_per_s = Eigen::VectorXd::Zero(body.dof_count());
@@ -101,19 +105,29 @@ struct CutSpecimen {
     exact.vertex_snap_fraction = 0.0;
     exact.min_volume_fraction = SMALLEST_MIN_VOLUME_FRACTION;
     VolumeCutter cutter(mesh, adjacency, surface, exact);
-    for (const BladePath& stroke : strokes) {
-      Blade previous;
-      for (size_t n = 0; n < stroke.size(); ++n) {
-        const Eigen::Vector2d& at = stroke[n];
-        const Blade blade{Eigen::Vector3d(at.x(), at.y(), z_below), Eigen::Vector3d(at.x(), at.y(), z_above)};
-        cutter.step(n == 0 ? blade : previous, blade, rest, bvh);
-        previous = blade;
-        for (const TetCut& cut : cutter.new_cuts()) recut_tets += body.cut_tet_index(cut.tet) >= 0 ? 1 : 0;
-        if (!cutter.new_cuts().empty()) body.enrich(cutter.new_cuts(), state);
-      }
-      cutter.end_cut(rest);  // the scalpel is lifted where it is: the next stroke is a new session
+    const double height_m = z_above - z_below;
+    const auto blade_at = [&](const Eigen::Vector2d& at, double tip_z) {
+      return Blade{Eigen::Vector3d(at.x(), at.y(), tip_z), Eigen::Vector3d(at.x(), at.y(), tip_z + height_m)};
+    };
+    const auto apply = [&] {
       for (const TetCut& cut : cutter.new_cuts()) recut_tets += body.cut_tet_index(cut.tet) >= 0 ? 1 : 0;
       if (!cutter.new_cuts().empty()) body.enrich(cutter.new_cuts(), state);
+    };
+    constexpr int PLUNGE_STEPS = 10;
+    for (const BladePath& stroke : strokes) {
+      std::vector<Blade> blades;
+      for (int n = 0; plunge && n < PLUNGE_STEPS; ++n) blades.push_back(blade_at(stroke.front(), z_above - height_m * n / PLUNGE_STEPS));
+      for (const Eigen::Vector2d& at : stroke) blades.push_back(blade_at(at, z_below));
+      for (int n = 1; plunge && n <= PLUNGE_STEPS; ++n) blades.push_back(blade_at(stroke.back(), z_below + height_m * n / PLUNGE_STEPS));
+      for (size_t n = 0; n < blades.size(); ++n) {
+        cutter.step(blades[n == 0 ? 0 : n - 1], blades[n], rest, bvh);
+        apply();
+      }
+      if (plunge) {
+        EXPECT_FALSE(cutter.cutting()) << "the blade was lifted out";
+      }
+      cutter.end_cut(rest);  // the scalpel is taken away where it is: the next stroke is a new session
+      apply();
     }
   }
 
@@ -296,8 +310,9 @@ TEST(CrossingCuts, AnXCutLeavesFourPiecesOfTheExactVolumesAndTheThreeFreeOnesFal
 // --- the flap out of the frog's back -------------------------------------------------------------
 
 /// Three strokes along the sides of a triangle on the frog's back, each running past the corners at
-/// its ends by `overshoot_m` (0: from corner to corner, the strokes meeting at the corners).
-void expect_triangular_flap_falls(double overshoot_m) {
+/// its ends by `overshoot_m` (0: from corner to corner, the strokes meeting at the corners); with
+/// `plunge`, the blade is lowered in at a stroke's start and lifted out at its end.
+void expect_triangular_flap_falls(double overshoot_m, bool plunge = false) {
   TetMesh mesh = read_mesh(std::string(TISSUE_MESH_DIR) + "/frog.veg");
   const std::array<Eigen::Vector2d, 3> corner{Eigen::Vector2d(-0.0213, -0.0117), Eigen::Vector2d(0.0161, -0.0129),
                                               Eigen::Vector2d(-0.0019, 0.0147)};
@@ -340,7 +355,7 @@ void expect_triangular_flap_falls(double overshoot_m) {
   for (int v = 0; v < mesh.vertex_count(); ++v) {
     if (mesh.rest_positions_m[static_cast<size_t>(v)].x() > x_max - 0.15 * (x_max - x_min)) fixed.push_back(v);
   }
-  CutSpecimen frog(std::move(mesh), std::move(fixed), straight_paths(strokes), -0.03, 0.06);
+  CutSpecimen frog(std::move(mesh), std::move(fixed), straight_paths(strokes), -0.03, 0.06, plunge);
   ASSERT_GT(frog.recut_tets, 0);  // the corners' tets were cut twice
   // The frog sags between its held ends; the flap falls away from it.
   expect_pieces_fall_as_regions(frog, flap_region, {frog_m3 - prism_m3, prism_m3}, 0, 40, 5e-3);
@@ -354,6 +369,12 @@ TEST(CrossingCuts, ThreeStrokesOvershootingTheCornersCutATriangularFlapThatFalls
 // corner), the tets up to the blade are cut: a flap needs no overshoot.
 TEST(CrossingCuts, ThreeStrokesMeetingAtTheCornersCutATriangularFlapThatFallsWithThePrismsMass) {
   expect_triangular_flap_falls(0.0);
+}
+
+// The same strokes as a surgeon makes them: the blade lowered into the back at one corner, drawn to
+// the next and lifted out there (the stroke ends when the blade leaves the body).
+TEST(CrossingCuts, ThreeStrokesPlungedAndLiftedAtTheCornersCutATriangularFlapThatFalls) {
+  expect_triangular_flap_falls(0.0, true);
 }
 
 // --- a T junction in a slab ----------------------------------------------------------------------
