@@ -34,6 +34,7 @@
 #include <cstdio>
 #include <functional>
 #include <map>
+#include <random>
 #include <memory>
 #include <string>
 #include <vector>
@@ -87,6 +88,9 @@ struct CutSpecimen {
   DeformableBody body;
   DynamicState state;
   int recut_tets = 0;  ///< cuts of tets an earlier stroke cut
+  /// Enrichments after which the tangent held fewer blocks than before: the blocks only retired cut
+  /// tets used were dropped (RETIRED_SLOT_SHARE_TO_COMPACT), so the checks run on the compacted matrix.
+  int compactions = 0;
 
   /// Each stroke: the vertical blade from z_below to z_above stands at the path's points. With
   /// `plunge`, it is first lowered into the body at the path's start from above it (its tip from
@@ -111,7 +115,10 @@ struct CutSpecimen {
     };
     const auto apply = [&] {
       for (const TetCut& cut : cutter.new_cuts()) recut_tets += body.cut_tet_index(cut.tet) >= 0 ? 1 : 0;
-      if (!cutter.new_cuts().empty()) body.enrich(cutter.new_cuts(), state);
+      if (cutter.new_cuts().empty()) return;
+      const int blocks_before = body.tangent().nonzero_blocks();
+      body.enrich(cutter.new_cuts(), state);
+      compactions += body.tangent().nonzero_blocks() < blocks_before ? 1 : 0;
     };
     constexpr int PLUNGE_STEPS = 10;
     for (const BladePath& stroke : strokes) {
@@ -375,6 +382,76 @@ TEST(CrossingCuts, ThreeStrokesMeetingAtTheCornersCutATriangularFlapThatFallsWit
 // the next and lifted out there (the stroke ends when the blade leaves the body).
 TEST(CrossingCuts, ThreeStrokesPlungedAndLiftedAtTheCornersCutATriangularFlapThatFalls) {
   expect_triangular_flap_falls(0.0, true);
+}
+
+// --- the retired cut tets' blocks ----------------------------------------------------------------
+
+// The frog hatched by 4 + 4 full-height strokes (tets cut up to three times, their earlier cut tets
+// retired): dropping the blocks only retired cut tets used (DeformableBody::drop_retired_blocks, which
+// enrich() does itself past RETIRED_SLOT_SHARE_TO_COMPACT) leaves the internal forces bitwise and the
+// tangent's product to round-off as they were (the dropped blocks were zeros), and every XFEM block
+// left is one a live cut tet uses.
+TEST(CrossingCuts, DroppingTheRetiredCutTetsBlocksChangesNeitherTheForcesNorTheProduct) {
+  std::vector<Stroke> strokes;
+  for (int k = 0; k < 4; ++k) {
+    const double x = -0.02 + 0.04 * k / 3.0 + 0.0003;
+    const double y = -0.03 + 0.06 * k / 3.0 + 0.0007;
+    strokes.push_back(Stroke{{x, -0.09}, {x + 0.003, 0.09}});
+    strokes.push_back(Stroke{{-0.12, y}, {0.12, y - 0.002}});
+  }
+  TetMesh mesh = read_mesh(std::string(TISSUE_MESH_DIR) + "/frog.veg");
+  std::vector<int> fixed = vertices_at_minimum(mesh, 2, 0.25);
+  CutSpecimen frog(std::move(mesh), std::move(fixed), straight_paths(strokes), -0.03, 0.06);
+  ASSERT_GT(frog.recut_tets, 50);
+  DeformableBody& body = frog.body;
+
+  std::mt19937 rng(21);
+  std::normal_distribution<double> normal;
+  Eigen::VectorXd u(body.dof_count()), x(body.dof_count());
+  for (Eigen::Index i = 0; i < u.size(); ++i) {
+    u(i) = 1e-4 * normal(rng);
+    x(i) = normal(rng);
+  }
+  Eigen::VectorXd force_before, force_after, product_before, product_after;
+  // Both evaluations from the same rotation warm starts (an evaluate moves them).
+  DeformableBody::Rotations warm_starts;
+  body.save_rotations(warm_starts);
+  body.evaluate(u, force_before, /*update_tangent=*/true);
+  body.tangent().multiply(x, product_before);
+  const int blocks_before = body.tangent().nonzero_blocks();
+
+  ASSERT_TRUE(body.drop_retired_blocks());
+  EXPECT_LT(body.tangent().nonzero_blocks(), blocks_before);
+  body.restore_rotations(warm_starts);
+  body.evaluate(u, force_after, /*update_tangent=*/true);
+  body.tangent().multiply(x, product_after);
+  EXPECT_TRUE((force_after.array() == force_before.array()).all());
+  // The product to round-off: the multiply kernel sums a row's blocks in an order that depends on how
+  // many there are.
+  EXPECT_LT((product_after - product_before).cwiseAbs().maxCoeff(), 1e-13 * product_before.cwiseAbs().maxCoeff());
+  std::printf("dropped %d of %d blocks; the product moved by %.3g of its largest entry\n",
+              blocks_before - body.tangent().nonzero_blocks(), blocks_before,
+              (product_after - product_before).cwiseAbs().maxCoeff() / product_before.cwiseAbs().maxCoeff());
+  EXPECT_FALSE(body.drop_retired_blocks());  // nothing left to drop
+
+  // Every block with a ghost row or column is one a live cut tet uses.
+  const BlockSparseMatrix& tangent = body.tangent();
+  std::vector<char> used(static_cast<size_t>(tangent.slot_capacity()), 0);
+  for (int k = 0; k < body.xfem().cut_tet_count(); ++k) {
+    if (body.retired(k)) continue;
+    for (const int slot : const_cast<XfemElasticity&>(body.xfem()).slots(k)) {
+      if (slot >= 0) used[static_cast<size_t>(slot)] = 1;
+    }
+  }
+  const int u_rows = body.dofs().free_vertex_count();
+  for (int row = 0; row < tangent.block_rows(); ++row) {
+    for (int slot = tangent.row_begin(row); slot < tangent.row_begin(row) + tangent.row_size(row); ++slot) {
+      const int column = tangent.slot_column(slot);
+      if ((row >= u_rows || column >= u_rows) && column != row) {
+        EXPECT_TRUE(used[static_cast<size_t>(slot)] != 0) << "block (" << row << ", " << column << ")";
+      }
+    }
+  }
 }
 
 // --- a T junction in a slab ----------------------------------------------------------------------

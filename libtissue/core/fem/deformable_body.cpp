@@ -372,6 +372,10 @@ void DeformableBody::refresh_cut_tet_slots(int cut_tet_index) {
   const int dofs = m_xfem.dof_count(cut_tet_index);
   const auto row_of = [&](int dof) { return cut_tet_dof_row(cut_tet_index, dof); };
   const CutTetSlots slots = m_xfem.slots(cut_tet_index);
+  if (m_xfem.retired(cut_tet_index)) {
+    std::fill(slots.begin(), slots.end(), -1);
+    return;
+  }
   for (int r = 0; r < dofs; ++r) {
     for (int col = 0; col < dofs; ++col) {
       int slot = -1;
@@ -383,6 +387,29 @@ void DeformableBody::refresh_cut_tet_slots(int cut_tet_index) {
       slots[static_cast<size_t>(dofs * r + col)] = slot;
     }
   }
+}
+
+bool DeformableBody::drop_retired_blocks() {
+  const int u_rows = m_dofs.free_vertex_count();
+  std::vector<std::uint8_t> keep(static_cast<size_t>(m_tangent.slot_capacity()), 0);
+  // The blocks between two u rows stay (the uncut tets' and the force terms'): only XFEM blocks can
+  // be left over.
+  for (int row = 0; row < u_rows; ++row) {
+    const int begin = m_tangent.row_begin(row);
+    for (int slot = begin; slot < begin + m_tangent.row_size(row); ++slot) {
+      if (m_tangent.slot_column(slot) < u_rows) keep[static_cast<size_t>(slot)] = 1;
+    }
+  }
+  for (int k = 0; k < m_xfem.cut_tet_count(); ++k) {
+    if (m_xfem.retired(k)) continue;
+    for (const int slot : m_xfem.slots(k)) {
+      if (slot >= 0) keep[static_cast<size_t>(slot)] = 1;
+    }
+  }
+  m_retired_slots = 0;
+  if (!m_tangent.remove_blocks(keep)) return false;
+  refresh_all_slots(/*one_relayout=*/true);
+  return true;
 }
 
 void DeformableBody::refresh_all_slots(bool one_relayout) {

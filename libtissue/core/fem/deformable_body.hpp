@@ -79,6 +79,10 @@ struct CutTetGeometry {
 };
 
 /// What an enrichment changed.
+/// The tangent drops the blocks only retired cut tets used once the slots of the cut tets retired
+/// since it last did reach this share of its blocks (DeformableBody::enrich).
+inline constexpr double RETIRED_SLOT_SHARE_TO_COMPACT = 0.25;
+
 struct EnrichmentResult {
   int new_cut_tets = 0;          ///< cut tets made (one per cut, and those remade with other ghosts)
   int new_enriched_dofs = 0;     ///< new block rows (3 unknowns each), appended at the end
@@ -177,6 +181,12 @@ class DeformableBody final : public DynamicsModel {
   [[nodiscard]] int cut_tet_count() const { return m_tets_cut; }
   /// How cut tet k is cut (its cuts and pieces).
   [[nodiscard]] const CutTetGeometry& cut_geometry(int k) const { return m_cut_geometry.at(static_cast<size_t>(k)); }
+  /// Drops from the tangent the XFEM blocks (a ghost row or column) that no live cut tet uses (those
+  /// only retired cut tets used: zeros the product multiplies every step) and looks every slot up
+  /// again; returns whether any went (the tangent's layout changed). enrich() does it itself once
+  /// the retired cut tets' slots reach RETIRED_SLOT_SHARE_TO_COMPACT of the blocks. The product and
+  /// the forces are unchanged.
+  bool drop_retired_blocks();
   /// Whether cut tet k was replaced by a later cut of its tet (then it adds nothing).
   [[nodiscard]] bool retired(int k) const { return m_xfem.retired(k); }
   /// Index into cut_tets() of a tet's current cut tet, or -1 if it is not cut.
@@ -258,7 +268,9 @@ class DeformableBody final : public DynamicsModel {
   // All slots again after the tangent was re-laid out: by its slot map when it was re-laid out once
   // since they were right (`one_relayout`), else by search.
   void refresh_all_slots(bool one_relayout);
+  /// A retired cut tet's slots are all -1 (it adds nothing; its blocks may be gone).
   void refresh_cut_tet_slots(int cut_tet_index);
+
   /// The block row of local DOF `dof` of a cut tet (XfemElasticity::dof_count): u of a local vertex
   /// (-1 if fixed) or a ghost row.
   [[nodiscard]] int cut_tet_dof_row(int cut_tet_index, int dof) const;
@@ -298,6 +310,7 @@ class DeformableBody final : public DynamicsModel {
   std::vector<EnrichedDof> m_enriched_dofs;
   std::vector<CutTetGeometry> m_cut_geometry;  // per cut tet
   std::vector<int> m_ghost_users;              // per enriched unknown: pieces of live cut tets using it
+  long m_retired_slots = 0;  // slots of the cut tets retired since the last compaction (shared ones counted again)
   std::vector<int> m_orphaned_rows;            // rows the last enrich() left unused
   // A piece's share at a vertex that the last enrich() moved to another copy (from_row -1: a fixed
   // vertex, at rest): its momentum goes with it.

@@ -210,6 +210,12 @@ EnrichmentResult DeformableBody::enrich_pieces(std::span<const TetCut> cuts,
   } else {
     for (int k = first_new_cut_tet; k < m_xfem.cut_tet_count(); ++k) refresh_cut_tet_slots(k);
   }
+  // 6. The blocks only retired cut tets used are zeros the product would multiply every step: gone
+  // once the retired slots reach RETIRED_SLOT_SHARE_TO_COMPACT of the blocks (a quarter of the
+  // blocks after 30 + 30 careless strokes; docs/BENCHMARKS.md).
+  if (static_cast<double>(m_retired_slots) >= RETIRED_SLOT_SHARE_TO_COMPACT * m_tangent.nonzero_blocks()) {
+    if (drop_retired_blocks()) result.matrix_relayout = true;
+  }
   return result;
 }
 
@@ -347,6 +353,7 @@ int DeformableBody::replace_cut_tet(EnrichBatch& batch, size_t c, const std::vec
   const int u_rows = m_dofs.free_vertex_count();
   if (old >= 0) {
     add_piece_loads(old, -1.0);
+    for (const int slot : m_xfem.slots(old)) m_retired_slots += slot >= 0 ? 1 : 0;
     m_xfem.retire(old);
   } else {
     // The uncut tet's share leaves its vertices (its pieces bring theirs back below).

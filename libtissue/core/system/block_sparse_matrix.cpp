@@ -268,6 +268,45 @@ void BlockSparseMatrix::relayout(const std::vector<std::pair<int, int>>& min_cap
   ++m_pattern_revision;
 }
 
+bool BlockSparseMatrix::remove_blocks(const std::vector<std::uint8_t>& keep) {
+  if (keep.size() != m_column.size()) {
+    throw std::invalid_argument("BlockSparseMatrix::remove_blocks: " + std::to_string(keep.size()) + " marks for " +
+                                std::to_string(m_column.size()) + " slots");
+  }
+  m_relayout_slot_map.assign(m_column.size(), -1);
+  bool removed = false;
+  for (int r = 0; r < block_rows(); ++r) {
+    const int begin = m_row_begin[to_size(r)];
+    const int size = m_row_size[to_size(r)];
+    int kept = 0;
+    for (int k = 0; k < size; ++k) {
+      const int slot = begin + k;
+      if (keep[to_size(slot)] == 0 && m_column[to_size(slot)] != r) {
+        removed = true;
+        continue;
+      }
+      const int target = begin + kept++;  // never after `slot`: the row closes up front to back
+      if (target != slot) {
+        m_column[to_size(target)] = m_column[to_size(slot)];
+        std::copy_n(&m_values[9 * to_size(slot)], 9, &m_values[9 * to_size(target)]);
+      }
+      m_relayout_slot_map[to_size(slot)] = target;
+      if (m_column[to_size(target)] == r) m_diagonal_slot[to_size(r)] = target;
+    }
+    for (int k = kept; k < size; ++k) {
+      m_column[to_size(begin + k)] = -1;
+      std::fill_n(&m_values[9 * to_size(begin + k)], 9, 0.0);
+    }
+    m_nonzero_blocks -= size - kept;
+    m_row_size[to_size(r)] = kept;
+  }
+  if (removed) {
+    ++m_layout_revision;
+    ++m_pattern_revision;
+  }
+  return removed;
+}
+
 int BlockSparseMatrix::append_block_row(int min_capacity) {
   int n = block_rows();
   int begin = n == 0 ? 0 : m_row_begin[to_size(n - 1)] + m_row_capacity[to_size(n - 1)];

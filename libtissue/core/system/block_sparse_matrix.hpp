@@ -94,6 +94,12 @@ class BlockSparseMatrix {
   /// they need, at least twice their blocks, in one re-layout (none when every row has the room).
   /// Pairs need not be unique (a row's extras add up). Returns whether the storage was re-laid out.
   bool reserve_room(const std::vector<std::pair<int, int>>& row_extra);
+  /// Removes the blocks whose slot is not marked in `keep` (one entry per slot, slot_capacity();
+  /// the diagonal blocks stay whatever it says), each row's blocks closing up in place (the row
+  /// keeps its room). Returns whether a block went; then the layout changed (layout_revision(),
+  /// pattern_revision()) and relayout_slot_map() tells where the kept slots went. For the XFEM's
+  /// blocks that only retired cut tets used (zeros the product would multiply every step).
+  bool remove_blocks(const std::vector<std::uint8_t>& keep);
   /// After a re-layout: the new slot of each old slot (-1: an unused one), until the next re-layout.
   [[nodiscard]] const std::vector<int>& relayout_slot_map() const { return m_relayout_slot_map; }
 
