@@ -78,11 +78,11 @@ struct CutTetGeometry {
   std::vector<CutPlane> planes;
 };
 
-/// What an enrichment changed.
 /// The tangent drops the blocks only retired cut tets used once the slots of the cut tets retired
 /// since it last did reach this share of its blocks (DeformableBody::enrich).
 inline constexpr double RETIRED_SLOT_SHARE_TO_COMPACT = 0.25;
 
+/// What an enrichment changed.
 struct EnrichmentResult {
   int new_cut_tets = 0;          ///< cut tets made (one per cut, and those remade with other ghosts)
   int new_enriched_dofs = 0;     ///< new block rows (3 unknowns each), appended at the end
@@ -270,7 +270,6 @@ class DeformableBody final : public DynamicsModel {
   void refresh_all_slots(bool one_relayout);
   /// A retired cut tet's slots are all -1 (it adds nothing; its blocks may be gone).
   void refresh_cut_tet_slots(int cut_tet_index);
-
   /// The block row of local DOF `dof` of a cut tet (XfemElasticity::dof_count): u of a local vertex
   /// (-1 if fixed) or a ghost row.
   [[nodiscard]] int cut_tet_dof_row(int cut_tet_index, int dof) const;

@@ -210,9 +210,9 @@ EnrichmentResult DeformableBody::enrich_pieces(std::span<const TetCut> cuts,
   } else {
     for (int k = first_new_cut_tet; k < m_xfem.cut_tet_count(); ++k) refresh_cut_tet_slots(k);
   }
-  // 6. The blocks only retired cut tets used are zeros the product would multiply every step: gone
-  // once the retired slots reach RETIRED_SLOT_SHARE_TO_COMPACT of the blocks (a quarter of the
-  // blocks after 30 + 30 careless strokes; docs/BENCHMARKS.md).
+  // 6. The blocks only retired cut tets used are zeros the product would multiply every step (40%
+  // of the blocks after 30 + 30 careless strokes; docs/BENCHMARKS.md): gone once the retired slots
+  // reach RETIRED_SLOT_SHARE_TO_COMPACT of the blocks.
   if (static_cast<double>(m_retired_slots) >= RETIRED_SLOT_SHARE_TO_COMPACT * m_tangent.nonzero_blocks()) {
     if (drop_retired_blocks()) result.matrix_relayout = true;
   }
