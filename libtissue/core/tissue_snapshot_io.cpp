@@ -14,8 +14,8 @@ constexpr std::uint64_t MAGIC = 0x31305353'49535354ULL;  // "TSSISS01" read as l
 // 5: several cuts per tet (pieces' offsets and rotations, the cuts' smallest fraction, cut counts);
 // 7: a ghost's unknown is its copy's displacement, not a difference from u (issue 40): the same
 // fields, other meanings; 8: the cutter's per-vertex sides, distances and the blade's plane of the
-// open session (issue 41)
-constexpr std::uint32_t VERSION = 8;
+// open session (issue 41); 9: each cut's blade normal (TetCut::blade_normal)
+constexpr std::uint32_t VERSION = 9;
 
 // The core's Eigen types and cut records on top of the shared byte stream.
 class Writer : public serial::ByteWriter {
@@ -55,6 +55,7 @@ class Writer : public serial::ByteWriter {
     put(cut.volume_fraction_above);
     put_item(cut.edge_ratio);
     put(cut.min_volume_fraction);
+    put(cut.blade_normal);
   }
   template <class T>
   void put_item(const std::vector<T>& values) {
@@ -91,6 +92,7 @@ class Reader : public serial::ByteReader {
     get(cut.volume_fraction_above);
     get(cut.edge_ratio);
     get(cut.min_volume_fraction);
+    get(cut.blade_normal);
   }
   template <class T>
   void get(std::vector<T>& values) {
@@ -199,7 +201,7 @@ TissueSnapshot read_snapshot(std::span<const std::uint8_t> bytes) {
   }
   TissueSnapshot s;
   r.get(s.model_fingerprint);
-  r.get_all(s.cuts, 4 + 4 + 4 + 8 + 48 + 8);
+  r.get_all(s.cuts, 4 + 4 + 4 + 8 + 48 + 8 + 24);
   r.get_all(s.cut_batch_ends, 4);
   r.get_all(s.cut_offsets, 8);
   r.get(s.dynamics.displacement_m);

@@ -29,7 +29,7 @@ int sweep_substeps(const ToolPose& from, const ToolPose& to) {
 bool same_cut(const TetCut& a, const TetCut& b) {
   return a.tet == b.tet && a.cut_id == b.cut_id && a.side == b.side &&
          a.volume_fraction_above == b.volume_fraction_above && a.edge_ratio == b.edge_ratio &&
-         a.min_volume_fraction == b.min_volume_fraction;
+         a.min_volume_fraction == b.min_volume_fraction && a.blade_normal == b.blade_normal;
 }
 
 }  // namespace

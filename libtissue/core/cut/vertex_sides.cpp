@@ -287,6 +287,7 @@ std::optional<TetCut> VolumeCutter::cut_of(int tet, double end_margin) const {
   cut.tet = tet;
   cut.cut_id = m_cut_id;
   cut.min_volume_fraction = m_settings.min_volume_fraction;
+  cut.blade_normal = m_plane.valid ? m_plane.normal : m_last_stroke_normal;
   return cut;
 }
 

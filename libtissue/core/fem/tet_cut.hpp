@@ -2,6 +2,8 @@
 // (dissertation 3.3, 4.3.2). A tet may be cut by several sessions, one TetCut each (issue 21).
 #pragma once
 
+#include <Eigen/Core>
+
 #include <array>
 #include <cstdint>
 
@@ -26,6 +28,9 @@ struct TetCut {
   /// The cutter's smallest piece (CutterSettings::min_volume_fraction): a later cut of the tet
   /// splits a piece only if both sides keep at least this fraction of the tet (split_pieces).
   double min_volume_fraction = DEFAULT_MIN_VOLUME_FRACTION;
+  /// The blade's plane's unit normal when the cutter made the cut (zero: not known, as for a cut given
+  /// by hand). It orients the cut's plane where the crossing points cannot (cut_plane).
+  Eigen::Vector3d blade_normal = Eigen::Vector3d::Zero();
 };
 
 }  // namespace tissue

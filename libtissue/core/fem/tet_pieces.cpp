@@ -44,8 +44,23 @@ CutPlane cut_plane(const std::array<Eigen::Vector3d, 4>& rest_m, const TetCut& c
   Eigen::Vector3d centre = Eigen::Vector3d::Zero();
   for (int k = 0; k < count; ++k) centre += points[static_cast<std::size_t>(k)];
   centre /= count;
+  // The crossing points held a margin off a vertex on the blade bunch around it: with fewer than three
+  // such places (a vertex or an edge on the blade) their plane leans any way, parallel to the far
+  // face for one vertex; the blade's own normal is the cut's.
+  constexpr double SAME_PLACE_FRACTION = 1e-3;
+  const double same_place_m = SAME_PLACE_FRACTION * largest_edge_m(rest_m);
+  int places = 0;
+  for (int k = 0; k < count; ++k) {
+    bool seen = false;
+    for (int m = 0; m < k; ++m) {
+      seen = seen || (points[static_cast<std::size_t>(k)] - points[static_cast<std::size_t>(m)]).norm() <= same_place_m;
+    }
+    places += seen ? 0 : 1;
+  }
   Eigen::Vector3d normal;
-  if (count == 3) {
+  if (places < 3 && cut.blade_normal.squaredNorm() > 0.0) {
+    normal = cut.blade_normal;
+  } else if (count == 3) {
     normal = (points[1] - points[0]).cross(points[2] - points[0]);
   } else {
     Eigen::Matrix3d scatter = Eigen::Matrix3d::Zero();

@@ -8,7 +8,6 @@
 #include <Eigen/Dense>
 
 #include <algorithm>
-#include <climits>
 #include <cmath>
 #include <cstddef>
 #include <limits>
@@ -19,155 +18,13 @@
 
 namespace tissue {
 
+using cut_render_detail::border_loops;
 using cut_render_detail::directed_key;
+using cut_render_detail::ear_clip;
 using cut_render_detail::edge_key;
+using cut_render_detail::junction_smoothed;
 
 namespace {
-
-// Triangulates the closed polygon `loop` (point indices, positions `x`) by ear clipping in its
-// best-fit plane, each triangle wound as the polygon (counter-clockwise about its Newell normal),
-// never cutting along an edge the mesh has already (edge_exists(u, v), either way: it would then
-// have four triangles).
-template <typename EdgeExists>
-void ear_clip(const std::vector<int>& loop, const std::vector<Eigen::Vector3d>& x,
-              std::vector<std::array<int, 3>>& triangles, const EdgeExists& edge_exists) {
-  const size_t n = loop.size();
-  if (n < 3) return;
-  Eigen::Vector3d normal = Eigen::Vector3d::Zero();
-  for (size_t i = 0; i < n; ++i) {
-    normal += x[static_cast<size_t>(loop[i])].cross(x[static_cast<size_t>(loop[(i + 1) % n])]);
-  }
-  std::vector<int> left = loop;
-  if (normal.norm() <= 0.0) {  // no area: a fan closes it
-    for (size_t i = 1; i + 1 < n; ++i) triangles.push_back({loop[0], loop[i], loop[i + 1]});
-    return;
-  }
-  normal.normalize();
-  const Eigen::Vector3d e1 = normal.unitOrthogonal();
-  const Eigen::Vector3d e2 = normal.cross(e1);
-  // The loop's points in the plane, once, beside `left`.
-  std::vector<Eigen::Vector2d> flat(n);
-  for (size_t i = 0; i < n; ++i) {
-    const Eigen::Vector3d& p = x[static_cast<size_t>(loop[i])];
-    flat[i] = Eigen::Vector2d(p.dot(e1), p.dot(e2));
-  }
-  const auto cross = [](const Eigen::Vector2d& a, const Eigen::Vector2d& b, const Eigen::Vector2d& c) {
-    return (b - a).x() * (c - a).y() - (b - a).y() * (c - a).x();
-  };
-  // Only a corner that is not convex can lie inside a convex corner's triangle: the test of an ear
-  // looks at those (flagged, kept up to date for the two corners next to each ear cut).
-  const auto convex_at = [&](size_t i, size_t m) {
-    const Eigen::Vector2d& a = flat[(i + m - 1) % m];
-    const Eigen::Vector2d& b = flat[i];
-    const Eigen::Vector2d& c = flat[(i + 1) % m];
-    return cross(a, b, c) > 1e-9 * (b - a).norm() * (c - b).norm();
-  };
-  std::vector<char> convex(n);
-  for (size_t i = 0; i < n; ++i) convex[i] = convex_at(i, n) ? 1 : 0;
-  size_t from = 0;  // the search goes on where the last ear was cut
-  while (left.size() > 3) {
-    const size_t m = left.size();
-    size_t ear = m;
-    for (size_t k = 0; k < m && ear == m; ++k) {
-      const size_t i = (from + k) % m;
-      if (convex[i] == 0) continue;  // reflex or flat
-      const Eigen::Vector2d& a = flat[(i + m - 1) % m];
-      const Eigen::Vector2d& b = flat[i];
-      const Eigen::Vector2d& c = flat[(i + 1) % m];
-      if (m > 3 && edge_exists(left[(i + 1) % m], left[(i + m - 1) % m])) continue;  // a diagonal the mesh has
-      bool empty = true;
-      for (size_t j = 0; j < m && empty; ++j) {
-        if (convex[j] != 0 || j == i || j == (i + m - 1) % m || j == (i + 1) % m) continue;
-        const Eigen::Vector2d& p = flat[j];
-        empty = !(cross(a, b, p) > 0.0 && cross(b, c, p) > 0.0 && cross(c, a, p) > 0.0);
-      }
-      if (empty) ear = i;
-    }
-    // No clean ear (a degenerate loop): cut one anyway, the topology stays closed; one whose
-    // diagonal the mesh lacks, so that no edge gets four triangles (cutting the first corner along a
-    // surface edge made the complete-cut frog non-manifold in 4 frames under baseline x86-64).
-    for (size_t i = 0; i < m && ear == m; ++i) {
-      if (!edge_exists(left[(i + 1) % m], left[(i + m - 1) % m])) ear = i;
-    }
-    if (ear == m) ear = 0;
-    triangles.push_back({left[(ear + m - 1) % m], left[ear], left[(ear + 1) % m]});
-    left.erase(left.begin() + static_cast<std::ptrdiff_t>(ear));
-    flat.erase(flat.begin() + static_cast<std::ptrdiff_t>(ear));
-    convex.erase(convex.begin() + static_cast<std::ptrdiff_t>(ear));
-    const size_t before = (ear + m - 2) % (m - 1), after = ear % (m - 1);
-    convex[before] = convex_at(before, m - 1) ? 1 : 0;
-    convex[after] = convex_at(after, m - 1) ? 1 : 0;
-    from = after;
-  }
-  triangles.push_back({left[0], left[1], left[2]});
-}
-
-// The border loops of a split surface from its directed edges at split points (a border edge has
-// no twin), each in the order its cap runs them (against the skin).
-std::vector<std::vector<int>> border_loops(const std::unordered_map<long long, int>& directed) {
-  std::vector<std::pair<int, int>> next;  // border edges u -> v, sorted
-  for (const auto& [edge, uses] : directed) {
-    const auto u = static_cast<int>(edge >> 32), v = static_cast<int>(edge & 0xffffffffLL);
-    if (!directed.contains(directed_key(v, u))) next.emplace_back(u, v);
-  }
-  std::sort(next.begin(), next.end());
-  std::vector<char> used(next.size(), 0);
-  // The first unused border edge from `at` (next.size(): none).
-  const auto from = [&](int at) {
-    for (auto i =
-             static_cast<size_t>(std::lower_bound(next.begin(), next.end(), std::pair{at, INT_MIN}) - next.begin());
-         i < next.size() && next[i].first == at; ++i) {
-      if (used[i] == 0) return i;
-    }
-    return next.size();
-  };
-  std::vector<std::vector<int>> loops;
-  for (size_t first = 0; first < next.size(); ++first) {
-    if (used[first] != 0) continue;
-    std::vector<int> loop;
-    const int start = next[first].first;
-    int at = start;
-    while (true) {
-      const size_t i = from(at);
-      if (i == next.size()) break;
-      loop.push_back(at);
-      at = next[i].second;
-      used[i] = 1;
-      if (at == start) break;
-    }
-    std::reverse(loop.begin(), loop.end());
-    loops.push_back(std::move(loop));
-  }
-  return loops;
-}
-
-// A loop's points' cuts (-1: a surface vertex, a crack tip). Where two cuts meet on the surface the
-// points next to the junction may be split by either, so a run shorter than JUNCTION_RUN points
-// between two other runs takes a neighbour's cut (the longer's); a tip between two runs of one cut
-// (a slit's) stays.
-std::vector<int> junction_smoothed(std::vector<int> label) {
-  constexpr size_t JUNCTION_RUN = 4;
-  const size_t n = label.size();
-  for (bool changed = true; changed;) {
-    changed = false;
-    for (size_t i = 0; i < n && !changed; ++i) {
-      if (label[(i + n - 1) % n] == label[i]) continue;  // not a run's start
-      size_t length = 1;
-      while (length < n && label[(i + length) % n] == label[i]) ++length;
-      if (length >= JUNCTION_RUN || length == n) continue;
-      const int before = label[(i + n - 1) % n], after = label[(i + length) % n];
-      if (label[i] < 0 && before == after) continue;  // a slit's tip
-      if (before < 0 && after < 0) continue;
-      size_t before_length = 1, after_length = 1;
-      while (before_length < n && label[(i + n - 1 - before_length) % n] == before) ++before_length;
-      while (after_length < n && label[(i + length + after_length) % n] == after) ++after_length;
-      const int into = after < 0 || (before >= 0 && before_length >= after_length) ? before : after;
-      for (size_t k = 0; k < length; ++k) label[(i + k) % n] = into;
-      changed = true;
-    }
-  }
-  return label;
-}
 
 // A maximal run of a loop's points split by one cut.
 struct Chain {
@@ -210,11 +67,11 @@ std::vector<std::pair<size_t, size_t>> paired_switches(
 }
 
 // The crack fronts' tip pairs: each tip with the nearest unpaired tip of the same material part and
-// cut whose loop turns the other way (its facings swapped).
+// cut whose loop turns the other way (its facings swapped). `paired`: the tips taken (in and out).
 std::vector<std::pair<size_t, size_t>> paired_tips(const std::vector<Tip>& tips,
-                                                   const std::vector<Eigen::Vector3d>& rest_m) {
+                                                   const std::vector<Eigen::Vector3d>& rest_m,
+                                                   std::vector<bool>& paired) {
   std::vector<std::pair<size_t, size_t>> pairs;
-  std::vector<bool> paired(tips.size(), false);
   for (size_t a = 0; a < tips.size(); ++a) {
     if (paired[a]) continue;
     size_t best = tips.size();
@@ -320,7 +177,7 @@ void find_split_edges(const std::vector<std::array<int, 3>>& triangles, size_t p
 void cap_polygon(const std::vector<int>& polygon, const std::vector<Eigen::Vector3d>& rest_m,
                  std::vector<std::array<int, 3>>& triangles, CapEdges& edges) {
   const size_t before = triangles.size();
-  ear_clip(polygon, rest_m, triangles, edges);
+  ear_clip(polygon, rest_m, triangles, [&edges](int u, int v) { return edges(u, v); });
   for (size_t t = before; t < triangles.size(); ++t) edges.add(triangles[t]);
 }
 
@@ -419,6 +276,7 @@ struct ChainEnds {
   // (part, cut lo, cut hi, facing on lo, facing on hi: the quadrant) -> the chains ending there
   std::map<std::array<int, 5>, std::vector<size_t>> switches;
   std::vector<Tip> tips;
+  std::vector<bool> tip_taken;  // by a junction that ends inside (bridge_notches) or a crack front
 };
 
 // Each chain's end: at a switch, a tip, or (the material on one side before and after) going on
@@ -488,12 +346,92 @@ void bridge_switches(const std::vector<std::vector<int>>& loops, const std::vect
   }
 }
 
-// The crack fronts between paired tips.
+// Where a partial cut meets a cut through the body only part of the way (its crack turns away from
+// the junction inside the body, a notch in the through cut's face): two switches without a partner,
+// x where a chain of the through cut K ends and one of the notched cut N begins, y where an N chain
+// ends and a K chain begins (same part, the same side of K, opposite sides of N), and a tip of N in
+// that part between the two walls. The junction runs from x into the body to a point J (the tip
+// projected onto K's plane, plane_of(point, cut)), and back to y; the crack front from the tip to J.
+// K's face takes the notch (x, J, y); N's walls take the junction and the front on either side.
+template <typename LinePoints, typename PointAt, typename PlaneOf>
+void bridge_notches(const std::vector<std::vector<int>>& loops, const std::vector<Chain>& chains,
+                    const std::map<int, size_t>& chain_starting_at, const std::vector<Eigen::Vector3d>& rest_m,
+                    const LinePoints& line_points, const PointAt& point_at, const PlaneOf& plane_of, ChainEnds& ends) {
+  struct Lone {
+    size_t ending, beginning;  // the chains either side of the switch
+    int part;
+  };
+  std::vector<Lone> lone;
+  for (const auto& [junction, list] : ends.switches) {
+    if (list.size() != 1) continue;
+    const auto next = chain_starting_at.find(point_after(loops, chains[list[0]], 1));
+    if (next != chain_starting_at.end()) lone.push_back(Lone{list[0], next->second, junction[0]});
+  }
+  ends.tip_taken.assign(ends.tips.size(), false);
+  std::vector<bool> used(lone.size(), false);
+  for (size_t i = 0; i < lone.size(); ++i) {
+    const Chain& k_end = chains[lone[i].ending];  // x: a K chain ends, an N chain begins
+    const Chain& n_begin = chains[lone[i].beginning];
+    for (size_t j = 0; j < lone.size() && !used[i]; ++j) {
+      const Chain& n_end = chains[lone[j].ending];  // y: an N chain ends, a K chain begins
+      const Chain& k_begin = chains[lone[j].beginning];
+      if (used[j] || j == i || lone[j].part != lone[i].part || n_end.cut != n_begin.cut || k_begin.cut != k_end.cut ||
+          k_begin.facing != k_end.facing || n_end.facing == n_begin.facing)
+        continue;
+      size_t best = ends.tips.size();
+      double nearest = std::numeric_limits<double>::infinity();
+      const int x_point = loops[static_cast<size_t>(n_begin.loop)][static_cast<size_t>(n_begin.first)];
+      for (size_t t = 0; t < ends.tips.size(); ++t) {
+        const Tip& tip = ends.tips[t];
+        if (ends.tip_taken[t] || tip.part != lone[i].part || tip.cut != n_begin.cut || tip.before != n_begin.facing ||
+            tip.after != n_end.facing)
+          continue;
+        const double distance = (rest_m[static_cast<size_t>(tip.point())] - rest_m[static_cast<size_t>(x_point)]).norm();
+        if (distance < nearest) {
+          nearest = distance;
+          best = t;
+        }
+      }
+      if (best == ends.tips.size()) continue;
+      used[i] = used[j] = true;
+      ends.tip_taken[best] = true;
+      const Tip& tip = ends.tips[best];
+      const int y_point = loops[static_cast<size_t>(n_end.loop)][static_cast<size_t>(n_end.last)];
+      const CutPlane k_plane = plane_of(x_point, k_end.cut);
+      const Eigen::Vector3d& at_tip = rest_m[static_cast<size_t>(tip.point())];
+      const int inner = point_at(tip.point(), at_tip - k_plane.signed_distance(at_tip) * k_plane.normal);  // J
+      const std::vector<int> down = line_points(x_point, inner);  // x to J
+      const std::vector<int> up = line_points(inner, y_point);    // J to y
+      const std::vector<int> front = line_points(tip.point(), inner);
+      Link& k_face = ends.link[lone[i].ending];
+      k_face.bridge = {x_point};
+      k_face.bridge.insert(k_face.bridge.end(), down.begin(), down.end());
+      k_face.bridge.push_back(inner);
+      k_face.bridge.insert(k_face.bridge.end(), up.begin(), up.end());
+      k_face.bridge.push_back(y_point);
+      k_face.next_first = loops[static_cast<size_t>(k_begin.loop)][static_cast<size_t>(k_begin.first)];
+      Link& wall_before = ends.link[tip.chain];  // the tip, the front to J, the junction up to x
+      wall_before.bridge = tip.run;
+      wall_before.bridge.insert(wall_before.bridge.end(), front.begin(), front.end());
+      wall_before.bridge.push_back(inner);
+      wall_before.bridge.insert(wall_before.bridge.end(), down.rbegin(), down.rend());
+      wall_before.next_first = x_point;
+      Link& wall_after = ends.link[lone[j].ending];  // from y down to J, the front back to the tip
+      wall_after.bridge.assign(up.rbegin(), up.rend());
+      wall_after.bridge.push_back(inner);
+      wall_after.bridge.insert(wall_after.bridge.end(), front.rbegin(), front.rend());
+      wall_after.bridge.push_back(tip.point());
+      wall_after.next_first = tip.first_after;
+    }
+  }
+}
+
+// The crack fronts between paired tips (those no junction took).
 template <typename LinePoints>
 void bridge_tips(const std::vector<Eigen::Vector3d>& rest_m, const LinePoints& line_points, ChainEnds& ends) {
   std::map<size_t, Link>& link = ends.link;
   const std::vector<Tip>& tips = ends.tips;
-  for (const auto& [a, best] : paired_tips(tips, rest_m)) {
+  for (const auto& [a, best] : paired_tips(tips, rest_m, ends.tip_taken)) {
     std::vector<int> front = line_points(tips[a].point(), tips[best].point());  // one crack front for both walls
     for (const auto& [from, to] : {std::pair{a, best}, std::pair{best, a}}) {
       // The wall's own tip run, the front, the other tip's front end; then the chain after it.
@@ -574,6 +512,19 @@ void CutRenderSurface::cap_loops(const DeformableBody& body) {
   ChainEnds ends = find_chain_ends(loops, labels, chains, chain_starting_at, part_of_point);
   const auto line = [&](int from, int to) { return line_points(from, to); };
   bridge_switches(loops, chains, line, ends);
+  const auto point_at = [&](int model, const Eigen::Vector3d& rest_m) { return add_point_like(model, rest_m); };
+  // The plane of cut `cut` at a point's cell (none, a zero normal, if its cell is not cut by it).
+  const auto plane_of = [&](int point, int cut) {
+    const Point& at = m_points[static_cast<size_t>(point)];
+    if (at.cut_tet >= 0) {
+      const CutTetGeometry& geometry = body.cut_geometry(at.cut_tet);
+      for (size_t c = 0; c < geometry.cuts.size(); ++c) {
+        if (geometry.cuts[c].cut_id == cut) return geometry.planes[c];
+      }
+    }
+    return CutPlane{Eigen::Vector3d::Zero(), 0.0};
+  };
+  bridge_notches(loops, chains, chain_starting_at, m_rest_m, line, point_at, plane_of, ends);
   bridge_tips(m_rest_m, line, ends);
   std::vector<std::vector<int>> faces;
   m_open_loops += walk_faces(loops, chains, ends.link, chain_starting_at, faces);

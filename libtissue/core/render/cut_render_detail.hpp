@@ -1,13 +1,31 @@
 // Private to core/render: the edge keys CutRenderSurface's files share (cut_render_surface.cpp,
-// cut_render_split.cpp, cut_render_caps.cpp).
+// cut_render_split.cpp, cut_render_caps.cpp) and the caps' loops (cut_render_loops.cpp).
 #pragma once
 
+#include <Eigen/Core>
+
 #include <algorithm>
+#include <array>
+#include <functional>
+#include <unordered_map>
+#include <vector>
 
 namespace tissue::cut_render_detail {
 
 // An edge as one integer: (u, v) directed, and the same for either direction (lower, higher).
 inline long long directed_key(int u, int v) { return (static_cast<long long>(u) << 32) | static_cast<unsigned int>(v); }
 inline long long edge_key(int u, int v) { return directed_key(std::min(u, v), std::max(u, v)); }
+
+// The border loops of a split surface from its directed edges at split points (a border edge has
+// no twin), each in the order its cap runs them (against the skin).
+std::vector<std::vector<int>> border_loops(const std::unordered_map<long long, int>& directed);
+
+// Triangulates the closed polygon `loop` (point indices, positions `x`) by ear clipping in its
+// best-fit plane, wound as the polygon, never along an edge for which edge_exists(u, v) holds.
+void ear_clip(const std::vector<int>& loop, const std::vector<Eigen::Vector3d>& x,
+              std::vector<std::array<int, 3>>& triangles, const std::function<bool(int, int)>& edge_exists);
+
+// A loop's points' cuts with the short runs next to a junction given a neighbour's cut.
+std::vector<int> junction_smoothed(std::vector<int> label);
 
 }  // namespace tissue::cut_render_detail

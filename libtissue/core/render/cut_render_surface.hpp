@@ -16,7 +16,10 @@
 //   between two chains), the junction line to the other switch of the same material part, cut pair
 //   and quadrant (the chains' sides of the two cuts), and where a partial cut ends (a crack tip, an
 //   uncut surface vertex between two chains of one cut), the crack front to the tip of the same part
-//   and cut whose loop turns the other way, nearest first. Each face is ear-clipped, never along an
+//   and cut whose loop turns the other way, nearest first. Where a partial cut meets another only part
+//   of the way (a notch: two switches without a partner and a tip between the notched cut's walls),
+//   the junction runs into the body to the tip's projection on the other plane and back, the crack
+//   front from the tip to there. Each face is ear-clipped, never along an
 //   edge the mesh has. The line's points ride on the cell of their nearer end.
 // * Material parts: cells joined where they share a copy of a vertex (real or ghost), the simulation's
 //   own connectivity.
@@ -28,8 +31,8 @@
 //   time, when the unchanged points' material parts regroup (a piece came free), and when the split
 //   points dropped by re-splits exceed a quarter of the surface's vertices.
 // Limits: the crack front is the straight line between the tips (right for a stroke through the
-// full depth), and its points follow one side; where two partial cuts cross, a switch has no
-// partner (the junction line ends inside the body) and the loop stays open.
+// full depth), and its points follow one side; where two partial cuts cross, a switch may have no
+// partner and no tip to close on (the junction line ends inside the body) and the loop stays open.
 #pragma once
 
 #include "core/fem/deformable_body.hpp"

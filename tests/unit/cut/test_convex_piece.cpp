@@ -263,3 +263,67 @@ TEST(TetPieces, ACrossingCutSplitsBothPiecesAndAFarCutOnlyTheOneItReaches) {
 
 }  // namespace
 }  // namespace tissue
+
+namespace tissue {
+namespace {
+
+// A blade through a vertex (or an edge) of a tet: the cutter puts that vertex above and holds the
+// crossing points 1e-6 of an edge off it (cut_from_sides), so they bunch at the vertex and their own
+// plane is parallel to the far face, any lean at all. The cut's plane is the blade's: its normal, and
+// the vertex on it (the render surface sorts its points by this plane; before, a tet cut at a vertex by
+// the plane y = 0 had its plane's normal along (1, 1, 1)).
+TEST(TetPieces, ABladeThroughAVertexOrAnEdgeGivesTheCutTheBladesPlane) {
+  const double s = 0.01;
+  const std::array<Eigen::Vector3d, 4> x{Eigen::Vector3d(0, 0, 0), Eigen::Vector3d(s, -s, 0.2 * s),
+                                         Eigen::Vector3d(0.3 * s, -s, s), Eigen::Vector3d(-0.5 * s, -0.2 * s, -0.4 * s)};
+  const CutPlane blade{Eigen::Vector3d::UnitY(), 0.0};  // through vertex 0
+  const auto cut_with = [&](const std::array<std::int8_t, 4>& side, const Eigen::Vector3d& normal) {
+    std::array<double, 6> ratio{};
+    for (size_t k = 0; k < 6; ++k) {
+      const double d0 = blade.signed_distance(x[static_cast<size_t>(TET_EDGES[k][0])]);
+      const double d1 = blade.signed_distance(x[static_cast<size_t>(TET_EDGES[k][1])]);
+      ratio[k] = d0 == d1 ? 0.5 : d0 / (d0 - d1);
+    }
+    TetCut cut = cut_from_sides(x, side, ratio, 1e-6, 1e-3);
+    cut.blade_normal = normal;
+    return cut;
+  };
+  const TetCut vertex_on_blade = cut_with({1, -1, -1, -1}, Eigen::Vector3d::UnitY());
+  const CutPlane plane = cut_plane(x, vertex_on_blade);
+  EXPECT_NEAR(plane.normal.dot(Eigen::Vector3d::UnitY()), 1.0, 1e-12);
+  EXPECT_NEAR(plane.signed_distance(x[0]), 0.0, 1e-6 * s);
+  // Without the blade's normal (a cut given by hand), the crossing points' own plane.
+  const CutPlane own = cut_plane(x, cut_with({1, -1, -1, -1}, Eigen::Vector3d::Zero()));
+  EXPECT_LT(own.normal.dot(Eigen::Vector3d::UnitY()), 0.9);
+  // An edge on the blade (vertices 0 and 3 moved onto it): the same.
+  std::array<Eigen::Vector3d, 4> edge_on = x;
+  edge_on[3].y() = 0.0;
+  const auto edge_cut = [&] {
+    std::array<double, 6> ratio{};
+    for (size_t k = 0; k < 6; ++k) {
+      const double d0 = blade.signed_distance(edge_on[static_cast<size_t>(TET_EDGES[k][0])]);
+      const double d1 = blade.signed_distance(edge_on[static_cast<size_t>(TET_EDGES[k][1])]);
+      ratio[k] = d0 == d1 ? 0.5 : d0 / (d0 - d1);
+    }
+    TetCut cut = cut_from_sides(edge_on, {1, -1, -1, 1}, ratio, 1e-6, 1e-3);
+    cut.blade_normal = Eigen::Vector3d::UnitY();
+    return cut;
+  }();
+  EXPECT_NEAR(cut_plane(edge_on, edge_cut).normal.dot(Eigen::Vector3d::UnitY()), 1.0, 1e-12);
+  // A blade through the middle of the tet keeps the crossing points' plane (three places or more).
+  const CutPlane middle{Eigen::Vector3d(0.1, 1.0, 0.05).normalized(), -0.5 * s};
+  std::array<double, 6> ratio{};
+  std::array<std::int8_t, 4> side{};
+  for (size_t j = 0; j < 4; ++j) side[j] = middle.signed_distance(x[j]) >= 0.0 ? 1 : -1;
+  for (size_t k = 0; k < 6; ++k) {
+    const double d0 = middle.signed_distance(x[static_cast<size_t>(TET_EDGES[k][0])]);
+    const double d1 = middle.signed_distance(x[static_cast<size_t>(TET_EDGES[k][1])]);
+    ratio[k] = d0 == d1 ? 0.5 : d0 / (d0 - d1);
+  }
+  TetCut through = cut_from_sides(x, side, ratio, 1e-6, 1e-3);
+  through.blade_normal = Eigen::Vector3d::UnitZ();  // not used: the crossings tell
+  EXPECT_NEAR(cut_plane(x, through).normal.dot(middle.normal), 1.0, 1e-12);
+}
+
+}  // namespace
+}  // namespace tissue

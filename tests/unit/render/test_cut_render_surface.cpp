@@ -23,6 +23,7 @@
 
 #include <algorithm>
 #include <cstdio>
+#include <cstdlib>
 #include <functional>
 #include <memory>
 #include <map>
@@ -199,8 +200,10 @@ struct RenderPart {
 /// material part's volume to within the mesh's resolution (parts matched largest to largest): the
 /// smooth render surface lies outside the tets' flat faces where the shape is convex and inside
 /// where it is concave (the uncut one encloses r0 = 1.042 times their volume), so a part's ratio lies
-/// within 0.08 of 1. Returns the parts (rest volumes and centroids).
-std::vector<RenderPart> expect_closed_parts(const CutRenderSurface& render, const CutFrog& frog) {
+/// within 0.08 of 1 (for parts of at least `judged_m3`: the bulge is the tets' sagitta over the part's
+/// size, 17% for the frog's toes of 1 cm^3). Returns the parts (rest volumes and centroids).
+std::vector<RenderPart> expect_closed_parts(const CutRenderSurface& render, const CutFrog& frog,
+                                            double judged_m3 = 0.0) {
   const auto& triangles = render.triangles();
   const auto& x = render.rest_positions_m();
   int count = 0;
@@ -234,7 +237,9 @@ std::vector<RenderPart> expect_closed_parts(const CutRenderSurface& render, cons
   for (size_t p = 0; p < std::min(render_m3.size(), simulated_m3.size()); ++p) {
     std::printf("part %zu: render %.4g m3, simulated %.4g m3, ratio %.4f\n", p, render_m3[p], simulated_m3[p],
                 render_m3[p] / simulated_m3[p]);
-    EXPECT_NEAR(render_m3[p] / simulated_m3[p], 1.0, 0.08);
+    if (simulated_m3[p] >= judged_m3) {
+      EXPECT_NEAR(render_m3[p] / simulated_m3[p], 1.0, 0.08);
+    }
   }
   return parts;
 }
@@ -525,6 +530,41 @@ TEST(TissueRenderSurface, TheScalpelsCutIsDrawnOnTheRenderSurfaceAndSurvivesARes
   far.vertices_m[7] += Eigen::Vector3d(0.0, 0.0, 0.05);
   settings.render_surface = std::make_shared<const TriangleSurface>(far);
   EXPECT_THROW(Tissue(mesh, settings), ParameterError);
+}
+
+}  // namespace
+}  // namespace tissue
+
+namespace tissue {
+namespace {
+
+// N strokes across the frog through its whole width and N along its middle that end inside it (the
+// benchmark's hatching, BM_CutRenderSurfaceHatched): the strokes along run into the body and out of the
+// cuts across, on planes through the render surface's vertices (y = 0 is the frog's plane of symmetry).
+std::vector<std::array<Eigen::Vector2d, 2>> hatching(int strokes) {
+  std::vector<std::array<Eigen::Vector2d, 2>> hatched;
+  for (int k = 0; k < strokes; ++k) {
+    const double x = -0.025 + 0.06 * (k + 0.5) / strokes;
+    hatched.push_back({Eigen::Vector2d(x, -0.0702), Eigen::Vector2d(x, 0.0698)});
+  }
+  for (int k = 0; k < strokes; ++k) {
+    const double y = -0.05 + 0.10 * (k + 0.5) / strokes;
+    hatched.push_back({Eigen::Vector2d(-0.0301, y), Eigen::Vector2d(0.0399, y)});
+  }
+  return hatched;
+}
+
+// Where a stroke ends inside the body next to another cut, its crack turns away from the junction
+// inside the body: the through cut's face has a notch (the junction down to where the crack leaves
+// it) and the walls close along it and the crack front. Before, those loops stayed open (1 + 1: 4
+// open loops, 3 + 3: 3) and the pieces had holes.
+TEST(CutRenderSurface, HatchedStrokesEndingInsideLeaveClosedPieces) {
+  for (const int strokes : {1, 3}) {
+    CutFrog frog(hatching(strokes));
+    CutRenderSurface render = frog.cut_render_surface();
+    EXPECT_EQ(render.open_loop_count(), 0) << strokes << " + " << strokes;
+    expect_closed_parts(render, frog, 5e-6);  // the frog is 8.1e-5 m^3
+  }
 }
 
 }  // namespace

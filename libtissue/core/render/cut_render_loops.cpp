@@ -1,0 +1,159 @@
+// CutRenderSurface's caps: the split surface's border loops and their points' cuts, before the
+// faces are walked, and the ear clipping that triangulates the faces (cut_render_caps.cpp).
+#include "core/render/cut_render_detail.hpp"
+
+#include <Eigen/Geometry>
+
+#include <algorithm>
+#include <climits>
+#include <cstddef>
+#include <functional>
+#include <utility>
+
+namespace tissue::cut_render_detail {
+
+// Triangulates the closed polygon `loop` (point indices, positions `x`) by ear clipping in its
+// best-fit plane, each triangle wound as the polygon (counter-clockwise about its Newell normal),
+// never cutting along an edge the mesh has already (edge_exists(u, v), either way: it would then
+// have four triangles).
+void ear_clip(const std::vector<int>& loop, const std::vector<Eigen::Vector3d>& x,
+              std::vector<std::array<int, 3>>& triangles, const std::function<bool(int, int)>& edge_exists) {
+  const size_t n = loop.size();
+  if (n < 3) return;
+  Eigen::Vector3d normal = Eigen::Vector3d::Zero();
+  for (size_t i = 0; i < n; ++i) {
+    normal += x[static_cast<size_t>(loop[i])].cross(x[static_cast<size_t>(loop[(i + 1) % n])]);
+  }
+  std::vector<int> left = loop;
+  if (normal.norm() <= 0.0) {  // no area: a fan closes it
+    for (size_t i = 1; i + 1 < n; ++i) triangles.push_back({loop[0], loop[i], loop[i + 1]});
+    return;
+  }
+  normal.normalize();
+  const Eigen::Vector3d e1 = normal.unitOrthogonal();
+  const Eigen::Vector3d e2 = normal.cross(e1);
+  // The loop's points in the plane, once, beside `left`.
+  std::vector<Eigen::Vector2d> flat(n);
+  for (size_t i = 0; i < n; ++i) {
+    const Eigen::Vector3d& p = x[static_cast<size_t>(loop[i])];
+    flat[i] = Eigen::Vector2d(p.dot(e1), p.dot(e2));
+  }
+  const auto cross = [](const Eigen::Vector2d& a, const Eigen::Vector2d& b, const Eigen::Vector2d& c) {
+    return (b - a).x() * (c - a).y() - (b - a).y() * (c - a).x();
+  };
+  // Only a corner that is not convex can lie inside a convex corner's triangle: the test of an ear
+  // looks at those (flagged, kept up to date for the two corners next to each ear cut).
+  const auto convex_at = [&](size_t i, size_t m) {
+    const Eigen::Vector2d& a = flat[(i + m - 1) % m];
+    const Eigen::Vector2d& b = flat[i];
+    const Eigen::Vector2d& c = flat[(i + 1) % m];
+    return cross(a, b, c) > 1e-9 * (b - a).norm() * (c - b).norm();
+  };
+  std::vector<char> convex(n);
+  for (size_t i = 0; i < n; ++i) convex[i] = convex_at(i, n) ? 1 : 0;
+  size_t from = 0;  // the search goes on where the last ear was cut
+  while (left.size() > 3) {
+    const size_t m = left.size();
+    size_t ear = m;
+    for (size_t k = 0; k < m && ear == m; ++k) {
+      const size_t i = (from + k) % m;
+      if (convex[i] == 0) continue;  // reflex or flat
+      const Eigen::Vector2d& a = flat[(i + m - 1) % m];
+      const Eigen::Vector2d& b = flat[i];
+      const Eigen::Vector2d& c = flat[(i + 1) % m];
+      if (m > 3 && edge_exists(left[(i + 1) % m], left[(i + m - 1) % m])) continue;  // a diagonal the mesh has
+      bool empty = true;
+      for (size_t j = 0; j < m && empty; ++j) {
+        if (convex[j] != 0 || j == i || j == (i + m - 1) % m || j == (i + 1) % m) continue;
+        const Eigen::Vector2d& p = flat[j];
+        empty = !(cross(a, b, p) > 0.0 && cross(b, c, p) > 0.0 && cross(c, a, p) > 0.0);
+      }
+      if (empty) ear = i;
+    }
+    // No clean ear (a degenerate loop): cut one anyway, the topology stays closed; one whose
+    // diagonal the mesh lacks, so that no edge gets four triangles (cutting the first corner along a
+    // surface edge made the complete-cut frog non-manifold in 4 frames under baseline x86-64).
+    for (size_t i = 0; i < m && ear == m; ++i) {
+      if (!edge_exists(left[(i + 1) % m], left[(i + m - 1) % m])) ear = i;
+    }
+    if (ear == m) ear = 0;
+    triangles.push_back({left[(ear + m - 1) % m], left[ear], left[(ear + 1) % m]});
+    left.erase(left.begin() + static_cast<std::ptrdiff_t>(ear));
+    flat.erase(flat.begin() + static_cast<std::ptrdiff_t>(ear));
+    convex.erase(convex.begin() + static_cast<std::ptrdiff_t>(ear));
+    const size_t before = (ear + m - 2) % (m - 1), after = ear % (m - 1);
+    convex[before] = convex_at(before, m - 1) ? 1 : 0;
+    convex[after] = convex_at(after, m - 1) ? 1 : 0;
+    from = after;
+  }
+  triangles.push_back({left[0], left[1], left[2]});
+}
+
+// The border loops of a split surface from its directed edges at split points (a border edge has
+// no twin), each in the order its cap runs them (against the skin).
+std::vector<std::vector<int>> border_loops(const std::unordered_map<long long, int>& directed) {
+  std::vector<std::pair<int, int>> next;  // border edges u -> v, sorted
+  for (const auto& [edge, uses] : directed) {
+    const auto u = static_cast<int>(edge >> 32), v = static_cast<int>(edge & 0xffffffffLL);
+    if (!directed.contains(directed_key(v, u))) next.emplace_back(u, v);
+  }
+  std::sort(next.begin(), next.end());
+  std::vector<char> used(next.size(), 0);
+  // The first unused border edge from `at` (next.size(): none).
+  const auto from = [&](int at) {
+    for (auto i =
+             static_cast<size_t>(std::lower_bound(next.begin(), next.end(), std::pair{at, INT_MIN}) - next.begin());
+         i < next.size() && next[i].first == at; ++i) {
+      if (used[i] == 0) return i;
+    }
+    return next.size();
+  };
+  std::vector<std::vector<int>> loops;
+  for (size_t first = 0; first < next.size(); ++first) {
+    if (used[first] != 0) continue;
+    std::vector<int> loop;
+    const int start = next[first].first;
+    int at = start;
+    while (true) {
+      const size_t i = from(at);
+      if (i == next.size()) break;
+      loop.push_back(at);
+      at = next[i].second;
+      used[i] = 1;
+      if (at == start) break;
+    }
+    std::reverse(loop.begin(), loop.end());
+    loops.push_back(std::move(loop));
+  }
+  return loops;
+}
+
+// A loop's points' cuts (-1: a surface vertex, a crack tip). Where two cuts meet on the surface the
+// points next to the junction may be split by either, so a run shorter than JUNCTION_RUN points
+// between two other runs takes a neighbour's cut (the longer's); a tip between two runs of one cut
+// (a slit's) stays.
+std::vector<int> junction_smoothed(std::vector<int> label) {
+  constexpr size_t JUNCTION_RUN = 4;
+  const size_t n = label.size();
+  for (bool changed = true; changed;) {
+    changed = false;
+    for (size_t i = 0; i < n && !changed; ++i) {
+      if (label[(i + n - 1) % n] == label[i]) continue;  // not a run's start
+      size_t length = 1;
+      while (length < n && label[(i + length) % n] == label[i]) ++length;
+      if (length >= JUNCTION_RUN || length == n) continue;
+      const int before = label[(i + n - 1) % n], after = label[(i + length) % n];
+      if (label[i] < 0 && before == after) continue;  // a slit's tip
+      if (before < 0 && after < 0) continue;
+      size_t before_length = 1, after_length = 1;
+      while (before_length < n && label[(i + n - 1 - before_length) % n] == before) ++before_length;
+      while (after_length < n && label[(i + length + after_length) % n] == after) ++after_length;
+      const int into = after < 0 || (before >= 0 && before_length >= after_length) ? before : after;
+      for (size_t k = 0; k < length; ++k) label[(i + k) % n] = into;
+      changed = true;
+    }
+  }
+  return label;
+}
+
+}  // namespace tissue::cut_render_detail
