@@ -234,6 +234,26 @@ TEST(RenderSurface, TheCompleteCutDrawsTheFrogClosedInEveryFrame) {
   EXPECT_TRUE(contents(skin_dir / "log.csv") == contents(dir / "log.csv")) << "the logs differ";
 }
 
+// The X and the flap (partial cuts crossing and ending inside, on the sagging frog) draw the render
+// surface closed in every frame (issue 41: before, their loops stayed open and they drew the tet skin).
+class CrossingCutsScenario : public ::testing::TestWithParam<const char*> {};
+TEST_P(CrossingCutsScenario, DrawsTheRenderSurfaceClosedInEveryFrame) {
+  const Scenario scenario = load_scenario(SCENARIOS / (std::string(GetParam()) + ".toml"));
+  const std::filesystem::path dir = fresh_dir(std::string("render_") + GetParam());
+  const SessionSummary s = run_offline(scenario, dir);
+  ASSERT_GT(s.cut_tets, 50u);
+  std::vector<std::filesystem::path> frames;
+  for (const auto& entry : std::filesystem::directory_iterator(dir / "frames")) frames.push_back(entry.path());
+  ASSERT_GT(frames.size(), 40u);
+  for (const std::filesystem::path& frame : frames) {
+    const SurfaceShape shape = shape_of(vtu_triangles(frame));
+    EXPECT_EQ(shape.border, 0u) << frame.filename();
+    EXPECT_EQ(shape.repeated, 0u) << frame.filename();
+  }
+  EXPECT_GT(vtu_triangles(frames.back()).size(), 3u * 23240u);  // the render surface, not the skin
+}
+INSTANTIATE_TEST_SUITE_P(HostScenarios, CrossingCutsScenario, ::testing::Values("x_cut_frog", "flap_frog"));
+
 // The hand's figures reach the summary (device kind "hand"): a hand pressing the frog was in contact,
 // and the device's force did work on it.
 // A scalpel drawn by a hand through the frog (E = 1 MPa): the stroke cuts through although the
