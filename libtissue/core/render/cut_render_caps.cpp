@@ -14,6 +14,7 @@
 #include <map>
 #include <unordered_map>
 #include <unordered_set>
+#include <tuple>
 #include <utility>
 
 namespace tissue {
@@ -53,15 +54,38 @@ struct Tip {
 // The junctions' switch pairs (forward, backward): of the chains ending at a switch between two
 // cuts, keyed by (material part, cut lo, cut hi, facing on lo, facing on hi), the two whose switches
 // run opposite ways, forward leaving the lower cut. A key without exactly such a pair gets none.
+template <typename Stray>
 std::vector<std::pair<size_t, size_t>> paired_switches(
-    const std::map<std::array<int, 5>, std::vector<size_t>>& switches, const std::vector<Chain>& chains) {
+    const std::map<std::array<int, 5>, std::vector<size_t>>& switches, const std::vector<Chain>& chains,
+    const Stray& stray) {
   std::vector<std::pair<size_t, size_t>> pairs;
   for (const auto& [junction, ends] : switches) {
-    if (ends.size() != 2) continue;
-    size_t forward = ends[0], backward = ends[1];
-    if (chains[forward].cut != junction[1]) std::swap(forward, backward);
-    if (chains[forward].cut != junction[1] || chains[backward].cut != junction[2]) continue;
-    pairs.emplace_back(forward, backward);
+    std::vector<size_t> forward, backward;
+    for (const size_t c : ends) {
+      if (chains[c].cut == junction[1]) forward.push_back(c);
+      if (chains[c].cut == junction[2]) backward.push_back(c);
+    }
+    if (forward.empty() || forward.size() != backward.size() || forward.size() + backward.size() != ends.size()) continue;
+    if (forward.size() == 1) {
+      pairs.emplace_back(forward[0], backward[0]);
+      continue;
+    }
+    // Several junction lines in one quadrant of one part (strokes closer than a tet): each forward
+    // switch with the backward one whose line strays least from the cuts' junction direction.
+    std::vector<std::tuple<double, size_t, size_t>> candidates;
+    for (const size_t f : forward) {
+      for (const size_t b : backward) candidates.emplace_back(stray(f, b), f, b);
+    }
+    std::sort(candidates.begin(), candidates.end());
+    std::vector<size_t> taken;
+    for (const auto& [unused, f, b] : candidates) {
+      if (std::find(taken.begin(), taken.end(), f) != taken.end() ||
+          std::find(taken.begin(), taken.end(), b) != taken.end())
+        continue;
+      taken.push_back(f);
+      taken.push_back(b);
+      pairs.emplace_back(f, b);
+    }
   }
   return pairs;
 }
@@ -326,14 +350,30 @@ ChainEnds find_chain_ends(const std::vector<std::vector<int>>& loops, const std:
 }
 
 // The lines between paired switches: the lower cut's face takes both switch edges and the line; the
-// higher cut's runs it back. line_points(from, to): new points between two.
-template <typename LinePoints>
+// higher cut's runs it back. line_points(from, to): new points between two; plane_of(point, cut): the
+// plane of a cut at a point's cell (a zero normal if its cell is not cut by it).
+template <typename LinePoints, typename PlaneOf>
 void bridge_switches(const std::vector<std::vector<int>>& loops, const std::vector<Chain>& chains,
-                     const LinePoints& line_points, ChainEnds& ends) {
+                     const std::vector<Eigen::Vector3d>& rest_m, const LinePoints& line_points,
+                     const PlaneOf& plane_of, ChainEnds& ends) {
   std::map<size_t, Link>& link = ends.link;
-  for (const auto& [forward, backward] : paired_switches(ends.switches, chains)) {
-    const int line_start = point_after(loops, chains[forward], 1);  // on the higher cut
-    const int line_end = loops[static_cast<size_t>(chains[backward].loop)][static_cast<size_t>(chains[backward].last)];
+  const auto line_start_of = [&](size_t forward) { return point_after(loops, chains[forward], 1); };  // on the higher cut
+  const auto line_end_of = [&](size_t backward) {
+    return loops[static_cast<size_t>(chains[backward].loop)][static_cast<size_t>(chains[backward].last)];
+  };
+  // How far a line from a forward switch to a backward one strays from the two cuts' junction.
+  const auto stray = [&](size_t forward, size_t backward) {
+    const int start = line_start_of(forward);
+    const int before = loops[static_cast<size_t>(chains[forward].loop)][static_cast<size_t>(chains[forward].last)];
+    const Eigen::Vector3d along = plane_of(before, chains[forward].cut).normal.cross(plane_of(start, chains[backward].cut).normal);
+    const Eigen::Vector3d v = rest_m[static_cast<size_t>(line_end_of(backward))] - rest_m[static_cast<size_t>(start)];
+    if (along.norm() < 1e-6) return v.norm();
+    const Eigen::Vector3d d = along.normalized();
+    return (v - v.dot(d) * d).norm();
+  };
+  for (const auto& [forward, backward] : paired_switches(ends.switches, chains, stray)) {
+    const int line_start = line_start_of(forward);
+    const int line_end = line_end_of(backward);
     const std::vector<int> line = line_points(line_start, line_end);
     Link& out = link[forward];
     out.bridge.push_back(line_start);
@@ -511,7 +551,6 @@ void CutRenderSurface::cap_loops(const DeformableBody& body) {
   }
   ChainEnds ends = find_chain_ends(loops, labels, chains, chain_starting_at, part_of_point);
   const auto line = [&](int from, int to) { return line_points(from, to); };
-  bridge_switches(loops, chains, line, ends);
   const auto point_at = [&](int model, const Eigen::Vector3d& rest_m) { return add_point_like(model, rest_m); };
   // The plane of cut `cut` at a point's cell (none, a zero normal, if its cell is not cut by it).
   const auto plane_of = [&](int point, int cut) {
@@ -524,6 +563,7 @@ void CutRenderSurface::cap_loops(const DeformableBody& body) {
     }
     return CutPlane{Eigen::Vector3d::Zero(), 0.0};
   };
+  bridge_switches(loops, chains, m_rest_m, line, plane_of, ends);
   bridge_notches(loops, chains, chain_starting_at, m_rest_m, line, point_at, plane_of, ends);
   bridge_tips(m_rest_m, line, ends);
   std::vector<std::vector<int>> faces;

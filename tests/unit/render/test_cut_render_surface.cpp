@@ -23,7 +23,6 @@
 
 #include <algorithm>
 #include <cstdio>
-#include <cstdlib>
 #include <functional>
 #include <memory>
 #include <map>
@@ -202,14 +201,20 @@ struct RenderPart {
 /// where it is concave (the uncut one encloses r0 = 1.042 times their volume), so a part's ratio lies
 /// within 0.08 of 1 (for parts of at least `judged_m3`: the bulge is the tets' sagitta over the part's
 /// size, 17% for the frog's toes of 1 cm^3). Returns the parts (rest volumes and centroids).
+/// With `shells_per_part_may_exceed_one`, a material part may be drawn as several closed shells (held
+/// together by a piece too small for a later cut to split, which the render surface's planes do split).
 std::vector<RenderPart> expect_closed_parts(const CutRenderSurface& render, const CutFrog& frog,
-                                            double judged_m3 = 0.0) {
+                                            double judged_m3 = 0.0, bool shells_per_part_may_exceed_one = false) {
   const auto& triangles = render.triangles();
   const auto& x = render.rest_positions_m();
   int count = 0;
   const std::vector<int> part = parts_of(triangles, count);
   const std::vector<double> simulated_m3 = material_part_volumes_m3(frog.mesh, frog.body);
-  EXPECT_EQ(count, static_cast<int>(simulated_m3.size()));
+  if (shells_per_part_may_exceed_one) {
+    EXPECT_GE(count, static_cast<int>(simulated_m3.size()));
+  } else {
+    EXPECT_EQ(count, static_cast<int>(simulated_m3.size()));
+  }
   std::map<std::pair<int, int>, int> directed;
   for (const auto& t : triangles) {
     for (size_t k = 0; k < 3; ++k) ++directed[{t[k], t[(k + 1) % 3]}];
@@ -556,14 +561,16 @@ std::vector<std::array<Eigen::Vector2d, 2>> hatching(int strokes) {
 
 // Where a stroke ends inside the body next to another cut, its crack turns away from the junction
 // inside the body: the through cut's face has a notch (the junction down to where the crack leaves
-// it) and the walls close along it and the crack front. Before, those loops stayed open (1 + 1: 4
-// open loops, 3 + 3: 3) and the pieces had holes.
+// it) and the walls close along it and the crack front. Strokes closer than a tet (10 + 10: 6 mm
+// apart) give one quadrant of a part several junction lines, each closed between the switches it
+// joins. Before, those loops stayed open (1 + 1: 4 open loops, 3 + 3: 3, 10 + 10: 25) and the
+// pieces had holes. At 10 + 10 five parts are drawn as two shells each (59 parts, 64 shells).
 TEST(CutRenderSurface, HatchedStrokesEndingInsideLeaveClosedPieces) {
-  for (const int strokes : {1, 3}) {
+  for (const int strokes : {1, 3, 10}) {
     CutFrog frog(hatching(strokes));
     CutRenderSurface render = frog.cut_render_surface();
     EXPECT_EQ(render.open_loop_count(), 0) << strokes << " + " << strokes;
-    expect_closed_parts(render, frog, 5e-6);  // the frog is 8.1e-5 m^3
+    expect_closed_parts(render, frog, 5e-6, strokes > 3);  // the frog is 8.1e-5 m^3
   }
 }
 
