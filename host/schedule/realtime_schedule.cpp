@@ -57,7 +57,7 @@ class RealtimeScheduler {
 void RealtimeScheduler::haptic_thread(RealtimeRun& run) {
   if (m_options.realtime_priority) run.haptic_priority = try_fifo_priority(80);
   run.ready.fetch_add(1);
-  while (!run.go.load(std::memory_order_acquire)) std::this_thread::yield();
+  run.go.wait(false, std::memory_order_acquire);  // blocked, not spinning: see run()
   const Nanoseconds period = to_ns(m_schedule.haptic_period_s);
   Nanoseconds previous_wake = 0;
   if (m_options.haptic_thread_started) m_options.haptic_thread_started();
@@ -92,7 +92,7 @@ void RealtimeScheduler::haptic_thread(RealtimeRun& run) {
 void RealtimeScheduler::dynamics_thread(RealtimeRun& run, FramePipe& pipe) {
   if (m_options.realtime_priority) run.dynamics_priority = try_fifo_priority(70);
   run.ready.fetch_add(1);
-  while (!run.go.load(std::memory_order_acquire)) std::this_thread::yield();
+  run.go.wait(false, std::memory_order_acquire);  // blocked, not spinning: see run()
   const Nanoseconds slot = to_ns(m_schedule.slot_s);
   const std::uint64_t slots_total = m_schedule.slots();
   std::uint64_t k = 0;  // the slot this step starts in
@@ -160,7 +160,12 @@ void RealtimeScheduler::run() {
     (void)mlockall(MCL_CURRENT);
   }
   run.start = now_ns() + 20'000'000;  // 20 ms from now: both threads are waiting
+  // The two threads wait for this blocked: spinning at SCHED_FIFO on both cores while mlockall ran
+  // (longer with a render surface's megabytes to lock) used up the real-time bandwidth
+  // (sched_rt_runtime_us, 95% of each second) and the kernel held every real-time thread back for
+  // the rest of the period: the first haptic ticks came up to 15 ms late.
   run.go.store(true, std::memory_order_release);
+  run.go.notify_all();
 
   Nanoseconds next_progress = run.start + 1'000'000'000;
   const auto drain = [&](std::chrono::milliseconds timeout) {
