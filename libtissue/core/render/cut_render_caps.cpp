@@ -24,6 +24,7 @@ using cut_render_detail::directed_key;
 using cut_render_detail::ear_clip;
 using cut_render_detail::edge_key;
 using cut_render_detail::junction_smoothed;
+using cut_render_detail::merge_unfacing_switches;
 
 namespace {
 
@@ -355,7 +356,8 @@ ChainEnds find_chain_ends(const std::vector<std::vector<int>>& loops, const std:
 template <typename LinePoints, typename PlaneOf>
 void bridge_switches(const std::vector<std::vector<int>>& loops, const std::vector<Chain>& chains,
                      const std::vector<Eigen::Vector3d>& rest_m, const LinePoints& line_points,
-                     const PlaneOf& plane_of, ChainEnds& ends) {
+                     const PlaneOf& plane_of, const std::map<std::array<int, 5>, std::vector<size_t>>& switches,
+                     ChainEnds& ends) {
   std::map<size_t, Link>& link = ends.link;
   const auto line_start_of = [&](size_t forward) { return point_after(loops, chains[forward], 1); };  // on the higher cut
   const auto line_end_of = [&](size_t backward) {
@@ -371,7 +373,7 @@ void bridge_switches(const std::vector<std::vector<int>>& loops, const std::vect
     const Eigen::Vector3d d = along.normalized();
     return (v - v.dot(d) * d).norm();
   };
-  for (const auto& [forward, backward] : paired_switches(ends.switches, chains, stray)) {
+  for (const auto& [forward, backward] : paired_switches(switches, chains, stray)) {
     const int line_start = line_start_of(forward);
     const int line_end = line_end_of(backward);
     const std::vector<int> line = line_points(line_start, line_end);
@@ -563,8 +565,16 @@ void CutRenderSurface::cap_loops(const DeformableBody& body) {
     }
     return CutPlane{Eigen::Vector3d::Zero(), 0.0};
   };
-  bridge_switches(loops, chains, m_rest_m, line, plane_of, ends);
+  bridge_switches(loops, chains, m_rest_m, line, plane_of, ends.switches, ends);
   bridge_notches(loops, chains, chain_starting_at, m_rest_m, line, point_at, plane_of, ends);
+  // The switches still alone, those of chains that face neither side merged with their partners.
+  std::map<std::array<int, 5>, std::vector<size_t>> alone;
+  for (const auto& [key, list] : ends.switches) {
+    if (list.size() == 1 && !ends.link.contains(list[0])) alone.emplace(key, list);
+  }
+  merge_unfacing_switches(alone);
+  std::erase_if(alone, [](const auto& entry) { return entry.second.size() != 2; });
+  bridge_switches(loops, chains, m_rest_m, line, plane_of, alone, ends);
   bridge_tips(m_rest_m, line, ends);
   std::vector<std::vector<int>> faces;
   m_open_loops += walk_faces(loops, chains, ends.link, chain_starting_at, faces);

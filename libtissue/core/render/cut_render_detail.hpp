@@ -6,7 +6,9 @@
 
 #include <algorithm>
 #include <array>
+#include <cstddef>
 #include <functional>
+#include <map>
 #include <unordered_map>
 #include <vector>
 
@@ -24,6 +26,11 @@ std::vector<std::vector<int>> border_loops(const std::unordered_map<long long, i
 // best-fit plane, wound as the polygon, never along an edge for which edge_exists(u, v) holds.
 void ear_clip(const std::vector<int>& loop, const std::vector<Eigen::Vector3d>& x,
               std::vector<std::array<int, 3>>& triangles, const std::function<bool(int, int)>& edge_exists);
+
+// A chain whose points all ride on uncut tets faces neither side of its cut (0): a switch of it alone
+// under its key (part, cut lo, cut hi, facing on lo, facing on hi) joins the one lone switch whose
+// key differs only there.
+void merge_unfacing_switches(std::map<std::array<int, 5>, std::vector<size_t>>& switches);
 
 // A loop's points' cuts with the short runs next to a junction given a neighbour's cut.
 std::vector<int> junction_smoothed(std::vector<int> label);

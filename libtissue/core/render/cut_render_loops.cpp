@@ -8,6 +8,7 @@
 #include <climits>
 #include <cstddef>
 #include <functional>
+#include <map>
 #include <utility>
 
 namespace tissue::cut_render_detail {
@@ -154,6 +155,37 @@ std::vector<int> junction_smoothed(std::vector<int> label) {
     }
   }
   return label;
+}
+
+// A chain whose points all ride on uncut tets faces neither side of its cut (0): a switch of it alone
+// under its key joins the one lone switch whose key differs only there.
+void merge_unfacing_switches(std::map<std::array<int, 5>, std::vector<size_t>>& switches) {
+  for (auto it = switches.begin(); it != switches.end();) {
+    const std::array<int, 5> key = it->first;
+    if (it->second.size() != 1 || (key[3] != 0 && key[4] != 0)) {
+      ++it;
+      continue;
+    }
+    std::vector<size_t>* into = nullptr;
+    int found = 0;
+    for (const size_t slot : {size_t{3}, size_t{4}}) {
+      if (key[slot] != 0) continue;
+      for (const int side : {-1, 1}) {
+        std::array<int, 5> other = key;
+        other[slot] = side;
+        const auto match = switches.find(other);
+        if (match == switches.end() || match->second.size() != 1) continue;
+        into = &match->second;
+        ++found;
+      }
+    }
+    if (found != 1) {
+      ++it;
+      continue;
+    }
+    into->push_back(it->second[0]);
+    it = switches.erase(it);
+  }
 }
 
 }  // namespace tissue::cut_render_detail
