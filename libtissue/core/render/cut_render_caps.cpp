@@ -12,9 +12,9 @@
 #include <cstddef>
 #include <limits>
 #include <map>
+#include <tuple>
 #include <unordered_map>
 #include <unordered_set>
-#include <tuple>
 #include <utility>
 
 namespace tissue {

@@ -1,5 +1,5 @@
-// CutRenderSurface's caps: the split surface's border loops and their points' cuts, before the
-// faces are walked, and the ear clipping that triangulates the faces (cut_render_caps.cpp).
+// CutRenderSurface's caps: the split surface's border loops and their points' cuts, the switches of
+// chains that face neither side, and the ear clipping that triangulates the faces (cut_render_caps.cpp).
 #include "core/render/cut_render_detail.hpp"
 
 #include <Eigen/Geometry>
