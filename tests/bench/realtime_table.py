@@ -11,6 +11,9 @@ Usage: tests/bench/realtime_table.py [--host build/release/host/tissue-host] [--
 scenario's runs twice over, interleaved, without and with these overrides, and prints both tables
 (the same machine state for both: the way to compare two settings on a shared machine).
 A scenario driven by the browser's mouse runs 5 s with the live view up and no one at it.
+Each run writes its frames to a temporary folder (Python's tempfile: TMPDIR): a render surface's VTU
+frames are 1.7 MB each, and on the 2-core VM their writeback to disk delays the haptic thread's
+wake-ups (docs/BENCHMARKS.md, Host); TMPDIR=/dev/shm measures the session without the disk.
 Uses only the Python standard library.
 """
 import argparse
