@@ -288,6 +288,11 @@ int point_after(const std::vector<std::vector<int>>& loops, const Chain& chain, 
   const std::vector<int>& loop = loops[static_cast<size_t>(chain.loop)];
   return loop[(static_cast<size_t>(chain.last) + static_cast<size_t>(steps)) % loop.size()];
 }
+// A chain's first and last points.
+int first_point(const std::vector<std::vector<int>>& loops, const Chain& chain) {
+  return loops[static_cast<size_t>(chain.loop)][static_cast<size_t>(chain.first)];
+}
+int last_point(const std::vector<std::vector<int>>& loops, const Chain& chain) { return point_after(loops, chain, 0); }
 int label_after(const std::vector<std::vector<int>>& labels, const Chain& chain, int steps) {
   const std::vector<int>& label = labels[static_cast<size_t>(chain.loop)];
   return label[(static_cast<size_t>(chain.last) + static_cast<size_t>(steps)) % label.size()];
@@ -360,13 +365,11 @@ void bridge_switches(const std::vector<std::vector<int>>& loops, const std::vect
                      ChainEnds& ends) {
   std::map<size_t, Link>& link = ends.link;
   const auto line_start_of = [&](size_t forward) { return point_after(loops, chains[forward], 1); };  // on the higher cut
-  const auto line_end_of = [&](size_t backward) {
-    return loops[static_cast<size_t>(chains[backward].loop)][static_cast<size_t>(chains[backward].last)];
-  };
+  const auto line_end_of = [&](size_t backward) { return last_point(loops, chains[backward]); };
   // How far a line from a forward switch to a backward one strays from the two cuts' junction.
   const auto stray = [&](size_t forward, size_t backward) {
     const int start = line_start_of(forward);
-    const int before = loops[static_cast<size_t>(chains[forward].loop)][static_cast<size_t>(chains[forward].last)];
+    const int before = last_point(loops, chains[forward]);
     const Eigen::Vector3d along = plane_of(before, chains[forward].cut).normal.cross(plane_of(start, chains[backward].cut).normal);
     const Eigen::Vector3d v = rest_m[static_cast<size_t>(line_end_of(backward))] - rest_m[static_cast<size_t>(start)];
     if (along.norm() < 1e-6) return v.norm();
@@ -422,7 +425,7 @@ void bridge_notches(const std::vector<std::vector<int>>& loops, const std::vecto
         continue;
       size_t best = ends.tips.size();
       double nearest = std::numeric_limits<double>::infinity();
-      const int x_point = loops[static_cast<size_t>(n_begin.loop)][static_cast<size_t>(n_begin.first)];
+      const int x_point = first_point(loops, n_begin);
       for (size_t t = 0; t < ends.tips.size(); ++t) {
         const Tip& tip = ends.tips[t];
         if (ends.tip_taken[t] || tip.part != lone[i].part || tip.cut != n_begin.cut || tip.before != n_begin.facing ||
@@ -438,7 +441,7 @@ void bridge_notches(const std::vector<std::vector<int>>& loops, const std::vecto
       used[i] = used[j] = true;
       ends.tip_taken[best] = true;
       const Tip& tip = ends.tips[best];
-      const int y_point = loops[static_cast<size_t>(n_end.loop)][static_cast<size_t>(n_end.last)];
+      const int y_point = last_point(loops, n_end);
       const CutPlane k_plane = plane_of(x_point, k_end.cut);
       const Eigen::Vector3d& at_tip = rest_m[static_cast<size_t>(tip.point())];
       const int inner = point_at(tip.point(), at_tip - k_plane.signed_distance(at_tip) * k_plane.normal);  // J
@@ -451,7 +454,7 @@ void bridge_notches(const std::vector<std::vector<int>>& loops, const std::vecto
       k_face.bridge.push_back(inner);
       k_face.bridge.insert(k_face.bridge.end(), up.begin(), up.end());
       k_face.bridge.push_back(y_point);
-      k_face.next_first = loops[static_cast<size_t>(k_begin.loop)][static_cast<size_t>(k_begin.first)];
+      k_face.next_first = first_point(loops, k_begin);
       Link& wall_before = ends.link[tip.chain];  // the tip, the front to J, the junction up to x
       wall_before.bridge = tip.run;
       wall_before.bridge.insert(wall_before.bridge.end(), front.begin(), front.end());
@@ -572,8 +575,7 @@ void CutRenderSurface::cap_loops(const DeformableBody& body) {
   for (const auto& [key, list] : ends.switches) {
     if (list.size() == 1 && !ends.link.contains(list[0])) alone.emplace(key, list);
   }
-  merge_unfacing_switches(alone);
-  std::erase_if(alone, [](const auto& entry) { return entry.second.size() != 2; });
+  merge_unfacing_switches(alone);  // a key still alone pairs nothing (paired_switches)
   bridge_switches(loops, chains, m_rest_m, line, plane_of, alone, ends);
   bridge_tips(m_rest_m, line, ends);
   std::vector<std::vector<int>> faces;
