@@ -14,8 +14,9 @@ constexpr std::uint64_t MAGIC = 0x31305353'49535354ULL;  // "TSSISS01" read as l
 // 5: several cuts per tet (pieces' offsets and rotations, the cuts' smallest fraction, cut counts);
 // 7: a ghost's unknown is its copy's displacement, not a difference from u (issue 40): the same
 // fields, other meanings; 8: the cutter's per-vertex sides, distances and the blade's plane of the
-// open session (issue 41); 9: each cut's blade normal (TetCut::blade_normal)
-constexpr std::uint32_t VERSION = 9;
+// open session (issue 41); 9: each cut's blade normal (TetCut::blade_normal); 10: how far the blade
+// had turned when each tet was cut and each edge crossed (a spiral cuts a tet once per turn)
+constexpr std::uint32_t VERSION = 10;
 
 // The core's Eigen types and cut records on top of the shared byte stream.
 class Writer : public serial::ByteWriter {
@@ -143,11 +144,13 @@ std::vector<std::uint8_t> serialize_snapshot(const TissueSnapshot& s) {
   w.put(static_cast<std::uint8_t>(c.cutting));
   w.put(c.cut_id);
   w.put_all(c.tet_cut_session);
+  w.put_all(c.tet_cut_turn_rad);
   w.put_all(c.tet_ignored_session);
   w.put_all(c.tet_cut_count);
   w.put_all(c.tet_cut_above);
   w.put_all(c.edge_session);
   w.put_all(c.edge_ratio);
+  w.put_all(c.edge_turn_rad);
   w.put_all(c.vertex_session);
   w.put_all(c.vertex_side);
   w.put_all(c.vertex_distance_m);
@@ -216,11 +219,13 @@ TissueSnapshot read_snapshot(std::span<const std::uint8_t> bytes) {
   c.cutting = r.get_bool();
   r.get(c.cut_id);
   r.get_all(c.tet_cut_session, 4);
+  r.get_all(c.tet_cut_turn_rad, 8);
   r.get_all(c.tet_ignored_session, 4);
   r.get_all(c.tet_cut_count, 1);
   r.get_all(c.tet_cut_above, 1);
   r.get_all(c.edge_session, 4);
   r.get_all(c.edge_ratio, 8);
+  r.get_all(c.edge_turn_rad, 8);
   r.get_all(c.vertex_session, 4);
   r.get_all(c.vertex_side, 1);
   r.get_all(c.vertex_distance_m, 8);

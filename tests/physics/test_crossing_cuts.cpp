@@ -492,91 +492,109 @@ TEST(CrossingCuts, AStrokeEndingAtAnEarlierCutCutsTheTetsUpToItAndFreesTheCorner
 // --- the spiral through a slab --------------------------------------------------------------------
 
 // The dissertation's figure 7.1: a spiral stroke, where one global Heaviside leaves a vertex between
-// two turns on both sides of the same cut. An Archimedean spiral r = b theta about SPIRAL_CENTRE,
-// two turns from theta = 2 pi + SPIRAL_ENDS to 6 pi + SPIRAL_ENDS (both ends on one ray), with a
-// pitch 2 pi b of 2 cube edges: no tet (longest edge, a face diagonal: sqrt 2 cube edges) meets
-// both turns; the stars of some vertices between the turns meet both.
-const Eigen::Vector2d SPIRAL_CENTRE(0.0501, 0.0502);
-constexpr double SPIRAL_PITCH_M = 2.0 * SLAB_EDGE_M;
-constexpr double SPIRAL_ENDS = 0.3;
+// two turns on both sides of the same cut. An Archimedean spiral r = b theta about its centre, two
+// turns from `first_rad` to `first_rad` + 4 pi (both ends on one ray).
+struct Spiral {
+  Eigen::Vector2d centre{0.0501, 0.0502};
+  double pitch_m = 0.0;  ///< 2 pi b: how far apart the turns are
+  double first_rad = 0.0;
 
-double spiral_radius_m(double theta) { return SPIRAL_PITCH_M / (2.0 * M_PI) * theta; }
+  [[nodiscard]] double last_rad() const { return first_rad + 4.0 * M_PI; }
+  [[nodiscard]] double radius_m(double theta) const { return pitch_m / (2.0 * M_PI) * theta; }
 
-/// A tet's cut is one plane: where the spiral bends, it passes the tet's vertices at up to the
-/// sagitta of its longest edge (a face diagonal) over the turn's radius from the curve, on either
-/// side (an edge may even dip across the curve and back). A vertex closer than this to the curve may
-/// be on either side.
-double spiral_side_tolerance_m(double radius_m) { return std::pow(std::sqrt(2.0) * SLAB_EDGE_M, 2) / (8.0 * radius_m); }
-
-/// How many turns of the spiral lie between the centre and `p` on the ray through `p` (seen from
-/// above): 0 inside the inner turn, 1 between the turns, 2 outside; -1 within the side tolerance of a
-/// turn. Two points of different bands are separated by the cut wherever both ends of the
-/// spiral are far.
-int spiral_band(const Eigen::Vector3d& p) {
-  const Eigen::Vector2d d = p.head<2>() - SPIRAL_CENTRE;
-  double phi = std::atan2(d.y(), d.x());
-  if (phi < 0.0) phi += 2.0 * M_PI;
-  int band = 0;
-  for (int turn = 0; turn < 4; ++turn) {
-    const double theta = phi + 2.0 * M_PI * turn;
-    if (theta < 2.0 * M_PI + SPIRAL_ENDS || theta > 6.0 * M_PI + SPIRAL_ENDS) continue;
-    if (std::abs(spiral_radius_m(theta) - d.norm()) < spiral_side_tolerance_m(spiral_radius_m(theta))) return -1;
-    if (spiral_radius_m(theta) < d.norm()) ++band;
+  /// The blade's path, about 1 mm a step.
+  [[nodiscard]] BladePath path() const {
+    BladePath points;
+    for (double theta = first_rad; theta <= last_rad(); theta += 1e-3 / radius_m(theta)) {
+      points.push_back(centre + radius_m(theta) * Eigen::Vector2d(std::cos(theta), std::sin(theta)));
+    }
+    return points;
   }
-  return band;
-}
 
-/// Distance (seen from above) from `p` to the ray on which the spiral starts and ends.
-double distance_to_ends_ray_m(const Eigen::Vector3d& p) {
-  const Eigen::Vector2d ray(std::cos(SPIRAL_ENDS), std::sin(SPIRAL_ENDS));
-  const Eigen::Vector2d d = p.head<2>() - SPIRAL_CENTRE;
-  const double along = std::max(0.0, d.dot(ray));
-  return (d - along * ray).norm();
-}
+  /// A tet's cut is one plane: where the spiral bends, it passes the tet's vertices at up to the
+  /// sagitta of its longest edge (a face diagonal of the slab's cubes) over the turn's radius from
+  /// the curve, on either side (an edge may even dip across the curve and back). A vertex closer than
+  /// this to the curve may be on either side.
+  [[nodiscard]] static double side_tolerance_m(double radius_m) {
+    return std::pow(std::sqrt(2.0) * SLAB_EDGE_M, 2) / (8.0 * radius_m);
+  }
 
-TEST(CrossingCuts, ASpiralStrokeCutsAlongItsWholePathWithEveryPieceOnItsSideOfTheTurns) {
-  // A 10 x 10 x 1 cm slab of 5 mm cubes; one session, the blade about 1 mm a step.
+  /// How many turns of the spiral lie between the centre and `p` on the ray through `p` (seen from
+  /// above): 0 inside the inner turn, 1 between the turns, 2 outside; -1 within the side tolerance
+  /// of a turn. Two points of different bands are separated by the cut wherever both ends of the
+  /// spiral are far.
+  [[nodiscard]] int band(const Eigen::Vector3d& p) const {
+    const Eigen::Vector2d d = p.head<2>() - centre;
+    double phi = std::atan2(d.y(), d.x());
+    if (phi < 0.0) phi += 2.0 * M_PI;
+    int band = 0;
+    for (double theta = phi; theta <= last_rad(); theta += 2.0 * M_PI) {
+      if (theta < first_rad) continue;
+      if (std::abs(radius_m(theta) - d.norm()) < side_tolerance_m(radius_m(theta))) return -1;
+      if (radius_m(theta) < d.norm()) ++band;
+    }
+    return band;
+  }
+
+  /// Distance (seen from above) from `p` to the ray on which the spiral starts and ends.
+  [[nodiscard]] double distance_to_ends_ray_m(const Eigen::Vector3d& p) const {
+    const Eigen::Vector2d ray(std::cos(first_rad), std::sin(first_rad));
+    const Eigen::Vector2d d = p.head<2>() - centre;
+    const double along = std::max(0.0, d.dot(ray));
+    return (d - along * ray).norm();
+  }
+};
+
+/// What cutting a slab along a spiral did, judged away from the spiral's two ends.
+struct SpiralCut {
+  int cut_tets = 0;              ///< judged tets cut
+  int twice_cut_tets = 0;        ///< judged tets cut by both turns
+  int recut_tets = 0;            ///< cuts of a tet cut before (CutSpecimen::recut_tets)
+  int ghost_uses = 0;            ///< ghost rows used by judged pieces
+  int between_turns = 0;         ///< vertices between the turns with ghosts beyond both
+};
+
+/// A 10 x 10 x 1 cm slab of 5 mm cubes cut at rest along `spiral` in one session. Checks: the mass
+/// is unchanged; each judged tet (its vertices at least three cube edges from the ends' ray, none
+/// within the side tolerance of a turn) carries one cut per turn between its vertices (the span of
+/// their bands); no vertex on the wrong side: a piece's real vertices lie in one band (the piece's),
+/// a ghost of vertex v is used by pieces of one band only, not v's.
+SpiralCut cut_slab_along(const Spiral& spiral) {
   TetMesh mesh = make_box_mesh(20, 20, 2, SLAB_EDGE_M);
-  BladePath spiral;
-  for (double theta = 2.0 * M_PI + SPIRAL_ENDS; theta <= 6.0 * M_PI + SPIRAL_ENDS;
-       theta += 1e-3 / spiral_radius_m(theta)) {
-    spiral.push_back(SPIRAL_CENTRE + spiral_radius_m(theta) * Eigen::Vector2d(std::cos(theta), std::sin(theta)));
-  }
   double slab_m3 = 0.0;
   for (int t = 0; t < mesh.tet_count(); ++t) slab_m3 += ConvexPiece::tet(mesh.rest_corners(t)).volume_m3();
-  CutSpecimen slab(std::move(mesh), {}, {spiral}, -0.01, 0.02);
+  CutSpecimen slab(std::move(mesh), {}, {spiral.path()}, -0.01, 0.02);
   const DeformableBody& body = slab.body;
   const TetMesh& slab_mesh = slab.mesh;
   EXPECT_NEAR(body.total_mass_kg(), DENSITY * slab_m3, 1e-12 * DENSITY * slab_m3);
+  SpiralCut result;
+  result.recut_tets = slab.recut_tets;
 
-  // Judged away from the spiral's two ends (where the blade stood inside the body, the tets around
-  // it stay whole): every vertex of a tet at least 1.5 cm (three cube edges) from their ray.
-  const auto vertex_band = [&](int v) { return spiral_band(slab_mesh.rest_positions_m[static_cast<size_t>(v)]); };
+  const auto vertex_band = [&](int v) { return spiral.band(slab_mesh.rest_positions_m[static_cast<size_t>(v)]); };
   const auto judged = [&](int tet) {
     for (int v : slab_mesh.tets[static_cast<size_t>(tet)]) {
-      if (distance_to_ends_ray_m(slab_mesh.rest_positions_m[static_cast<size_t>(v)]) < 3.0 * SLAB_EDGE_M) return false;
+      if (spiral.distance_to_ends_ray_m(slab_mesh.rest_positions_m[static_cast<size_t>(v)]) < 3.0 * SLAB_EDGE_M) {
+        return false;
+      }
     }
     return true;
   };
-  // Cut along the whole path: a judged tet is cut exactly when the turns separate its vertices.
-  int judged_cut = 0;
   for (int t = 0; t < slab_mesh.tet_count(); ++t) {
     if (!judged(t)) continue;
     const auto& tet = slab_mesh.tets[static_cast<size_t>(t)];
-    if (std::any_of(tet.begin(), tet.end(), [&](int v) { return vertex_band(v) < 0; })) continue;
-    const bool separated = std::any_of(tet.begin(), tet.end(), [&](int v) { return vertex_band(v) != vertex_band(tet[0]); });
-    EXPECT_EQ(body.cut_tet_index(t) >= 0, separated) << "tet " << t;
-    judged_cut += separated ? 1 : 0;
+    std::array<int, 4> bands{};
+    std::transform(tet.begin(), tet.end(), bands.begin(), vertex_band);
+    if (*std::min_element(bands.begin(), bands.end()) < 0) continue;
+    const int turns_between = *std::max_element(bands.begin(), bands.end()) - *std::min_element(bands.begin(), bands.end());
+    const int k = body.cut_tet_index(t);
+    const int cuts = k < 0 ? 0 : static_cast<int>(body.cut_geometry(k).cuts.size());
+    EXPECT_EQ(cuts, turns_between) << "tet " << t;
+    result.cut_tets += cuts > 0 ? 1 : 0;
+    result.twice_cut_tets += cuts > 1 ? 1 : 0;
   }
-  EXPECT_GT(judged_cut, 200);
-  EXPECT_EQ(slab.recut_tets, 0);  // no tet meets both turns
 
-  // No vertex on the wrong side: a piece's real vertices lie in one band (the piece's); a ghost of
-  // vertex v is used by pieces of one band only, not v's. Between the turns, a vertex whose ghosts
-  // carry the pieces beyond the inner turn and beyond the outer one is the figure's vertex.
   std::map<int, int> ghost_band;  // block row -> band of the pieces using it
   std::map<int, std::vector<int>> vertex_ghost_bands;
-  int judged_ghost_uses = 0;
   for (int k = 0; k < static_cast<int>(body.cut_tets().size()); ++k) {
     const int tet = body.cut_tets()[static_cast<size_t>(k)].cut.tet;
     if (body.retired(k) || !judged(tet)) continue;
@@ -590,31 +608,48 @@ TEST(CrossingCuts, ASpiralStrokeCutsAlongItsWholePathWithEveryPieceOnItsSideOfTh
         if (band < 0) band = real_band;
         EXPECT_EQ(real_band, band) << "a real vertex of tet " << tet << " on the wrong side of the spiral";
       }
-      if (band < 0) continue;  // its real vertices lie on the curve
+      if (band < 0) continue;  // its real vertices lie on the curve, or it has none (between two cuts)
       for (size_t j = 0; j < 4; ++j) {
         const int row = piece.ghost_row[j];
         if (row < 0) continue;
         const int v = slab_mesh.tets[static_cast<size_t>(tet)][j];
         EXPECT_NE(vertex_band(v), band) << "a ghost of vertex " << v << " on the vertex's own side";
-        ++judged_ghost_uses;
+        ++result.ghost_uses;
         const auto [it, added] = ghost_band.emplace(row, band);
         EXPECT_EQ(it->second, band) << "ghost row " << row << " of vertex " << v << " joins two bands";
         if (added) vertex_ghost_bands[v].push_back(band);
       }
     }
   }
-  int between_turns = 0;
   for (const auto& [v, bands] : vertex_ghost_bands) {
-    between_turns += (vertex_band(v) == 1 && std::count(bands.begin(), bands.end(), 0) > 0 &&
-                      std::count(bands.begin(), bands.end(), 2) > 0)
-                         ? 1
-                         : 0;
+    result.between_turns += (vertex_band(v) == 1 && std::count(bands.begin(), bands.end(), 0) > 0 &&
+                             std::count(bands.begin(), bands.end(), 2) > 0)
+                                ? 1
+                                : 0;
   }
-  EXPECT_GT(between_turns, 0);
-  EXPECT_GT(judged_ghost_uses, 1000);
-  std::printf("spiral: %d judged tets cut, %d ghost uses judged, %d vertices between the turns with ghosts beyond "
-              "both\n",
-              judged_cut, judged_ghost_uses, between_turns);
+  std::printf("spiral of pitch %.1f mm: %d judged tets cut, %d of them twice, %d ghost uses judged, %d vertices "
+              "between the turns with ghosts beyond both\n",
+              1e3 * spiral.pitch_m, result.cut_tets, result.twice_cut_tets, result.ghost_uses, result.between_turns);
+  return result;
+}
+
+TEST(CrossingCuts, ASpiralStrokeCutsAlongItsWholePathWithEveryPieceOnItsSideOfTheTurns) {
+  // A pitch of 2 cube edges: no tet (longest edge, a face diagonal: sqrt 2 cube edges) meets both
+  // turns; the stars of some vertices between the turns meet both.
+  const SpiralCut cut = cut_slab_along(Spiral{.pitch_m = 2.0 * SLAB_EDGE_M, .first_rad = 2.0 * M_PI + 0.3});
+  EXPECT_GT(cut.cut_tets, 200);
+  EXPECT_EQ(cut.recut_tets, 0);  // no tet meets both turns
+  EXPECT_GT(cut.between_turns, 0);
+  EXPECT_GT(cut.ghost_uses, 1000);
+}
+
+TEST(CrossingCuts, ASpiralTighterThanATetCutsTheTetsBetweenItsTurnsOncePerTurn) {
+  // A pitch of 0.8 cube edges, from 16 to 24 mm about the centre: one session crosses many tets
+  // twice, a turn apart, and cuts each of them twice.
+  const SpiralCut cut = cut_slab_along(Spiral{.pitch_m = 0.8 * SLAB_EDGE_M, .first_rad = 12.0 * M_PI + 0.3});
+  EXPECT_GT(cut.twice_cut_tets, 50);
+  EXPECT_GE(cut.recut_tets, cut.twice_cut_tets);
+  EXPECT_GT(cut.between_turns, 0);
 }
 
 }  // namespace

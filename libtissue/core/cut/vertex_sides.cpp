@@ -186,7 +186,7 @@ void VolumeCutter::close_session(CutStepReport& report, const Eigen::VectorXd& p
       const int end = m_adjacency.vertex_tets_begin[at(vertex) + 1];
       for (int k = m_adjacency.vertex_tets_begin[at(vertex)]; k < end; ++k) {
         const int tet = m_adjacency.vertex_tets[at(k)];
-        if (m_tet_stamp[at(tet)] == m_stamp || m_tet_cut_session[at(tet)] == m_cut_id) continue;
+        if (m_tet_stamp[at(tet)] == m_stamp || cut_now(tet)) continue;
         m_tet_stamp[at(tet)] = m_stamp;
         const bool stopped = stopped_in(tet);
         const bool both_sides = has_both_sides_passed(tet);
@@ -272,7 +272,7 @@ std::optional<TetCut> VolumeCutter::cut_of(int tet, double end_margin) const {
     const int edge = m_adjacency.tet_edges[at(tet)][k];
     const auto& ends = m_adjacency.edges[at(edge)];
     double r = 0.0;  // along {v0, v1}
-    if (m_edge_session[at(edge)] == m_record_epoch) {
+    if (crossed_now(edge)) {
       r = m_edge_ratio[at(edge)];
     } else {
       const double d0 = m_vertex_distance_m[at(ends[0])];

@@ -145,12 +145,14 @@ VolumeCutter::VolumeCutter(const TetMesh& mesh, const TetAdjacency& adjacency, c
   m_tet_stamp.assign(tets, 0);
   m_candidate_stamp.assign(tets, 0);
   m_tet_cut_session.assign(tets, -1);
+  m_tet_cut_turn_rad.assign(tets, 0.0);
   m_tet_ignored_session.assign(tets, -1);
   m_tet_cut_count.assign(tets, 0);
   m_tet_cut_above.assign(tets, 0);
   m_edge_stamp.assign(edges, 0);
   m_edge_session.assign(edges, -1);
   m_edge_ratio.assign(edges, 0.0);
+  m_edge_turn_rad.assign(edges, 0.0);
   const std::size_t vertices = static_cast<std::size_t>(mesh.vertex_count());
   m_vertex_session.assign(vertices, -1);
   m_vertex_side.assign(vertices, 0);
@@ -189,7 +191,7 @@ VolumeCutter::VolumeCutter(const TetMesh& mesh, const TetAdjacency& adjacency, c
 }
 
 std::optional<double> VolumeCutter::edge_crossing(int edge) const {
-  if (m_cut_id < 0 || m_edge_session[at(edge)] != m_record_epoch) return std::nullopt;
+  if (m_cut_id < 0 || !crossed_now(edge)) return std::nullopt;
   return m_edge_ratio[at(edge)];
 }
 
@@ -216,11 +218,13 @@ void VolumeCutter::save(SessionState& state) const {
   state.cutting = m_cutting;
   state.cut_id = m_cut_id;
   state.tet_cut_session = m_tet_cut_session;
+  state.tet_cut_turn_rad = m_tet_cut_turn_rad;
   state.tet_ignored_session = m_tet_ignored_session;
   state.tet_cut_count = m_tet_cut_count;
   state.tet_cut_above = m_tet_cut_above;
   state.edge_session = m_edge_session;
   state.edge_ratio = m_edge_ratio;
+  state.edge_turn_rad = m_edge_turn_rad;
   state.vertex_session = m_vertex_session;
   state.vertex_side = m_vertex_side;
   state.vertex_distance_m = m_vertex_distance_m;
@@ -248,8 +252,12 @@ void VolumeCutter::restore(const SessionState& state) {
                    [](std::int8_t side) { return side >= -1 && side <= 1; })) {
     fail("a vertex's side is not -1, 0 or +1");
   }
-  if (state.vertex_turn_rad.size() != vertices || !std::isfinite(state.turn_rad) ||
-      !std::all_of(state.vertex_turn_rad.begin(), state.vertex_turn_rad.end(), [](double a) { return std::isfinite(a); })) {
+  const auto all_finite = [](const std::vector<double>& values) {
+    return std::all_of(values.begin(), values.end(), [](double a) { return std::isfinite(a); });
+  };
+  if (state.vertex_turn_rad.size() != vertices || state.tet_cut_turn_rad.size() != tets ||
+      state.edge_turn_rad.size() != edges || !std::isfinite(state.turn_rad) || !all_finite(state.vertex_turn_rad) ||
+      !all_finite(state.tet_cut_turn_rad) || !all_finite(state.edge_turn_rad)) {
     fail("the state's blade turning is of another mesh or not finite");
   }
   if (state.vertex_distance_m.size() != vertices ||
@@ -297,11 +305,13 @@ void VolumeCutter::restore(const SessionState& state) {
   m_cutting = state.cutting;
   m_cut_id = state.cut_id;
   std::copy(state.tet_cut_session.begin(), state.tet_cut_session.end(), m_tet_cut_session.begin());
+  std::copy(state.tet_cut_turn_rad.begin(), state.tet_cut_turn_rad.end(), m_tet_cut_turn_rad.begin());
   std::copy(state.tet_ignored_session.begin(), state.tet_ignored_session.end(), m_tet_ignored_session.begin());
   std::copy(state.tet_cut_count.begin(), state.tet_cut_count.end(), m_tet_cut_count.begin());
   std::copy(state.tet_cut_above.begin(), state.tet_cut_above.end(), m_tet_cut_above.begin());
   std::copy(state.edge_session.begin(), state.edge_session.end(), m_edge_session.begin());
   std::copy(state.edge_ratio.begin(), state.edge_ratio.end(), m_edge_ratio.begin());
+  std::copy(state.edge_turn_rad.begin(), state.edge_turn_rad.end(), m_edge_turn_rad.begin());
   std::copy(state.vertex_session.begin(), state.vertex_session.end(), m_vertex_session.begin());
   std::copy(state.vertex_side.begin(), state.vertex_side.end(), m_vertex_side.begin());
   std::copy(state.vertex_distance_m.begin(), state.vertex_distance_m.end(), m_vertex_distance_m.begin());
@@ -512,8 +522,9 @@ void VolumeCutter::process_edge(int edge, const Sweep& sweep, const Eigen::Vecto
   const auto& ends = m_adjacency.edges[at(edge)];
   const auto crossing = sweep.cross_edge(vertex_position(positions_m, ends[0]), vertex_position(positions_m, ends[1]));
   if (!crossing) return;
-  if (m_edge_session[at(edge)] != m_record_epoch) {
+  if (!crossed_now(edge)) {
     m_edge_session[at(edge)] = m_record_epoch;
+    m_edge_turn_rad[at(edge)] = m_turn_rad;
     m_edge_ratio[at(edge)] = *crossing;
     ++m_new_crossings;
   }
@@ -558,7 +569,7 @@ void VolumeCutter::cut_around_new_vertices(CutStepReport& report) {
   m_new_vertices.clear();
   const double end_margin = MIN_CUT_POINT_MARGIN;  // the classification is snapped, never the geometry
   for (const int tet : m_candidates) {
-    if (m_tet_cut_session[at(tet)] == m_cut_id) continue;
+    if (cut_now(tet)) continue;
     const auto cut = cut_of(tet, end_margin);
     if (!cut) continue;
     if (m_tet_cut_count[at(tet)] >= MAX_PIECE_CUTS) {  // the pieces' capacity (convex_piece.hpp)
@@ -578,6 +589,7 @@ void VolumeCutter::cut_around_new_vertices(CutStepReport& report) {
       continue;
     }
     m_tet_cut_session[at(tet)] = m_cut_id;
+    m_tet_cut_turn_rad[at(tet)] = m_turn_rad;
     m_tet_cut_above[at(tet)] = above;
     ++m_tet_cut_count[at(tet)];
     m_new_cuts.push_back(*cut);

@@ -185,11 +185,13 @@ class VolumeCutter {
     bool cutting = false;
     int cut_id = -1;
     std::vector<int> tet_cut_session;
+    std::vector<double> tet_cut_turn_rad;
     std::vector<int> tet_ignored_session;
     std::vector<std::int8_t> tet_cut_count;
     std::vector<std::uint8_t> tet_cut_above;
     std::vector<int> edge_session;
     std::vector<double> edge_ratio;
+    std::vector<double> edge_turn_rad;
     std::vector<int> vertex_session;
     std::vector<std::int8_t> vertex_side;
     std::vector<double> vertex_distance_m;
@@ -268,6 +270,17 @@ class VolumeCutter {
   [[nodiscard]] bool decided_now(int vertex) const {
     return side_decided(vertex) && m_turn_rad - m_vertex_turn_rad[static_cast<std::size_t>(vertex)] <= PASSAGE_TURN_RAD;
   }
+  /// Cut in this session and in this passage: the blade's plane has not turned through
+  /// PASSAGE_TURN_RAD since (the next turn of a spiral tighter than the tet cuts it again).
+  [[nodiscard]] bool cut_now(int tet) const {
+    const auto t = static_cast<std::size_t>(tet);
+    return m_tet_cut_session[t] == m_cut_id && m_turn_rad - m_tet_cut_turn_rad[t] <= PASSAGE_TURN_RAD;
+  }
+  /// The edge's crossing recorded since the session (re)started, in this passage.
+  [[nodiscard]] bool crossed_now(int edge) const {
+    const auto e = static_cast<std::size_t>(edge);
+    return m_edge_session[e] == m_record_epoch && m_turn_rad - m_edge_turn_rad[e] <= PASSAGE_TURN_RAD;
+  }
   void push_unvisited(int tet);
   void find_next_active(const Blade& blade, const Eigen::VectorXd& positions_m);
   void complete_touched_tets(CutStepReport& report, const Eigen::VectorXd& positions_m);
@@ -286,12 +299,14 @@ class VolumeCutter {
   std::vector<std::int64_t> m_tet_stamp;        ///< visited (algorithms 1, 2)
   std::vector<std::int64_t> m_candidate_stamp;  ///< already queued for the completion test
   std::vector<int> m_tet_cut_session;           ///< last session that cut the tet, -1 if uncut
+  std::vector<double> m_tet_cut_turn_rad;       ///< how far that session's plane had turned then
   std::vector<std::int8_t> m_tet_cut_count;     ///< sessions that cut the tet
   std::vector<std::uint8_t> m_tet_cut_above;    ///< the local vertices the last cut put above (bits)
   std::vector<int> m_tet_ignored_session;       ///< last session that reported an ignored cut
   std::vector<std::int64_t> m_edge_stamp;       ///< tested against the current sweep
   std::vector<int> m_edge_session;              ///< record epoch whose crossing is recorded, -1 if none
   std::vector<double> m_edge_ratio;             ///< along {v0, v1}
+  std::vector<double> m_edge_turn_rad;          ///< how far the plane had turned when it was recorded
   int m_new_crossings = 0;
   /// Each vertex's side of the blade's plane (+1 above, -1 below, 0 on it: within its snap distance,
   /// vertex_snap_fraction of its shortest edge), decided once per session when the blade has passed

@@ -41,8 +41,11 @@ void DeformableBody::check_cuts(std::span<const TetCut> cuts) const {
     }
     if (const int k = cut_tet_index(cut.tet); k >= 0) {
       const std::vector<TetCut>& earlier = m_cut_geometry[static_cast<size_t>(k)].cuts;
-      if (std::any_of(earlier.begin(), earlier.end(), [&](const TetCut& e) { return e.cut_id == cut.cut_id; })) {
-        throw ParameterError(where + "the tet is cut already by cut " + std::to_string(cut.cut_id));
+      // One cut may cross a tet twice (a spiral tighter than the tet), never at the same place.
+      if (std::any_of(earlier.begin(), earlier.end(), [&](const TetCut& e) {
+            return e.cut_id == cut.cut_id && e.side == cut.side && e.edge_ratio == cut.edge_ratio;
+          })) {
+        throw ParameterError(where + "the tet is cut already by cut " + std::to_string(cut.cut_id) + " there");
       }
       if (earlier.size() >= static_cast<size_t>(MAX_PIECE_CUTS)) {
         throw ParameterError(where + "the tet carries " + std::to_string(MAX_PIECE_CUTS) + " cuts already");
