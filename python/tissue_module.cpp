@@ -219,6 +219,12 @@ class PyTissue {
     out["linear_iterations"] = report.dynamics.linear_iterations;
     out["energy_guarded"] = report.dynamics.energy_guarded;
     out["newly_cut_tets"] = report.cut.newly_cut_tets;
+    out["new_enriched_dofs"] = report.enrichment.new_enriched_dofs;
+    out["assembly_s"] = report.dynamics.assembly_s;
+    out["solve_s"] = report.dynamics.solve_s;
+    out["cut_s"] = report.cut_s;
+    out["enrich_s"] = report.enrich_s;
+    out["contact_s"] = report.contact_s;
     out["total_s"] = report.total_s;
     return out;
   }
