@@ -9,6 +9,7 @@
 #include "core/mesh/topology.hpp"
 #include "core/render/cut_render_surface.hpp"
 #include "core/render/embedded_surface.hpp"
+#include "core/solve/two_level_preconditioner.hpp"
 #include "core/tissue.hpp"
 #include "resources/default_mesh.hpp"
 
@@ -125,6 +126,33 @@ void BM_Pcg10Iterations(benchmark::State& state) {
   solve_benchmark(state, solver);
 }
 BENCHMARK(BM_Pcg10Iterations)->Arg(0)->Arg(1)->Unit(benchmark::kMicrosecond);
+
+// The two-level preconditioner's set-up (tissue's default real-time solver): Arg 1 = aggregating
+// anew and the coarse level (a cut step's), Arg 0 = a coarse refresh over the kept aggregates
+// (COARSE_REFRESH_SETUPS setups, one of which refreshes: the steps between cuts, per refresh).
+void BM_TwoLevelSetup(benchmark::State& state) {
+  Fixture f(static_cast<int>(state.range(0)));
+  const double h = 0.01;
+  const Eigen::VectorXd diagonal = f.body.mass_kg();
+  ShiftedSystem system{&f.body.tangent(), h * h, &diagonal};
+  system.block_positions = f.body.block_positions(f.displacement);
+  const Eigen::VectorXd inverse_diagonal = Eigen::VectorXd::Ones(f.body.dof_count());
+  const bool aggregate = state.range(1) != 0;
+  TwoLevelPreconditioner preconditioner;
+  preconditioner.setup(system, inverse_diagonal);
+  for (auto _ : state) {
+    if (aggregate) {
+      preconditioner.forget();
+      preconditioner.setup(system, inverse_diagonal);
+    } else {
+      for (int k = 0; k < TwoLevelPreconditioner::COARSE_REFRESH_SETUPS; ++k) preconditioner.setup(system, inverse_diagonal);
+    }
+    benchmark::DoNotOptimize(preconditioner.coarse_size());
+  }
+  f.count(state);
+  state.counters["coarse"] = preconditioner.coarse_size();
+}
+BENCHMARK(BM_TwoLevelSetup)->Args({0, 0})->Args({0, 1})->Args({1, 0})->Args({1, 1})->Unit(benchmark::kMicrosecond);
 
 void BM_CholmodFactorizeAndSolve(benchmark::State& state) {
   CholmodSolver solver;

@@ -107,7 +107,7 @@ def run_once(host, scenario, overrides):
 
 def print_table(rows):
     print("| scenario | tissue overruns | haptic misses (of ticks) | misses % | tissue step p50 / p99 / max (ms), "
-          "median run | cut steps p50 / before the cut p50 |")
+          "median run | cut steps / before the cut: p50; p99 |")
     print("|---|---|---|---:|---|---|")
     for name, runs in rows:
         overruns = [r["tissue_overruns"] for r in runs]
@@ -116,9 +116,13 @@ def print_table(rows):
         p99s = [r["tissue_step_ms"]["p99"] for r in runs]
         median_run = sorted(runs, key=lambda r: r["tissue_step_ms"]["p99"])[len(runs) // 2]
         s = median_run["tissue_step_ms"]
-        during = median_run.get("tissue_step_during_cut_ms", {}).get("p50", 0.0)
-        before = median_run.get("tissue_step_before_cut_ms", {}).get("p50", 0.0)
-        cut = "%.2f / %.2f = %.2fx" % (during, before, during / before) if during > 0 and before > 0 else "-"
+        ratios = []
+        for q in ("p50", "p99"):
+            during = median_run.get("tissue_step_during_cut_ms", {}).get(q, 0.0)
+            before = median_run.get("tissue_step_before_cut_ms", {}).get(q, 0.0)
+            if during > 0 and before > 0:
+                ratios.append("%.2f / %.2f = %.2fx" % (during, before, during / before))
+        cut = "; ".join(ratios) if ratios else "-"
         print("| %s | %s | %s (of %d) | %.3f | %.2f / %.2f / %.2f (p99 of the runs %.2f-%.2f) | %s |"
               % (name, " ".join(map(str, overruns)), " ".join(map(str, misses)), ticks,
                  100.0 * statistics.mean(misses) / max(ticks, 1), s["p50"], s["p99"], s["max"], min(p99s), max(p99s),

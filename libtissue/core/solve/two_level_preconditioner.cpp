@@ -27,14 +27,15 @@ Eigen::Matrix3d cross_matrix(const Eigen::Vector3d& v) {
 
 void TwoLevelPreconditioner::setup(const ShiftedSystem& system, const Eigen::VectorXd& inverse_diagonal) {
   m_inverse_diagonal = &inverse_diagonal;
-  if (!aggregates_fit(system)) {
+  const bool aggregated = !aggregates_fit(system);
+  if (aggregated) {
     m_with_rotations = system.block_positions != nullptr;
-    aggregate(system);
+    aggregate(system);  // with this setup's basis
     m_setups_since_coarse = COARSE_REFRESH_SETUPS;  // a coarse level now
   }
   if (++m_setups_since_coarse < COARSE_REFRESH_SETUPS) return;
   m_setups_since_coarse = 0;
-  make_basis(system, /*count_rotations=*/false);
+  if (!aggregated) make_basis(system, /*count_rotations=*/false);
   assemble_and_factorize(system);
 }
 
@@ -167,7 +168,7 @@ void TwoLevelPreconditioner::aggregate(const ShiftedSystem& system) {
 }
 
 // The coarse block pattern (aggregate pairs that share a fine block), each fine slot's block and
-// each block's mirror, and the scalar lower triangle of the coarse matrix with its symbolic analysis.
+// and the scalar lower triangle of the coarse matrix with its symbolic analysis.
 void TwoLevelPreconditioner::make_coarse_pattern(const BlockSparseMatrix& k) {
   const int count = aggregate_count();
   // Per aggregate a (its rows in m_aggregate_rows): the aggregates its rows' blocks reach, in
@@ -203,15 +204,6 @@ void TwoLevelPreconditioner::make_coarse_pattern(const BlockSparseMatrix& k) {
     m_coarse_row_begin[static_cast<size_t>(a) + 1] = static_cast<int>(m_coarse_column.size());
   }
   m_coarse_blocks.assign(m_coarse_column.size(), {});
-  m_coarse_mirror.resize(m_coarse_column.size());
-  for (int a = 0; a < count; ++a) {
-    for (int p = m_coarse_row_begin[static_cast<size_t>(a)]; p < m_coarse_row_begin[static_cast<size_t>(a) + 1]; ++p) {
-      const int b = m_coarse_column[static_cast<size_t>(p)];
-      const auto first = m_coarse_column.begin() + m_coarse_row_begin[static_cast<size_t>(b)];
-      const auto last = m_coarse_column.begin() + m_coarse_row_begin[static_cast<size_t>(b) + 1];
-      m_coarse_mirror[static_cast<size_t>(p)] = static_cast<int>(std::lower_bound(first, last, a) - m_coarse_column.begin());
-    }
-  }
 
   // The scalar lower triangle of the coarse matrix (compressed columns), made in the order
   // for_each_lower_entry visits it.
@@ -278,40 +270,51 @@ void TwoLevelPreconditioner::make_basis(const ShiftedSystem& system, bool count_
   }
 }
 
+// Coarse block (a, b), a <= b, is the sum over rows i of a and j of b of P_i^T A_ij P_j, with
+// P_j = [t_b I, C_j W_b] and C_j = -[r_j]x. Row by row, over the aggregates b >= a its blocks reach:
+// S_b = sum_j A_ij and T_b = sum_j A_ij C_j (27 multiply-adds a block), so that
+// sum_j A_ij P_j = [t_b S_b, T_b W_b] and the block takes P_i^T that = [t_a (.); W_a^T C_i^T (.)]
+// once per (row, aggregate) pair instead of once per fine block. K's rows hold both halves, so
+// every pair (i, j) of a block with a <= b is met from row i.
 void TwoLevelPreconditioner::assemble_and_factorize(const ShiftedSystem& system) {
   const BlockSparseMatrix& k = *system.stiffness;
   for (auto& block : m_coarse_blocks) block.fill(0.0);
-  // P_i = [t_a I, -[r_i]x W_a] (3 x the columns of a, zero beyond them), once per row.
-  m_row_basis.resize(static_cast<size_t>(m_rows));
   for (int i = 0; i < m_rows; ++i) {
     const int a = m_aggregate_of_row[static_cast<size_t>(i)];
-    RowBasis& p = m_row_basis[static_cast<size_t>(i)];
-    p.setZero();
-    p.leftCols<3>().diagonal().setConstant(m_translation_scale[static_cast<size_t>(a)]);
-    if (m_with_rotations) {
-      p.rightCols<3>() = -cross_matrix(m_offset[static_cast<size_t>(i)]) * m_rotation_axes[static_cast<size_t>(a)];
-    }
-  }
-  // For the blocks with j >= i (A is symmetric; K's rows hold both halves), P_i^T A_ij P_j goes
-  // into the coarse block that for_each_lower_entry reads: (a, b) when a <= b, else the transpose
-  // into (b, a); a diagonal coarse block takes both.
-  const auto add = [&](int coarse_block, const Eigen::Matrix<double, 6, 6>& term) {
-    Eigen::Map<Eigen::Matrix<double, 6, 6>>(m_coarse_blocks[static_cast<size_t>(coarse_block)].data()) += term;
-  };
-  for (int i = 0; i < m_rows; ++i) {
-    const RowBasis& p_i = m_row_basis[static_cast<size_t>(i)];
-    const int a = m_aggregate_of_row[static_cast<size_t>(i)];
+    const int first_block = m_coarse_row_begin[static_cast<size_t>(a)];
+    const size_t reach = static_cast<size_t>(m_coarse_row_begin[static_cast<size_t>(a) + 1] - first_block);
+    if (m_row_sums.size() < reach) m_row_sums.resize(reach);
+    m_touched.clear();
     for (int s = k.row_begin(i); s < k.row_begin(i) + k.row_size(i); ++s) {
       const int j = k.slot_column(s);
-      if (j < i) continue;
+      if (j < 0) continue;
+      const int coarse_block = m_coarse_block_of_slot[static_cast<size_t>(s)];
+      if (m_coarse_column[static_cast<size_t>(coarse_block)] < a) continue;
       Eigen::Matrix3d block = system.stiffness_scale * k.block(s);
       if (j == i) block.diagonal() += system.diagonal->segment<3>(3L * i);
-      const Eigen::Matrix<double, 3, 6> block_p_j = block * m_row_basis[static_cast<size_t>(j)];
-      const Eigen::Matrix<double, 6, 6> coarse = p_i.transpose() * block_p_j;
-      const int b = m_aggregate_of_row[static_cast<size_t>(j)];
-      const int coarse_block = m_coarse_block_of_slot[static_cast<size_t>(s)];
-      if (a <= b) add(coarse_block, coarse);
-      if (a >= b && j != i) add(a == b ? coarse_block : m_coarse_mirror[static_cast<size_t>(coarse_block)], coarse.transpose());
+      RowSums& sums = m_row_sums[static_cast<size_t>(coarse_block - first_block)];
+      if (!sums.used) {
+        sums = RowSums{Eigen::Matrix3d::Zero(), Eigen::Matrix3d::Zero(), true};
+        m_touched.push_back(coarse_block);
+      }
+      sums.force += block;
+      if (m_with_rotations) sums.moment -= block * cross_matrix(m_offset[static_cast<size_t>(j)]);
+    }
+    const double t_a = m_translation_scale[static_cast<size_t>(a)];
+    const int rotations_a = m_rotation_count[static_cast<size_t>(a)];
+    const Eigen::Matrix3d c_i_transpose = cross_matrix(m_offset[static_cast<size_t>(i)]);  // C_i^T = [r_i]x
+    for (const int coarse_block : m_touched) {
+      RowSums& sums = m_row_sums[static_cast<size_t>(coarse_block - first_block)];
+      sums.used = false;
+      const int b = m_coarse_column[static_cast<size_t>(coarse_block)];
+      Eigen::Matrix<double, 3, 6> reached = Eigen::Matrix<double, 3, 6>::Zero();  // sum_j A_ij P_j
+      reached.leftCols<3>() = m_translation_scale[static_cast<size_t>(b)] * sums.force;
+      if (m_with_rotations) reached.rightCols<3>() = sums.moment * m_rotation_axes[static_cast<size_t>(b)];
+      Eigen::Map<Eigen::Matrix<double, 6, 6>> coarse(m_coarse_blocks[static_cast<size_t>(coarse_block)].data());
+      coarse.topRows<3>() += t_a * reached;
+      if (rotations_a > 0) {
+        coarse.bottomRows<3>() += m_rotation_axes[static_cast<size_t>(a)].transpose() * (c_i_transpose * reached);
+      }
     }
   }
   double* values = m_coarse_matrix.valuePtr();

@@ -123,9 +123,15 @@ class TwoLevelPreconditioner {
   std::vector<int> m_coarse_column;
   std::vector<int> m_coarse_block_of_slot;  // per fine slot (-1: unused slot)
   std::vector<std::array<double, 36>> m_coarse_blocks;  // 6x6 column-major, used up to the columns
-  std::vector<int> m_coarse_mirror;                     // per coarse block (a, b): the block (b, a)
-  using RowBasis = Eigen::Matrix<double, 3, 6>;
-  std::vector<RowBasis> m_row_basis;  // per block row, its rows of the coarse basis (this setup)
+  // assemble_and_factorize's scratch for one row i: per coarse block (a, b) of its aggregate's row,
+  // sum_j A_ij and sum_j A_ij C_j over the rows j of b; the blocks it touched.
+  struct RowSums {
+    Eigen::Matrix3d force;
+    Eigen::Matrix3d moment;
+    bool used = false;
+  };
+  std::vector<RowSums> m_row_sums;
+  std::vector<int> m_touched;
   Eigen::SparseMatrix<double> m_coarse_matrix;           // lower triangle, pattern fixed per aggregation
   Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> m_coarse_factor;
   bool m_coarse_ok = false;
