@@ -220,6 +220,7 @@ class PyTissue {
     out["energy_guarded"] = report.dynamics.energy_guarded;
     out["newly_cut_tets"] = report.cut.newly_cut_tets;
     out["new_enriched_dofs"] = report.enrichment.new_enriched_dofs;
+    out["matrix_relayout"] = report.enrichment.matrix_relayout;
     out["assembly_s"] = report.dynamics.assembly_s;
     out["solve_s"] = report.dynamics.solve_s;
     out["cut_s"] = report.cut_s;

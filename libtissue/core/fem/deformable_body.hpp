@@ -82,6 +82,12 @@ struct CutTetGeometry {
 /// since it last did reach this share of its blocks (DeformableBody::enrich).
 inline constexpr double RETIRED_SLOT_SHARE_TO_COMPACT = 0.25;
 
+/// When a cut must re-lay the tangent out (a row near it lacks room), the rows of the vertices within
+/// this many rings (vertex - tet - vertex) of its cut tets get a cut's room in the same re-layout, so
+/// that the blade moving on finds room for the next steps: a stroke through the frog re-laid the
+/// storage out at 34 of its 43 cutting steps with the two rings its tets' stars reach.
+inline constexpr int CUT_ROOM_RINGS = 4;
+
 /// What an enrichment changed.
 struct EnrichmentResult {
   int new_cut_tets = 0;          ///< cut tets made (one per cut, and those remade with other ghosts)

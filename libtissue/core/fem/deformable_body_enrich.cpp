@@ -422,9 +422,10 @@ void DeformableBody::list_coupled_blocks(int k, std::vector<std::pair<int, int>>
 }
 
 // The batch's new blocks: room for all of them at once (rows start compact, MatrixReserve), then in.
-// The rows around the cut tets also get a cut's room (their ghost room, as an enriched row's), so
-// that the next strokes of a blade moving on find it: one re-layout where a cut starts, not one
-// per step.
+// The rows around the cut tets also get a cut's room (their ghost room, as an enriched row's): those
+// of their stars' vertices, and when that needs a re-layout, those within CUT_ROOM_RINGS of them, so
+// that the next strokes of a blade moving on find it: a re-layout every few steps of a stroke, not
+// one per step.
 void DeformableBody::insert_coupled_blocks(std::vector<std::pair<int, int>>& new_blocks, int first_new_cut_tet) {
   std::sort(new_blocks.begin(), new_blocks.end());
   new_blocks.erase(std::unique(new_blocks.begin(), new_blocks.end()), new_blocks.end());
@@ -432,20 +433,41 @@ void DeformableBody::insert_coupled_blocks(std::vector<std::pair<int, int>>& new
   for (const auto& [row, column] : new_blocks) {
     if (m_tangent.find_slot(row, column) < 0) ++extra_of_row[row];
   }
+  std::vector<int> ring;  // the vertices of the new cut tets, then the rings around them
   for (int k = first_new_cut_tet; k < m_xfem.cut_tet_count(); ++k) {
-    for (const int v : m_xfem.cut_tets()[static_cast<size_t>(k)].vertices) {
+    for (const int v : m_xfem.cut_tets()[static_cast<size_t>(k)].vertices) ring.push_back(v);
+  }
+  std::vector<std::uint8_t> reached(static_cast<size_t>(m_mesh.vertex_count()), 0);
+  for (const int v : ring) reached[static_cast<size_t>(v)] = 1;
+  const auto lacks_room = [&] {
+    return std::any_of(extra_of_row.begin(), extra_of_row.end(), [&](const std::pair<const int, int>& row_extra) {
+      return m_tangent.row_size(row_extra.first) + row_extra.second > m_tangent.row_capacity(row_extra.first);
+    });
+  };
+  const auto give_room = [&](int w) {
+    const int row = vertex_block_row(w);
+    if (row < 0) return;
+    const int room = m_enriched_row_capacity[static_cast<size_t>(w)] - m_tangent.row_size(row);
+    int& extra = extra_of_row[row];
+    extra = std::max(extra, room);
+  };
+  for (const int v : ring) give_room(v);
+  for (int rings = 1; rings <= CUT_ROOM_RINGS && !ring.empty(); ++rings) {
+    if (rings == 2 && !lacks_room()) break;  // the stars have room: no re-layout, so none wider
+    std::vector<int> next;
+    for (const int v : ring) {
       const auto first = static_cast<size_t>(m_adjacency.vertex_tets_begin[static_cast<size_t>(v)]);
       const auto end = static_cast<size_t>(m_adjacency.vertex_tets_begin[static_cast<size_t>(v) + 1]);
       for (size_t e = first; e < end; ++e) {
         for (const int w : m_mesh.tets[static_cast<size_t>(m_adjacency.vertex_tets[e])]) {
-          const int row = vertex_block_row(w);
-          if (row < 0) continue;
-          const int room = m_enriched_row_capacity[static_cast<size_t>(w)] - m_tangent.row_size(row);
-          int& extra = extra_of_row[row];
-          extra = std::max(extra, room);
+          if (reached[static_cast<size_t>(w)] != 0) continue;
+          reached[static_cast<size_t>(w)] = 1;
+          next.push_back(w);
+          give_room(w);
         }
       }
     }
+    ring = std::move(next);
   }
   m_tangent.reserve_room(std::vector<std::pair<int, int>>(extra_of_row.begin(), extra_of_row.end()));
   for (const auto& [row, column] : new_blocks) m_tangent.insert_block(row, column);

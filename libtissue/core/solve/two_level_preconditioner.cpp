@@ -126,14 +126,18 @@ void TwoLevelPreconditioner::aggregate(const ShiftedSystem& system) {
   std::vector<int> strong_begin(static_cast<size_t>(rows) + 1, 0);
   std::vector<int> strong_column;
   std::vector<double> strong_weight;
+  strong_column.reserve(static_cast<size_t>(k.nonzero_blocks()));
+  strong_weight.reserve(static_cast<size_t>(k.nonzero_blocks()));
   for (int i = 0; i < rows; ++i) {
     for (int s = k.row_begin(i); s < k.row_begin(i) + k.row_size(i); ++s) {
       const int j = k.slot_column(s);
       if (j < 0 || j == i) continue;
-      const double coupling = frobenius(system, s, i, j);
-      if (coupling > STRENGTH * std::sqrt(diagonal_norm[static_cast<size_t>(i)] * diagonal_norm[static_cast<size_t>(j)])) {
+      // Off the diagonal A_ij = s K_ij: compared squared, without forming the block.
+      const double coupling_squared = system.stiffness_scale * system.stiffness_scale * k.block(s).squaredNorm();
+      if (coupling_squared >
+          STRENGTH * STRENGTH * diagonal_norm[static_cast<size_t>(i)] * diagonal_norm[static_cast<size_t>(j)]) {
         strong_column.push_back(j);
-        strong_weight.push_back(coupling);
+        strong_weight.push_back(coupling_squared);  // only compared
       }
     }
     strong_begin[static_cast<size_t>(i) + 1] = static_cast<int>(strong_column.size());

@@ -76,6 +76,8 @@ class BlockSparseMatrix {
   // --- Iteration over the pattern (for conversions such as CHOLMOD) ---
   [[nodiscard]] int row_begin(int row) const { return m_row_begin[static_cast<size_t>(row)]; }
   [[nodiscard]] int row_size(int row) const { return m_row_size[static_cast<size_t>(row)]; }
+  /// Blocks the row has room for before it must be re-laid out.
+  [[nodiscard]] int row_capacity(int row) const { return m_row_capacity[static_cast<size_t>(row)]; }
   /// Block column of a slot.
   [[nodiscard]] int slot_column(int slot) const { return m_column[static_cast<size_t>(slot)]; }
 
