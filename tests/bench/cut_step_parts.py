@@ -2,13 +2,19 @@
 """Where a cut step's time goes (issue 41, item 5): the frog of cut_frog_complete (held at its hind
 30%, E 300 kPa, 10 ms steps) through `import tissue`, a vertical scalpel drawn across at 60% of its
 length in 175 steps. Prints, per kind of step, the medians of the step's parts (TissueStepReport's
-wall times, ms) and how often the tangent was re-laid out:
+wall times, ms), how often the tangent was re-laid out and the mean Newton corrections (a step that
+turns an element far is corrected: a cost that follows the trajectory, not the code):
 
 * before: 40 steps with the scalpel beside the body, before any cut;
 * enriching: the stroke's steps that cut tets (the volume cutter's new cuts, enriched at once);
 * plain: the stroke's other steps.
 
-Usage: tests/bench/cut_step_parts.py [--runs 3] [--solver pcgTwoLevel] [--module DIR]
+With --organ: the 52k-tet organ of host/scenarios/cut_organ.toml (meshes/liver.veg hung by its
+ridge, E 300 kPa) and a vertical scalpel through its left lobe at 80% of its length in 150 steps,
+20 steps before, and 40 "after" steps with the tool put away.
+
+Usage: /usr/bin/python3 tests/bench/cut_step_parts.py [--runs 3] [--solver pcgTwoLevel] [--organ]
+       [--module DIR]
 (DIR: where tissue*.so is, default build/release/python). One thread; run nothing else meanwhile.
 """
 import argparse
@@ -20,26 +26,39 @@ ROOT = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..")
 PARTS = ("total_s", "assembly_s", "solve_s", "cut_s", "enrich_s")
 
 
-def stroke(tissue, solver):
-    kwargs = dict(mesh="frog", step_size_s=0.01, fixed_axis=0, fixed_fraction=0.3, young_modulus_pa=3e5,
-                  blade_length_m=0.2)
+def stroke(tissue, solver, organ):
+    kwargs = dict(step_size_s=0.01, young_modulus_pa=3e5, blade_length_m=0.2, threads=1)
+    if organ:
+        kwargs.update(mesh=os.path.join(ROOT, "meshes", "liver.veg"), fixed_axis=1, fixed_fraction=0.04)
+    else:
+        kwargs.update(mesh="frog", fixed_axis=0, fixed_fraction=0.3)
     if solver:
         kwargs["linear_solver"] = solver
-    frog = tissue.Tissue(**kwargs)
-    rest = frog.rest_positions_m
+    body = tissue.Tissue(**kwargs)
+    rest = body.rest_positions_m
     lower, upper = rest.min(axis=0), rest.max(axis=0)
-    frog.step(20)  # settle under gravity
-    x = lower[0] + 0.6 * (upper[0] - lower[0])
+    size = upper - lower
+    body.step(5 if organ else 20)  # settle under gravity
+    x = lower[0] + (0.8 if organ else 0.6) * size[0]
+    tip_z = lower[2] - (0.02 if organ else 0.05)
     kinds = {"before": [], "enriching": [], "plain": []}
-    for _ in range(40):
-        frog.set_tool((x, lower[1] - 0.05, lower[2] - 0.05), mode="scalpel")
-        kinds["before"].append(frog.step())
-    steps = 175
+    for _ in range(20 if organ else 40):
+        body.set_tool((x, lower[1] - 0.05, tip_z), mode="scalpel")
+        kinds["before"].append(body.step())
+    steps = 150 if organ else 175
     for n in range(steps + 1):
-        y = lower[1] - 0.01 + n / steps * (upper[1] - lower[1] + 0.02)
-        frog.set_tool((x, y, lower[2] - 0.05), mode="scalpel")
-        report = frog.step()
+        if organ:  # from the front to the back, as cut_organ's
+            y = upper[1] + 0.15 * size[1] - n / steps * 1.3 * size[1]
+        else:
+            y = lower[1] - 0.01 + n / steps * (size[1] + 0.02)
+        body.set_tool((x, y, tip_z), mode="scalpel")
+        report = body.step()
         kinds["enriching" if report["newly_cut_tets"] > 0 else "plain"].append(report)
+    if organ:
+        kinds["after"] = []
+        body.set_tool((x, lower[1] - 0.1, upper[2] + 0.1), mode="none")
+        for _ in range(40):
+            kinds["after"].append(body.step())
     return kinds
 
 
@@ -47,22 +66,27 @@ def main():
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("--runs", type=int, default=3)
     parser.add_argument("--solver", default="")
+    parser.add_argument("--organ", action="store_true")
     parser.add_argument("--module", default=os.path.join(ROOT, "build", "release", "python"))
     args = parser.parse_args()
     sys.path.insert(0, args.module)
     import tissue  # noqa: E402
 
-    print("| run | steps | n | total | assembly | solve | cut | enrich | re-layouts | total / before |")
-    print("|---|---|---:|---:|---:|---:|---:|---:|---:|---:|")
+    print("| run | steps | n | total | assembly | solve | cut | enrich | re-layouts | Newton corrections (mean) "
+          "| total / before |")
+    print("|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|")
     for run in range(args.runs):
-        kinds = stroke(tissue, args.solver)
+        kinds = stroke(tissue, args.solver, args.organ)
         before_ms = 1e3 * statistics.median(r["total_s"] for r in kinds["before"])
         for name, reports in kinds.items():
-            medians = [1e3 * statistics.median(r[p] for r in reports) for p in PARTS]
-            relayouts = sum(bool(r["matrix_relayout"]) for r in reports)
-            print("| %d | %s | %d | %s | %d | %.2fx |" % (run + 1, name, len(reports),
-                                                       " | ".join("%.2f" % m for m in medians), relayouts,
-                                                       medians[0] / before_ms))
+            # A module from before a part was reported (--module of an older build) leaves it "-".
+            medians = [1e3 * statistics.median(r[p] for r in reports) if p in reports[0] else None for p in PARTS]
+            relayouts = sum(bool(r["matrix_relayout"]) for r in reports) if "matrix_relayout" in reports[0] else "-"
+            newton = statistics.mean(r["newton_iterations"] for r in reports)
+            print("| %d | %s | %d | %s | %s | %.2f | %.2fx |" % (run + 1, name, len(reports),
+                                                              " | ".join("-" if m is None else "%.2f" % m
+                                                                         for m in medians),
+                                                              relayouts, newton, medians[0] / before_ms))
 
 
 if __name__ == "__main__":
