@@ -10,6 +10,8 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <cstdio>
 #include <string>
 
 namespace tissue {
@@ -173,6 +175,68 @@ TEST(TissueState, ABackgroundStiffnessRefreshUnderWayIsSavedWithTheState) {
 // Pressing (contact and its stiffness refresh), before the stroke, mid-stroke (a session open and
 // tets partly cut), between the strokes, mid-way through the second (cut tets cut again) and after.
 INSTANTIATE_TEST_SUITE_P(SavedAtStep, TissueState, ::testing::Values(15, 21, 40, 63, 85, 107));
+
+// A spiral stroke whose turns are 4 mm apart (closer than the frog's tets) cuts the tets between its
+// turns twice in one session, a turn apart (snapshot v10: the turn at which each tet was cut and each
+// edge crossed). Saved in the second turn, after some tets were cut twice, and serialized into a
+// fresh instance, the session goes on bitwise.
+TEST(TissueState, ASpiralSavedInItsSecondTurnContinuesBitwise) {
+  const TetMesh mesh = frog();
+  const Session session(mesh);
+  constexpr double PITCH_M = 0.004;
+  const auto spiral_pose = [&](int step) {
+    const Eigen::Quaterniond upright = Eigen::Quaterniond::Identity();  // tool axis +z
+    double theta = 4.0 * M_PI;  // 8 mm from the centre, about 1.5 mm a step outward along the spiral
+    for (int n = 0; n < step; ++n) theta += 1.5e-3 / (PITCH_M / (2.0 * M_PI) * theta);
+    const double radius_m = PITCH_M / (2.0 * M_PI) * theta;
+    if (theta > 8.0 * M_PI) {
+      return ToolPose{Eigen::Vector3d(session.centre().x(), session.upper().y() + 0.05, session.upper().z() + 0.05),
+                      upright, ToolMode::none};
+    }
+    return ToolPose{Eigen::Vector3d(session.centre().x() + 0.0011 + radius_m * std::cos(theta),
+                                    session.centre().y() + 0.0003 + radius_m * std::sin(theta), -1.0),
+                    upright, ToolMode::scalpel};
+  };
+  Tissue original(mesh, frog_settings(mesh));
+  const double tip_z = session.pose(22).tip_position_m.z();  // the straight strokes' blade: from below the belly
+  const auto run_spiral = [&](Tissue& tissue, int from, int to) {
+    for (int n = from; n < to; ++n) {
+      ToolPose pose = spiral_pose(n);
+      if (pose.mode == ToolMode::scalpel) pose.tip_position_m.z() = tip_z;
+      tissue.set_tool(pose);
+      tissue.step();
+    }
+  };
+  const auto cut_twice_in_one_session = [](const Tissue& tissue) {
+    int twice = 0;
+    for (int k = 0; k < static_cast<int>(tissue.body().cut_tets().size()); ++k) {
+      if (tissue.body().retired(k)) continue;
+      const std::vector<TetCut>& cuts = tissue.body().cut_geometry(k).cuts;
+      for (size_t a = 0; a < cuts.size(); ++a) {
+        for (size_t b = a + 1; b < cuts.size(); ++b) twice += cuts[a].cut_id == cuts[b].cut_id ? 1 : 0;
+      }
+    }
+    return twice;
+  };
+  constexpr int SAVED_AT = 75;  // in the second turn
+  constexpr int END = 110;      // the stroke is over
+  run_spiral(original, 0, SAVED_AT);
+  ASSERT_EQ(spiral_pose(SAVED_AT).mode, ToolMode::scalpel);
+  ASSERT_GT(cut_twice_in_one_session(original), 0) << "the second turn should have recut some tets by now";
+  TissueSnapshot snapshot;
+  original.save(snapshot);
+  const std::vector<std::uint8_t> bytes = serialize_snapshot(snapshot);
+  run_spiral(original, SAVED_AT, END);
+  const int twice = cut_twice_in_one_session(original);
+  std::printf("spiral through the frog: %zu cut tets, %d cut twice by the one stroke\n",
+              original.body().cut_tets().size(), twice);
+
+  Tissue fresh(mesh, frog_settings(mesh));
+  fresh.restore(deserialize_snapshot(bytes));
+  run_spiral(fresh, SAVED_AT, END);
+  EXPECT_EQ(cut_twice_in_one_session(fresh), twice);
+  expect_same_continuation(original, fresh);
+}
 
 TEST(TissueState, RestoredInPlaceRepeatsTheSameSteps) {
   const TetMesh mesh = frog();
