@@ -226,6 +226,8 @@ class PyTissue {
     out["cut_s"] = report.cut_s;
     out["enrich_s"] = report.enrich_s;
     out["contact_s"] = report.contact_s;
+    out["guard_s"] = report.dynamics.guard_s;
+    out["positions_s"] = report.positions_s;
     out["total_s"] = report.total_s;
     return out;
   }

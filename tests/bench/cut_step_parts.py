@@ -23,7 +23,7 @@ import statistics
 import sys
 
 ROOT = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..")
-PARTS = ("total_s", "assembly_s", "solve_s", "cut_s", "enrich_s")
+PARTS = ("total_s", "assembly_s", "solve_s", "guard_s", "cut_s", "enrich_s", "positions_s")
 
 
 def stroke(tissue, solver, organ):
@@ -72,9 +72,9 @@ def main():
     sys.path.insert(0, args.module)
     import tissue  # noqa: E402
 
-    print("| run | steps | n | total | assembly | solve | cut | enrich | re-layouts | Newton corrections (mean) "
-          "| total / before |")
-    print("|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|")
+    print("| run | steps | n | total | assembly | solve | energy guard | cut | enrich | positions | re-layouts "
+          "| Newton corrections (mean) | total / before |")
+    print("|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|")
     for run in range(args.runs):
         kinds = stroke(tissue, args.solver, args.organ)
         before_ms = 1e3 * statistics.median(r["total_s"] for r in kinds["before"])

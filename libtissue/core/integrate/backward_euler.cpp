@@ -148,7 +148,11 @@ StepReport BackwardEuler::step(DynamicsModel& model, DynamicState& state, double
   }
   const bool guard = turn_rad > newton.energy_guard_angle_rad;
   state.displacement_m += h * m_end_velocity;
-  if (guard) report.energy_guarded = guard_energy(model, state, h);
+  if (guard) {
+    const auto guard_start = std::chrono::steady_clock::now();
+    report.energy_guarded = guard_energy(model, state, h);
+    report.guard_s = seconds_since(guard_start);
+  }
   state.velocity_m_per_s = m_end_velocity;
   state.time_s += h;
   return report;

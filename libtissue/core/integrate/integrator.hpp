@@ -40,6 +40,7 @@ struct StepReport {
   int newton_iterations = 0;    ///< nonlinear iterations (0 for the linearized backward Euler)
   long linear_iterations = 0;   ///< Krylov iterations of all solves (PCG, GMRES); 0 for direct solves
   bool energy_guarded = false;  ///< backward Euler scaled the velocity down so the energy did not rise
+  double guard_s = 0.0;         ///< backward Euler's energy guard: its two energy passes (wall time)
 };
 
 /// Why an integrator must start afresh at its next step.
