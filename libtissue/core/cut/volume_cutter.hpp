@@ -268,19 +268,22 @@ class VolumeCutter {
   /// Decided in this session and in this passage: the blade's plane has not turned through
   /// PASSAGE_TURN_RAD since (a spiral's earlier turn decided it for the tets there, not for these).
   [[nodiscard]] bool decided_now(int vertex) const {
-    return side_decided(vertex) && m_turn_rad - m_vertex_turn_rad[static_cast<std::size_t>(vertex)] <= PASSAGE_TURN_RAD;
+    return side_decided(vertex) && in_this_passage(m_vertex_turn_rad[static_cast<std::size_t>(vertex)]);
   }
-  /// Cut in this session and in this passage: the blade's plane has not turned through
-  /// PASSAGE_TURN_RAD since (the next turn of a spiral tighter than the tet cuts it again).
+  /// Cut in this session and in this passage (the next turn of a spiral tighter than the tet cuts it
+  /// again).
   [[nodiscard]] bool cut_now(int tet) const {
     const auto t = static_cast<std::size_t>(tet);
-    return m_tet_cut_session[t] == m_cut_id && m_turn_rad - m_tet_cut_turn_rad[t] <= PASSAGE_TURN_RAD;
+    return m_tet_cut_session[t] == m_cut_id && in_this_passage(m_tet_cut_turn_rad[t]);
   }
   /// The edge's crossing recorded since the session (re)started, in this passage.
   [[nodiscard]] bool crossed_now(int edge) const {
     const auto e = static_cast<std::size_t>(edge);
-    return m_edge_session[e] == m_record_epoch && m_turn_rad - m_edge_turn_rad[e] <= PASSAGE_TURN_RAD;
+    return m_edge_session[e] == m_record_epoch && in_this_passage(m_edge_turn_rad[e]);
   }
+  /// Whether something the session did when its plane had turned through `turn_rad` belongs to this
+  /// passage of the blade: the plane has not turned through PASSAGE_TURN_RAD since.
+  [[nodiscard]] bool in_this_passage(double turn_rad) const { return m_turn_rad - turn_rad <= PASSAGE_TURN_RAD; }
   void push_unvisited(int tet);
   void find_next_active(const Blade& blade, const Eigen::VectorXd& positions_m);
   void complete_touched_tets(CutStepReport& report, const Eigen::VectorXd& positions_m);

@@ -527,15 +527,22 @@ void CutRenderSurface::cap_loops(const DeformableBody& body) {
   const auto part_of_point = [&](int point) { return part_of(body, m_points[static_cast<size_t>(point)]); };
   // Which side of cut `cut` the material of a point's piece lies on (+1 above, -1 below, 0 unknown:
   // a point riding on an uncut tet).
-  const auto facing = [&](int point, int cut) {
+  // Cut `cut`'s index among the cuts of a point's cell (its first, if the cell is cut by it twice);
+  // -1 if the point rides on an uncut tet or its cell is not cut by it.
+  const auto cut_index = [&](int point, int cut) {
     const Point& at = m_points[static_cast<size_t>(point)];
-    if (at.cut_tet < 0) return 0;
-    const CutTetGeometry& geometry = body.cut_geometry(at.cut_tet);
-    for (size_t c = 0; c < geometry.cuts.size(); ++c) {
-      if (geometry.cuts[c].cut_id != cut) continue;
-      return (geometry.pieces[static_cast<size_t>(at.piece)].sides.above & (1u << c)) != 0 ? 1 : -1;
+    if (at.cut_tet < 0) return -1;
+    const std::vector<TetCut>& cuts = body.cut_geometry(at.cut_tet).cuts;
+    for (size_t c = 0; c < cuts.size(); ++c) {
+      if (cuts[c].cut_id == cut) return static_cast<int>(c);
     }
-    return 0;
+    return -1;
+  };
+  const auto facing = [&](int point, int cut) {
+    const int c = cut_index(point, cut);
+    if (c < 0) return 0;
+    const Point& at = m_points[static_cast<size_t>(point)];
+    return (body.cut_geometry(at.cut_tet).pieces[static_cast<size_t>(at.piece)].sides.above & (1u << c)) != 0 ? 1 : -1;
   };
 
   // Chains: maximal runs of points split by one cut, in loops that are not a single plane's opening.
@@ -559,14 +566,9 @@ void CutRenderSurface::cap_loops(const DeformableBody& body) {
   const auto point_at = [&](int model, const Eigen::Vector3d& rest_m) { return add_point_like(model, rest_m); };
   // The plane of cut `cut` at a point's cell (none, a zero normal, if its cell is not cut by it).
   const auto plane_of = [&](int point, int cut) {
-    const Point& at = m_points[static_cast<size_t>(point)];
-    if (at.cut_tet >= 0) {
-      const CutTetGeometry& geometry = body.cut_geometry(at.cut_tet);
-      for (size_t c = 0; c < geometry.cuts.size(); ++c) {
-        if (geometry.cuts[c].cut_id == cut) return geometry.planes[c];
-      }
-    }
-    return CutPlane{Eigen::Vector3d::Zero(), 0.0};
+    const int c = cut_index(point, cut);
+    if (c < 0) return CutPlane{Eigen::Vector3d::Zero(), 0.0};
+    return body.cut_geometry(m_points[static_cast<size_t>(point)].cut_tet).planes[static_cast<size_t>(c)];
   };
   bridge_switches(loops, chains, m_rest_m, line, plane_of, ends.switches, ends);
   bridge_notches(loops, chains, chain_starting_at, m_rest_m, line, point_at, plane_of, ends);

@@ -171,8 +171,8 @@ void TwoLevelPreconditioner::aggregate(const ShiftedSystem& system) {
   m_rows = rows;
 }
 
-// The coarse block pattern (aggregate pairs that share a fine block), each fine slot's block and
-// and the scalar lower triangle of the coarse matrix with its symbolic analysis.
+// The coarse block pattern (aggregate pairs that share a fine block), each fine slot's block, and
+// the scalar lower triangle of the coarse matrix with its symbolic analysis.
 void TwoLevelPreconditioner::make_coarse_pattern(const BlockSparseMatrix& k) {
   const int count = aggregate_count();
   // Per aggregate a (its rows in m_aggregate_rows): the aggregates its rows' blocks reach, in
