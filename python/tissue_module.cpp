@@ -221,6 +221,7 @@ class PyTissue {
     out["newly_cut_tets"] = report.cut.newly_cut_tets;
     out["new_enriched_dofs"] = report.enrichment.new_enriched_dofs;
     out["matrix_relayout"] = report.enrichment.matrix_relayout;
+    out["parked_rows"] = report.parked_rows;
     out["assembly_s"] = report.dynamics.assembly_s;
     out["solve_s"] = report.dynamics.solve_s;
     out["cut_s"] = report.cut_s;
@@ -249,6 +250,7 @@ class PyTissue {
     return out;
   }
   [[nodiscard]] int dof_count() const { return m_tissue->body().dof_count(); }
+  [[nodiscard]] int parked_rows() const { return m_tissue->body().parked_row_count(); }
   [[nodiscard]] int cut_tets() const { return m_tissue->body().cut_tet_count(); }
   [[nodiscard]] int enriched_vertices() const { return m_tissue->body().enriched_dof_count(); }
   [[nodiscard]] double kinetic_energy_j() const { return m_tissue->kinetic_energy_j(); }
@@ -515,6 +517,9 @@ PYBIND11_MODULE(tissue, m) {
       .def_property_readonly("regions", &PyTissue::regions,
                              "The mesh's regions: {name: (young_modulus_pa, poisson_ratio, density_kg_per_m3)}")
       .def_property_readonly("dof_count", &PyTissue::dof_count)
+      .def_property_readonly("parked_rows", &PyTissue::parked_rows,
+                             "Block rows (3 unknowns each) of parts cut free that fell out of the operating field "
+                             "(field_margin_fraction) and left the dynamics")
       .def_property_readonly("cut_tets", &PyTissue::cut_tets)
       .def_property_readonly("enriched_vertices", &PyTissue::enriched_vertices)
       .def_property_readonly("kinetic_energy_j", &PyTissue::kinetic_energy_j)

@@ -95,6 +95,7 @@ TissueStepReport Tissue::step() {
     throw;
   }
   m_tool.apply(move);
+  report.parked_rows = park_fallen_parts();
 
   const auto positions_start = std::chrono::steady_clock::now();
   m_surfaces.update_positions(m_body, m_state.displacement_m);
@@ -108,6 +109,25 @@ TissueStepReport Tissue::step() {
   report.contact_s += seconds_since(output_start);
   report.total_s = seconds_since(start);
   return report;
+}
+
+Eigen::AlignedBox3d Tissue::operating_field() const {
+  Eigen::AlignedBox3d rest;
+  for (const Eigen::Vector3d& x : m_body.mesh().rest_positions_m) rest.extend(x);
+  // The same margin on every side (of the largest size): a thin body's field is not thin.
+  const Eigen::Vector3d margin = Eigen::Vector3d::Constant(m_settings.field_margin_fraction * rest.sizes().maxCoeff());
+  return {rest.min() - margin, rest.max() + margin};
+}
+
+int Tissue::park_fallen_parts() {
+  if (m_body.cut_tet_count() == 0 || ++m_steps_since_park_check < PARK_CHECK_STEPS) return 0;
+  m_steps_since_park_check = 0;
+  std::vector<int> rows = m_body.park_parts_outside(operating_field(), m_state);
+  if (rows.empty()) return 0;
+  m_integrator->restart(Restart::system_grown);  // velocities set, blocks dropped
+  const int count = static_cast<int>(rows.size());
+  m_parked.push_back({static_cast<int>(m_cuts.batch_ends().size()), std::move(rows)});
+  return count;
 }
 
 EnrichmentResult Tissue::apply_cuts(std::span<const TetCut> cuts,
@@ -143,6 +163,8 @@ void Tissue::save(TissueSnapshot& snapshot) {
   snapshot.cuts = m_cuts.history();
   snapshot.cut_batch_ends = m_cuts.batch_ends();
   snapshot.cut_offsets = cut_offsets();
+  snapshot.parked = m_parked;
+  snapshot.steps_since_park_check = m_steps_since_park_check;
   snapshot.dynamics = m_state;
   m_body.save_rotations(snapshot.rotations);
   snapshot.integrator_state = m_integrator->internal_state();
@@ -161,7 +183,29 @@ void Tissue::save(TissueSnapshot& snapshot) {
 }
 
 bool Tissue::has_cuts_of(const TissueSnapshot& snapshot) const {
-  return m_cuts.has_history(snapshot.cuts, snapshot.cut_batch_ends) && snapshot.cut_offsets == cut_offsets();
+  return m_cuts.has_history(snapshot.cuts, snapshot.cut_batch_ends) && snapshot.cut_offsets == cut_offsets() &&
+         snapshot.parked == m_parked;
+}
+
+void Tissue::replay(const TissueSnapshot& snapshot) {
+  const std::vector<ParkedRows>& parked = snapshot.parked;
+  for (size_t k = 0; k < parked.size(); ++k) {
+    if (parked[k].after_batch < 1 || parked[k].after_batch > static_cast<int>(snapshot.cut_batch_ends.size()) ||
+        (k > 0 && parked[k].after_batch < parked[k - 1].after_batch)) {
+      throw StateError("the state's parked parts do not follow its cuts");
+    }
+  }
+  size_t next = 0;
+  const ApplyCuts apply = [&](std::span<const TetCut> cuts, std::span<const std::vector<TetPositions>> offsets_m) {
+    const EnrichmentResult made = apply_cuts(cuts, offsets_m);
+    const int batches = static_cast<int>(m_cuts.batch_ends().size()) + 1;  // this one is recorded after
+    for (; next < parked.size() && parked[next].after_batch == batches; ++next) {
+      m_body.park_rows(parked[next].rows);  // std::invalid_argument: the replay's StateError
+      m_parked.push_back(parked[next]);
+    }
+    return made;
+  };
+  m_cuts.replay(snapshot.cuts, snapshot.cut_batch_ends, snapshot.cut_offsets, apply);
 }
 
 void Tissue::restore(const TissueSnapshot& snapshot) {
@@ -172,8 +216,9 @@ void Tissue::restore(const TissueSnapshot& snapshot) {
   if (!can_restore(snapshot)) {
     throw StateError("the state has other cuts than this instance; restore it into a fresh instance");
   }
-  if (!has_cuts_of(snapshot)) {
-    m_cuts.replay(snapshot.cuts, snapshot.cut_batch_ends, snapshot.cut_offsets, cut_applier());
+  if (!has_cuts_of(snapshot)) replay(snapshot);
+  if (snapshot.steps_since_park_check < 0 || snapshot.steps_since_park_check >= PARK_CHECK_STEPS) {
+    throw StateError("the state's steps since the last look for fallen parts are out of range");
   }
   // Check everything before changing anything.
   const Eigen::Index dofs = m_body.dof_count();
@@ -208,6 +253,7 @@ void Tissue::restore(const TissueSnapshot& snapshot) {
   }
   m_body.restore_rotations(rotations);
   m_state = dynamics;
+  m_steps_since_park_check = snapshot.steps_since_park_check;
   m_integrator->restore_internal_state(snapshot.integrator_state);
   m_integrator->restart(Restart::state_restored);
   m_tool.restore(tool);

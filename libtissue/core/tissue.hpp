@@ -51,6 +51,9 @@ struct TissueSettings {
   SolverSettings solver;          ///< backward Euler's linear solver
   InteractionSettings interaction;
   double step_size_s = 1e-3;
+  /// The operating field is the body's rest box grown by this fraction of its largest size on every side: a
+  /// part cut free that falls wholly outside it leaves the dynamics (DeformableBody::park_parts_outside).
+  double field_margin_fraction = 0.5;
   /// A finer surface of the same shape to draw (issue 22), riding on the tets and cut with them
   /// (Tissue::render_surface()); none: the tet skin only. Not part of the model fingerprint: it does
   /// not change the dynamics.
@@ -77,7 +80,19 @@ struct TissueStepReport {
   double contact_s = 0.0;       ///< god-object update and contact outputs
   double positions_s = 0.0;     ///< positions after the step (the BVH refit waits for the next query)
   double total_s = 0.0;
+  int parked_rows = 0;  ///< block rows this step took out of the dynamics (parts fallen out of the field)
 };
+
+/// Rows taken out of the dynamics (DeformableBody::park_parts_outside) after `after_batch` batches
+/// of cuts: what a replay repeats at the same point.
+struct ParkedRows {
+  int after_batch = 0;
+  std::vector<int> rows;
+  bool operator==(const ParkedRows&) const = default;
+};
+
+/// How many steps apart a Tissue looks for parts that fell out of the operating field.
+inline constexpr int PARK_CHECK_STEPS = 10;
 
 /// Everything a Tissue carries from one step to the next, so that a restored instance continues
 /// bitwise as the saved one would have (FMI get/set/serialize FMU state). The cuts are kept as the
@@ -87,6 +102,8 @@ struct TissueSnapshot {
   std::vector<TetCut> cuts;             ///< every enriched cut, in order
   std::vector<int> cut_batch_ends;      ///< after enrichment k, cuts [0, cut_batch_ends[k]) were applied
   std::vector<std::vector<TetPositions>> cut_offsets;  ///< per cut tet made: its pieces' CutPiece::offset_m
+  std::vector<ParkedRows> parked;       ///< in order
+  int steps_since_park_check = 0;
   DynamicState dynamics;
   DeformableBody::Rotations rotations;
   Eigen::VectorXd integrator_state;
@@ -137,6 +154,8 @@ class Tissue {
   TissueStepReport step();
 
   [[nodiscard]] const DeformableBody& body() const { return m_body; }
+  /// The body's rest box grown on every side by TissueSettings::field_margin_fraction of its largest size.
+  [[nodiscard]] Eigen::AlignedBox3d operating_field() const;
   [[nodiscard]] const DynamicState& state() const { return m_state; }
   [[nodiscard]] const TissueSettings& settings() const { return m_settings; }
   [[nodiscard]] double time_s() const { return m_state.time_s; }
@@ -192,7 +211,7 @@ class Tissue {
   /// True when restore() can take the snapshot here: it has the same cuts, or nothing was cut here
   /// yet (the snapshot's cuts are replayed). Cuts cannot be undone: otherwise use a fresh Tissue.
   [[nodiscard]] bool can_restore(const TissueSnapshot& snapshot) const {
-    return m_cuts.batch_ends().empty() || has_cuts_of(snapshot);
+    return (m_cuts.batch_ends().empty() && m_parked.empty()) || has_cuts_of(snapshot);
   }
   /// Restores a snapshot of this model: in place when has_cuts_of(snapshot), by replaying the cuts
   /// when nothing was cut here yet (a fresh instance). Throws StateError unless can_restore(), or
@@ -217,8 +236,13 @@ class Tissue {
       return apply_cuts(cuts, offsets_m);
     };
   }
+  /// Replays a snapshot's cuts batch by batch, and its parked rows where they were parked.
+  void replay(const TissueSnapshot& snapshot);
   /// Per cut tet, its pieces' offsets (what a replay needs besides the cuts).
   [[nodiscard]] std::vector<std::vector<TetPositions>> cut_offsets() const;
+  /// Every PARK_CHECK_STEPS steps of a cut body: parts fallen out of the operating field leave the
+  /// dynamics (recorded for a replay). Returns the rows parked.
+  int park_fallen_parts();
   /// The near-surface report of the pose set, at the current positions (the tissue's sample).
   void sample_near_surface() { m_contact.sample_near_surface(m_tool.touching(), m_surfaces.bvh()); }
 
@@ -231,6 +255,8 @@ class Tissue {
   ToolKinematics m_tool;
   CutSession m_cuts;
   ContactModel m_contact;
+  std::vector<ParkedRows> m_parked;
+  int m_steps_since_park_check = 0;
   std::uint64_t m_model_fingerprint = 0;
 };
 

@@ -251,6 +251,16 @@ constexpr auto interaction_settings() {
           .start("true")
           .describe("Cutting; off: the scalpel does not cut; the cutter and the edge adjacency are not built")
           .member(TISSUE_MEMBER(settings.interaction.cutting_enabled)),
+      Setting("scene.fieldMargin", 87, real)
+          .python("field_margin_fraction")
+          .unit("1")
+          .start("0.5")
+          .at_least("0")
+          .describe("The operating field: the body's rest box grown by this fraction of its largest size on every side. A "
+                    "part cut free that has fallen wholly outside it leaves the dynamics (looked for every 10 steps): "
+                    "its elements add nothing, its rows fall on freely as one rigid body (spin dropped). A large "
+                    "value (1e6) keeps every part")
+          .member(TISSUE_MEMBER(settings.field_margin_fraction)),
       Setting("tool.probeRadius", 18, real)
           .python("probe_radius_m")
           .unit("m")

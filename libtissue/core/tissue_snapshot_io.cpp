@@ -16,7 +16,7 @@ constexpr std::uint64_t MAGIC = 0x31305353'49535354ULL;  // "TSSISS01" read as l
 // fields, other meanings; 8: the cutter's per-vertex sides, distances and the blade's plane of the
 // open session (issue 41); 9: each cut's blade normal (TetCut::blade_normal); 10: how far the blade
 // had turned when each tet was cut and each edge crossed (a spiral cuts a tet once per turn)
-constexpr std::uint32_t VERSION = 10;
+constexpr std::uint32_t VERSION = 11;
 
 // The core's Eigen types and cut records on top of the shared byte stream.
 class Writer : public serial::ByteWriter {
@@ -58,6 +58,10 @@ class Writer : public serial::ByteWriter {
     put(cut.min_volume_fraction);
     put(cut.blade_normal);
   }
+  void put_item(const ParkedRows& parked) {
+    put(parked.after_batch);
+    put_all(parked.rows);
+  }
   template <class T>
   void put_item(const std::vector<T>& values) {
     put_all(values);
@@ -94,6 +98,10 @@ class Reader : public serial::ByteReader {
     get(cut.edge_ratio);
     get(cut.min_volume_fraction);
     get(cut.blade_normal);
+  }
+  void get(ParkedRows& parked) {
+    get(parked.after_batch);
+    get_all(parked.rows, 4);
   }
   template <class T>
   void get(std::vector<T>& values) {
@@ -132,6 +140,8 @@ std::vector<std::uint8_t> serialize_snapshot(const TissueSnapshot& s) {
   w.put_all(s.cuts);
   w.put_all(s.cut_batch_ends);
   w.put_all(s.cut_offsets);
+  w.put_all(s.parked);
+  w.put(s.steps_since_park_check);
   w.put(s.dynamics.displacement_m);
   w.put(s.dynamics.velocity_m_per_s);
   w.put(s.dynamics.time_s);
@@ -207,6 +217,8 @@ TissueSnapshot read_snapshot(std::span<const std::uint8_t> bytes) {
   r.get_all(s.cuts, 4 + 4 + 4 + 8 + 48 + 8 + 24);
   r.get_all(s.cut_batch_ends, 4);
   r.get_all(s.cut_offsets, 8);
+  r.get_all(s.parked, 4 + 8);
+  r.get(s.steps_since_park_check);
   r.get(s.dynamics.displacement_m);
   r.get(s.dynamics.velocity_m_per_s);
   r.get(s.dynamics.time_s);

@@ -245,6 +245,7 @@ TISSUE_HOT_KERNEL double DeformableBody::largest_element_turn_rad(const Eigen::V
     if (m_xfem.retired(k)) continue;
     const CutTet& cut_tet = m_xfem.cut_tets()[static_cast<size_t>(k)];
     for (int p = 0; p < static_cast<int>(m_xfem.piece_count(k)); ++p) {
+      if (m_xfem.parked(k, p)) continue;
       const CutPiece& piece = m_xfem.piece(k, p);
       for (size_t j = 0; j < 4; ++j) {
         increment[j] = piece.ghost_row[j] < 0 ? vertex_increment(cut_tet.vertices[j])
@@ -402,8 +403,13 @@ bool DeformableBody::drop_retired_blocks() {
   }
   for (int k = 0; k < m_xfem.cut_tet_count(); ++k) {
     if (m_xfem.retired(k)) continue;
-    for (const int slot : m_xfem.slots(k)) {
-      if (slot >= 0) keep[static_cast<size_t>(slot)] = 1;
+    const int dofs = m_xfem.dof_count(k);
+    const CutTetSlots slots = m_xfem.slots(k);
+    for (int r = 0; r < dofs; ++r) {
+      for (int c = 0; c < dofs; ++c) {
+        const int slot = slots[static_cast<size_t>(dofs * r + c)];
+        if (slot >= 0 && m_xfem.couples(k, r, c)) keep[static_cast<size_t>(slot)] = 1;
+      }
     }
   }
   m_retired_slots = 0;

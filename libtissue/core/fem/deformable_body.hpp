@@ -24,6 +24,7 @@
 #include "core/system/rayleigh_damping.hpp"
 
 #include <Eigen/Core>
+#include <Eigen/Geometry>
 
 #include <array>
 #include <cstdint>
@@ -187,12 +188,33 @@ class DeformableBody final : public DynamicsModel {
   [[nodiscard]] int cut_tet_count() const { return m_tets_cut; }
   /// How cut tet k is cut (its cuts and pieces).
   [[nodiscard]] const CutTetGeometry& cut_geometry(int k) const { return m_cut_geometry.at(static_cast<size_t>(k)); }
-  /// Drops from the tangent the XFEM blocks (a ghost row or column) that no live cut tet uses (those
-  /// only retired cut tets used: zeros the product multiplies every step) and looks every slot up
-  /// again; returns whether any went (the tangent's layout changed). enrich() does it itself once
-  /// the retired cut tets' slots reach RETIRED_SLOT_SHARE_TO_COMPACT of the blocks. The product and
-  /// the forces are unchanged.
+  /// Drops from the tangent the XFEM blocks (a ghost row or column) that no live cut tet's unparked
+  /// piece uses (those only retired cut tets or parked pieces used: zeros the product multiplies
+  /// every step) and looks every slot up again; returns whether any went (the tangent's layout
+  /// changed). enrich() does it itself once the retired cut tets' slots reach
+  /// RETIRED_SLOT_SHARE_TO_COMPACT of the blocks, park_parts_outside() whenever it parks. The
+  /// product and the forces are unchanged.
   bool drop_retired_blocks();
+  // --- Parts out of the dynamics ---
+
+  /// Takes out of the dynamics every part of the body (find_body_parts) that no fixed vertex holds
+  /// and whose block rows' points all lie outside `field` (their bounding box misses it): a piece cut
+  /// free that fell out of the operating field. Its uncut tets and cut pieces add no force, block or
+  /// energy from now on, its XFEM blocks leave the tangent, and each of its rows keeps its mass and
+  /// weight only, so it falls on freely; each row's velocity becomes the part's mean velocity
+  /// (momentum kept, its spin and vibration dropped), so that it falls as one rigid body. Parked
+  /// rows stay parked (a later cut of a parked tet makes live pieces, which a later call parks
+  /// again). Returns the rows this call parked, ascending. O(elements + unknowns).
+  std::vector<int> park_parts_outside(const Eigen::AlignedBox3d& field, DynamicState& state);
+  /// What park_parts_outside does to the rows it chose, velocities aside (a replay's: the recorded
+  /// state follows). Throws std::invalid_argument, nothing changed, for a row out of range.
+  void park_rows(std::span<const int> rows);
+  /// Whether block row `row` belongs to a part taken out of the dynamics.
+  [[nodiscard]] bool parked(int row) const {
+    return static_cast<size_t>(row) < m_row_parked.size() && m_row_parked[static_cast<size_t>(row)] != 0;
+  }
+  [[nodiscard]] int parked_row_count() const { return m_parked_rows; }
+
   /// Whether cut tet k was replaced by a later cut of its tet (then it adds nothing).
   [[nodiscard]] bool retired(int k) const { return m_xfem.retired(k); }
   /// Index into cut_tets() of a tet's current cut tet, or -1 if it is not cut.
@@ -300,6 +322,7 @@ class DeformableBody final : public DynamicsModel {
                       const std::vector<Eigen::Matrix3d>& rotations);
   void list_coupled_blocks(int k, std::vector<std::pair<int, int>>& new_blocks) const;
   void insert_coupled_blocks(std::vector<std::pair<int, int>>& new_blocks, int first_new_cut_tet);
+  void orphan_unused_vertex_rows(const EnrichBatch& batch);
   // Adds (sign +1) or removes (-1) what cut tet k's pieces put on the rows they use: rho w_p V / 4
   // of mass, its mass damping and its weight.
   void add_piece_loads(int k, double sign);
@@ -332,6 +355,8 @@ class DeformableBody final : public DynamicsModel {
   std::vector<int> m_first_enriched_dof;        // per vertex: first of its enriched unknowns, or -1
   std::vector<int> m_next_enriched_dof;         // per enriched unknown: next one of the same vertex, or -1
   std::vector<int> m_cut_index;                 // per tet: index into cut_tets(), or -1
+  std::vector<std::uint8_t> m_row_parked;       // per block row (shorter: the rest are not parked)
+  int m_parked_rows = 0;
 
   std::vector<ForceTerm*> m_force_terms;                // attached, not owned
   WorkTeam* m_team = nullptr;                           // lent for a step (lend_work_team)

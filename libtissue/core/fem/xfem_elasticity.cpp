@@ -40,6 +40,7 @@ void XfemElasticity::reserve(int cut_tets) {
   m_cut_tets.reserve(n);
   m_rest.reserve(n);
   m_retired.reserve(n);
+  m_parked.reserve(2 * n);
   m_piece_begin.reserve(n + 1);
   m_pieces.reserve(2 * n);
   m_ghost_dofs.reserve(2 * n);
@@ -88,6 +89,7 @@ void XfemElasticity::add(const CutTet& cut_tet, std::span<const CutPiece> pieces
       dofs[j] = row < 0 ? -1 : 4 + static_cast<int>(std::find(rows.begin(), rows.end(), row) - rows.begin());
     }
     m_pieces.push_back(piece);
+    m_parked.push_back(0);
     m_ghost_dofs.push_back(dofs);
     m_rotations.push_back(rotations[p]);
     m_warm_starts.emplace_back(rotations[p]);
@@ -101,10 +103,17 @@ void XfemElasticity::add(const CutTet& cut_tet, std::span<const CutPiece> pieces
   m_retired.push_back(0);
 }
 
+bool XfemElasticity::all_parked(int k) const {
+  const std::size_t begin = piece_begin(k);
+  return std::all_of(m_parked.begin() + static_cast<long>(begin),
+                     m_parked.begin() + static_cast<long>(begin + piece_count(k)), [](std::uint8_t p) { return p != 0; });
+}
+
 bool XfemElasticity::couples(int k, int dof_i, int dof_j) const {
   if (dof_i < 4 && dof_j < 4) return true;  // the uncut tet's blocks (kept)
   const std::size_t begin = piece_begin(k);
   for (std::size_t p = begin; p < begin + piece_count(k); ++p) {
+    if (m_parked[p] != 0) continue;
     const std::array<int, 4>& dofs = m_ghost_dofs[p];
     const auto uses = [&](int dof) {
       return dof < 4 ? dofs[to_size(dof)] < 0 : std::find(dofs.begin(), dofs.end(), dof) != dofs.end();
@@ -150,7 +159,7 @@ void XfemElasticity::evaluate(const Eigen::VectorXd& positions_m, const Eigen::V
                               BlockSparseMatrix* tangent) {
   TetPositions real_m;
   for (size_t k = 0; k < m_cut_tets.size(); ++k) {
-    if (m_retired[k] != 0) continue;
+    if (m_retired[k] != 0 || all_parked(static_cast<int>(k))) continue;
     const CutTet& cut_tet = m_cut_tets[k];
     const TetRest& rest = m_rest[k];
     const std::size_t first = piece_begin(static_cast<int>(k));
@@ -160,6 +169,7 @@ void XfemElasticity::evaluate(const Eigen::VectorXd& positions_m, const Eigen::V
     // Per piece: F_p, R_p (warm-started per piece), its nodal forces Fp_i, and what it adds.
     Eigen::Matrix<double, 3, 4> vertex_sum = Eigen::Matrix<double, 3, 4>::Zero();
     for (size_t p = first; p < first + count; ++p) {
+      if (m_parked[p] != 0) continue;
       const CutPiece& piece = m_pieces[p];
       const Eigen::Matrix3d f =
           deformation_gradient(rest, piece_positions(piece, real_m, cut_tet.rest_m, displacement_m));
@@ -185,6 +195,7 @@ void XfemElasticity::evaluate(const Eigen::VectorXd& positions_m, const Eigen::V
       for (int j = i; j < 4; ++j) uu[to_size(4 * i + j)].setZero();
     }
     for (size_t p = first; p < first + count; ++p) {
+      if (m_parked[p] != 0) continue;
       const CutPiece& piece = m_pieces[p];
       // The piece's DOF at each local vertex: u of the vertex (i) or its ghost (>= 4).
       std::array<int, 4> dof{};
@@ -235,6 +246,7 @@ double XfemElasticity::elastic_energy_j(const Eigen::VectorXd& positions_m,
     gather(k, positions_m, real_m);
     const std::size_t first = piece_begin(static_cast<int>(k));
     for (size_t p = first; p < first + piece_count(static_cast<int>(k)); ++p) {
+      if (m_parked[p] != 0) continue;
       const CutPiece& piece = m_pieces[p];
       const Eigen::Matrix3d f =
           deformation_gradient(m_rest[k], piece_positions(piece, real_m, m_cut_tets[k].rest_m, displacement_m));

@@ -131,6 +131,12 @@ class XfemElasticity {
   /// and slots stay, its forces are no longer added.
   void retire(int k) { m_retired[static_cast<std::size_t>(k)] = 1; }
   [[nodiscard]] bool retired(int k) const { return m_retired[static_cast<std::size_t>(k)] != 0; }
+  /// Piece p of cut tet k no longer counts: its part was taken out of the dynamics
+  /// (DeformableBody::park_parts_outside). Its forces, blocks and energy are no longer added.
+  void park(int k, int p) { m_parked[piece_begin(k) + static_cast<std::size_t>(p)] = 1; }
+  [[nodiscard]] bool parked(int k, int p) const { return m_parked[piece_begin(k) + static_cast<std::size_t>(p)] != 0; }
+  /// Whether every piece of cut tet k is parked (then it adds nothing, as a retired one).
+  [[nodiscard]] bool all_parked(int k) const;
 
   [[nodiscard]] int cut_tet_count() const { return static_cast<int>(m_cut_tets.size()); }
   [[nodiscard]] const std::vector<CutTet>& cut_tets() const { return m_cut_tets; }
@@ -146,7 +152,8 @@ class XfemElasticity {
   }
   /// 4 + ghost_rows(k).size().
   [[nodiscard]] int dof_count(int k) const { return 4 + static_cast<int>(ghost_rows(k).size()); }
-  /// Whether some piece of cut tet k uses both local DOFs (so that their block exists).
+  /// Whether some piece of cut tet k that is not parked uses both local DOFs (so that their block
+  /// exists); the four u DOFs always couple.
   [[nodiscard]] bool couples(int k, int dof_i, int dof_j) const;
   [[nodiscard]] CutTetSlots slots(int k) {
     const auto begin = m_slot_begin[static_cast<std::size_t>(k)];
@@ -197,6 +204,7 @@ class XfemElasticity {
   std::vector<CutTet> m_cut_tets;
   std::vector<TetRest> m_rest;
   std::vector<std::uint8_t> m_retired;  // per cut tet
+  std::vector<std::uint8_t> m_parked;   // per piece
   std::vector<int> m_piece_begin{0};
   std::vector<CutPiece> m_pieces;
   std::vector<std::array<int, 4>> m_ghost_dofs;  // per piece and local vertex: its local DOF, -1 real

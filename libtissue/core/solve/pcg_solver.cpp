@@ -5,6 +5,7 @@
 #include "core/solve/pcg_iteration.hpp"
 
 #include <cmath>
+#include <sstream>
 #include <string>
 
 namespace tissue {
@@ -22,8 +23,11 @@ void jacobi_inverse_diagonal(const ShiftedSystem& system, Eigen::VectorXd& inver
   for (long i = 0; i < inverse_diagonal.size(); ++i) {
     const double a_ii = inverse_diagonal[i];
     if (!(a_ii > 0.0) || !std::isfinite(a_ii)) {
-      throw SolverError(std::string(who) + ": A is not positive definite: diagonal entry " + std::to_string(i) +
-                        " is " + std::to_string(a_ii));
+      const double d_i = (*system.diagonal)[i];
+      std::ostringstream what;
+      what << who << ": A is not positive definite: diagonal entry " << i << " (block row " << i / 3 << ") is " << a_ii
+           << " (s K_ii " << a_ii - d_i << ", d_i " << d_i << ")";
+      throw SolverError(what.str());
     }
     inverse_diagonal[i] = 1.0 / a_ii;
   }

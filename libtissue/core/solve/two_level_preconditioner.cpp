@@ -63,8 +63,9 @@ int TwoLevelPreconditioner::aggregate_within(int reach, int rows, const std::vec
   std::vector<int> reached;
   std::vector<int> mark(static_cast<size_t>(rows), -1);
   int count = 0;
+  const auto alone = [&](int i) { return strong_begin[static_cast<size_t>(i)] == strong_begin[static_cast<size_t>(i) + 1]; };
   for (int root = 0; root < rows; ++root) {
-    if (m_aggregate_of_row[static_cast<size_t>(root)] >= 0) continue;
+    if (m_aggregate_of_row[static_cast<size_t>(root)] >= 0 || alone(root)) continue;
     reached.assign(1, root);
     mark[static_cast<size_t>(root)] = root;
     bool free = true;
@@ -92,7 +93,7 @@ int TwoLevelPreconditioner::aggregate_within(int reach, int rows, const std::vec
   }
   const std::vector<int> phase_one = m_aggregate_of_row;
   for (int i = 0; i < rows; ++i) {
-    if (phase_one[static_cast<size_t>(i)] >= 0) continue;
+    if (phase_one[static_cast<size_t>(i)] >= 0 || alone(i)) continue;
     double strongest = -1.0;
     for (int e = strong_begin[static_cast<size_t>(i)]; e < strong_begin[static_cast<size_t>(i) + 1]; ++e) {
       const int j = strong_column[static_cast<size_t>(e)];
@@ -145,11 +146,16 @@ void TwoLevelPreconditioner::aggregate(const ShiftedSystem& system) {
   const int count = aggregate_within(AGGREGATE_REACH, rows, strong_begin, strong_column, strong_weight);
   // Rows of each aggregate, in row order.
   m_aggregate_rows_begin.assign(static_cast<size_t>(count) + 1, 0);
-  for (const int a : m_aggregate_of_row) ++m_aggregate_rows_begin[static_cast<size_t>(a) + 1];
+  for (const int a : m_aggregate_of_row) {
+    if (a >= 0) ++m_aggregate_rows_begin[static_cast<size_t>(a) + 1];
+  }
   for (int a = 0; a < count; ++a) m_aggregate_rows_begin[static_cast<size_t>(a) + 1] += m_aggregate_rows_begin[static_cast<size_t>(a)];
-  m_aggregate_rows.resize(static_cast<size_t>(rows));
+  m_aggregate_rows.resize(static_cast<size_t>(m_aggregate_rows_begin.back()));
   std::vector<int> fill(m_aggregate_rows_begin.begin(), m_aggregate_rows_begin.end() - 1);
-  for (int i = 0; i < rows; ++i) m_aggregate_rows[static_cast<size_t>(fill[static_cast<size_t>(m_aggregate_of_row[static_cast<size_t>(i)])]++)] = i;
+  for (int i = 0; i < rows; ++i) {
+    const int a = m_aggregate_of_row[static_cast<size_t>(i)];
+    if (a >= 0) m_aggregate_rows[static_cast<size_t>(fill[static_cast<size_t>(a)]++)] = i;
+  }
 
   // Columns per aggregate: 3 translations, and the rotations the points then span.
   m_centroid.assign(static_cast<size_t>(count), Eigen::Vector3d::Zero());
@@ -191,7 +197,7 @@ void TwoLevelPreconditioner::make_coarse_pattern(const BlockSparseMatrix& k) {
         const int j = k.slot_column(s);
         if (j < 0) continue;
         const int b = m_aggregate_of_row[static_cast<size_t>(j)];
-        if (seen[static_cast<size_t>(b)] == a) continue;
+        if (b < 0 || seen[static_cast<size_t>(b)] == a) continue;
         seen[static_cast<size_t>(b)] = a;
         m_coarse_column.push_back(b);
       }
@@ -202,7 +208,8 @@ void TwoLevelPreconditioner::make_coarse_pattern(const BlockSparseMatrix& k) {
       const int i = m_aggregate_rows[static_cast<size_t>(p)];
       for (int s = k.row_begin(i); s < k.row_begin(i) + k.row_size(i); ++s) {
         const int j = k.slot_column(s);
-        if (j >= 0) m_coarse_block_of_slot[static_cast<size_t>(s)] = position[static_cast<size_t>(m_aggregate_of_row[static_cast<size_t>(j)])];
+        const int b = j >= 0 ? m_aggregate_of_row[static_cast<size_t>(j)] : -1;
+        if (b >= 0) m_coarse_block_of_slot[static_cast<size_t>(s)] = position[static_cast<size_t>(b)];
       }
     }
     m_coarse_row_begin[static_cast<size_t>(a) + 1] = static_cast<int>(m_coarse_column.size());
@@ -285,6 +292,7 @@ void TwoLevelPreconditioner::assemble_and_factorize(const ShiftedSystem& system)
   for (auto& block : m_coarse_blocks) block.fill(0.0);
   for (int i = 0; i < m_rows; ++i) {
     const int a = m_aggregate_of_row[static_cast<size_t>(i)];
+    if (a < 0) continue;  // a row alone: Jacobi solves it
     const int first_block = m_coarse_row_begin[static_cast<size_t>(a)];
     const size_t reach = static_cast<size_t>(m_coarse_row_begin[static_cast<size_t>(a) + 1] - first_block);
     if (m_row_sums.size() < reach) m_row_sums.resize(reach);
@@ -293,7 +301,7 @@ void TwoLevelPreconditioner::assemble_and_factorize(const ShiftedSystem& system)
       const int j = k.slot_column(s);
       if (j < 0) continue;
       const int coarse_block = m_coarse_block_of_slot[static_cast<size_t>(s)];
-      if (m_coarse_column[static_cast<size_t>(coarse_block)] < a) continue;
+      if (coarse_block < 0 || m_coarse_column[static_cast<size_t>(coarse_block)] < a) continue;
       Eigen::Matrix3d block = system.stiffness_scale * k.block(s);
       if (j == i) block.diagonal() += system.diagonal->segment<3>(3L * i);
       RowSums& sums = m_row_sums[static_cast<size_t>(coarse_block - first_block)];

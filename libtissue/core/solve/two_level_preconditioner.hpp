@@ -7,7 +7,9 @@
 // Aggregates (Vanek, Mandel and Brezina 1996, "Algebraic multigrid by smoothed aggregation",
 // phases 1 and 2): in row order, a row whose strong neighbours (within AGGREGATE_REACH edges) are all
 // unassigned becomes a root and takes them; a row left over joins the aggregate of its strongest
-// assigned neighbour (or becomes one of its own). A coupling is strong when ||A_ij||_F > STRENGTH sqrt(||A_ii||_F ||A_jj||_F):
+// assigned neighbour (or becomes one of its own). A row with no strong neighbour (an orphaned ghost,
+// a part taken out of the dynamics: nothing but its mass) joins none: its coarse columns would only
+// repeat Jacobi's solve of it, and the thousands a hatched body leaves grew the coarse level. A coupling is strong when ||A_ij||_F > STRENGTH sqrt(||A_ii||_F ||A_jj||_F):
 // the blocks a cut left in the pattern at zero never join the two sides of a cut. Made at the
 // first setup and again whenever K's pattern or layout changes (a cut), from that setup's values.
 //
@@ -71,7 +73,7 @@ class TwoLevelPreconditioner {
   [[nodiscard]] int aggregate_count() const { return static_cast<int>(m_aggregate_rows_begin.size()) - 1; }
   /// Columns of the coarse space (0 after a failed coarse factorization).
   [[nodiscard]] int coarse_size() const { return m_coarse_ok ? m_coarse_size : 0; }
-  /// Aggregate of each block row of the last setup's A.
+  /// Aggregate of each block row of the last setup's A, or -1 for a row with no strong neighbour.
   [[nodiscard]] const std::vector<int>& aggregate_of_row() const { return m_aggregate_of_row; }
 
  private:

@@ -4,6 +4,7 @@
 // another model, a truncated or corrupt buffer, or cuts the instance cannot undo are refused with
 // the instance unchanged.
 #include "core/fixed_region.hpp"
+#include "core/mesh/box_mesh.hpp"
 #include "core/mesh/mesh_io.hpp"
 #include "core/tissue.hpp"
 #include "core/tissue_snapshot_io.hpp"
@@ -236,6 +237,66 @@ TEST(TissueState, ASpiralSavedInItsSecondTurnContinuesBitwise) {
   run_spiral(fresh, SAVED_AT, END);
   EXPECT_EQ(cut_twice_in_one_session(fresh), twice);
   expect_same_continuation(original, fresh);
+}
+
+// Two strokes across the held beam (10 x 2 x 2 cm of 1 cm cubes, 10 ms steps): the end cut off by
+// the first falls out of the operating field and leaves the dynamics before the second stroke cuts
+// nearer the holder. Saved while the second piece falls, restored into a fresh instance through
+// bytes: the replay parks the first piece's rows between the two strokes' batches, where the
+// original did, so the tangent is laid out alike and the continuation (the second piece parked too)
+// is bitwise the same. A record that does not follow the cuts is refused.
+TEST(TissueState, PartsParkedBetweenStrokesAreReplayedWhereTheyWereParked) {
+  const TetMesh mesh = make_box_mesh(10, 2, 2, 0.01);
+  TissueSettings settings;
+  settings.body.gravity_m_per_s2 = {0.0, 0.0, -9.81};
+  settings.body.material = Material{2.0e6, 0.3, 1000.0};
+  settings.body.fixed_vertices = vertices_at_minimum(mesh, 0, 1e-6);
+  settings.step_size_s = 0.01;
+  settings.interaction.blade_length_m = 0.1;
+  const auto stroke = [](Tissue& tissue, double x_m) {
+    for (int n = 0; n <= 16; ++n) {
+      const Eigen::Vector3d tip(x_m, -0.01 + 0.04 * n / 16, -0.05);
+      tissue.set_tool(ToolPose{tip, Eigen::Quaterniond::Identity(), ToolMode::scalpel});
+      tissue.step();
+    }
+    tissue.set_tool(ToolPose{Eigen::Vector3d(x_m, 0.2, -0.05), Eigen::Quaterniond::Identity(), ToolMode::none});
+    tissue.step();
+  };
+  const auto steps = [](Tissue& tissue, int count) {
+    for (int n = 0; n < count; ++n) tissue.step();
+  };
+  Tissue original(mesh, settings);
+  stroke(original, 0.075);
+  steps(original, 40);
+  const int first_parked = original.body().parked_row_count();
+  ASSERT_GT(first_parked, 0) << "the first piece should have left the field";
+  stroke(original, 0.045);
+  steps(original, 3);
+  ASSERT_EQ(original.body().parked_row_count(), first_parked) << "the second piece is still in the field";
+  TissueSnapshot snapshot;
+  original.save(snapshot);
+  ASSERT_EQ(snapshot.parked.size(), 1u);
+  ASSERT_LT(snapshot.parked[0].after_batch, static_cast<int>(snapshot.cut_batch_ends.size()));
+  const std::vector<std::uint8_t> bytes = serialize_snapshot(snapshot);
+  const int blocks_at_save = original.body().tangent().nonzero_blocks();
+  steps(original, 40);
+  EXPECT_GT(original.body().parked_row_count(), first_parked) << "the second piece should have left the field";
+
+  Tissue fresh(mesh, settings);
+  fresh.restore(deserialize_snapshot(bytes));
+  EXPECT_EQ(fresh.body().parked_row_count(), first_parked);
+  EXPECT_EQ(fresh.body().tangent().nonzero_blocks(), blocks_at_save);
+  steps(fresh, 40);
+  expect_same_continuation(original, fresh);
+
+  TissueSnapshot early = snapshot;
+  early.parked[0].after_batch = 0;
+  Tissue refusing(mesh, settings);
+  EXPECT_THROW(refusing.restore(early), StateError);
+  TissueSnapshot out_of_range = snapshot;
+  out_of_range.parked[0].rows.push_back(1000000);
+  Tissue refusing_too(mesh, settings);
+  EXPECT_THROW(refusing_too.restore(out_of_range), StateError);
 }
 
 TEST(TissueState, RestoredInPlaceRepeatsTheSameSteps) {
