@@ -402,15 +402,7 @@ bool DeformableBody::drop_retired_blocks() {
     }
   }
   for (int k = 0; k < m_xfem.cut_tet_count(); ++k) {
-    if (m_xfem.retired(k)) continue;
-    const int dofs = m_xfem.dof_count(k);
-    const CutTetSlots slots = m_xfem.slots(k);
-    for (int r = 0; r < dofs; ++r) {
-      for (int c = 0; c < dofs; ++c) {
-        const int slot = slots[static_cast<size_t>(dofs * r + c)];
-        if (slot >= 0 && m_xfem.couples(k, r, c)) keep[static_cast<size_t>(slot)] = 1;
-      }
-    }
+    if (!m_xfem.retired(k)) m_xfem.mark_written_slots(k, keep);
   }
   m_retired_slots = 0;
   if (!m_tangent.remove_blocks(keep)) return false;

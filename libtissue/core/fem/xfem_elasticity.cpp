@@ -109,6 +109,26 @@ bool XfemElasticity::all_parked(int k) const {
                      m_parked.begin() + static_cast<long>(begin + piece_count(k)), [](std::uint8_t p) { return p != 0; });
 }
 
+void XfemElasticity::mark_written_slots(int k, std::vector<std::uint8_t>& keep) const {
+  const int dofs = dof_count(k);
+  const int* const slots = m_slots.data() + m_slot_begin[static_cast<std::size_t>(k)];
+  const std::size_t begin = piece_begin(k);
+  for (std::size_t p = begin; p < begin + piece_count(k); ++p) {
+    if (m_parked[p] != 0) continue;
+    std::array<int, 4> dof{};
+    for (int i = 0; i < 4; ++i) {
+      const int ghost = m_ghost_dofs[p][to_size(i)];
+      dof[to_size(i)] = ghost < 0 ? i : ghost;
+    }
+    for (const int a : dof) {
+      for (const int b : dof) {
+        const int slot = slots[dofs * a + b];
+        if (slot >= 0) keep[static_cast<std::size_t>(slot)] = 1;
+      }
+    }
+  }
+}
+
 bool XfemElasticity::couples(int k, int dof_i, int dof_j) const {
   if (dof_i < 4 && dof_j < 4) return true;  // the uncut tet's blocks (kept)
   const std::size_t begin = piece_begin(k);

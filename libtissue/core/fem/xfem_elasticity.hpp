@@ -155,6 +155,8 @@ class XfemElasticity {
   /// Whether some piece of cut tet k that is not parked uses both local DOFs (so that their block
   /// exists); the four u DOFs always couple.
   [[nodiscard]] bool couples(int k, int dof_i, int dof_j) const;
+  /// Marks keep[slot] for every slot the unparked pieces of cut tet k write (evaluate's blocks).
+  void mark_written_slots(int k, std::vector<std::uint8_t>& keep) const;
   [[nodiscard]] CutTetSlots slots(int k) {
     const auto begin = m_slot_begin[static_cast<std::size_t>(k)];
     return std::span<int>(m_slots).subspan(begin, m_slot_begin[static_cast<std::size_t>(k) + 1] - begin);
