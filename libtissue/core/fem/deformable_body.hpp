@@ -10,6 +10,7 @@
 // the cut must be free to move.
 #pragma once
 
+#include "core/fem/body_parts.hpp"
 #include "core/fem/corotational.hpp"
 #include "core/fem/tet_cut.hpp"
 #include "core/fem/tet_pieces.hpp"
@@ -357,6 +358,12 @@ class DeformableBody final : public DynamicsModel {
   std::vector<int> m_cut_index;                 // per tet: index into cut_tets(), or -1
   std::vector<std::uint8_t> m_row_parked;       // per block row (shorter: the rest are not parked)
   int m_parked_rows = 0;
+  // park_parts_outside's parts, found again only after a cut changed the elements (parking does not
+  // change how they join): the union-find over the organ's 52k tets is milliseconds, and the look
+  // every 10 steps should not be.
+  BodyParts m_parts;
+  long m_element_revision = 0;  // counts enrichments
+  long m_parts_revision = -1;   // m_element_revision when m_parts was found
 
   std::vector<ForceTerm*> m_force_terms;                // attached, not owned
   WorkTeam* m_team = nullptr;                           // lent for a step (lend_work_team)

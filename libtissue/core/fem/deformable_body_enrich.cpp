@@ -171,6 +171,7 @@ EnrichmentResult DeformableBody::enrich_pieces(std::span<const TetCut> cuts,
   check_cuts(cuts);
   EnrichBatch batch;
   plan_cuts(cuts, batch);
+  ++m_element_revision;
 
   // The ghosts, vertex by vertex around the batch's tets.
   std::vector<int> vertices;

@@ -1,17 +1,17 @@
 // The bodies a cut body consists of, found from its elements alone (for tests that judge a cut by
-// what falls): the rows each uncut tet and each live cut-tet piece use (a real vertex's u or a
-// ghost's c) joined into connected components. A component that holds a fixed vertex is held; its
-// mass is computed from the geometry (rho V of its uncut tets, rho w_p V of its pieces), not from the
-// body's lumped masses, so that a test can compare the two.
+// what falls): the core's parts (core/fem/body_parts.hpp: the rows each uncut tet and each live
+// cut-tet piece use, joined; a part that holds a fixed vertex is held), each with its mass computed
+// from the geometry (rho V of its uncut tets, rho w_p V of its pieces), not from the body's lumped
+// masses, so that a test can compare the two.
 #pragma once
 
+#include "core/fem/body_parts.hpp"
 #include "core/fem/deformable_body.hpp"
 
 #include <Eigen/Core>
 
 #include <algorithm>
 #include <array>
-#include <numeric>
 #include <vector>
 
 namespace tissue::xfem_test {
@@ -23,32 +23,32 @@ struct BodyPiece {
   double volume_m3 = 0.0;
 };
 
-/// The connected pieces of `body`, largest mass first.
+/// The connected pieces of `body` (the core's find_body_parts), largest mass first, each with its
+/// mass and volume summed from its elements' geometry.
 inline std::vector<BodyPiece> body_pieces(const DeformableBody& body) {
   const TetMesh& mesh = body.mesh();
-  const int rows = body.dof_count() / 3;
-  // Union-find over the rows, plus one node for "held" (index rows).
-  std::vector<int> parent(static_cast<size_t>(rows + 1));
-  std::iota(parent.begin(), parent.end(), 0);
-  const auto find = [&](int a) {
-    while (parent[static_cast<size_t>(a)] != a) a = parent[static_cast<size_t>(a)] = parent[static_cast<size_t>(parent[static_cast<size_t>(a)])];
-    return a;
-  };
-  const auto join = [&](int a, int b) { parent[static_cast<size_t>(find(a))] = find(b); };
-  const int held = rows;
-  std::vector<double> element_mass;
-  std::vector<double> element_volume;
-  std::vector<int> element_row;  // a row of each element (or `held`)
+  const BodyParts parts = find_body_parts(body);
+  std::vector<BodyPiece> pieces(static_cast<size_t>(parts.count()));
+  int held_piece = -1;
+  for (int p = 0; p < parts.count(); ++p) {
+    pieces[static_cast<size_t>(p)].held = parts.held[static_cast<size_t>(p)] != 0;
+    if (parts.held[static_cast<size_t>(p)] != 0) held_piece = p;
+  }
+  // An element's piece: that of any of its rows, else (fixed vertices only) the held one.
   const auto element = [&](const std::array<int, 4>& element_rows, double volume_m3, double density) {
-    int first = -1;
+    int piece = -1;
     for (const int row : element_rows) {
-      const int node = row < 0 ? held : row;
-      if (first < 0) first = node;
-      join(node, first);
+      if (row >= 0) piece = parts.part_of_row[static_cast<size_t>(row)];
     }
-    element_mass.push_back(density * volume_m3);
-    element_volume.push_back(volume_m3);
-    element_row.push_back(first);
+    if (piece < 0) {
+      if (held_piece < 0) {
+        held_piece = static_cast<int>(pieces.size());
+        pieces.emplace_back().held = true;
+      }
+      piece = held_piece;
+    }
+    pieces[static_cast<size_t>(piece)].mass_kg += density * volume_m3;
+    pieces[static_cast<size_t>(piece)].volume_m3 += volume_m3;
   };
   const auto density_of = [&](const TetRest& rest) {
     return body.materials()[static_cast<size_t>(rest.material)].density_kg_per_m3;
@@ -72,25 +72,9 @@ inline std::vector<BodyPiece> body_pieces(const DeformableBody& body) {
       element(element_rows, piece.weight * rest.volume_m3, density_of(rest));
     }
   }
-  std::vector<int> piece_of(static_cast<size_t>(rows + 1), -1);
-  std::vector<BodyPiece> pieces;
-  const auto piece_at = [&](int node) -> BodyPiece& {
-    const int root = find(node);
-    if (piece_of[static_cast<size_t>(root)] < 0) {
-      piece_of[static_cast<size_t>(root)] = static_cast<int>(pieces.size());
-      pieces.emplace_back();
-      pieces.back().held = find(held) == root;
-    }
-    return pieces[static_cast<size_t>(piece_of[static_cast<size_t>(root)])];
-  };
-  for (size_t e = 0; e < element_row.size(); ++e) {
-    BodyPiece& piece = piece_at(element_row[e]);
-    piece.mass_kg += element_mass[e];
-    piece.volume_m3 += element_volume[e];
-  }
-  for (int row = 0; row < rows; ++row) {
-    const int root = find(row);
-    if (piece_of[static_cast<size_t>(root)] >= 0) pieces[static_cast<size_t>(piece_of[static_cast<size_t>(root)])].rows.push_back(row);
+  for (size_t row = 0; row < parts.part_of_row.size(); ++row) {
+    const int part = parts.part_of_row[row];
+    if (part >= 0) pieces[static_cast<size_t>(part)].rows.push_back(static_cast<int>(row));
   }
   std::sort(pieces.begin(), pieces.end(), [](const BodyPiece& a, const BodyPiece& b) { return a.mass_kg > b.mass_kg; });
   return pieces;
