@@ -216,10 +216,10 @@ void Tissue::restore(const TissueSnapshot& snapshot) {
   if (!can_restore(snapshot)) {
     throw StateError("the state has other cuts than this instance; restore it into a fresh instance");
   }
-  if (!has_cuts_of(snapshot)) replay(snapshot);
   if (snapshot.steps_since_park_check < 0 || snapshot.steps_since_park_check >= PARK_CHECK_STEPS) {
     throw StateError("the state's steps since the last look for fallen parts are out of range");
   }
+  if (!has_cuts_of(snapshot)) replay(snapshot);
   // Check everything before changing anything.
   const Eigen::Index dofs = m_body.dof_count();
   const DynamicState& dynamics = snapshot.dynamics;

@@ -2,6 +2,7 @@
 #include "core/fem/body_parts.hpp"
 
 #include "core/fem/deformable_body.hpp"
+#include "core/fem/union_find.hpp"
 
 #include <array>
 #include <numeric>
@@ -17,12 +18,7 @@ class RowUnion {
     std::iota(m_parent.begin(), m_parent.end(), 0);
   }
   [[nodiscard]] int held_root() const { return m_held; }
-  int root(int i) {
-    if (i < 0) i = m_held;
-    while (m_parent[static_cast<size_t>(i)] != i)
-      i = m_parent[static_cast<size_t>(i)] = m_parent[static_cast<size_t>(m_parent[static_cast<size_t>(i)])];
-    return i;
-  }
+  int root(int i) { return find_root(m_parent, i < 0 ? m_held : i); }
   void join(const std::array<int, 4>& rows) {
     for (size_t j = 1; j < 4; ++j) unite(rows[0], rows[j]);
   }
@@ -62,15 +58,7 @@ BodyParts find_body_parts(const DeformableBody& body) {
   const XfemElasticity& xfem = body.xfem();
   for (int k = 0; k < xfem.cut_tet_count(); ++k) {
     if (xfem.retired(k)) continue;
-    const Tet& vertices = xfem.cut_tets()[static_cast<size_t>(k)].vertices;
-    for (size_t p = 0; p < xfem.piece_count(k); ++p) {
-      const CutPiece& piece = xfem.piece(k, static_cast<int>(p));
-      std::array<int, 4> element_rows{};
-      for (size_t j = 0; j < 4; ++j) {
-        element_rows[j] = piece.ghost_row[j] >= 0 ? piece.ghost_row[j] : vertex_row[static_cast<size_t>(vertices[j])];
-      }
-      join(element_rows);
-    }
+    for (int p = 0; p < static_cast<int>(xfem.piece_count(k)); ++p) join(body.piece_rows(k, p));
   }
   BodyParts result;
   result.part_of_row.assign(static_cast<size_t>(rows), -1);

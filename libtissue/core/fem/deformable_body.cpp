@@ -452,6 +452,14 @@ TetPositions DeformableBody::piece_positions(const Eigen::VectorXd& displacement
   return tissue::piece_positions(m_xfem.piece(cut_tet_index, piece), real_m, cut_tet.rest_m, displacement_m);
 }
 
+std::array<int, 4> DeformableBody::piece_rows(int cut_tet_index, int piece) const {
+  const CutPiece& of = m_xfem.piece(cut_tet_index, piece);
+  const Tet& vertices = m_xfem.cut_tets()[static_cast<size_t>(cut_tet_index)].vertices;
+  std::array<int, 4> rows{};
+  for (size_t j = 0; j < 4; ++j) rows[j] = of.ghost_row[j] >= 0 ? of.ghost_row[j] : vertex_block_row(vertices[j]);
+  return rows;
+}
+
 double DeformableBody::piece_mass_kg(int cut_tet_index, int piece) const {
   return density_kg_per_m3(m_xfem.rest(cut_tet_index)) * m_xfem.piece(cut_tet_index, piece).weight *
          m_xfem.rest(cut_tet_index).volume_m3;

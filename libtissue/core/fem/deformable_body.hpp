@@ -225,6 +225,8 @@ class DeformableBody final : public DynamicsModel {
   /// Positions of the 4 vertices of piece `piece` of cut tet `cut_tet_index` (index into cut_tets()):
   /// the real vertices in the piece, the ghost copies elsewhere. [m]
   [[nodiscard]] TetPositions piece_positions(const Eigen::VectorXd& displacement_m, int cut_tet_index, int piece) const;
+  /// The block rows of a piece's four nodes: its ghost's, or the vertex's own (-1: a fixed vertex).
+  [[nodiscard]] std::array<int, 4> piece_rows(int cut_tet_index, int piece) const;
   /// Rest mass of a piece, rho w_p V. [kg]
   [[nodiscard]] double piece_mass_kg(int cut_tet_index, int piece) const;
   /// The same for a tet cut once: part a is piece 0, part b piece 1 (p_j = x_j, or the ghost X_j + c_j).

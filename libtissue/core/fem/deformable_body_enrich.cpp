@@ -122,12 +122,12 @@ void DeformableBody::add_piece_loads(int k, double sign) {
   const int u_rows = m_dofs.free_vertex_count();
   const double mass_kg = tet_mass_kg(m_xfem.rest(k));
   const double alpha_per_s = mass_damping_per_s(m_xfem.rest(k));
-  const Tet& vertices = m_xfem.cut_tets()[static_cast<size_t>(k)].vertices;
   for (size_t p = 0; p < m_xfem.piece_count(k); ++p) {
     const CutPiece& piece = m_xfem.piece(k, static_cast<int>(p));
     const double quarter_mass_kg = 0.25 * piece.weight * mass_kg;
+    const std::array<int, 4> rows = piece_rows(k, static_cast<int>(p));
     for (size_t j = 0; j < 4; ++j) {
-      const int row = piece.ghost_row[j] >= 0 ? piece.ghost_row[j] : vertex_block_row(vertices[j]);
+      const int row = rows[j];
       if (row < 0) continue;  // a fixed vertex
       add_row_load(row, sign * quarter_mass_kg, alpha_per_s);
       if (piece.ghost_row[j] >= 0) m_ghost_users[static_cast<size_t>(row - u_rows)] += sign > 0.0 ? 1 : -1;

@@ -2,6 +2,7 @@
 // copies, Molino et al. 2004): around each vertex, the pieces that the same cuts separate from it and
 // that touch across faces share one.
 #include "core/fem/deformable_body.hpp"
+#include "core/fem/union_find.hpp"
 
 #include "core/fem/deformable_body_enrich.hpp"
 
@@ -15,13 +16,6 @@
 
 namespace tissue {
 namespace {
-
-// The root of element i of a union-find, halving its path.
-int find_root(std::vector<int>& parent_of, int i) {
-  while (parent_of[static_cast<size_t>(i)] != i)
-    i = parent_of[static_cast<size_t>(i)] = parent_of[static_cast<size_t>(parent_of[static_cast<size_t>(i)])];
-  return i;
-}
 
 // The cuts of `geometry` that separate piece q from its local vertex j, as (cut id, H of the
 // vertex) sorted by cut id; none when j lies in the piece.

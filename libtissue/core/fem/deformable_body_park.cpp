@@ -81,14 +81,9 @@ void DeformableBody::park_rows(std::span<const int> rows) {
   }
   for (int k = 0; k < m_xfem.cut_tet_count(); ++k) {
     if (m_xfem.retired(k)) continue;
-    const Tet& vertices = m_xfem.cut_tets()[static_cast<size_t>(k)].vertices;
     for (int p = 0; p < static_cast<int>(m_xfem.piece_count(k)); ++p) {
-      const CutPiece& piece = m_xfem.piece(k, p);
-      bool all = true;
-      for (size_t j = 0; j < 4 && all; ++j) {
-        all = parked(piece.ghost_row[j] >= 0 ? piece.ghost_row[j] : vertex_block_row(vertices[j]));
-      }
-      if (all) m_xfem.park(k, p);
+      const std::array<int, 4> rows_of_piece = piece_rows(k, p);
+      if (std::all_of(rows_of_piece.begin(), rows_of_piece.end(), [&](int row) { return parked(row); })) m_xfem.park(k, p);
     }
   }
   drop_retired_blocks();

@@ -61,15 +61,9 @@ inline std::vector<BodyPiece> body_pieces(const DeformableBody& body) {
   }
   for (int k = 0; k < body.xfem().cut_tet_count(); ++k) {
     if (body.xfem().retired(k)) continue;
-    const Tet& vertices = body.xfem().cut_tets()[static_cast<size_t>(k)].vertices;
     for (int p = 0; p < static_cast<int>(body.xfem().piece_count(k)); ++p) {
-      const CutPiece& piece = body.xfem().piece(k, p);
-      std::array<int, 4> element_rows{};
-      for (size_t j = 0; j < 4; ++j) {
-        element_rows[j] = piece.ghost_row[j] >= 0 ? piece.ghost_row[j] : body.dofs().vertex_row[static_cast<size_t>(vertices[j])];
-      }
       const TetRest& rest = body.xfem().rest(k);
-      element(element_rows, piece.weight * rest.volume_m3, density_of(rest));
+      element(body.piece_rows(k, p), body.xfem().piece(k, p).weight * rest.volume_m3, density_of(rest));
     }
   }
   for (size_t row = 0; row < parts.part_of_row.size(); ++row) {
