@@ -1,5 +1,6 @@
 #!/usr/bin/python3
-"""Builds the organ-scale specimen (issue 23): a liver-sized organ of about 50k tets.
+"""Builds the organ-scale specimens (issues 23, 42): a liver-sized organ as a 52k-tet reference, as the
+6k-tet physics mesh of the real-time scenes, and its fine render surface.
 
     /usr/bin/python3 meshes/make_liver.py [--gmsh gmsh]
 
@@ -9,12 +10,15 @@ with a ridge on its back, the "ligament": the vertices of that ridge (the slab o
 LIGAMENT_FRACTION of its extent from the minimum y, `fixedRegion.axis = 1`) are the fixed region,
 as the coronary ligament and the bare area hold a liver to the diaphragm. The script writes the
 mapped sphere as an STL (a fine triangulation of the smooth shape), lets Gmsh re-mesh that
-surface and fill it with tets of at most MESH_SIZE_M (liver.geo), checks the result (every tet
-positive, one closed surface, the tet count within 15% of TARGET_TETS, the ligament slab holding
-only ridge vertices), renumbers the vertices and tets for locality and writes meshes/liver.veg and the ligament's vertices as
-meshes/liver.bou (Vega's fixed-vertex list, 1-based, for side-by-side runs). Gmsh 4.8.4 (single thread, fixed seed) wrote
-the committed files; the script reuses make_frog.py's reader and checks. Frame: x from the right
-lobe to the left, y from back to front, z up; metres.
+surface and fill it with tets (VARIANTS: liver.geo, at most 4.6 mm; liver_coarse.geo, at most 14 mm
+and graded by the surface's curvature), checks each result (every tet positive, one closed surface,
+the tet count within 15% of its target, the ligament slab holding only ridge vertices), renumbers
+the vertices and tets for locality and writes meshes/NAME.veg and the ligament's vertices as
+meshes/NAME.bou (Vega's fixed-vertex list, 1-based, for side-by-side runs). The render surface
+meshes/liver_surface.obj is the shape itself, the map of a finer icosphere (81 920 triangles,
+outward, closed). Gmsh 4.8.4 (single thread, fixed seed) wrote the committed files; the script
+reuses make_frog.py's reader, checks and writers. Frame: x from the right lobe to the left, y from
+back to front, z up; metres.
 """
 
 import argparse
@@ -24,12 +28,30 @@ import subprocess
 import sys
 
 from make_bar import signed_volume
-from make_frog import GMSH_OPTIONS, check, read_msh41, write_veg
+from make_frog import GMSH_OPTIONS, check, oriented_surface, read_msh41, write_obj, write_veg
 
-TARGET_TETS = 50000
 TOLERANCE = 0.15
-MESH_SIZE_M = 0.0046  # largest tet edge: lands near TARGET_TETS
 SPHERE_LEVEL = 5  # icosphere subdivisions of the shape's STL (20480 triangles)
+RENDER_LEVEL = 6  # the render surface: the shape itself at 6 subdivisions (81920 triangles)
+MIN_RENDER_TRIANGLES = 50000
+
+
+class Variant:
+    """A committed tet mesh of the organ: its name (name.veg, name.bou, name.geo), largest tet edge,
+    Gmsh's curvature sizing (elements per 2 pi of radius; 0: none) and the tet count it must land near."""
+
+    def __init__(self, name, mesh_size_m, curvature, target_tets):
+        self.name, self.mesh_size_m, self.curvature, self.target_tets = name, mesh_size_m, curvature, target_tets
+
+
+# The 52k-tet reference (issue 23), uniform; and the physics mesh of the real-time scenes (issue 42):
+# coarse where the organ is thick, graded by the surface's curvature so that the thin left lobe and
+# the rims keep several tets across (and the render surface lies within a quarter of a mean edge of
+# the tets, as the embedding requires).
+REFERENCE = Variant("liver", 0.0046, 0, 50000)
+COARSE = Variant("liver_coarse", 0.014, 12, 6000)
+VARIANTS = (REFERENCE, COARSE)
+MESH_SIZE_M = REFERENCE.mesh_size_m
 
 HALF_LENGTH_M = 0.11  # x: right lobe tip to left lobe tip, 22 cm
 HALF_DEPTH_M = 0.075  # y: back to front at mid length
@@ -103,11 +125,13 @@ def write_stl(path, points, faces):
         out.write("\n".join(lines) + "\n")
 
 
-def geo_text(stl_name, mesh_size_m):
+def geo_text(stl_name, mesh_size_m, curvature=0):
+    options = [o.replace("Mesh.MeshSizeFromCurvature = 0;", "Mesh.MeshSizeFromCurvature = %d;" % curvature)
+               for o in GMSH_OPTIONS]
     return "\n".join([
         "// Liver-sized organ, written by meshes/make_liver.py: edit the script, not this file.",
         "// The smooth shape comes as an STL (%s, written by the script); Gmsh re-meshes it." % stl_name,
-        *GMSH_OPTIONS,
+        *options,
         "Mesh.MeshSizeMin = 0;",
         "Mesh.MeshSizeMax = %r;" % mesh_size_m,
         "Mesh.ElementOrder = 1;",
@@ -154,29 +178,19 @@ def renumbered_for_locality(coords, tets):
     return [coords[v] for v in order], tets
 
 
-def main():
-    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    parser.add_argument("--gmsh", default="gmsh", help="the gmsh executable (4.8.4 made the committed files)")
-    parser.add_argument("--mesh-size", type=float, default=MESH_SIZE_M,
-                        help="largest tet edge [m]; another size than the default skips the tet-count target "
-                             "(the scaling benchmark's sizes)")
-    parser.add_argument("--output-dir", default=None, help="where liver.veg and liver.bou go (default: meshes/)")
-    args = parser.parse_args()
-
-    here = os.path.dirname(os.path.abspath(__file__))
-    out_dir = os.path.abspath(args.output_dir) if args.output_dir else here
-    committed = args.mesh_size == MESH_SIZE_M and out_dir == here
+def build(args, here, out_dir, name, mesh_size_m, curvature, target_tets):
+    """Meshes the shape into out_dir/name.veg and name.bou; target_tets None: no count check."""
     stl_name = "liver_shape.stl"  # temporary: removed after meshing
     points, faces = icosphere(SPHERE_LEVEL)
     write_stl(os.path.join(here, stl_name), [liver_point(*p) for p in points], faces)
-    geo_name = "liver.geo" if committed else "liver_size_tmp.geo"
+    geo_name = name + ".geo" if target_tets is not None else "liver_size_tmp.geo"
     with open(os.path.join(here, geo_name), "w", newline="\n") as out:
-        out.write(geo_text(stl_name, args.mesh_size))
+        out.write(geo_text(stl_name, mesh_size_m, curvature))
     tmp = os.path.join(here, "liver.msh.tmp")
     result = subprocess.run([args.gmsh, geo_name, "-3", "-nt", "1", "-format", "msh41", "-o",
                              os.path.basename(tmp)], cwd=here, capture_output=True, text=True)
     os.remove(os.path.join(here, stl_name))
-    if not committed:
+    if target_tets is None:
         os.remove(os.path.join(here, geo_name))
     if result.returncode != 0 or not os.path.exists(tmp):
         sys.stderr.write(result.stdout + result.stderr)
@@ -192,9 +206,9 @@ def main():
     tets = [tuple(renumber[v] for v in tet) for tet in tets]
     coords, tets = renumbered_for_locality(coords, tets)
     problems, (lower, upper) = check(coords, tets, 1)
-    if committed and abs(len(tets) - TARGET_TETS) > TOLERANCE * TARGET_TETS:
-        problems.append("%d tets, target %d within %d%%: tune MESH_SIZE_M" % (len(tets), TARGET_TETS,
-                                                                           round(100 * TOLERANCE)))
+    if target_tets is not None and abs(len(tets) - target_tets) > TOLERANCE * target_tets:
+        problems.append("%d tets, target %d within %d%%: tune the variant's mesh size" % (len(tets), target_tets,
+                                                                                      round(100 * TOLERANCE)))
     # The fixed slab must hold the ridge and nothing else: its vertices lie within the ridge's width.
     slab_top = lower[1] + LIGAMENT_FRACTION * (upper[1] - lower[1])
     fixed_ids = [n for n, c in enumerate(coords) if c[1] <= slab_top]
@@ -204,19 +218,55 @@ def main():
         problems.append("the ligament slab holds %d vertices, not only the ridge's: tune RIDGE_M or "
                         "LIGAMENT_FRACTION" % len(fixed))
     if problems:
-        sys.exit("liver mesh refused:\n  " + "\n  ".join(problems))
+        sys.exit("liver mesh %s refused:\n  " % name + "\n  ".join(problems))
 
     size = [upper[n] - lower[n] for n in range(3)]
     volume_l = 1e3 * sum(signed_volume(*(coords[v] for v in tet)) for tet in tets)
     comment = ("liver-sized organ by meshes/make_liver.py (%.3f x %.3f x %.3f m, %.2f l); fixed region: "
                "fixedRegion.axis = 1, fixedRegion.fraction = %g (%d vertices, the ligament ridge)"
                % (size[0], size[1], size[2], volume_l, LIGAMENT_FRACTION, len(fixed)))
-    write_veg(os.path.join(out_dir, "liver.veg"), coords, tets, comment)
-    with open(os.path.join(out_dir, "liver.bou"), "w", newline="\n") as out:  # the same vertices, for Vega
+    write_veg(os.path.join(out_dir, name + ".veg"), coords, tets, comment)
+    with open(os.path.join(out_dir, name + ".bou"), "w", newline="\n") as out:  # the same vertices, for Vega
         ids = [str(n + 1) for n in fixed_ids]
         out.write("".join(",".join(ids[k:k + 8]) + ",\n" for k in range(0, len(ids), 8)))
-    print("liver: %d vertices, %d tets, %.3f x %.3f x %.3f m, %.2f l, %d ligament vertices"
-          % ((len(coords), len(tets)) + tuple(size) + (volume_l, len(fixed))))
+    print("%s: %d vertices, %d tets, %.3f x %.3f x %.3f m, %.2f l, %d ligament vertices"
+          % ((name, len(coords), len(tets)) + tuple(size) + (volume_l, len(fixed))))
+
+
+def write_render_surface(out_dir):
+    """The organ's own shape, finely: the mapped icosphere at RENDER_LEVEL, wound outward."""
+    points, faces = icosphere(RENDER_LEVEL)
+    coords = [tuple(round(c, 6) for c in liver_point(*p)) for p in points]
+    triangles, problems = oriented_surface(coords, [tuple(f) for f in faces])
+    if len(triangles) < MIN_RENDER_TRIANGLES:
+        problems.append("%d triangles, fewer than %d" % (len(triangles), MIN_RENDER_TRIANGLES))
+    if problems:
+        sys.exit("liver render surface refused:\n  " + "\n  ".join(problems))
+    write_obj(os.path.join(out_dir, "liver_surface.obj"), coords, triangles,
+              "liver render surface by meshes/make_liver.py: the shape's map of an icosphere of %d subdivisions"
+              % RENDER_LEVEL)
+    print("liver render surface: %d triangles" % len(triangles))
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("--gmsh", default="gmsh", help="the gmsh executable (4.8.4 made the committed files)")
+    parser.add_argument("--mesh-size", type=float, default=None,
+                        help="largest tet edge [m]: one mesh of that size (the scaling benchmark's sizes), "
+                             "named liver, without the tet-count target")
+    parser.add_argument("--curvature", type=int, default=0,
+                        help="with --mesh-size: Gmsh's curvature sizing, elements per 2 pi of radius (0: none)")
+    parser.add_argument("--output-dir", default=None, help="where the files go (default: meshes/)")
+    args = parser.parse_args()
+
+    here = os.path.dirname(os.path.abspath(__file__))
+    out_dir = os.path.abspath(args.output_dir) if args.output_dir else here
+    if args.mesh_size is not None:
+        build(args, here, out_dir, "liver", args.mesh_size, args.curvature, None)
+        return 0
+    for variant in VARIANTS:
+        build(args, here, out_dir, variant.name, variant.mesh_size_m, variant.curvature, variant.target_tets)
+    write_render_surface(out_dir)
     return 0
 
 

@@ -204,7 +204,7 @@ std::string region_materials_text(const Reader& r, const toml::table& regions) {
 // [tissue] (optional): the FMU, the communication step, the parameters and a mesh file.
 void read_tissue(const Reader& r, const toml::table& root, const std::filesystem::path& base, Scenario& s) {
   if (const toml::table* tissue = root["tissue"].as_table()) {
-    r.only(*tissue, "tissue", {"fmu", "communication_step", "mesh", "parameters", "regions"});
+    r.only(*tissue, "tissue", {"fmu", "communication_step", "mesh", "render_surface", "parameters", "regions"});
     if (const toml::node* n = tissue->get("fmu")) s.tissue_fmu = relative_to(base, r.string(*n, "tissue.fmu"));
     if (const toml::node* n = tissue->get("communication_step")) {
       s.tissue_step_s = r.positive(*n, "tissue.communication_step");
@@ -225,6 +225,17 @@ void read_tissue(const Reader& r, const toml::table& root, const std::filesystem
       if (!std::filesystem::exists(mesh)) r.fail("tissue.mesh", "no file " + mesh.string());
       s.tissue_parameters.insert(s.tissue_parameters.begin(),
                                  ParameterSetting{"mesh", std::filesystem::absolute(mesh).lexically_normal().string()});
+    }
+    if (const toml::node* n = tissue->get("render_surface")) {
+      // A render surface file next to the scenario (an OBJ): the FMU is given its absolute path.
+      if (std::any_of(s.tissue_parameters.begin(), s.tissue_parameters.end(),
+                      [](const ParameterSetting& p) { return p.name == "surface.renderSurface"; })) {
+        r.fail("tissue.render_surface", "given twice: also as tissue.parameters.\"surface.renderSurface\"");
+      }
+      const std::filesystem::path surface = relative_to(base, r.string(*n, "tissue.render_surface"));
+      if (!std::filesystem::exists(surface)) r.fail("tissue.render_surface", "no file " + surface.string());
+      s.tissue_parameters.push_back(
+          ParameterSetting{"surface.renderSurface", std::filesystem::absolute(surface).lexically_normal().string()});
     }
   }
   // Unless the scenario says otherwise, one internal step per communication step: the frog's

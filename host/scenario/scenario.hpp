@@ -91,7 +91,8 @@ struct Scenario {
   // The tissue.
   std::filesystem::path tissue_fmu;  ///< "" = the Tissue.fmu built next to tissue-host
   double tissue_step_s = 0.01;       ///< communication step (one slot of the dynamics thread)
-  /// By name (tissue.parameters); `tissue.mesh = "file"` adds "mesh" with the file's absolute path,
+  /// By name (tissue.parameters); `tissue.mesh = "file"` adds "mesh" with the file's absolute path
+  /// (`tissue.render_surface = "file"` the same for "surface.renderSurface"),
   /// and "stepSize" is the communication step unless given.
   std::vector<ParameterSetting> tissue_parameters;
   // The haptic loop.

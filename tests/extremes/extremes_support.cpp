@@ -371,11 +371,15 @@ bool Run::step() {
   if (verbose()) {
     std::printf(
         "[extremes] %s step %d t %.6g: T+V %.6g J, bound %.6g J (tool %.6g J), internal steps %d, newton %d, "
-        "linear %ld, unknowns %d, cut tets %zu, contact %d, %.3g ms\n",
+        "linear %ld, unknowns %d, cut tets %zu, contact %d, %.3g ms (step %.3g: assembly %.3g, solve %.3g, guard "
+        "%.3g, cut %.3g, enrich %.3g, contact %.3g, positions %.3g)\n",
         m_name.c_str(), m_outcome.steps, tissue.time_s(), m_last_energy_j, m_last_bound_j, m_tool_work_j,
         report.dynamics.internal_steps, report.dynamics.newton_iterations, report.dynamics.linear_iterations,
         tissue.body().dof_count(), static_cast<size_t>(tissue.body().cut_tet_count()), tissue.contact().active ? 1 : 0,
-        1e3 * std::chrono::duration<double>(std::chrono::steady_clock::now() - step_start).count());
+        1e3 * std::chrono::duration<double>(std::chrono::steady_clock::now() - step_start).count(),
+        1e3 * report.total_s, 1e3 * report.dynamics.assembly_s, 1e3 * report.dynamics.solve_s,
+        1e3 * report.dynamics.guard_s, 1e3 * report.cut_s, 1e3 * report.enrich_s, 1e3 * report.contact_s,
+        1e3 * report.positions_s);
   }
   if (m_running &&
       std::chrono::duration<double>(std::chrono::steady_clock::now() - m_start).count() > case_budget_s()) {
