@@ -84,6 +84,7 @@ std::string SessionSummary::to_json() const {
   }
   j["frames_written"] = frames_written;
   j["frames_dropped"] = frames_dropped;
+  j["frames_deferred"] = frames_deferred;
   if (view) {
     j["view"] = {{"connections", view_connections}, {"frames_sent", view_frames_sent},
                  {"frames_skipped", view_frames_skipped}, {"messages", view_messages},

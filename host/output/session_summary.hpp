@@ -41,6 +41,8 @@ struct SessionSummary {
   DeviceCounters device;
   std::optional<HandFigures> hand;  ///< a simulated hand's motion (device kind "hand")
   std::uint64_t frames_written = 0, frames_dropped = 0;
+  /// Real time: due frames left to a later slot because the step left too little of its own (FrameBudget).
+  std::uint64_t frames_deferred = 0;
   bool view = false;
   std::uint64_t view_connections = 0, view_frames_sent = 0, view_frames_skipped = 0, view_messages = 0,
                 view_malformed = 0, view_oversized = 0, view_flood = 0, view_out_of_order = 0, view_withdrawals = 0;

@@ -1,6 +1,7 @@
 // run_realtime (see realtime_schedule.hpp).
 #include "schedule/realtime_schedule.hpp"
 
+#include "schedule/frame_budget.hpp"
 #include "sync/frame_pipe.hpp"
 #include "sync/realtime_clock.hpp"
 
@@ -95,6 +96,7 @@ void RealtimeScheduler::dynamics_thread(RealtimeRun& run, FramePipe& pipe) {
   run.go.wait(false, std::memory_order_acquire);  // blocked, not spinning: see run()
   const Nanoseconds slot = to_ns(m_schedule.slot_s);
   const std::uint64_t slots_total = m_schedule.slots();
+  FrameBudget frames;    // due frames captured in the time the steps leave over
   std::uint64_t k = 0;  // the slot this step starts in
   int slots = 1;        // slots this step covers
   double tissue_time_s = 0.0;
@@ -105,8 +107,13 @@ void RealtimeScheduler::dynamics_thread(RealtimeRun& run, FramePipe& pipe) {
     m_steps.publish_tissue_sample();
     m_steps.tissue_sample_published(tissue_time_s);
     if (m_steps.frame_due(tissue_time_s)) {
-      if (auto frame = pipe.take_free()) {
+      const Nanoseconds slot_end = run.start + static_cast<Nanoseconds>(k + static_cast<std::uint64_t>(slots)) * slot;
+      if (const Nanoseconds ended = now_ns(); !frames.capture_now(ended, slot_end)) {
+        frames.deferred();
+        ++m_summary.frames_deferred;
+      } else if (auto frame = pipe.take_free()) {
         m_steps.capture_frame(*frame, tissue_time_s);
+        frames.captured(now_ns() - ended);
         pipe.push_filled(std::move(frame));
       } else {
         ++m_summary.frames_dropped;

@@ -30,7 +30,7 @@ struct RealtimeOptions {
 /// (needed when steps.frame_due() can be true), finished at the end. Sets summary's timing fields:
 /// haptic_ticks (fewer when stopped), haptic_period_us, haptic_period_max_at_s,
 /// haptic_first_tick_late_us, deadline_misses, tissue_overruns, catch_up_slots, skipped_slots,
-/// sim_time_s, wall_time_s (from the first deadline), frames_written, frames_dropped and
+/// sim_time_s, wall_time_s (from the first deadline), frames_written, frames_dropped, frames_deferred and
 /// realtime_priority with its note.
 void run_realtime(SessionSteps& steps, const Schedule& schedule, const RealtimeOptions& options, FrameWriter* writer,
                   SessionSummary& summary);
