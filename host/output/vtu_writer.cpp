@@ -2,17 +2,18 @@
 #include "output/vtu_writer.hpp"
 
 #include <array>
+#include <bit>
 #include <charconv>
 #include <cstddef>
 #include <cstdint>
+#include <cstring>
 #include <string_view>
+#include <vector>
 
 namespace tissue::host {
 namespace {
 
 constexpr std::uint8_t VTK_TRIANGLE = 5;
-// Values per line of the long scalar arrays (offsets, types, cut_face).
-constexpr std::size_t VALUES_PER_LINE = 16;
 
 /// Appends the shortest decimal that reads back as @p value ("C" locale regardless of the global one).
 void append_number(std::string& out, double value) {
@@ -27,8 +28,46 @@ void append_number(std::string& out, std::uint64_t value) {
   out.append(buffer.data(), static_cast<std::size_t>(result.ptr - buffer.data()));
 }
 
+// VTK's "binary" DataArray (XML formats, version 0.1, header_type UInt32): base64 of the byte
+// count (UInt32, little-endian) followed by the values' own little-endian bytes. An organ's frame
+// (41k points, 82k triangles) is 3.5 MB this way against 6.4 MB of shortest decimals, and encodes
+// in a fraction of their time: the recording shares two cores with the dynamics (issue 42).
+constexpr std::string_view BASE64_DIGITS = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+
+void append_base64(std::string& out, const std::vector<std::uint8_t>& bytes) {
+  const std::size_t n = bytes.size();
+  const std::size_t start = out.size();
+  out.resize(start + 4 * ((n + 2) / 3));
+  char* digit = out.data() + start;
+  std::size_t i = 0;
+  for (; i + 3 <= n; i += 3) {
+    const std::uint32_t triple = (std::uint32_t{bytes[i]} << 16) | (std::uint32_t{bytes[i + 1]} << 8) | bytes[i + 2];
+    *digit++ = BASE64_DIGITS[(triple >> 18) & 63U];
+    *digit++ = BASE64_DIGITS[(triple >> 12) & 63U];
+    *digit++ = BASE64_DIGITS[(triple >> 6) & 63U];
+    *digit++ = BASE64_DIGITS[triple & 63U];
+  }
+  if (i < n) {
+    const std::uint32_t triple = (std::uint32_t{bytes[i]} << 16) | (i + 1 < n ? std::uint32_t{bytes[i + 1]} << 8 : 0U);
+    *digit++ = BASE64_DIGITS[(triple >> 18) & 63U];
+    *digit++ = BASE64_DIGITS[(triple >> 12) & 63U];
+    *digit++ = i + 1 < n ? BASE64_DIGITS[(triple >> 6) & 63U] : '=';
+    *digit = '=';
+  }
+}
+
+/// Appends @p value's bytes, little-endian (the host's order on every platform we build for,
+/// checked at compile time below).
+template <typename Value>
+void append_bytes(std::vector<std::uint8_t>& bytes, Value value) {
+  static_assert(std::endian::native == std::endian::little, "the VTU writer writes the host's bytes as LittleEndian");
+  std::array<std::uint8_t, sizeof(Value)> raw{};
+  std::memcpy(raw.data(), &value, sizeof(Value));
+  bytes.insert(bytes.end(), raw.begin(), raw.end());
+}
+
 void open_array(std::string& out, std::string_view indent, std::string_view type, std::string_view name,
-                std::size_t components, std::string_view extra = {}) {
+                std::size_t components, std::string_view extra = {}, std::string_view format = "ascii") {
   out += indent;
   out += "<DataArray type=\"";
   out += type;
@@ -41,7 +80,9 @@ void open_array(std::string& out, std::string_view indent, std::string_view type
     out += '"';
   }
   out += extra;
-  out += " format=\"ascii\">\n";
+  out += " format=\"";
+  out += format;
+  out += "\">\n";
 }
 
 void close_array(std::string& out, std::string_view indent) {
@@ -63,18 +104,20 @@ void field_array(std::string& out, std::string_view name, const double* values, 
   close_array(out, INDENT);
 }
 
-/// Writes value(i) for i < count, VALUES_PER_LINE to a line.
-template <typename Value>
-void scalar_lines(std::string& out, std::string_view indent, std::size_t count, Value value) {
-  for (std::size_t i = 0; i < count; ++i) {
-    if (i % VALUES_PER_LINE == 0) {
-      out += indent;
-    } else {
-      out += ' ';
-    }
-    append_number(out, std::uint64_t{value(i)});
-    if (i % VALUES_PER_LINE == VALUES_PER_LINE - 1 || i + 1 == count) out += '\n';
-  }
+/// A DataArray of value(i), i < count, in VTK's binary format (one base64 line).
+template <typename Stored, typename Value>
+void binary_array(std::string& out, std::string_view type, std::string_view name, std::size_t components,
+                  std::size_t count, Value value) {
+  constexpr std::string_view ARRAY_INDENT = "        ";
+  open_array(out, ARRAY_INDENT, type, name, components, {}, "binary");
+  std::vector<std::uint8_t> bytes;
+  bytes.reserve(sizeof(std::uint32_t) + count * sizeof(Stored));
+  append_bytes(bytes, static_cast<std::uint32_t>(count * sizeof(Stored)));
+  for (std::size_t i = 0; i < count; ++i) append_bytes(bytes, static_cast<Stored>(value(i)));
+  out += "          ";
+  append_base64(out, bytes);
+  out += '\n';
+  close_array(out, ARRAY_INDENT);
 }
 
 }  // namespace
@@ -85,8 +128,8 @@ std::string vtu_document(const SurfaceFrame& frame) {
   const std::size_t triangle_count = frame.triangle_count();
 
   std::string out;
-  // About 60 characters per vertex and 40 per triangle; a guess, not a bound.
-  out.reserve(1024 + 60 * vertex_count + 40 * triangle_count);
+  // Base64 of 24 bytes per vertex and 18 per triangle, a third more.
+  out.reserve(1024 + 32 * vertex_count + 24 * triangle_count);
   out += "<?xml version=\"1.0\"?>\n";
   out += "<VTKFile type=\"UnstructuredGrid\" version=\"0.1\" byte_order=\"LittleEndian\">\n";
   out += "  <UnstructuredGrid>\n";
@@ -112,47 +155,24 @@ std::string vtu_document(const SurfaceFrame& frame) {
   append_number(out, std::uint64_t{triangle_count});
   out += "\">\n";
 
-  constexpr std::string_view ARRAY_INDENT = "        ";
-  constexpr std::string_view VALUE_INDENT = "          ";
-
   out += "      <CellData Scalars=\"cut_face\">\n";
-  open_array(out, ARRAY_INDENT, "UInt8", "cut_face", 1);
-  scalar_lines(out, VALUE_INDENT, triangle_count,
-               [&frame](std::size_t t) { return t < frame.mesh_triangle_count ? 0U : 1U; });
-  close_array(out, ARRAY_INDENT);
+  binary_array<std::uint8_t>(out, "UInt8", "cut_face", 1, triangle_count,
+                             [&frame](std::size_t t) { return t < frame.mesh_triangle_count ? 0U : 1U; });
   out += "      </CellData>\n";
 
   out += "      <Points>\n";
-  open_array(out, ARRAY_INDENT, "Float64", "Points", 3);
-  for (std::size_t v = 0; v < vertex_count; ++v) {
-    out += VALUE_INDENT;
-    for (std::size_t c = 0; c < 3; ++c) {
-      if (c != 0) out += ' ';
-      append_number(out, frame.positions_m[3 * v + c]);
-    }
-    out += '\n';
-  }
-  close_array(out, ARRAY_INDENT);
+  binary_array<double>(out, "Float64", "Points", 3, 3 * vertex_count,
+                       [&frame](std::size_t i) { return frame.positions_m[i]; });
   out += "      </Points>\n";
 
+  // Int32 indices: a frame's points number far below 2^31 (validate_surface_frame checks the
+  // triangles' corners against the points). VTK's offsets are where each cell's connectivity ends.
   out += "      <Cells>\n";
-  open_array(out, ARRAY_INDENT, "Int64", "connectivity", 1);
-  for (std::size_t t = 0; t < triangle_count; ++t) {
-    out += VALUE_INDENT;
-    for (std::size_t c = 0; c < 3; ++c) {
-      if (c != 0) out += ' ';
-      append_number(out, std::uint64_t{frame.triangles[3 * t + c]});
-    }
-    out += '\n';
-  }
-  close_array(out, ARRAY_INDENT);
-  // VTK's offsets are where each cell's connectivity ends.
-  open_array(out, ARRAY_INDENT, "Int64", "offsets", 1);
-  scalar_lines(out, VALUE_INDENT, triangle_count, [](std::size_t t) { return std::uint64_t{3 * (t + 1)}; });
-  close_array(out, ARRAY_INDENT);
-  open_array(out, ARRAY_INDENT, "UInt8", "types", 1);
-  scalar_lines(out, VALUE_INDENT, triangle_count, [](std::size_t) { return VTK_TRIANGLE; });
-  close_array(out, ARRAY_INDENT);
+  binary_array<std::int32_t>(out, "Int32", "connectivity", 1, 3 * triangle_count,
+                             [&frame](std::size_t i) { return frame.triangles[i]; });
+  binary_array<std::int32_t>(out, "Int32", "offsets", 1, triangle_count,
+                             [](std::size_t t) { return 3 * (t + 1); });
+  binary_array<std::uint8_t>(out, "UInt8", "types", 1, triangle_count, [](std::size_t) { return VTK_TRIANGLE; });
   out += "      </Cells>\n";
 
   out += "    </Piece>\n";

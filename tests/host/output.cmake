@@ -15,4 +15,5 @@ add_executable(test_host_output ${CMAKE_CURRENT_LIST_DIR}/test_output.cpp)
 find_package(nlohmann_json REQUIRED)
 target_link_libraries(test_host_output PRIVATE tissue::host_output PNG::PNG ${TISSUE_OUTPUT_TEST_PUGIXML} nlohmann_json::nlohmann_json
                                                GTest::gtest GTest::gtest_main tissue::warnings)
+target_include_directories(test_host_output PRIVATE ${PROJECT_SOURCE_DIR}/tests)  # host/vtu_read.hpp
 gtest_discover_tests(test_host_output PROPERTIES LABELS "host" DISCOVERY_TIMEOUT 60)

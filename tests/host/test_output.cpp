@@ -6,6 +6,7 @@
 #include "output/session_summary.hpp"
 #include "output/surface_frame.hpp"
 #include "output/vtu_writer.hpp"
+#include "host/vtu_read.hpp"
 
 #include <png.h>
 #include <pugixml.hpp>
@@ -58,20 +59,6 @@ class TempDir {
 std::string read_bytes(const std::filesystem::path& path) {
   std::ifstream in(path, std::ios::binary);
   return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-}
-
-/// The whitespace-separated tokens of @p text.
-std::vector<std::string> tokens(const char* text) {
-  std::istringstream in(text);
-  std::vector<std::string> out;
-  for (std::string token; in >> token;) out.push_back(token);
-  return out;
-}
-
-std::vector<double> numbers(const char* text) {
-  std::vector<double> out;
-  for (const std::string& token : tokens(text)) out.push_back(std::strtod(token.c_str(), nullptr));
-  return out;
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -128,6 +115,11 @@ pugi::xml_node data_array(const pugi::xml_node& parent, const char* name) {
   return parent.find_child_by_attribute("DataArray", "Name", name);
 }
 
+/// The values of a DataArray node, in whichever format it is written (vtu_read.hpp).
+std::vector<double> values(const pugi::xml_node& array) {
+  return vtu_read::data_array_values(array.attribute("type").value(), array.attribute("format").value(), array.child_value());
+}
+
 // summary.json parses back to the summary's own values: text with quotes, backslashes, control
 // characters and bytes that are not UTF-8 (a device's name, an error from a library), numbers at
 // full precision, and null for the figures of a hand that never settled (NaN).
@@ -177,25 +169,26 @@ TEST(VtuWriter, TetrahedronWithCutFaceParsesBack) {
   const pugi::xml_node points = data_array(piece.child("Points"), "Points");
   EXPECT_STREQ(points.attribute("type").value(), "Float64");
   EXPECT_EQ(points.attribute("NumberOfComponents").as_int(), 3);
-  const std::vector<double> xyz = numbers(points.child_value());
+  EXPECT_STREQ(points.attribute("format").value(), "binary");  // exact values, a third the text of decimals
+  const std::vector<double> xyz = values(points);
   ASSERT_EQ(xyz.size(), frame.positions_m.size());
   for (std::size_t i = 0; i < xyz.size(); ++i) EXPECT_EQ(xyz[i], frame.positions_m[i]) << "coordinate " << i;
 
   const pugi::xml_node cells = piece.child("Cells");
-  const std::vector<double> connectivity = numbers(data_array(cells, "connectivity").child_value());
+  const std::vector<double> connectivity = values(data_array(cells, "connectivity"));
   ASSERT_EQ(connectivity.size(), frame.triangles.size());
   for (std::size_t i = 0; i < connectivity.size(); ++i) EXPECT_EQ(connectivity[i], frame.triangles[i]);
-  EXPECT_EQ(numbers(data_array(cells, "offsets").child_value()), (std::vector<double>{3, 6, 9, 12, 15}));
+  EXPECT_EQ(values(data_array(cells, "offsets")), (std::vector<double>{3, 6, 9, 12, 15}));
   const pugi::xml_node types = data_array(cells, "types");
   EXPECT_STREQ(types.attribute("type").value(), "UInt8");
-  EXPECT_EQ(numbers(types.child_value()), (std::vector<double>{5, 5, 5, 5, 5}));  // VTK_TRIANGLE
+  EXPECT_EQ(values(types), (std::vector<double>{5, 5, 5, 5, 5}));  // VTK_TRIANGLE
 
   const pugi::xml_node cell_data = piece.child("CellData");
   EXPECT_STREQ(cell_data.attribute("Scalars").value(), "cut_face");
-  EXPECT_EQ(numbers(data_array(cell_data, "cut_face").child_value()), (std::vector<double>{0, 0, 0, 0, 1}));
+  EXPECT_EQ(values(data_array(cell_data, "cut_face")), (std::vector<double>{0, 0, 0, 0, 1}));
 
   const pugi::xml_node time = data_array(grid.child("FieldData"), "TimeValue");
-  EXPECT_EQ(numbers(time.child_value()), std::vector<double>{0.125});
+  EXPECT_EQ(values(time), std::vector<double>{0.125});
   EXPECT_FALSE(data_array(grid.child("FieldData"), "tool_tip_m"));
   EXPECT_FALSE(data_array(grid.child("FieldData"), "force_n"));
 }
@@ -227,11 +220,11 @@ TEST(VtuWriter, ToolAndContactGoToFieldData) {
   const std::string text = vtu_document(frame);
   ASSERT_TRUE(doc.load_string(text.c_str()));
   const pugi::xml_node field = doc.child("VTKFile").child("UnstructuredGrid").child("FieldData");
-  EXPECT_EQ(numbers(data_array(field, "tool_tip_m").child_value()), (std::vector<double>{0.01, 0.02, 0.03}));
-  EXPECT_EQ(numbers(data_array(field, "tool_handle_m").child_value()), (std::vector<double>{0.01, 0.02, 0.13}));
-  EXPECT_EQ(numbers(data_array(field, "tool_mode").child_value()), std::vector<double>{2});
-  EXPECT_EQ(numbers(data_array(field, "contact_point_m").child_value()), (std::vector<double>{0.01, 0.02, 0.025}));
-  EXPECT_EQ(numbers(data_array(field, "force_n").child_value()), (std::vector<double>{0.0, -0.5, 1.25}));
+  EXPECT_EQ(values(data_array(field, "tool_tip_m")), (std::vector<double>{0.01, 0.02, 0.03}));
+  EXPECT_EQ(values(data_array(field, "tool_handle_m")), (std::vector<double>{0.01, 0.02, 0.13}));
+  EXPECT_EQ(values(data_array(field, "tool_mode")), std::vector<double>{2});
+  EXPECT_EQ(values(data_array(field, "contact_point_m")), (std::vector<double>{0.01, 0.02, 0.025}));
+  EXPECT_EQ(values(data_array(field, "force_n")), (std::vector<double>{0.0, -0.5, 1.25}));
   EXPECT_EQ(data_array(field, "force_n").attribute("NumberOfComponents").as_int(), 3);
 }
 

@@ -8,6 +8,7 @@
 // * scenario files with mistakes are refused naming the key.
 #include "scenario/scenario.hpp"
 #include "session/session.hpp"
+#include "host/vtu_read.hpp"
 #include "support/under_sanitizer.hpp"
 
 #include <gtest/gtest.h>
@@ -133,11 +134,17 @@ INSTANTIATE_TEST_SUITE_P(HostScenarios, EveryScenario,
 // The triangles of a VTU frame (the host's ASCII cells).
 std::vector<std::uint32_t> vtu_triangles(const std::filesystem::path& file) {
   const std::string text = contents(file);
-  const std::size_t at = text.find("Name=\"connectivity\"");
-  std::istringstream numbers(text.substr(text.find('>', at) + 1));
-  std::vector<std::uint32_t> triangles;
-  for (std::uint32_t v = 0; numbers >> v;) triangles.push_back(v);
-  return triangles;
+  const std::size_t name = text.find("Name=\"connectivity\"");
+  const std::size_t open = text.rfind("<DataArray", name);
+  const std::size_t body = text.find('>', name) + 1;
+  const std::string tag = text.substr(open, body - open);
+  const auto attribute = [&](const std::string& key) {
+    const std::size_t at = tag.find(key + "=\"") + key.size() + 2;
+    return tag.substr(at, tag.find('"', at) - at);
+  };
+  const std::vector<double> values = vtu_read::data_array_values(
+      attribute("type"), attribute("format"), std::string_view(text).substr(body, text.find("</DataArray>", body) - body));
+  return {values.begin(), values.end()};
 }
 
 // Border edges (directed edges without their twin), directed edges used twice, and connected pieces
