@@ -154,6 +154,19 @@ void TissueModel::build() {
   m_capacity_warned = false;
 }
 
+namespace {
+
+// A render surface's triangles as the surface ports carry them, three corners after another.
+void flat_triangles(const CutRenderSurface& render, std::vector<std::uint32_t>& out) {
+  out.clear();
+  out.reserve(3 * render.triangles().size());
+  for (const auto& triangle : render.triangles()) {
+    for (const int v : triangle) out.push_back(static_cast<std::uint32_t>(v));
+  }
+}
+
+}  // namespace
+
 const ports::SurfaceMesh& TissueModel::drawn_mesh() {
   ensure_built();
   if (m_drawn_current) return m_drawn;
@@ -162,9 +175,7 @@ const ports::SurfaceMesh& TissueModel::drawn_mesh() {
   m_drawn.triangles.clear();
   if (const CutRenderSurface* render = tissue.render_surface()) {
     for (const Eigen::Vector3d& x : render->positions_m()) m_drawn.positions_m.insert(m_drawn.positions_m.end(), x.data(), x.data() + 3);
-    for (const auto& triangle : render->triangles()) {
-      for (const int v : triangle) m_drawn.triangles.push_back(static_cast<std::uint32_t>(v));
-    }
+    flat_triangles(*render, m_drawn.triangles);
     m_drawn.cut_triangle_count = static_cast<std::uint64_t>(render->cap_triangle_count());
   } else {
     const Eigen::VectorXd& x = tissue.current_positions_m();
@@ -179,14 +190,15 @@ const ports::SurfaceMesh& TissueModel::drawn_mesh() {
 }
 
 void TissueModel::drawn_embedding(ports::SurfaceEmbedding& embedding) {
-  const ports::SurfaceMesh& drawn = drawn_mesh();
+  ensure_built();
   embedding.revision = m_surface_revision;
-  embedding.triangles = drawn.triangles;
-  embedding.cut_triangle_count = drawn.cut_triangle_count;
-  const std::size_t points = drawn.positions_m.size() / 3;
-  embedding.point_nodes.resize(4 * points);
-  embedding.point_weights.resize(4 * points);
   if (const CutRenderSurface* render = m_tissue->render_surface()) {
+    // From the render surface itself, not through the drawn mesh (whose points it would copy).
+    flat_triangles(*render, embedding.triangles);
+    embedding.cut_triangle_count = static_cast<std::uint64_t>(render->cap_triangle_count());
+    const std::size_t points = render->positions_m().size();
+    embedding.point_nodes.resize(4 * points);
+    embedding.point_weights.resize(4 * points);
     embedding.node_count = static_cast<std::uint64_t>(render->node_count());
     for (std::size_t i = 0; i < points; ++i) {
       const Eigen::Vector4d w = render->point_weights(static_cast<int>(i));
@@ -198,6 +210,12 @@ void TissueModel::drawn_embedding(ports::SurfaceEmbedding& embedding) {
     return;
   }
   // The tet skin: each point is its own node.
+  const ports::SurfaceMesh& drawn = drawn_mesh();
+  embedding.triangles = drawn.triangles;
+  embedding.cut_triangle_count = drawn.cut_triangle_count;
+  const std::size_t points = drawn.positions_m.size() / 3;
+  embedding.point_nodes.resize(4 * points);
+  embedding.point_weights.resize(4 * points);
   embedding.node_count = points;
   for (std::size_t i = 0; i < points; ++i) {
     for (std::size_t k = 0; k < 4; ++k) {
@@ -208,14 +226,16 @@ void TissueModel::drawn_embedding(ports::SurfaceEmbedding& embedding) {
 }
 
 void TissueModel::drawn_nodes(ports::SurfaceNodes& nodes) {
-  const ports::SurfaceMesh& drawn = drawn_mesh();
+  ensure_built();
   nodes.revision = m_surface_revision;
   if (const CutRenderSurface* render = m_tissue->render_surface()) {
+    // The nodes alone: not the drawn mesh's points and triangles (a copy of the organ's 82k
+    // triangles every frame, which the host maps itself).
     nodes.positions_m.clear();
     for (const Eigen::Vector3d& x : render->node_positions_m()) nodes.positions_m.insert(nodes.positions_m.end(), x.data(), x.data() + 3);
     return;
   }
-  nodes.positions_m = drawn.positions_m;
+  nodes.positions_m = drawn_mesh().positions_m;
 }
 
 void TissueModel::ensure_built() {

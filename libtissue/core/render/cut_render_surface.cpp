@@ -41,6 +41,7 @@ CutRenderSurface::CutRenderSurface(const TetMesh& mesh, TriangleSurface surface,
 }
 
 void CutRenderSurface::rebuild(const DeformableBody& body) {
+  m_normals_current = false;  // the triangles change
   find_material_parts(body);
   const size_t vertices = m_surface.vertices_m.size();
   const auto tet_count = static_cast<size_t>(m_mesh.tet_count());
@@ -142,7 +143,15 @@ void CutRenderSurface::update(const DeformableBody& body, const Eigen::VectorXd&
       x += weights(static_cast<Eigen::Index>(k)) * m_node_positions_m[static_cast<size_t>(nodes[k])];
     m_positions_m[i] = x;
   }
-  vertex_normals(m_positions_m, m_triangles, m_normals);
+  m_normals_current = false;
+}
+
+const std::vector<Eigen::Vector3d>& CutRenderSurface::normals() const {
+  if (!m_normals_current) {
+    vertex_normals(m_positions_m, m_triangles, m_normals);
+    m_normals_current = true;
+  }
+  return m_normals;
 }
 
 }  // namespace tissue

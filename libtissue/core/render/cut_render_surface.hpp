@@ -58,7 +58,8 @@ class CutRenderSurface {
   /// Re-meshes the surface for the body's cuts: again only where the cut tets changed since the
   /// last call (from the surface as given the first time, and when a piece came free).
   void rebuild(const DeformableBody& body);
-  /// Positions and normals for the body's state (after rebuild for the body's current cuts).
+  /// Positions for the body's state (after rebuild for the body's current cuts); the normals are
+  /// found when next read.
   void update(const DeformableBody& body, const Eigen::VectorXd& displacement_m);
 
   /// The render surface's triangles: the surface's, split along the cuts, then cap_triangle_count()
@@ -66,7 +67,9 @@ class CutRenderSurface {
   [[nodiscard]] const std::vector<std::array<int, 3>>& triangles() const { return m_triangles; }
   [[nodiscard]] int cap_triangle_count() const { return m_cap_triangles; }
   [[nodiscard]] const std::vector<Eigen::Vector3d>& positions_m() const { return m_positions_m; }
-  [[nodiscard]] const std::vector<Eigen::Vector3d>& normals() const { return m_normals; }
+  /// Unit vertex normals of positions_m(), found at the first read after an update (82k triangles:
+  /// ~1 ms, which a reader of the embedding and the nodes alone, as the FMU's, does not pay).
+  [[nodiscard]] const std::vector<Eigen::Vector3d>& normals() const;
   /// Rest position of each point (the surface's vertices, then the split points). [m]
   [[nodiscard]] const std::vector<Eigen::Vector3d>& rest_positions_m() const { return m_rest_m; }
   /// Render points: the surface's vertices first, then two per cut edge (and, after incremental
@@ -162,7 +165,8 @@ class CutRenderSurface {
   std::vector<std::array<int, 4>> m_point_nodes;
   std::vector<Eigen::Vector3d> m_node_positions_m;
   std::vector<Eigen::Vector3d> m_positions_m;
-  std::vector<Eigen::Vector3d> m_normals;
+  mutable std::vector<Eigen::Vector3d> m_normals;  // of m_positions_m once m_normals_current
+  mutable bool m_normals_current = false;
   mutable Eigen::VectorXd m_real_positions_m;
 };
 

@@ -267,6 +267,25 @@ TEST(CutRenderSurface, ACompleteCutLeavesTwoClosedPiecesOfTheSimulatedVolumes) {
   }
 }
 
+// The normals are found when read (issue 42: the FMU's frames read the embedding and the nodes alone),
+// and always of the positions as the last update left them: after an update that moves every
+// unknown, what normals() gives is vertex_normals of the new positions, not of the old.
+TEST(CutRenderSurface, NormalsReadAfterAnUpdateAreThoseOfItsPositions) {
+  CutFrog frog({{Eigen::Vector2d(0.0051, -0.07), Eigen::Vector2d(0.0051, 0.07)}});
+  CutRenderSurface render = frog.cut_render_surface();
+  std::vector<Eigen::Vector3d> expected;
+  for (int pass = 0; pass < 2; ++pass) {
+    Eigen::VectorXd u = Eigen::VectorXd::Zero(frog.body.dof_count());
+    for (Eigen::Index i = 0; i < u.size(); ++i) u(i) = 1e-3 * pass * std::sin(0.37 * static_cast<double>(i));
+    render.update(frog.body, u);
+    vertex_normals(render.positions_m(), render.triangles(), expected);
+    ASSERT_EQ(render.normals().size(), expected.size());
+    double largest = 0.0;
+    for (size_t v = 0; v < expected.size(); ++v) largest = std::max(largest, (render.normals()[v] - expected[v]).norm());
+    EXPECT_EQ(largest, 0.0) << "pass " << pass;
+  }
+}
+
 TEST(CutRenderSurface, APartialCutIsASlitWithAWallOnEachSide) {
   // From the side of the body to its middle, through the whole height: the frog stays one piece, its
   // surface closed, the slit's two walls meeting along the crack front.
