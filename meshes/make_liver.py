@@ -178,20 +178,21 @@ def renumbered_for_locality(coords, tets):
     return [coords[v] for v in order], tets
 
 
-def build(args, here, out_dir, name, mesh_size_m, curvature, target_tets):
-    """Meshes the shape into out_dir/name.veg and name.bou; target_tets None: no count check."""
+def build(args, out_dir, name, mesh_size_m, curvature, target_tets):
+    """Meshes the shape into out_dir/name.veg and name.bou (its work files, and name.geo unless target_tets
+    is None, in out_dir too); target_tets None: no count check."""
     stl_name = "liver_shape.stl"  # temporary: removed after meshing
     points, faces = icosphere(SPHERE_LEVEL)
-    write_stl(os.path.join(here, stl_name), [liver_point(*p) for p in points], faces)
+    write_stl(os.path.join(out_dir, stl_name), [liver_point(*p) for p in points], faces)
     geo_name = name + ".geo" if target_tets is not None else "liver_size_tmp.geo"
-    with open(os.path.join(here, geo_name), "w", newline="\n") as out:
+    with open(os.path.join(out_dir, geo_name), "w", newline="\n") as out:
         out.write(geo_text(stl_name, mesh_size_m, curvature))
-    tmp = os.path.join(here, "liver.msh.tmp")
+    tmp = os.path.join(out_dir, "liver.msh.tmp")
     result = subprocess.run([args.gmsh, geo_name, "-3", "-nt", "1", "-format", "msh41", "-o",
-                             os.path.basename(tmp)], cwd=here, capture_output=True, text=True)
-    os.remove(os.path.join(here, stl_name))
+                             os.path.basename(tmp)], cwd=out_dir, capture_output=True, text=True)
+    os.remove(os.path.join(out_dir, stl_name))
     if target_tets is None:
-        os.remove(os.path.join(here, geo_name))
+        os.remove(os.path.join(out_dir, geo_name))
     if result.returncode != 0 or not os.path.exists(tmp):
         sys.stderr.write(result.stdout + result.stderr)
         sys.exit("gmsh failed")
@@ -262,10 +263,10 @@ def main():
     here = os.path.dirname(os.path.abspath(__file__))
     out_dir = os.path.abspath(args.output_dir) if args.output_dir else here
     if args.mesh_size is not None:
-        build(args, here, out_dir, "liver", args.mesh_size, args.curvature, None)
+        build(args, out_dir, "liver", args.mesh_size, args.curvature, None)
         return 0
     for variant in VARIANTS:
-        build(args, here, out_dir, variant.name, variant.mesh_size_m, variant.curvature, variant.target_tets)
+        build(args, out_dir, variant.name, variant.mesh_size_m, variant.curvature, variant.target_tets)
     write_render_surface(out_dir)
     return 0
 
