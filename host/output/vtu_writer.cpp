@@ -30,7 +30,7 @@ void append_number(std::string& out, std::uint64_t value) {
 
 // VTK's "binary" DataArray (XML formats, version 0.1, header_type UInt32): base64 of the byte
 // count (UInt32, little-endian) followed by the values' own little-endian bytes. An organ's frame
-// (41k points, 82k triangles) is 3.5 MB this way against 6.4 MB of shortest decimals, and encodes
+// (41k points, 82k triangles) is 3.2 MB this way against 6.4 MB of shortest decimals, and encodes
 // in a fraction of their time: the recording shares two cores with the dynamics (issue 42).
 constexpr std::string_view BASE64_DIGITS = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
 
