@@ -51,7 +51,6 @@ class Variant:
 REFERENCE = Variant("liver", 0.0046, 0, 50000)
 COARSE = Variant("liver_coarse", 0.014, 12, 6000)
 VARIANTS = (REFERENCE, COARSE)
-MESH_SIZE_M = REFERENCE.mesh_size_m
 
 HALF_LENGTH_M = 0.11  # x: right lobe tip to left lobe tip, 22 cm
 HALF_DEPTH_M = 0.075  # y: back to front at mid length
@@ -125,7 +124,7 @@ def write_stl(path, points, faces):
         out.write("\n".join(lines) + "\n")
 
 
-def geo_text(stl_name, mesh_size_m, curvature=0):
+def geo_text(stl_name, mesh_size_m, curvature):
     options = [o.replace("Mesh.MeshSizeFromCurvature = 0;", "Mesh.MeshSizeFromCurvature = %d;" % curvature)
                for o in GMSH_OPTIONS]
     return "\n".join([

@@ -9,6 +9,7 @@
 #include <fstream>
 #include <set>
 #include <sstream>
+#include <string_view>
 
 namespace tissue::host {
 namespace {
@@ -172,11 +173,21 @@ void read_scenario_table(const Reader& r, const toml::table& root, const std::fi
 }
 
 // A default the host gives an FMU: `setting` unless the scenario sets that parameter itself.
+bool is_set(const std::vector<ParameterSetting>& parameters, std::string_view name) {
+  return std::any_of(parameters.begin(), parameters.end(), [&](const ParameterSetting& p) { return p.name == name; });
+}
+
 void add_unless_set(std::vector<ParameterSetting>& parameters, ParameterSetting setting) {
-  if (std::none_of(parameters.begin(), parameters.end(),
-                   [&](const ParameterSetting& p) { return p.name == setting.name; })) {
-    parameters.push_back(std::move(setting));
-  }
+  if (!is_set(parameters, setting.name)) parameters.push_back(std::move(setting));
+}
+
+// A file next to the scenario that [tissue] names (`key`: its mesh, its render surface): its
+// absolute path, which is what the FMU is given; refused naming the key if there is no such file.
+std::string scenario_file(const Reader& r, const toml::node& node, const std::filesystem::path& base,
+                          const std::string& key) {
+  const std::filesystem::path file = relative_to(base, r.string(node, key));
+  if (!std::filesystem::exists(file)) r.fail(key, "no file " + file.string());
+  return std::filesystem::absolute(file).lexically_normal().string();
 }
 
 // [tissue.regions.NAME] (optional): a region's material, as the Tissue FMU's material.regions text.
@@ -201,7 +212,7 @@ std::string region_materials_text(const Reader& r, const toml::table& regions) {
   return text;
 }
 
-// [tissue] (optional): the FMU, the communication step, the parameters and a mesh file.
+// [tissue] (optional): the FMU, the communication step, the parameters, a mesh file and a render surface file.
 void read_tissue(const Reader& r, const toml::table& root, const std::filesystem::path& base, Scenario& s) {
   if (const toml::table* tissue = root["tissue"].as_table()) {
     r.only(*tissue, "tissue", {"fmu", "communication_step", "mesh", "render_surface", "parameters", "regions"});
@@ -213,29 +224,21 @@ void read_tissue(const Reader& r, const toml::table& root, const std::filesystem
     if (const toml::node* n = tissue->get("regions")) {
       const toml::table* regions = n->as_table();
       if (regions == nullptr) r.fail("tissue.regions", "must be a table of regions ([tissue.regions.NAME])");
-      if (std::any_of(s.tissue_parameters.begin(), s.tissue_parameters.end(),
-                      [](const ParameterSetting& p) { return p.name == "material.regions"; })) {
+      if (is_set(s.tissue_parameters, "material.regions")) {
         r.fail("tissue.regions", "given twice: also as tissue.parameters.\"material.regions\"");
       }
       s.tissue_parameters.push_back(ParameterSetting{"material.regions", region_materials_text(r, *regions)});
     }
     if (const toml::node* n = tissue->get("mesh")) {
-      // A mesh file next to the scenario: the FMU is given its absolute path.
-      const std::filesystem::path mesh = relative_to(base, r.string(*n, "tissue.mesh"));
-      if (!std::filesystem::exists(mesh)) r.fail("tissue.mesh", "no file " + mesh.string());
       s.tissue_parameters.insert(s.tissue_parameters.begin(),
-                                 ParameterSetting{"mesh", std::filesystem::absolute(mesh).lexically_normal().string()});
+                                 ParameterSetting{"mesh", scenario_file(r, *n, base, "tissue.mesh")});
     }
     if (const toml::node* n = tissue->get("render_surface")) {
-      // A render surface file next to the scenario (an OBJ): the FMU is given its absolute path.
-      if (std::any_of(s.tissue_parameters.begin(), s.tissue_parameters.end(),
-                      [](const ParameterSetting& p) { return p.name == "surface.renderSurface"; })) {
+      if (is_set(s.tissue_parameters, "surface.renderSurface")) {
         r.fail("tissue.render_surface", "given twice: also as tissue.parameters.\"surface.renderSurface\"");
       }
-      const std::filesystem::path surface = relative_to(base, r.string(*n, "tissue.render_surface"));
-      if (!std::filesystem::exists(surface)) r.fail("tissue.render_surface", "no file " + surface.string());
       s.tissue_parameters.push_back(
-          ParameterSetting{"surface.renderSurface", std::filesystem::absolute(surface).lexically_normal().string()});
+          ParameterSetting{"surface.renderSurface", scenario_file(r, *n, base, "tissue.render_surface")});
     }
   }
   // Unless the scenario says otherwise, one internal step per communication step: the frog's

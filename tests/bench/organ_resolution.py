@@ -31,6 +31,8 @@ import numpy as np
 from scipy.spatial import ConvexHull
 
 ROOT = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..")
+sys.path.insert(0, os.path.join(ROOT, "meshes"))
+from make_palpation import boundary_triangles, read_veg  # noqa: E402  (the meshes' own .veg reader)
 STEP_S = 0.01
 CUT_FRACTION = 0.8  # cut_organ's stroke: x at 80% of the rest box's length
 TIP_X_M = 0.095  # the left lobe's tip material point (x; y = 0, mid-thickness)
@@ -38,24 +40,14 @@ PROBE_XS_M = (-0.015, -0.045)  # palpate_liver's two dwells (beside and over its
 PROBE_DEPTH_M = 0.002
 
 
-def read_veg(path):
-    lines = [line.strip() for line in open(path) if line.strip() and not line.startswith("#")]
-    k = lines.index("*VERTICES")
-    count = int(lines[k + 1].split()[0])
-    vertices = np.array([[float(v) for v in lines[k + 2 + n].split()[1:4]] for n in range(count)])
-    k = lines.index("*ELEMENTS")
-    count = int(lines[k + 2].split()[0])
-    tets = np.array([[int(v) - 1 for v in lines[k + 3 + n].split()[1:5]] for n in range(count)])
-    return vertices, tets
+def read_mesh(path):
+    """Rest positions (n x 3) and tets (m x 4, 0-based) of a .veg file, by make_palpation.py's reader."""
+    _, vertices, tets = read_veg(path)
+    return np.array(vertices), np.array(tets)
 
 
 def boundary_faces(tets):
-    count = {}
-    for tet in tets:
-        for face in ((0, 1, 2), (0, 1, 3), (0, 2, 3), (1, 2, 3)):
-            key = tuple(sorted(int(tet[f]) for f in face))
-            count[key] = count.get(key, 0) + 1
-    return np.array([face for face, n in count.items() if n == 1])
+    return np.array(boundary_triangles(tets.tolist()))
 
 
 def vertical_hits(x, faces, px, py):
@@ -182,11 +174,11 @@ def main():
 
     meshes = args.mesh or [os.path.join(ROOT, "meshes", "liver.veg"), os.path.join(ROOT, "meshes", "liver_coarse.veg")]
     rows = []
-    reference_vertices, reference_tets = read_veg(meshes[0])
+    reference_vertices, reference_tets = read_mesh(meshes[0])
     reference_faces = boundary_faces(reference_tets)
     for mesh in meshes:
         start = time.time()
-        vertices, tets = read_veg(mesh)
+        vertices, tets = read_mesh(mesh)
         faces = boundary_faces(tets)
         lower, upper = vertices.min(axis=0), vertices.max(axis=0)
         cut_volume = clipped_volume(vertices, tets, 0, lower[0] + CUT_FRACTION * (upper[0] - lower[0]))

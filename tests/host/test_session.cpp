@@ -131,7 +131,7 @@ INSTANTIATE_TEST_SUITE_P(HostScenarios, EveryScenario,
                                            "careless_hand", "cantilever_release", "hand_press_frog", "hand_cut_frog",
                                            "x_cut_frog", "flap_frog", "cut_organ", "resect_lobe"));
 
-// The triangles of a VTU frame (the host's ASCII cells).
+// The triangles of a VTU frame (its connectivity DataArray, binary or ASCII).
 std::vector<std::uint32_t> vtu_triangles(const std::filesystem::path& file) {
   const std::string text = contents(file);
   const std::size_t name = text.find("Name=\"connectivity\"");
