@@ -325,6 +325,16 @@ constexpr auto interaction_settings() {
                     "has no FMI switch that allows threads); tissue-host turns it on for its own Tissue.fmu, whose "
                     "step shares its slot with nothing else")
           .member(TISSUE_MEMBER(settings.interaction.contact.stiffness_in_background)),
+      Setting("contact.stiffnessLatencySteps", 88, integer)
+          .python("contact_stiffness_latency_steps")
+          .start("1")
+          .at_least("1")
+          .describe("With contact.stiffnessInBackground: a K_c refresh started at a step is rendered this many "
+                    "internal steps later (the worker has that long before the step waits for it; a new contact "
+                    "renders the elementLocal estimate until then), and the next refresh starts then: K_c is "
+                    "refreshed every max(contact.stiffnessRefreshSteps, this) steps. For bodies whose "
+                    "factorization takes longer than a step (the 52k-tet organ: ~0.7-1 s)")
+          .member(TISSUE_MEMBER(settings.interaction.contact.stiffness_latency_steps)),
   });
 }
 

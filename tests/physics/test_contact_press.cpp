@@ -87,7 +87,7 @@ PressReference press_reference(const TetMesh& mesh, const SurfaceMesh& surface, 
       contact_interpolation(body.dofs(), surface.triangles[static_cast<size_t>(point.triangle)], point.barycentric);
   const Eigen::Matrix3d k_c = *effective.stiffness_n_per_m(at_point);
   const double k_fn = frictionless_normal_stiffness_n_per_m(k_c, n0);
-  const Eigen::VectorXd field = effective.unit_force_response() * n0;
+  const Eigen::VectorXd field = effective.unit_force_response(at_point) * n0;
   reference.normal_mass_kg = k_fn * k_fn * field.dot(body.mass_kg().cwiseProduct(field));
   reference.force_on_tool_n.push_back(Eigen::Vector3d::Zero());
   reference.normal.push_back(n0);

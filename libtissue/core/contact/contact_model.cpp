@@ -4,6 +4,8 @@
 #include "core/contact/surface_point.hpp"
 #include "core/state_error.hpp"
 
+#include <algorithm>
+
 namespace tissue {
 
 namespace {
@@ -94,12 +96,20 @@ void ContactModel::refresh_stiffness(int triangle) {
     out.stiffness_n_per_m = element_local_contact_stiffness(m_body.elasticity(), m_surface, triangle);
     return;
   }
-  // A refresh started in the background at the last step is rendered from this step on.
+  // A refresh started in the background stiffness_latency_steps ago is rendered from this step on;
+  // until then the one before stands, and no other starts.
+  const bool new_contact = m_steps_since_stiffness < 0;
   if (m_stiffness_refresh.state() != BackgroundContactStiffness::State::idle) {
+    if (!new_contact && m_steps_since_stiffness < m_settings.stiffness_latency_steps) {
+      ++m_steps_since_stiffness;
+      return;
+    }
     out.stiffness_n_per_m = landed_stiffness(m_stiffness_refresh.take(), triangle);
   }
-  const bool new_contact = m_steps_since_stiffness < 0;
-  if (!new_contact && m_steps_since_stiffness < m_settings.stiffness_refresh_steps) {
+  const int period = m_settings.stiffness_in_background
+                         ? std::max(m_settings.stiffness_refresh_steps, m_settings.stiffness_latency_steps)
+                         : m_settings.stiffness_refresh_steps;
+  if (!new_contact && m_steps_since_stiffness < period) {
     ++m_steps_since_stiffness;
     return;
   }

@@ -40,6 +40,11 @@ struct ContactSettings {
   /// estimate (the one the near-surface report gave) stands for that first step. The results are
   /// the same with or without a thread to be had. Off: no thread unless asked (the FMU's rule).
   bool stiffness_in_background = false;
+  /// In the background: a refresh started at a step is rendered this many steps later (>= 1), the
+  /// step waiting for the worker only if it is later still; the next refresh starts then, so K_c is
+  /// refreshed every max(stiffness_refresh_steps, this) steps. A fixed step, not "when ready": a run
+  /// gives the same K_c whatever the machine.
+  int stiffness_latency_steps = 1;
   /// A probe not in contact but this close to the surface reports it (ToolContact::near) [m];
   /// 0: never.
   double near_surface_margin_m = 0.01;

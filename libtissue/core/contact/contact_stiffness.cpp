@@ -42,10 +42,18 @@ ShiftedSystem static_contact_system(const BlockSparseMatrix& tangent, Eigen::Vec
   return ShiftedSystem{&tangent, 1.0, &diagonal};
 }
 
+// The forward solves' output, kept between calls (no allocation once sized).
+struct LowerSolutionBuffer {
+  CholmodFactor::LowerSolution solution;
+};
+
 EffectiveContactStiffness::EffectiveContactStiffness()
-    // Solves without BLAS: they may run in a worker beside the step's own CHOLMOD calls
-    // (cholmod_factor.hpp); the frog's factor is simplicial anyway.
-    : m_factor(std::make_unique<CholmodFactor>(CholmodFactor::Solves::without_blas)) {}
+    // K_c needs forward solves only (lower_solve: this project's loops, no BLAS). Full solves, rare
+    // (unit_force_response, solve), use a simplicial copy made when first asked: they may run in a
+    // worker beside the step's own CHOLMOD calls (cholmod_factor.hpp).
+    : m_factor(std::make_unique<CholmodFactor>(CholmodFactor::Solves::without_blas_on_demand,
+                                               CholmodFactor::Layout::quickest_factorization)),
+      m_lower(std::make_unique<LowerSolutionBuffer>()) {}
 
 EffectiveContactStiffness::~EffectiveContactStiffness() = default;
 
@@ -99,31 +107,43 @@ bool EffectiveContactStiffness::check(const ContactInterpolation& point) const {
   return moves;
 }
 
-void EffectiveContactStiffness::solve_columns(const ContactInterpolation& point, ResponseMatrix& response) {
+const EffectiveContactStiffness::ResponseMatrix& EffectiveContactStiffness::unit_force_response(
+    const ContactInterpolation& point) {
   // Column a of P holds w_k at scalar row 3 row_k + a; A Z = P column by column.
+  (void)check(point);
   const int n = rows();
-  response.resize(n, 3);
+  m_response.resize(n, 3);
   m_column.setZero(n);
   for (int axis = 0; axis < 3; ++axis) {
     for (size_t k = 0; k < 3; ++k) {
       if (point.rows[k] >= 0) m_column[3 * point.rows[k] + axis] += point.weights[static_cast<Eigen::Index>(k)];
     }
     solve(m_column, m_solution);
-    response.col(axis) = m_solution;
+    m_response.col(axis) = m_solution;
     m_column.setZero();
   }
+  return m_response;
+}
+
+Eigen::MatrixXd EffectiveContactStiffness::gram(std::span<const ContactInterpolation> points) {
+  m_columns.resize(3 * points.size());
+  for (size_t p = 0; p < points.size(); ++p) {
+    for (int axis = 0; axis < 3; ++axis) {
+      auto& column = m_columns[3 * p + static_cast<size_t>(axis)];
+      column.clear();
+      for (size_t k = 0; k < 3; ++k) {
+        if (points[p].rows[k] >= 0) {
+          column.emplace_back(3 * points[p].rows[k] + axis, points[p].weights[static_cast<Eigen::Index>(k)]);
+        }
+      }
+    }
+  }
+  m_factor->lower_solve(m_columns, m_lower->solution);
+  const Eigen::MatrixXd& y = m_lower->solution.values;
+  return y.transpose() * y;
 }
 
 namespace {
-
-// P^T X for X (n x 3): the rows of X at the point, weighted.
-Eigen::Matrix3d gather(const ContactInterpolation& point, const Eigen::Matrix<double, Eigen::Dynamic, 3>& x) {
-  Eigen::Matrix3d sum = Eigen::Matrix3d::Zero();
-  for (size_t k = 0; k < 3; ++k) {
-    if (point.rows[k] >= 0) sum += point.weights[static_cast<Eigen::Index>(k)] * x.middleRows<3>(3 * point.rows[k]);
-  }
-  return sum;
-}
 
 Eigen::Matrix3d symmetric_inverse(const Eigen::Matrix3d& m) {
   const Eigen::Matrix3d inverse = (0.5 * (m + m.transpose())).inverse();
@@ -134,8 +154,8 @@ Eigen::Matrix3d symmetric_inverse(const Eigen::Matrix3d& m) {
 
 std::optional<Eigen::Matrix3d> EffectiveContactStiffness::stiffness_n_per_m(const ContactInterpolation& point) {
   if (!check(point)) return std::nullopt;
-  solve_columns(point, m_response);
-  return symmetric_inverse(gather(point, m_response));  // (P^T A^-1 P)^-1
+  const Eigen::Matrix3d compliance = gram(std::span<const ContactInterpolation>(&point, 1));  // P^T A^-1 P
+  return symmetric_inverse(compliance);
 }
 
 std::optional<Eigen::Matrix3d> EffectiveContactStiffness::stiffness_n_per_m(const ContactInterpolation& point,
@@ -148,16 +168,16 @@ std::optional<Eigen::Matrix3d> EffectiveContactStiffness::stiffness_n_per_m(cons
   if (spring_stiffness_n_per_m == 0.0 || !check(spring_point)) return stiffness_n_per_m(point);
   // The factor is of A' = A + k U U^T (U interpolates the spring's point). Woodbury:
   //   A^-1 = A'^-1 + A'^-1 U M^-1 U^T A'^-1,   M = I/k - U^T A'^-1 U,
-  // so P^T A^-1 P = P^T Z + (P^T W) M^-1 (P^T W)^T with Z = A'^-1 P, W = A'^-1 U. M ~ K_u / k^2 is
-  // formed with a cancellation of ~log10(k / K_u) digits, harmless for k up to ~1e6 K_u.
-  solve_columns(point, m_response);
-  solve_columns(spring_point, m_spring_response);
-  const Eigen::Matrix3d cross = gather(point, m_spring_response);  // P^T W
-  Eigen::Matrix3d m = -gather(spring_point, m_spring_response);    // -U^T W
+  // so P^T A^-1 P = P^T A'^-1 P + (P^T A'^-1 U) M^-1 (P^T A'^-1 U)^T, all blocks of one Gram matrix.
+  // M ~ K_u / k^2 is formed with a cancellation of ~log10(k / K_u) digits, harmless for k up to
+  // ~1e6 K_u.
+  const std::array<ContactInterpolation, 2> points{point, spring_point};
+  const Eigen::MatrixXd g = gram(points);
+  const Eigen::Matrix3d cross = g.topRightCorner<3, 3>();  // P^T A'^-1 U
+  Eigen::Matrix3d m = -g.bottomRightCorner<3, 3>();         // -U^T A'^-1 U
   m.diagonal().array() += 1.0 / spring_stiffness_n_per_m;
-  const Eigen::Matrix3d m_inverse = symmetric_inverse(m);
-  m_response += m_spring_response * (m_inverse * cross.transpose());  // A^-1 P
-  return symmetric_inverse(gather(point, m_response));
+  const Eigen::Matrix3d compliance = g.topLeftCorner<3, 3>() + cross * symmetric_inverse(m) * cross.transpose();
+  return symmetric_inverse(compliance);
 }
 
 Eigen::Matrix3d element_local_contact_stiffness(const CorotationalElasticity& elasticity, int tet,

@@ -5,7 +5,9 @@
 //   contact point, K_c = (P^T K^-1 P)^-1, P (3n x 3) interpolating the contact point from the
 //   free unknowns (x_p = P^T u + fixed part). It is the force per unit displacement of the point
 //   when the rest of the body settles (static condensation); a quasi-static poke of the full
-//   model converges to K_c d as d -> 0 (tests/unit/contact). One factorization, three solves.
+//   model converges to K_c d as d -> 0 (tests/unit/contact). One factorization, then per point the
+//   forward halves of three solves over the rows above the point in the elimination tree alone
+//   (CholmodFactor::lower_solve): K_c^-1 = (L^-1 P)^T (L^-1 P).
 // * element_local (the cheap option): eq. 4.23 with u_d = [d d d d] is a rigid translation of
 //   the tet and gives zero force for every valid K_e (the erratum). The repair used here pushes
 //   the contacted face (its three vertices) by d and holds the tet's fourth vertex:
@@ -33,11 +35,15 @@
 #include <array>
 #include <memory>
 #include <optional>
+#include <span>
 #include <string_view>
+#include <utility>
+#include <vector>
 
 namespace tissue {
 
 class CholmodFactor;
+struct LowerSolutionBuffer;
 
 enum class ContactStiffnessModel { effective_static, element_local };
 
@@ -102,9 +108,9 @@ class EffectiveContactStiffness {
                                                                  const ContactInterpolation& spring_point,
                                                                  double spring_stiffness_n_per_m);
   using ResponseMatrix = Eigen::Matrix<double, Eigen::Dynamic, 3>;
-  /// A^-1 P of the last stiffness_n_per_m() (rows() x 3; A without the spring): the displacement
-  /// field of a unit force at the point along each axis.
-  [[nodiscard]] const ResponseMatrix& unit_force_response() const { return m_response; }
+  /// A^-1 P (rows() x 3): the displacement field of a unit force at `point` along each axis, by three
+  /// full solves (stiffness_n_per_m needs only the forward halves). Throws as stiffness_n_per_m.
+  [[nodiscard]] const ResponseMatrix& unit_force_response(const ContactInterpolation& point);
   /// x = A^-1 b with the same factor. Throws SolverError without one.
   void solve(const Eigen::VectorXd& b, Eigen::VectorXd& x);
   /// Rows of the factorized matrix, 0 without a factor.
@@ -113,15 +119,17 @@ class EffectiveContactStiffness {
  private:
   /// Whether the point moves with the unknowns; throws as documented above.
   [[nodiscard]] bool check(const ContactInterpolation& point) const;
-  /// response = A'^-1 P (A' the factorized matrix), three solves.
-  void solve_columns(const ContactInterpolation& point, ResponseMatrix& response);
+  /// The Gram matrix (L^-1 Q)^T (L^-1 Q) = Q^T A'^-1 Q of Q = [P of each point] (A' the factorized
+  /// matrix) by one sparse forward solve: the rows of the elimination tree the points reach.
+  [[nodiscard]] Eigen::MatrixXd gram(std::span<const ContactInterpolation> points);
 
   std::unique_ptr<CholmodFactor> m_factor;
   bool m_loaded = false;  ///< the factor holds a matrix the last load() copied (not one before a failed load)
   Eigen::VectorXd m_column;
   Eigen::VectorXd m_solution;
   ResponseMatrix m_response;
-  ResponseMatrix m_spring_response;
+  std::vector<std::vector<std::pair<int, double>>> m_columns;  // gram()'s right-hand sides
+  std::unique_ptr<LowerSolutionBuffer> m_lower;
 };
 
 /// What K_c at a contact point needs besides the factorized matrix, copied from the body when the

@@ -81,7 +81,7 @@ struct BondedSolver {
 
       stiffness.solve(residual, correction);  // y = K^-1 r
       const Eigen::Vector3d lambda_step = contact_stiffness * (gap + point_displacement(point, correction));
-      u += stiffness.unit_force_response() * lambda_step - correction;
+      u += stiffness.unit_force_response(point) * lambda_step - correction;
       lambda += lambda_step;
       ++newton_iterations;
     }

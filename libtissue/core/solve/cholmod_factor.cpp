@@ -3,20 +3,31 @@
 // refill values, factorize; a solve: back-substitute.
 //
 // Choices, each for the real-time case of small to medium meshes (10^3 - 10^4 unknowns):
-// * Ordering: AMD only (nmethods = 1). The default also tries METIS/NESDIS when AMD fills much,
-//   which costs far more than it saves at this size (on the frog, 2433 unknowns, METIS and NESDIS
-//   give more fill than AMD), and the analysis is redone whenever a cut changes the pattern.
+// * Ordering: one method (nmethods = 1), no trial of several. AMD below METIS_FROM_ROWS rows: on
+//   the frog (2433 unknowns) METIS and NESDIS give more fill than AMD, and the analysis is redone
+//   whenever a cut changes the pattern. METIS from there: on the organ's static K (meshes/
+//   liver_tumour.veg, 25 479 unknowns) METIS gives 9.1e6 entries of L and 6.8e9 flops against AMD's
+//   1.21e7 and 1.29e10, and factorizes in 0.67-0.72 s against 1.09-1.24 s (Debian's serial
+//   OpenBLAS, one core of the 2-core VM of docs/BENCHMARKS.md).
 // * Supernodal vs simplicial: CHOLMOD_AUTO (CHOLMOD's flops-per-nonzero switch), which picks
 //   supernodal for 3D tet-mesh stiffness from ~10^3 unknowns on. Measured on a 2430-unknown
 //   Kuhn-grid stiffness (14 neighbours per vertex, 1e8 flops per factorization, Debian's
 //   reference BLAS): simplicial and supernodal both take ~45 ms, within timing noise, and AMD
 //   alone gives the same fill as the default AMD/METIS trial.
+// * Layout::quickest_factorization (the contact stiffness's factors, read by lower_solve()):
+//   supernodal from SUPERNODAL_FROM_ROWS rows. Minimum of five refactorizations of the static K:
+//   meshes/liver_coarse.veg (4008 unknowns) 27-30 ms supernodal against 45-80 simplicial,
+//   bar_40x8x8 (6642) 33 against 56; the frog (2433) is faster simplicial (above).
 // * final_ll = TRUE: a simplicial factorization is LL' as well. CHOLMOD's simplicial LDL' only
 //   stops at a zero pivot, so an indefinite A would be factorized and "solved" silently.
 // * print = 0: failures come back as a status and a message, not as text on stdout.
 #include "core/solve/cholmod_factor.hpp"
 
+#include <Eigen/Dense>
+
 #include <algorithm>
+#include <cstddef>
+#include <stdexcept>
 #include <mutex>
 #include <utility>
 
@@ -39,12 +50,14 @@ std::mutex& blas_turn() {
 
 }  // namespace
 
-CholmodFactor::CholmodFactor(Solves solves, Layout layout) : m_solves(solves) {
+CholmodFactor::CholmodFactor(Solves solves, Layout layout, Ordering ordering)
+    : m_solves(solves), m_ordering(ordering) {
   cholmod_start(&m_common);
   m_common.print = 0;
   m_common.nmethods = 1;
   m_common.method[0].ordering = CHOLMOD_AMD;
   m_common.supernodal = layout == Layout::supernodal ? CHOLMOD_SUPERNODAL : CHOLMOD_AUTO;
+  m_layout = layout;
   m_common.supernodal_switch = SUPERNODAL_SWITCH;
   m_common.final_ll = 1;
 }
@@ -157,6 +170,12 @@ CholmodFactor::Status CholmodFactor::factorize() noexcept {
   }
   if (m_analysis_pending) {
     cholmod_free_factor(&m_factor, &m_common);
+    const bool metis = m_ordering == Ordering::metis || (m_ordering == Ordering::automatic && m_rows >= METIS_FROM_ROWS);
+    m_common.method[0].ordering = metis ? CHOLMOD_METIS : CHOLMOD_AMD;
+    m_ordering_used = m_common.method[0].ordering;
+    if (m_layout == Layout::quickest_factorization) {
+      m_common.supernodal = m_rows >= SUPERNODAL_FROM_ROWS ? CHOLMOD_SUPERNODAL : CHOLMOD_AUTO;
+    }
     m_factor = cholmod_analyze(m_matrix, &m_common);
     ++m_analysis_count;
     if (m_factor == nullptr || m_common.status < 0) {
@@ -181,18 +200,51 @@ CholmodFactor::Status CholmodFactor::factorize() noexcept {
     m_status = Status::not_positive_definite;
     return m_status;
   }
+  m_status = Status::ok;
   if (m_solves == Solves::without_blas && m_factor->is_super) {
+    try {
+      (void)solve_factor();
+    } catch (const SolverError&) {
+      m_status = Status::failed;
+      m_failed_step = "simplicial copy of the factor";
+      m_cholmod_status = m_common.status;
+    }
+  }
+  return m_status;
+}
+
+double CholmodFactor::factor_entries() const {
+  if (!factored()) return 0.0;
+  if (!m_factor->is_super) {
+    double entries = 0.0;
+    const int* counts = static_cast<const int*>(m_factor->nz);
+    for (size_t j = 0; j < m_factor->n; ++j) entries += counts[j];
+    return entries;
+  }
+  const int* super = static_cast<const int*>(m_factor->super);
+  const int* pi = static_cast<const int*>(m_factor->pi);
+  double entries = 0.0;  // the lower trapezoid of each supernode
+  for (size_t s = 0; s < m_factor->nsuper; ++s) {
+    const double columns = super[s + 1] - super[s];
+    const double rows = pi[s + 1] - pi[s];
+    entries += columns * rows - columns * (columns - 1.0) / 2.0;
+  }
+  return entries;
+}
+
+cholmod_factor* CholmodFactor::solve_factor() {
+  if (m_solves == Solves::with_factor || !m_factor->is_super) return m_factor;
+  if (m_simplicial == nullptr) {
     m_simplicial = cholmod_copy_factor(m_factor, &m_common);
     if (m_simplicial == nullptr ||
         cholmod_change_factor(CHOLMOD_REAL, /*to_ll=*/1, /*to_super=*/0, /*to_packed=*/1, /*to_monotonic=*/1,
                               m_simplicial, &m_common) == 0) {
-      m_failed_step = "simplicial copy of the factor";
-      m_cholmod_status = m_common.status;
-      return m_status;
+      cholmod_free_factor(&m_simplicial, &m_common);
+      throw_if_failed("simplicial copy of the factor");
+      throw SolverError("CHOLMOD: simplicial copy of the factor failed");
     }
   }
-  m_status = Status::ok;
-  return m_status;
+  return m_simplicial;
 }
 
 std::string CholmodFactor::failure_message(const std::string& who) const {
@@ -215,7 +267,7 @@ void CholmodFactor::solve(std::span<const double> b, std::span<double> x) {
     if (m_rhs == nullptr) throw SolverError("CHOLMOD: allocating b failed");
   }
   std::copy(b.begin(), b.end(), static_cast<double*>(m_rhs->x));
-  cholmod_factor* factor = m_simplicial != nullptr ? m_simplicial : m_factor;
+  cholmod_factor* factor = solve_factor();
   std::unique_lock<std::mutex> turn(blas_turn(), std::defer_lock);
   if (factor->is_super) turn.lock();  // a simplicial solve calls no BLAS
   const int solved =
@@ -227,6 +279,113 @@ void CholmodFactor::solve(std::span<const double> b, std::span<double> x) {
   }
   const double* solution = static_cast<const double*>(m_solution->x);
   std::copy(solution, solution + n, x.begin());
+}
+
+}  // namespace tissue
+
+namespace tissue {
+
+// L's elimination tree, node by node: a supernode s holds columns super[s] .. super[s + 1] - 1, a
+// dense trapezoid of pi[s + 1] - pi[s] rows (the first super[s + 1] - super[s] its own columns,
+// sorted) at x + px[s], column-major; its parent is the supernode of its first row below its own
+// columns. A simplicial LL' column j holds nz[j] entries at p[j], the diagonal first (the rest in any
+// order); its parent is the smallest row below the diagonal. A parent's index exceeds its child's.
+int CholmodFactor::tree_node(int column) const {
+  if (!m_factor->is_super) return column;
+  const int* super = static_cast<const int*>(m_factor->super);
+  const auto nsuper = static_cast<std::ptrdiff_t>(m_factor->nsuper);
+  return static_cast<int>(std::upper_bound(super, super + nsuper + 1, column) - super) - 1;
+}
+
+int CholmodFactor::tree_parent(int node) const {
+  if (m_factor->is_super) {
+    const int* super = static_cast<const int*>(m_factor->super);
+    const int* pi = static_cast<const int*>(m_factor->pi);
+    const int* rows = static_cast<const int*>(m_factor->s);
+    const int own = super[node + 1] - super[node];
+    return pi[node + 1] - pi[node] > own ? tree_node(rows[pi[node] + own]) : -1;
+  }
+  const int* p = static_cast<const int*>(m_factor->p);
+  const int* nz = static_cast<const int*>(m_factor->nz);
+  const int* rows = static_cast<const int*>(m_factor->i);
+  int parent = -1;
+  for (int k = p[node] + 1; k < p[node] + nz[node]; ++k) {
+    if (parent < 0 || rows[k] < parent) parent = rows[k];
+  }
+  return parent;
+}
+
+void CholmodFactor::eliminate(int node) {
+  const double* values = static_cast<const double*>(m_factor->x);
+  if (!m_factor->is_super) {
+    const int* p = static_cast<const int*>(m_factor->p);
+    const int* nz = static_cast<const int*>(m_factor->nz);
+    const int* rows = static_cast<const int*>(m_factor->i);
+    m_work.row(node) /= values[p[node]];
+    for (int k = p[node] + 1; k < p[node] + nz[node]; ++k) m_work.row(rows[k]) -= values[k] * m_work.row(node);
+    return;
+  }
+  const int* super = static_cast<const int*>(m_factor->super);
+  const int* pi = static_cast<const int*>(m_factor->pi);
+  const int* px = static_cast<const int*>(m_factor->px);
+  const int* rows = static_cast<const int*>(m_factor->s);
+  const int first = super[node];
+  const int own = super[node + 1] - first;
+  const int height = pi[node + 1] - pi[node];
+  const Eigen::Map<const Eigen::MatrixXd> block(values + px[node], height, own);
+  auto solved = m_work.middleRows(first, own);
+  solved = block.topRows(own).triangularView<Eigen::Lower>().solve(solved);
+  if (height == own) return;
+  m_update.noalias() = block.bottomRows(height - own) * solved;
+  for (int k = own; k < height; ++k) m_work.row(rows[pi[node] + k]) -= m_update.row(k - own);
+}
+
+void CholmodFactor::lower_solve(std::span<const SparseColumn> columns, LowerSolution& y) {
+  if (!factored()) throw SolverError("CHOLMOD: lower solve without a factor");
+  if (!m_factor->is_ll) throw SolverError("CHOLMOD: lower solve of an LDL' factor");
+  const int n = static_cast<int>(m_rows);
+  if (m_inverse_perm_analysis != m_analysis_count) {
+    const int* perm = static_cast<const int*>(m_factor->Perm);
+    m_inverse_perm.resize(static_cast<size_t>(n));
+    for (int k = 0; k < n; ++k) m_inverse_perm[static_cast<size_t>(perm[k])] = k;
+    m_inverse_perm_analysis = m_analysis_count;
+  }
+  const auto width = static_cast<Eigen::Index>(columns.size());
+  if (m_work.rows() != n || m_work.cols() != width) m_work.setZero(n, width);
+  const size_t nodes = m_factor->is_super ? m_factor->nsuper : static_cast<size_t>(n);
+  if (m_reached.size() != nodes) m_reached.assign(nodes, 0);
+  m_reach.clear();
+  for (Eigen::Index c = 0; c < width; ++c) {
+    for (const auto& [row, value] : columns[static_cast<size_t>(c)]) {
+      if (row < 0 || row >= n) {
+        throw std::invalid_argument("CHOLMOD lower solve: row " + std::to_string(row) + " outside [0, " +
+                                    std::to_string(n) + ")");
+      }
+      const int k = m_inverse_perm[static_cast<size_t>(row)];
+      m_work(k, c) += value;
+      for (int node = tree_node(k); node >= 0 && m_reached[static_cast<size_t>(node)] == 0; node = tree_parent(node)) {
+        m_reached[static_cast<size_t>(node)] = 1;
+        m_reach.push_back(node);
+      }
+    }
+  }
+  std::sort(m_reach.begin(), m_reach.end());  // children before parents
+  for (const int node : m_reach) eliminate(node);
+  y.rows.clear();
+  for (const int node : m_reach) {
+    m_reached[static_cast<size_t>(node)] = 0;
+    if (!m_factor->is_super) {
+      y.rows.push_back(node);
+      continue;
+    }
+    const int* super = static_cast<const int*>(m_factor->super);
+    for (int j = super[node]; j < super[node + 1]; ++j) y.rows.push_back(j);
+  }
+  y.values.resize(static_cast<Eigen::Index>(y.rows.size()), width);
+  for (size_t r = 0; r < y.rows.size(); ++r) {
+    y.values.row(static_cast<Eigen::Index>(r)) = m_work.row(y.rows[r]);
+    m_work.row(y.rows[r]).setZero();
+  }
 }
 
 }  // namespace tissue

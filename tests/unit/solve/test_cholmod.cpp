@@ -10,6 +10,7 @@
 
 #include <Eigen/Dense>
 
+#include <algorithm>
 #include <cstdio>
 #include <limits>
 #include <random>
@@ -261,6 +262,62 @@ TEST(Cholmod, TwoSupernodalFactorsOnTwoThreadsGiveBitwiseTheirSerialResults) {
     EXPECT_TRUE(beside_first[k] == alone_first[k]) << "solve " << k << " of the first system";
     EXPECT_TRUE(beside_second[k] == alone_second[k]) << "solve " << k << " of the second system";
   }
+}
+
+// The forward half of a solve for a sparse right-hand side (lower_solve, what the contact stiffness
+// needs): for sparse b and c, y_b^T y_c must be b^T A^-1 c from full solves, in both layouts and
+// both orderings, while reaching only part of L (the elimination tree above b's rows).
+TEST(Cholmod, ALowerSolveOfSparseColumnsGivesTheFullSolvesInnerProducts) {
+  const test::TestSystem system = test::make_grid_system(9, 8, 7, 64, 0.05, {}, false);  // 1512 unknowns
+  const ShiftedSystem shifted = system.shifted(1.0);
+  const int n = shifted.rows();
+  std::mt19937 rng(65);
+  std::uniform_int_distribution<int> row(0, n - 1);
+  std::uniform_real_distribution<double> value(-1.0, 1.0);
+  std::vector<CholmodFactor::SparseColumn> columns(4);
+  for (auto& column : columns) {
+    for (int k = 0; k < 5; ++k) column.emplace_back(row(rng), value(rng));
+  }
+  columns[3].push_back(columns[3].front());  // a repeated row: summed
+  using Layout = CholmodFactor::Layout;
+  using Ordering = CholmodFactor::Ordering;
+  for (const Layout layout : {Layout::automatic, Layout::supernodal}) {
+    for (const Ordering ordering : {Ordering::amd, Ordering::metis}) {
+      CholmodFactor factor(CholmodFactor::Solves::with_factor, layout, ordering);
+      factor.load(shifted);
+      ASSERT_EQ(factor.factorize(), CholmodFactor::Status::ok);
+      EXPECT_EQ(factor.supernodal(), layout == Layout::supernodal);
+      EXPECT_EQ(factor.ordering_used(), ordering == Ordering::metis ? CHOLMOD_METIS : CHOLMOD_AMD);
+      Eigen::MatrixXd dense_b = Eigen::MatrixXd::Zero(n, 4);
+      for (size_t c = 0; c < columns.size(); ++c) {
+        for (const auto& [r, v] : columns[c]) dense_b(r, static_cast<Eigen::Index>(c)) += v;
+      }
+      Eigen::MatrixXd solved(n, 4);
+      for (Eigen::Index c = 0; c < 4; ++c) {
+        Eigen::VectorXd b = dense_b.col(c), x(n);
+        factor.solve(std::span<const double>(b.data(), static_cast<size_t>(n)),
+                     std::span<double>(x.data(), static_cast<size_t>(n)));
+        solved.col(c) = x;
+      }
+      const Eigen::MatrixXd expected = dense_b.transpose() * solved;
+      CholmodFactor::LowerSolution y;
+      for (int repeat = 0; repeat < 2; ++repeat) {  // the work rows are left zero for the next call
+        factor.lower_solve(columns, y);
+        const Eigen::MatrixXd gram = y.values.transpose() * y.values;
+        EXPECT_LE((gram - expected).norm(), 1e-10 * expected.norm())
+            << (layout == Layout::supernodal ? "supernodal" : "simplicial") << ", "
+            << (ordering == Ordering::metis ? "METIS" : "AMD");
+      }
+      EXPECT_TRUE(std::is_sorted(y.rows.begin(), y.rows.end()));
+      EXPECT_LT(static_cast<int>(y.rows.size()), n);
+      EXPECT_GT(y.rows.size(), 0U);
+      std::vector<CholmodFactor::SparseColumn> outside{{{n, 1.0}}};
+      EXPECT_THROW(factor.lower_solve(outside, y), std::invalid_argument);
+    }
+  }
+  CholmodFactor unfactored;
+  CholmodFactor::LowerSolution y;
+  EXPECT_THROW(unfactored.lower_solve(columns, y), SolverError);
 }
 
 }  // namespace

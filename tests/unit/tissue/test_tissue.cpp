@@ -269,53 +269,101 @@ TEST(Tissue, FreeBodyContactStiffnessLeavesTheSpringOut) {
   EXPECT_LT((tissue.contact().stiffness_n_per_m - *k_c).norm(), 1e-9 * k_c->norm());
 }
 
-// In the background (contact_stiffness_in_background), a refresh started at a step is what the next
-// step renders: the K_c the caller's thread condenses from the static K and the proxy as they were
-// when the step that started it ended. A new contact's first step renders the elementLocal
-// estimate (what the near-surface report gives before the touch).
-TEST(Tissue, ABackgroundContactStiffnessIsRenderedOneStepLate) {
-  const TetMesh mesh = make_box_mesh(6, 4, 2, 0.01);
-  TissueSettings settings;
-  settings.body.gravity_m_per_s2.setZero();
-  settings.body.fixed_vertices = vertices_at_minimum(mesh, 0, 0.0);
-  settings.step_size_s = 0.01;
-  settings.interaction.contact.stiffness_in_background = true;
-  settings.interaction.contact.stiffness_refresh_steps = 1;
-  Tissue tissue(mesh, settings);
-  const Eigen::Vector3d above(0.0413, 0.0187, 0.025);
-  tissue.set_tool({above, Eigen::Quaterniond::Identity(), ToolMode::probe});
-  tissue.step();
-  Eigen::Matrix3d expected = Eigen::Matrix3d::Zero();
-  EffectiveContactStiffness reference;
-  Eigen::VectorXd zero_diagonal;
-  for (int n = 1; n <= 12; ++n) {
-    const double depth_m = 2e-4 * n;
-    tissue.set_tool({Eigen::Vector3d(above.x(), above.y(), 0.02 - depth_m), Eigen::Quaterniond::Identity(),
-                     ToolMode::probe});
+// A box held at x = 0, its K_c refreshed in the background at every step (with a latency), pressed
+// from above 0.2 mm deeper each step; condensed_now() is the K_c the caller's thread condenses from
+// the static K and the proxy as they are when a step ends.
+struct BackgroundPress {
+  static TissueSettings settings(const TetMesh& mesh, int latency_steps) {
+    TissueSettings settings;
+    settings.body.gravity_m_per_s2.setZero();
+    settings.body.fixed_vertices = vertices_at_minimum(mesh, 0, 0.0);
+    settings.step_size_s = 0.01;
+    settings.interaction.contact.stiffness_in_background = true;
+    settings.interaction.contact.stiffness_refresh_steps = 1;
+    settings.interaction.contact.stiffness_latency_steps = latency_steps;
+    return settings;
+  }
+  explicit BackgroundPress(int latency_steps)
+      : mesh(make_box_mesh(6, 4, 2, 0.01)), tissue(mesh, settings(mesh, latency_steps)) {
+    press(0);
+  }
+  void press(int n) {
+    const double height_m = n == 0 ? ABOVE.z() : 0.02 - 2e-4 * n;
+    tissue.set_tool({Eigen::Vector3d(ABOVE.x(), ABOVE.y(), height_m), Eigen::Quaterniond::Identity(), ToolMode::probe});
     tissue.step();
-    ASSERT_TRUE(tissue.contact().active) << n;
-    const int triangle = tissue.point_contact().proxy().triangle;
-    if (n == 1) {
-      EXPECT_TRUE(tissue.contact().stiffness_n_per_m ==
-                  element_local_contact_stiffness(tissue.body().elasticity(), tissue.surface(), triangle));
-    } else {
-      EXPECT_TRUE(tissue.contact().stiffness_n_per_m == expected)
-          << "step " << n << ": max difference " << (tissue.contact().stiffness_n_per_m - expected).cwiseAbs().maxCoeff();
-    }
-    // What the next step will render: K_c condensed here, now.
+  }
+  [[nodiscard]] Eigen::Matrix3d element_local() const {
+    return element_local_contact_stiffness(tissue.body().elasticity(), tissue.surface(),
+                                           tissue.point_contact().proxy().triangle);
+  }
+  [[nodiscard]] std::optional<Eigen::Matrix3d> condensed_now() {
     const SurfacePoint& proxy = tissue.point_contact().proxy();
-    const std::optional<Eigen::Matrix3d> now = condensed_contact_stiffness(
+    return condensed_contact_stiffness(
         reference, static_contact_system(tissue.body().tangent(), zero_diagonal), tissue.body().dofs(),
         contact_interpolation(tissue.body().dofs(), tissue.surface_bvh().triangle(proxy.triangle), proxy.barycentric),
         tissue.contact_spring().spring(), tissue.contact_spring_stiffness_n_per_m(), 0.0);
+  }
+
+  static inline const Eigen::Vector3d ABOVE{0.0413, 0.0187, 0.025};
+  TetMesh mesh;
+  Tissue tissue;
+  EffectiveContactStiffness reference;
+  Eigen::VectorXd zero_diagonal;
+};
+
+// In the background (contact_stiffness_in_background), a refresh started at a step is what the next
+// step renders (the default latency, one step). A new contact's first step renders the elementLocal
+// estimate (what the near-surface report gives before the touch).
+TEST(Tissue, ABackgroundContactStiffnessIsRenderedOneStepLate) {
+  BackgroundPress press(1);
+  Eigen::Matrix3d expected = Eigen::Matrix3d::Zero();
+  for (int n = 1; n <= 12; ++n) {
+    press.press(n);
+    ASSERT_TRUE(press.tissue.contact().active) << n;
+    const Eigen::Matrix3d& rendered = press.tissue.contact().stiffness_n_per_m;
+    if (n == 1) {
+      EXPECT_TRUE(rendered == press.element_local());
+    } else {
+      EXPECT_TRUE(rendered == expected) << "step " << n << ": max difference "
+                                        << (rendered - expected).cwiseAbs().maxCoeff();
+    }
+    const std::optional<Eigen::Matrix3d> now = press.condensed_now();  // what the next step will render
     ASSERT_TRUE(now.has_value());
     // The stiffness changes as the probe presses in, so that rendering it a step late is seen.
     if (n >= 3) {
-      EXPECT_FALSE(tissue.contact().stiffness_n_per_m == *now) << n;
+      EXPECT_FALSE(rendered == *now) << n;
     }
     expected = *now;
   }
-  EXPECT_EQ(tissue.contact_stiffness_fallbacks(), 0);
+  EXPECT_EQ(press.tissue.contact_stiffness_fallbacks(), 0);
+}
+
+// With contact_stiffness_latency_steps = 3 (a factorization longer than a step: the organ), a refresh
+// started at a step is rendered three steps later, the one before standing until then, and the next
+// starts at that step: K_c is refreshed every 3 steps (the refresh period, 1 here, is shorter). The
+// new contact's elementLocal estimate (of its first step) stands for the first three steps.
+TEST(Tissue, ABackgroundContactStiffnessIsRenderedAfterItsLatency) {
+  constexpr int LATENCY = 3;
+  BackgroundPress press(LATENCY);
+  std::vector<Eigen::Matrix3d> condensed;  // K_c condensed at the end of each step in contact
+  Eigen::Matrix3d expected = Eigen::Matrix3d::Zero();
+  for (int n = 1; n <= 13; ++n) {
+    press.press(n);
+    ASSERT_TRUE(press.tissue.contact().active) << n;
+    const Eigen::Matrix3d& rendered = press.tissue.contact().stiffness_n_per_m;
+    // Refreshes start at steps 1, 4, 7, ... (the contact's first, then every LATENCY) and land
+    // LATENCY steps later.
+    if (n == 1) expected = press.element_local();
+    if (n > LATENCY && (n - 1) % LATENCY == 0) expected = condensed[static_cast<size_t>(n - 1 - LATENCY)];
+    EXPECT_TRUE(rendered == expected) << "step " << n << ": max difference "
+                                      << (rendered - expected).cwiseAbs().maxCoeff();
+    const std::optional<Eigen::Matrix3d> now = press.condensed_now();
+    ASSERT_TRUE(now.has_value());
+    condensed.push_back(*now);
+  }
+  // The stiffness changed between the refreshes, so that rendering the wrong one would be seen.
+  EXPECT_FALSE(condensed[3] == condensed[6]);
+  EXPECT_EQ(press.tissue.contact_stiffness_fallbacks(), 0);
 }
 
 TEST(Tissue, BuildsOnlyWhatTheSceneRequires) {
