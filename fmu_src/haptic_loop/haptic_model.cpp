@@ -257,6 +257,10 @@ void HapticModel::serialize(const fmi3::ModelState& model_state, serial::ByteWri
   put_array(w, r.contact_stiffness_n_per_m);
   put_array(w, r.contact_damping_n_s_per_m);
   put_array(w, r.sample_tool_velocity_m_per_s);
+  w.put_bool(r.has_estimate_pair);
+  put_array(w, r.estimate_pair);
+  put_array(w, r.normal_model);
+  put_array(w, r.sample_motion_m_per_s);
   put_array(w, r.tool_position_m);
   w.put(r.blade_depth_m);
   w.put_bool(r.has_previous_position);
@@ -286,6 +290,10 @@ std::unique_ptr<fmi3::ModelState> HapticModel::deserialize(serial::ByteReader& r
   get_array(r, s.contact_stiffness_n_per_m);
   get_array(r, s.contact_damping_n_s_per_m);
   get_array(r, s.sample_tool_velocity_m_per_s);
+  s.has_estimate_pair = r.get_bool();
+  get_array(r, s.estimate_pair);
+  get_array(r, s.normal_model);
+  get_array(r, s.sample_motion_m_per_s);
   get_array(r, s.tool_position_m);
   r.get(s.blade_depth_m);
   s.has_previous_position = r.get_bool();

@@ -2,6 +2,7 @@
 
 #include "haptic/contact_force.hpp"
 #include "haptic/force_limits.hpp"
+#include "haptic/normal_model_estimate.hpp"
 #include "haptic/velocity_filter.hpp"
 
 #include <algorithm>
@@ -58,30 +59,50 @@ HapticRenderer::HapticRenderer(RendererSettings settings) : m_settings(settings)
 void HapticRenderer::set_sample(const TissueSample& sample) {
   TissueSample prepared = sample;
   const SampleRepair repair = prepare_sample(prepared);  // throws before anything changes
-  if (prepared.contact_active && prepared.contact_stiffness_n_per_m.isZero(0.0)) {
-    prepared.contact_stiffness_n_per_m = estimated_stiffness(prepared);
-  }
   const bool touching = prepared.contact_active || prepared.surface_near;
   const bool followed = m_has_sample && (m_sample.contact_active || m_sample.surface_near);
   const double interval_s = prepared.time_s - m_sample.time_s;
-  m_sample_tool_velocity_m_per_s = touching && followed && interval_s > 0.0
-                                       ? ((prepared.tool_position_m - m_sample.tool_position_m) / interval_s).eval()
-                                       : Eigen::Vector3d::Zero();
+  const Eigen::Vector3d tool_velocity_m_per_s =
+      touching && followed && interval_s > 0.0
+          ? ((prepared.tool_position_m - m_sample.tool_position_m) / interval_s).eval()
+          : Eigen::Vector3d::Zero();
+  // The tool's motion over the sample interval whatever the contact (the estimate's depth rate).
+  const Eigen::Vector3d motion_m_per_s = m_has_sample && interval_s > 0.0
+                                             ? ((prepared.tool_position_m - m_sample.tool_position_m) / interval_s).eval()
+                                             : Eigen::Vector3d::Zero();
+  if (prepared.contact_active && prepared.contact_stiffness_n_per_m.isZero(0.0)) {
+    estimate_contact_model(prepared, motion_m_per_s);
+  } else {
+    m_estimate_pair.reset();
+  }
+  m_sample_tool_velocity_m_per_s = tool_velocity_m_per_s;
+  m_sample_motion_m_per_s = motion_m_per_s;
   m_sample = prepared;
   m_has_sample = true;
   m_last_sample_repaired = repair.stiffness_repaired || repair.damping_repaired;
 }
 
-Eigen::Matrix3d HapticRenderer::estimated_stiffness(const TissueSample& sample) const {
+void HapticRenderer::estimate_contact_model(TissueSample& sample, const Eigen::Vector3d& motion_m_per_s) {
   const Eigen::Vector3d& n = sample.contact_normal;
-  if (!m_has_sample || !m_sample.contact_active) return Eigen::Matrix3d::Zero();
-  double k_n_per_m = n.dot(m_sample.contact_stiffness_n_per_m * n);  // the last estimate, along n
-  const double moved_m = (sample.tool_position_m - m_sample.tool_position_m).dot(n);
-  if (std::abs(moved_m) > MIN_SECANT_MOTION_M) {
-    const double secant = -(sample.force_on_tool_n - m_sample.force_on_tool_n).dot(n) / moved_m;
-    if (std::isfinite(secant)) k_n_per_m = std::clamp(secant, 0.0, m_settings.max_estimated_stiffness_n_per_m);
+  const Eigen::Matrix3d normal_projector = (n * n.transpose()).eval();  // exactly symmetric
+  const bool damping_reported = !sample.contact_damping_n_s_per_m.isZero(0.0);
+  NormalModel model = m_normal_model;  // the last estimate, of this contact or the one before
+  if (damping_reported) model.damping_n_s_per_m = n.dot(sample.contact_damping_n_s_per_m * n);
+  if (m_has_sample && m_sample.contact_active) {
+    const NormalPair pair{-(sample.tool_position_m - m_sample.tool_position_m).dot(n),
+                          -(motion_m_per_s - m_sample_motion_m_per_s).dot(n),
+                          (sample.force_on_tool_n - m_sample.force_on_tool_n).dot(n)};
+    NormalModelLimits limits;
+    limits.max_stiffness_n_per_m = m_settings.max_estimated_stiffness_n_per_m;
+    limits.min_depth_change_m = MIN_SECANT_MOTION_M;
+    model = estimate_normal_model(model, pair, m_estimate_pair, damping_reported, limits);
+    m_estimate_pair = pair;
+  } else {
+    m_estimate_pair.reset();  // the contact's first sample: the last contact's model stands
   }
-  return k_n_per_m * (n * n.transpose()).eval();  // n n^T first: exactly symmetric
+  m_normal_model = model;
+  sample.contact_stiffness_n_per_m = model.stiffness_n_per_m * normal_projector;
+  if (!damping_reported) sample.contact_damping_n_s_per_m = model.damping_n_s_per_m * normal_projector;
 }
 
 Eigen::Vector3d HapticRenderer::tick(const Eigen::Vector3d& device_position_m, ToolMode mode, double dt_s) {
@@ -184,6 +205,13 @@ RendererState HapticRenderer::save_state() const {
   Eigen::Map<Eigen::Matrix3d>(state.contact_stiffness_n_per_m.data()) = m_sample.contact_stiffness_n_per_m;
   Eigen::Map<Eigen::Matrix3d>(state.contact_damping_n_s_per_m.data()) = m_sample.contact_damping_n_s_per_m;
   state.sample_tool_velocity_m_per_s = to_array(m_sample_tool_velocity_m_per_s);
+  state.sample_motion_m_per_s = to_array(m_sample_motion_m_per_s);
+  state.normal_model = {m_normal_model.stiffness_n_per_m, m_normal_model.damping_n_s_per_m};
+  state.has_estimate_pair = m_estimate_pair.has_value();
+  if (m_estimate_pair) {
+    state.estimate_pair = {m_estimate_pair->depth_change_m, m_estimate_pair->rate_change_m_per_s,
+                           m_estimate_pair->force_change_n};
+  }
   state.tool_position_m = to_array(m_sample.tool_position_m);
   state.blade_depth_m = m_sample.blade_depth_m;
   state.has_previous_position = m_has_previous_position;
@@ -216,7 +244,11 @@ void HapticRenderer::restore_state(const RendererState& state) {
     throw std::invalid_argument("RendererState: the contact stiffness or damping is not symmetric positive semi-definite");
   }
   const bool motion_finite = all_finite(state.previous_position_m) && all_finite(state.filtered_velocity_m_per_s) &&
-                             all_finite(state.sample_tool_velocity_m_per_s);
+                             all_finite(state.sample_tool_velocity_m_per_s) && all_finite(state.estimate_pair) &&
+                             all_finite(state.sample_motion_m_per_s);
+  const bool model_valid = state.normal_model[0] >= 0.0 && state.normal_model[1] >= 0.0 &&
+                           std::isfinite(state.normal_model[0]) && std::isfinite(state.normal_model[1]);
+  if (!model_valid) throw std::invalid_argument("RendererState: the estimated contact model is not finite and >= 0");
   const bool command_finite = all_finite(state.commanded_force_n) && all_finite(state.commanded_damping_n);
   if (!motion_finite || !command_finite || !std::isfinite(state.observed_energy_j) ||
       !std::isfinite(state.dissipated_energy_j)) {
@@ -228,6 +260,12 @@ void HapticRenderer::restore_state(const RendererState& state) {
 
   m_sample = sample;
   m_sample_tool_velocity_m_per_s = to_vector(state.sample_tool_velocity_m_per_s);
+  m_sample_motion_m_per_s = to_vector(state.sample_motion_m_per_s);
+  m_normal_model = NormalModel{state.normal_model[0], state.normal_model[1]};
+  m_estimate_pair.reset();
+  if (state.has_estimate_pair) {
+    m_estimate_pair = NormalPair{state.estimate_pair[0], state.estimate_pair[1], state.estimate_pair[2]};
+  }
   m_has_sample = state.has_sample;
   m_last_sample_repaired = false;
   m_has_previous_position = state.has_previous_position;

@@ -19,12 +19,14 @@
 
 #include "core/parameter_error.hpp"
 #include "haptic/cutting_force.hpp"
+#include "haptic/normal_model_estimate.hpp"
 #include "haptic/passivity.hpp"
 #include "haptic/tissue_sample.hpp"
 
 #include <Eigen/Core>
 
 #include <array>
+#include <optional>
 #include <type_traits>
 
 namespace tissue::haptic {
@@ -101,6 +103,12 @@ struct RendererState {
   std::array<double, 9> contact_stiffness_n_per_m{};
   std::array<double, 9> contact_damping_n_s_per_m{};
   std::array<double, 3> sample_tool_velocity_m_per_s{};  ///< v0 (HapticRenderer::sample_tool_velocity_m_per_s)
+  /// The force-only estimate's last pair of samples in contact (normal_model_estimate.hpp): depth,
+  /// rate and force changes.
+  bool has_estimate_pair = false;
+  std::array<double, 3> estimate_pair{};
+  std::array<double, 2> normal_model{};               ///< the last estimate: K [N/m], c [N s/m]
+  std::array<double, 3> sample_motion_m_per_s{};      ///< the tool's velocity over the last sample interval
   std::array<double, 3> tool_position_m{};
   double blade_depth_m = 0.0;
   // Motion.
@@ -126,10 +134,11 @@ class HapticRenderer {
   /// Throws std::invalid_argument (naming the field; the renderer unchanged) for a sample that
   /// prepare_sample() refuses: non-finite numbers, negative blade depth, a non-unit normal.
   /// The tool's velocity over the tissue step (sample_tool_velocity_m_per_s) is estimated here.
-  /// A sample in contact without stiffness (K_c = 0) gets k n n^T, k the secant of its normal force
-  /// over the tool's normal motion since the previous sample in contact (clamped to [0,
-  /// max_estimated_stiffness_n_per_m]; the previous k while the tool moved less than 1 um): held
-  /// force alone renders a delayed, active spring (issue 20; docs/DESIGN.md, "Haptic loop").
+  /// A sample in contact without stiffness (K_c = 0: a tissue that reports its force only) gets
+  /// K n n^T and, without damping either, c n n^T: the normal model its force's changes over the last
+  /// two sample pairs give (normal_model_estimate.hpp; K at most max_estimated_stiffness_n_per_m):
+  /// held force alone renders a delayed, active spring and damper (issues 20, 42; docs/DESIGN.md,
+  /// "Haptic loop").
   void set_sample(const TissueSample& sample);
 
   /// One haptic tick: the device (hand) position now, the tool mode, the tick length. Returns the
@@ -165,11 +174,17 @@ class HapticRenderer {
   double dissipated_energy_j() const { return m_observer.dissipated_j(); }
 
  private:
-  /// k n n^T for a sample without stiffness (set_sample).
-  [[nodiscard]] Eigen::Matrix3d estimated_stiffness(const TissueSample& sample) const;
+  /// K_c = K n n^T (and D_c = c n n^T unless the sample reports it) for a sample in contact without
+  /// stiffness, from the normal force's changes over the last two sample pairs (set_sample;
+  /// normal_model_estimate.hpp).
+  /// `motion_m_per_s`: the tool's velocity over the interval since the previous sample, in contact or not.
+  void estimate_contact_model(TissueSample& sample, const Eigen::Vector3d& motion_m_per_s);
   RendererSettings m_settings;
   TissueSample m_sample;
   Eigen::Vector3d m_sample_tool_velocity_m_per_s = Eigen::Vector3d::Zero();
+  std::optional<NormalPair> m_estimate_pair;  // the last pair of samples in contact, for the estimate
+  NormalModel m_normal_model;                 // the last estimate (kept from one contact to the next)
+  Eigen::Vector3d m_sample_motion_m_per_s = Eigen::Vector3d::Zero();  // the tool's, over the last interval
   bool m_has_sample = false;
   bool m_last_sample_repaired = false;
   bool m_has_previous_position = false;

@@ -108,21 +108,24 @@ Sample ViscoelasticWall::sample(const Vec3& tool_m, double time_s) {
   if (m_last && time_s > m_last->first) rate_m_per_s = (depth_m - m_last->second) / (time_s - m_last->first);
   m_last = {time_s, depth_m};
   s.contact_active = depth_m > 0.0;
-  s.contact_near = !s.contact_active && tool_m[2] < NEAR_MARGIN_M;
+  s.contact_near = m_reports.near && !s.contact_active && tool_m[2] < NEAR_MARGIN_M;
   s.point_m = {tool_m[0], tool_m[1], 0.0};
   if (s.contact_active) {
     s.force_n = {0.0, 0.0, std::max(0.0, m_stiffness_n_per_m * depth_m + m_damping_n_s_per_m * rate_m_per_s)};
   }
-  s.stiffness_n_per_m[8] = m_stiffness_n_per_m;
-  if (m_reports_damping) s.damping_n_s_per_m[8] = m_damping_n_s_per_m;
+  if (m_reports.stiffness) s.stiffness_n_per_m[8] = m_stiffness_n_per_m;
+  if (m_reports.damping) s.damping_n_s_per_m[8] = m_damping_n_s_per_m;
   s.tool_position_m = tool_m;
   return s;
 }
 
 std::string ViscoelasticWall::name() const {
+  std::string reported = m_reports.stiffness ? "K_c" : "";
+  if (m_reports.damping) reported += reported.empty() ? "D_c" : ", D_c";
+  if (m_reports.near) reported += reported.empty() ? "near" : ", near";
   return std::to_string(static_cast<int>(m_stiffness_n_per_m)) + " N/m viscoelastic wall (" +
-         std::to_string(static_cast<int>(m_damping_n_s_per_m)) + " N s/m" + (m_reports_damping ? "" : ", not reported") +
-         ")";
+         std::to_string(static_cast<int>(m_damping_n_s_per_m)) + " N s/m; " +
+         (reported.empty() ? std::string("force only") : "reports " + reported) + ")";
 }
 
 Sample CorruptedSamples::sample(const Vec3& tool_m, double time_s) {

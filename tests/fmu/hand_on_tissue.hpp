@@ -63,19 +63,26 @@ class Wall final : public SyntheticTissue {
   bool m_reports_near;
 };
 
+/// What a synthetic tissue reports besides its force.
+struct Reports {
+  bool stiffness = true;  ///< K_c (else 0)
+  bool damping = true;    ///< D_c (else 0)
+  bool near = true;       ///< the surface within NEAR_MARGIN_M of a tool not in contact
+};
+
 /// A Kelvin-Voigt wall whose force lags its depth: K d + c dd/dt (dd/dt from the last two samples),
-/// K_c = K e_z e_z^T, D_c = c e_z e_z^T (or 0: a tissue that does not report its damping).
+/// K_c = K e_z e_z^T, D_c = c e_z e_z^T, each reported or 0 as `reports` says (all off: a tissue
+/// from another tool that reports its force only).
 class ViscoelasticWall final : public SyntheticTissue {
  public:
-  ViscoelasticWall(double stiffness_n_per_m, double damping_n_s_per_m, bool reports_damping = true)
-      : m_stiffness_n_per_m(stiffness_n_per_m), m_damping_n_s_per_m(damping_n_s_per_m),
-        m_reports_damping(reports_damping) {}
+  ViscoelasticWall(double stiffness_n_per_m, double damping_n_s_per_m, Reports reports = {})
+      : m_stiffness_n_per_m(stiffness_n_per_m), m_damping_n_s_per_m(damping_n_s_per_m), m_reports(reports) {}
   Sample sample(const Vec3& tool_m, double time_s) override;
   [[nodiscard]] std::string name() const override;
 
  private:
   double m_stiffness_n_per_m, m_damping_n_s_per_m;
-  bool m_reports_damping;
+  Reports m_reports;
   std::optional<std::pair<double, double>> m_last;  // (time, depth)
 };
 

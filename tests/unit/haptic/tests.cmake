@@ -3,7 +3,7 @@
 add_executable(test_haptic
   ${CMAKE_CURRENT_LIST_DIR}/test_contact_force.cpp ${CMAKE_CURRENT_LIST_DIR}/test_force_limits.cpp
   ${CMAKE_CURRENT_LIST_DIR}/test_cutting_force.cpp ${CMAKE_CURRENT_LIST_DIR}/test_passivity.cpp
-  ${CMAKE_CURRENT_LIST_DIR}/test_haptic_renderer.cpp)
+  ${CMAKE_CURRENT_LIST_DIR}/test_haptic_renderer.cpp ${CMAKE_CURRENT_LIST_DIR}/test_normal_model_estimate.cpp)
 target_link_libraries(test_haptic PRIVATE tissue::haptic_core tissue::warnings GTest::gtest GTest::gtest_main)
 target_include_directories(test_haptic PRIVATE ${PROJECT_SOURCE_DIR}/tests)
 # Two labels: LABELS "unit;physics" loses its ';' on the way through the discovery script (CMake

@@ -1,0 +1,95 @@
+// The contact model of a force-only tissue from its samples (normal_model_estimate.hpp, issue 42):
+// a Kelvin-Voigt wall f_n = K p + c q (p the depth along a tilted normal, q its rate over the sample
+// period, as the tissue computes it) gives back K and c exactly once the tool's speed changes between
+// two sample pairs; at a constant speed c cannot be told from the offset and stays, K exact; a
+// reported D_c is kept and only K estimated; out-of-range solutions fall back.
+#include "haptic/haptic_renderer.hpp"
+#include "haptic/normal_model_estimate.hpp"
+
+#include <gtest/gtest.h>
+
+#include <Eigen/Geometry>
+
+#include <cmath>
+#include <optional>
+
+namespace tissue::haptic {
+namespace {
+
+constexpr double K = 1800.0;   // N/m
+constexpr double C = 27.0;     // N s/m
+constexpr double PERIOD_S = 0.01;
+
+// The wall's sample for a tool at depth p(t) along n (the tissue's rate from its own last two samples).
+TissueSample wall_sample(double time_s, double depth_m, double previous_depth_m, bool reports_damping) {
+  TissueSample s;
+  s.time_s = time_s;
+  s.contact_active = true;
+  s.contact_normal = Eigen::Vector3d(0.2, -0.3, 1.0).normalized();
+  s.contact_point_m = Eigen::Vector3d(0.01, 0.02, 0.0);
+  s.tool_position_m = s.contact_point_m - depth_m * s.contact_normal + Eigen::Vector3d(1e-4, 2e-4, 0.0).cross(s.contact_normal);
+  const double rate = (depth_m - previous_depth_m) / PERIOD_S;
+  s.force_on_tool_n = (K * depth_m + C * rate) * s.contact_normal;
+  if (reports_damping) s.contact_damping_n_s_per_m = C * s.contact_normal * s.contact_normal.transpose();
+  return s;
+}
+
+double depth_at(int k) { return 1e-3 + 4e-4 * std::sin(0.9 * k); }  // a hand ringing at ~14 Hz
+
+TEST(NormalModelEstimate, AKelvinVoigtWallGivesBackItsStiffnessAndDamping) {
+  for (const bool reports_damping : {false, true}) {
+    HapticRenderer renderer;
+    for (int k = 1; k <= 6; ++k) {
+      renderer.set_sample(wall_sample(k * PERIOD_S, depth_at(k), depth_at(k - 1), reports_damping));
+      const Eigen::Vector3d& n = renderer.sample().contact_normal;
+      const double k_n = n.dot(renderer.sample().contact_stiffness_n_per_m * n);
+      const double c_n = n.dot(renderer.sample().contact_damping_n_s_per_m * n);
+      if (k == 1) {
+        EXPECT_EQ(k_n, 0.0) << "the contact's first sample is held";
+      } else if (k >= (reports_damping ? 3 : 4)) {
+        // The first sample's rate is unknown to the loop (no sample before it), so the first pair's
+        // rate change is off: one pair after it gives K with c known, two split K from c.
+        EXPECT_NEAR(k_n, K, 1e-6 * K) << "sample " << k;
+        EXPECT_NEAR(c_n, C, 1e-6 * C) << "sample " << k;
+        EXPECT_NEAR((renderer.sample().contact_stiffness_n_per_m - k_n * n * n.transpose()).norm(), 0.0, 1e-9 * K);
+      }
+    }
+  }
+}
+
+TEST(NormalModelEstimate, AtAConstantSpeedTheDampingStaysAndTheStiffnessIsExact) {
+  const NormalModelLimits limits;
+  const NormalModel last{500.0, 10.0};
+  // Pairs at the same speed: dq = 0, the two equations are one; df = K dp.
+  const NormalPair pair{2e-4, 0.0, K * 2e-4}, previous{2e-4, 0.0, K * 2e-4};
+  const NormalModel model = estimate_normal_model(last, pair, previous, false, limits);
+  EXPECT_NEAR(model.stiffness_n_per_m, K, 1e-9 * K);
+  EXPECT_EQ(model.damping_n_s_per_m, 10.0);
+  // No motion: the last model stands.
+  const NormalModel held = estimate_normal_model(last, NormalPair{1e-8, 0.0, 0.3}, previous, false, limits);
+  EXPECT_EQ(held.stiffness_n_per_m, 500.0);
+  EXPECT_EQ(held.damping_n_s_per_m, 10.0);
+}
+
+TEST(NormalModelEstimate, SolutionsOutOfRangeFallBackToTheSecant) {
+  NormalModelLimits limits;
+  const NormalModel last{500.0, 10.0};
+  // A force that fell as the tool went deeper, with a rate change that makes the joint solve negative:
+  // the secant (clamped at 0) and the last c.
+  const NormalPair pair{2e-4, 0.02, -0.5}, previous{-1e-4, 0.03, 0.2};
+  const NormalModel model = estimate_normal_model(last, pair, previous, false, limits);
+  EXPECT_EQ(model.damping_n_s_per_m, 10.0);
+  EXPECT_EQ(model.stiffness_n_per_m, 0.0);
+  // A stiffness above the limit is clamped.
+  limits.max_stiffness_n_per_m = 1000.0;
+  const NormalModel stiff = estimate_normal_model(NormalModel{}, NormalPair{1e-4, 0.0, 0.5}, std::nullopt, false, limits);
+  EXPECT_EQ(stiff.stiffness_n_per_m, 1000.0);
+  // max_estimated_stiffness 0 (no estimate) allows no damping either.
+  limits.max_stiffness_n_per_m = 0.0;
+  const NormalModel none = estimate_normal_model(NormalModel{}, NormalPair{2e-4, 0.02, 0.6}, previous, false, limits);
+  EXPECT_EQ(none.stiffness_n_per_m, 0.0);
+  EXPECT_EQ(none.damping_n_s_per_m, 0.0);
+}
+
+}  // namespace
+}  // namespace tissue::haptic
