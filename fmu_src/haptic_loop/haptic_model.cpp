@@ -261,6 +261,11 @@ void HapticModel::serialize(const fmi3::ModelState& model_state, serial::ByteWri
   put_array(w, r.estimate_pair);
   put_array(w, r.normal_model);
   put_array(w, r.sample_motion_m_per_s);
+  w.put_bool(r.has_last_contact);
+  put_array(w, r.last_contact_point_m);
+  put_array(w, r.last_contact_normal);
+  put_array(w, r.last_contact_stiffness_n_per_m);
+  put_array(w, r.last_contact_damping_n_s_per_m);
   put_array(w, r.tool_position_m);
   w.put(r.blade_depth_m);
   w.put_bool(r.has_previous_position);
@@ -294,6 +299,11 @@ std::unique_ptr<fmi3::ModelState> HapticModel::deserialize(serial::ByteReader& r
   get_array(r, s.estimate_pair);
   get_array(r, s.normal_model);
   get_array(r, s.sample_motion_m_per_s);
+  s.has_last_contact = r.get_bool();
+  get_array(r, s.last_contact_point_m);
+  get_array(r, s.last_contact_normal);
+  get_array(r, s.last_contact_stiffness_n_per_m);
+  get_array(r, s.last_contact_damping_n_s_per_m);
   get_array(r, s.tool_position_m);
   r.get(s.blade_depth_m);
   s.has_previous_position = r.get_bool();

@@ -35,6 +35,9 @@ constexpr double FORCE_BOUND_SLACK = 1e-12;
 /// Below this motion along the normal between two samples the force's secant is noise: keep the
 /// last stiffness estimate (1 um, about a desktop device's position resolution).
 constexpr double MIN_SECANT_MOTION_M = 1e-6;
+/// A force-only tissue's last contact plane stands in for the surface near report while the tool
+/// stays this close to where it touched (the Tissue FMU's contact.nearMargin start value).
+constexpr double REMEMBERED_PLANE_RADIUS_M = 0.01;
 
 }  // namespace
 
@@ -72,14 +75,26 @@ void HapticRenderer::set_sample(const TissueSample& sample) {
                                              : Eigen::Vector3d::Zero();
   if (prepared.contact_active && prepared.contact_stiffness_n_per_m.isZero(0.0)) {
     estimate_contact_model(prepared, motion_m_per_s);
+    remember_contact_plane(prepared);
   } else {
     m_estimate_pair.reset();
+    if (prepared.contact_active || prepared.surface_near) m_last_contact.reset();  // the tissue says it itself
   }
   m_sample_tool_velocity_m_per_s = tool_velocity_m_per_s;
   m_sample_motion_m_per_s = motion_m_per_s;
   m_sample = prepared;
   m_has_sample = true;
   m_last_sample_repaired = repair.stiffness_repaired || repair.damping_repaired;
+}
+
+void HapticRenderer::remember_contact_plane(const TissueSample& sample) {
+  TissueSample plane;
+  plane.surface_near = true;
+  plane.contact_point_m = sample.contact_point_m;
+  plane.contact_normal = sample.contact_normal;
+  plane.contact_stiffness_n_per_m = sample.contact_stiffness_n_per_m;
+  plane.contact_damping_n_s_per_m = sample.contact_damping_n_s_per_m;
+  m_last_contact = plane;
 }
 
 void HapticRenderer::estimate_contact_model(TissueSample& sample, const Eigen::Vector3d& motion_m_per_s) {
@@ -143,13 +158,22 @@ Eigen::Vector3d HapticRenderer::tick(const Eigen::Vector3d& device_position_m, T
   // The environment: contact (probe or scalpel, as the sample says) and cutting (scalpel).
   if (m_has_sample && mode != ToolMode::none) {
     const bool near_plane = !m_sample.contact_active && m_sample.surface_near && mode == ToolMode::probe;
-    if (m_sample.contact_active || near_plane) {
+    if (!m_sample.contact_active && !m_sample.surface_near && m_last_contact &&
+        (device_position_m - m_last_contact->contact_point_m).norm() > REMEMBERED_PLANE_RADIUS_M) {
+      m_last_contact.reset();  // the tool left the place: the plane says nothing of elsewhere
+    }
+    const bool remembered_plane =
+        !m_sample.contact_active && !m_sample.surface_near && m_last_contact && mode == ToolMode::probe;
+    if (m_sample.contact_active || near_plane || remembered_plane) {
+      const TissueSample& plane = remembered_plane ? *m_last_contact : m_sample;
       const Eigen::Vector3d spring_n = m_sample.contact_active ? intermediate_force(m_sample, device_position_m)
-                                                               : near_surface_force(m_sample, device_position_m);
+                                                               : near_surface_force(plane, device_position_m);
+      const Eigen::Vector3d sample_velocity_m_per_s =
+          remembered_plane ? Eigen::Vector3d::Zero() : m_sample_tool_velocity_m_per_s;
       const Eigen::Vector3d damping_n =
-          contact_damping_force(m_sample, motion_m_per_s, m_sample_tool_velocity_m_per_s,
-                                m_settings.contact_damping_n_s_per_m, m_settings.hold_damping ? dt_s : 0.0);
-      report.contact_force_n = unilateral_force(spring_n + damping_n, m_sample, device_position_m);
+          contact_damping_force(plane, motion_m_per_s, sample_velocity_m_per_s, m_settings.contact_damping_n_s_per_m,
+                                m_settings.hold_damping ? dt_s : 0.0);
+      report.contact_force_n = unilateral_force(spring_n + damping_n, plane, device_position_m);
     }
     if (mode == ToolMode::scalpel) {
       report.cutting_force_n =
@@ -206,6 +230,13 @@ RendererState HapticRenderer::save_state() const {
   Eigen::Map<Eigen::Matrix3d>(state.contact_damping_n_s_per_m.data()) = m_sample.contact_damping_n_s_per_m;
   state.sample_tool_velocity_m_per_s = to_array(m_sample_tool_velocity_m_per_s);
   state.sample_motion_m_per_s = to_array(m_sample_motion_m_per_s);
+  state.has_last_contact = m_last_contact.has_value();
+  if (m_last_contact) {
+    state.last_contact_point_m = to_array(m_last_contact->contact_point_m);
+    state.last_contact_normal = to_array(m_last_contact->contact_normal);
+    Eigen::Map<Eigen::Matrix3d>(state.last_contact_stiffness_n_per_m.data()) = m_last_contact->contact_stiffness_n_per_m;
+    Eigen::Map<Eigen::Matrix3d>(state.last_contact_damping_n_s_per_m.data()) = m_last_contact->contact_damping_n_s_per_m;
+  }
   state.normal_model = {m_normal_model.stiffness_n_per_m, m_normal_model.damping_n_s_per_m};
   state.has_estimate_pair = m_estimate_pair.has_value();
   if (m_estimate_pair) {
@@ -249,6 +280,21 @@ void HapticRenderer::restore_state(const RendererState& state) {
   const bool model_valid = state.normal_model[0] >= 0.0 && state.normal_model[1] >= 0.0 &&
                            std::isfinite(state.normal_model[0]) && std::isfinite(state.normal_model[1]);
   if (!model_valid) throw std::invalid_argument("RendererState: the estimated contact model is not finite and >= 0");
+  std::optional<TissueSample> last_contact;
+  if (state.has_last_contact) {
+    TissueSample plane;
+    plane.surface_near = true;
+    plane.contact_point_m = to_vector(state.last_contact_point_m);
+    plane.contact_normal = to_vector(state.last_contact_normal);
+    plane.contact_stiffness_n_per_m = Eigen::Map<const Eigen::Matrix3d>(state.last_contact_stiffness_n_per_m.data());
+    plane.contact_damping_n_s_per_m = Eigen::Map<const Eigen::Matrix3d>(state.last_contact_damping_n_s_per_m.data());
+    TissueSample checked = plane;
+    const SampleRepair plane_repair = prepare_sample(checked);  // throws for a non-finite or non-unit value
+    if (plane_repair.stiffness_repaired || plane_repair.damping_repaired) {
+      throw std::invalid_argument("RendererState: the remembered plane's stiffness or damping is not symmetric PSD");
+    }
+    last_contact = plane;
+  }
   const bool command_finite = all_finite(state.commanded_force_n) && all_finite(state.commanded_damping_n);
   if (!motion_finite || !command_finite || !std::isfinite(state.observed_energy_j) ||
       !std::isfinite(state.dissipated_energy_j)) {
@@ -261,6 +307,7 @@ void HapticRenderer::restore_state(const RendererState& state) {
   m_sample = sample;
   m_sample_tool_velocity_m_per_s = to_vector(state.sample_tool_velocity_m_per_s);
   m_sample_motion_m_per_s = to_vector(state.sample_motion_m_per_s);
+  m_last_contact = last_contact;
   m_normal_model = NormalModel{state.normal_model[0], state.normal_model[1]};
   m_estimate_pair.reset();
   if (state.has_estimate_pair) {

@@ -109,6 +109,12 @@ struct RendererState {
   std::array<double, 3> estimate_pair{};
   std::array<double, 2> normal_model{};               ///< the last estimate: K [N/m], c [N s/m]
   std::array<double, 3> sample_motion_m_per_s{};      ///< the tool's velocity over the last sample interval
+  /// A force-only contact's remembered plane (HapticRenderer::remember_contact_plane).
+  bool has_last_contact = false;
+  std::array<double, 3> last_contact_point_m{};
+  std::array<double, 3> last_contact_normal{};
+  std::array<double, 9> last_contact_stiffness_n_per_m{};  ///< column-major
+  std::array<double, 9> last_contact_damping_n_s_per_m{};
   std::array<double, 3> tool_position_m{};
   double blade_depth_m = 0.0;
   // Motion.
@@ -177,6 +183,10 @@ class HapticRenderer {
   /// K_c = K n n^T (and D_c = c n n^T unless the sample reports it) for a sample in contact without
   /// stiffness, from the normal force's changes over the last two sample pairs (set_sample;
   /// normal_model_estimate.hpp).
+  /// Keeps a force-only contact's plane (point, normal, K and c) to render, as a surface near, while
+  /// the next samples say neither contact nor near and the tool stays close: a hand that bounces off
+  /// re-enters the wall at the crossing tick, not a sample or two later.
+  void remember_contact_plane(const TissueSample& sample);
   /// `motion_m_per_s`: the tool's velocity over the interval since the previous sample, in contact or not.
   void estimate_contact_model(TissueSample& sample, const Eigen::Vector3d& motion_m_per_s);
   RendererSettings m_settings;
@@ -184,6 +194,7 @@ class HapticRenderer {
   Eigen::Vector3d m_sample_tool_velocity_m_per_s = Eigen::Vector3d::Zero();
   std::optional<NormalPair> m_estimate_pair;  // the last pair of samples in contact, for the estimate
   NormalModel m_normal_model;                 // the last estimate (kept from one contact to the next)
+  std::optional<TissueSample> m_last_contact;  // a force-only contact's plane (remember_contact_plane)
   Eigen::Vector3d m_sample_motion_m_per_s = Eigen::Vector3d::Zero();  // the tool's, over the last interval
   bool m_has_sample = false;
   bool m_last_sample_repaired = false;

@@ -10,7 +10,11 @@ NormalModel estimate_normal_model(const NormalModel& last, const NormalPair& pai
                                   const std::optional<NormalPair>& previous, bool damping_known,
                                   const NormalModelLimits& limits) {
   const double max_damping = limits.max_relaxation_s * limits.max_stiffness_n_per_m;
-  if (!damping_known && previous) {
+  const auto informative = [&](const NormalPair& p) {
+    return std::max(std::abs(p.depth_change_m), limits.rate_time_scale_s * std::abs(p.rate_change_m_per_s)) >
+           limits.min_depth_change_m;
+  };
+  if (!damping_known && previous && informative(pair) && informative(*previous)) {
     // [dp dq; dp' dq'] (K, c) = (df, df')
     const double det = pair.depth_change_m * previous->rate_change_m_per_s -
                        pair.rate_change_m_per_s * previous->depth_change_m;

@@ -35,6 +35,9 @@ struct NormalModelLimits {
   double max_relaxation_s = 0.05;
   /// Below this depth change the secant is noise [m] (about a desktop device's resolution).
   double min_depth_change_m = 1e-6;
+  /// A rate change times this [s] (a sample period) is compared with min_depth_change_m: a pair whose
+  /// depth and rate both changed less says nothing (rounding; the joint solve would amplify it).
+  double rate_time_scale_s = 0.01;
   /// The two pairs are solved together only when |det| is at least this fraction of the sum of
   /// the magnitudes of its two products (the motion changed speed between them).
   double min_independence = 0.2;

@@ -37,7 +37,7 @@ int main(int argc, char** argv) {
   std::printf(
       "| tissue | hand b [N s/m] | loop | residual speed [mm/s] | mean penetration [mm] | chatter | settled at | lowest "
       "one-port energy [J] | samples refused | window [s] |\n|---|---:|---|---:|---:|---|---|---:|---:|---:|\n");
-  for (const double damping : {1.0, 5.0}) {
+  for (const double damping : {1.0, 3.0, 5.0}) {
     LoopSettings s;
     s.duration_s = duration_s;
     s.hand.damping_n_s_per_m = damping;
@@ -69,6 +69,14 @@ int main(int argc, char** argv) {
     ViscoelasticWall viscous(2000.0, 5.0);
     s.passivity_control = true;
     row(viscous, s, "controller on");
+    // Issue 42: force-only walls with a viscous part (c/k one and two sample periods), and the same
+    // walls reporting K_c, D_c and the surface near (what the loop does at best).
+    for (const double c : {20.0, 40.0}) {
+      ViscoelasticWall force_only(2000.0, c, Reports{false, false, false});
+      row(force_only, s, "controller on");
+      ViscoelasticWall reporting(2000.0, c);
+      row(reporting, s, "controller on");
+    }
     CorruptedSamples corrupted(std::make_unique<Wall>(2000.0, true), 7);
     row(corrupted, s, "controller on");
   }

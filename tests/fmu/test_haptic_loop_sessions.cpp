@@ -303,11 +303,13 @@ void print(const char* name, const PassivityRun& r) {
 //   the tick) misses, |f| |a| dt^2 <= 3.3 N x 0.070 m/s^2 x 1e-6 s^2 = 2.3e-7 J (passivity.hpp). The
 //   last tick, not yet booked, is bounded by the same prediction error; dropped credit only lowers the
 //   balance. Against ~2e-2 J the hand pushes into the wall.
-// * Off: the sample reaches the loop 34 to 67 ms after the tool entered the wall, so each of the 10
-//   contacts starts at a depth d0 >= A sin(2 pi 34 ms) = 0.318 mm, below which the hand pushed in for
+// * Off, with K_c in the samples: the sample reaches the loop 34 to 67 ms after the tool entered the
+//   wall, so each of the 10 contacts starts at a depth d0 >= A sin(2 pi 34 ms) = 0.318 mm, below which the hand pushed in for
 //   free and from which it is pushed all the way out: >= (K/2) d0^2 = 1.0e-4 J per contact (the 1 kHz
 //   hold leak and the rate-limited onset only add to it). A mis-estimated K_c adds a force along the
 //   motion, (K - K_c)(z - z0), more energy still. The bound asserted: 10 (K/2) d0^2 = 1.0e-3 J.
+//   Force-only (K_c 0): the loop remembers the last contact's plane (issue 42), so only the first
+//   contact starts late. The exact-work check needs a balance negative whenever idle: with K_c only.
 // * passivity.dissipatedEnergy > 0 on, exactly 0 off; |device.force| <= device.maxForce always; with
 //   K_c exact the controller does not remove the wall: the 3 N at full depth are still felt.
 TEST(HapticLoopFmu, WallSampledAt30HzGivesTheHandNoEnergyWithTheControllerOn) {
@@ -327,7 +329,14 @@ TEST(HapticLoopFmu, WallSampledAt30HzGivesTheHandNoEnergyWithTheControllerOn) {
     EXPECT_LE(on.wall.hand_energy_j, tolerance_j) << "K_c " << s.reported_stiffness_n_per_m;
     const double onset_depth_m = s.depth_amplitude_m * std::sin(2.0 * PI * s.frequency_hz * 0.034);
     const double onset_leak_j = 10.0 * 0.5 * s.wall_stiffness_n_per_m * onset_depth_m * onset_depth_m;
-    EXPECT_GT(off.wall.hand_energy_j, onset_leak_j) << "K_c " << s.reported_stiffness_n_per_m;
+    if (fraction > 0.0) {
+      EXPECT_GT(off.wall.hand_energy_j, onset_leak_j) << "K_c " << s.reported_stiffness_n_per_m;
+    } else {
+      // Force-only samples: the loop keeps the last contact's plane and its estimated K and c (issue
+      // 42), so every contact after the first starts at the crossing tick: one late onset's leak at
+      // most, not ten.
+      EXPECT_LT(off.wall.hand_energy_j, onset_leak_j / 10.0);
+    }
 
     EXPECT_GT(on.dissipated_j, 0.0);
     EXPECT_GT(on.wall.controller_ticks, 0);
@@ -338,7 +347,9 @@ TEST(HapticLoopFmu, WallSampledAt30HzGivesTheHandNoEnergyWithTheControllerOn) {
     // The observer through the FMU is the exact work: with the controller off the balance is negative
     // at every idle moment (each contact gives energy), so no credit is dropped and it equals minus the
     // hand's energy through the last booked tick (rounding of 1e4 terms of <1e-4 J: far below 1e-12 J).
-    EXPECT_NEAR(-off.observed_j, off.wall.hand_energy_j - off.wall.last_tick_work_j, 1e-12);
+    if (fraction > 0.0) {
+      EXPECT_NEAR(-off.observed_j, off.wall.hand_energy_j - off.wall.last_tick_work_j, 1e-12);
+    }
     if (fraction == 1.0) {
       EXPECT_NEAR(on.wall.max_force_n, 3.0, 0.05);  // the wall's K A
     }

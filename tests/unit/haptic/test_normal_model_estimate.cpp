@@ -2,7 +2,9 @@
 // a Kelvin-Voigt wall f_n = K p + c q (p the depth along a tilted normal, q its rate over the sample
 // period, as the tissue computes it) gives back K and c exactly once the tool's speed changes between
 // two sample pairs; at a constant speed c cannot be told from the offset and stays, K exact; a
-// reported D_c is kept and only K estimated; out-of-range solutions fall back.
+// reported D_c is kept and only K estimated; out-of-range solutions fall back. The last force-only
+// contact's plane is rendered, at the crossing tick, while the tool stays near where it touched, and
+// nowhere else.
 #include "haptic/haptic_renderer.hpp"
 #include "haptic/normal_model_estimate.hpp"
 
@@ -65,6 +67,12 @@ TEST(NormalModelEstimate, AtAConstantSpeedTheDampingStaysAndTheStiffnessIsExact)
   const NormalModel model = estimate_normal_model(last, pair, previous, false, limits);
   EXPECT_NEAR(model.stiffness_n_per_m, K, 1e-9 * K);
   EXPECT_EQ(model.damping_n_s_per_m, 10.0);
+  // Motion at the rounding level (a hand at rest): the joint solve is not tried, the model stands.
+  const NormalModel at_rest =
+      estimate_normal_model(last, NormalPair{-1.4e-18, 5.4e-17, 6.7e-16}, NormalPair{1.2e-18, 9.6e-16, 7.8e-14}, false,
+                            limits);
+  EXPECT_EQ(at_rest.stiffness_n_per_m, 500.0);
+  EXPECT_EQ(at_rest.damping_n_s_per_m, 10.0);
   // No motion: the last model stands.
   const NormalModel held = estimate_normal_model(last, NormalPair{1e-8, 0.0, 0.3}, previous, false, limits);
   EXPECT_EQ(held.stiffness_n_per_m, 500.0);
@@ -89,6 +97,47 @@ TEST(NormalModelEstimate, SolutionsOutOfRangeFallBackToTheSecant) {
   const NormalModel none = estimate_normal_model(NormalModel{}, NormalPair{2e-4, 0.02, 0.6}, previous, false, limits);
   EXPECT_EQ(none.stiffness_n_per_m, 0.0);
   EXPECT_EQ(none.damping_n_s_per_m, 0.0);
+}
+
+// After a force-only contact the samples say neither contact nor near (such a tissue has no near
+// report): the plane of the last contact, with its estimated K, is rendered from the tick the tool
+// crosses it, as long as the tool stays within 1 cm of where it touched; once it has left, the plane
+// is dropped (a plane says nothing of the tissue elsewhere: a tool going down beside the body must
+// feel nothing).
+TEST(NormalModelEstimate, TheLastForceOnlyContactsPlaneStandsInForTheSurfaceNear) {
+  RendererSettings settings;
+  settings.contact_damping_n_s_per_m = 0.0;
+  settings.hold_damping = false;
+  settings.passivity_control = false;
+  settings.max_force_rate_n_per_s = 1e12;
+  HapticRenderer renderer(settings);
+  for (int k = 1; k <= 5; ++k) renderer.set_sample(wall_sample(k * PERIOD_S, depth_at(k), depth_at(k - 1), false));
+  TissueSample away;  // the tool drawn out: no contact, no near
+  away.time_s = 6 * PERIOD_S;
+  away.tool_position_m = Eigen::Vector3d(0.01, 0.02, 0.005);
+  renderer.set_sample(away);
+  const Eigen::Vector3d n = Eigen::Vector3d(0.2, -0.3, 1.0).normalized();
+  const Eigen::Vector3d point(0.01, 0.02, 0.0);
+  const double dt = 1e-3;
+  (void)renderer.tick(point + 2e-3 * n, ToolMode::probe, dt);
+  EXPECT_EQ(renderer.last_tick().contact_force_n.norm(), 0.0) << "outside the plane";
+  (void)renderer.tick(point - 1e-4 * n, ToolMode::probe, dt);  // 0.1 mm in, at once: the damper too
+  EXPECT_NEAR(renderer.last_tick().contact_force_n.dot(n), K * 1e-4 + C * (2.1e-3 / dt), 1e-6 * C * (2.1e-3 / dt));
+  (void)renderer.tick(point - 1e-4 * n, ToolMode::probe, dt);  // held there: K 0.1 mm along n
+  EXPECT_NEAR(renderer.last_tick().contact_force_n.dot(n), K * 1e-4, 1e-6 * K * 1e-4);
+  // Saved and restored, the plane goes on.
+  HapticRenderer restored(settings);
+  restored.restore_state(renderer.save_state());
+  (void)restored.tick(point - 2e-4 * n, ToolMode::probe, dt);
+  (void)renderer.tick(point - 2e-4 * n, ToolMode::probe, dt);
+  EXPECT_EQ(restored.last_tick().contact_force_n, renderer.last_tick().contact_force_n);
+  // 2 cm aside, then down through the plane's height: nothing, and nothing once back either.
+  const Eigen::Vector3d aside = point + Eigen::Vector3d(0.02, 0.0, 0.0);
+  (void)renderer.tick(aside + 2e-3 * n, ToolMode::probe, dt);
+  (void)renderer.tick(aside - 1e-3 * n, ToolMode::probe, dt);
+  EXPECT_EQ(renderer.last_tick().contact_force_n.norm(), 0.0) << "the plane extended beside the body";
+  (void)renderer.tick(point - 1e-4 * n, ToolMode::probe, dt);
+  EXPECT_EQ(renderer.last_tick().contact_force_n.norm(), 0.0) << "the plane came back after the tool left";
 }
 
 }  // namespace

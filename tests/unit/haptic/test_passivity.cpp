@@ -180,9 +180,12 @@ TEST(Passivity, WithoutStiffnessTheHeldForceActsAsNegativeDamping) {
 
 // Issue 20: the renderer estimates the missing stiffness from successive samples (the secant of the
 // force along the normal over the tool's motion), so the same force-only wall is rendered as a
-// spring at 1 kHz again, except over the first sample period of each contact (no secant yet, the
-// force held): the hand gains under a quarter of what the held force gives it (measured 0.19), the
-// rest of the way to the reported K_c's hold leak being those first periods.
+// spring at 1 kHz again: the hand gains under a quarter of what the held force gives it (measured
+// 0.19 with the first sample period of each contact held). Issue 42: the estimate is kept from one
+// contact to the next, and the last contact's plane stands in for the surface near report, so that
+// the contacts after the first start at the crossing tick with the known spring, where the samples
+// with K_c but no surface near start them a sample late: the estimate now gives the hand less than
+// the reported K_c (measured 3.4e-4 against 4.6e-4 J; 0.05 of the held force's).
 TEST(Passivity, AnEstimatedStiffnessRestoresTheSpring) {
   WallScenario s;
   s.reported_stiffness_n_per_m = 0.0;
@@ -194,7 +197,7 @@ TEST(Passivity, AnEstimatedStiffnessRestoresTheSpring) {
   std::printf("  energy to the hand: estimated K %.3e J, reported K_c %.3e J, held force (predicted) %.3e J\n",
               estimated.hand_energy_j, reported.hand_energy_j, held_j);
   EXPECT_LT(estimated.hand_energy_j, 0.25 * held_j);
-  EXPECT_GT(estimated.hand_energy_j, reported.hand_energy_j);
+  EXPECT_LT(estimated.hand_energy_j, reported.hand_energy_j);
 }
 
 // Why the observer books f_{k-1} . (x_k - x_{k-1}) and not, as printed, f_k . v_k dt: the same
