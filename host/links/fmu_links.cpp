@@ -144,6 +144,12 @@ void TissueLink::reserve(SurfaceFrame& frame) const {
 }
 
 void TissueLink::read_surface(SurfaceFrame& frame) {
+  read_surface_unmapped(frame);
+  m_mapping.complete(frame);
+  if (!m_embedding) m_embedding = frame.embedding;
+}
+
+void TissueLink::read_surface_unmapped(SurfaceFrame& frame) {
   const auto binary = [&](fmi3ValueReference which, const char* what) {
     std::size_t size = 0;
     fmi3Binary bytes = nullptr;
@@ -155,18 +161,41 @@ void TissueLink::read_surface(SurfaceFrame& frame) {
   try {
     fmi3UInt64 revision = 0;
     (void)m_instance.get_uint64(std::span(&m_revision, 1), std::span(&revision, 1));
-    if (!m_embedding || m_embedding->revision != revision) {
-      auto embedding = std::make_shared<ports::SurfaceEmbedding>();
-      ports::decode(binary(m_embedding_vr, "surface.embedding"), *embedding);
-      m_embedding = std::move(embedding);
+    if (!m_embedding_bytes || revision != m_embedding_revision) {
+      const std::span<const std::uint8_t> bytes = binary(m_embedding_vr, "surface.embedding");
+      m_embedding_bytes = std::make_shared<const std::vector<std::uint8_t>>(bytes.begin(), bytes.end());
+      m_embedding_revision = revision;
     }
     ports::decode(binary(m_nodes_vr, "surface.nodes"), m_nodes);
+  } catch (const ports::SurfaceBinaryError& error) {
+    throw FmuError(std::string("Tissue: ") + error.what());
+  }
+  frame.embedding.reset();
+  frame.embedding_bytes = m_embedding_bytes;
+  frame.node_revision = m_nodes.revision;
+  frame.node_positions_m.assign(m_nodes.positions_m.begin(), m_nodes.positions_m.end());
+  frame.positions_m.clear();
+  frame.triangles.clear();
+  frame.mesh_triangle_count = 0;
+}
+
+void SurfaceMapping::complete(SurfaceFrame& frame) {
+  if (!frame.embedding_bytes) return;
+  try {
+    if (frame.embedding_bytes != m_bytes) {
+      auto embedding = std::make_shared<ports::SurfaceEmbedding>();
+      ports::decode(*frame.embedding_bytes, *embedding);
+      m_embedding = std::move(embedding);
+      m_bytes = frame.embedding_bytes;
+    }
+    m_nodes.revision = frame.node_revision;
+    m_nodes.positions_m.assign(frame.node_positions_m.begin(), frame.node_positions_m.end());
     ports::map_points(*m_embedding, m_nodes, frame.positions_m);
   } catch (const ports::SurfaceBinaryError& error) {
     throw FmuError(std::string("Tissue: ") + error.what());
   }
   frame.embedding = m_embedding;
-  frame.node_positions_m.assign(m_nodes.positions_m.begin(), m_nodes.positions_m.end());
+  frame.embedding_bytes.reset();
   frame.triangles.assign(m_embedding->triangles.begin(), m_embedding->triangles.end());
   // The cut faces are the last rows; the rest is the skin.
   frame.mesh_triangle_count = frame.triangle_count() - static_cast<std::size_t>(m_embedding->cut_triangle_count);

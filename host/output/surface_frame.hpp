@@ -46,6 +46,12 @@ struct SurfaceFrame {
   /// triangles. Null: the frame has positions only.
   std::shared_ptr<const ports::SurfaceEmbedding> embedding;
   std::vector<double> node_positions_m;
+  /// A frame captured without its mapping (TissueLink::read_surface_unmapped, the recording's in the
+  /// dynamics thread's slot): the embedding's encoded bytes (shared while the surface's revision
+  /// stands) and the nodes' revision; positions_m, triangles and embedding are filled later, in the
+  /// writer's thread (SurfaceMapping::complete). Null: the frame is complete.
+  std::shared_ptr<const std::vector<std::uint8_t>> embedding_bytes;
+  std::uint64_t node_revision = 0;
   // Optional overlays.
   bool has_tool = false;
   std::array<double, 3> tool_tip_m{}, tool_handle_m{};

@@ -26,6 +26,7 @@ void run_offline(SessionSteps& steps, const Schedule& schedule, FrameWriter* wri
         pending = true;
         if (steps.frame_due(tissue_time_s)) {
           steps.capture_frame(frame, tissue_time_s);
+          steps.complete_frame(frame);
           writer->write(frame);
         }
       }

@@ -177,6 +177,7 @@ void RealtimeScheduler::run() {
   Nanoseconds next_progress = run.start + 1'000'000'000;
   const auto drain = [&](std::chrono::milliseconds timeout) {
     while (auto frame = pipe.wait_filled(timeout)) {
+      m_steps.complete_frame(*frame);
       m_writer->write(*frame);
       pipe.give_back(std::move(frame));
       timeout = std::chrono::milliseconds(0);

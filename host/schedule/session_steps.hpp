@@ -38,8 +38,12 @@ class SessionSteps {
   // --- the recording's surface frames (tissue side) ---
   /// True when the recording wants a frame at tissue time `time_s`.
   [[nodiscard]] virtual bool frame_due(double time_s) const = 0;
-  /// The surface, tool and contact at tissue time `time_s` into `frame` (no allocation once reserved).
+  /// The surface, tool and contact at tissue time `time_s` into `frame` (no allocation once reserved),
+  /// the surface's mapping left to complete_frame().
   virtual void capture_frame(SurfaceFrame& frame, double time_s) = 0;
+  /// Maps a captured frame's surface (decodes its embedding when a cut changed it): in the thread
+  /// that writes the frames, out of the dynamics thread's slot. Throws like the capture.
+  virtual void complete_frame(SurfaceFrame& frame) = 0;
   /// A due frame had no free buffer (the writer is behind): the recording goes on to the next one.
   virtual void frame_dropped() = 0;
   /// Gives `frame` the capacity capture_frame() needs (before the run).

@@ -252,16 +252,22 @@ class Session final : public SessionSteps {
     return m_options.write_outputs && m_scenario.frame_rate_hz > 0.0 && time_s + 1e-9 >= m_next_frame_s;
   }
   void capture_frame(SurfaceFrame& frame, double time_s) override {
-    fill_frame(frame, time_s);
+    fill_frame(frame, time_s, Mapping::deferred);
     // The next recorded frame is the first one due after this one (not a period past it).
     while (m_next_frame_s <= time_s + 1e-9) m_next_frame_s += 1.0 / m_scenario.frame_rate_hz;
   }
+  void complete_frame(SurfaceFrame& frame) override { m_recording_mapping.complete(frame); }
   void frame_dropped() override { m_next_frame_s += 1.0 / m_scenario.frame_rate_hz; }
   void reserve_frame(SurfaceFrame& frame) override { m_tissue.reserve(frame); }
   // The surface, the tool and the contact at `time_s` (the recording's frames, the live view's and
   // the OpenIGTLink surfaces; each keeps its own rate).
-  void fill_frame(SurfaceFrame& frame, double time_s) {
-    m_tissue.read_surface(frame);
+  enum class Mapping { now, deferred };
+  void fill_frame(SurfaceFrame& frame, double time_s, Mapping mapping = Mapping::now) {
+    if (mapping == Mapping::now) {
+      m_tissue.read_surface(frame);
+    } else {
+      m_tissue.read_surface_unmapped(frame);
+    }
     frame.time_s = time_s;
     const ToolCommand& tool = m_tool_command.read_buffer();
     frame.has_tool = tool.mode != 0;
@@ -330,6 +336,7 @@ class Session final : public SessionSteps {
       SurfaceFrame frame;
       m_next_frame_s = 0.0;
       capture_frame(frame, m_summary.sim_time_s);
+      complete_frame(frame);
       render_png(dir / "final.png", frame, operating_field());
     }
     std::ofstream(dir / "summary.json") << m_summary.to_json();
@@ -355,6 +362,7 @@ class Session final : public SessionSteps {
   Fmu3 m_tissue_fmu;
   Fmu3 m_haptic_fmu;
   TissueLink m_tissue;
+  SurfaceMapping m_recording_mapping;  // complete_frame()'s: the recording's frames, in the writer's thread
   HapticLink m_haptic;
   SampleRelay m_relay;  // the tissue sample from m_tissue to m_haptic, and its fields' slots
   SampleSlot m_contact_slot, m_point_slot, m_force_slot, m_blade_depth_slot;

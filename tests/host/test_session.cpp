@@ -8,6 +8,7 @@
 // * scenario files with mistakes are refused naming the key.
 #include "scenario/scenario.hpp"
 #include "session/session.hpp"
+#include "links/fmu_links.hpp"
 #include "host/vtu_read.hpp"
 #include "support/under_sanitizer.hpp"
 
@@ -599,6 +600,43 @@ TEST(ScenarioRegions, ARegionsTableBecomesTheTissuesMaterialRegions) {
                                      "[tissue.regions.a]\ndensity = 2\n",
                               "regions.toml"),
                ScenarioError);
+}
+
+// Issue 42: the recording's frames are captured without their mapping (the embedding's bytes and the
+// nodes, in the dynamics thread's slot) and mapped in the writer's thread. Completed, such a frame is
+// the frame read and mapped at once, while the frog is cut (the embedding changes, its bytes are
+// taken anew) and between (the bytes are shared, not copied again).
+TEST(SurfaceMapping, AnUnmappedFrameCompletedIsTheFrameMappedAtOnce) {
+  const Fmu3 fmu(FMUS / "Tissue.fmu");
+  TissueLink link(fmu, {});
+  const std::array<double, 3> lower = link.rest_lower(), upper = link.rest_upper();
+  SurfaceMapping mapping;
+  std::shared_ptr<const std::vector<std::uint8_t>> last_bytes;
+  int new_bytes = 0, shared_bytes = 0;
+  for (int n = 0; n <= 30; ++n) {
+    ToolCommand scalpel;  // a vertical blade drawn across the frog's middle, its tip below it
+    const double along = -0.1 + 1.2 * n / 25.0;
+    scalpel.position_m = {lower[0] + along * (upper[0] - lower[0]), 0.5 * (lower[1] + upper[1]), lower[2] - 0.005};
+    scalpel.mode = n <= 25 ? 2 : 0;
+    link.set_tool(scalpel);
+    ASSERT_EQ(link.step(0.01 * n, 0.01).status, fmi3OK);
+    SurfaceFrame mapped, unmapped;
+    link.read_surface(mapped);
+    link.read_surface_unmapped(unmapped);
+    ASSERT_TRUE(unmapped.embedding_bytes);
+    EXPECT_TRUE(unmapped.positions_m.empty());
+    (unmapped.embedding_bytes == last_bytes ? shared_bytes : new_bytes) += 1;
+    last_bytes = unmapped.embedding_bytes;
+    mapping.complete(unmapped);
+    EXPECT_FALSE(unmapped.embedding_bytes);
+    EXPECT_EQ(unmapped.positions_m, mapped.positions_m) << "step " << n;
+    EXPECT_EQ(unmapped.triangles, mapped.triangles) << "step " << n;
+    EXPECT_EQ(unmapped.mesh_triangle_count, mapped.mesh_triangle_count) << "step " << n;
+    EXPECT_EQ(unmapped.embedding->revision, mapped.embedding->revision) << "step " << n;
+  }
+  std::printf("  embedding bytes taken anew %d times, shared %d times\n", new_bytes, shared_bytes);
+  EXPECT_GT(new_bytes, 2) << "the cut changed the embedding";
+  EXPECT_GT(shared_bytes, 2) << "between changes the bytes are shared";
 }
 
 }  // namespace
