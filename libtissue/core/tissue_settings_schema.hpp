@@ -333,7 +333,7 @@ constexpr auto interaction_settings() {
                     "internal steps later (the worker has that long before the step waits for it; a new contact "
                     "renders the elementLocal estimate until then), and the next refresh starts then: K_c is "
                     "refreshed every max(contact.stiffnessRefreshSteps, this) steps. For bodies whose "
-                    "factorization takes longer than a step (the 52k-tet organ: ~0.7-1 s)")
+                    "factorization takes longer than a step (the 52k-tet organ: ~1-1.5 s on one core)")
           .member(TISSUE_MEMBER(settings.interaction.contact.stiffness_latency_steps)),
   });
 }
