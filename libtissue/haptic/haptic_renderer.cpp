@@ -78,7 +78,11 @@ void HapticRenderer::set_sample(const TissueSample& sample) {
     remember_contact_plane(prepared);
   } else {
     m_estimate_pair.reset();
-    if (prepared.contact_active || prepared.surface_near) m_last_contact.reset();  // the tissue says it itself
+    // The tissue reports its surface itself, or says the tool touched nothing where the plane has it
+    // inside: the tissue moved away (sagged, fell, was cut), and the plane would be a phantom wall.
+    const bool inside_plane =
+        m_last_contact && (prepared.tool_position_m - m_last_contact->contact_point_m).dot(m_last_contact->contact_normal) < 0.0;
+    if (prepared.contact_active || prepared.surface_near || inside_plane) m_last_contact.reset();
   }
   m_sample_tool_velocity_m_per_s = tool_velocity_m_per_s;
   m_sample_motion_m_per_s = motion_m_per_s;

@@ -140,5 +140,24 @@ TEST(NormalModelEstimate, TheLastForceOnlyContactsPlaneStandsInForTheSurfaceNear
   EXPECT_EQ(renderer.last_tick().contact_force_n.norm(), 0.0) << "the plane came back after the tool left";
 }
 
+// The plane is the tissue's last word, not a wall of the loop's own: a sample that says "no contact"
+// for a tool the plane has inside (the tissue sagged, fell or was cut away) drops it, so that the
+// loop renders no phantom wall where the tissue no longer is (at most until that sample arrives).
+TEST(NormalModelEstimate, ASampleWithoutContactInsideThePlaneDropsIt) {
+  RendererSettings settings;
+  settings.passivity_control = false;
+  HapticRenderer renderer(settings);
+  for (int k = 1; k <= 5; ++k) renderer.set_sample(wall_sample(k * PERIOD_S, depth_at(k), depth_at(k - 1), false));
+  const Eigen::Vector3d n = Eigen::Vector3d(0.2, -0.3, 1.0).normalized();
+  const Eigen::Vector3d point(0.01, 0.02, 0.0);
+  TissueSample gone;  // the tool 1 mm inside the old plane, and the tissue touched nothing
+  gone.time_s = 6 * PERIOD_S;
+  gone.tool_position_m = point - 1e-3 * n;
+  renderer.set_sample(gone);
+  (void)renderer.tick(point - 1e-3 * n, ToolMode::probe, 1e-3);
+  (void)renderer.tick(point - 1e-3 * n, ToolMode::probe, 1e-3);
+  EXPECT_EQ(renderer.last_tick().contact_force_n.norm(), 0.0) << "a phantom wall where the tissue was";
+}
+
 }  // namespace
 }  // namespace tissue::haptic
