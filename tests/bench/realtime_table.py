@@ -6,10 +6,14 @@ Markdown table with the machine. Real time needs the cores to itself: run nothin
 
 Usage: tests/bench/realtime_table.py [--host build/release/host/tissue-host] [--runs 5] [--only NAME,NAME]
                                     [--set PARAMETER=VALUE ...] [--alternate PARAMETER=VALUE ...]
+                                    [--alternate-host OTHER/tissue-host]
 --set overrides Tissue parameters in every scenario (e.g. the default before issue 40:
 --set integrator.linearSolver=pcg --set integrator.newtonMaxIterations=5); --alternate runs each
 scenario's runs twice over, interleaved, without and with these overrides, and prints both tables
-(the same machine state for both: the way to compare two settings on a shared machine).
+(the same machine state for both: the way to compare two settings on a shared machine);
+--alternate-host does the same with another build of tissue-host (a change to the host or the FMUs:
+copy the other build's host/tissue-host and fmus/ aside as DIR/host/tissue-host and DIR/fmus/ first;
+a tissue-host takes the FMUs of ../fmus beside it).
 A scenario driven by the browser's mouse runs 5 s with the live view up and no one at it.
 Each run writes its frames to a temporary folder (Python's tempfile: TMPDIR): a render surface's VTU
 frames are 1.7 MB each, and on the 2-core VM their writeback to disk delays the haptic thread's
@@ -37,29 +41,35 @@ def main():
                         help="a Tissue parameter set in every scenario")
     parser.add_argument("--alternate", action="append", default=[], metavar="PARAMETER=VALUE",
                         help="also run every scenario with these, interleaved run by run, and print both tables")
+    parser.add_argument("--alternate-host", default=None, metavar="TISSUE_HOST",
+                        help="also run every scenario with this tissue-host, interleaved run by run, and print both tables")
     args = parser.parse_args()
     wanted = args.only.split(",")
     scenarios = sorted(p for p in (ROOT / "host" / "scenarios").glob("*.toml")
                        if not p.name.startswith(".") and any(w in p.stem for w in wanted))
-    variants = [("", args.set)] + ([("with " + " ".join(args.alternate), args.set + args.alternate)] if args.alternate else [])
-    rows = {label: [] for label, _ in variants}
+    variants = [("", args.host, args.set)]
+    if args.alternate:
+        variants.append(("with " + " ".join(args.alternate), args.host, args.set + args.alternate))
+    if args.alternate_host:
+        variants.append(("with " + args.alternate_host, args.alternate_host, args.set))
+    rows = {label: [] for label, _, _ in variants}
     for scenario in scenarios:
-        runs = {label: [] for label, _ in variants}
+        runs = {label: [] for label, _, _ in variants}
         for k in range(args.runs):
-            for label, overrides in variants:
-                runs[label].append(run_once(args.host, scenario, overrides))
+            for label, host, overrides in variants:
+                runs[label].append(run_once(host, scenario, overrides))
                 r = runs[label][-1]
                 print("  %s%s run %d/%d: overruns %d, misses %d of %d, step p99 %.2f ms, SCHED_FIFO %s"
                       % (scenario.stem, " (" + label + ")" if label else "", k + 1, args.runs, r["tissue_overruns"],
                          r["deadline_misses"], r["haptic_ticks"], r["tissue_step_ms"]["p99"], r["realtime_priority"]),
                       file=sys.stderr)
-        for label, _ in variants:
+        for label, _, _ in variants:
             rows[label].append((scenario.stem, runs[label]))
 
     print("Machine: %d cores (`nproc`); %d real-time runs of each scenario (`tissue-host run`, not offline); "
           "figures per run, listed run by run where they differ.%s\n"
           % (os.cpu_count(), args.runs, " Parameters set: " + " ".join(args.set) + "." if args.set else ""))
-    for label, _ in variants:
+    for label, _, _ in variants:
         if label:
             print("\n%s (runs interleaved with the table above):\n" % label)
         print_table(rows[label])
