@@ -51,13 +51,12 @@ std::mutex& blas_turn() {
 }  // namespace
 
 CholmodFactor::CholmodFactor(Solves solves, Layout layout, Ordering ordering)
-    : m_solves(solves), m_ordering(ordering) {
+    : m_solves(solves), m_ordering(ordering), m_layout(layout) {
   cholmod_start(&m_common);
   m_common.print = 0;
   m_common.nmethods = 1;
   m_common.method[0].ordering = CHOLMOD_AMD;
   m_common.supernodal = layout == Layout::supernodal ? CHOLMOD_SUPERNODAL : CHOLMOD_AUTO;
-  m_layout = layout;
   m_common.supernodal_switch = SUPERNODAL_SWITCH;
   m_common.final_ll = 1;
 }
@@ -281,10 +280,6 @@ void CholmodFactor::solve(std::span<const double> b, std::span<double> x) {
   std::copy(solution, solution + n, x.begin());
 }
 
-}  // namespace tissue
-
-namespace tissue {
-
 // L's elimination tree, node by node: a supernode s holds columns super[s] .. super[s + 1] - 1, a
 // dense trapezoid of pi[s + 1] - pi[s] rows (the first super[s + 1] - super[s] its own columns,
 // sorted) at x + px[s], column-major; its parent is the supernode of its first row below its own
@@ -350,6 +345,16 @@ void CholmodFactor::lower_solve(std::span<const SparseColumn> columns, LowerSolu
     for (int k = 0; k < n; ++k) m_inverse_perm[static_cast<size_t>(perm[k])] = k;
     m_inverse_perm_analysis = m_analysis_count;
   }
+  // Every row checked before the work rows and the reach's marks are touched: a refused call leaves
+  // them zero for the next.
+  for (const SparseColumn& column : columns) {
+    for (const auto& [row, value] : column) {
+      if (row < 0 || row >= n) {
+        throw std::invalid_argument("CHOLMOD lower solve: row " + std::to_string(row) + " outside [0, " +
+                                    std::to_string(n) + ")");
+      }
+    }
+  }
   const auto width = static_cast<Eigen::Index>(columns.size());
   if (m_work.rows() != n || m_work.cols() != width) m_work.setZero(n, width);
   const size_t nodes = m_factor->is_super ? m_factor->nsuper : static_cast<size_t>(n);
@@ -357,10 +362,6 @@ void CholmodFactor::lower_solve(std::span<const SparseColumn> columns, LowerSolu
   m_reach.clear();
   for (Eigen::Index c = 0; c < width; ++c) {
     for (const auto& [row, value] : columns[static_cast<size_t>(c)]) {
-      if (row < 0 || row >= n) {
-        throw std::invalid_argument("CHOLMOD lower solve: row " + std::to_string(row) + " outside [0, " +
-                                    std::to_string(n) + ")");
-      }
       const int k = m_inverse_perm[static_cast<size_t>(row)];
       m_work(k, c) += value;
       for (int node = tree_node(k); node >= 0 && m_reached[static_cast<size_t>(node)] == 0; node = tree_parent(node)) {
