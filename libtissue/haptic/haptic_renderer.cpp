@@ -39,6 +39,29 @@ constexpr double MIN_SECANT_MOTION_M = 1e-6;
 /// stays this close to where it touched (the Tissue FMU's contact.nearMargin start value).
 constexpr double REMEMBERED_PLANE_RADIUS_M = 0.01;
 
+/// A contact's plane as a surface-near sample: its point, normal, K_c and D_c, no force.
+TissueSample contact_plane(const Eigen::Vector3d& point_m, const Eigen::Vector3d& normal,
+                           const Eigen::Matrix3d& stiffness_n_per_m, const Eigen::Matrix3d& damping_n_s_per_m) {
+  TissueSample plane;
+  plane.surface_near = true;
+  plane.contact_point_m = point_m;
+  plane.contact_normal = normal;
+  plane.contact_stiffness_n_per_m = stiffness_n_per_m;
+  plane.contact_damping_n_s_per_m = damping_n_s_per_m;
+  return plane;
+}
+
+/// A saved sample was prepared already: checks it as prepare_sample() would (throws for non-finite
+/// or non-unit values), and refuses it (`what` names it) where prepare_sample() would have had to
+/// repair it, keeping its exact numbers so that a restored renderer continues bitwise.
+void require_prepared(const TissueSample& sample, const std::string& what) {
+  TissueSample check = sample;
+  const SampleRepair repair = prepare_sample(check);
+  if (repair.stiffness_repaired || repair.damping_repaired) {
+    throw std::invalid_argument("RendererState: " + what + " is not symmetric positive semi-definite");
+  }
+}
+
 }  // namespace
 
 void validate(const RendererSettings& settings) {
@@ -65,14 +88,12 @@ void HapticRenderer::set_sample(const TissueSample& sample) {
   const bool touching = prepared.contact_active || prepared.surface_near;
   const bool followed = m_has_sample && (m_sample.contact_active || m_sample.surface_near);
   const double interval_s = prepared.time_s - m_sample.time_s;
-  const Eigen::Vector3d tool_velocity_m_per_s =
-      touching && followed && interval_s > 0.0
-          ? ((prepared.tool_position_m - m_sample.tool_position_m) / interval_s).eval()
-          : Eigen::Vector3d::Zero();
-  // The tool's motion over the sample interval whatever the contact (the estimate's depth rate).
+  // The tool's motion over the sample interval whatever the contact (the estimate's depth rate), and
+  // v0, the same while the tool touches or nears the surface in both samples (0 otherwise).
   const Eigen::Vector3d motion_m_per_s = m_has_sample && interval_s > 0.0
                                              ? ((prepared.tool_position_m - m_sample.tool_position_m) / interval_s).eval()
                                              : Eigen::Vector3d::Zero();
+  const Eigen::Vector3d tool_velocity_m_per_s = touching && followed ? motion_m_per_s : Eigen::Vector3d::Zero();
   if (prepared.contact_active && prepared.contact_stiffness_n_per_m.isZero(0.0)) {
     estimate_contact_model(prepared, motion_m_per_s);
     remember_contact_plane(prepared);
@@ -92,13 +113,8 @@ void HapticRenderer::set_sample(const TissueSample& sample) {
 }
 
 void HapticRenderer::remember_contact_plane(const TissueSample& sample) {
-  TissueSample plane;
-  plane.surface_near = true;
-  plane.contact_point_m = sample.contact_point_m;
-  plane.contact_normal = sample.contact_normal;
-  plane.contact_stiffness_n_per_m = sample.contact_stiffness_n_per_m;
-  plane.contact_damping_n_s_per_m = sample.contact_damping_n_s_per_m;
-  m_last_contact = plane;
+  m_last_contact = contact_plane(sample.contact_point_m, sample.contact_normal, sample.contact_stiffness_n_per_m,
+                                 sample.contact_damping_n_s_per_m);
 }
 
 void HapticRenderer::estimate_contact_model(TissueSample& sample, const Eigen::Vector3d& motion_m_per_s) {
@@ -271,13 +287,7 @@ void HapticRenderer::restore_state(const RendererState& state) {
   sample.contact_damping_n_s_per_m = Eigen::Map<const Eigen::Matrix3d>(state.contact_damping_n_s_per_m.data());
   sample.tool_position_m = to_vector(state.tool_position_m);
   sample.blade_depth_m = state.blade_depth_m;
-  // The saved sample was prepared already: check it the same way, but keep its exact numbers so
-  // that a restored renderer continues bitwise as the saved one.
-  TissueSample check = sample;
-  const SampleRepair repair = prepare_sample(check);
-  if (repair.stiffness_repaired || repair.damping_repaired) {
-    throw std::invalid_argument("RendererState: the contact stiffness or damping is not symmetric positive semi-definite");
-  }
+  require_prepared(sample, "the contact stiffness or damping");
   const bool motion_finite = all_finite(state.previous_position_m) && all_finite(state.filtered_velocity_m_per_s) &&
                              all_finite(state.sample_tool_velocity_m_per_s) && all_finite(state.estimate_pair) &&
                              all_finite(state.sample_motion_m_per_s);
@@ -286,18 +296,10 @@ void HapticRenderer::restore_state(const RendererState& state) {
   if (!model_valid) throw std::invalid_argument("RendererState: the estimated contact model is not finite and >= 0");
   std::optional<TissueSample> last_contact;
   if (state.has_last_contact) {
-    TissueSample plane;
-    plane.surface_near = true;
-    plane.contact_point_m = to_vector(state.last_contact_point_m);
-    plane.contact_normal = to_vector(state.last_contact_normal);
-    plane.contact_stiffness_n_per_m = Eigen::Map<const Eigen::Matrix3d>(state.last_contact_stiffness_n_per_m.data());
-    plane.contact_damping_n_s_per_m = Eigen::Map<const Eigen::Matrix3d>(state.last_contact_damping_n_s_per_m.data());
-    TissueSample checked = plane;
-    const SampleRepair plane_repair = prepare_sample(checked);  // throws for a non-finite or non-unit value
-    if (plane_repair.stiffness_repaired || plane_repair.damping_repaired) {
-      throw std::invalid_argument("RendererState: the remembered plane's stiffness or damping is not symmetric PSD");
-    }
-    last_contact = plane;
+    last_contact = contact_plane(to_vector(state.last_contact_point_m), to_vector(state.last_contact_normal),
+                                 Eigen::Map<const Eigen::Matrix3d>(state.last_contact_stiffness_n_per_m.data()),
+                                 Eigen::Map<const Eigen::Matrix3d>(state.last_contact_damping_n_s_per_m.data()));
+    require_prepared(*last_contact, "the remembered plane's stiffness or damping");
   }
   const bool command_finite = all_finite(state.commanded_force_n) && all_finite(state.commanded_damping_n);
   if (!motion_finite || !command_finite || !std::isfinite(state.observed_energy_j) ||
