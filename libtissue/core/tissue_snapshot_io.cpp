@@ -15,8 +15,9 @@ constexpr std::uint64_t MAGIC = 0x31305353'49535354ULL;  // "TSSISS01" read as l
 // 7: a ghost's unknown is its copy's displacement, not a difference from u (issue 40): the same
 // fields, other meanings; 8: the cutter's per-vertex sides, distances and the blade's plane of the
 // open session (issue 41); 9: each cut's blade normal (TetCut::blade_normal); 10: how far the blade
-// had turned when each tet was cut and each edge crossed (a spiral cuts a tet once per turn)
-constexpr std::uint32_t VERSION = 11;
+// had turned when each tet was cut and each edge crossed (a spiral cuts a tet once per turn);
+// 12: the contact spring's direction (issue 42)
+constexpr std::uint32_t VERSION = 12;
 
 // The core's Eigen types and cut records on top of the shared byte stream.
 class Writer : public serial::ByteWriter {
@@ -187,6 +188,7 @@ std::vector<std::uint8_t> serialize_snapshot(const TissueSnapshot& s) {
     w.put(s.point_spring->target_m);
     w.put(s.point_spring->stiffness_n_per_m);
     w.put(s.point_spring->tangent_fraction);
+    w.put(s.point_spring->direction);
   }
   put_tool(w, s.tool);
   put_tool(w, s.previous_tool);
@@ -264,6 +266,7 @@ TissueSnapshot read_snapshot(std::span<const std::uint8_t> bytes) {
     r.get(spring.target_m);
     r.get(spring.stiffness_n_per_m);
     r.get(spring.tangent_fraction);
+    r.get(spring.direction);
     s.point_spring = spring;
   }
   s.tool = get_tool(r);

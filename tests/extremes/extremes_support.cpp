@@ -364,8 +364,9 @@ bool Run::step() {
       x0 += spring->weights(i) * vertex_of(m_positions_before, v);
       x1 += spring->weights(i) * vertex_of(after, v);
     }
+    const Eigen::Matrix3d projector = spring_projector(*spring);  // along its direction alone, or every axis
     m_tool_work_j += 0.5 * spring->stiffness_n_per_m *
-                     ((spring->target_m - x0).squaredNorm() - (spring->target_m - x1).squaredNorm());
+                     ((projector * (spring->target_m - x0)).squaredNorm() - (projector * (spring->target_m - x1)).squaredNorm());
   }
   record_energy();
   if (verbose()) {

@@ -53,7 +53,7 @@ void ContactModel::probe(const Eigen::Vector3d& previous_m, const Eigen::Vector3
   // normal force over its normal contact stiffness.
   const ContactOutput& last = m_output;
   const double pressed_n = last.active ? last.force_on_tool_n.dot(last.normal) : 0.0;
-  const double normal_stiffness_n_per_m = last.normal.dot(last.stiffness_n_per_m * last.normal);
+  const double normal_stiffness_n_per_m = last.normal.dot(rendered_stiffness_n_per_m() * last.normal);
   const double follow_distance_m =
       pressed_n > 0.0 && normal_stiffness_n_per_m > 0.0 ? pressed_n / normal_stiffness_n_per_m : 0.0;
   m_contact.update(previous_m, current_m, bvh.positions_m(), bvh.fitted(), follow_distance_m);
@@ -168,6 +168,12 @@ void ContactModel::sample_near_surface(const ToolPose& touching, const LazySurfa
                         m_body.elasticity(), m_near_hits);
 }
 
+Eigen::Matrix3d ContactModel::rendered_stiffness_n_per_m() const {
+  const ContactOutput& contact = m_output;
+  if (!contact.active) return Eigen::Matrix3d::Zero();
+  return sliding_contact_stiffness_n_per_m(contact.stiffness_n_per_m, contact.normal);
+}
+
 ToolContact ContactModel::tool_contact(const Eigen::Vector3d& ball_offset_m) const {
   const ContactOutput& contact = m_output;
   const bool near = !contact.active && m_near.has_value();
@@ -177,7 +183,7 @@ ToolContact ContactModel::tool_contact(const Eigen::Vector3d& ball_offset_m) con
   out.point_m = (near ? m_near->point_m : contact.point_m) + ball_offset_m;
   out.normal = near ? m_near->normal : contact.normal;
   out.force_on_tool_n = contact.force_on_tool_n;
-  out.stiffness_n_per_m = near ? m_near->stiffness_n_per_m : contact.stiffness_n_per_m;
+  out.stiffness_n_per_m = near ? m_near->stiffness_n_per_m : rendered_stiffness_n_per_m();
   out.damping_n_s_per_m = m_stiffness_damping_s * out.stiffness_n_per_m;
   out.penetration_depth_m = contact.penetration_depth_m;
   return out;

@@ -56,7 +56,7 @@ struct ContactOutput {
   Eigen::Vector3d point_m = Eigen::Vector3d::Zero();  ///< the god-object (proxy) position
   Eigen::Vector3d normal = Eigen::Vector3d::Zero();   ///< unit outward surface normal there
   Eigen::Vector3d force_on_tool_n = Eigen::Vector3d::Zero();
-  Eigen::Matrix3d stiffness_n_per_m = Eigen::Matrix3d::Zero();  ///< K_c (model from the settings)
+  Eigen::Matrix3d stiffness_n_per_m = Eigen::Matrix3d::Zero();  ///< K_c bonded (model from the settings)
   double penetration_depth_m = 0.0;                             ///< |tip - proxy|
 };
 
@@ -68,7 +68,9 @@ struct ToolContact {
   Eigen::Vector3d point_m = Eigen::Vector3d::Zero();  ///< the proxy (or near point), offset as the tool's position
   Eigen::Vector3d normal = Eigen::Vector3d::Zero();
   Eigen::Vector3d force_on_tool_n = Eigen::Vector3d::Zero();
-  Eigen::Matrix3d stiffness_n_per_m = Eigen::Matrix3d::Zero();  ///< K_c
+  /// K_c as the tool meets the frictionless contact (sliding_contact_stiffness_n_per_m); near the
+  /// surface, the nearest point's.
+  Eigen::Matrix3d stiffness_n_per_m = Eigen::Matrix3d::Zero();
   /// D_c = beta K_c: pressed at a speed v, the tool feels the quasi-static force plus beta K_n v
   /// (point_contact.hpp; tests/physics/test_contact_press.cpp).
   Eigen::Matrix3d damping_n_s_per_m = Eigen::Matrix3d::Zero();
@@ -110,6 +112,8 @@ class ContactModel {
   void sample_near_surface(const ToolPose& touching, const LazySurfaceBvh& bvh);
 
   [[nodiscard]] const ContactOutput& output() const { return m_output; }
+  /// K_c as the tool meets it (ToolContact::stiffness_n_per_m) in contact; zero out of contact.
+  [[nodiscard]] Eigen::Matrix3d rendered_stiffness_n_per_m() const;
   /// The complete output, `ball_offset_m` (the tool position minus its touching point) added to the
   /// point.
   [[nodiscard]] ToolContact tool_contact(const Eigen::Vector3d& ball_offset_m) const;

@@ -160,7 +160,8 @@ std::optional<Eigen::Matrix3d> EffectiveContactStiffness::stiffness_n_per_m(cons
 
 std::optional<Eigen::Matrix3d> EffectiveContactStiffness::stiffness_n_per_m(const ContactInterpolation& point,
                                                                             const ContactInterpolation& spring_point,
-                                                                            double spring_stiffness_n_per_m) {
+                                                                            double spring_stiffness_n_per_m,
+                                                                            const Eigen::Vector3d& spring_direction) {
   if (!(spring_stiffness_n_per_m >= 0.0) || !std::isfinite(spring_stiffness_n_per_m)) {
     throw std::invalid_argument("effective contact stiffness: the spring stiffness must be finite and >= 0");
   }
@@ -174,7 +175,13 @@ std::optional<Eigen::Matrix3d> EffectiveContactStiffness::stiffness_n_per_m(cons
   const std::array<ContactInterpolation, 2> points{point, spring_point};
   const Eigen::MatrixXd g = gram(points);
   const Eigen::Matrix3d cross = g.topRightCorner<3, 3>();  // P^T A'^-1 U
-  Eigen::Matrix3d m = -g.bottomRightCorner<3, 3>();         // -U^T A'^-1 U
+  if (!spring_direction.isZero(0.0)) {
+    // A spring along d alone: A' = A + k (U d)(U d)^T, the same with the 1 x 1 M = 1/k - d^T U^T A'^-1 U d.
+    const Eigen::Vector3d cross_d = cross * spring_direction;
+    const double m = 1.0 / spring_stiffness_n_per_m - spring_direction.dot(g.bottomRightCorner<3, 3>() * spring_direction);
+    return symmetric_inverse(g.topLeftCorner<3, 3>() + cross_d * cross_d.transpose() / m);
+  }
+  Eigen::Matrix3d m = -g.bottomRightCorner<3, 3>();  // -U^T A'^-1 U
   m.diagonal().array() += 1.0 / spring_stiffness_n_per_m;
   const Eigen::Matrix3d compliance = g.topLeftCorner<3, 3>() + cross * symmetric_inverse(m) * cross.transpose();
   return symmetric_inverse(compliance);
@@ -213,6 +220,14 @@ double normal_stiffness_n_per_m(const Eigen::Matrix3d& stiffness, const Eigen::V
 
 double frictionless_normal_stiffness_n_per_m(const Eigen::Matrix3d& stiffness, const Eigen::Vector3d& unit_normal) {
   return 1.0 / unit_normal.dot(stiffness.ldlt().solve(unit_normal));
+}
+
+Eigen::Matrix3d sliding_contact_stiffness_n_per_m(const Eigen::Matrix3d& bonded, const Eigen::Vector3d& unit_normal) {
+  double normal_n_per_m = frictionless_normal_stiffness_n_per_m(bonded, unit_normal);
+  if (!(normal_n_per_m > 0.0) || !std::isfinite(normal_n_per_m)) {
+    normal_n_per_m = std::max(normal_stiffness_n_per_m(bonded, unit_normal), 0.0);
+  }
+  return normal_n_per_m * (unit_normal * unit_normal.transpose());
 }
 
 double recommended_contact_spring_stiffness_n_per_m(const DeformableBody& body, const SurfaceMesh& surface,
@@ -257,6 +272,7 @@ ContactStiffnessRequest contact_stiffness_request(const ShiftedSystem& system, c
   if (spring) {
     request.spring_point = contact_interpolation(dofs, spring->vertices, spring->weights);
     request.spring_in_matrix_n_per_m = system.stiffness_scale * spring->tangent_fraction * spring->stiffness_n_per_m;
+    request.spring_direction = spring->direction;
   }
   request.rigid_support_n_per_m = rigid_support_n_per_m;
   request.floor_n_per_m = floor_n_per_m;
@@ -269,7 +285,8 @@ std::optional<Eigen::Matrix3d> condense_loaded(EffectiveContactStiffness& effect
     effective.factorize_loaded();
     const std::optional<Eigen::Matrix3d> stiffness =
         request.spring_point
-            ? effective.stiffness_n_per_m(request.point, *request.spring_point, request.spring_in_matrix_n_per_m)
+            ? effective.stiffness_n_per_m(request.point, *request.spring_point, request.spring_in_matrix_n_per_m,
+                                          request.spring_direction)
             : effective.stiffness_n_per_m(request.point);
     if (!stiffness) return Eigen::Matrix3d::Identity() * request.rigid_support_n_per_m;
     const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eigen(*stiffness, Eigen::EigenvaluesOnly);

@@ -100,13 +100,14 @@ class EffectiveContactStiffness {
   /// unknowns (all its weight on fixed vertices: a rigid support). Throws SolverError without a
   /// factor, std::invalid_argument for a row outside the factorized matrix.
   [[nodiscard]] std::optional<Eigen::Matrix3d> stiffness_n_per_m(const ContactInterpolation& point);
-  /// K_c of the tissue alone when the factorized matrix also holds the contact spring, k w_i w_j I
-  /// at the vertices of `spring_point` (DeformableBody's point spring is in its tangent while set):
-  /// the spring is taken out exactly (Sherman-Morrison-Woodbury, three more solves). Without that,
-  /// the matrix gives K_c + k I at the spring's own point. Throws std::invalid_argument for k < 0.
-  [[nodiscard]] std::optional<Eigen::Matrix3d> stiffness_n_per_m(const ContactInterpolation& point,
-                                                                 const ContactInterpolation& spring_point,
-                                                                 double spring_stiffness_n_per_m);
+  /// K_c of the tissue alone when the factorized matrix also holds the contact spring, k w_i w_j D
+  /// at the vertices of `spring_point` (DeformableBody's point spring is in its tangent while set;
+  /// D = I, or d d^T for a unit `spring_direction` d, zero meaning none: PointSpring): the spring is
+  /// taken out exactly (Sherman-Morrison-Woodbury, from the same forward solves). Without that, the
+  /// matrix gives K_c + k D at the spring's own point. Throws std::invalid_argument for k < 0.
+  [[nodiscard]] std::optional<Eigen::Matrix3d> stiffness_n_per_m(
+      const ContactInterpolation& point, const ContactInterpolation& spring_point, double spring_stiffness_n_per_m,
+      const Eigen::Vector3d& spring_direction = Eigen::Vector3d::Zero());
   using ResponseMatrix = Eigen::Matrix<double, Eigen::Dynamic, 3>;
   /// A^-1 P (rows() x 3): the displacement field of a unit force at `point` along each axis, by three
   /// full solves (stiffness_n_per_m needs only the forward halves). Throws as stiffness_n_per_m.
@@ -138,6 +139,7 @@ struct ContactStiffnessRequest {
   ContactInterpolation point;
   std::optional<ContactInterpolation> spring_point;  ///< the contact spring's point, while a spring is set
   double spring_in_matrix_n_per_m = 0.0;             ///< what the matrix holds of the spring
+  Eigen::Vector3d spring_direction = Eigen::Vector3d::Zero();  ///< the spring's (PointSpring::direction)
   double rigid_support_n_per_m = 0.0;                ///< K_c = this I at a point on fixed vertices only
   double floor_n_per_m = 0.0;                        ///< K_c's smallest eigenvalue must be above this
 };
@@ -185,6 +187,11 @@ double normal_stiffness_n_per_m(const Eigen::Matrix3d& stiffness, const Eigen::V
 /// 1 / (n^T K^-1 n): force along n per unit normal displacement, the tangential force zero (a
 /// frictionless contact). <= normal_stiffness_n_per_m for SPD K.
 double frictionless_normal_stiffness_n_per_m(const Eigen::Matrix3d& stiffness, const Eigen::Vector3d& unit_normal);
+
+/// The stiffness a sliding (frictionless or slipping) contact renders: k n n^T, k the frictionless
+/// normal stiffness of the bonded K_c (n^T K n where that is not finite and > 0): moving the tool
+/// across n changes nothing, the tissue's tangential stiffness belongs to a contact that sticks.
+Eigen::Matrix3d sliding_contact_stiffness_n_per_m(const Eigen::Matrix3d& bonded, const Eigen::Vector3d& unit_normal);
 
 /// The mean edge length of the body's surface triangles at rest [m] (0 for no triangles).
 double mean_surface_edge_m(const DeformableBody& body, const SurfaceMesh& surface);

@@ -23,13 +23,16 @@
 // (K_n the contact's normal stiffness; tests/physics/test_contact_press.cpp). The force on the
 // tool is the spring's at the end of the step, k (x_p - HIP), the reaction of the body.
 //
-// The spring is isotropic (PointSpring), so within a step it also holds the
-// material point tangentially; the re-projection then releases only the tangential stretch
-// |f_t| / k per step, and a tangential load relaxes by a factor (1 - k_t / k) per step (k_t the
-// tangential contact stiffness): with k = 100 k_t, ~100 steps per e-fold, felt as a viscous
-// stickiness. A spring acting along the normal only (k n n^T) would release it within the step;
-// a one-line change in spring() once PointSpring takes a direction (measured: the settled force in
-// ~100 instead of ~1000+ steps).
+// Sliding (issue 42): the spring pulls along the surface's smooth normal n at the proxy alone
+// (k n n^T; PointSpring::direction), so the material point slides freely across n within the step
+// and the contact is frictionless. An isotropic spring held the material point tangentially within
+// the step too; the re-projection then released only the tangential stretch |f_t| / k per step,
+// and the body's tangential load relaxed by a factor (1 - k_t / k) per step (k_t the tangential
+// contact stiffness): with k = 100 k_t, a drag of 19-35 % of the normal force on a probe swept at
+// 5-30 mm/s over a flat box, stick-slip on the organ. The normal is the interpolated vertex normal
+// (smooth_normal), not the face's: along the face normal a point probe's pit (a cone of faces
+// around the vertex it presses) threw the proxy from face to face (docs/DESIGN.md, "Palpating the
+// organ").
 #pragma once
 
 #include "core/collide/surface_bvh.hpp"
@@ -94,7 +97,8 @@ class PointContact {
   [[nodiscard]] const SurfacePoint& proxy() const { return m_proxy; }
   /// The proxy's position at the last update [m].
   [[nodiscard]] const Eigen::Vector3d& proxy_position_m() const { return m_proxy_position_m; }
-  /// Unit outward (pseudo-)normal of the surface at the proxy at the last update.
+  /// Unit outward smooth normal of the surface at the proxy at the last update (smooth_normal): the
+  /// direction the spring pulls along.
   [[nodiscard]] const Eigen::Vector3d& normal() const { return m_normal; }
   /// The HIP of the last update [m].
   [[nodiscard]] const Eigen::Vector3d& hip_m() const { return m_hip_m; }
@@ -128,7 +132,7 @@ class PointContact {
   }
   /// term.set(spring(surface), layout): `term` attached to the body whose term_layout() is `layout`.
   void apply(const SurfaceBvh& surface, PointSpringTerm& term, const TermLayout& layout) const;
-  /// The force on the tool k (x_p - HIP) with the proxy's material point at `positions_m` (e.g.
+  /// The force on the tool k n n^T (x_p - HIP) with the proxy's material point at `positions_m` (e.g.
   /// after the step), i.e. minus the spring's force on the body; zero when not in contact. [N]
   [[nodiscard]] Eigen::Vector3d force_on_tool_n(const SurfaceBvh& surface, const Eigen::VectorXd& positions_m) const;
 

@@ -16,11 +16,17 @@ Eigen::Vector3d PointSpringTerm::material_point_m(const Eigen::VectorXd& positio
   return point_m;
 }
 
+Eigen::Matrix3d spring_projector(const PointSpring& spring) {
+  if (spring.direction.isZero(0.0)) return Eigen::Matrix3d::Identity();
+  return spring.direction * spring.direction.transpose();
+}
+
 void PointSpringTerm::add_force(const Eigen::VectorXd& positions_m, Eigen::VectorXd& vertex_forces_n) {
   m_force_on_body_n.setZero();
   if (!m_spring) return;
-  // f_int gains k (x_p - target) w_i on vertex i; the body feels the opposite, k (target - x_p).
-  const Eigen::Vector3d stretch_force_n = m_spring->stiffness_n_per_m * (material_point_m(positions_m) - m_spring->target_m);
+  // f_int gains k D (x_p - target) w_i on vertex i; the body feels the opposite.
+  const Eigen::Vector3d stretch_force_n =
+      m_spring->stiffness_n_per_m * (spring_projector(*m_spring) * (material_point_m(positions_m) - m_spring->target_m));
   m_force_on_body_n = -stretch_force_n;
   for (size_t i = 0; i < 3; ++i) {
     vertex_forces_n.segment<3>(3 * m_spring->vertices[i]) += m_spring->weights[static_cast<Eigen::Index>(i)] * stretch_force_n;
@@ -30,20 +36,24 @@ void PointSpringTerm::add_force(const Eigen::VectorXd& positions_m, Eigen::Vecto
 void PointSpringTerm::add_tangent(BlockSparseMatrix& tangent) const {
   if (!m_spring) return;
   const PointSpring& spring = *m_spring;
+  const Eigen::Matrix3d projector = spring_projector(spring);
   for (size_t i = 0; i < 3; ++i) {
     for (size_t j = 0; j < 3; ++j) {
       const int slot = m_slots[3 * i + j];
       if (slot < 0) continue;  // a fixed vertex
-      tangent.block(slot).diagonal().array() += spring.tangent_fraction * spring.stiffness_n_per_m *
-                                                spring.weights[static_cast<Eigen::Index>(i)] *
-                                                spring.weights[static_cast<Eigen::Index>(j)];
+      tangent.block(slot) += (spring.tangent_fraction * spring.stiffness_n_per_m *
+                              spring.weights[static_cast<Eigen::Index>(i)] *
+                              spring.weights[static_cast<Eigen::Index>(j)]) *
+                             projector;
     }
   }
 }
 
 double PointSpringTerm::energy_j(const Eigen::VectorXd& positions_m) const {
   if (!m_spring) return 0.0;
-  return 0.5 * m_spring->stiffness_n_per_m * (material_point_m(positions_m) - m_spring->target_m).squaredNorm();
+  // D is a projector (D^T D = D): k/2 |D (x_p - target)|^2.
+  const Eigen::Vector3d stretch_m = material_point_m(positions_m) - m_spring->target_m;
+  return 0.5 * m_spring->stiffness_n_per_m * (spring_projector(*m_spring) * stretch_m).squaredNorm();
 }
 
 void PointSpringTerm::locate(const TermLayout& layout) {
@@ -71,6 +81,9 @@ void PointSpringTerm::set(std::optional<PointSpring> spring, const TermLayout& l
       throw ParameterError("point spring: weights must be finite and sum to 1");
     }
     if (!s.target_m.allFinite()) throw ParameterError("point spring: target must be finite");
+    if (!s.direction.allFinite() || (!s.direction.isZero(0.0) && std::abs(s.direction.norm() - 1.0) > 1e-6)) {
+      throw ParameterError("point spring: the direction must be zero or a unit vector");
+    }
     if (!std::isfinite(s.stiffness_n_per_m) || s.stiffness_n_per_m < 0.0) {
       throw ParameterError("point spring: stiffness must be finite and >= 0, got " +
                            std::to_string(s.stiffness_n_per_m));

@@ -156,7 +156,8 @@ QuasiStaticPoke quasi_static_poke(DeformableBody& body, const SurfaceTriangles& 
 
     body.positions(u, positions);
     const SurfaceProjection here = slide_to_closest_point(target_m, contact, triangles, adjacency, positions);
-    const Eigen::Vector3d tangential = lambda - lambda.dot(here.normal) * here.normal;
+    const Eigen::Vector3d normal = smooth_normal(here.point, triangles, adjacency, positions);
+    const Eigen::Vector3d tangential = lambda - lambda.dot(normal) * normal;
     result.tangential_residual = lambda.norm() > 0.0 ? tangential.norm() / lambda.norm() : 0.0;
     result.slide_iterations = slide;
     if (!solved) break;
@@ -168,7 +169,7 @@ QuasiStaticPoke quasi_static_poke(DeformableBody& body, const SurfaceTriangles& 
 
     // Shift the held point by delta in the tangent plane: the tangential reaction changes by
     // -T^T K_c delta, which cancels it to first order.
-    const Eigen::Matrix<double, 3, 2> basis = tangent_basis(here.normal);
+    const Eigen::Matrix<double, 3, 2> basis = tangent_basis(normal);
     const Eigen::Matrix2d tangential_stiffness = basis.transpose() * bonded.contact_stiffness * basis;
     const Eigen::Vector3d delta = basis * tangential_stiffness.ldlt().solve(basis.transpose() * lambda);
     const SurfaceProjection next = slide_to_closest_point(target_m + delta, contact, triangles, adjacency, positions);
@@ -183,7 +184,8 @@ QuasiStaticPoke quasi_static_poke(DeformableBody& body, const SurfaceTriangles& 
   result.force_on_tool_n = -lambda;
   result.contact = contact;
   body.positions(u, positions);
-  result.normal = slide_to_closest_point(target_m, contact, triangles, adjacency, positions).normal;
+  result.normal = smooth_normal(slide_to_closest_point(target_m, contact, triangles, adjacency, positions).point,
+                                triangles, adjacency, positions);
   result.displacement_m = std::move(u);
   result.contact_stiffness_n_per_m = bonded.contact_stiffness;
   result.force_residual = bonded.force_residual;

@@ -14,9 +14,9 @@
 // Two kinds of contact:
 // * bonded: the material point s stays the one held (the reaction may have a tangential part);
 //   as d -> 0 the reaction tends to K_c d with the effectiveStatic K_c;
-// * frictionless: the point held slides until the reaction is normal to the deformed surface,
-//   which is the equilibrium the god-object contact (PointContact) settles to as its spring
-//   stiffness grows. Outer iterations: the bonded solution at s, then s moves to the material
+// * frictionless: the point held slides until the reaction is along the deformed surface's smooth
+//   normal (smooth_normal, at the surface point closest to the target), which is the equilibrium the
+//   god-object contact (PointContact) settles to as its spring stiffness grows. Outer iterations: the bonded solution at s, then s moves to the material
 //   point now at target + T (T^T K_c T)^-1 T^T lambda (T the tangent plane): the shift that
 //   cancels the tangential reaction to first order.
 #pragma once
@@ -47,7 +47,7 @@ struct QuasiStaticPoke {
   bool converged = false;
   Eigen::Vector3d force_on_tool_n = Eigen::Vector3d::Zero();  ///< -lambda [N]
   SurfacePoint contact;                                       ///< the material point held at the target
-  Eigen::Vector3d normal = Eigen::Vector3d::Zero();           ///< unit outward pseudo-normal there, deformed
+  Eigen::Vector3d normal = Eigen::Vector3d::Zero();           ///< unit outward smooth normal there, deformed
   Eigen::VectorXd displacement_m;                             ///< the equilibrium u (free unknowns)
   /// Effective-static K_c = (P^T K^-1 P)^-1 with the tangent at the equilibrium [N/m].
   Eigen::Matrix3d contact_stiffness_n_per_m = Eigen::Matrix3d::Zero();

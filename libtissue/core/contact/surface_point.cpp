@@ -119,6 +119,25 @@ void VertexTriangles::build(const SurfaceTriangles& surface, int vertex_count) {
   triangle_count = static_cast<int>(surface.size());
 }
 
+Eigen::Vector3d smooth_normal(const SurfacePoint& point, const SurfaceTriangles& triangles,
+                              const VertexTriangles& adjacency, const Eigen::VectorXd& positions_m) {
+  const std::array<int, 3>& corners = triangles[static_cast<size_t>(point.triangle)];
+  Eigen::Vector3d normal = Eigen::Vector3d::Zero();
+  for (size_t k = 0; k < 3; ++k) {
+    const int v = corners[k];
+    Eigen::Vector3d vertex_normal = Eigen::Vector3d::Zero();
+    for (int a = adjacency.begin[static_cast<size_t>(v)]; a < adjacency.begin[static_cast<size_t>(v) + 1]; ++a) {
+      vertex_normal += triangle_area_normal(triangles[static_cast<size_t>(adjacency.triangles[static_cast<size_t>(a)])],
+                                            positions_m);
+    }
+    const double length = vertex_normal.norm();
+    if (length > 0.0) normal += point.barycentric[static_cast<Eigen::Index>(k)] * vertex_normal / length;
+  }
+  const double length = normal.norm();
+  return length > 0.0 ? Eigen::Vector3d(normal / length)
+                      : Eigen::Vector3d(triangle_area_normal(corners, positions_m).normalized());
+}
+
 SurfaceProjection slide_to_closest_point(const Eigen::Vector3d& query, const SurfacePoint& start,
                                          const SurfaceTriangles& triangles, const VertexTriangles& adjacency,
                                          const Eigen::VectorXd& positions_m) {

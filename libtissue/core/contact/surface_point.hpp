@@ -34,6 +34,13 @@ struct VertexTriangles {
   void build(const SurfaceTriangles& surface, int vertex_count);
 };
 
+/// The surface's smooth normal at a material point: the area-weighted vertex normals of its
+/// triangle's corners (each the sum of its incident triangles' area normals) interpolated with the
+/// point's barycentric coordinates, normalized (Phong 1975). Continuous over edges and vertices,
+/// where the face normal jumps. Falls back to the face normal where the sum vanishes.
+Eigen::Vector3d smooth_normal(const SurfacePoint& point, const SurfaceTriangles& triangles,
+                              const VertexTriangles& adjacency, const Eigen::VectorXd& positions_m);
+
 /// Where the sliding step ended.
 struct SurfaceProjection {
   SurfacePoint point;

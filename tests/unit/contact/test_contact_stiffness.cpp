@@ -126,6 +126,22 @@ TEST(EffectiveContactStiffness, TakesTheContactSpringOutOfTheMatrix) {
                 spring_at.triangle, (k_tissue - k_c).norm() / k_c.norm(), (naive - k_c).norm() / k_c.norm());
     EXPECT_THROW((void)with_spring.stiffness_n_per_m(frog.interpolation(point), frog.interpolation(spring_at), -1.0),
                  std::invalid_argument);
+
+    // A spring along one direction alone (the sliding contact, k d d^T): taken out the same way.
+    PointSpring along{frog.surface.triangles[static_cast<size_t>(spring_at.triangle)], spring_at.barycentric,
+                      frog.position(spring_at), k};
+    along.direction = Eigen::Vector3d(0.3, -0.2, 0.9).normalized();
+    spring_term.set(along, frog.body.term_layout());
+    frog.body.evaluate(Eigen::VectorXd::Zero(frog.body.dof_count()), force, true);
+    EffectiveContactStiffness with_along;
+    with_along.factorize(static_contact_system(frog.body.tangent(), diagonal));
+    const Eigen::Matrix3d k_tissue_along =
+        *with_along.stiffness_n_per_m(frog.interpolation(point), frog.interpolation(spring_at), k, along.direction);
+    EXPECT_LE((k_tissue_along - k_c).norm(), 1e-9 * k_c.norm()) << "along, on triangle " << spring_at.triangle;
+    // Taken out as if isotropic instead, it is wrong by far more.
+    const Eigen::Matrix3d wrong =
+        *with_along.stiffness_n_per_m(frog.interpolation(point), frog.interpolation(spring_at), k);
+    EXPECT_GT((wrong - k_c).norm(), 1e-3 * k_c.norm());
   }
   frog.body.detach(spring_term);
 }

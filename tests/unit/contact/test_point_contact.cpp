@@ -68,6 +68,11 @@ struct FrogSurface {
   SurfaceMesh surface = extract_surface(mesh);
   Eigen::VectorXd rest = rest_positions(mesh);
   SurfaceBvh bvh{surface.triangles, rest};
+  VertexTriangles adjacency = [this] {
+    VertexTriangles built;
+    built.build(surface.triangles, mesh.vertex_count());
+    return built;
+  }();
 };
 
 TEST(PointContact, StartsWhenTheToolEntersAndEndsWhenItLeaves) {
@@ -89,9 +94,13 @@ TEST(PointContact, StartsWhenTheToolEntersAndEndsWhenItLeaves) {
   EXPECT_EQ(contact.proxy().triangle, target.triangle);
   EXPECT_LE((contact.proxy_position_m() - x).norm(), 1e-15);
   EXPECT_NEAR(contact.penetration_depth_m(), 1e-3, 1e-15);
-  EXPECT_LE((contact.normal() - n).norm(), 1e-12);
-  // The spring pulls the proxy to the HIP: the tool is pushed out along n with k * depth.
-  EXPECT_LE((contact.force_on_tool_n(frog.bvh, frog.rest) - 2000.0 * 1e-3 * n).norm(), 1e-12);
+  // The normal is the smooth one there (interpolated vertex normals), near the face's on the back.
+  const Eigen::Vector3d smooth = smooth_normal(target, frog.surface.triangles, frog.adjacency, frog.rest);
+  EXPECT_LE((contact.normal() - smooth).norm(), 1e-15);
+  EXPECT_GT(smooth.dot(n), std::cos(0.2));
+  // The spring pulls the proxy to the HIP along that normal alone: the tool is pushed out along it
+  // with k times the depth along it.
+  EXPECT_LE((contact.force_on_tool_n(frog.bvh, frog.rest) - 2000.0 * 1e-3 * smooth.dot(n) * smooth).norm(), 1e-12);
   const std::optional<PointSpring> spring = contact.spring(frog.bvh);
   ASSERT_TRUE(spring.has_value());
   EXPECT_EQ(spring->vertices, frog.surface.triangles[static_cast<size_t>(contact.proxy().triangle)]);
@@ -99,6 +108,7 @@ TEST(PointContact, StartsWhenTheToolEntersAndEndsWhenItLeaves) {
   EXPECT_EQ(spring->target_m, contact.hip_m());
   EXPECT_EQ(spring->stiffness_n_per_m, 2000.0);
   EXPECT_EQ(spring->tangent_fraction, contact.settings().spring_tangent_fraction);
+  EXPECT_EQ(spring->direction, contact.normal());
 
   // Sliding deeper and sideways: the proxy is the surface point closest to the HIP.
   const Eigen::Vector3d hip = x - 1.5e-3 * n + 2e-3 * tangent;
@@ -203,6 +213,67 @@ TEST(SlideToClosestPoint, FindsTheClosestSurfacePointNearTheBack) {
   EXPECT_THROW(slide_to_closest_point(Eigen::Vector3d::Zero(), {-1, Eigen::Vector3d::Zero()}, frog.surface.triangles,
                                       adjacency, frog.rest),
                std::invalid_argument);
+}
+
+// The sliding contact's direction (point_contact.hpp): continuous where the face normals jump. At
+// every edge of the frog's surface, the point a third of the way along it has the same smooth normal
+// seen from either triangle (to rounding), while the two face normals differ by up to tens of degrees;
+// and on a flat face away from bends it is the face's normal.
+TEST(SmoothNormal, IsContinuousOverEdgesAndTheFaceNormalOnAFlat) {
+  FrogSurface frog;
+  const SurfaceTriangles& triangles = frog.surface.triangles;
+  double worst_jump = 0.0;
+  double largest_face_jump = 0.0;
+  for (int t = 0; t < static_cast<int>(triangles.size()); ++t) {
+    for (int a = 0; a < 3; ++a) {
+      const int v0 = triangles[static_cast<size_t>(t)][static_cast<size_t>(a)];
+      const int v1 = triangles[static_cast<size_t>(t)][static_cast<size_t>((a + 1) % 3)];
+      // The other triangle on this edge.
+      for (int k = frog.adjacency.begin[static_cast<size_t>(v0)]; k < frog.adjacency.begin[static_cast<size_t>(v0) + 1]; ++k) {
+        const int u = frog.adjacency.triangles[static_cast<size_t>(k)];
+        const std::array<int, 3>& other = triangles[static_cast<size_t>(u)];
+        if (u == t || std::find(other.begin(), other.end(), v1) == other.end()) continue;
+        const auto on_edge = [&](int triangle) {
+          SurfacePoint point{triangle, Eigen::Vector3d::Zero()};
+          const std::array<int, 3>& corners = triangles[static_cast<size_t>(triangle)];
+          for (int c = 0; c < 3; ++c) {
+            if (corners[static_cast<size_t>(c)] == v0) point.barycentric[c] = 2.0 / 3.0;
+            if (corners[static_cast<size_t>(c)] == v1) point.barycentric[c] = 1.0 / 3.0;
+          }
+          return point;
+        };
+        const Eigen::Vector3d mine = smooth_normal(on_edge(t), triangles, frog.adjacency, frog.rest);
+        const Eigen::Vector3d theirs = smooth_normal(on_edge(u), triangles, frog.adjacency, frog.rest);
+        worst_jump = std::max(worst_jump, (mine - theirs).norm());
+        largest_face_jump = std::max(largest_face_jump, (unit_normal(triangles[static_cast<size_t>(t)], frog.rest) -
+                                                         unit_normal(other, frog.rest))
+                                                            .norm());
+      }
+    }
+  }
+  EXPECT_LT(worst_jump, 1e-14);
+  EXPECT_GT(largest_face_jump, 0.3);
+
+  const TetMesh box = make_box_mesh(4, 4, 2, 0.01);
+  const SurfaceMesh surface = extract_surface(box);
+  const Eigen::VectorXd rest = rest_positions(box);
+  VertexTriangles adjacency;
+  adjacency.build(surface.triangles, box.vertex_count());
+  int flat = 0;
+  for (int t = 0; t < static_cast<int>(surface.triangles.size()); ++t) {
+    // A top triangle whose corners are all inside the top face (no corner on the box's rim).
+    bool inside = unit_normal(surface.triangles[static_cast<size_t>(t)], rest).z() > 0.99;
+    for (const int v : surface.triangles[static_cast<size_t>(t)]) {
+      const Eigen::Vector3d x = rest.segment<3>(3 * v);
+      inside = inside && x.x() > 1e-9 && x.x() < 0.04 - 1e-9 && x.y() > 1e-9 && x.y() < 0.04 - 1e-9;
+    }
+    if (!inside) continue;
+    ++flat;
+    const Eigen::Vector3d n = smooth_normal(SurfacePoint{t, Eigen::Vector3d(0.2, 0.3, 0.5)}, surface.triangles,
+                                            adjacency, rest);
+    EXPECT_LT((n - Eigen::Vector3d::UnitZ()).norm(), 1e-14);
+  }
+  EXPECT_GT(flat, 0);
 }
 
 TEST(PointContact, TheProxyStaysOnTheSurfaceWhileTheSurfaceMoves) {

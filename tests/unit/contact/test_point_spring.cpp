@@ -141,6 +141,37 @@ TEST(PointSpring, ForceAndTangentMatchTheDefinitionAndFiniteDifferences) {
     bar.body.evaluate(u, f_shared, true);
     EXPECT_LT((f_shared - f_with).norm(), 1e-12 * f_with.norm());
     EXPECT_LT(((dense(bar.body.tangent()) - k_without) - 0.25 * k_spring).norm(), 1e-6 * k_spring.norm());
+
+    // Along a direction d alone (the sliding contact): force k d d^T (x_p - target), tangent
+    // k w_i w_j d d^T, energy k/2 (d . (x_p - target))^2, whose gradient the force is.
+    PointSpring along = spring;
+    along.direction = Eigen::Vector3d(1.0, -2.0, 0.5).normalized();
+    bar.set_point_spring(along);
+    Eigen::VectorXd f_along;
+    bar.body.evaluate(u, f_along, true);
+    const Eigen::Matrix3d projector = along.direction * along.direction.transpose();
+    Eigen::VectorXd expected_along = Eigen::VectorXd::Zero(u.size());
+    Eigen::MatrixXd expected_tangent = Eigen::MatrixXd::Zero(u.size(), u.size());
+    for (int i = 0; i < 3; ++i) {
+      const int row = bar.body.dofs().vertex_row[static_cast<size_t>(spring.vertices[static_cast<size_t>(i)])];
+      if (row < 0) continue;
+      expected_along.segment<3>(3 * row) += spring.stiffness_n_per_m * spring.weights(i) * (projector * stretch);
+      for (int j = 0; j < 3; ++j) {
+        const int col = bar.body.dofs().vertex_row[static_cast<size_t>(spring.vertices[static_cast<size_t>(j)])];
+        if (col >= 0) {
+          expected_tangent.block<3, 3>(3 * row, 3 * col) +=
+              spring.stiffness_n_per_m * spring.weights(i) * spring.weights(j) * projector;
+        }
+      }
+    }
+    EXPECT_LT(((f_along - f_without) - expected_along).norm(), 1e-12 * f_with.norm());
+    EXPECT_LT(((dense(bar.body.tangent()) - k_without) - expected_tangent).norm(), 1e-9 * k_spring.norm());
+    EXPECT_NEAR(bar.spring_term.energy_j(positions),
+                0.5 * spring.stiffness_n_per_m * std::pow(along.direction.dot(stretch), 2), 1e-15);
+    along.direction *= 1.01;  // not a unit vector: refused, the spring kept
+    EXPECT_THROW(bar.spring_term.set(along, bar.body.term_layout()), ParameterError);
+    ASSERT_TRUE(bar.spring_term.spring().has_value());
+    EXPECT_EQ(bar.spring_term.spring()->direction, along.direction / 1.01);
   }
 }
 

@@ -227,8 +227,14 @@ TEST(Tissue, TheToolContactIsWhatAHapticLoopRenders) {
   EXPECT_NEAR((pressed.point_m - (tissue.contact().point_m + ball_offset)).norm(), 0.0, 1e-15);  // rounding
   EXPECT_EQ(pressed.force_on_tool_n, tissue.contact().force_on_tool_n);
   EXPECT_GT(pressed.force_on_tool_n.z(), 0.0);
-  EXPECT_EQ(pressed.stiffness_n_per_m, tissue.contact().stiffness_n_per_m);
-  EXPECT_EQ(pressed.damping_n_s_per_m, 0.01 * tissue.contact().stiffness_n_per_m);
+  // The contact slides (frictionless): K_c's normal part along the contact's normal, no tangential stiffness.
+  const Eigen::Matrix3d sliding =
+      sliding_contact_stiffness_n_per_m(tissue.contact().stiffness_n_per_m, tissue.contact().normal);
+  EXPECT_EQ(pressed.stiffness_n_per_m, sliding);
+  EXPECT_NEAR((sliding * tissue.contact().normal).norm(),
+              frictionless_normal_stiffness_n_per_m(tissue.contact().stiffness_n_per_m, tissue.contact().normal),
+              1e-9 * sliding.norm());
+  EXPECT_EQ(pressed.damping_n_s_per_m, 0.01 * sliding);
 
   settings.interaction.contact.near_surface_margin_m = 0.0;  // never reported
   Tissue no_margin(mesh, settings);
