@@ -237,7 +237,7 @@ constexpr auto ida_settings() {
   });
 }
 
-/// What the scene builds, the tool and the contact.
+/// What the scene builds, and the tool.
 constexpr auto interaction_settings() {
   return std::to_array<SettingInfo>({
       Setting("scene.contact", 15, boolean)
@@ -285,6 +285,12 @@ constexpr auto interaction_settings() {
           .describe("Fastest a hand moves the tool: a pose farther than this times stepSize from the last is "
                     "approached at this speed (the tool is clamped; a scalpel sweeps its path in sub-sweeps)")
           .member(TISSUE_MEMBER(settings.interaction.max_tool_speed_m_per_s)),
+  });
+}
+
+/// The probe's contact.
+constexpr auto contact_settings() {
+  return std::to_array<SettingInfo>({
       Setting("contact.nearMargin", 77, real)
           .python("near_surface_margin_m")
           .unit("m")
@@ -335,6 +341,16 @@ constexpr auto interaction_settings() {
                     "refreshed every max(contact.stiffnessRefreshSteps, this) steps. For bodies whose "
                     "factorization takes longer than a step (the 52k-tet organ: ~1-1.5 s on one core)")
           .member(TISSUE_MEMBER(settings.interaction.contact.stiffness_latency_steps)),
+      Setting("contact.friction", 89, real)
+          .python("contact_friction")
+          .start("0")
+          .at_least("0")
+          .at_most("2")
+          .describe("Coulomb friction coefficient mu of the probe on the tissue. 0: frictionless, the probe slides "
+                    "and presses along the surface's normal only. Above 0 the contact sticks (the tissue dragged "
+                    "with the tool, contact.stiffness the bonded one) until the force along the surface would "
+                    "exceed mu times the normal force, then slips with that force against the tool's motion")
+          .member(TISSUE_MEMBER(settings.interaction.contact.friction_coefficient)),
   });
 }
 
@@ -390,7 +406,9 @@ constexpr std::array<T, A + B> joined(const std::array<T, A>& a, const std::arra
 inline constexpr auto TISSUE_SETTINGS = settings_detail::joined(
     settings_detail::joined(settings_detail::joined(settings_detail::body_settings(), settings_detail::integrator_settings()),
                             settings_detail::ida_settings()),
-    settings_detail::joined(settings_detail::interaction_settings(), settings_detail::cutter_and_surface_settings()));
+    settings_detail::joined(
+        settings_detail::joined(settings_detail::interaction_settings(), settings_detail::contact_settings()),
+        settings_detail::cutter_and_surface_settings()));
 
 /// The setting of an FMU / scenario name, or nullptr.
 const SettingInfo* find_setting(std::string_view name);

@@ -16,7 +16,7 @@ constexpr std::uint64_t MAGIC = 0x31305353'49535354ULL;  // "TSSISS01" read as l
 // fields, other meanings; 8: the cutter's per-vertex sides, distances and the blade's plane of the
 // open session (issue 41); 9: each cut's blade normal (TetCut::blade_normal); 10: how far the blade
 // had turned when each tet was cut and each edge crossed (a spiral cuts a tet once per turn);
-// 12: the contact spring's direction (issue 42)
+// 12: the contact spring's direction and constant force, the contact's sticking and friction (issue 42)
 constexpr std::uint32_t VERSION = 12;
 
 // The core's Eigen types and cut records on top of the shared byte stream.
@@ -181,6 +181,8 @@ std::vector<std::uint8_t> serialize_snapshot(const TissueSnapshot& s) {
   w.put(s.contact.normal);
   w.put(s.contact.hip_m);
   w.put(s.contact.depth_m);
+  w.put(static_cast<std::uint8_t>(s.contact.sticking));
+  w.put(s.contact.friction_on_body_n);
   w.put(static_cast<std::uint8_t>(s.point_spring.has_value()));
   if (s.point_spring) {
     w.put_item(s.point_spring->vertices);
@@ -189,6 +191,7 @@ std::vector<std::uint8_t> serialize_snapshot(const TissueSnapshot& s) {
     w.put(s.point_spring->stiffness_n_per_m);
     w.put(s.point_spring->tangent_fraction);
     w.put(s.point_spring->direction);
+    w.put(s.point_spring->constant_force_on_body_n);
   }
   put_tool(w, s.tool);
   put_tool(w, s.previous_tool);
@@ -259,6 +262,8 @@ TissueSnapshot read_snapshot(std::span<const std::uint8_t> bytes) {
   r.get(s.contact.normal);
   r.get(s.contact.hip_m);
   r.get(s.contact.depth_m);
+  s.contact.sticking = r.get_bool();
+  r.get(s.contact.friction_on_body_n);
   if (r.get_bool()) {
     PointSpring spring;
     r.get(spring.vertices);
@@ -267,6 +272,7 @@ TissueSnapshot read_snapshot(std::span<const std::uint8_t> bytes) {
     r.get(spring.stiffness_n_per_m);
     r.get(spring.tangent_fraction);
     r.get(spring.direction);
+    r.get(spring.constant_force_on_body_n);
     s.point_spring = spring;
   }
   s.tool = get_tool(r);

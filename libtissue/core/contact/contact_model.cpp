@@ -27,6 +27,7 @@ PointContactSettings point_contact_settings(const ContactSettings& settings, dou
   contact.passed_over_depth_m = 0.5 * mean_surface_edge_m(body, surface);
   // The spring stands for the rigid tool: the step must not damp it (issue 9).
   contact.spring_tangent_fraction = integrator.undamped_tangent_share(step_size_s, stiffness_damping_s);
+  contact.friction_coefficient = settings.friction_coefficient;
   return contact;
 }
 
@@ -56,7 +57,7 @@ void ContactModel::probe(const Eigen::Vector3d& previous_m, const Eigen::Vector3
   const double normal_stiffness_n_per_m = last.normal.dot(rendered_stiffness_n_per_m() * last.normal);
   const double follow_distance_m =
       pressed_n > 0.0 && normal_stiffness_n_per_m > 0.0 ? pressed_n / normal_stiffness_n_per_m : 0.0;
-  m_contact.update(previous_m, current_m, bvh.positions_m(), bvh.fitted(), follow_distance_m);
+  m_contact.update(previous_m, current_m, bvh.positions_m(), bvh.fitted(), follow_distance_m, normal_stiffness_n_per_m);
   // The probe touches the mesh's surface only: a cut face's corners are not vertices the spring can
   // act on (they move with the enriched unknowns), so a probe reaching into a crack feels nothing.
   if (m_contact.in_contact() && m_contact.proxy().triangle >= static_cast<int>(m_surface.triangles.size())) {
@@ -171,6 +172,7 @@ void ContactModel::sample_near_surface(const ToolPose& touching, const LazySurfa
 Eigen::Matrix3d ContactModel::rendered_stiffness_n_per_m() const {
   const ContactOutput& contact = m_output;
   if (!contact.active) return Eigen::Matrix3d::Zero();
+  if (m_contact.sticking()) return contact.stiffness_n_per_m;
   return sliding_contact_stiffness_n_per_m(contact.stiffness_n_per_m, contact.normal);
 }
 

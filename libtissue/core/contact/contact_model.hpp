@@ -48,6 +48,9 @@ struct ContactSettings {
   /// A probe not in contact but this close to the surface reports it (ToolContact::near) [m];
   /// 0: never.
   double near_surface_margin_m = 0.01;
+  /// Coulomb friction coefficient of the probe on the tissue, >= 0; 0: frictionless (the contact
+  /// slides; point_contact.hpp).
+  double friction_coefficient = 0.0;
 };
 
 /// The contact outputs of the last step, as the contact point is (the haptic loop's input).
@@ -68,8 +71,8 @@ struct ToolContact {
   Eigen::Vector3d point_m = Eigen::Vector3d::Zero();  ///< the proxy (or near point), offset as the tool's position
   Eigen::Vector3d normal = Eigen::Vector3d::Zero();
   Eigen::Vector3d force_on_tool_n = Eigen::Vector3d::Zero();
-  /// K_c as the tool meets the frictionless contact (sliding_contact_stiffness_n_per_m); near the
-  /// surface, the nearest point's.
+  /// K_c as the tool meets it: the bonded K_c while a contact with friction sticks, its sliding part
+  /// (sliding_contact_stiffness_n_per_m) while it slides; near the surface, the nearest point's.
   Eigen::Matrix3d stiffness_n_per_m = Eigen::Matrix3d::Zero();
   /// D_c = beta K_c: pressed at a speed v, the tool feels the quasi-static force plus beta K_n v
   /// (point_contact.hpp; tests/physics/test_contact_press.cpp).

@@ -3,6 +3,7 @@
 
 #include "core/material/material.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 #include <string>
@@ -28,6 +29,10 @@ void validate(const PointContactSettings& settings) {
     throw ParameterError("contact spring tangent fraction must be in (0, 1], got " +
                          std::to_string(settings.spring_tangent_fraction));
   }
+  if (!(settings.friction_coefficient >= 0.0) || !std::isfinite(settings.friction_coefficient)) {
+    throw ParameterError("contact friction coefficient must be finite and >= 0, got " +
+                         std::to_string(settings.friction_coefficient));
+  }
 }
 
 bool PointContact::inside_by_parity(const Eigen::Vector3d& point_m, const Eigen::VectorXd& positions_m,
@@ -43,7 +48,8 @@ bool PointContact::inside_by_parity(const Eigen::Vector3d& point_m, const Eigen:
 PointContact::PointContact(PointContactSettings settings) : m_settings(settings) { validate(m_settings); }
 
 bool PointContact::update(const Eigen::Vector3d& hip_previous_m, const Eigen::Vector3d& hip_m,
-                          const Eigen::VectorXd& positions_m, const SurfaceBvh& surface, double follow_distance_m) {
+                          const Eigen::VectorXd& positions_m, const SurfaceBvh& surface, double follow_distance_m,
+                          double normal_stiffness_n_per_m) {
   if (!hip_m.allFinite() || !hip_previous_m.allFinite()) {
     throw std::invalid_argument("point contact: the tool tip position is not finite");
   }
@@ -57,6 +63,8 @@ bool PointContact::update(const Eigen::Vector3d& hip_previous_m, const Eigen::Ve
     m_adjacency.build(surface.triangles(), vertex_count);  // throws (state unchanged) for ids out of range
   }
 
+  // The last step's force on the tool (the spring as it was, at the positions it left).
+  const Eigen::Vector3d last_force_n = m_in_contact ? force_on_tool_n(surface, positions_m) : Eigen::Vector3d::Zero();
   m_hip_m = hip_m;
   SurfacePoint start = m_proxy;
   const bool was_in_contact = m_in_contact;
@@ -99,14 +107,57 @@ bool PointContact::update(const Eigen::Vector3d& hip_previous_m, const Eigen::Ve
     return false;
   }
   m_in_contact = true;
-  m_proxy = projection.point;
-  m_proxy_position_m = projection.position_m;
-  // The spring pulls along the smooth normal alone, not the face's: pulled along the face normal,
-  // a point probe's pit (a cone of faces around the vertex it presses) throws the proxy from face to
-  // face, 1.4 mm at a time, the force swinging by +-1.7 N on 1.8 N (a 5 mm box swept at 15 mm/s).
+  // The smooth normal, not the face's: pulled along the face normal, a point probe's pit (a cone of
+  // faces around the vertex it presses) throws the proxy from face to face, 1.4 mm at a time, the
+  // force swinging by +-1.7 N on 1.8 N (a 5 mm box swept at 15 mm/s).
   m_normal = smooth_normal(projection.point, surface.triangles(), m_adjacency, positions_m);
-  m_depth_m = projection.distance_m;
+  if (m_settings.friction_coefficient > 0.0 && was_in_contact) {
+    // The normal force's change the HIP's motion along -m asks for: the contact's normal stiffness
+    // in series with the spring.
+    const double k = m_settings.spring_stiffness_n_per_m;
+    const double series_n_per_m = normal_stiffness_n_per_m > 0.0 && std::isfinite(normal_stiffness_n_per_m)
+                                      ? normal_stiffness_n_per_m * k / (normal_stiffness_n_per_m + k)
+                                      : 0.0;
+    stick_or_slip(projection, last_force_n, series_n_per_m * (hip_previous_m - hip_m).dot(m_normal), positions_m,
+                  surface);
+  } else {
+    m_proxy = projection.point;
+    m_proxy_position_m = projection.position_m;
+    m_sticking = m_settings.friction_coefficient > 0.0;  // a new contact with friction sticks
+    m_friction_on_body_n.setZero();
+  }
+  m_depth_m = (m_proxy_position_m - hip_m).norm();
   return true;
+}
+
+void PointContact::stick_or_slip(const SurfaceProjection& closest, const Eigen::Vector3d& last_force_on_tool_n,
+                                 double normal_force_change_n, const Eigen::VectorXd& positions_m,
+                                 const SurfaceBvh& surface) {
+  const Eigen::Vector3d& m = m_normal;
+  const double mu = m_settings.friction_coefficient;
+  const double cone_n = mu * std::max(last_force_on_tool_n.dot(m), 0.0);  // the last step's
+  const Eigen::Vector3d tangential_force_n = last_force_on_tool_n - last_force_on_tool_n.dot(m) * m;
+  bool slip = false;
+  Eigen::Vector3d drag = Eigen::Vector3d::Zero();  // t: the way the tool drags the surface
+  const Eigen::Vector3d held_m = surface_point_position_m(m_proxy, surface.triangles(), positions_m);
+  if (m_sticking) {
+    slip = tangential_force_n.norm() > cone_n;
+    if (slip) drag = -tangential_force_n.normalized();
+  } else {
+    const Eigen::Vector3d previous = m_friction_on_body_n - m_friction_on_body_n.dot(m) * m;
+    drag = previous.normalized();
+    slip = !drag.isZero(0.0) && (m_hip_m - held_m).dot(drag) > cone_n / m_settings.spring_stiffness_n_per_m;
+  }
+  const bool was_sticking = m_sticking;
+  m_sticking = !slip;
+  const double predicted_normal_n = std::max(last_force_on_tool_n.dot(m) + normal_force_change_n, 0.0);
+  m_friction_on_body_n = slip ? Eigen::Vector3d(mu * predicted_normal_n * drag) : Eigen::Vector3d::Zero();
+  if (m_sticking && was_sticking) {  // the material point stays held
+    m_proxy_position_m = held_m;
+    return;
+  }
+  m_proxy = closest.point;  // slipping, or held from the point under the tool
+  m_proxy_position_m = closest.position_m;
 }
 
 std::optional<PointSpring> PointContact::spring(const SurfaceBvh& surface) const {
@@ -115,7 +166,8 @@ std::optional<PointSpring> PointContact::spring(const SurfaceBvh& surface) const
                      m_hip_m,
                      m_settings.spring_stiffness_n_per_m,
                      m_settings.spring_tangent_fraction,
-                     m_normal};
+                     m_sticking ? Eigen::Vector3d::Zero() : m_normal,
+                     m_friction_on_body_n};
 }
 
 void PointContact::apply(const SurfaceBvh& surface, PointSpringTerm& term, const TermLayout& layout) const {
@@ -125,7 +177,8 @@ void PointContact::apply(const SurfaceBvh& surface, PointSpringTerm& term, const
 Eigen::Vector3d PointContact::force_on_tool_n(const SurfaceBvh& surface, const Eigen::VectorXd& positions_m) const {
   if (!m_in_contact) return Eigen::Vector3d::Zero();
   const Eigen::Vector3d proxy_m = surface_point_position_m(m_proxy, surface.triangles(), positions_m);
-  return m_settings.spring_stiffness_n_per_m * m_normal * m_normal.dot(proxy_m - m_hip_m);
+  const PointSpring spring = *this->spring(surface);
+  return spring.stiffness_n_per_m * (spring_projector(spring) * (proxy_m - m_hip_m)) - spring.constant_force_on_body_n;
 }
 
 }  // namespace tissue

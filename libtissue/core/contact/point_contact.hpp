@@ -33,6 +33,23 @@
 // (smooth_normal), not the face's: along the face normal a point probe's pit (a cone of faces
 // around the vertex it presses) threw the proxy from face to face (docs/DESIGN.md, "Palpating the
 // organ").
+//
+// With Coulomb friction (coefficient mu > 0; the friction cone, as CHAI3D's finger proxy) the
+// contact sticks or slips:
+// * sticking: the proxy stays the material point it was (no re-projection) and the spring pulls
+//   along every axis: the tissue is dragged with the tool;
+// * slipping: the proxy is the closest point and the spring pulls along m alone, as without
+//   friction, and a constant force mu f_n t acts on the body there (PointSpring::
+//   constant_force_on_body_n): f_n the normal force predicted for the step (the last one plus the
+//   contact's normal stiffness times the HIP's motion along -m), t the direction the tool drags the
+//   surface. Explicit: its tangent would be unsymmetric (with the last f_n as it was, a sweep over
+//   a 5 mm box at 30 mm/s dragged 0.28-0.36 f_n for mu = 0.3). (An isotropic spring with the proxy
+//   on the cone's rim was tried: the body's tangential load then followed a falling normal force
+//   only at the rate k_t / k per step, 0.3 mu f_n too much within a few mm.)
+// A sticking contact slips when the last step's force (the body's answer included) left the cone,
+// |f_t| > mu f_n, along t = -f_t / |f_t|; a slipping one sticks, held from the point under the
+// tool, when the tool is no longer ahead of the surface point it was over along t by more than the
+// cone's reach mu f_n / k (it stopped or turned). A new contact starts sticking.
 #pragma once
 
 #include "core/collide/surface_bvh.hpp"
@@ -58,9 +75,12 @@ struct PointContactSettings {
   /// > 0: a HIP found inside the surface without crossing it (the surface moved over a tool that
   /// stood still or moved less) starts a contact too, if it is at most this deep; 0: crossings only.
   double passed_over_depth_m = 0.0;
+  /// Coulomb friction coefficient mu of the tool on the surface, finite and >= 0 (0: frictionless).
+  double friction_coefficient = 0.0;
 };
 
-/// Throws ParameterError unless the spring stiffness is finite and > 0 and its tangent fraction in (0, 1].
+/// Throws ParameterError unless the spring stiffness is finite and > 0, its tangent fraction in (0, 1]
+/// and the friction coefficient finite and >= 0.
 void validate(const PointContactSettings& settings);
 
 class PointContact {
@@ -85,10 +105,13 @@ class PointContact {
   ///   the step. Ending the contact instead lets the released surface spring up through the tool
   ///   unresisted for a whole step, and the next step finds the tool deep inside (issue 20: a hand
   ///   easing off a 1 N press by 10 um, under 1 mm/s, got 13 N back and chattered).
+  /// * With friction, the contact sticks or slips (the header); a slip's friction force is mu times
+  ///   the normal force predicted at the new HIP from the last one and `normal_stiffness_n_per_m`
+  ///   (the contact's, in series with the spring; 0: the last one as it was).
   /// Returns in_contact(). Throws std::invalid_argument (state unchanged) for a non-finite HIP or
   /// positions that do not cover the surface's vertices.
   bool update(const Eigen::Vector3d& hip_previous_m, const Eigen::Vector3d& hip_m, const Eigen::VectorXd& positions_m,
-              const SurfaceBvh& surface, double follow_distance_m = 0.0);
+              const SurfaceBvh& surface, double follow_distance_m = 0.0, double normal_stiffness_n_per_m = 0.0);
   /// Ends a contact (e.g. the tool mode changed).
   void release() { m_in_contact = false; }
 
@@ -104,6 +127,9 @@ class PointContact {
   [[nodiscard]] const Eigen::Vector3d& hip_m() const { return m_hip_m; }
   /// |HIP - proxy| at the last update while in contact, else 0 [m].
   [[nodiscard]] double penetration_depth_m() const { return m_in_contact ? m_depth_m : 0.0; }
+  /// With friction: the contact sticks (the proxy held as a material point). False without friction,
+  /// slipping, or out of contact.
+  [[nodiscard]] bool sticking() const { return m_in_contact && m_sticking; }
   [[nodiscard]] const PointContactSettings& settings() const { return m_settings; }
 
   /// The spring from the proxy's material point to the HIP, for the body's PointSpringTerm;
@@ -118,9 +144,12 @@ class PointContact {
     Eigen::Vector3d normal = Eigen::Vector3d::Zero();
     Eigen::Vector3d hip_m = Eigen::Vector3d::Zero();
     double depth_m = 0.0;
+    bool sticking = false;
+    Eigen::Vector3d friction_on_body_n = Eigen::Vector3d::Zero();  ///< slipping: mu f_n t
   };
   [[nodiscard]] State state() const {
-    return State{m_in_contact, m_proxy, m_proxy_position_m, m_normal, m_hip_m, m_depth_m};
+    return State{m_in_contact, m_proxy,    m_proxy_position_m, m_normal,
+                 m_hip_m,      m_depth_m, m_sticking,         m_friction_on_body_n};
   }
   void restore(const State& state) {
     m_in_contact = state.in_contact;
@@ -129,16 +158,21 @@ class PointContact {
     m_normal = state.normal;
     m_hip_m = state.hip_m;
     m_depth_m = state.depth_m;
+    m_sticking = state.sticking;
+    m_friction_on_body_n = state.friction_on_body_n;
   }
   /// term.set(spring(surface), layout): `term` attached to the body whose term_layout() is `layout`.
   void apply(const SurfaceBvh& surface, PointSpringTerm& term, const TermLayout& layout) const;
-  /// The force on the tool k n n^T (x_p - HIP) with the proxy's material point at `positions_m` (e.g.
+  /// The force on the tool, k D (x_p - HIP) - F (PointSpring; D = n n^T unless sticking), the proxy's material point at `positions_m` (e.g.
   /// after the step), i.e. minus the spring's force on the body; zero when not in contact. [N]
   [[nodiscard]] Eigen::Vector3d force_on_tool_n(const SurfaceBvh& surface, const Eigen::VectorXd& positions_m) const;
 
  private:
   /// Whether `point_m` is inside the surface by a ray's parity (the ray's hits stay in m_segment_hits).
   bool inside_by_parity(const Eigen::Vector3d& point_m, const Eigen::VectorXd& positions_m, const SurfaceBvh& surface);
+  /// With friction, a contact that goes on sticks or slips (the header); sets the proxy.
+  void stick_or_slip(const SurfaceProjection& closest, const Eigen::Vector3d& last_force_on_tool_n,
+                     double normal_force_change_n, const Eigen::VectorXd& positions_m, const SurfaceBvh& surface);
   PointContactSettings m_settings;
   bool m_in_contact = false;
   SurfacePoint m_proxy;
@@ -146,6 +180,8 @@ class PointContact {
   Eigen::Vector3d m_normal = Eigen::Vector3d::Zero();
   Eigen::Vector3d m_hip_m = Eigen::Vector3d::Zero();
   double m_depth_m = 0.0;
+  bool m_sticking = false;
+  Eigen::Vector3d m_friction_on_body_n = Eigen::Vector3d::Zero();
   VertexTriangles m_adjacency;                         // rebuilt when the surface grows (a cut)
   std::vector<SurfaceBvh::SegmentHit> m_segment_hits;  // work buffer
 };

@@ -24,9 +24,10 @@ Eigen::Matrix3d spring_projector(const PointSpring& spring) {
 void PointSpringTerm::add_force(const Eigen::VectorXd& positions_m, Eigen::VectorXd& vertex_forces_n) {
   m_force_on_body_n.setZero();
   if (!m_spring) return;
-  // f_int gains k D (x_p - target) w_i on vertex i; the body feels the opposite.
+  // f_int gains (k D (x_p - target) - F) w_i on vertex i; the body feels the opposite.
   const Eigen::Vector3d stretch_force_n =
-      m_spring->stiffness_n_per_m * (spring_projector(*m_spring) * (material_point_m(positions_m) - m_spring->target_m));
+      m_spring->stiffness_n_per_m * (spring_projector(*m_spring) * (material_point_m(positions_m) - m_spring->target_m)) -
+      m_spring->constant_force_on_body_n;
   m_force_on_body_n = -stretch_force_n;
   for (size_t i = 0; i < 3; ++i) {
     vertex_forces_n.segment<3>(3 * m_spring->vertices[i]) += m_spring->weights[static_cast<Eigen::Index>(i)] * stretch_force_n;
@@ -51,9 +52,10 @@ void PointSpringTerm::add_tangent(BlockSparseMatrix& tangent) const {
 
 double PointSpringTerm::energy_j(const Eigen::VectorXd& positions_m) const {
   if (!m_spring) return 0.0;
-  // D is a projector (D^T D = D): k/2 |D (x_p - target)|^2.
-  const Eigen::Vector3d stretch_m = material_point_m(positions_m) - m_spring->target_m;
-  return 0.5 * m_spring->stiffness_n_per_m * (spring_projector(*m_spring) * stretch_m).squaredNorm();
+  // D is a projector (D^T D = D): k/2 |D (x_p - target)|^2; F's potential is -F . x_p.
+  const Eigen::Vector3d point_m = material_point_m(positions_m);
+  return 0.5 * m_spring->stiffness_n_per_m * (spring_projector(*m_spring) * (point_m - m_spring->target_m)).squaredNorm() -
+         m_spring->constant_force_on_body_n.dot(point_m);
 }
 
 void PointSpringTerm::locate(const TermLayout& layout) {
@@ -81,6 +83,7 @@ void PointSpringTerm::set(std::optional<PointSpring> spring, const TermLayout& l
       throw ParameterError("point spring: weights must be finite and sum to 1");
     }
     if (!s.target_m.allFinite()) throw ParameterError("point spring: target must be finite");
+    if (!s.constant_force_on_body_n.allFinite()) throw ParameterError("point spring: the constant force must be finite");
     if (!s.direction.allFinite() || (!s.direction.isZero(0.0) && std::abs(s.direction.norm() - 1.0) > 1e-6)) {
       throw ParameterError("point spring: the direction must be zero or a unit vector");
     }

@@ -13,9 +13,10 @@
 namespace tissue {
 
 /// A spring of stiffness k from a material point x_p = sum_i w_i x_i of the body (a point of a
-/// surface triangle) to a target: the body feels k D (target - x_p), shared out with the weights,
-/// D = I (the spring pulls along every axis) or d d^T (along a unit direction d alone: the point
-/// slides freely across d, a frictionless contact; point_contact.hpp).
+/// surface triangle) to a target: the body feels k D (target - x_p) + F, shared out with the
+/// weights, D = I (the spring pulls along every axis) or d d^T (along a unit direction d alone: the
+/// point slides freely across d, a frictionless contact), F a constant force (a slipping contact's
+/// friction; point_contact.hpp).
 struct PointSpring {
   std::array<int, 3> vertices{};  ///< mesh vertices (the 3 vertices of a surface triangle)
   Eigen::Vector3d weights = Eigen::Vector3d::Constant(1.0 / 3.0);  ///< w_i, summing to 1
@@ -28,6 +29,8 @@ struct PointSpring {
   double tangent_fraction = 1.0;
   /// Zero: D = I. A unit vector d: D = d d^T.
   Eigen::Vector3d direction = Eigen::Vector3d::Zero();
+  /// F, a constant force on the body at x_p [N] (in no tangent).
+  Eigen::Vector3d constant_force_on_body_n = Eigen::Vector3d::Zero();
 };
 
 /// D (see PointSpring): the identity, or d d^T for a spring with a direction.
@@ -37,14 +40,14 @@ Eigen::Matrix3d spring_projector(const PointSpring& spring);
 /// as the contact starts, moves and ends.
 class PointSpringTerm final : public ForceTerm {
  public:
-  /// Sets (or clears) the spring: f_int gains w_i k D (x_p - target) on each vertex i, the
+  /// Sets (or clears) the spring: f_int gains w_i (k D (x_p - target) - F) on each vertex i, the
   /// tangent c k w_i w_j D between free vertices (c its tangent_fraction). Throws ParameterError
   /// (spring unchanged) unless the vertices are in range, every pair of free ones shares a tet,
-  /// weights and target are finite with |sum w - 1| <= 1e-6, 0 <= k < inf, 0 < c <= 1 and the
+  /// weights, target and F are finite with |sum w - 1| <= 1e-6, 0 <= k < inf, 0 < c <= 1 and the
   /// direction zero or of length 1 within 1e-6. `layout` is the body's (DeformableBody::term_layout).
   void set(std::optional<PointSpring> spring, const TermLayout& layout);
   [[nodiscard]] const std::optional<PointSpring>& spring() const { return m_spring; }
-  /// k D (target - x_p) at the last add_force(): the force the spring applies to the body (zero
+  /// k D (target - x_p) + F at the last add_force(): the force the spring applies to the body (zero
   /// without a spring) [N].
   [[nodiscard]] const Eigen::Vector3d& force_on_body_n() const { return m_force_on_body_n; }
 
