@@ -69,6 +69,22 @@ std::vector<LogRow> read_log(const std::filesystem::path& file) {
   return rows;
 }
 
+// Runs the scenario offline into a fresh temporary folder `name` and reads its log; empty (with a
+// test failure) when the tissue reported an error or a NaN.
+std::vector<LogRow> run_offline(const Scenario& scenario, const char* name) {
+  const std::filesystem::path dir = std::filesystem::temp_directory_path() / name;
+  std::filesystem::remove_all(dir);
+  SessionOptions options;
+  options.offline = true;
+  options.output_dir = dir;
+  options.fmu_dir = FMUS;
+  const SessionSummary summary = run_session(scenario, options);
+  EXPECT_EQ(summary.tissue_errors, 0u) << summary.first_error;
+  EXPECT_FALSE(summary.nan_detected);
+  if (summary.tissue_errors != 0 || summary.nan_detected) return {};
+  return read_log(dir / "log.csv");
+}
+
 // Where the scripted path holds still in probe mode for SHORTEST_DWELL_S or longer: the end times.
 std::vector<double> dwell_ends_s(const DeviceConfig& device) {
   std::vector<double> ends;
@@ -157,16 +173,8 @@ TEST(Palpation, TheHandFeelsTheInclusionByTheRatioTheQuasiStaticPokesPredict) {
   ASSERT_EQ(ends.size(), 2u) << "the scenario dwells beside the inclusion, then over it";
   scenario.duration_s = ends.back() + 0.1;  // the sweep that follows is the figure's, not this test's
 
-  const std::filesystem::path dir = std::filesystem::temp_directory_path() / "tissue_host_test_palpation";
-  std::filesystem::remove_all(dir);
-  SessionOptions options;
-  options.offline = true;
-  options.output_dir = dir;
-  options.fmu_dir = FMUS;
-  const SessionSummary summary = run_session(scenario, options);
-  ASSERT_EQ(summary.tissue_errors, 0u) << summary.first_error;
-  ASSERT_FALSE(summary.nan_detected);
-  const std::vector<LogRow> rows = read_log(dir / "log.csv");
+  const std::vector<LogRow> rows = run_offline(scenario, "tissue_host_test_palpation");
+  ASSERT_FALSE(rows.empty());
 
   const std::unique_ptr<Tissue> tissue = scenario_tissue(scenario);
   const double spring_n_per_m = tissue->contact_spring_stiffness_n_per_m();
@@ -217,14 +225,7 @@ TEST(Palpation, AHandSlidingOverTheFrogFeelsTheSlopeAndKeepsTheContact) {
   const double start_s = path[2].time_s + 0.1;  // pressed, held, then the slide
   const double end_s = path[path.size() - 2].time_s;
 
-  const std::filesystem::path dir = std::filesystem::temp_directory_path() / "tissue_host_test_slide_frog";
-  std::filesystem::remove_all(dir);
-  SessionOptions options;
-  options.offline = true;
-  options.output_dir = dir;
-  options.fmu_dir = FMUS;
-  const SessionSummary summary = run_session(scenario, options);
-  ASSERT_EQ(summary.tissue_errors, 0u) << summary.first_error;
+  const std::vector<LogRow> rows = run_offline(scenario, "tissue_host_test_slide_frog");
   const auto slope_at = [&](double x_m) {
     for (std::size_t k = 3; k + 1 < path.size(); ++k) {
       const Waypoint& a = path[k - 1];
@@ -237,7 +238,7 @@ TEST(Palpation, AHandSlidingOverTheFrogFeelsTheSlopeAndKeepsTheContact) {
   };
   std::vector<double> off;
   int lost = 0;
-  for (const LogRow& row : read_log(dir / "log.csv")) {
+  for (const LogRow& row : rows) {
     if (row.time_s < start_s || row.time_s > end_s) continue;
     if (!row.contact) ++lost;
     const double s = slope_at(row.tool_m.x());
