@@ -355,18 +355,11 @@ bool Run::step() {
     fail("the state is not finite and the step did not refuse");
     return false;
   }
-  // The contact spring's work on the body in this step (file comment of the header).
-  if (const std::optional<PointSpring>& spring = tissue.contact_spring().spring()) {
-    const Eigen::VectorXd& after = tissue.current_positions_m();
-    Eigen::Vector3d x0 = Eigen::Vector3d::Zero(), x1 = Eigen::Vector3d::Zero();
-    for (int i = 0; i < 3; ++i) {
-      const int v = spring->vertices[static_cast<size_t>(i)];
-      x0 += spring->weights(i) * vertex_of(m_positions_before, v);
-      x1 += spring->weights(i) * vertex_of(after, v);
-    }
-    const Eigen::Matrix3d projector = spring_projector(*spring);  // along its direction alone, or every axis
-    m_tool_work_j += 0.5 * spring->stiffness_n_per_m *
-                     ((projector * (spring->target_m - x0)).squaredNorm() - (projector * (spring->target_m - x1)).squaredNorm());
+  // The contact spring's work on the body in this step (file comment of the header): the fall of its
+  // potential, the spring fixed within the step.
+  if (tissue.contact_spring().spring()) {
+    m_tool_work_j += tissue.contact_spring().energy_j(m_positions_before) -
+                     tissue.contact_spring().energy_j(tissue.current_positions_m());
   }
   record_energy();
   if (verbose()) {

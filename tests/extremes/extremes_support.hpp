@@ -10,7 +10,7 @@
 // new enriched unknown starts at a = 0, so a cut should leave the sum as it is), plus, for the
 // probe, the work of its spring on the body. The spring's end (the tool tip) is fixed within a step, so
 // the spring is conservative there and its work in step k is exact whatever path the body takes:
-//   W_k = k/2 (|tip_k - x_p(t_{k-1})|^2 - |tip_k - x_p(t_k)|^2),
+//   W_k = E_k(x_p(t_{k-1})) - E_k(x_p(t_k)),   E_k = PointSpringTerm::energy_j (k/2 |D (x_p - tip_k)|^2 - F . x_p),
 // x_p the spring's material point. Backward Euler's numerical damping and the solvers' errors
 // only lower T + V; IDA's error control allows a drift of order of its tolerance: a case passes
 // when T + V <= B + 5% of the largest B so far + 1e-12 J at every step. The scalpel puts no work

@@ -63,8 +63,10 @@ bool PointContact::update(const Eigen::Vector3d& hip_previous_m, const Eigen::Ve
     m_adjacency.build(surface.triangles(), vertex_count);  // throws (state unchanged) for ids out of range
   }
 
-  // The last step's force on the tool (the spring as it was, at the positions it left).
-  const Eigen::Vector3d last_force_n = m_in_contact ? force_on_tool_n(surface, positions_m) : Eigen::Vector3d::Zero();
+  // With friction, the last step's force on the tool (the spring as it was, at the positions it left).
+  const Eigen::Vector3d last_force_n = m_in_contact && m_settings.friction_coefficient > 0.0
+                                           ? force_on_tool_n(surface, positions_m)
+                                           : Eigen::Vector3d::Zero();
   m_hip_m = hip_m;
   SurfacePoint start = m_proxy;
   const bool was_in_contact = m_in_contact;
@@ -176,9 +178,7 @@ void PointContact::apply(const SurfaceBvh& surface, PointSpringTerm& term, const
 
 Eigen::Vector3d PointContact::force_on_tool_n(const SurfaceBvh& surface, const Eigen::VectorXd& positions_m) const {
   if (!m_in_contact) return Eigen::Vector3d::Zero();
-  const Eigen::Vector3d proxy_m = surface_point_position_m(m_proxy, surface.triangles(), positions_m);
-  const PointSpring spring = *this->spring(surface);
-  return spring.stiffness_n_per_m * (spring_projector(spring) * (proxy_m - m_hip_m)) - spring.constant_force_on_body_n;
+  return -spring_force_on_body_n(*spring(surface), surface_point_position_m(m_proxy, surface.triangles(), positions_m));
 }
 
 }  // namespace tissue

@@ -21,14 +21,17 @@ Eigen::Matrix3d spring_projector(const PointSpring& spring) {
   return spring.direction * spring.direction.transpose();
 }
 
+Eigen::Vector3d spring_force_on_body_n(const PointSpring& spring, const Eigen::Vector3d& material_point_m) {
+  return spring.stiffness_n_per_m * (spring_projector(spring) * (spring.target_m - material_point_m)) +
+         spring.constant_force_on_body_n;
+}
+
 void PointSpringTerm::add_force(const Eigen::VectorXd& positions_m, Eigen::VectorXd& vertex_forces_n) {
   m_force_on_body_n.setZero();
   if (!m_spring) return;
-  // f_int gains (k D (x_p - target) - F) w_i on vertex i; the body feels the opposite.
-  const Eigen::Vector3d stretch_force_n =
-      m_spring->stiffness_n_per_m * (spring_projector(*m_spring) * (material_point_m(positions_m) - m_spring->target_m)) -
-      m_spring->constant_force_on_body_n;
-  m_force_on_body_n = -stretch_force_n;
+  // f_int gains (k D (x_p - target) - F) w_i on vertex i: minus the force on the body.
+  m_force_on_body_n = spring_force_on_body_n(*m_spring, material_point_m(positions_m));
+  const Eigen::Vector3d stretch_force_n = -m_force_on_body_n;
   for (size_t i = 0; i < 3; ++i) {
     vertex_forces_n.segment<3>(3 * m_spring->vertices[i]) += m_spring->weights[static_cast<Eigen::Index>(i)] * stretch_force_n;
   }

@@ -35,6 +35,9 @@ struct PointSpring {
 
 /// D (see PointSpring): the identity, or d d^T for a spring with a direction.
 Eigen::Matrix3d spring_projector(const PointSpring& spring);
+/// The force the spring applies to the body with its material point at `material_point_m`:
+/// k D (target - x_p) + F [N] (the force on the tool is its opposite).
+Eigen::Vector3d spring_force_on_body_n(const PointSpring& spring, const Eigen::Vector3d& material_point_m);
 
 /// The body's point spring, or none. Attach it to the body (DeformableBody::attach) once; set() it
 /// as the contact starts, moves and ends.
