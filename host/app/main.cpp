@@ -39,16 +39,27 @@ namespace {
 
 using namespace tissue::host;
 
-// build/<preset>/host/tissue-host -> build/<preset>/fmus, where the build packages the FMUs.
-std::filesystem::path default_fmu_dir() {
+// This program's own folder (empty if the system does not say).
+std::filesystem::path program_dir() {
   std::error_code error;
   const std::filesystem::path exe = std::filesystem::read_symlink("/proc/self/exe", error);
-  if (!error) {
-    const std::filesystem::path next_to_build = exe.parent_path().parent_path() / "fmus";
-    if (std::filesystem::exists(next_to_build / "Tissue.fmu")) return next_to_build;
-  }
-  return TISSUE_DEFAULT_FMU_DIR;
+  return error ? std::filesystem::path() : exe.parent_path();
 }
+
+// Installed: <prefix>/bin/tissue-host -> <prefix>/share/tissue/<folder>; in the build tree:
+// build/<preset>/host/tissue-host -> build/<preset>/<folder>, then `built` (where this build put it).
+std::filesystem::path data_dir(const std::string& folder, const std::string& holds, const std::filesystem::path& built) {
+  const std::filesystem::path here = program_dir();
+  if (!here.empty()) {
+    const std::filesystem::path installed = here / TISSUE_DATA_DIR_FROM_BIN / folder;
+    if (std::filesystem::exists(installed / holds)) return installed.lexically_normal();
+    const std::filesystem::path next_to_build = here.parent_path() / folder;
+    if (std::filesystem::exists(next_to_build / holds)) return next_to_build;
+  }
+  return built;
+}
+
+std::filesystem::path default_fmu_dir() { return data_dir("fmus", "Tissue.fmu", TISSUE_DEFAULT_FMU_DIR); }
 
 int run_command(const std::string& scenario_file, SessionOptions options, bool quiet, double duration_s) {
   Scenario scenario = load_scenario(scenario_file);
@@ -249,7 +260,7 @@ SessionOptions::View view_options(const RunArguments& a) {
   SessionOptions::View v;
   v.address = a.view_listen;
   v.port = static_cast<std::uint16_t>(a.view_port);
-  v.static_dir = TISSUE_VIEW_DIR;
+  v.static_dir = data_dir("view", "index.html", TISSUE_VIEW_DIR);
   if (!is_loopback_address(a.view_listen)) {
     v.token = random_token();
     std::cerr << "tissue-host: WARNING: the live view listens on " << a.view_listen

@@ -19,7 +19,8 @@ add_library(tissue_fmi_importer STATIC
 add_library(tissue::fmi_importer ALIAS tissue_fmi_importer)
 # Headers are included as "importer/<file>.hpp".
 get_filename_component(TISSUE_HOST_INCLUDE_DIR "${CMAKE_CURRENT_LIST_DIR}" DIRECTORY)
-target_include_directories(tissue_fmi_importer PUBLIC ${TISSUE_HOST_INCLUDE_DIR})
+target_include_directories(tissue_fmi_importer PUBLIC $<BUILD_INTERFACE:${TISSUE_HOST_INCLUDE_DIR}>
+                                                      $<INSTALL_INTERFACE:${TISSUE_INSTALL_INCLUDEDIR}>)
 target_compile_features(tissue_fmi_importer PUBLIC cxx_std_20)
 target_link_libraries(tissue_fmi_importer
   PUBLIC tissue::fmi3_abi

@@ -35,6 +35,7 @@ std::string SessionSummary::to_json() const {
   nlohmann::ordered_json j;
   j["scenario"] = scenario;
   j["mode"] = offline ? "offline" : "realtime";
+  j["fmus"] = {{"tissue", tissue_fmu}, {"haptic_loop", haptic_fmu}};
   j["sim_time_s"] = sim_time_s;
   j["wall_time_s"] = wall_time_s;
   j["realtime_factor"] = realtime_factor;

@@ -21,6 +21,7 @@ struct Percentiles {
 
 struct SessionSummary {
   std::string scenario;
+  std::string tissue_fmu, haptic_fmu;  ///< the FMU files the session loaded
   bool offline = false;
   double sim_time_s = 0.0, wall_time_s = 0.0, realtime_factor = 0.0;
   double haptic_rate_hz = 0.0;

@@ -101,6 +101,9 @@ class Session final : public SessionSteps {
     m_step_s.reserve(m_schedule.slots() + 8);
     m_step_cutting.reserve(m_schedule.slots() + 8);
     m_summary.scenario = scenario.name;
+    m_summary.tissue_fmu = std::filesystem::absolute(fmu_path(scenario.tissue_fmu, options.fmu_dir, "Tissue.fmu")).string();
+    m_summary.haptic_fmu =
+        std::filesystem::absolute(fmu_path(scenario.haptic_fmu, options.fmu_dir, "HapticLoop.fmu")).string();
     m_summary.offline = options.offline;
     m_summary.tissue_step_s = m_schedule.slot_s;
     m_summary.device_name = std::string(m_device->name());

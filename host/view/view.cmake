@@ -27,7 +27,7 @@ target_link_libraries(tissue_host_view
   PRIVATE nlohmann_json::nlohmann_json tissue::warnings)
 
 # The page and three.js (npm, ./scripts/setup) are served from the build, never from the network.
-set(TISSUE_VIEW_DIR ${CMAKE_BINARY_DIR}/view)
+set(TISSUE_VIEW_DIR ${CMAKE_BINARY_DIR}/view CACHE INTERNAL "The live view's page and three.js, as served and installed")
 set(TISSUE_THREE_DIR ${PROJECT_SOURCE_DIR}/node_modules/three)
 foreach(file index.html view.js)
   configure_file(${CMAKE_CURRENT_LIST_DIR}/web/${file} ${TISSUE_VIEW_DIR}/${file} COPYONLY)

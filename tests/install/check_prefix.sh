@@ -1,0 +1,34 @@
+# Sourced by check_install.sh and check_package.sh: check_prefix PREFIX WORK checks an installed tissue
+# as a user of the prefix would use it, with no build tree: a CMake project builds against it
+# (find_package(Tissue)), steps and cuts the frog and steps the Tissue FMU (consumer/); tissue-host from
+# PREFIX/bin runs a shipped scenario with the shipped FMUs; python3 imports the installed module.
+check_prefix() {
+  local prefix=$1 work=$2 here
+  here=$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)
+  echo "== consumer project against $prefix"
+  cmake -S "$here/consumer" -B "$work/consumer" -DCMAKE_PREFIX_PATH="$prefix" -DCMAKE_BUILD_TYPE=Release >"$work/consumer.log"
+  cmake --build "$work/consumer" -j2 >>"$work/consumer.log" || { cat "$work/consumer.log"; return 1; }
+  "$work/consumer/consumer"
+
+  echo "== $prefix/bin/tissue-host run cut_frog_complete.toml --offline"
+  "$prefix/bin/tissue-host" run "$prefix/share/tissue/scenarios/cut_frog_complete.toml" --offline \
+    --output "$work/session" >"$work/session.log"
+  /usr/bin/python3 - "$prefix" "$work/session/summary.json" <<'PY'
+import json, os, sys
+prefix, summary = os.path.realpath(sys.argv[1]), json.load(open(sys.argv[2]))
+for role, path in summary["fmus"].items():
+    assert os.path.realpath(path).startswith(prefix + os.sep), f"the {role} FMU came from {path}, not {prefix}"
+assert summary["cut_tets"] > 0 and summary["tissue_errors"] == 0, summary
+print(f"host: {summary['cut_tets']} tets cut, FMUs from {os.path.dirname(summary['fmus']['tissue'])}")
+PY
+
+  echo "== python3 -c 'import tissue' from $prefix"
+  PYTHONPATH="$prefix/lib/python3/dist-packages" /usr/bin/python3 - "$prefix" <<'PY'
+import os, sys, tissue
+prefix = os.path.realpath(sys.argv[1])
+assert os.path.realpath(tissue.__file__).startswith(prefix + os.sep), tissue.__file__
+frog = tissue.Tissue()
+frog.step()
+print(f"python: tissue from {tissue.__file__}, the frog steps")
+PY
+}
