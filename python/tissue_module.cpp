@@ -6,6 +6,7 @@
 // and restore the state as bytes. Errors come back as Python exceptions with the core's message:
 // ValueError for a bad setting or pose, RuntimeError for a failed step or a state that cannot be
 // restored. The core's arrays are copied out (numpy owns them), so nothing dangles after a step.
+// The HapticLoop FMU's renderer is tissue.HapticLoop (haptic_loop.hpp), fed from a Tissue here.
 #include "core/mesh/box_mesh.hpp"
 #include "core/mesh/mesh_io.hpp"
 #include "core/material/region_materials.hpp"
@@ -13,7 +14,10 @@
 #include "core/tissue_settings_schema.hpp"
 #include "core/tissue_snapshot_io.hpp"
 #include "device/scripted_device.hpp"
+#include "arrays.hpp"
 #include "fmi3/value_store.hpp"
+#include "haptic_loop.hpp"
+#include "quasi_static.hpp"
 #include "resources/default_mesh.hpp"
 #include "scenario/scenario.hpp"
 #include "tissue_fmu/tissue_model.hpp"
@@ -48,14 +52,6 @@ Array matrix(const double* values, py::ssize_t rows, py::ssize_t columns) {
   std::copy(values, values + rows * columns, out.mutable_data());
   return out;
 }
-
-Array vector3(const Eigen::Vector3d& v) {
-  Array out(3);
-  std::copy(v.data(), v.data() + 3, out.mutable_data());
-  return out;
-}
-
-Eigen::Vector3d to_vector3(const std::array<double, 3>& v) { return {v[0], v[1], v[2]}; }
 
 ToolMode tool_mode(const std::string& mode) {
   if (mode == "none") return ToolMode::none;
@@ -540,7 +536,20 @@ PYBIND11_MODULE(tissue, m) {
       .def_property_readonly("cut_tet_ids", &PyTissue::cut_tet_ids, "Mesh ids of the tets a cut went through")
       .def("cut_faces", &PyTissue::cut_faces, "The faces the cuts opened (k x 3, into surface()'s points)")
       .def("save", &PyTissue::save, "The state as bytes (what FMI's serialized FMU state holds)")
-      .def("restore", &PyTissue::restore, py::arg("state"), "Restores a state save() gave, cuts and all");
+      .def("restore", &PyTissue::restore, py::arg("state"), "Restores a state save() gave, cuts and all")
+      .def(
+          "quasi_static_poke",
+          [](const PyTissue& t, const std::array<double, 3>& target_m) {
+            return python::quasi_static_poke(t.core(), target_m);
+          },
+          py::arg("target_m"),
+          "The uncut body's static equilibrium (gravity included) with the surface point straight below target_m "
+          "pushed there, frictionless: {converged, force_on_tool_n, normal, stiffness_n_per_m}");
+
+  python::bind_haptic_loop(m).def(
+      "set_sample",
+      [](python::PyHapticLoop& loop, const PyTissue& t) { loop.set_sample(python::tissue_sample(t.core())); },
+      py::arg("tissue"), "The tissue's sample after its last step (what the Tissue FMU sends the HapticLoop FMU)");
 
   using tissue::python::PyScenario;
   py::class_<PyScenario>(m, "Scenario")

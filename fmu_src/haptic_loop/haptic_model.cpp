@@ -66,13 +66,19 @@ HapticModel::HapticModel(const fmi3::ModelContext& context, const ValueStore& va
 // The inputs are not checked here: the schema's rules hold at every set (device.orientation's
 // min_norm), and the tissue sample is checked where it is used (take_tissue_sample: a bad one is
 // refused and counted, the hand's loop goes on).
-void HapticModel::validate_parameters(const ValueStore& values) const {
+void check_parameters(const ValueStore& values) {
   (void)renderer_settings(values);
   const double step_s = values.float64(vr(Vr::step_size));
   if (!(step_s > 0.0)) throw VariableError("stepSize must be > 0 s, got " + std::to_string(step_s));
   const double scale = values.float64(vr(Vr::workspace_scale));
   if (!(scale > 0.0)) throw VariableError("workspace.scale must be > 0, got " + std::to_string(scale));
 }
+
+Eigen::Vector3d tool_position(const ValueStore& values, const Eigen::Vector3d& device_position_m) {
+  return vector3(values, Vr::workspace_offset) + values.float64(vr(Vr::workspace_scale)) * device_position_m;
+}
+
+void HapticModel::validate_parameters(const ValueStore& values) const { check_parameters(values); }
 
 void HapticModel::parameters_changed() { m_renderer = haptic::HapticRenderer(renderer_settings(m_values)); }
 
@@ -81,8 +87,7 @@ void HapticModel::enter_initialization_mode(double start_time_s) { m_time_s = st
 void HapticModel::exit_initialization_mode() {}
 
 Eigen::Vector3d HapticModel::tool_position() const {
-  return vector3(m_values, Vr::workspace_offset) +
-         m_values.float64(vr(Vr::workspace_scale)) * vector3(m_values, Vr::device_position);
+  return haptic_fmu::tool_position(m_values, vector3(m_values, Vr::device_position));
 }
 
 void HapticModel::take_tissue_sample() {

@@ -19,6 +19,12 @@ namespace tissue::haptic_fmu {
 
 /// The renderer's settings from the FMU's parameters (throws tissue::ParameterError when refused).
 haptic::RendererSettings renderer_settings(const fmi3::ValueStore& values);
+/// Every parameter checked as a set of them is (the renderer's ranges, stepSize and workspace.scale > 0):
+/// throws tissue::ParameterError or fmi3::VariableError with the reason. Also the Python module's
+/// HapticLoop's check (python/haptic_loop.cpp), so that both refuse the same values.
+void check_parameters(const fmi3::ValueStore& values);
+/// tool.position: workspace.offset + workspace.scale * the device's position.
+Eigen::Vector3d tool_position(const fmi3::ValueStore& values, const Eigen::Vector3d& device_position_m);
 
 class HapticModel final : public fmi3::Model {
  public:

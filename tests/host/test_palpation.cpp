@@ -141,29 +141,9 @@ std::unique_ptr<Tissue> scenario_tissue(const Scenario& scenario) {
 // The material point of the top surface straight below `point_m` at rest (the vertical line through it
 // meets the upward-facing triangle there): the point a probe pressed straight down holds.
 SurfacePoint point_below(const Tissue& tissue, const Eigen::Vector3d& point_m) {
-  const Eigen::VectorXd& x = tissue.current_positions_m();
-  const SurfaceTriangles& triangles = tissue.surface().triangles;
-  SurfacePoint best;
-  double best_height_m = -std::numeric_limits<double>::infinity();
-  for (std::size_t t = 0; t < triangles.size(); ++t) {
-    const Eigen::Vector3d a = x.segment<3>(3 * triangles[t][0]);
-    const Eigen::Vector3d b = x.segment<3>(3 * triangles[t][1]);
-    const Eigen::Vector3d c = x.segment<3>(3 * triangles[t][2]);
-    if ((b - a).cross(c - a).z() <= 0.0) continue;  // facing down or vertical
-    // Barycentric coordinates of (x, y) in the triangle's projection on the horizontal plane.
-    Eigen::Matrix2d edges;
-    edges << (b - a).head<2>(), (c - a).head<2>();
-    const Eigen::Vector2d beta = edges.inverse() * (point_m - a).head<2>();
-    const Eigen::Vector3d barycentric(1.0 - beta.sum(), beta.x(), beta.y());
-    if (barycentric.minCoeff() < 0.0) continue;
-    const double height_m = barycentric.x() * a.z() + barycentric.y() * b.z() + barycentric.z() * c.z();
-    if (height_m > best_height_m) {
-      best_height_m = height_m;
-      best = SurfacePoint{static_cast<int>(t), barycentric};
-    }
-  }
-  EXPECT_GE(best.triangle, 0) << "no surface above or below (" << point_m.transpose() << ")";
-  return best;
+  const SurfacePoint below = surface_point_below(point_m, tissue.surface().triangles, tissue.current_positions_m());
+  EXPECT_GE(below.triangle, 0) << "no surface above or below (" << point_m.transpose() << ")";
+  return below;
 }
 
 TEST(Palpation, TheHandFeelsTheInclusionByTheRatioTheQuasiStaticPokesPredict) {

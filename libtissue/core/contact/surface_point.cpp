@@ -6,6 +6,7 @@
 #include <Eigen/Geometry>
 
 #include <cmath>
+#include <limits>
 #include <stdexcept>
 #include <string>
 #include <utility>
@@ -193,6 +194,30 @@ SurfaceProjection slide_to_closest_point(const Eigen::Vector3d& query, const Sur
   projection.distance_m = std::sqrt(current.squared_distance_m2);
   projection.steps = steps;
   return projection;
+}
+
+SurfacePoint surface_point_below(const Eigen::Vector3d& point_m, const SurfaceTriangles& triangles,
+                                 const Eigen::VectorXd& positions_m) {
+  SurfacePoint best;
+  double best_height_m = -std::numeric_limits<double>::infinity();
+  for (std::size_t t = 0; t < triangles.size(); ++t) {
+    const Eigen::Vector3d a = positions_m.segment<3>(3 * triangles[t][0]);
+    const Eigen::Vector3d b = positions_m.segment<3>(3 * triangles[t][1]);
+    const Eigen::Vector3d c = positions_m.segment<3>(3 * triangles[t][2]);
+    if ((b - a).cross(c - a).z() <= 0.0) continue;  // facing down or vertical
+    // Barycentric coordinates of (x, y) in the triangle's projection on the horizontal plane.
+    Eigen::Matrix2d edges;
+    edges << (b - a).head<2>(), (c - a).head<2>();
+    const Eigen::Vector2d beta = edges.inverse() * (point_m - a).head<2>();
+    const Eigen::Vector3d barycentric(1.0 - beta.sum(), beta.x(), beta.y());
+    if (barycentric.minCoeff() < 0.0) continue;
+    const double height_m = barycentric.dot(Eigen::Vector3d(a.z(), b.z(), c.z()));
+    if (height_m > best_height_m) {
+      best_height_m = height_m;
+      best = SurfacePoint{static_cast<int>(t), barycentric};
+    }
+  }
+  return best;
 }
 
 }  // namespace tissue

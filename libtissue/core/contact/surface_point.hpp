@@ -25,6 +25,12 @@ Eigen::Vector3d surface_point_position_m(const SurfacePoint& point, const Surfac
 /// (x1 - x0) x (x2 - x0) at `positions_m`: outward for the outward-wound surface, |.| = 2 area. [m^2]
 Eigen::Vector3d triangle_area_normal(const std::array<int, 3>& triangle, const Eigen::VectorXd& positions_m);
 
+/// The material point straight below (or above) `point_m` along z in the configuration `positions_m`:
+/// on the highest upward-facing triangle the vertical line through it meets (the point a probe pressed
+/// straight down holds); triangle -1 when the line meets none.
+SurfacePoint surface_point_below(const Eigen::Vector3d& point_m, const SurfaceTriangles& triangles,
+                                 const Eigen::VectorXd& positions_m);
+
 /// Vertex -> incident triangles (compressed rows), the adjacency the sliding step walks over.
 struct VertexTriangles {
   std::vector<int> begin;      ///< triangles of vertex v: triangles[begin[v] .. begin[v + 1])
