@@ -22,27 +22,14 @@ double ratio_from(const TetCut& cut, int a, int b) {
   return 0.5;  // unreachable for two distinct local vertices
 }
 
-// The weights of the point (1 - ratio) x_from + ratio x_to.
-std::array<double, 4> on_edge(int from, int to, double ratio) {
-  std::array<double, 4> weights{};
-  weights[static_cast<size_t>(from)] = 1.0 - ratio;
-  weights[static_cast<size_t>(to)] = ratio;
-  return weights;
-}
-
-// Barycentric weights of x in the tet `corners`.
-std::array<double, 4> barycentric(const std::array<Eigen::Vector3d, 4>& corners, const Eigen::Vector3d& x) {
-  Eigen::Matrix3d edges;
-  for (int i = 0; i < 3; ++i) edges.col(i) = corners[static_cast<size_t>(i + 1)] - corners[0];
-  const Eigen::Vector3d tail = edges.partialPivLu().solve(x - corners[0]);
-  return {1.0 - tail.sum(), tail(0), tail(1), tail(2)};
-}
-
 }  // namespace
 
-int CutSurface::add_point(int cut_tet, int piece, const std::array<double, 4>& weights) {
+int CutSurface::add_point(int cut_tet, int piece, const std::array<double, 4>& weights, const WeldKey& key) {
   m_points.push_back(Point{cut_tet, piece, weights});
-  return m_vertex_count + static_cast<int>(m_points.size()) - 1;
+  m_point_owner.push_back(cut_tet);
+  const int id = m_vertex_count + static_cast<int>(m_points.size()) - 1;
+  m_point_key.push_back(weld_key_id(key, id));
+  return id;
 }
 
 int CutSurface::add_cut_tets(const DeformableBody& body, int first_cut_tet, const SurfaceMesh& surface) {
@@ -63,14 +50,9 @@ int CutSurface::add_cut_tets(const DeformableBody& body, int first_cut_tet, cons
       retired_any = true;
     }
   }
-  if (retired_any) {
-    m_drawn.clear();
-    for (size_t t = 0; t < m_triangles.size(); ++t) {
-      if (m_retired[static_cast<size_t>(m_triangle_cut_tet[t])] == 0) m_drawn.push_back(m_triangles[t]);
-    }
-  } else {
-    m_drawn.insert(m_drawn.end(), m_triangles.begin() + triangles_before, m_triangles.end());
-  }
+  if (retired_any) fix_retired_representatives();
+  update_fronts(body);
+  rebuild_drawn(body, surface);
   m_cut_tets = cut_tets;
   return static_cast<int>(m_triangles.size()) - triangles_before;
 }
@@ -79,25 +61,18 @@ void CutSurface::retire(const DeformableBody& body, int k) {
   m_retired[static_cast<size_t>(k)] = 1;
   // Its corners all follow vertex 0 of the first piece of the tet's current cut tet: zero area.
   const int current = body.cut_tet_index(body.cut_tets()[static_cast<size_t>(k)].cut.tet);
-  for (Point& point : m_points) {
-    if (point.cut_tet == k) point = Point{current, 0, {1.0, 0.0, 0.0, 0.0}};
+  // (Its corners are no longer drawn: the weld's keys turn to live corners.)
+  for (size_t p = 0; p < m_points.size(); ++p) {
+    if (m_point_owner[p] == k) m_points[p] = Point{current, 0, {1.0, 0.0, 0.0, 0.0}};
   }
-  size_t kept = 0;
-  for (size_t t = 0; t < m_skin.size(); ++t) {
-    if (m_skin_cut_tet[t] == k) continue;
-    m_skin[kept] = m_skin[t];
-    m_skin_cut_tet[kept++] = m_skin_cut_tet[t];
-  }
-  m_skin.resize(kept);
-  m_skin_cut_tet.resize(kept);
 }
 
 void CutSurface::replace_surface_triangles(int tet, const SurfaceMesh& surface) {
   const auto [first, last] = std::equal_range(surface.triangle_tet.begin(), surface.triangle_tet.end(), tet);
   for (auto it = first; it != last; ++it) {
     const int triangle_index = static_cast<int>(it - surface.triangle_tet.begin());
-    const auto at = std::lower_bound(m_replaced.begin(), m_replaced.end(), triangle_index);
-    if (at == m_replaced.end() || *at != triangle_index) m_replaced.insert(at, triangle_index);
+    const auto at = std::lower_bound(m_cut_replaced.begin(), m_cut_replaced.end(), triangle_index);
+    if (at == m_cut_replaced.end() || *at != triangle_index) m_cut_replaced.insert(at, triangle_index);
   }
 }
 
@@ -119,21 +94,23 @@ void CutSurface::add_piece_faces(const DeformableBody& body, int k, const Surfac
       const int tag = piece.face_tag(f);
       const bool cap = tag >= 4;
       if (!cap && !on_surface[static_cast<size_t>(tag)]) continue;  // inside the mesh
-      const int first_corner = add_point(k, p, barycentric(rest, piece.corner(f, 0)));
-      int previous = add_point(k, p, barycentric(rest, piece.corner(f, 1)));
+      const int first_corner = add_corner_point(body, k, p, piece.corner(f, 0));
+      int previous = add_corner_point(body, k, p, piece.corner(f, 1));
       for (int c = 2; c < piece.corner_count(f); ++c) {
-        const int next = add_point(k, p, barycentric(rest, piece.corner(f, c)));
+        const int next = add_corner_point(body, k, p, piece.corner(f, c));
         if (cap) {
           m_triangles.push_back({first_corner, previous, next});
           m_triangle_cut_tet.push_back(k);
         } else {
-          m_skin.push_back({first_corner, previous, next});
+          m_skin_made.push_back({first_corner, previous, next});
           m_skin_cut_tet.push_back(k);
         }
         previous = next;
       }
+      if (cap) note_cap_edges(geometry.cuts[static_cast<size_t>(tag - 4)].cut_id, first_corner, piece.corner_count(f));
     }
   }
+  match_cap_edges(k);
 }
 
 void CutSurface::add_once_cut_faces(const DeformableBody& body, int k, const SurfaceMesh& surface) {
@@ -180,12 +157,13 @@ void CutSurface::add_once_cut_faces(const DeformableBody& body, int k, const Sur
     const Eigen::Vector3d above_to_below = below_centre / (4 - above_count) - above_centre / above_count;
     const bool polygon_faces_below = normal.dot(above_to_below) >= 0.0;
 
+    const int first_above = m_vertex_count + static_cast<int>(m_points.size());
     for (CutPart part : {CutPart::above, CutPart::below}) {
       const int piece = part == CutPart::above ? 0 : 1;
       const int first_point = m_vertex_count + static_cast<int>(m_points.size());
       for (int e : crossed) {
         const auto& edge = TET_EDGES[static_cast<size_t>(e)];
-        add_point(k, piece, on_edge(edge[0], edge[1], cut.edge_ratio[static_cast<size_t>(e)]));
+        add_edge_point(body, k, piece, edge[0], edge[1], cut.edge_ratio[static_cast<size_t>(e)]);
       }
       // Outward from the part: toward below for part above, toward above for part below.
       const bool keep_order = (part == CutPart::above) == polygon_faces_below;
@@ -197,6 +175,7 @@ void CutSurface::add_once_cut_faces(const DeformableBody& body, int k, const Sur
         m_triangle_cut_tet.push_back(k);
       }
     }
+    note_crack_edges(k, cut.cut_id, crossed, first_above, polygon_faces_below);
 
     // The skin: the tet's surface triangles (triangle_tet is in tet order), split along the cut.
     replace_surface_triangles(cut.tet, surface);
@@ -218,11 +197,11 @@ void CutSurface::add_once_cut_faces(const DeformableBody& body, int k, const Sur
           const int b = local[static_cast<size_t>((c + 1) % 3)];
           if (cut.side[static_cast<size_t>(a)] == side) polygon.push_back(triangle[static_cast<size_t>(c)]);
           if (cut.side[static_cast<size_t>(a)] != cut.side[static_cast<size_t>(b)]) {
-            polygon.push_back(add_point(k, part == CutPart::above ? 0 : 1, on_edge(a, b, ratio_from(cut, a, b))));
+            polygon.push_back(add_edge_point(body, k, part == CutPart::above ? 0 : 1, a, b, ratio_from(cut, a, b)));
           }
         }
         for (size_t t = 1; t + 1 < polygon.size(); ++t) {
-          m_skin.push_back({polygon[0], polygon[t], polygon[t + 1]});
+          m_skin_made.push_back({polygon[0], polygon[t], polygon[t + 1]});
           m_skin_cut_tet.push_back(k);
         }
       }
@@ -239,6 +218,14 @@ void CutSurface::update_points(const DeformableBody& body, const Eigen::VectorXd
                                Eigen::Vector3d::Zero()};
   for (size_t p = 0; p < m_points.size(); ++p) {
     const Point& point = m_points[p];
+    if (point.cut_tet < 0) {  // of real vertices, whose positions the caller wrote
+      Eigen::Vector3d x = Eigen::Vector3d::Zero();
+      for (size_t j = 0; j < 4; ++j) {
+        if (point.vertices[j] >= 0) x += point.weights[j] * positions_m.segment<3>(3 * point.vertices[j]);
+      }
+      positions_m.segment<3>(3 * (m_vertex_count + static_cast<Eigen::Index>(p))) = x;
+      continue;
+    }
     if (point.cut_tet != last_cut_tet || point.piece != last_piece) {
       piece_positions = body.piece_positions(displacement_m, point.cut_tet, point.piece);
       last_cut_tet = point.cut_tet;

@@ -12,6 +12,16 @@
 // ConvexPiece's order), each corner following its piece by its barycentric weights. The faces of the
 // cut tet it replaced (retired) collapse to a point: they stay in the BVH (ids never change) with
 // zero area, and are no longer drawn.
+// The drawn surface is welded (issue 43): the faces above keep corners of their own (the BVH's
+// triangles), but the triangles to draw name one point per corner of the material. Two corners are
+// one when they have the same weld key: the mesh vertices that carry them, the copy of each (real or
+// which ghost row) and the cuts they lie on; a corner that is a real mesh vertex is that vertex.
+// Where the blade stopped inside (the crack's front: a cut face's edge on a tet face whose other tet
+// the cut did not cut), the two sides' cut faces are joined by a strip of two triangles (zero area
+// at rest, the crack tip's wedge as the sides open), and the uncut surface triangles on an edge at
+// the front are drawn split at both sides' crossings. Keys are hashed when the faces are made
+// (add_cut_tets), never per frame; sides that separated have different ghost rows, so their corners
+// stay apart.
 #pragma once
 
 #include "core/fem/deformable_body.hpp"
@@ -20,7 +30,10 @@
 #include <Eigen/Core>
 
 #include <array>
+#include <cstddef>
 #include <cstdint>
+#include <unordered_map>
+#include <utility>
 #include <vector>
 
 namespace tissue {
@@ -44,21 +57,73 @@ class CutSurface {
   /// Every cut face made, in the BVH's order: corner ids >= the mesh's vertex count (id -
   /// vertex_count indexes the points). The faces of retired cut tets are collapsed to a point.
   [[nodiscard]] const std::vector<std::array<int, 3>>& triangles() const { return m_triangles; }
-  /// The cut faces to draw: triangles() without the retired ones.
+  /// The cut faces to draw: triangles() without the retired ones, corners welded (drawn_point).
   [[nodiscard]] const std::vector<std::array<int, 3>>& drawn_triangles() const { return m_drawn; }
   /// The pieces that replace the surface triangles of cut tets in the output (not in the BVH: the
-  /// contact and the cutter work on the mesh's own triangles). Corner ids as in triangles().
+  /// contact and the cutter work on the mesh's own triangles), corners welded; then the uncut surface
+  /// triangles split at the crack's front.
   [[nodiscard]] const std::vector<std::array<int, 3>>& skin_triangles() const { return m_skin; }
   /// Indices into SurfaceMesh::triangles of the triangles the skin pieces replace, ascending.
   [[nodiscard]] const std::vector<int>& replaced_triangles() const { return m_replaced; }
+  /// The point drawn for corner id `id` (a mesh vertex, or a cut-face corner as triangles() names it):
+  /// the vertex itself, or the first live corner made with the same weld key.
+  [[nodiscard]] int drawn_point(int id) const;
 
  private:
   struct Point {
-    int cut_tet = -1;
+    int cut_tet = -1;  ///< -1: a point of real mesh vertices, sum_j weights_j x(vertices_j)
     int piece = 0;
     std::array<double, 4> weights{};  ///< the corner is sum_j weights_j p_j of the piece's vertices
+    std::array<int, 4> vertices{-1, -1, -1, -1};
   };
-  int add_point(int cut_tet, int piece, const std::array<double, 4>& weights);
+  /// What a corner is in the material (cut_surface_weld.cpp): its mesh vertices (ascending, -1
+  /// after), the ghost row each is seen through (-1: the real vertex), the cut ids it lies on.
+  struct WeldKey {
+    std::array<int, 4> vertex{-1, -1, -1, -1};
+    std::array<int, 4> ghost_row{-1, -1, -1, -1};
+    std::array<int, 3> cut_id{-1, -1, -1};
+    bool operator==(const WeldKey&) const = default;
+  };
+  struct WeldKeyHash {
+    std::size_t operator()(const WeldKey& key) const;
+  };
+  /// A mesh edge crossed by a cut; at the crack's front (a tet around it not cut by the cut) the
+  /// uncut surface triangles on it are drawn split at its corners on either side.
+  struct CrossedEdge {
+    int cut_id = -1;
+    int edge = -1;       ///< TetAdjacency edge id
+    double ratio = 0.5;  ///< the crossing from the edge's lower vertex
+    bool front = false;
+    int lower_side = -1;  ///< a corner of the side holding the edge's lower vertex (its id)
+    int upper_side = -1;  ///< and of the side holding its upper vertex
+  };
+  /// An edge of a cut tet's cut face on the tet's local face `face` (cut `cut_id`): `above` as one
+  /// side's cut face runs along it, `below` the other side's corners at the same places. At the
+  /// crack's front the strip between them is drawn (add_front_strips).
+  struct CrackEdge {
+    int cut_tet = -1;
+    int cut_id = -1;
+    int face = -1;
+    std::array<int, 2> above{};
+    std::array<int, 2> below{};
+  };
+  int add_point(int cut_tet, int piece, const std::array<double, 4>& weights, const WeldKey& key);
+  int add_edge_point(const DeformableBody& body, int k, int piece, int a, int b, double ratio_from_a);
+  int add_corner_point(const DeformableBody& body, int k, int piece, const Eigen::Vector3d& corner_m);
+  int add_real_point(const std::array<int, 4>& vertices, const std::array<double, 4>& weights);
+  int weld_key_id(const WeldKey& key, int point);
+  void note_crossed_edge(const WeldKey& key, int edge, double ratio_from_lower, int point);
+  void note_crack_edges(int k, int cut_id, const std::vector<int>& crossed, int first_above, bool above_forward);
+  void note_cap_edges(int cut_id, int first_corner, int count);
+  void match_cap_edges(int k);
+  void add_front_strips(const DeformableBody& body);
+  void update_fronts(const DeformableBody& body);
+  void fix_retired_representatives();
+  void rebuild_drawn(const DeformableBody& body, const SurfaceMesh& surface);
+  void split_front_triangles(const DeformableBody& body, const SurfaceMesh& surface);
+  void split_front_triangle(const DeformableBody& body, const SurfaceMesh& surface, int t, std::size_t begin,
+                            std::size_t end);
+  [[nodiscard]] std::array<int, 3> drawn(const std::array<int, 3>& triangle) const;
   void add_once_cut_faces(const DeformableBody& body, int k, const SurfaceMesh& surface);
   void add_piece_faces(const DeformableBody& body, int k, const SurfaceMesh& surface);
   void replace_surface_triangles(int tet, const SurfaceMesh& surface);
@@ -70,10 +135,37 @@ class CutSurface {
   std::vector<std::array<int, 3>> m_triangles;
   std::vector<int> m_triangle_cut_tet;  // per triangle, the cut tet it belongs to
   std::vector<std::array<int, 3>> m_drawn;
-  std::vector<std::array<int, 3>> m_skin;
-  std::vector<int> m_skin_cut_tet;      // per skin triangle, the cut tet it belongs to
-  std::vector<std::uint8_t> m_retired;  // per cut tet: its faces retired
-  std::vector<int> m_replaced;
+  std::vector<std::array<int, 3>> m_skin_made;  // the skin pieces as made (own corners)
+  std::vector<int> m_skin_cut_tet;              // per made skin triangle, the cut tet it belongs to
+  std::vector<std::array<int, 3>> m_skin;       // drawn: welded, live, then the front splits
+  std::vector<std::uint8_t> m_retired;          // per cut tet: its faces retired
+  std::vector<int> m_cut_replaced;              // surface triangles of cut tets, ascending
+  std::vector<int> m_replaced;                  // those and the uncut ones split at a front, ascending
+  // The weld (cut_surface_weld.cpp): per point its key and maker (-1: a point of real vertices);
+  // per key the key and the point drawn for it.
+  std::unordered_map<WeldKey, int, WeldKeyHash> m_key_ids;
+  std::vector<int> m_point_key;
+  std::vector<int> m_point_owner;
+  std::vector<WeldKey> m_keys;
+  std::vector<int> m_key_drawn;
+  std::unordered_map<std::int64_t, int> m_crossed_ids;  // (cut id, edge) -> index into m_crossed
+  std::vector<CrossedEdge> m_crossed;
+  std::vector<int> m_touched_edges;  // crossed edges given corners since the last update_fronts
+  std::vector<int> m_front_edges;    // crossed edges at the front, in the order they got there
+  std::vector<CrackEdge> m_crack_edges;
+  /// A cap edge of a piece of a tet cut several times, on the tet's local face `face`, as the cap
+  /// runs along it (from, to: corner ids); paired with the other side's in match_cap_edges.
+  struct CapEdge {
+    int face = -1;
+    int cut_id = -1;
+    int from = -1;
+    int to = -1;
+  };
+  std::vector<CapEdge> m_cap_edges;             // of the cut tet being made
+  std::unordered_map<int, int> m_centres;       // surface triangle split at a front -> its centre point
+  std::vector<std::pair<int, int>> m_on_front;  // split_front_triangles' work space
+  std::vector<std::pair<double, std::array<int, 2>>> m_along;
+  std::vector<int> m_polygon;
 };
 
 }  // namespace tissue

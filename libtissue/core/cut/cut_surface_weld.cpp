@@ -1,0 +1,399 @@
+// CutSurface's weld (see cut_surface.hpp, issue 43): which corners of the cut faces and skin pieces are
+// one point of the drawn surface. Decided from topology when the faces are made: a corner's mesh
+// vertices, the copy of each its piece uses (the real vertex or a ghost row: pieces that the same
+// cuts separate from a vertex and that touch share its ghost, so equal rows mean joined material),
+// and the cuts it lies on. Never by distance between points: two sides that separated keep theirs.
+#include "core/cut/cut_surface.hpp"
+
+#include "core/mesh/topology.hpp"
+
+#include <Eigen/LU>
+
+#include <algorithm>
+#include <functional>
+#include <utility>
+
+namespace tissue {
+
+namespace {
+
+// A multi-cut piece's corner is carried by the tet vertices whose barycentric weight exceeds this
+// (the clipper's corners lie on the tet's faces to rounding, ~1e-16).
+constexpr double SUPPORT_WEIGHT = 1e-9;
+// A corner lies on a cut's plane within this fraction of the tet's largest edge.
+constexpr double ON_PLANE_FRACTION = 1e-9;
+
+// The weights of the point (1 - ratio) x_from + ratio x_to.
+std::array<double, 4> on_edge(int from, int to, double ratio) {
+  std::array<double, 4> weights{};
+  weights[static_cast<size_t>(from)] = 1.0 - ratio;
+  weights[static_cast<size_t>(to)] = ratio;
+  return weights;
+}
+
+// Barycentric weights of x in the tet `corners`.
+std::array<double, 4> barycentric(const std::array<Eigen::Vector3d, 4>& corners, const Eigen::Vector3d& x) {
+  Eigen::Matrix3d edges;
+  for (int i = 0; i < 3; ++i) edges.col(i) = corners[static_cast<size_t>(i + 1)] - corners[0];
+  const Eigen::Vector3d tail = edges.partialPivLu().solve(x - corners[0]);
+  return {1.0 - tail.sum(), tail(0), tail(1), tail(2)};
+}
+
+// The index into TET_EDGES of local edge a-b.
+int local_edge(int a, int b) {
+  for (int e = 0; e < 6; ++e) {
+    const auto& edge = TET_EDGES[static_cast<size_t>(e)];
+    if ((edge[0] == a && edge[1] == b) || (edge[0] == b && edge[1] == a)) return e;
+  }
+  return 0;  // unreachable for two distinct local vertices
+}
+
+double largest_edge_m(const std::array<Eigen::Vector3d, 4>& x) {
+  double longest = 0.0;
+  for (const auto& edge : TET_EDGES)
+    longest = std::max(longest, (x[static_cast<size_t>(edge[0])] - x[static_cast<size_t>(edge[1])]).norm());
+  return longest;
+}
+
+// Sorts the first n entries by `less` (a few: insertion; std::sort on a std::array of 4 trips GCC 12's
+// array-bounds warning).
+template <class T, std::size_t N, class Less>
+void sort_first(std::array<T, N>& values, int n, Less less) {
+  for (int i = 1; i < n; ++i) {
+    for (int j = i; j > 0 && less(values[static_cast<size_t>(j)], values[static_cast<size_t>(j - 1)]); --j) {
+      std::swap(values[static_cast<size_t>(j)], values[static_cast<size_t>(j - 1)]);
+    }
+  }
+}
+
+// Whether session `cut_id` cut tet `tet`.
+bool cut_by(const DeformableBody& body, int tet, int cut_id) {
+  const int k = body.cut_tet_index(tet);
+  if (k < 0) return false;
+  const auto& cuts = body.cut_geometry(k).cuts;
+  return std::any_of(cuts.begin(), cuts.end(), [cut_id](const TetCut& cut) { return cut.cut_id == cut_id; });
+}
+
+// Whether some tet around mesh edge `edge` is not cut by session `cut_id`: the material is joined
+// around the edge there (the crack's front).
+bool at_front(const DeformableBody& body, int cut_id, int edge) {
+  const TetAdjacency& adjacency = body.adjacency();
+  for (int i = adjacency.edge_tets_begin[static_cast<size_t>(edge)];
+       i < adjacency.edge_tets_begin[static_cast<size_t>(edge) + 1]; ++i) {
+    if (!cut_by(body, adjacency.edge_tets[static_cast<size_t>(i)], cut_id)) return true;
+  }
+  return false;
+}
+
+}  // namespace
+
+std::size_t CutSurface::WeldKeyHash::operator()(const WeldKey& key) const {
+  std::size_t hash = 0;
+  const auto mix = [&hash](int value) {
+    hash ^= std::hash<int>{}(value) + 0x9e3779b97f4a7c15ULL + (hash << 6) + (hash >> 2);
+  };
+  for (const int v : key.vertex) mix(v);
+  for (const int g : key.ghost_row) mix(g);
+  for (const int c : key.cut_id) mix(c);
+  return hash;
+}
+
+int CutSurface::weld_key_id(const WeldKey& key, int point) {
+  const auto [it, inserted] = m_key_ids.try_emplace(key, static_cast<int>(m_key_drawn.size()));
+  if (inserted) {
+    const bool real_vertex = key.vertex[1] < 0 && key.ghost_row[0] < 0;
+    m_key_drawn.push_back(real_vertex ? key.vertex[0] : point);
+    m_keys.push_back(key);
+  }
+  return it->second;
+}
+
+int CutSurface::add_real_point(const std::array<int, 4>& vertices, const std::array<double, 4>& weights) {
+  m_points.push_back(Point{-1, 0, weights, vertices});
+  m_point_owner.push_back(-1);
+  m_point_key.push_back(-1);
+  return m_vertex_count + static_cast<int>(m_points.size()) - 1;
+}
+
+void CutSurface::note_crossed_edge(const WeldKey& key, int edge, double ratio_from_lower, int point) {
+  const int cut_id = key.cut_id[0];
+  const std::int64_t id = (static_cast<std::int64_t>(cut_id) << 32) | static_cast<std::uint32_t>(edge);
+  const auto [it, inserted] = m_crossed_ids.try_emplace(id, static_cast<int>(m_crossed.size()));
+  if (inserted) m_crossed.push_back(CrossedEdge{cut_id, edge, ratio_from_lower});
+  m_touched_edges.push_back(it->second);
+  // The side a corner is on: the end of the edge its piece holds (sees as the real vertex).
+  CrossedEdge& crossed = m_crossed[static_cast<size_t>(it->second)];
+  if (key.ghost_row[0] < 0 && crossed.lower_side < 0) crossed.lower_side = point;
+  if (key.ghost_row[1] < 0 && crossed.upper_side < 0) crossed.upper_side = point;
+}
+
+int CutSurface::add_edge_point(const DeformableBody& body, int k, int piece, int a, int b, double ratio_from_a) {
+  const CutTet& cut_tet = body.cut_tets()[static_cast<size_t>(k)];
+  const CutPiece& of = body.xfem().piece(k, piece);
+  const bool a_lower = cut_tet.vertices[static_cast<size_t>(a)] < cut_tet.vertices[static_cast<size_t>(b)];
+  const auto lower = static_cast<size_t>(a_lower ? a : b);
+  const auto upper = static_cast<size_t>(a_lower ? b : a);
+  WeldKey key;
+  key.vertex = {cut_tet.vertices[lower], cut_tet.vertices[upper], -1, -1};
+  key.ghost_row = {of.ghost_row[lower], of.ghost_row[upper], -1, -1};
+  key.cut_id[0] = cut_tet.cut.cut_id;
+  const int id = add_point(k, piece, on_edge(a, b, ratio_from_a), key);
+  const int edge =
+      body.adjacency().tet_edges[static_cast<size_t>(cut_tet.cut.tet)][static_cast<size_t>(local_edge(a, b))];
+  note_crossed_edge(key, edge, a_lower ? ratio_from_a : 1.0 - ratio_from_a, id);
+  return id;
+}
+
+int CutSurface::add_corner_point(const DeformableBody& body, int k, int piece, const Eigen::Vector3d& corner_m) {
+  const CutTet& cut_tet = body.cut_tets()[static_cast<size_t>(k)];
+  const CutPiece& of = body.xfem().piece(k, piece);
+  const std::array<Eigen::Vector3d, 4> rest = body.mesh().rest_corners(cut_tet.cut.tet);
+  const std::array<double, 4> weights = barycentric(rest, corner_m);
+  std::array<int, 4> local{};  // the local vertices carrying the corner, by mesh vertex id
+  int n = 0;
+  for (int j = 0; j < 4; ++j) {
+    if (std::abs(weights[static_cast<size_t>(j)]) > SUPPORT_WEIGHT) local[static_cast<size_t>(n++)] = j;
+  }
+  const auto vertex_of = [&](int j) { return cut_tet.vertices[static_cast<size_t>(j)]; };
+  sort_first(local, n, [&](int i, int j) { return vertex_of(i) < vertex_of(j); });
+  WeldKey key;
+  for (int i = 0; i < n; ++i) {
+    key.vertex[static_cast<size_t>(i)] = vertex_of(local[static_cast<size_t>(i)]);
+    key.ghost_row[static_cast<size_t>(i)] = of.ghost_row[static_cast<size_t>(local[static_cast<size_t>(i)])];
+  }
+  if (n == 1) return add_point(k, piece, weights, key);  // a tet vertex (real: drawn as the vertex)
+  // The cuts it lies on: an edge crossing's nearest plane; a face or inner corner's planes through it.
+  const CutTetGeometry& geometry = body.cut_geometry(k);
+  std::vector<std::pair<double, int>> distances;  // (distance, cut id)
+  for (size_t c = 0; c < geometry.planes.size(); ++c) {
+    const CutPlane& plane = geometry.planes[c];
+    distances.emplace_back(std::abs(plane.signed_distance(corner_m)) / plane.normal.norm(), geometry.cuts[c].cut_id);
+  }
+  std::sort(distances.begin(), distances.end());
+  const double on_plane_m = ON_PLANE_FRACTION * largest_edge_m(rest);
+  int found = 0;
+  for (size_t c = 0; c < distances.size() && found < static_cast<int>(key.cut_id.size()); ++c) {
+    if (n == 2 ? c == 0 : distances[c].first <= on_plane_m)
+      key.cut_id[static_cast<size_t>(found++)] = distances[c].second;
+  }
+  sort_first(key.cut_id, found, std::less<int>());
+  const int id = add_point(k, piece, weights, key);
+  if (n == 2 && key.cut_id[0] >= 0) {
+    const int edge =
+        body.adjacency()
+            .tet_edges[static_cast<size_t>(cut_tet.cut.tet)][static_cast<size_t>(local_edge(local[0], local[1]))];
+    const double lower = weights[static_cast<size_t>(local[0])];
+    const double upper = weights[static_cast<size_t>(local[1])];
+    note_crossed_edge(key, edge, upper / (lower + upper), id);
+  }
+  return id;
+}
+
+void CutSurface::update_fronts(const DeformableBody& body) {
+  std::sort(m_touched_edges.begin(), m_touched_edges.end());
+  m_touched_edges.erase(std::unique(m_touched_edges.begin(), m_touched_edges.end()), m_touched_edges.end());
+  for (const int e : m_touched_edges) {
+    CrossedEdge& crossed = m_crossed[static_cast<size_t>(e)];
+    const bool front = at_front(body, crossed.cut_id, crossed.edge);
+    if (front == crossed.front) continue;
+    crossed.front = front;
+    if (front) {
+      m_front_edges.push_back(e);
+    } else {
+      std::erase(m_front_edges, e);
+    }
+  }
+  m_touched_edges.clear();
+}
+
+void CutSurface::fix_retired_representatives() {
+  const auto retired_point = [this](int id) {
+    if (id < m_vertex_count) return false;
+    const int owner = m_point_owner[static_cast<size_t>(id - m_vertex_count)];
+    return owner >= 0 && m_retired[static_cast<size_t>(owner)] != 0;
+  };
+  for (int& representative : m_key_drawn) {
+    if (retired_point(representative)) representative = -1;
+  }
+  for (size_t p = 0; p < m_points.size(); ++p) {
+    const int key = m_point_key[p];
+    const int id = m_vertex_count + static_cast<int>(p);
+    if (key >= 0 && m_key_drawn[static_cast<size_t>(key)] < 0 && !retired_point(id))
+      m_key_drawn[static_cast<size_t>(key)] = id;
+  }
+}
+
+int CutSurface::drawn_point(int id) const {
+  if (id < m_vertex_count) return id;
+  const int key = m_point_key[static_cast<size_t>(id - m_vertex_count)];
+  if (key < 0) return id;
+  const int representative = m_key_drawn[static_cast<size_t>(key)];
+  return representative >= 0 ? representative : id;
+}
+
+std::array<int, 3> CutSurface::drawn(const std::array<int, 3>& triangle) const {
+  return {drawn_point(triangle[0]), drawn_point(triangle[1]), drawn_point(triangle[2])};
+}
+
+void CutSurface::note_crack_edges(int k, int cut_id, const std::vector<int>& crossed, int first_above,
+                                  bool above_forward) {
+  const int n = static_cast<int>(crossed.size());
+  for (int i = 0; i < n; ++i) {
+    const int j = (i + 1) % n;
+    // The face holding both crossed edges is the one opposite the vertex neither has.
+    const auto& e = TET_EDGES[static_cast<size_t>(crossed[static_cast<size_t>(i)])];
+    const auto& f = TET_EDGES[static_cast<size_t>(crossed[static_cast<size_t>(j)])];
+    int face = 0;
+    while (face == e[0] || face == e[1] || face == f[0] || face == f[1]) ++face;
+    CrackEdge edge{k, cut_id, face, {first_above + i, first_above + j}, {first_above + n + i, first_above + n + j}};
+    if (!above_forward) {
+      std::swap(edge.above[0], edge.above[1]);
+      std::swap(edge.below[0], edge.below[1]);
+    }
+    m_crack_edges.push_back(edge);
+  }
+}
+
+// A cap's corners first_corner .. + count (made in a row, counter-clockwise from outside its piece):
+// its edges that lie on a face of the tet (both ends with zero weight on the vertex opposite it).
+void CutSurface::note_cap_edges(int cut_id, int first_corner, int count) {
+  for (int i = 0; i < count; ++i) {
+    const int from = first_corner + i;
+    const int to = first_corner + (i + 1) % count;
+    const auto& w_from = m_points[static_cast<size_t>(from - m_vertex_count)].weights;
+    const auto& w_to = m_points[static_cast<size_t>(to - m_vertex_count)].weights;
+    for (int face = 0; face < 4; ++face) {
+      const auto j = static_cast<size_t>(face);
+      if (std::abs(w_from[j]) <= SUPPORT_WEIGHT && std::abs(w_to[j]) <= SUPPORT_WEIGHT)
+        m_cap_edges.push_back({face, cut_id, from, to});
+    }
+  }
+}
+
+// Pairs the cap edges of cut tet k's pieces that run between the same two places of the same face
+// and cut in opposite directions (the two sides of the cut there) into crack edges for the strips.
+void CutSurface::match_cap_edges(int k) {
+  const auto place = [this](int id) -> const WeldKey& {
+    return m_keys[static_cast<size_t>(m_point_key[static_cast<size_t>(id - m_vertex_count)])];
+  };
+  const auto same_place = [&](int a, int b) {
+    return place(a).vertex == place(b).vertex && place(a).cut_id == place(b).cut_id;
+  };
+  for (size_t i = 0; i < m_cap_edges.size(); ++i) {
+    const CapEdge& one = m_cap_edges[i];
+    for (size_t j = i + 1; j < m_cap_edges.size(); ++j) {
+      const CapEdge& other = m_cap_edges[j];
+      if (other.face != one.face || other.cut_id != one.cut_id) continue;
+      if (!same_place(one.from, other.to) || !same_place(one.to, other.from)) continue;
+      m_crack_edges.push_back(CrackEdge{k, one.cut_id, one.face, {one.from, one.to}, {other.to, other.from}});
+      break;
+    }
+  }
+  m_cap_edges.clear();
+}
+
+// Where a cut face's edge lies on a face whose other tet the cut did not cut, the above side runs
+// A_s -> A_t along it and the below side B_t -> B_s: the strip A_t A_s B_s B_t closes the two.
+void CutSurface::add_front_strips(const DeformableBody& body) {
+  const TetAdjacency& adjacency = body.adjacency();
+  for (const CrackEdge& edge : m_crack_edges) {
+    if (m_retired[static_cast<size_t>(edge.cut_tet)] != 0) continue;
+    const int tet = body.cut_tets()[static_cast<size_t>(edge.cut_tet)].cut.tet;
+    const int neighbour = adjacency.face_neighbor[static_cast<size_t>(tet)][static_cast<size_t>(edge.face)];
+    if (neighbour < 0 || cut_by(body, neighbour, edge.cut_id)) continue;
+    const int a_s = drawn_point(edge.above[0]), a_t = drawn_point(edge.above[1]);
+    const int b_s = drawn_point(edge.below[0]), b_t = drawn_point(edge.below[1]);
+    m_drawn.push_back({a_t, a_s, b_s});
+    m_drawn.push_back({a_t, b_s, b_t});
+  }
+}
+
+void CutSurface::rebuild_drawn(const DeformableBody& body, const SurfaceMesh& surface) {
+  const auto add_live = [this](std::vector<std::array<int, 3>>& out, const std::array<int, 3>& made, int cut_tet) {
+    if (m_retired[static_cast<size_t>(cut_tet)] != 0) return;
+    const std::array<int, 3> t = drawn(made);
+    if (t[0] != t[1] && t[1] != t[2] && t[2] != t[0]) out.push_back(t);  // a face the weld folded away: none
+  };
+  m_drawn.clear();
+  for (size_t t = 0; t < m_triangles.size(); ++t) add_live(m_drawn, m_triangles[t], m_triangle_cut_tet[t]);
+  add_front_strips(body);
+  m_skin.clear();
+  for (size_t t = 0; t < m_skin_made.size(); ++t) add_live(m_skin, m_skin_made[t], m_skin_cut_tet[t]);
+  m_replaced = m_cut_replaced;
+  split_front_triangles(body, surface);
+}
+
+void CutSurface::split_front_triangles(const DeformableBody& body, const SurfaceMesh& surface) {
+  const TetAdjacency& adjacency = body.adjacency();
+  m_on_front.clear();  // (surface triangle of an uncut tet, front edge on it)
+  for (const int e : m_front_edges) {
+    const CrossedEdge& crossed = m_crossed[static_cast<size_t>(e)];
+    if (crossed.lower_side < 0 || crossed.upper_side < 0) continue;
+    // The surface triangles on the edge (two on a closed surface): one of an uncut tet is split where
+    // the other's tet is cut by the session (the crack opens to the surface there). Two uncut ones
+    // stay whole: the front only touches the surface at the crossing.
+    std::array<int, 2> on_edge{-1, -1};
+    int found = 0;
+    const auto& ends = adjacency.edges[static_cast<size_t>(crossed.edge)];
+    for (int i = adjacency.edge_tets_begin[static_cast<size_t>(crossed.edge)];
+         i < adjacency.edge_tets_begin[static_cast<size_t>(crossed.edge) + 1]; ++i) {
+      const int tet = adjacency.edge_tets[static_cast<size_t>(i)];
+      const auto [first, last] = std::equal_range(surface.triangle_tet.begin(), surface.triangle_tet.end(), tet);
+      for (auto it = first; it != last && found < 2; ++it) {
+        const auto& triangle = surface.triangles[static_cast<size_t>(it - surface.triangle_tet.begin())];
+        const auto has = [&](int v) { return std::find(triangle.begin(), triangle.end(), v) != triangle.end(); };
+        if (has(ends[0]) && has(ends[1]))
+          on_edge[static_cast<size_t>(found++)] = static_cast<int>(it - surface.triangle_tet.begin());
+      }
+    }
+    if (found != 2) continue;
+    for (size_t i = 0; i < 2; ++i) {
+      const int tet = surface.triangle_tet[static_cast<size_t>(on_edge[i])];
+      const int other = surface.triangle_tet[static_cast<size_t>(on_edge[1 - i])];
+      if (body.cut_tet_index(tet) < 0 && cut_by(body, other, crossed.cut_id)) m_on_front.emplace_back(on_edge[i], e);
+    }
+  }
+  std::sort(m_on_front.begin(), m_on_front.end());
+  for (size_t i = 0; i < m_on_front.size();) {
+    size_t end = i;
+    while (end < m_on_front.size() && m_on_front[end].first == m_on_front[i].first) ++end;
+    split_front_triangle(body, surface, m_on_front[i].first, i, end);
+    i = end;
+  }
+}
+
+// Surface triangle t with the front edges m_on_front[begin, end): drawn as its corners in its winding
+// with, on each side at the front, the corner of the side holding the side's start, then the other's;
+// fanned from its centre (a point of its vertices, made once), so that no sliver joins two points
+// of one side.
+void CutSurface::split_front_triangle(const DeformableBody& body, const SurfaceMesh& surface, int t, size_t begin,
+                                      size_t end) {
+  const auto& triangle = surface.triangles[static_cast<size_t>(t)];
+  m_polygon.clear();
+  for (size_t c = 0; c < 3; ++c) {
+    const int a = triangle[c];
+    const int b = triangle[(c + 1) % 3];
+    m_polygon.push_back(a);
+    m_along.clear();
+    for (size_t j = begin; j < end; ++j) {
+      const CrossedEdge& crossed = m_crossed[static_cast<size_t>(m_on_front[j].second)];
+      const auto& ends = body.adjacency().edges[static_cast<size_t>(crossed.edge)];
+      if (ends[0] == a && ends[1] == b) {
+        m_along.push_back({crossed.ratio, {drawn_point(crossed.lower_side), drawn_point(crossed.upper_side)}});
+      } else if (ends[0] == b && ends[1] == a) {
+        m_along.push_back({1.0 - crossed.ratio, {drawn_point(crossed.upper_side), drawn_point(crossed.lower_side)}});
+      }
+    }
+    std::sort(m_along.begin(), m_along.end());
+    for (const auto& [ratio, sides] : m_along) m_polygon.insert(m_polygon.end(), sides.begin(), sides.end());
+  }
+  auto [centre, made] = m_centres.try_emplace(t, -1);
+  if (made)
+    centre->second =
+        add_real_point({triangle[0], triangle[1], triangle[2], -1}, {1.0 / 3.0, 1.0 / 3.0, 1.0 / 3.0, 0.0});
+  for (size_t c = 0; c < m_polygon.size(); ++c)
+    m_skin.push_back({centre->second, m_polygon[c], m_polygon[(c + 1) % m_polygon.size()]});
+  m_replaced.insert(std::lower_bound(m_replaced.begin(), m_replaced.end(), t), t);
+}
+
+}  // namespace tissue
