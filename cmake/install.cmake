@@ -43,7 +43,11 @@ foreach(scenario ${TISSUE_SCENARIO_FILES})
 endforeach()
 
 if(TARGET tissue_python)
-  install(TARGETS tissue_python LIBRARY DESTINATION ${TISSUE_PYTHON_INSTALL_DIR} COMPONENT runtime)
+  set(python_dir ${TISSUE_PYTHON_INSTALL_DIR})
+  if(NOT python_dir)
+    set(python_dir lib/python3.${TISSUE_PYTHON_MINOR_VERSION}/dist-packages)
+  endif()
+  install(TARGETS tissue_python LIBRARY DESTINATION ${python_dir} COMPONENT runtime)
 endif()
 
 # -- dev: headers, static libraries, the CMake package ---------------------------------------------

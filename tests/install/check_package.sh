@@ -26,7 +26,7 @@ expect_files() {  # expect_files DEB PATH_REGEX...
 expect_files "$runtime" /usr/bin/tissue-host /usr/bin/tissue-bench /usr/share/tissue/fmus/Tissue.fmu \
   /usr/share/tissue/fmus/HapticLoop.fmu /usr/share/tissue/fmus/fmi2/Tissue.fmu /usr/share/tissue/ssp/TissueHaptic.ssp \
   /usr/share/tissue/scenarios/cut_frog_complete.toml /usr/share/tissue/meshes/frog.veg /usr/share/tissue/view/index.html \
-  '/usr/lib/python3/dist-packages/tissue\.cpython-3[0-9]+-x86_64-linux-gnu\.so'
+  '/usr/lib/python3\.[0-9]+/dist-packages/tissue\.cpython-3[0-9]+-x86_64-linux-gnu\.so'
 expect_files "$dev" /usr/include/tissue/core/tissue.hpp /usr/include/tissue/importer/fmu3.hpp \
   /usr/include/tissue/haptic/haptic_renderer.hpp /usr/lib/libtissue_core.a /usr/lib/cmake/Tissue/TissueConfig.cmake \
   /usr/lib/cmake/Tissue/TissueTargets.cmake

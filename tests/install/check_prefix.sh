@@ -23,10 +23,14 @@ print(f"host: {summary['cut_tets']} tets cut, FMUs from {os.path.dirname(summary
 PY
 
   echo "== python3 -c 'import tissue' from $prefix"
-  PYTHONPATH="$prefix/lib/python3/dist-packages" /usr/bin/python3 - "$prefix" <<'PY'
+  PYTHONPATH=$(echo "$prefix"/lib/python3*/dist-packages) /usr/bin/python3 - "$prefix" <<'PY'
 import os, sys, tissue
 prefix = os.path.realpath(sys.argv[1])
 assert os.path.realpath(tissue.__file__).startswith(prefix + os.sep), tissue.__file__
+# Installed under /usr or /usr/local, Debian's python3 finds it with no PYTHONPATH.
+where = os.path.relpath(os.path.dirname(os.path.realpath(tissue.__file__)), prefix)
+for system_prefix in ("/usr", "/usr/local"):
+    assert os.path.join(system_prefix, where) in sys.path, f"{system_prefix}/{where} is not on python3's path"
 frog = tissue.Tissue()
 frog.step()
 print(f"python: tissue from {tissue.__file__}, the frog steps")
