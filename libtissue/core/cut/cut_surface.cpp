@@ -83,9 +83,12 @@ void CutSurface::add_piece_faces(const DeformableBody& body, int k, const Surfac
   const std::array<Eigen::Vector3d, 4> rest = mesh.rest_corners(tet_index);
   // Which local faces of the tet are on the mesh's surface.
   std::array<bool, 4> on_surface{};
+  std::array<int, 4> surface_triangle{-1, -1, -1, -1};
   const auto [first, last] = std::equal_range(surface.triangle_tet.begin(), surface.triangle_tet.end(), tet_index);
   for (auto it = first; it != last; ++it) {
-    on_surface[static_cast<size_t>(surface.triangle_local_face[static_cast<size_t>(it - surface.triangle_tet.begin())])] = true;
+    const auto t = static_cast<size_t>(it - surface.triangle_tet.begin());
+    on_surface[static_cast<size_t>(surface.triangle_local_face[t])] = true;
+    surface_triangle[static_cast<size_t>(surface.triangle_local_face[t])] = static_cast<int>(t);
   }
   replace_surface_triangles(tet_index, surface);
   for (int p = 0; p < static_cast<int>(geometry.pieces.size()); ++p) {
@@ -104,6 +107,7 @@ void CutSurface::add_piece_faces(const DeformableBody& body, int k, const Surfac
         } else {
           m_skin_made.push_back({first_corner, previous, next});
           m_skin_cut_tet.push_back(k);
+          m_skin_surface.push_back(surface_triangle[static_cast<size_t>(tag)]);
         }
         previous = next;
       }
@@ -203,6 +207,7 @@ void CutSurface::add_once_cut_faces(const DeformableBody& body, int k, const Sur
         for (size_t t = 1; t + 1 < polygon.size(); ++t) {
           m_skin_made.push_back({polygon[0], polygon[t], polygon[t + 1]});
           m_skin_cut_tet.push_back(k);
+          m_skin_surface.push_back(triangle_index);
         }
       }
     }

@@ -19,7 +19,8 @@
 // Where the blade stopped inside (the crack's front: a cut face's edge on a tet face whose other tet
 // the cut did not cut), the two sides' cut faces are joined by a strip of two triangles (zero area
 // at rest, the crack tip's wedge as the sides open), and the uncut surface triangles on an edge at
-// the front are drawn split at both sides' crossings. Keys are hashed when the faces are made
+// the front are drawn split at both sides' crossings; so are the skin pieces of a tet cut by other
+// cuts along such an edge. Keys are hashed when the faces are made
 // (add_cut_tets), never per frame; sides that separated have different ghost rows, so their corners
 // stay apart.
 #pragma once
@@ -112,7 +113,7 @@ class CutSurface {
   int add_corner_point(const DeformableBody& body, int k, int piece, const Eigen::Vector3d& corner_m);
   int add_real_point(const std::array<int, 4>& vertices, const std::array<double, 4>& weights);
   int weld_key_id(const WeldKey& key, int point);
-  void note_crossed_edge(const WeldKey& key, int edge, double ratio_from_lower, int point);
+  void note_crossed_edge(const WeldKey& key, int edge, double ratio_from_lower, bool lower_side, int point);
   void note_crack_edges(int k, int cut_id, const std::vector<int>& crossed, int first_above, bool above_forward);
   void note_cap_edges(int cut_id, int first_corner, int count);
   void match_cap_edges(int k);
@@ -120,7 +121,10 @@ class CutSurface {
   void update_fronts(const DeformableBody& body);
   void fix_retired_representatives();
   void rebuild_drawn(const DeformableBody& body, const SurfaceMesh& surface);
+  void collect_front_triangles(const DeformableBody& body, const SurfaceMesh& surface);
   void split_front_triangles(const DeformableBody& body, const SurfaceMesh& surface);
+  void split_skin_piece(const DeformableBody& body, const std::array<int, 3>& made, std::size_t begin, std::size_t end);
+  [[nodiscard]] double ratio_on_edge(const DeformableBody& body, int id, int lower, int upper) const;
   void split_front_triangle(const DeformableBody& body, const SurfaceMesh& surface, int t, std::size_t begin,
                             std::size_t end);
   [[nodiscard]] std::array<int, 3> drawn(const std::array<int, 3>& triangle) const;
@@ -137,6 +141,7 @@ class CutSurface {
   std::vector<std::array<int, 3>> m_drawn;
   std::vector<std::array<int, 3>> m_skin_made;  // the skin pieces as made (own corners)
   std::vector<int> m_skin_cut_tet;              // per made skin triangle, the cut tet it belongs to
+  std::vector<int> m_skin_surface;              // and the surface triangle it is a piece of
   std::vector<std::array<int, 3>> m_skin;       // drawn: welded, live, then the front splits
   std::vector<std::uint8_t> m_retired;          // per cut tet: its faces retired
   std::vector<int> m_cut_replaced;              // surface triangles of cut tets, ascending
@@ -161,9 +166,10 @@ class CutSurface {
     int from = -1;
     int to = -1;
   };
-  std::vector<CapEdge> m_cap_edges;             // of the cut tet being made
-  std::unordered_map<int, int> m_centres;       // surface triangle split at a front -> its centre point
-  std::vector<std::pair<int, int>> m_on_front;  // split_front_triangles' work space
+  std::vector<CapEdge> m_cap_edges;                 // of the cut tet being made
+  std::unordered_map<int, int> m_centres;           // surface triangle split at a front -> its centre point
+  std::vector<std::pair<int, int>> m_on_front;      // (uncut surface triangle, front edge) to split
+  std::vector<std::pair<int, int>> m_on_cut_front;  // (surface triangle of a cut tet, front edge)
   std::vector<std::pair<double, std::array<int, 2>>> m_along;
   std::vector<int> m_polygon;
 };

@@ -115,16 +115,15 @@ int CutSurface::add_real_point(const std::array<int, 4>& vertices, const std::ar
   return m_vertex_count + static_cast<int>(m_points.size()) - 1;
 }
 
-void CutSurface::note_crossed_edge(const WeldKey& key, int edge, double ratio_from_lower, int point) {
+void CutSurface::note_crossed_edge(const WeldKey& key, int edge, double ratio_from_lower, bool lower_side, int point) {
   const int cut_id = key.cut_id[0];
   const std::int64_t id = (static_cast<std::int64_t>(cut_id) << 32) | static_cast<std::uint32_t>(edge);
   const auto [it, inserted] = m_crossed_ids.try_emplace(id, static_cast<int>(m_crossed.size()));
   if (inserted) m_crossed.push_back(CrossedEdge{cut_id, edge, ratio_from_lower});
   m_touched_edges.push_back(it->second);
-  // The side a corner is on: the end of the edge its piece holds (sees as the real vertex).
   CrossedEdge& crossed = m_crossed[static_cast<size_t>(it->second)];
-  if (key.ghost_row[0] < 0 && crossed.lower_side < 0) crossed.lower_side = point;
-  if (key.ghost_row[1] < 0 && crossed.upper_side < 0) crossed.upper_side = point;
+  int& side = lower_side ? crossed.lower_side : crossed.upper_side;
+  if (side < 0) side = point;
 }
 
 int CutSurface::add_edge_point(const DeformableBody& body, int k, int piece, int a, int b, double ratio_from_a) {
@@ -140,7 +139,8 @@ int CutSurface::add_edge_point(const DeformableBody& body, int k, int piece, int
   const int id = add_point(k, piece, on_edge(a, b, ratio_from_a), key);
   const int edge =
       body.adjacency().tet_edges[static_cast<size_t>(cut_tet.cut.tet)][static_cast<size_t>(local_edge(a, b))];
-  note_crossed_edge(key, edge, a_lower ? ratio_from_a : 1.0 - ratio_from_a, id);
+  // The side a corner is on: the end of the edge its piece holds (sees as the real vertex).
+  note_crossed_edge(key, edge, a_lower ? ratio_from_a : 1.0 - ratio_from_a, key.ghost_row[0] < 0, id);
   return id;
 }
 
@@ -184,7 +184,13 @@ int CutSurface::add_corner_point(const DeformableBody& body, int k, int piece, c
             .tet_edges[static_cast<size_t>(cut_tet.cut.tet)][static_cast<size_t>(local_edge(local[0], local[1]))];
     const double lower = weights[static_cast<size_t>(local[0])];
     const double upper = weights[static_cast<size_t>(local[1])];
-    note_crossed_edge(key, edge, upper / (lower + upper), id);
+    // The side a corner is on: its piece's side of the cut, which may hold neither end of the edge
+    // when another cut crosses the edge too.
+    size_t ci = 0;  // the index of its cut in geometry.cuts
+    while (ci + 1 < geometry.cuts.size() && geometry.cuts[ci].cut_id != key.cut_id[0]) ++ci;
+    const bool piece_above = ((geometry.pieces[static_cast<size_t>(piece)].sides.above >> ci) & 1U) != 0;
+    const bool lower_above = geometry.cuts[ci].side[static_cast<size_t>(local[0])] > 0;
+    note_crossed_edge(key, edge, upper / (lower + upper), piece_above == lower_above, id);
   }
   return id;
 }
@@ -318,14 +324,29 @@ void CutSurface::rebuild_drawn(const DeformableBody& body, const SurfaceMesh& su
   for (size_t t = 0; t < m_triangles.size(); ++t) add_live(m_drawn, m_triangles[t], m_triangle_cut_tet[t]);
   add_front_strips(body);
   m_skin.clear();
-  for (size_t t = 0; t < m_skin_made.size(); ++t) add_live(m_skin, m_skin_made[t], m_skin_cut_tet[t]);
+  collect_front_triangles(body, surface);
+  const auto by_triangle = [](const std::pair<int, int>& a, const std::pair<int, int>& b) { return a.first < b.first; };
+  for (size_t t = 0; t < m_skin_made.size(); ++t) {
+    const auto [first, last] = std::equal_range(m_on_cut_front.begin(), m_on_cut_front.end(),
+                                                std::pair<int, int>{m_skin_surface[t], 0}, by_triangle);
+    if (first == last || m_retired[static_cast<size_t>(m_skin_cut_tet[t])] != 0) {
+      add_live(m_skin, m_skin_made[t], m_skin_cut_tet[t]);
+    } else {
+      split_skin_piece(body, m_skin_made[t], static_cast<size_t>(first - m_on_cut_front.begin()),
+                       static_cast<size_t>(last - m_on_cut_front.begin()));
+    }
+  }
   m_replaced = m_cut_replaced;
   split_front_triangles(body, surface);
 }
 
-void CutSurface::split_front_triangles(const DeformableBody& body, const SurfaceMesh& surface) {
+// The surface triangles on the front's crossed edges whose other triangle's tet the front's cut cut
+// (the crack opens to the surface there): of uncut tets (m_on_front, drawn split whole) and of tets
+// cut by other cuts only (m_on_cut_front, their skin pieces on the edge drawn split).
+void CutSurface::collect_front_triangles(const DeformableBody& body, const SurfaceMesh& surface) {
   const TetAdjacency& adjacency = body.adjacency();
-  m_on_front.clear();  // (surface triangle of an uncut tet, front edge on it)
+  m_on_front.clear();
+  m_on_cut_front.clear();
   for (const int e : m_front_edges) {
     const CrossedEdge& crossed = m_crossed[static_cast<size_t>(e)];
     if (crossed.lower_side < 0 || crossed.upper_side < 0) continue;
@@ -350,10 +371,15 @@ void CutSurface::split_front_triangles(const DeformableBody& body, const Surface
     for (size_t i = 0; i < 2; ++i) {
       const int tet = surface.triangle_tet[static_cast<size_t>(on_edge[i])];
       const int other = surface.triangle_tet[static_cast<size_t>(on_edge[1 - i])];
-      if (body.cut_tet_index(tet) < 0 && cut_by(body, other, crossed.cut_id)) m_on_front.emplace_back(on_edge[i], e);
+      if (!cut_by(body, other, crossed.cut_id) || cut_by(body, tet, crossed.cut_id)) continue;
+      (body.cut_tet_index(tet) < 0 ? m_on_front : m_on_cut_front).emplace_back(on_edge[i], e);
     }
   }
   std::sort(m_on_front.begin(), m_on_front.end());
+  std::sort(m_on_cut_front.begin(), m_on_cut_front.end());
+}
+
+void CutSurface::split_front_triangles(const DeformableBody& body, const SurfaceMesh& surface) {
   for (size_t i = 0; i < m_on_front.size();) {
     size_t end = i;
     while (end < m_on_front.size() && m_on_front[end].first == m_on_front[i].first) ++end;
@@ -394,6 +420,65 @@ void CutSurface::split_front_triangle(const DeformableBody& body, const SurfaceM
   for (size_t c = 0; c < m_polygon.size(); ++c)
     m_skin.push_back({centre->second, m_polygon[c], m_polygon[(c + 1) % m_polygon.size()]});
   m_replaced.insert(std::lower_bound(m_replaced.begin(), m_replaced.end(), t), t);
+}
+
+// Where corner `id` lies on the mesh edge lower-upper, as a ratio from lower: at either end, or on a
+// crossing of that edge by one cut; -1 elsewhere.
+double CutSurface::ratio_on_edge(const DeformableBody& body, int id, int lower, int upper) const {
+  if (id < m_vertex_count) return id == lower ? 0.0 : id == upper ? 1.0 : -1.0;
+  const int key = m_point_key[static_cast<size_t>(id - m_vertex_count)];
+  if (key < 0) return -1.0;
+  const WeldKey& weld = m_keys[static_cast<size_t>(key)];
+  if (weld.vertex[1] < 0 && weld.cut_id[0] < 0)
+    return weld.vertex[0] == lower ? 0.0 : weld.vertex[0] == upper ? 1.0 : -1.0;
+  if (weld.vertex[0] != lower || weld.vertex[1] != upper || weld.vertex[2] >= 0 || weld.cut_id[1] >= 0) return -1.0;
+  const Point& point = m_points[static_cast<size_t>(id - m_vertex_count)];
+  const auto& vertices = body.cut_tets()[static_cast<size_t>(point.cut_tet)].vertices;
+  double at_lower = 0.0, at_upper = 0.0;
+  for (size_t j = 0; j < 4; ++j) {
+    if (vertices[j] == lower) at_lower = point.weights[j];
+    if (vertices[j] == upper) at_upper = point.weights[j];
+  }
+  return at_upper / (at_lower + at_upper);
+}
+
+// A skin piece `made` (of a tet not cut by the front's cut) with an edge along front edges
+// m_on_cut_front[begin, end): drawn with both sides' crossings inserted on that edge where they lie
+// between its ends, fanned from the corner opposite it (the wedge the crack opens at the surface is a
+// middle triangle of the fan).
+void CutSurface::split_skin_piece(const DeformableBody& body, const std::array<int, 3>& made, size_t begin,
+                                  size_t end) {
+  const std::array<int, 3> t = drawn(made);
+  if (t[0] == t[1] || t[1] == t[2] || t[2] == t[0]) return;
+  m_polygon.clear();
+  int apex = -1;  // the corner opposite the first edge split
+  std::array<int, 3> at{};
+  for (size_t c = 0; c < 3; ++c) {
+    at[c] = static_cast<int>(m_polygon.size());
+    m_polygon.push_back(t[c]);
+    m_along.clear();
+    for (size_t j = begin; j < end; ++j) {
+      const CrossedEdge& crossed = m_crossed[static_cast<size_t>(m_on_cut_front[j].second)];
+      const auto& ends = body.adjacency().edges[static_cast<size_t>(crossed.edge)];
+      const double from = ratio_on_edge(body, made[c], ends[0], ends[1]);
+      const double to = ratio_on_edge(body, made[(c + 1) % 3], ends[0], ends[1]);
+      if (from < 0.0 || to < 0.0 || (crossed.ratio - from) * (to - crossed.ratio) <= 0.0) continue;
+      const std::array<int, 2> sides{drawn_point(crossed.lower_side), drawn_point(crossed.upper_side)};
+      m_along.push_back({std::abs(crossed.ratio - from), from < to ? sides : std::array<int, 2>{sides[1], sides[0]}});
+    }
+    if (m_along.empty()) continue;
+    if (apex < 0) apex = static_cast<int>((c + 2) % 3);
+    std::sort(m_along.begin(), m_along.end());
+    for (const auto& [distance, sides] : m_along) m_polygon.insert(m_polygon.end(), sides.begin(), sides.end());
+  }
+  if (apex < 0) {
+    m_skin.push_back(t);
+    return;
+  }
+  const auto n = m_polygon.size();
+  const auto from = static_cast<size_t>(at[static_cast<size_t>(apex)]);
+  for (size_t i = 1; i + 1 < n; ++i)
+    m_skin.push_back({m_polygon[from], m_polygon[(from + i) % n], m_polygon[(from + i + 1) % n]});
 }
 
 }  // namespace tissue

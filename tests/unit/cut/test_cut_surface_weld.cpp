@@ -133,5 +133,70 @@ TEST(CutSurfaceWeld, ClosedAtEveryStepOfTheStroke) {
   EXPECT_EQ(worst_open, 0);
 }
 
+// A vertical scalpel drawn in a straight line from (x, y) `from` to `to` at 0.2 m/s, then put away;
+// returns the most open edges the drawn surface had after any step.
+int stroke_worst_open(Tissue& tissue, const Eigen::Vector2d& from, const Eigen::Vector2d& to) {
+  const int steps = static_cast<int>(std::ceil((to - from).norm() / (0.2 * STEP_S)));
+  int worst_open = 0;
+  for (int n = 0; n <= steps; ++n) {
+    const Eigen::Vector2d at = from + (to - from) * n / steps;
+    tissue.set_tool(
+        ToolPose{Eigen::Vector3d(at.x(), at.y(), -0.02), Eigen::Quaterniond::Identity(), ToolMode::scalpel});
+    tissue.step();
+    worst_open = std::max(worst_open, check_drawn_surface(tissue).open_edges);
+  }
+  tissue.set_tool(ToolPose{Eigen::Vector3d(to.x(), to.y(), -0.02), Eigen::Quaterniond::Identity(), ToolMode::none});
+  tissue.step();
+  return std::max(worst_open, check_drawn_surface(tissue).open_edges);
+}
+
+TissueSettings block_settings(const TetMesh& mesh) {
+  TissueSettings settings = beam_settings(mesh);
+  settings.body.gravity_m_per_s2 = {0.0, 0.0, 0.0};
+  return settings;
+}
+
+// Tets cut by two strokes (issue 21), a flap's corner: a 4 x 4 x 2 cm block cut through along
+// x = 2.53 cm, then a second stroke run in from the side to just short of the first cut. Its crack's
+// front ends in tets the first stroke cut: the surface triangles there, skin pieces of those tets, are
+// drawn split where the second crack opens to the surface (before: 8 open edges).
+TEST(CutSurfaceWeld, StrokeStoppingShortOfAnotherCutStaysClosedAtEveryStep) {
+  const TetMesh mesh = make_box_mesh(4, 4, 2, 0.01);
+  Tissue tissue(mesh, block_settings(mesh));
+  EXPECT_EQ(stroke_worst_open(tissue, {0.0253, -0.005}, {0.0253, 0.045}), 0);
+  const std::size_t once = tissue.body().cut_tets().size();
+  EXPECT_EQ(stroke_worst_open(tissue, {0.045, 0.0207}, {0.0305, 0.0207}), 0);
+  ASSERT_GT(tissue.body().cut_tets().size(), once);
+  const SurfaceCheck cut = check_drawn_surface(tissue);
+  EXPECT_EQ(cut.degenerate, 0);
+  EXPECT_EQ(cut.pieces, 2);  // the second crack does not part the far side
+}
+
+// A T junction as a hand makes it: the second stroke runs through the first cut and a little past
+// it, so its front lies in tets the first cut, some of them cut by both (before: 8 open edges).
+TEST(CutSurfaceWeld, StrokeRunningPastAnotherCutStaysClosedAtEveryStep) {
+  const TetMesh mesh = make_box_mesh(4, 4, 2, 0.01);
+  Tissue tissue(mesh, block_settings(mesh));
+  EXPECT_EQ(stroke_worst_open(tissue, {0.0253, -0.005}, {0.0253, 0.045}), 0);
+  const std::size_t once = tissue.body().cut_tets().size();
+  EXPECT_EQ(stroke_worst_open(tissue, {0.045, 0.0137}, {0.0212, 0.0137}), 0);
+  ASSERT_GT(tissue.body().cut_tets().size(), once);
+  const SurfaceCheck cut = check_drawn_surface(tissue);
+  EXPECT_EQ(cut.degenerate, 0);
+  EXPECT_EQ(cut.pieces, 3);  // the first cut's far side parted, its near side cracked
+}
+
+// Not yet closed (docs/DESIGN.md, "The tet skin welded"): where the second stroke's front crosses a
+// mesh edge the first cut crosses too (an X; a T at y = 2.07 cm here), the first cut's corners on
+// that edge in the tet cut twice and in its neighbour the second did not cut see the vertex beyond
+// the second cut through different ghost rows, so they are not welded (24 to 48 open edges).
+TEST(CutSurfaceWeld, DISABLED_CrossingStrokesStayClosedAtEveryStep) {
+  const TetMesh mesh = make_box_mesh(4, 4, 2, 0.01);
+  Tissue tissue(mesh, block_settings(mesh));
+  EXPECT_EQ(stroke_worst_open(tissue, {0.0033, -0.005}, {0.0347, 0.045}), 0);
+  EXPECT_EQ(stroke_worst_open(tissue, {0.0374, -0.005}, {0.0060, 0.045}), 0);
+  EXPECT_EQ(check_drawn_surface(tissue).pieces, 4);
+}
+
 }  // namespace
 }  // namespace tissue
