@@ -21,6 +21,20 @@ for role, path in summary["fmus"].items():
 assert summary["cut_tets"] > 0 and summary["tissue_errors"] == 0, summary
 print(f"host: {summary['cut_tets']} tets cut, FMUs from {os.path.dirname(summary['fmus']['tissue'])}")
 PY
+  # Every file an installed scenario names (its mesh, its render surface) is where it says.
+  /usr/bin/python3 - "$prefix/share/tissue/scenarios" <<'PY'
+import glob, os, sys, tomllib
+named = 0
+for scenario in sorted(glob.glob(os.path.join(sys.argv[1], "*.toml"))):
+    tissue = tomllib.load(open(scenario, "rb")).get("tissue", {})
+    for key in ("mesh", "render_surface"):
+        if key in tissue:
+            path = os.path.join(os.path.dirname(scenario), tissue[key])
+            assert os.path.isfile(path), f"{os.path.basename(scenario)}: {key} {tissue[key]} is not installed"
+            named += 1
+assert named > 0, "no installed scenario names a file: the check checks nothing"
+print(f"scenarios: the {named} files they name are installed")
+PY
 
   echo "== python3 -c 'import tissue' from $prefix"
   PYTHONPATH=$(echo "$prefix"/lib/python3*/dist-packages) /usr/bin/python3 - "$prefix" <<'PY'
