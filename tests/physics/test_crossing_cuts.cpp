@@ -26,6 +26,7 @@
 #include "core/mesh/mesh_io.hpp"
 #include "core/mesh/topology.hpp"
 #include "core/surface_views.hpp"
+#include "support/closed_surface.hpp"
 
 #include <gtest/gtest.h>
 
@@ -290,14 +291,20 @@ double shoelace_m2(const std::vector<Eigen::Vector2d>& polygon) {
   return 0.5 * std::abs(twice);
 }
 
-TEST(CrossingCuts, AnXCutLeavesFourPiecesOfTheExactVolumesAndTheThreeFreeOnesFall) {
+// The beam held at x = 0 and cut through along both lines of the X (each stroke past both sides).
+CutSpecimen x_cut_beam() {
   const double w = BEAM_SIDE_M;
   const auto stroke = [&](int line) {
     return Stroke{{line_x(line, -0.005), -0.005}, {line_x(line, w + 0.005), w + 0.005}};
   };
   TetMesh mesh = make_box_mesh(10, 2, 2, 0.01);
   std::vector<int> fixed = vertices_at_minimum(mesh, 0, 1e-6);
-  CutSpecimen beam(std::move(mesh), std::move(fixed), straight_paths({stroke(0), stroke(1)}), -0.02, 0.04);
+  return CutSpecimen(std::move(mesh), std::move(fixed), straight_paths({stroke(0), stroke(1)}), -0.02, 0.04);
+}
+
+TEST(CrossingCuts, AnXCutLeavesFourPiecesOfTheExactVolumesAndTheThreeFreeOnesFall) {
+  const double w = BEAM_SIDE_M;
+  CutSpecimen beam = x_cut_beam();
   ASSERT_GT(beam.recut_tets, 0);  // the second stroke cut tets of the first again
 
   // The exact volumes: prisms over the regions' polygons.
@@ -318,26 +325,13 @@ TEST(CrossingCuts, AnXCutLeavesFourPiecesOfTheExactVolumesAndTheThreeFreeOnesFal
 // The drawn tet skin after the X cut (issue 43): welded across the tets cut twice too, a closed
 // 2-manifold per piece, every edge (by its pair of point ids) with one triangle each way.
 TEST(CrossingCuts, AnXCutDrawsAClosedSurfacePerPiece) {
-  const double w = BEAM_SIDE_M;
-  const auto stroke = [&](int line) {
-    return Stroke{{line_x(line, -0.005), -0.005}, {line_x(line, w + 0.005), w + 0.005}};
-  };
-  TetMesh mesh = make_box_mesh(10, 2, 2, 0.01);
-  std::vector<int> fixed = vertices_at_minimum(mesh, 0, 1e-6);
-  CutSpecimen beam(std::move(mesh), std::move(fixed), straight_paths({stroke(0), stroke(1)}), -0.02, 0.04);
+  CutSpecimen beam = x_cut_beam();
   ASSERT_GT(beam.recut_tets, 0);
   SurfaceViews views(beam.body, false, nullptr);
   views.add_cut_tets(beam.body, beam.state.displacement_m, 0);
-  std::map<std::pair<int, int>, int> directed;
-  views.for_each_drawn_triangle([&](const std::array<int, 3>& t) {
-    for (size_t c = 0; c < 3; ++c) ++directed[{t[c], t[(c + 1) % 3]}];
-  });
-  int open_edges = 0;
-  for (const auto& [edge, count] : directed) {
-    const auto back = directed.find({edge.second, edge.first});
-    open_edges += count != 1 || back == directed.end() || back->second != 1 ? 1 : 0;
-  }
-  EXPECT_EQ(open_edges, 0);
+  std::vector<std::array<int, 3>> triangles;
+  views.for_each_drawn_triangle([&](const std::array<int, 3>& t) { triangles.push_back(t); });
+  EXPECT_EQ(test_support::check_surface(triangles, static_cast<int>(views.positions_m().size() / 3)).open_edges, 0);
 }
 
 // --- the flap out of the frog's back -------------------------------------------------------------

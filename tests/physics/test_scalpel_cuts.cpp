@@ -7,6 +7,7 @@
 #include "core/fixed_region.hpp"
 #include "core/mesh/box_mesh.hpp"
 #include "core/tissue.hpp"
+#include "support/scalpel_stroke.hpp"
 #include "unit/fem/body_pieces.hpp"
 
 #include <gtest/gtest.h>
@@ -41,19 +42,9 @@ TissueSettings beam_settings(const TetMesh& mesh) {
   return settings;
 }
 
-// A vertical scalpel (tool axis +z) at x = cut_x, swept along y from y_from to y_to at 0.2 m/s.
+// A vertical scalpel at x = cut_x, swept along y from y_from to y_to at 0.2 m/s, then put away.
 void sweep(Tissue& tissue, double cut_x, double y_from, double y_to) {
-  const double speed_m_per_step = 0.2 * STEP_S;
-  const int steps = static_cast<int>(std::ceil(std::abs(y_to - y_from) / speed_m_per_step));
-  for (int n = 0; n <= steps; ++n) {
-    const double y = y_from + (y_to - y_from) * n / steps;
-    tissue.set_tool(ToolPose{Eigen::Vector3d(cut_x, y, -0.02), Eigen::Quaterniond::Identity(), ToolMode::scalpel});
-    tissue.step();
-  }
-  // Put the scalpel away (a step with mode none): the next sweep starts from where it is set next,
-  // not from here (a scalpel moved between two steps sweeps the whole way).
-  tissue.set_tool(ToolPose{Eigen::Vector3d(cut_x, y_to, -0.02), Eigen::Quaterniond::Identity(), ToolMode::none});
-  tissue.step();
+  test_support::draw_scalpel(tissue, {cut_x, y_from}, {cut_x, y_to}, STEP_S, [] {});
 }
 
 double mean_z_displacement(const Tissue& tissue, double x_min, double x_max) {

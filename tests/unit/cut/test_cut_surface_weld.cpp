@@ -6,21 +6,20 @@
 #include "core/fixed_region.hpp"
 #include "core/mesh/box_mesh.hpp"
 #include "core/tissue.hpp"
+#include "support/closed_surface.hpp"
+#include "support/scalpel_stroke.hpp"
 
 #include <gtest/gtest.h>
 #include <Eigen/Geometry>
 
 #include <algorithm>
 #include <array>
-#include <cmath>
-#include <map>
-#include <numeric>
-#include <set>
-#include <utility>
 #include <vector>
 
 namespace tissue {
 namespace {
+
+using test_support::SurfaceCheck;
 
 constexpr double STEP_S = 1e-3;
 
@@ -36,55 +35,33 @@ TissueSettings beam_settings(const TetMesh& mesh) {
   return settings;
 }
 
-// A vertical scalpel (tool axis +z) at x = cut_x drawn along y from y_from to y_to at 0.2 m/s, then
-// put away.
+// A vertical scalpel at x = cut_x drawn along y from y_from to y_to at 0.2 m/s, then put away.
 void sweep(Tissue& tissue, double cut_x, double y_from, double y_to) {
-  const int steps = static_cast<int>(std::ceil(std::abs(y_to - y_from) / (0.2 * STEP_S)));
-  for (int n = 0; n <= steps; ++n) {
-    const double y = y_from + (y_to - y_from) * n / steps;
-    tissue.set_tool(ToolPose{Eigen::Vector3d(cut_x, y, -0.02), Eigen::Quaterniond::Identity(), ToolMode::scalpel});
-    tissue.step();
-  }
-  tissue.set_tool(ToolPose{Eigen::Vector3d(cut_x, y_to, -0.02), Eigen::Quaterniond::Identity(), ToolMode::none});
-  tissue.step();
+  test_support::draw_scalpel(tissue, {cut_x, y_from}, {cut_x, y_to}, STEP_S, [] {});
 }
 
-struct SurfaceCheck {
-  int open_edges = 0;  ///< edges with other than one triangle each way
-  int pieces = 0;      ///< sets of triangles joined through shared points
-  int degenerate = 0;  ///< triangles naming a point twice
-};
-
+// The drawn surface over current_positions_m, as a viewer gets it.
 SurfaceCheck check_drawn_surface(const Tissue& tissue) {
   std::vector<std::array<int, 3>> triangles;
   tissue.for_each_drawn_triangle([&](const std::array<int, 3>& t) { triangles.push_back(t); });
   EXPECT_EQ(triangles.size(), tissue.drawn_triangle_count());
-  SurfaceCheck check;
-  std::map<std::pair<int, int>, int> directed;  // (from, to) -> triangles
   const auto points = static_cast<int>(tissue.current_positions_m().size() / 3);
-  std::vector<int> parent(static_cast<size_t>(points));
-  std::iota(parent.begin(), parent.end(), 0);
-  const auto root = [&](int v) {
-    while (parent[static_cast<size_t>(v)] != v)
-      v = parent[static_cast<size_t>(v)] = parent[static_cast<size_t>(parent[static_cast<size_t>(v)])];
-    return v;
-  };
   for (const auto& t : triangles) {
-    if (t[0] == t[1] || t[1] == t[2] || t[2] == t[0]) ++check.degenerate;
-    for (int c = 0; c < 3; ++c) {
-      EXPECT_LT(t[static_cast<size_t>(c)], points);
-      ++directed[{t[static_cast<size_t>(c)], t[static_cast<size_t>((c + 1) % 3)]}];
-      parent[static_cast<size_t>(root(t[static_cast<size_t>(c)]))] = root(t[static_cast<size_t>((c + 1) % 3)]);
+    for (const int point : t) {
+      EXPECT_LT(point, points);
+      if (point >= points) return {};  // failed: not a surface over these points
     }
   }
-  for (const auto& [edge, count] : directed) {
-    const auto back = directed.find({edge.second, edge.first});
-    if (count != 1 || back == directed.end() || back->second != 1) ++check.open_edges;
-  }
-  std::set<int> roots;
-  for (const auto& t : triangles) roots.insert(root(t[0]));
-  check.pieces = static_cast<int>(roots.size());
-  return check;
+  return test_support::check_surface(triangles, points);
+}
+
+// A stroke from (x, y) `from` to `to` (then put away): the most open edges the drawn surface had after
+// any step.
+int stroke_worst_open(Tissue& tissue, const Eigen::Vector2d& from, const Eigen::Vector2d& to) {
+  int worst_open = 0;
+  test_support::draw_scalpel(tissue, from, to, STEP_S,
+                             [&] { worst_open = std::max(worst_open, check_drawn_surface(tissue).open_edges); });
+  return worst_open;
 }
 
 TEST(CutSurfaceWeld, CompleteCutDrawsTwoClosedSurfacesSharingNoPoint) {
@@ -120,35 +97,11 @@ TEST(CutSurfaceWeld, CutStoppedInsideStaysClosedAndJoined) {
 TEST(CutSurfaceWeld, ClosedAtEveryStepOfTheStroke) {
   const TetMesh mesh = make_box_mesh(10, 2, 2, 0.01);
   Tissue tissue(mesh, beam_settings(mesh));
-  const double y_from = -0.005, y_to = 0.025;
-  const int steps = static_cast<int>(std::ceil((y_to - y_from) / (0.2 * STEP_S)));
-  int worst_open = 0;
-  for (int n = 0; n <= steps; ++n) {
-    const double y = y_from + (y_to - y_from) * n / steps;
-    tissue.set_tool(ToolPose{Eigen::Vector3d(0.0553, y, -0.02), Eigen::Quaterniond::Identity(), ToolMode::scalpel});
-    tissue.step();
-    worst_open = std::max(worst_open, check_drawn_surface(tissue).open_edges);
-  }
+  const int worst_open = stroke_worst_open(tissue, {0.0553, -0.005}, {0.0553, 0.025});
   EXPECT_EQ(tissue.body().cut_tets().size(), 20u);
   EXPECT_EQ(worst_open, 0);
 }
 
-// A vertical scalpel drawn in a straight line from (x, y) `from` to `to` at 0.2 m/s, then put away;
-// returns the most open edges the drawn surface had after any step.
-int stroke_worst_open(Tissue& tissue, const Eigen::Vector2d& from, const Eigen::Vector2d& to) {
-  const int steps = static_cast<int>(std::ceil((to - from).norm() / (0.2 * STEP_S)));
-  int worst_open = 0;
-  for (int n = 0; n <= steps; ++n) {
-    const Eigen::Vector2d at = from + (to - from) * n / steps;
-    tissue.set_tool(
-        ToolPose{Eigen::Vector3d(at.x(), at.y(), -0.02), Eigen::Quaterniond::Identity(), ToolMode::scalpel});
-    tissue.step();
-    worst_open = std::max(worst_open, check_drawn_surface(tissue).open_edges);
-  }
-  tissue.set_tool(ToolPose{Eigen::Vector3d(to.x(), to.y(), -0.02), Eigen::Quaterniond::Identity(), ToolMode::none});
-  tissue.step();
-  return std::max(worst_open, check_drawn_surface(tissue).open_edges);
-}
 
 TissueSettings block_settings(const TetMesh& mesh) {
   TissueSettings settings = beam_settings(mesh);
