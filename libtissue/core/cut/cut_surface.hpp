@@ -67,7 +67,7 @@ class CutSurface {
   /// Indices into SurfaceMesh::triangles of the triangles the skin pieces replace, ascending.
   [[nodiscard]] const std::vector<int>& replaced_triangles() const { return m_replaced; }
   /// The point drawn for corner id `id` (a mesh vertex, or a cut-face corner as triangles() names it):
-  /// the vertex itself, or the first live corner made with the same weld key.
+  /// the vertex itself, or the first live corner made with the same weld key or one joined to it.
   [[nodiscard]] int drawn_point(int id) const;
 
  private:
@@ -120,6 +120,9 @@ class CutSurface {
   void add_front_strips(const DeformableBody& body);
   void update_fronts(const DeformableBody& body);
   void fix_retired_representatives();
+  void join_compatible_keys(const DeformableBody& body);
+  [[nodiscard]] int key_root(int key) const;
+  [[nodiscard]] WeldKey key_place(int key) const;
   void rebuild_drawn(const DeformableBody& body, const SurfaceMesh& surface);
   void collect_front_triangles(const DeformableBody& body, const SurfaceMesh& surface);
   void split_front_triangles(const DeformableBody& body, const SurfaceMesh& surface);
@@ -153,6 +156,8 @@ class CutSurface {
   std::vector<int> m_point_owner;
   std::vector<WeldKey> m_keys;
   std::vector<int> m_key_drawn;
+  std::vector<int> m_key_parent;  // per key: the key it is joined to (join_compatible_keys), itself at a root
+  std::vector<int> m_root_drawn;  // per root key: the point drawn for its keys
   std::unordered_map<std::int64_t, int> m_crossed_ids;  // (cut id, edge) -> index into m_crossed
   std::vector<CrossedEdge> m_crossed;
   std::vector<int> m_touched_edges;  // crossed edges given corners since the last update_fronts

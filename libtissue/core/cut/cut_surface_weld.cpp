@@ -11,6 +11,8 @@
 
 #include <algorithm>
 #include <functional>
+#include <iterator>
+#include <numeric>
 #include <utility>
 
 namespace tissue {
@@ -229,11 +231,113 @@ void CutSurface::fix_retired_representatives() {
   }
 }
 
+int CutSurface::key_root(int key) const {
+  while (m_key_parent[static_cast<size_t>(key)] != key) key = m_key_parent[static_cast<size_t>(key)];
+  return key;
+}
+
+namespace {
+
+// The cuts that separate a piece from a vertex it sees through block row `row` (-1: the real vertex,
+// none), kept to the cuts in `common` (ascending).
+SeparatingCuts separating_among(const DeformableBody& body, const std::vector<int>& dof_of_row, int row,
+                                const std::vector<int>& common) {
+  SeparatingCuts kept;
+  if (row < 0) return kept;
+  const SeparatingCuts& all =
+      body.enriched_dofs()[static_cast<size_t>(dof_of_row[static_cast<size_t>(row)])].separated_by;
+  for (int i = 0; i < all.count; ++i) {
+    if (!std::binary_search(common.begin(), common.end(), all.cut_id[static_cast<size_t>(i)])) continue;
+    kept.cut_id[static_cast<size_t>(kept.count)] = all.cut_id[static_cast<size_t>(i)];
+    kept.side[static_cast<size_t>(kept.count++)] = all.side[static_cast<size_t>(i)];
+  }
+  return kept;
+}
+
+std::vector<int> sorted_cut_ids(const DeformableBody& body, int k) {
+  std::vector<int> ids;
+  for (const TetCut& cut : body.cut_geometry(k).cuts) ids.push_back(cut.cut_id);
+  std::sort(ids.begin(), ids.end());
+  return ids;
+}
+
+// Block row -> index into enriched_dofs().
+std::vector<int> enriched_dof_of_row(const DeformableBody& body) {
+  std::vector<int> dof_of_row;
+  for (size_t i = 0; i < body.enriched_dofs().size(); ++i) {
+    const auto row = static_cast<size_t>(body.enriched_dofs()[i].row);
+    if (row >= dof_of_row.size()) dof_of_row.resize(row + 1, -1);
+    dof_of_row[row] = static_cast<int>(i);
+  }
+  return dof_of_row;
+}
+
+}  // namespace
+
+// A corner's place: its key without the rows.
+CutSurface::WeldKey CutSurface::key_place(int key) const {
+  WeldKey place = m_keys[static_cast<size_t>(key)];
+  place.ghost_row = {-1, -1, -1, -1};
+  return place;
+}
+
+// Corners at one place (mesh vertices, cuts) made by tets that different sets of cuts cut: where a
+// cut's front ends in tets another cut cut too, the tet cut twice sees an edge's end beyond the second
+// cut through a ghost its neighbour, cut once, does not use. The two corners are one point when their
+// pieces lie on the same sides of the cuts both tets have: their rows agree once kept to those cuts.
+// Tets cut by the same cuts are never joined here (their rows are the whole answer).
+void CutSurface::join_compatible_keys(const DeformableBody& body) {
+  m_key_parent.resize(m_keys.size());
+  std::iota(m_key_parent.begin(), m_key_parent.end(), 0);
+  const auto live_on_edge_or_inside = [&](size_t p) {
+    const int key = m_point_key[p], owner = m_point_owner[p];
+    return key >= 0 && owner >= 0 && m_retired[static_cast<size_t>(owner)] == 0 &&
+           m_keys[static_cast<size_t>(key)].vertex[1] >= 0;  // a tet vertex's pieces all see it real
+  };
+  std::unordered_map<WeldKey, std::vector<size_t>, WeldKeyHash> at_place;  // place -> its points
+  for (size_t p = 0; p < m_points.size(); ++p) {
+    if (live_on_edge_or_inside(p) && body.cut_geometry(m_point_owner[p]).cuts.size() > 1)
+      at_place.try_emplace(key_place(m_point_key[p]));
+  }
+  for (size_t p = 0; p < m_points.size() && !at_place.empty(); ++p) {
+    if (!live_on_edge_or_inside(p)) continue;
+    const auto it = at_place.find(key_place(m_point_key[p]));
+    if (it != at_place.end()) it->second.push_back(p);
+  }
+  const std::vector<int> dof_of_row = at_place.empty() ? std::vector<int>{} : enriched_dof_of_row(body);
+  for (const auto& [place, points] : at_place) {
+    for (size_t i = 0; i < points.size(); ++i) {
+      const std::vector<int> cuts_i = sorted_cut_ids(body, m_point_owner[points[i]]);
+      for (size_t j = i + 1; j < points.size(); ++j) {
+        const int key_i = m_point_key[points[i]], key_j = m_point_key[points[j]];
+        if (key_root(key_i) == key_root(key_j)) continue;
+        const std::vector<int> cuts_j = sorted_cut_ids(body, m_point_owner[points[j]]);
+        if (cuts_i == cuts_j) continue;
+        std::vector<int> common;
+        std::set_intersection(cuts_i.begin(), cuts_i.end(), cuts_j.begin(), cuts_j.end(), std::back_inserter(common));
+        bool same_sides = true;
+        for (size_t v = 0; v < 4 && same_sides && place.vertex[v] >= 0; ++v) {
+          same_sides = separating_among(body, dof_of_row, m_keys[static_cast<size_t>(key_i)].ghost_row[v], common) ==
+                       separating_among(body, dof_of_row, m_keys[static_cast<size_t>(key_j)].ghost_row[v], common);
+        }
+        if (same_sides) m_key_parent[static_cast<size_t>(key_root(key_j))] = key_root(key_i);
+      }
+    }
+  }
+  m_root_drawn.assign(m_keys.size(), -1);
+  for (size_t key = 0; key < m_keys.size(); ++key) {
+    int& drawn = m_root_drawn[static_cast<size_t>(key_root(static_cast<int>(key)))];
+    if (drawn < 0) drawn = m_key_drawn[key];
+  }
+}
+
 int CutSurface::drawn_point(int id) const {
   if (id < m_vertex_count) return id;
   const int key = m_point_key[static_cast<size_t>(id - m_vertex_count)];
   if (key < 0) return id;
-  const int representative = m_key_drawn[static_cast<size_t>(key)];
+  const int representative = static_cast<size_t>(key) < m_root_drawn.size()
+                                 ? m_root_drawn[static_cast<size_t>(key_root(key))]
+                                 : m_key_drawn[static_cast<size_t>(key)];
   return representative >= 0 ? representative : id;
 }
 
@@ -320,6 +424,7 @@ void CutSurface::rebuild_drawn(const DeformableBody& body, const SurfaceMesh& su
     const std::array<int, 3> t = drawn(made);
     if (t[0] != t[1] && t[1] != t[2] && t[2] != t[0]) out.push_back(t);  // a face the weld folded away: none
   };
+  join_compatible_keys(body);
   m_drawn.clear();
   for (size_t t = 0; t < m_triangles.size(); ++t) add_live(m_drawn, m_triangles[t], m_triangle_cut_tet[t]);
   add_front_strips(body);
@@ -482,3 +587,5 @@ void CutSurface::split_skin_piece(const DeformableBody& body, const std::array<i
 }
 
 }  // namespace tissue
+
+

@@ -13,6 +13,7 @@
 #include <Eigen/Geometry>
 
 #include <algorithm>
+#include <cmath>
 #include <array>
 #include <vector>
 
@@ -139,10 +140,52 @@ TEST(CutSurfaceWeld, StrokeRunningPastAnotherCutStaysClosedAtEveryStep) {
   EXPECT_EQ(cut.pieces, 3);  // the first cut's far side parted, its near side cracked
 }
 
-// Not yet closed (docs/DESIGN.md, "The tet skin welded"): where the second stroke's front crosses a
-// mesh edge the first cut crosses too (an X; a T at y = 2.07 cm here), the first cut's corners on
-// that edge in the tet cut twice and in its neighbour the second did not cut see the vertex beyond
-// the second cut through different ghost rows, so they are not welded (24 to 48 open edges).
+// A T junction whose front crosses mesh edges the first cut crosses too: the second stroke stops
+// 0.6 mm past the first cut, in tets the first cut cut. Its corners there in the tets cut twice see
+// the vertex beyond the second cut through a ghost the neighbours cut once do not use; the rows kept
+// to the cuts both tets have agree, so they are one point (before: 8 open edges).
+TEST(CutSurfaceWeld, StrokeEndingJustPastAnotherCutStaysClosedAtEveryStep) {
+  const TetMesh mesh = make_box_mesh(4, 4, 2, 0.01);
+  Tissue tissue(mesh, block_settings(mesh));
+  EXPECT_EQ(stroke_worst_open(tissue, {0.0253, -0.005}, {0.0253, 0.045}), 0);
+  EXPECT_EQ(stroke_worst_open(tissue, {0.045, 0.0137}, {0.0247, 0.0137}), 0);
+  EXPECT_EQ(check_drawn_surface(tissue).degenerate, 0);
+}
+
+// What the weld joins is joined in the material: an X through a block held at both ends, whose top
+// and bottom quarters then fall 0.1 m, is drawn as four pieces and no drawn edge is longer than a
+// tet's (a corner welded across the cut would stretch a triangle from a held piece to a fallen one).
+TEST(CutSurfaceWeld, AnXCutThatFallsApartDrawsFourPiecesAndStretchesNothing) {
+  const TetMesh mesh = make_box_mesh(4, 4, 2, 0.01);
+  TissueSettings settings = beam_settings(mesh);
+  for (int v = 0; v < mesh.vertex_count(); ++v) {
+    if (mesh.rest_positions_m[static_cast<size_t>(v)].x() > 0.04 - 1e-9) settings.body.fixed_vertices.push_back(v);
+  }
+  Tissue tissue(mesh, settings);
+  test_support::draw_scalpel(tissue, {0.0033, -0.005}, {0.0347, 0.045}, STEP_S, [] {});
+  test_support::draw_scalpel(tissue, {0.0374, -0.005}, {0.0060, 0.045}, STEP_S, [] {});
+  for (int n = 0; n < 150; ++n) tissue.step();
+  std::vector<std::array<int, 3>> triangles;
+  tissue.for_each_drawn_triangle([&](const std::array<int, 3>& t) { triangles.push_back(t); });
+  const Eigen::VectorXd& x = tissue.current_positions_m();
+  double lowest_m = 0.0;
+  for (Eigen::Index i = 2; i < x.size(); i += 3) lowest_m = std::min(lowest_m, x(i));
+  ASSERT_LT(lowest_m, -0.05);  // the free quarters fell
+  double longest_m = 0.0;
+  for (const auto& t : triangles) {
+    for (size_t c = 0; c < 3; ++c) {
+      longest_m = std::max(longest_m, (x.segment<3>(3 * t[c]) - x.segment<3>(3 * t[(c + 1) % 3])).norm());
+    }
+  }
+  EXPECT_LT(longest_m, 0.01 * std::sqrt(3.0) * 1.05);  // a cube's diagonal, 5% strain
+  EXPECT_EQ(check_drawn_surface(tissue).pieces, 4);
+}
+
+// Not yet closed (docs/DESIGN.md, "The tet skin welded"): near the line where the two strokes cross,
+// the tets cut twice disagree where the second cut crosses a shared edge (each fits its own plane
+// through its crossings), so the pieces meeting at the edge differ from tet to tet; and a later cut
+// leaves a piece whole where it would cut off less than the smallest fraction, which no cap closes
+// (16-24 open edges).
 TEST(CutSurfaceWeld, DISABLED_CrossingStrokesStayClosedAtEveryStep) {
   const TetMesh mesh = make_box_mesh(4, 4, 2, 0.01);
   Tissue tissue(mesh, block_settings(mesh));
