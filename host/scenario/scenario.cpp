@@ -500,11 +500,17 @@ std::vector<DeviceWaypoint> placed_waypoints(const DeviceConfig& config, const s
 }
 
 Scenario load_scenario(const std::filesystem::path& file) {
-  std::ifstream in(file);
+  std::ifstream in(file, std::ios::binary);
   if (!in) throw ScenarioError(file.string() + ": cannot be read");
-  std::ostringstream text;
-  text << in.rdbuf();
-  return parse_scenario(text.str(), file);
+  std::string text(MAX_SCENARIO_FILE_BYTES + 1, '\0');  // one more: a longer file is refused, not cut
+  in.read(text.data(), static_cast<std::streamsize>(text.size()));
+  if (in.bad()) throw ScenarioError(file.string() + ": cannot be read");
+  text.resize(static_cast<std::size_t>(in.gcount()));
+  if (text.size() > MAX_SCENARIO_FILE_BYTES) {
+    throw ScenarioError(file.string() + ": larger than MAX_SCENARIO_FILE_BYTES (" +
+                        std::to_string(MAX_SCENARIO_FILE_BYTES) + " bytes)");
+  }
+  return parse_scenario(text, file);
 }
 
 }  // namespace tissue::host

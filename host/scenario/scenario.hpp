@@ -12,6 +12,7 @@
 #include "device/simulated_hand.hpp"
 
 #include <array>
+#include <cstddef>
 #include <cstdint>
 #include <filesystem>
 #include <optional>
@@ -116,6 +117,9 @@ struct Scenario {
 /// simulated hand, and the Python module's Scenario.tool_at, follow them).
 std::vector<DeviceWaypoint> placed_waypoints(const DeviceConfig& config, const std::array<double, 3>& rest_lower,
                                              const std::array<double, 3>& rest_upper);
+
+/// The largest scenario file load_scenario reads [bytes] (the shipped ones are under 4 KiB).
+inline constexpr std::size_t MAX_SCENARIO_FILE_BYTES = std::size_t{1} << 20;
 
 /// Reads and checks a scenario. Throws ScenarioError naming the file, the key and the reason.
 Scenario load_scenario(const std::filesystem::path& file);

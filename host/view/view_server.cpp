@@ -260,7 +260,7 @@ void ViewServer::start() {
   try {
     server.init_asio();
     server.set_reuse_addr(true);
-    server.set_max_message_size(64 * 1024);  // beyond: the connection is closed (counted as oversized)
+    server.set_max_message_size(MAX_VIEW_FRAME_BYTES);
     server.set_http_handler([&impl](Handle h) { impl.serve_http(h); });
     server.set_validate_handler([&impl](Handle h) { return impl.validate(h); });
     server.set_open_handler([&impl](Handle h) { impl.opened(h); });

@@ -22,6 +22,11 @@ class ViewServerError : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
+/// The largest WebSocket message the server receives whole [bytes]: beyond it the connection is
+/// closed before the message is buffered (counted as oversized); up to it, one over max_message_bytes
+/// is dropped unread.
+inline constexpr std::size_t MAX_VIEW_FRAME_BYTES = 64 * 1024;
+
 struct ViewServerSettings {
   std::string address = "127.0.0.1";
   std::uint16_t port = 8080;   ///< 0: any free port (port() tells which)

@@ -20,6 +20,8 @@ template <class... F>
 struct Overloaded : F... {
   using F::operator()...;
 };
+template <class... F>
+Overloaded(F...) -> Overloaded<F...>;  // clang 14 (the fuzz preset) deduces aggregates only with a guide
 
 double parse_real(std::string_view text) {
   double value = 0.0;

@@ -450,6 +450,17 @@ TEST(RealTime, AStopRequestEndsTheRunWithItsOutputs) {
   EXPECT_TRUE(std::filesystem::exists(options.output_dir / "final.png"));
 }
 
+// Issue 44: a file that never ends (a device, a pipe) or is larger than MAX_SCENARIO_FILE_BYTES is
+// refused after reading at most one byte more than the limit (before: read until memory ran out).
+TEST(ScenarioFile, AFileBeyondTheLimitIsRefusedUnreadPastIt) {
+  try {
+    (void)load_scenario("/dev/zero");
+    ADD_FAILURE() << "/dev/zero was accepted";
+  } catch (const ScenarioError& error) {
+    EXPECT_NE(std::string(error.what()).find("MAX_SCENARIO_FILE_BYTES"), std::string::npos) << error.what();
+  }
+}
+
 TEST(ScenarioFile, MistakesAreRefusedNamingTheKey) {
   const auto refused = [](const std::string& text, const std::string& key) {
     try {

@@ -32,6 +32,21 @@ BodySettings checked(BodySettings settings, int vertex_count) {
   return settings;
 }
 
+// The vertices without unknowns: the fixed ones and those no tet uses, which have no mass and no
+// stiffness (a row of zeros would make the system singular; readers warn of them, mesh_io.hpp).
+std::vector<int> held_vertices(const std::vector<int>& fixed_vertices, const TetMesh& mesh) {
+  std::vector<char> held(static_cast<size_t>(mesh.vertex_count()), 1);
+  for (const Tet& tet : mesh.tets) {
+    for (const int v : tet) held[static_cast<size_t>(v)] = 0;
+  }
+  for (const int v : fixed_vertices) held[static_cast<size_t>(v)] = 1;
+  std::vector<int> vertices;
+  for (int v = 0; v < mesh.vertex_count(); ++v) {
+    if (held[static_cast<size_t>(v)] != 0) vertices.push_back(v);
+  }
+  return vertices;
+}
+
 // Per vertex: how many vertices share a tet with it (itself included), all and free ones.
 struct Neighbourhoods {
   std::vector<int> all;
@@ -109,7 +124,7 @@ DeformableBody::DeformableBody(TetMesh mesh, BodySettings settings)
       m_settings(checked(std::move(settings), m_mesh.vertex_count())),
       m_materials(resolve_region_materials(m_mesh.regions, m_settings.material, m_settings.region_materials)),
       m_region_mass_damping_per_s(region_mass_damping(m_materials, m_settings.damping)),
-      m_dofs(make_dof_map(m_mesh.vertex_count(), m_settings.fixed_vertices, m_vertex_order)),
+      m_dofs(make_dof_map(m_mesh.vertex_count(), held_vertices(m_settings.fixed_vertices, m_mesh), m_vertex_order)),
       m_elasticity(m_mesh, m_materials, m_settings.rotation, m_vertex_order, m_settings.material_model),
       m_vertex_mass_kg(lumped_vertex_masses(m_mesh, m_materials)),
       m_vertex_mass_damping_kg_per_s(lumped_vertex_mass_damping(m_mesh, m_materials, m_region_mass_damping_per_s)),

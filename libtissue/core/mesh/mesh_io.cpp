@@ -6,8 +6,10 @@
 #include "core/mesh/mesh_io.hpp"
 
 #include "core/mesh/mesh_io_detail.hpp"
+#include "core/mesh/topology.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cctype>
 #include <charconv>
 #include <cmath>
@@ -37,12 +39,20 @@ std::string read_text(const std::filesystem::path& path) {
   if (!in) {
     fail(path.string(), 0, -1, "cannot open file");
   }
-  std::ostringstream buffer;
-  buffer << in.rdbuf();
+  // Read in blocks up to the limit, so that a device or a pipe that never ends (/dev/zero) is refused too.
+  std::string text;
+  std::array<char, 1 << 16> block{};
+  while (in.read(block.data(), block.size()) || in.gcount() > 0) {
+    const auto got = static_cast<std::size_t>(in.gcount());
+    if (text.size() + got > MAX_MESH_FILE_BYTES) {
+      fail(path.string(), 0, -1, "larger than MAX_MESH_FILE_BYTES (" + std::to_string(MAX_MESH_FILE_BYTES) + " bytes)");
+    }
+    text.append(block.data(), got);
+  }
   if (in.bad()) {
     fail(path.string(), 0, -1, "read error");
   }
-  return std::move(buffer).str();
+  return text;
 }
 
 std::string to_upper(std::string_view text) {
@@ -209,6 +219,10 @@ double zero_volume_threshold_m3(const TetMesh& mesh, const Sources& in) {
       fail(in.vertex_source, in.vertex_line(v), -1,
            "vertex " + std::to_string(v + in.index_base) + ": coordinate is not finite");
     }
+    if (p.cwiseAbs().maxCoeff() > MAX_ABS_COORDINATE) {
+      fail(in.vertex_source, in.vertex_line(v), -1,
+           "vertex " + std::to_string(v + in.index_base) + ": coordinate beyond +-1e6 (MAX_ABS_COORDINATE)");
+    }
     lower = lower.cwiseMin(p);
     upper = upper.cwiseMax(p);
   }
@@ -316,11 +330,23 @@ void warn_unused_vertices(const std::vector<char>& used, const Sources& in, Mesh
 }
 
 /// validate_tets, with the Sources of the vertices and tets.
+/// Refuses a face shared by more than two tets (overlapping elements: the core's adjacency has no
+/// place for them), naming the file and the third tet.
+void refuse_overlaps(const TetMesh& mesh, const Sources& in) {
+  try {
+    check_face_sharing(mesh);
+  } catch (const MeshError& error) {
+    const int t = error.element();
+    fail(in.element_source, t >= 0 ? in.element_line(t) : 0, t, error.what());
+  }
+}
+
 void validate_impl(TetMesh& mesh, const Sources& in, MeshWarnings* warnings) {
   check_counts_and_regions(mesh, in);
   const double zero_volume_m3 = zero_volume_threshold_m3(mesh, in);
   const std::vector<char> used = orient_tets(mesh, in, zero_volume_m3, warnings);
   refuse_duplicates(mesh, in);
+  refuse_overlaps(mesh, in);
   if (warnings != nullptr) {
     warn_unused_vertices(used, in, *warnings);
   }

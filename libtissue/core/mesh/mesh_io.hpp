@@ -9,12 +9,22 @@
 #include <Eigen/Core>
 
 #include <array>
+#include <cstddef>
 #include <filesystem>
 #include <string>
 #include <string_view>
 #include <vector>
 
 namespace tissue {
+
+/// The largest file a reader reads (.veg, .node/.ele, .msh, .bou, .obj) [bytes]: the readers hold
+/// the whole text, and their counts and reservations are bounded by it. 1 GiB (the 52k-tet organ's .veg is
+/// 2 MB).
+inline constexpr std::size_t MAX_MESH_FILE_BYTES = std::size_t{1} << 30;
+
+/// The largest absolute coordinate a reader takes, in the file's unit (metres for the engine; a mesh
+/// in millimetres fits too): beyond it volumes, masses and the surface tree's bounds overflow.
+inline constexpr double MAX_ABS_COORDINATE = 1e6;
 
 /// Non-fatal findings while loading (e.g. "file:line: tet 12 inverted, re-oriented").
 struct MeshWarnings {
@@ -35,6 +45,9 @@ TetMesh parse_veg(std::string_view text, const std::string& source_name, MeshWar
 /// Index base (0 or 1) is taken from the first vertex index in the .node file, as TetGen does.
 /// A .ele with attributes: the first is the tet's region (tetgen -A), named by its whole number.
 TetMesh read_tetgen(const std::filesystem::path& path, MeshWarnings* warnings = nullptr);
+/// Same, from the two files' text already in memory (the names are used in messages).
+TetMesh parse_tetgen(std::string_view node_text, std::string_view ele_text, const std::string& node_name,
+                     const std::string& ele_name, MeshWarnings* warnings = nullptr);
 
 /// Gmsh .msh 4.1 ASCII: $Nodes and $Elements (type 4 = 4-node tet); other element types are ignored.
 /// Regions: the physical groups of the tets' volumes ($Entities), named by $PhysicalNames or else by
@@ -64,12 +77,14 @@ TetMesh read_mesh(const std::filesystem::path& path, MeshWarnings* warnings = nu
 /// Vega .bou: 1-indexed vertex ids separated by commas/whitespace; returns sorted unique 0-based ids.
 /// Throws MeshError for ids outside [1, vertex_count].
 std::vector<int> read_bou(const std::filesystem::path& path, int vertex_count);
+std::vector<int> parse_bou(std::string_view text, int vertex_count, const std::string& source_name);
 
 /// Checks applied by every reader (exposed for tests and for meshes built in code):
-/// - NaN/Inf coordinates -> MeshError (line of the vertex);
+/// - NaN/Inf coordinates, or beyond +-MAX_ABS_COORDINATE -> MeshError (line of the vertex);
 /// - vertex index outside [0, vertex_count) -> MeshError;
 /// - a tet with a repeated vertex, or |volume| <= 1e-12 * (bounding-box diagonal)^3 -> MeshError ("zero-volume");
 /// - two tets with the same vertex set -> MeshError ("duplicate of element k");
+/// - a face shared by more than two tets -> MeshError ("overlapping elements");
 /// - negative volume -> vertices 2 and 3 swapped, warning (after 100 such warnings, one summary line);
 /// - vertices used by no tet -> one warning (they would get no mass).
 /// `vertex_lines` / `element_lines` give the source line of each vertex / tet (may be empty);

@@ -130,12 +130,15 @@ TetMesh read_tetgen(const std::filesystem::path& path, MeshWarnings* warnings) {
   // The stem may itself contain dots (TetGen writes "mesh.1.node"), so append rather than replace.
   const std::filesystem::path node_path = stem.string() + ".node";
   const std::filesystem::path ele_path = stem.string() + ".ele";
-  const std::string node_text = read_text(node_path);
-  const std::string ele_text = read_text(ele_path);
+  return parse_tetgen(read_text(node_path), read_text(ele_path), node_path.string(), ele_path.string(), warnings);
+}
+
+TetMesh parse_tetgen(std::string_view node_text, std::string_view ele_text, const std::string& node_name,
+                     const std::string& ele_name, MeshWarnings* warnings) {
   RawMesh raw;
-  read_tetgen_nodes(node_text, node_path.string(), raw);
-  read_tetgen_elements(ele_text, ele_path.string(), raw);
-  return finish(std::move(raw), node_path.string(), ele_path.string(), warnings);
+  read_tetgen_nodes(node_text, node_name, raw);
+  read_tetgen_elements(ele_text, ele_name, raw);
+  return finish(std::move(raw), node_name, ele_name, warnings);
 }
 
 }  // namespace tissue

@@ -58,6 +58,8 @@ std::vector<FaceKey> sorted_faces(const TetMesh& mesh) {
 
 }  // namespace
 
+void check_face_sharing(const TetMesh& mesh) { (void)sorted_faces(mesh); }
+
 SurfaceMesh extract_surface(const TetMesh& mesh) {
   const std::vector<FaceKey> faces = sorted_faces(mesh);
   std::vector<int> boundary;

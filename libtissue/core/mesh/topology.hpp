@@ -26,6 +26,9 @@ struct SurfaceMesh {
 /// Throws MeshError (no file, line 0) if a face is shared by more than two tets (overlapping elements).
 SurfaceMesh extract_surface(const TetMesh& mesh);
 
+/// Throws MeshError (naming the third tet) if a face is shared by more than two tets.
+void check_face_sharing(const TetMesh& mesh);
+
 struct TetAdjacency {
   /// face_neighbor[t][k]: the tet across local face k of tet t, or -1 on the boundary.
   std::vector<std::array<int, 4>> face_neighbor;

@@ -315,8 +315,10 @@ TetMesh read_veg(const std::filesystem::path& path, MeshWarnings* warnings) {
 }
 
 std::vector<int> read_bou(const std::filesystem::path& path, int vertex_count) {
-  const std::string source = path.string();
-  const std::string text = read_text(path);
+  return parse_bou(read_text(path), vertex_count, path.string());
+}
+
+std::vector<int> parse_bou(std::string_view text, int vertex_count, const std::string& source) {
   LineReader reader(text, '#', true);
   std::vector<int> ids;
   while (reader.next()) {

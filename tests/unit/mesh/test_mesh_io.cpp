@@ -179,6 +179,29 @@ TEST(VegReader, RefusesNonFiniteCoordinates) {
   EXPECT_EQ(parse_veg(replace_line(TWO_TETS_VEG, 8, "5 1 1 1e-999"), "test.veg").rest_positions_m[4].z(), 0.0);
 }
 
+// Found by fuzzing (issue 44): a coordinate of 1e308 was taken, and the surface tree's bounds then
+// overflowed (a bad free inside Bullet's btDbvt).
+TEST(VegReader, RefusesCoordinatesBeyondTheDeclaredMaximum) {
+  expect_veg_refused(replace_line(TWO_TETS_VEG, 8, "5 1e308 1 1"), 8, -1, {"vertex 5", "MAX_ABS_COORDINATE"});
+  expect_veg_refused(replace_line(TWO_TETS_VEG, 5, "2 1 -2e6 0"), 5, -1, {"vertex 2", "MAX_ABS_COORDINATE"});
+  // At the limit: the two tets scaled by 1e6 (a 1 m body in micrometres) are taken.
+  std::string scaled = replace_line(TWO_TETS_VEG, 5, "2 1e6 0 0");
+  scaled = replace_line(scaled, 6, "3 0 1e6 0");
+  scaled = replace_line(scaled, 7, "4 0 0 1e6");
+  scaled = replace_line(scaled, 8, "5 1e6 1e6 1e6");
+  EXPECT_NO_THROW(parse_veg(scaled, "test.veg"));
+}
+
+// Found by fuzzing (issue 44): three tets on one face were taken and then refused by the tissue
+// (its adjacency), with no file or line.
+TEST(VegReader, RefusesAFaceSharedByThreeTets) {
+  std::string text = replace_line(TWO_TETS_VEG, 14, "2 2 3 4 5\n3 2 3 4 6");
+  text = replace_line(text, 12, "3 4 0");
+  text = replace_line(text, 8, "5 1 1 1\n6 2 1 1");  // the third tet is on line 16 now
+  text = replace_line(text, 3, "6 3 0 0");
+  expect_veg_refused(text, 16, 2, {"shared by more than two tets", "overlapping"});
+}
+
 TEST(VegReader, RefusesNonNumericTokens) {
   expect_veg_refused(replace_line(TWO_TETS_VEG, 5, "2 1 zero 0"), 5, -1, {"vertex 2", "'zero' is not a number"});
   expect_veg_refused(replace_line(TWO_TETS_VEG, 5, "2 1 0.5x 0"), 5, -1, {"vertex 2", "'0.5x'"});
