@@ -26,7 +26,9 @@ void require_ok(fmi3Status status, const char* call) {
 }  // namespace
 
 void TissueFmuFixture::log(fmi3InstanceEnvironment environment, fmi3Status, fmi3String, fmi3String message) {
-  static_cast<TissueFmuFixture*>(environment)->m_message = message == nullptr ? "" : message;
+  std::string& messages = static_cast<TissueFmuFixture*>(environment)->m_message;
+  if (!messages.empty()) messages += " | ";
+  messages += message == nullptr ? "(null)" : message;
 }
 
 TissueFmuFixture::TissueFmuFixture() {

@@ -21,7 +21,7 @@ class TissueFmuFixture {
   [[nodiscard]] fmi3Instance instance() const { return m_instance; }
   /// Steps with the scalpel at `position_m` (mode 2) or the probe (mode 1).
   fmi3Status step(double x_m, double y_m, double z_m, std::int64_t mode);
-  /// The last message the FMU logged ("" since clear_message()).
+  /// The messages the FMU logged since clear_message(), joined by " | ".
   [[nodiscard]] const std::string& message() const { return m_message; }
   void clear_message() { m_message.clear(); }
   /// The serialized state of the instance now.

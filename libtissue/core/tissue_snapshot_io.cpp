@@ -4,6 +4,7 @@
 #include "serial/byte_stream.hpp"
 
 #include <array>
+#include <cmath>
 #include <string>
 
 namespace tissue {
@@ -74,18 +75,26 @@ class Reader : public serial::ByteReader {
   using serial::ByteReader::ByteReader;
   using serial::ByteReader::get;
 
+  // Every number a tissue keeps is finite: a state holding a NaN or an infinity is refused here,
+  // not by the step after it is restored (found by fuzzing, issue 44).
+  double real() {
+    const auto x = get<double>();
+    if (!std::isfinite(x)) fail("a non-finite number");
+    return x;
+  }
+  void get(double& x) { x = real(); }
   void get(Eigen::VectorXd& v) {
     v.resize(static_cast<Eigen::Index>(count(sizeof(double))));
-    for (Eigen::Index k = 0; k < v.size(); ++k) v(k) = get<double>();
+    for (Eigen::Index k = 0; k < v.size(); ++k) v(k) = real();
   }
   void get(Eigen::Vector3d& v) {
-    for (int k = 0; k < 3; ++k) v(k) = get<double>();
+    for (int k = 0; k < 3; ++k) v(k) = real();
   }
   void get(Eigen::Matrix3d& m) {
-    for (int k = 0; k < 9; ++k) m(k) = get<double>();
+    for (int k = 0; k < 9; ++k) m(k) = real();
   }
   void get(Eigen::Quaterniond& q) {
-    for (int k = 0; k < 4; ++k) q.coeffs()(k) = get<double>();
+    for (int k = 0; k < 4; ++k) q.coeffs()(k) = real();
   }
   template <class T, size_t N>
   void get(std::array<T, N>& values) {

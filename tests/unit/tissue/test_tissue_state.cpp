@@ -13,7 +13,10 @@
 
 #include <cmath>
 #include <cstdio>
+#include <functional>
+#include <limits>
 #include <string>
+#include <vector>
 
 namespace tissue {
 namespace {
@@ -391,6 +394,18 @@ TEST(TissueState, RefusesWhatItCannotRestoreAndKeepsItsState) {
   std::vector<std::uint8_t> huge = bytes;
   for (size_t k = 20; k < 28; ++k) huge[k] = 0xff;
   EXPECT_THROW((void)deserialize_snapshot(huge), StateError);
+
+  // A non-finite number anywhere (found by fuzzing the FMU's state, issue 44: a NaN tool position was
+  // restored and the next step failed in the contact): refused when read.
+  for (const auto& poison : std::vector<std::function<void(TissueSnapshot&)>>{
+           [](TissueSnapshot& s) { s.dynamics.displacement_m(4) = std::numeric_limits<double>::quiet_NaN(); },
+           [](TissueSnapshot& s) { s.tool.tip_position_m.y() = std::numeric_limits<double>::infinity(); },
+           [](TissueSnapshot& s) { s.applied_tool_position_m.x() = std::numeric_limits<double>::quiet_NaN(); },
+           [](TissueSnapshot& s) { s.dynamics.time_s = -std::numeric_limits<double>::infinity(); }}) {
+    TissueSnapshot poisoned = saved;
+    poison(poisoned);
+    EXPECT_THROW((void)deserialize_snapshot(serialize_snapshot(poisoned)), StateError);
+  }
 
   // A state whose unknowns do not match its cuts.
   TissueSnapshot inconsistent = saved;
