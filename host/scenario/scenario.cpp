@@ -441,7 +441,10 @@ Expectations read_expect(const Reader& r, const toml::table& expect) {
     const toml::node* n = expect.get(key);
     if (n == nullptr) return std::nullopt;
     const double value = r.number(*n, std::string("expect.") + key);
-    if (value < 0 || value != std::floor(value)) r.fail(std::string("expect.") + key, "must be a count");
+    // Up to 2^53, where doubles still count by one (found by fuzzing, issue 44: 1e300 was cast).
+    constexpr double LARGEST_COUNT = 9007199254740992.0;
+    if (!(value >= 0 && value <= LARGEST_COUNT) || value != std::floor(value))
+      r.fail(std::string("expect.") + key, "must be a count up to 2^53");
     return static_cast<std::uint64_t>(value);
   };
   Expectations expectations;

@@ -473,6 +473,8 @@ TEST(ScenarioFile, MistakesAreRefusedNamingTheKey) {
   const std::string device = "\n[device]\nwaypoints = [ { t = 0.0, position = [0, 0, 0] } ]\n";
   refused("[scenario]\nduration = 1.0\n[device]\nkind = \"scripted\"\n", "device.waypoints");
   refused("[scenario]\nduration = -1.0\n" + device, "scenario.duration");
+  // Found by fuzzing (issue 44): a count beyond what a double counts by one was cast (undefined).
+  refused("[scenario]\nduration = 1.0\n[expect]\nmin_cut_tets = 1e300\n" + device, "expect.min_cut_tets");
   refused("[scenario]\nduration = 1.0\ncolour = 3\n" + device, "scenario.colour");
   refused("[scenario]\nduration = 1.0\n[tissue]\ncommunication_step = 0.0105\n" + device, "tissue.communication_step");
   refused(

@@ -98,11 +98,6 @@ struct Blade {
 /// SWEEP_BACK_OVERLAP of its travel (the sweep ends at the current blade).
 Blade swept_from(const Blade& previous, const Blade& current);
 
-/// The floor of CutterSettings::min_volume_fraction. Below it a part's ghost unknowns weigh ~1e-16
-/// of their tet: a capped PCG solve moves them freely and the next enrichment gives them mass, so
-/// the energy jumps (tests/extremes: 5.7 times the work put in at 1e-300; bounded at 1e-12).
-inline constexpr double SMALLEST_MIN_VOLUME_FRACTION = 1e-12;
-
 struct CutterSettings {
   /// An edge crossing within this fraction of the edge length from an end passes through that
   /// vertex (docs/DESIGN.md, "Cutting": a cut that passes within eps of a vertex is treated as

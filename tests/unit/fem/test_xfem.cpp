@@ -585,6 +585,28 @@ TEST(XfemEnrich, RefusesBadCutsAndChangesNothing) {
     bad.volume_fraction_above = fraction;
     refused({good, bad});
   }
+  // Found by fuzzing the FMU's state (issue 44): a part under the floor SMALLEST_MIN_VOLUME_FRACTION
+  // (at 5e-324 a ghost had no mass and no stiffness and the solve refused the system), a smallest
+  // fraction under the floor, a crossing off its edge, a blade normal not finite.
+  for (double fraction : {5e-324, 1e-13, 1.0 - 1e-13}) {
+    bad.volume_fraction_above = fraction;
+    refused({good, bad});
+  }
+  bad = good;
+  bad.min_volume_fraction = 1e-300;
+  bad.volume_fraction_above = 1e-300;
+  refused({good, bad});
+  bad = good;
+  bad.edge_ratio[2] = 1.5;
+  refused({good, bad});
+  bad.edge_ratio[2] = std::nan("");
+  refused({good, bad});
+  bad = good;
+  bad.blade_normal.x() = std::numeric_limits<double>::infinity();
+  refused({good, bad});
+  bad = good;
+  bad.volume_fraction_above = 1e-4;  // under the cutter's clamp, over the floor (an exact cut in code): taken
+  EXPECT_NO_THROW(Box{}.body.enrich(bad));
   refused({good, good});  // the same tet twice
 
   box.body.enrich(good);
