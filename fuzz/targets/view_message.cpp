@@ -8,22 +8,9 @@
 #include "view/pose_message.hpp"
 #include "support/promise.hpp"
 
-#include <cmath>
+#include <algorithm>
 #include <string>
 #include <string_view>
-
-namespace {
-
-void require_usable(const tissue::host::DevicePose& pose) {
-  double norm_squared = 0.0;
-  for (const double q : pose.orientation_wxyz) norm_squared += q * q;
-  for (const double x : pose.position_m) {
-    if (!std::isfinite(x)) tissue::fuzz::broken("the view's hand pose is not finite");
-  }
-  if (!(std::abs(norm_squared - 1.0) < 1e-9)) tissue::fuzz::broken("the view's hand pose has no unit quaternion");
-}
-
-}  // namespace
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   using namespace tissue::host;
@@ -41,7 +28,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     device.handle_message(page, std::string(text));
     ++handed;
     if (static_cast<std::uint8_t>(line[0]) >= 0xf0) device.connection_closed(page);
-    require_usable(device.read(0.0));
+    tissue::fuzz::require_usable_pose(device.read(0.0), 1e-9, "view");  // normalized in double
   }
   const DeviceCounters c = device.counters();
   if (c.received != handed || c.received != c.accepted + c.malformed + c.out_of_order)

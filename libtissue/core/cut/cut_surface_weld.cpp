@@ -305,13 +305,16 @@ void CutSurface::join_compatible_keys(const DeformableBody& body) {
     if (it != at_place.end()) it->second.push_back(p);
   }
   const std::vector<int> dof_of_row = at_place.empty() ? std::vector<int>{} : enriched_dof_of_row(body);
+  std::vector<std::vector<int>> cuts_of;  // per point of the place: its tet's cut ids, ascending
   for (const auto& [place, points] : at_place) {
+    cuts_of.clear();
+    for (const size_t p : points) cuts_of.push_back(sorted_cut_ids(body, m_point_owner[p]));
     for (size_t i = 0; i < points.size(); ++i) {
-      const std::vector<int> cuts_i = sorted_cut_ids(body, m_point_owner[points[i]]);
+      const std::vector<int>& cuts_i = cuts_of[i];
       for (size_t j = i + 1; j < points.size(); ++j) {
         const int key_i = m_point_key[points[i]], key_j = m_point_key[points[j]];
         if (key_root(key_i) == key_root(key_j)) continue;
-        const std::vector<int> cuts_j = sorted_cut_ids(body, m_point_owner[points[j]]);
+        const std::vector<int>& cuts_j = cuts_of[j];
         if (cuts_i == cuts_j) continue;
         std::vector<int> common;
         std::set_intersection(cuts_i.begin(), cuts_i.end(), cuts_j.begin(), cuts_j.end(), std::back_inserter(common));
@@ -587,5 +590,3 @@ void CutSurface::split_skin_piece(const DeformableBody& body, const std::array<i
 }
 
 }  // namespace tissue
-
-

@@ -329,7 +329,6 @@ void warn_unused_vertices(const std::vector<char>& used, const Sources& in, Mesh
   }
 }
 
-/// validate_tets, with the Sources of the vertices and tets.
 /// Refuses a face shared by more than two tets (overlapping elements: the core's adjacency has no
 /// place for them), naming the file and the third tet.
 void refuse_overlaps(const TetMesh& mesh, const Sources& in) {
@@ -341,6 +340,7 @@ void refuse_overlaps(const TetMesh& mesh, const Sources& in) {
   }
 }
 
+/// validate_tets, with the Sources of the vertices and tets.
 void validate_impl(TetMesh& mesh, const Sources& in, MeshWarnings* warnings) {
   check_counts_and_regions(mesh, in);
   const double zero_volume_m3 = zero_volume_threshold_m3(mesh, in);
