@@ -4,6 +4,7 @@
 #include "importer/fmu_error.hpp"
 
 #include <algorithm>
+#include <chrono>
 #include <limits>
 
 namespace tissue::host {
@@ -107,7 +108,9 @@ TissueLink::TissueLink(const Fmu3& fmu, const std::vector<ParameterSetting>& par
   // The box of the nodes at rest: the tet mesh's vertices whichever surface is drawn (a render
   // surface lies within the tets), so that a scenario's tool path is the same for both.
   SurfaceFrame rest;
+  const auto read_begin = std::chrono::steady_clock::now();
   read_surface(rest);
+  m_first_surface_read_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - read_begin).count();
   m_rest_lower.fill(std::numeric_limits<double>::infinity());
   m_rest_upper.fill(-std::numeric_limits<double>::infinity());
   for (std::size_t i = 0; i < rest.node_positions_m.size(); ++i) {
@@ -143,6 +146,12 @@ void TissueLink::reserve(SurfaceFrame& frame) const {
   frame.node_positions_m.reserve(2 * 3 * m_embedding->node_count);
 }
 
+bool TissueLink::surface_remeshed() {
+  fmi3UInt64 revision = 0;
+  (void)m_instance.get_uint64(std::span(&m_revision, 1), std::span(&revision, 1));
+  return !m_embedding_bytes || revision != m_embedding_revision;
+}
+
 void TissueLink::read_surface(SurfaceFrame& frame) {
   read_surface_unmapped(frame);
   m_mapping.complete(frame);
@@ -162,8 +171,7 @@ void TissueLink::read_surface_unmapped(SurfaceFrame& frame) {
     fmi3UInt64 revision = 0;
     (void)m_instance.get_uint64(std::span(&m_revision, 1), std::span(&revision, 1));
     if (!m_embedding_bytes || revision != m_embedding_revision) {
-      const std::span<const std::uint8_t> bytes = binary(m_embedding_vr, "surface.embedding");
-      m_embedding_bytes = std::make_shared<const std::vector<std::uint8_t>>(bytes.begin(), bytes.end());
+      m_embedding_bytes = m_embedding_copies.copy(binary(m_embedding_vr, "surface.embedding"));
       m_embedding_revision = revision;
     }
     ports::decode(binary(m_nodes_vr, "surface.nodes"), m_nodes);

@@ -9,6 +9,7 @@
 #include "device/device.hpp"
 #include "importer/fmu3.hpp"
 #include "importer/fmu3_instance.hpp"
+#include "links/recycled_bytes.hpp"
 #include "links/sample_relay.hpp"
 #include "output/surface_frame.hpp"
 #include "scenario/scenario.hpp"
@@ -70,9 +71,15 @@ class TissueLink {
   /// not decode.
   void read_surface(SurfaceFrame& frame);
   /// The same without the mapping, for a consumer in another thread (SurfaceMapping::complete): the
-  /// embedding's bytes (copied when surface.revision changes) and the nodes. Issue 42: after a cut
+  /// embedding's bytes (copied when surface.revision changes, into a buffer no frame holds any more:
+  /// RecycledBytes) and the nodes. Issue 42: after a cut
   /// the decode and the mapping of the organ's fine surface took 1.5-2.5 ms of the step's slot.
   void read_surface_unmapped(SurfaceFrame& frame);
+  /// Whether surface.revision moved since the embedding was last read (a cut re-meshed the surface:
+  /// the next read copies the embedding).
+  [[nodiscard]] bool surface_remeshed();
+  /// How long the first read of the surface (the constructor's, the whole embedding) took [s].
+  [[nodiscard]] double first_surface_read_s() const { return m_first_surface_read_s; }
   /// Gives `frame` room for twice the surface at rest, so that reading into it rarely allocates.
   void reserve(SurfaceFrame& frame) const;
   /// Axis-aligned box of the tet mesh at rest (after initialization), whichever surface is drawn.
@@ -86,12 +93,14 @@ class TissueLink {
   fmi3ValueReference m_tool_position, m_tool_orientation, m_tool_mode;
   fmi3ValueReference m_revision, m_embedding_vr, m_nodes_vr, m_cut_tets, m_enriched;
   std::shared_ptr<const std::vector<std::uint8_t>> m_embedding_bytes;  // of the last revision read
+  RecycledBytes m_embedding_copies;  // m_embedding_bytes's buffers
   std::uint64_t m_embedding_revision = 0;
   std::shared_ptr<const ports::SurfaceEmbedding> m_embedding;            // of the first read (reserve())
   SurfaceMapping m_mapping;  // read_surface()'s
   ports::SurfaceNodes m_nodes;
   std::array<double, 3> m_rest_lower{}, m_rest_upper{};
   double m_blade_length_m = 0.0;
+  double m_first_surface_read_s = 0.0;
 };
 
 class HapticLink {

@@ -140,7 +140,7 @@ void print_summary(std::ostream& out, const SessionSummary& s, const std::filesy
         << c.forces_sent << ", surfaces sent " << c.surfaces_sent << "\n";
   }
   if (!s.first_error.empty()) out << "  first error: " << s.first_error << "\n";
-  out << "  outputs in " << output_dir.string() << ": summary.json, log.csv, ";
+  out << "  outputs in " << output_dir.string() << ": summary.json, log.csv, " << (s.offline ? "" : "slots.csv, ");
   if (s.frames_written > 0) {
     out << "surface.pvd (frames/, " << s.frames_written << " frames, open in ParaView), ";
   } else {

@@ -7,12 +7,19 @@
 // frames forced into a cutting step's slot are most of the organ's overruns; over three interleaved
 // real-time runs each of cut_organ and resect_lobe, 131 overruns with 10 against 166 with 6
 // (docs/BENCHMARKS.md, "The organ in a real session"). "Lately" is the longest recent capture, decaying
-// by DECAY per capture, so that one costly capture (after a cut) keeps the next ones careful.
+// by DECAY per capture, so that one costly capture (after a cut) keeps the next ones careful; it is
+// kept per kind of capture, since one after a cut (the surface re-meshed and its embedding copied,
+// 3-7 ms on the organ) costs ten times one of the positions alone: with one estimate for both, a
+// run of cheap captures let the next costly one into a slot it overran. Until a capture after a cut
+// has been measured, its estimate is the first read of the whole surface (seed()).
 #pragma once
 
+#include "output/slot_timing.hpp"
 #include "sync/realtime_clock.hpp"
 
 #include <algorithm>
+#include <array>
+#include <cstddef>
 
 namespace tissue::host {
 
@@ -21,22 +28,28 @@ class FrameBudget {
   static constexpr int MAX_DEFERRALS = 10;
   static constexpr double DECAY = 0.9;
 
+  /// The estimate of `kind` before any capture of it (>= 0).
+  void seed(CaptureKind kind, Nanoseconds estimate) { estimate_of(kind) = std::max<Nanoseconds>(estimate, 0); }
   /// Whether to capture now, `now` being when the step ended and `slot_end` when its slot ends.
-  [[nodiscard]] bool capture_now(Nanoseconds now, Nanoseconds slot_end) const {
-    return m_deferred_in_row >= MAX_DEFERRALS || now + m_capture_estimate_ns <= slot_end;
+  [[nodiscard]] bool capture_now(Nanoseconds now, Nanoseconds slot_end, CaptureKind kind) const {
+    return m_deferred_in_row >= MAX_DEFERRALS || now + capture_estimate_ns(kind) <= slot_end;
   }
-  /// A capture took `took` (>= 0).
-  void captured(Nanoseconds took) {
-    m_capture_estimate_ns =
-        std::max(took, static_cast<Nanoseconds>(DECAY * static_cast<double>(m_capture_estimate_ns)));
+  /// A capture of `kind` took `took` (>= 0).
+  void captured(Nanoseconds took, CaptureKind kind) {
+    Nanoseconds& estimate = estimate_of(kind);
+    estimate = std::max(took, static_cast<Nanoseconds>(DECAY * static_cast<double>(estimate)));
     m_deferred_in_row = 0;
   }
   /// A due frame was left to a later slot.
   void deferred() { ++m_deferred_in_row; }
-  [[nodiscard]] Nanoseconds capture_estimate_ns() const { return m_capture_estimate_ns; }
+  [[nodiscard]] Nanoseconds capture_estimate_ns(CaptureKind kind) const {
+    return m_estimate_ns[static_cast<std::size_t>(kind)];
+  }
 
  private:
-  Nanoseconds m_capture_estimate_ns = 0;
+  Nanoseconds& estimate_of(CaptureKind kind) { return m_estimate_ns[static_cast<std::size_t>(kind)]; }
+
+  std::array<Nanoseconds, 2> m_estimate_ns{};
   int m_deferred_in_row = 0;
 };
 

@@ -2,6 +2,7 @@
 #include "schedule/realtime_schedule.hpp"
 
 #include "schedule/frame_budget.hpp"
+#include "schedule/memory_reserve.hpp"
 #include "sync/frame_pipe.hpp"
 #include "sync/realtime_clock.hpp"
 
@@ -16,6 +17,8 @@
 
 namespace tissue::host {
 namespace {
+
+double ms_between(Nanoseconds from, Nanoseconds to) { return static_cast<double>(to - from) / 1e6; }
 
 // What the two real-time threads and the calling thread share during a run.
 struct RealtimeRun {
@@ -42,6 +45,8 @@ class RealtimeScheduler {
  private:
   void haptic_thread(RealtimeRun& run);
   void dynamics_thread(RealtimeRun& run, FramePipe& pipe);
+  void record_frame(FramePipe& pipe, FrameBudget& frames, Nanoseconds slot_end, double tissue_time_s,
+                    SlotTiming& timing);
 
   SessionSteps& m_steps;
   const Schedule& m_schedule;
@@ -89,41 +94,71 @@ void RealtimeScheduler::haptic_thread(RealtimeRun& run) {
   run.haptic_done.store(true, std::memory_order_release);
 }
 
+// The recording's due frame after a step, whose slot(s) end at `slot_end`: captured in the time the
+// step left, else left to a later slot (FrameBudget), or dropped when the writer has no free buffer.
+void RealtimeScheduler::record_frame(FramePipe& pipe, FrameBudget& frames, Nanoseconds slot_end, double tissue_time_s,
+                                     SlotTiming& timing) {
+  const CaptureKind kind = m_steps.frame_remeshed() ? CaptureKind::remeshed : CaptureKind::positions;
+  timing.capture_kind = kind;
+  const Nanoseconds ended = now_ns();
+  if (!frames.capture_now(ended, slot_end, kind)) {
+    frames.deferred();
+    ++m_summary.frames_deferred;
+    timing.frame = SlotFrame::deferred;
+  } else if (auto frame = pipe.take_free()) {
+    m_steps.capture_frame(*frame, tissue_time_s);
+    const Nanoseconds took = now_ns() - ended;
+    frames.captured(took, kind);
+    pipe.push_filled(std::move(frame));
+    timing.frame = SlotFrame::captured;
+    timing.capture_ms = static_cast<double>(took) / 1e6;
+  } else {
+    ++m_summary.frames_dropped;
+    m_steps.frame_dropped();
+    timing.frame = SlotFrame::dropped;
+  }
+}
+
 // The dynamics thread: a tissue step per slot, the overrun policy when one takes longer.
 void RealtimeScheduler::dynamics_thread(RealtimeRun& run, FramePipe& pipe) {
-  if (m_options.realtime_priority) run.dynamics_priority = try_fifo_priority(70);
+  if (m_options.realtime_priority) {
+    run.dynamics_priority = try_fifo_priority(70);
+    touch_heap(DYNAMICS_HEAP_RESERVE_BYTES);  // locked with the rest by run()
+  }
   run.ready.fetch_add(1);
   run.go.wait(false, std::memory_order_acquire);  // blocked, not spinning: see run()
   const Nanoseconds slot = to_ns(m_schedule.slot_s);
   const std::uint64_t slots_total = m_schedule.slots();
   FrameBudget frames;    // due frames captured in the time the steps leave over
+  frames.seed(CaptureKind::remeshed, to_ns(m_steps.first_surface_read_s()));
   std::uint64_t k = 0;  // the slot this step starts in
   int slots = 1;        // slots this step covers
   double tissue_time_s = 0.0;
   while (k < slots_total && !run.haptic_done.load(std::memory_order_acquire) && !m_steps.tissue_failed()) {
     sleep_until_ns(run.start + static_cast<Nanoseconds>(k) * slot);
     slots = static_cast<int>(std::min<std::uint64_t>(static_cast<std::uint64_t>(slots), slots_total - k));
+    const Nanoseconds slot_begin = run.start + static_cast<Nanoseconds>(k) * slot;
+    SlotTiming timing{k, slots};
+    const Nanoseconds began = now_ns();
     tissue_time_s = m_steps.tissue_step(tissue_time_s, slots);
+    const Nanoseconds stepped = now_ns();
     m_steps.publish_tissue_sample();
     m_steps.tissue_sample_published(tissue_time_s);
-    if (m_steps.frame_due(tissue_time_s)) {
-      const Nanoseconds slot_end = run.start + static_cast<Nanoseconds>(k + static_cast<std::uint64_t>(slots)) * slot;
-      if (const Nanoseconds ended = now_ns(); !frames.capture_now(ended, slot_end)) {
-        frames.deferred();
-        ++m_summary.frames_deferred;
-      } else if (auto frame = pipe.take_free()) {
-        m_steps.capture_frame(*frame, tissue_time_s);
-        frames.captured(now_ns() - ended);
-        pipe.push_filled(std::move(frame));
-      } else {
-        ++m_summary.frames_dropped;
-        m_steps.frame_dropped();
-      }
-    }
+    const Nanoseconds sampled = now_ns();
     k += static_cast<std::uint64_t>(slots);
     slots = 1;
+    if (m_steps.frame_due(tissue_time_s)) {
+      record_frame(pipe, frames, run.start + static_cast<Nanoseconds>(k) * slot, tissue_time_s, timing);
+    }
     const Nanoseconds finished = now_ns();
     const Nanoseconds slot_end = run.start + static_cast<Nanoseconds>(k) * slot;
+    if (m_options.slot_timings != nullptr && m_options.slot_timings->size() < m_options.slot_timings->capacity()) {
+      timing.start_late_ms = ms_between(slot_begin, began);
+      timing.step_ms = ms_between(began, stepped);
+      timing.sample_ms = ms_between(stepped, sampled);
+      timing.end_after_slot_ms = ms_between(slot_end, finished);
+      m_options.slot_timings->push_back(timing);  // within the capacity run() reserved: no allocation
+    }
     if (finished > slot_end) {
       // Overrun: the step took longer than its slot(s). Never silent: counted, and handled by
       // the scenario's policy.
@@ -152,6 +187,8 @@ void RealtimeScheduler::dynamics_thread(RealtimeRun& run, FramePipe& pipe) {
 }
 
 void RealtimeScheduler::run() {
+  if (m_options.realtime_priority) keep_freed_memory();
+  if (m_options.slot_timings != nullptr) m_options.slot_timings->reserve(m_schedule.slots());
   FramePipe pipe(8);
   pipe.prepare([&](SurfaceFrame& frame) { m_steps.reserve_frame(frame); });
   RealtimeRun run;

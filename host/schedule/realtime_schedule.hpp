@@ -6,12 +6,14 @@
 
 #include "output/frame_writer.hpp"
 #include "output/session_summary.hpp"
+#include "output/slot_timing.hpp"
 #include "schedule/schedule.hpp"
 #include "schedule/session_steps.hpp"
 
 #include <atomic>
 #include <functional>
 #include <iosfwd>
+#include <vector>
 
 namespace tissue::host {
 
@@ -24,6 +26,8 @@ struct RealtimeOptions {
   const std::atomic<bool>* stop = nullptr;
   /// A progress line a second (nullptr: quiet).
   std::ostream* progress = nullptr;
+  /// Where each step's timing goes (nullptr: nowhere); reserved for every slot before the threads start.
+  std::vector<SlotTiming>* slot_timings = nullptr;
 };
 
 /// Runs `schedule` through `steps` on a haptic and a dynamics thread; due frames go to `writer`

@@ -38,6 +38,11 @@ class SessionSteps {
   // --- the recording's surface frames (tissue side) ---
   /// True when the recording wants a frame at tissue time `time_s`.
   [[nodiscard]] virtual bool frame_due(double time_s) const = 0;
+  /// Whether a capture now reads a surface re-meshed since the last one (a cut): the costly kind.
+  [[nodiscard]] virtual bool frame_remeshed() = 0;
+  /// How long the first read of the whole surface took, before the session [s]: what a capture
+  /// after a cut is expected to take until one has been measured.
+  [[nodiscard]] virtual double first_surface_read_s() const = 0;
   /// The surface, tool and contact at tissue time `time_s` into `frame` (no allocation once reserved),
   /// the surface's mapping left to complete_frame().
   virtual void capture_frame(SurfaceFrame& frame, double time_s) = 0;

@@ -10,6 +10,7 @@
 #include "output/frame_writer.hpp"
 #include "output/png_renderer.hpp"
 #include "output/session_log.hpp"
+#include "output/slot_timing.hpp"
 #include "schedule/offline_schedule.hpp"
 #include "schedule/realtime_schedule.hpp"
 #include "schedule/schedule.hpp"
@@ -128,7 +129,9 @@ class Session final : public SessionSteps {
     if (m_options.offline) {
       run_offline(*this, m_schedule, frames, m_options.progress, m_summary);
     } else {
-      run_realtime(*this, m_schedule, realtime_options(m_options), frames, m_summary);
+      RealtimeOptions realtime = realtime_options(m_options);
+      if (m_options.write_outputs) realtime.slot_timings = &m_slot_timings;
+      run_realtime(*this, m_schedule, realtime, frames, m_summary);
     }
     m_rows.resize(m_summary.haptic_ticks);  // fewer when a real-time run was stopped early
     stop_view();
@@ -254,6 +257,8 @@ class Session final : public SessionSteps {
   bool frame_due(double time_s) const override {
     return m_options.write_outputs && m_scenario.frame_rate_hz > 0.0 && time_s + 1e-9 >= m_next_frame_s;
   }
+  bool frame_remeshed() override { return m_tissue.surface_remeshed(); }
+  double first_surface_read_s() const override { return m_tissue.first_surface_read_s(); }
   void capture_frame(SurfaceFrame& frame, double time_s) override {
     fill_frame(frame, time_s, Mapping::deferred);
     // The next recorded frame is the first one due after this one (not a period past it).
@@ -334,6 +339,7 @@ class Session final : public SessionSteps {
 
     const std::filesystem::path& dir = m_options.output_dir;
     write_log(dir / "log.csv", m_rows);
+    if (!m_options.offline) write_slot_timings(dir / "slots.csv", m_slot_timings);
     if (m_options.record) write_recording(*m_options.record, m_rows);
     if (m_scenario.write_png) {
       SurfaceFrame frame;
@@ -371,6 +377,7 @@ class Session final : public SessionSteps {
   SampleSlot m_contact_slot, m_point_slot, m_force_slot, m_blade_depth_slot;
   RelaySample m_step_sample;   // dynamics thread's: the step's sample, until published
   RelaySample m_last_outputs;  // dynamics thread's: the last step's sample
+  std::vector<SlotTiming> m_slot_timings;  // real time: each step's, written as slots.csv
   std::shared_ptr<IgtlServer> m_igtl;  // [openigtlink]: the device's and the surface stream's
   std::unique_ptr<Device> m_device;
   std::unique_ptr<LiveView> m_view;          // --view

@@ -404,6 +404,33 @@ TEST(RealTime, BothThreadsRunAShortSessionOnTheirDeadlines) {
   std::size_t rows = 0;
   while (std::getline(log, line)) ++rows;
   EXPECT_EQ(rows, 601u);
+  // slots.csv: a row per tissue step, saying slot by slot what the summary counts (whatever the
+  // machine's load: the same run's two accounts of its overruns and frames agree).
+  std::ifstream slots(options.output_dir / "slots.csv");
+  ASSERT_TRUE(std::getline(slots, line));
+  EXPECT_EQ(line, "slot,slots,start_late_ms,step_ms,sample_ms,frame,capture_ms,end_after_slot_ms");
+  std::uint64_t steps = 0, overruns = 0, captured = 0, deferred = 0, last_slot = 0;
+  while (std::getline(slots, line)) {
+    std::vector<std::string> fields;
+    std::stringstream row(line);
+    for (std::string field; std::getline(row, field, ',');) fields.push_back(field);
+    if (line.back() == ',') fields.emplace_back();
+    ASSERT_EQ(fields.size(), 8u) << line;
+    const std::uint64_t slot = std::stoull(fields[0]);
+    if (steps > 0) {
+      EXPECT_GT(slot, last_slot) << line;
+    }
+    last_slot = slot;
+    ++steps;
+    EXPECT_GE(std::stod(fields[3]), 0.0) << line;
+    overruns += std::stod(fields[7]) > 0.0 ? 1 : 0;
+    captured += fields[5].rfind("captured", 0) == 0 ? 1 : 0;
+    deferred += fields[5].rfind("deferred", 0) == 0 ? 1 : 0;
+  }
+  EXPECT_EQ(steps, s.tissue_steps);
+  EXPECT_EQ(overruns, s.tissue_overruns);
+  EXPECT_EQ(captured, s.frames_written);
+  EXPECT_EQ(deferred, s.frames_deferred);
 }
 
 TEST(RealTime, AStopRequestEndsTheRunWithItsOutputs) {
