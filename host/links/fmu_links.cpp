@@ -146,11 +146,13 @@ void TissueLink::reserve(SurfaceFrame& frame) const {
   frame.node_positions_m.reserve(2 * 3 * m_embedding->node_count);
 }
 
-bool TissueLink::surface_remeshed() {
+std::uint64_t TissueLink::surface_revision() {
   fmi3UInt64 revision = 0;
   (void)m_instance.get_uint64(std::span(&m_revision, 1), std::span(&revision, 1));
-  return !m_embedding_bytes || revision != m_embedding_revision;
+  return revision;
 }
+
+bool TissueLink::surface_remeshed() { return !m_embedding_bytes || surface_revision() != m_embedding_revision; }
 
 void TissueLink::read_surface(SurfaceFrame& frame) {
   read_surface_unmapped(frame);
@@ -168,8 +170,7 @@ void TissueLink::read_surface_unmapped(SurfaceFrame& frame) {
     return std::span<const std::uint8_t>(bytes, size);
   };
   try {
-    fmi3UInt64 revision = 0;
-    (void)m_instance.get_uint64(std::span(&m_revision, 1), std::span(&revision, 1));
+    const std::uint64_t revision = surface_revision();
     if (!m_embedding_bytes || revision != m_embedding_revision) {
       m_embedding_bytes = m_embedding_copies.copy(binary(m_embedding_vr, "surface.embedding"));
       m_embedding_revision = revision;

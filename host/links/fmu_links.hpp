@@ -72,8 +72,8 @@ class TissueLink {
   void read_surface(SurfaceFrame& frame);
   /// The same without the mapping, for a consumer in another thread (SurfaceMapping::complete): the
   /// embedding's bytes (copied when surface.revision changes, into a buffer no frame holds any more:
-  /// RecycledBytes) and the nodes. Issue 42: after a cut
-  /// the decode and the mapping of the organ's fine surface took 1.5-2.5 ms of the step's slot.
+  /// RecycledBytes) and the nodes. Issue 42: after a cut the decode and the mapping of the organ's
+  /// fine surface took 1.5-2.5 ms of the step's slot.
   void read_surface_unmapped(SurfaceFrame& frame);
   /// Whether surface.revision moved since the embedding was last read (a cut re-meshed the surface:
   /// the next read copies the embedding).
@@ -89,6 +89,8 @@ class TissueLink {
   [[nodiscard]] Fmu3Instance& instance() { return m_instance; }
 
  private:
+  [[nodiscard]] std::uint64_t surface_revision();  // the Tissue's surface.revision now
+
   Fmu3Instance m_instance;
   fmi3ValueReference m_tool_position, m_tool_orientation, m_tool_mode;
   fmi3ValueReference m_revision, m_embedding_vr, m_nodes_vr, m_cut_tets, m_enriched;
