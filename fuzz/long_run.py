@@ -105,11 +105,15 @@ def run(args):
                 if used < budget:
                     continue
                 process.send_signal(signal.SIGINT)
+                stopped = True
+            else:
+                stopped = False
             process.wait()
             executions, edges, features = final_stats(log_path.read_text(errors="replace"))
             with open(ledger, "a") as out:
-                out.write("%s\t%.0f\t%d\t%d\t%d\t%s\texit %d\n" % (door, used, executions, edges, features,
-                                                                   datetime.date.today(), process.returncode))
+                ended = "its budget" if stopped else "exit %d (a finding: WORK/art)" % process.returncode
+                out.write("%s\t%.0f\t%d\t%d\t%d\t%s\t%s\n" % (door, used, executions, edges, features,
+                                                             datetime.date.today(), ended))
             print("%s %s: %.0f s of CPU, %d executions, %d edges, exit %d" % (
                 time.strftime("%T"), door, used, executions, edges, process.returncode), flush=True)
             del running[door]
