@@ -9,7 +9,8 @@ executions, edges, features, the date) already holds for it, so a run stopped ea
 end) is continued by running the same command again. CPU time, not wall time: the machine may
 build or measure meanwhile (stop the targets with SIGSTOP while timing something; SIGCONT after).
 
-Wall-clock pauses (SIGSTOP, a build at nice 0) would read as hangs under -timeout=1, so the runs use
+Stop early with SIGINT to the targets (`pkill -INT -f build/fuzz/fuzz/fuzz_`): each run is written to the
+ledger as interrupted, with the CPU it used. Wall-clock pauses (SIGSTOP, a build at nice 0) would read as hangs under -timeout=1, so the runs use
 -timeout=60 and --replay runs every slow or timed-out input kept in WORK/art again under -timeout=1
 (with -runs=3): a real hang fails there.
 
@@ -109,9 +110,12 @@ def run(args):
             else:
                 stopped = False
             process.wait()
+            # libFuzzer exits 72 when interrupted: by us at the budget, or by a SIGINT from outside (a stop)
+            interrupted = process.returncode == 72
             executions, edges, features = final_stats(log_path.read_text(errors="replace"))
             with open(ledger, "a") as out:
-                ended = "its budget" if stopped else "exit %d (a finding: WORK/art)" % process.returncode
+                ended = ("its budget" if stopped else "interrupted" if interrupted
+                         else "exit %d (a finding: WORK/art)" % process.returncode)
                 out.write("%s\t%.0f\t%d\t%d\t%d\t%s\t%s\n" % (door, used, executions, edges, features,
                                                              datetime.date.today(), ended))
             print("%s %s: %.0f s of CPU, %d executions, %d edges, exit %d" % (
