@@ -152,7 +152,7 @@ std::uint64_t TissueLink::surface_revision() {
   return revision;
 }
 
-bool TissueLink::surface_remeshed() { return !m_embedding_bytes || surface_revision() != m_embedding_revision; }
+bool TissueLink::surface_remeshed() { return !embedding_read_at(surface_revision()); }
 
 void TissueLink::read_surface(SurfaceFrame& frame) {
   read_surface_unmapped(frame);
@@ -171,7 +171,7 @@ void TissueLink::read_surface_unmapped(SurfaceFrame& frame) {
   };
   try {
     const std::uint64_t revision = surface_revision();
-    if (!m_embedding_bytes || revision != m_embedding_revision) {
+    if (!embedding_read_at(revision)) {
       m_embedding_bytes = m_embedding_copies.copy(binary(m_embedding_vr, "surface.embedding"));
       m_embedding_revision = revision;
     }

@@ -90,6 +90,10 @@ class TissueLink {
 
  private:
   [[nodiscard]] std::uint64_t surface_revision();  // the Tissue's surface.revision now
+  /// Whether the embedding's bytes held are those of surface revision `revision`.
+  [[nodiscard]] bool embedding_read_at(std::uint64_t revision) const {
+    return m_embedding_bytes && revision == m_embedding_revision;
+  }
 
   Fmu3Instance m_instance;
   fmi3ValueReference m_tool_position, m_tool_orientation, m_tool_mode;

@@ -107,11 +107,11 @@ void RealtimeScheduler::record_frame(FramePipe& pipe, FrameBudget& frames, Nanos
     timing.frame = SlotFrame::deferred;
   } else if (auto frame = pipe.take_free()) {
     m_steps.capture_frame(*frame, tissue_time_s);
-    const Nanoseconds took = now_ns() - ended;
-    frames.captured(took, kind);
+    const Nanoseconds captured = now_ns();
+    frames.captured(captured - ended, kind);
     pipe.push_filled(std::move(frame));
     timing.frame = SlotFrame::captured;
-    timing.capture_ms = static_cast<double>(took) / 1e6;
+    timing.capture_ms = ms_between(ended, captured);
   } else {
     ++m_summary.frames_dropped;
     m_steps.frame_dropped();
@@ -135,9 +135,9 @@ void RealtimeScheduler::dynamics_thread(RealtimeRun& run, FramePipe& pipe) {
   int slots = 1;        // slots this step covers
   double tissue_time_s = 0.0;
   while (k < slots_total && !run.haptic_done.load(std::memory_order_acquire) && !m_steps.tissue_failed()) {
-    sleep_until_ns(run.start + static_cast<Nanoseconds>(k) * slot);
-    slots = static_cast<int>(std::min<std::uint64_t>(static_cast<std::uint64_t>(slots), slots_total - k));
     const Nanoseconds slot_begin = run.start + static_cast<Nanoseconds>(k) * slot;
+    sleep_until_ns(slot_begin);
+    slots = static_cast<int>(std::min<std::uint64_t>(static_cast<std::uint64_t>(slots), slots_total - k));
     SlotTiming timing{k, slots};
     const Nanoseconds began = now_ns();
     tissue_time_s = m_steps.tissue_step(tissue_time_s, slots);
@@ -147,11 +147,9 @@ void RealtimeScheduler::dynamics_thread(RealtimeRun& run, FramePipe& pipe) {
     const Nanoseconds sampled = now_ns();
     k += static_cast<std::uint64_t>(slots);
     slots = 1;
-    if (m_steps.frame_due(tissue_time_s)) {
-      record_frame(pipe, frames, run.start + static_cast<Nanoseconds>(k) * slot, tissue_time_s, timing);
-    }
+    const Nanoseconds slot_end = run.start + static_cast<Nanoseconds>(k) * slot;  // of the slots covered
+    if (m_steps.frame_due(tissue_time_s)) record_frame(pipe, frames, slot_end, tissue_time_s, timing);
     const Nanoseconds finished = now_ns();
-    const Nanoseconds slot_end = run.start + static_cast<Nanoseconds>(k) * slot;
     if (m_options.slot_timings != nullptr && m_options.slot_timings->size() < m_options.slot_timings->capacity()) {
       timing.start_late_ms = ms_between(slot_begin, began);
       timing.step_ms = ms_between(began, stepped);
