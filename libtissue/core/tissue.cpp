@@ -1,6 +1,7 @@
 // The Tissue facade: its parts composed, one step as a short list of calls, and its saved state.
 #include "core/tissue.hpp"
 
+#include "core/mesh/mesh_io.hpp"
 #include "core/tissue_settings_schema.hpp"
 
 #include <algorithm>
@@ -230,6 +231,12 @@ void Tissue::restore(const TissueSnapshot& snapshot) {
   if (!dynamics.displacement_m.allFinite() || !dynamics.velocity_m_per_s.allFinite() ||
       !std::isfinite(dynamics.time_s)) {
     throw StateError("the state holds a non-finite displacement, velocity or time");
+  }
+  // Bounded as mesh coordinates are: beyond, the elements' deformation overflows (found by fuzzing).
+  if (dynamics.displacement_m.cwiseAbs().maxCoeff() > MAX_ABS_COORDINATE ||
+      dynamics.velocity_m_per_s.cwiseAbs().maxCoeff() > MAX_ABS_COORDINATE) {
+    throw StateError("the state holds a displacement beyond +-1e6 m or a velocity beyond +-1e6 m/s "
+                     "(MAX_ABS_COORDINATE)");
   }
   const ToolKinematics::State tool{snapshot.tool, snapshot.previous_tool, snapshot.applied_tool_position_m};
   ToolKinematics::check(tool);

@@ -215,7 +215,8 @@ class Tissue {
   }
   /// Restores a snapshot of this model: in place when has_cuts_of(snapshot), by replaying the cuts
   /// when nothing was cut here yet (a fresh instance). Throws StateError unless can_restore(), or
-  /// when the snapshot is of another model or inconsistent; the instance is then unchanged, except
+  /// when the snapshot is of another model or inconsistent (a displacement or velocity beyond
+  /// +-MAX_ABS_COORDINATE [m, m/s] included); the instance is then unchanged, except
   /// when the replay of cuts into a fresh instance fails (discard it).
   void restore(const TissueSnapshot& snapshot);
 

@@ -421,5 +421,42 @@ TEST(TissueState, RefusesWhatItCannotRestoreAndKeepsItsState) {
   expect_kept();
 }
 
+// A finite state the elements cannot take (found by fuzzing the FMU's state, issue 44: one unknown at
+// 1e300 m restored, and the next step's stiffness was NaN): displacements and velocities are bounded
+// as mesh coordinates are (MAX_ABS_COORDINATE, per second for a velocity) and refused beyond; a state
+// far out but within the bound restores and steps on with a finite state.
+TEST(TissueState, RefusesDisplacementsAndVelocitiesBeyondTheLargestCoordinate) {
+  const TetMesh mesh = frog();
+  Session session(mesh);
+  Tissue tissue(mesh, frog_settings(mesh));
+  session.set_top(top_of_back(tissue, session));
+  run(tissue, session, 0, 30);
+  TissueSnapshot saved;
+  tissue.save(saved);
+  const DynamicState kept = tissue.state();
+  const Eigen::Index free_row = saved.dynamics.displacement_m.size() - 1;
+  for (const auto& poison : std::vector<std::function<void(TissueSnapshot&)>>{
+           [&](TissueSnapshot& s) { s.dynamics.displacement_m(free_row) = 1e300; },
+           [&](TissueSnapshot& s) { s.dynamics.displacement_m(free_row) = -2.0 * MAX_ABS_COORDINATE; },
+           [&](TissueSnapshot& s) { s.dynamics.velocity_m_per_s(free_row) = 1e300; },
+           [&](TissueSnapshot& s) { s.dynamics.velocity_m_per_s(free_row) = -2.0 * MAX_ABS_COORDINATE; }}) {
+    TissueSnapshot poisoned = saved;
+    poison(poisoned);
+    EXPECT_THROW(tissue.restore(deserialize_snapshot(serialize_snapshot(poisoned))), StateError);
+    EXPECT_TRUE(bitwise_equal(tissue.state().displacement_m, kept.displacement_m));
+  }
+  for (const double far_m : {0.5, 1e3, 0.5 * MAX_ABS_COORDINATE}) {
+    TissueSnapshot far = saved;
+    far.dynamics.displacement_m(free_row) = far_m;
+    far.dynamics.velocity_m_per_s(free_row) = -far_m;
+    tissue.restore(far);
+    for (int n = 0; n < 3; ++n) {
+      tissue.set_tool(session.pose(20));
+      EXPECT_NO_THROW(tissue.step()) << far_m;
+      EXPECT_TRUE(tissue.state().displacement_m.allFinite()) << far_m;
+    }
+  }
+}
+
 }  // namespace
 }  // namespace tissue
