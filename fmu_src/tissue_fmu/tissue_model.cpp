@@ -142,6 +142,8 @@ std::unique_ptr<Tissue> make_tissue(const TissueParameters& parameters, const st
 }
 
 void TissueModel::build() {
+  settle();
+  m_encoded_embedding.reset();
   const TissueParameters parameters = tissue_parameters(m_values);
   m_tissue = make_tissue(parameters, m_context.resource_path);
   m_tissue->set_tool(tool_pose(m_values));
@@ -238,6 +240,39 @@ void TissueModel::drawn_nodes(ports::SurfaceNodes& nodes) {
   nodes.positions_m = drawn_mesh().positions_m;
 }
 
+const std::vector<std::uint8_t>& TissueModel::embedding_bytes(bool mesh_output) {
+  if (m_encoded_embedding && m_encoded_embedding->revision == m_surface_revision &&
+      m_encoded_embedding->mesh_output == mesh_output) {
+    return m_embedding_bytes;
+  }
+  m_encoded_embedding.reset();
+  if (mesh_output) {
+    drawn_embedding(m_embedding);
+  } else {
+    m_embedding = ports::SurfaceEmbedding{};
+    m_embedding.revision = m_surface_revision;
+  }
+  ports::encode(m_embedding, m_embedding_bytes);
+  m_encoded_embedding = EncodedEmbedding{m_surface_revision, mesh_output};
+  return m_embedding_bytes;
+}
+
+void TissueModel::prepare_surface() {
+  const bool mesh_output = m_values.boolean(vr(Vr::mesh_output_enabled));
+  if (!m_values.boolean(vr(Vr::surface_prepare)) || !mesh_output) return;
+  if (m_encoded_embedding && m_encoded_embedding->revision == m_surface_revision) return;
+  // The job reads the tissue (const) and writes the render surface's and the embedding's members,
+  // which every other call leaves alone until settle(); noexcept: a failure leaves the bytes stale,
+  // so the read that follows computes them again and reports it.
+  m_surface_work.start([this] {
+    try {
+      (void)embedding_bytes(true);
+    } catch (...) {
+      m_encoded_embedding.reset();
+    }
+  });
+}
+
 void TissueModel::ensure_built() {
   if (m_dirty || !m_tissue) build();
 }
@@ -254,6 +289,7 @@ void TissueModel::update_surface_counters() {
 }
 
 void TissueModel::warn_if_arrays_truncate() {
+  settle();
   if (!m_values.boolean(vr(Vr::mesh_output_enabled)) || m_capacity_warned) return;
   const ports::SurfaceMesh& drawn = drawn_mesh();
   const std::uint64_t vertices = drawn.positions_m.size() / 3;
@@ -275,6 +311,7 @@ void TissueModel::enter_initialization_mode(double start_time_s) { m_start_time_
 void TissueModel::exit_initialization_mode() { ensure_built(); }
 
 fmi3::StepOutcome TissueModel::do_step(double current_time_s, double step_s) {
+  settle();
   Tissue& tissue = *m_tissue;
   const double now = m_start_time_s + tissue.time_s();
   const long count = fmi3::whole_internal_steps(now, current_time_s, step_s, tissue.settings().step_size_s);
@@ -309,10 +346,13 @@ fmi3::StepOutcome TissueModel::do_step(double current_time_s, double step_s) {
   }
   update_surface_counters();
   log_events();
+  prepare_surface();
   return {true, m_start_time_s + tissue.time_s()};
 }
 
 void TissueModel::reset() {
+  settle();
+  m_encoded_embedding.reset();
   m_start_time_s = 0.0;
   m_tissue.reset();
   m_dirty = true;
@@ -359,6 +399,7 @@ void TissueModel::get_float64(const VariableInfo& info, std::span<double> out) {
       out[0] = tissue.kinetic_energy_j();
       return;
     case Vr::elastic_energy:
+      settle();  // not const: the body's scratch
       out[0] = tissue.elastic_energy_j();
       return;
     case Vr::blade_depth:
@@ -368,6 +409,7 @@ void TissueModel::get_float64(const VariableInfo& info, std::span<double> out) {
       put3(tissue.applied_tool_position_m());
       return;
     case Vr::vertex_positions: {
+      settle();
       std::fill(out.begin(), out.end(), 0.0);
       if (!m_values.boolean(vr(Vr::mesh_output_enabled))) return;
       warn_if_arrays_truncate();
@@ -383,6 +425,7 @@ void TissueModel::get_float64(const VariableInfo& info, std::span<double> out) {
 void TissueModel::get_uint32(const VariableInfo& info, std::span<std::uint32_t> out) {
   if (static_cast<Vr>(info.vr) != Vr::triangles) Model::get_uint32(info, out);
   ensure_built();
+  settle();
   std::fill(out.begin(), out.end(), 0U);
   if (!m_values.boolean(vr(Vr::mesh_output_enabled))) return;
   warn_if_arrays_truncate();
@@ -397,7 +440,9 @@ void TissueModel::get_uint64(const VariableInfo& info, std::span<std::uint64_t> 
   const bool mesh_out = m_values.boolean(vr(Vr::mesh_output_enabled));
   // The drawn surface is brought up to date only for the variables that count it: reading the cut
   // counters after a step re-meshes and maps nothing.
-  switch (static_cast<Vr>(info.vr)) {
+  const Vr which = static_cast<Vr>(info.vr);
+  if (which == Vr::vertex_count || which == Vr::triangle_count || which == Vr::cut_triangle_count) settle();
+  switch (which) {
     case Vr::vertex_count:
       warn_if_arrays_truncate();
       out[0] = mesh_out ? std::min<std::uint64_t>(drawn_mesh().positions_m.size() / 3, m_values.uint64(vr(Vr::vertex_capacity))) : 0;
@@ -439,6 +484,7 @@ void TissueModel::get_boolean(const VariableInfo& info, std::span<bool> out) {
 
 std::span<const std::uint8_t> TissueModel::get_binary(const VariableInfo& info) {
   ensure_built();
+  settle();
   const bool mesh_out = m_values.boolean(vr(Vr::mesh_output_enabled));
   switch (static_cast<Vr>(info.vr)) {
     case Vr::surface_mesh: {
@@ -447,14 +493,7 @@ std::span<const std::uint8_t> TissueModel::get_binary(const VariableInfo& info) 
       return m_mesh_bytes;
     }
     case Vr::surface_embedding:
-      if (mesh_out) {
-        drawn_embedding(m_embedding);
-      } else {
-        m_embedding = ports::SurfaceEmbedding{};
-        m_embedding.revision = m_surface_revision;
-      }
-      ports::encode(m_embedding, m_embedding_bytes);
-      return m_embedding_bytes;
+      return embedding_bytes(mesh_out);
     case Vr::surface_nodes:
       if (mesh_out) {
         drawn_nodes(m_nodes);
@@ -472,6 +511,7 @@ std::span<const std::uint8_t> TissueModel::get_binary(const VariableInfo& info) 
 // --- FMU states ---
 
 std::unique_ptr<fmi3::ModelState> TissueModel::save() const {
+  settle();
   if (!m_tissue || m_dirty) throw VariableError("get FMU state: there is no model state before the model is built");
   auto state = std::make_unique<TissueState>();
   m_tissue->save(state->tissue);
@@ -484,6 +524,8 @@ void TissueModel::restore(const fmi3::ModelState& model_state) {
   const auto* state = dynamic_cast<const TissueState*>(&model_state);
   if (state == nullptr) throw VariableError("set FMU state: not a Tissue FMU state");
   ensure_built();
+  settle();
+  m_encoded_embedding.reset();  // the restored revision may number another surface
   try {
     restore_or_replay(m_tissue, state->tissue);
   } catch (const StateError& error) {

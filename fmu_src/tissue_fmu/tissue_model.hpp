@@ -5,12 +5,14 @@
 
 #include "core/mesh/tet_mesh.hpp"
 #include "core/tissue.hpp"
+#include "tissue_fmu/background_work.hpp"
 #include "fmi3/model.hpp"
 #include "ports/surface_binary.hpp"
 #include "tissue_fmu/variables.hpp"
 
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <span>
 #include <string>
 #include <vector>
@@ -37,7 +39,10 @@ class TissueModel final : public fmi3::Model {
   TissueModel(const fmi3::ModelContext& context, const fmi3::ValueStore& values);
 
   void validate_parameters(const fmi3::ValueStore& values) const override;
-  void parameters_changed() override { m_dirty = true; }
+  void parameters_changed() override {
+    settle();
+    m_dirty = true;
+  }
   void enter_initialization_mode(double start_time_s) override;
   void exit_initialization_mode() override;
   fmi3::StepOutcome do_step(double current_time_s, double step_s) override;
@@ -69,6 +74,14 @@ class TissueModel final : public fmi3::Model {
   const ports::SurfaceMesh& drawn_mesh();
   void drawn_embedding(ports::SurfaceEmbedding& embedding);
   void drawn_nodes(ports::SurfaceNodes& nodes);
+  /// surface.embedding's bytes for the current revision (encoded once per revision and output switch).
+  const std::vector<std::uint8_t>& embedding_bytes(bool mesh_output);
+  /// After a step: when surface.prepareAfterStep is set and the revision changed, embedding_bytes()
+  /// in the background (m_surface_work).
+  void prepare_surface();
+  /// Waits for the background preparation; every call that reads or changes the tissue beyond the
+  /// contact outputs and the counters calls this first.
+  void settle() const { m_surface_work.wait(); }
 
   fmi3::ModelContext m_context;
   const fmi3::ValueStore& m_values;
@@ -84,7 +97,15 @@ class TissueModel final : public fmi3::Model {
   ports::SurfaceEmbedding m_embedding;     // scratch of get_binary
   ports::SurfaceNodes m_nodes;             // scratch of get_binary
   std::vector<std::uint8_t> m_mesh_bytes, m_embedding_bytes, m_nodes_bytes;
+  // What m_embedding_bytes hold: the surface of this revision, with the output switch so (none: stale).
+  struct EncodedEmbedding {
+    std::uint64_t revision = 0;
+    bool mesh_output = false;
+  };
+  std::optional<EncodedEmbedding> m_encoded_embedding;
   bool m_capacity_warned = false;
+  // Last: destroyed first, so that a job still running ends before the members it uses.
+  mutable BackgroundWork m_surface_work;
 };
 
 }  // namespace tissue::tissue_fmu

@@ -35,6 +35,7 @@ enum class Vr : std::uint32_t {
   tool_position = 30,
   tool_orientation = 31,
   tool_mode = 32,
+  surface_prepare = 33,
   // outputs
   contact_active = ports::sample_field("contact.active").tissue_vr,
   contact_near = ports::sample_field("contact.near").tissue_vr,
@@ -140,7 +141,7 @@ constexpr auto structural_parameters() {
 });
 }
 
-/// The tool pose and mode (30-32).
+/// The tool pose and mode, and the surface's preparation (30-33).
 constexpr auto inputs() {
   using namespace fmi3;  // NOLINT(google-build-using-namespace): the table reads as the XML
   using enum VariableType;
@@ -162,6 +163,11 @@ constexpr auto inputs() {
         .declared_type("ToolMode")
         .start("0")
         .describe("What the tool does: none, probe or scalpel"),
+    input(Vr::surface_prepare, "surface.prepareAfterStep", boolean, discrete)
+        .start("false")
+        .describe("When true at a doStep that changes the surface's topology (a cut), the FMU prepares "
+                  "surface.embedding after the step in a thread of normal priority, so that a real-time "
+                  "importer reading it in its next slot finds it ready; every other call waits for it"),
 });
 }
 

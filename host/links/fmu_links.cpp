@@ -4,7 +4,6 @@
 #include "importer/fmu_error.hpp"
 
 #include <algorithm>
-#include <chrono>
 #include <limits>
 
 namespace tissue::host {
@@ -98,6 +97,9 @@ TissueLink::TissueLink(const Fmu3& fmu, const std::vector<ParameterSetting>& par
       m_nodes_vr(vr(m_instance, "surface.nodes")),
       m_cut_tets(vr(m_instance, "cutTets")),
       m_enriched(vr(m_instance, "enrichedVertices")) {
+  if (const auto* prepare = m_instance.description().find_variable("surface.prepareAfterStep")) {
+    m_prepare_vr = prepare->value_reference;
+  }
   apply_parameters(m_instance, parameters, "tissue.parameters");
   expect_ok(m_instance.enter_initialization_mode(std::nullopt, 0.0, std::nullopt), m_instance,
             "Tissue: enter initialization mode");
@@ -108,9 +110,7 @@ TissueLink::TissueLink(const Fmu3& fmu, const std::vector<ParameterSetting>& par
   // The box of the nodes at rest: the tet mesh's vertices whichever surface is drawn (a render
   // surface lies within the tets), so that a scenario's tool path is the same for both.
   SurfaceFrame rest;
-  const auto read_begin = std::chrono::steady_clock::now();
   read_surface(rest);
-  m_first_surface_read_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - read_begin).count();
   m_rest_lower.fill(std::numeric_limits<double>::infinity());
   m_rest_upper.fill(-std::numeric_limits<double>::infinity());
   for (std::size_t i = 0; i < rest.node_positions_m.size(); ++i) {
@@ -127,6 +127,12 @@ void TissueLink::set_tool(const ToolCommand& tool) {
   (void)m_instance.set_float64(vrs, values);
   const std::array<fmi3Int64, 1> mode{tool.mode};
   (void)m_instance.set_int64(std::span<const fmi3ValueReference>(&m_tool_mode, 1), mode);
+}
+
+void TissueLink::prepare_surface_after_step(bool prepare) {
+  if (!m_prepare_vr || prepare == m_prepare) return;
+  const std::array<fmi3Boolean, 1> value{prepare};
+  if (m_instance.set_boolean(std::span<const fmi3ValueReference>(&*m_prepare_vr, 1), value) == fmi3OK) m_prepare = prepare;
 }
 
 DoStepResult TissueLink::step(double time_s, double step_s) { return m_instance.do_step(time_s, step_s); }

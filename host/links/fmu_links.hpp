@@ -16,6 +16,7 @@
 
 #include <array>
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -62,6 +63,10 @@ class TissueLink {
   TissueLink(const Fmu3& fmu, const std::vector<ParameterSetting>& parameters);
 
   void set_tool(const ToolCommand& tool);
+  /// Sets surface.prepareAfterStep for the next steps: whether a step that cuts has the FMU prepare
+  /// surface.embedding after it, in its own thread (set when a frame will be read in the next slot).
+  /// Only calls the FMU when the value changes; nothing for an FMU without the input.
+  void prepare_surface_after_step(bool prepare);
   DoStepResult step(double time_s, double step_s);
   /// The cut counters into `sample` (the relay reads the sample's fields).
   void read_counters(RelaySample& sample);
@@ -78,8 +83,6 @@ class TissueLink {
   /// Whether surface.revision moved since the embedding was last read (a cut re-meshed the surface:
   /// the next read copies the embedding).
   [[nodiscard]] bool surface_remeshed();
-  /// How long the first read of the surface (the constructor's, the whole embedding) took [s].
-  [[nodiscard]] double first_surface_read_s() const { return m_first_surface_read_s; }
   /// Gives `frame` room for twice the surface at rest, so that reading into it rarely allocates.
   void reserve(SurfaceFrame& frame) const;
   /// Axis-aligned box of the tet mesh at rest (after initialization), whichever surface is drawn.
@@ -98,6 +101,8 @@ class TissueLink {
   Fmu3Instance m_instance;
   fmi3ValueReference m_tool_position, m_tool_orientation, m_tool_mode;
   fmi3ValueReference m_revision, m_embedding_vr, m_nodes_vr, m_cut_tets, m_enriched;
+  std::optional<fmi3ValueReference> m_prepare_vr;  // surface.prepareAfterStep, when the FMU has it
+  bool m_prepare = false;                           // its value as last set
   std::shared_ptr<const std::vector<std::uint8_t>> m_embedding_bytes;  // of the last revision read
   RecycledBytes m_embedding_copies;  // m_embedding_bytes's buffers
   std::uint64_t m_embedding_revision = 0;
@@ -106,7 +111,6 @@ class TissueLink {
   ports::SurfaceNodes m_nodes;
   std::array<double, 3> m_rest_lower{}, m_rest_upper{};
   double m_blade_length_m = 0.0;
-  double m_first_surface_read_s = 0.0;
 };
 
 class HapticLink {

@@ -10,11 +10,12 @@
 namespace tissue::host {
 namespace {
 
-const char* frame_name(SlotFrame frame, CaptureKind kind) {
+const char* frame_name(SlotFrame frame, CaptureKind kind, bool before_step) {
   switch (frame) {
     case SlotFrame::none:
       return "";
     case SlotFrame::captured:
+      if (before_step) return kind == CaptureKind::remeshed ? "captured remeshed before step" : "captured before step";
       return kind == CaptureKind::remeshed ? "captured remeshed" : "captured";
     case SlotFrame::deferred:
       return kind == CaptureKind::remeshed ? "deferred remeshed" : "deferred";
@@ -38,7 +39,7 @@ void write_slot_timings(const std::filesystem::path& path, std::span<const SlotT
     line += ',';
     append_number(line, r.sample_ms);
     line += ',';
-    line += frame_name(r.frame, r.capture_kind);
+    line += frame_name(r.frame, r.capture_kind, r.frame_before_step);
     line += ',';
     append_number(line, r.capture_ms);
     line += ',';

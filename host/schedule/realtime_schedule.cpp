@@ -46,7 +46,7 @@ class RealtimeScheduler {
   void haptic_thread(RealtimeRun& run);
   void dynamics_thread(RealtimeRun& run, FramePipe& pipe);
   void record_frame(FramePipe& pipe, FrameBudget& frames, Nanoseconds slot_end, double tissue_time_s,
-                    SlotTiming& timing);
+                    FrameBudget::Point point, SlotTiming& timing);
 
   SessionSteps& m_steps;
   const Schedule& m_schedule;
@@ -94,24 +94,29 @@ void RealtimeScheduler::haptic_thread(RealtimeRun& run) {
   run.haptic_done.store(true, std::memory_order_release);
 }
 
-// The recording's due frame after a step, whose slot(s) end at `slot_end`: captured in the time the
-// step left, else left to a later slot (FrameBudget), or dropped when the writer has no free buffer.
+// The recording's due frame at `point` of a slot whose step(s) end at `slot_end` (FrameBudget says
+// whether now): captured, left to a later slot (counted after the step only), or dropped when the
+// writer has no free buffer.
 void RealtimeScheduler::record_frame(FramePipe& pipe, FrameBudget& frames, Nanoseconds slot_end, double tissue_time_s,
-                                     SlotTiming& timing) {
+                                     FrameBudget::Point point, SlotTiming& timing) {
   const CaptureKind kind = m_steps.frame_remeshed() ? CaptureKind::remeshed : CaptureKind::positions;
+  const Nanoseconds begin = now_ns();
   timing.capture_kind = kind;
-  const Nanoseconds ended = now_ns();
-  if (!frames.capture_now(ended, slot_end, kind)) {
+  if (!frames.capture_at(point, begin, slot_end, kind)) {
+    if (point == FrameBudget::Point::before_step) return;  // looked at again after the step
     frames.deferred();
     ++m_summary.frames_deferred;
     timing.frame = SlotFrame::deferred;
-  } else if (auto frame = pipe.take_free()) {
+    return;
+  }
+  timing.frame_before_step = point == FrameBudget::Point::before_step;
+  if (auto frame = pipe.take_free()) {
     m_steps.capture_frame(*frame, tissue_time_s);
     const Nanoseconds captured = now_ns();
-    frames.captured(captured - ended, kind);
+    frames.captured(captured - begin, kind);
     pipe.push_filled(std::move(frame));
     timing.frame = SlotFrame::captured;
-    timing.capture_ms = ms_between(ended, captured);
+    timing.capture_ms = ms_between(begin, captured);
   } else {
     ++m_summary.frames_dropped;
     m_steps.frame_dropped();
@@ -130,7 +135,6 @@ void RealtimeScheduler::dynamics_thread(RealtimeRun& run, FramePipe& pipe) {
   const Nanoseconds slot = to_ns(m_schedule.slot_s);
   const std::uint64_t slots_total = m_schedule.slots();
   FrameBudget frames;    // due frames captured in the time the steps leave over
-  frames.seed(CaptureKind::remeshed, to_ns(m_steps.first_surface_read_s()));
   std::uint64_t k = 0;  // the slot this step starts in
   int slots = 1;        // slots this step covers
   double tissue_time_s = 0.0;
@@ -139,19 +143,28 @@ void RealtimeScheduler::dynamics_thread(RealtimeRun& run, FramePipe& pipe) {
     sleep_until_ns(slot_begin);
     slots = static_cast<int>(std::min<std::uint64_t>(static_cast<std::uint64_t>(slots), slots_total - k));
     SlotTiming timing{k, slots};
+    const Nanoseconds woke = now_ns();
+    const Nanoseconds slot_end = run.start + static_cast<Nanoseconds>(k + static_cast<std::uint64_t>(slots)) * slot;
+    if (m_steps.frame_due(tissue_time_s)) {  // one left to this slot
+      record_frame(pipe, frames, slot_end, tissue_time_s, FrameBudget::Point::before_step, timing);
+    }
+    const double step_end_s = tissue_time_s + slots * m_schedule.slot_s;
+    m_steps.prepare_surface_after_step(m_steps.frame_due(step_end_s) && frames.worth_preparing(slot));
     const Nanoseconds began = now_ns();
     tissue_time_s = m_steps.tissue_step(tissue_time_s, slots);
     const Nanoseconds stepped = now_ns();
+    frames.stepped(stepped - began);
     m_steps.publish_tissue_sample();
     m_steps.tissue_sample_published(tissue_time_s);
     const Nanoseconds sampled = now_ns();
     k += static_cast<std::uint64_t>(slots);
     slots = 1;
-    const Nanoseconds slot_end = run.start + static_cast<Nanoseconds>(k) * slot;  // of the slots covered
-    if (m_steps.frame_due(tissue_time_s)) record_frame(pipe, frames, slot_end, tissue_time_s, timing);
+    if (timing.frame == SlotFrame::none && m_steps.frame_due(tissue_time_s)) {
+      record_frame(pipe, frames, slot_end, tissue_time_s, FrameBudget::Point::after_step, timing);
+    }
     const Nanoseconds finished = now_ns();
     if (m_options.slot_timings != nullptr && m_options.slot_timings->size() < m_options.slot_timings->capacity()) {
-      timing.start_late_ms = ms_between(slot_begin, began);
+      timing.start_late_ms = ms_between(slot_begin, woke);
       timing.step_ms = ms_between(began, stepped);
       timing.sample_ms = ms_between(stepped, sampled);
       timing.end_after_slot_ms = ms_between(slot_end, finished);

@@ -30,6 +30,10 @@ class SessionSteps {
   /// returns the tissue time reached (the last good time after a discard). Its sample waits for
   /// publish_tissue_sample().
   virtual double tissue_step(double time_s, int slots) = 0;
+  /// Real time: whether the coming steps have the Tissue prepare a re-meshed surface after them, in
+  /// the time the slot leaves idle (its surface.prepareAfterStep), for a frame read at the next
+  /// slot's start.
+  virtual void prepare_surface_after_step(bool prepare) = 0;
   /// Hands the last step's sample to the haptic side (taken at its next tick).
   virtual void publish_tissue_sample() = 0;
   /// Real time, after publish_tissue_sample() (the live view's figures and frame).
@@ -40,9 +44,6 @@ class SessionSteps {
   [[nodiscard]] virtual bool frame_due(double time_s) const = 0;
   /// Whether a capture now reads a surface re-meshed since the last one (a cut): the costly kind.
   [[nodiscard]] virtual bool frame_remeshed() = 0;
-  /// How long the first read of the whole surface took, before the session [s]: what a capture
-  /// after a cut is expected to take until one has been measured.
-  [[nodiscard]] virtual double first_surface_read_s() const = 0;
   /// The surface, tool and contact at tissue time `time_s` into `frame` (no allocation once reserved),
   /// the surface's mapping left to complete_frame().
   virtual void capture_frame(SurfaceFrame& frame, double time_s) = 0;

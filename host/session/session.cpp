@@ -236,6 +236,8 @@ class Session final : public SessionSteps {
     return out.time_s;
   }
 
+  void prepare_surface_after_step(bool prepare) override { m_tissue.prepare_surface_after_step(prepare); }
+
   void publish_tissue_sample() override {
     m_tissue_sample.write_buffer() = m_step_sample;
     m_tissue_sample.publish();
@@ -258,7 +260,6 @@ class Session final : public SessionSteps {
     return m_options.write_outputs && m_scenario.frame_rate_hz > 0.0 && time_s + 1e-9 >= m_next_frame_s;
   }
   bool frame_remeshed() override { return m_tissue.surface_remeshed(); }
-  double first_surface_read_s() const override { return m_tissue.first_surface_read_s(); }
   void capture_frame(SurfaceFrame& frame, double time_s) override {
     fill_frame(frame, time_s, Mapping::deferred);
     // The next recorded frame is the first one due after this one (not a period past it).

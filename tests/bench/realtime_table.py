@@ -15,12 +15,14 @@ scenario's runs twice over, interleaved, without and with these overrides, and p
 copy the other build's host/tissue-host and fmus/ aside as DIR/host/tissue-host and DIR/fmus/ first;
 a tissue-host takes the FMUs of ../fmus beside it).
 A scenario driven by the browser's mouse runs 5 s with the live view up and no one at it.
+The progress lines (stderr) say what each overrun's slot held (slots.csv: the step, the frame).
 Each run writes its frames to a temporary folder (Python's tempfile: TMPDIR): a render surface's VTU
 frames are 1.7 MB each, and on the 2-core VM their writeback to disk delays the haptic thread's
 wake-ups (docs/BENCHMARKS.md, Host); TMPDIR=/dev/shm measures the session without the disk.
 Uses only the Python standard library.
 """
 import argparse
+import csv
 import json
 import os
 import pathlib
@@ -63,6 +65,8 @@ def main():
                       % (scenario.stem, " (" + label + ")" if label else "", k + 1, args.runs, r["tissue_overruns"],
                          r["deadline_misses"], r["haptic_ticks"], r["tissue_step_ms"]["p99"], r["realtime_priority"]),
                       file=sys.stderr)
+                for slot in r["overrun_slots"]:
+                    print("    overrun at " + slot, file=sys.stderr)
         for label, _, _ in variants:
             rows[label].append((scenario.stem, runs[label]))
 
@@ -109,10 +113,24 @@ def run_once(host, scenario, overrides):
             if 'kind = "openigtlink"' in scenario.read_text():
                 command += ["--duration", "5"]  # the OpenIGTLink server, no client: 5 s idle
             subprocess.run(command, check=True, capture_output=True, text=True)
-            return json.loads((pathlib.Path(out) / "summary.json").read_text())
+            summary = json.loads((pathlib.Path(out) / "summary.json").read_text())
+            summary["overrun_slots"] = overrun_slots(pathlib.Path(out) / "slots.csv")
+            return summary
     finally:
         if source != scenario:
             source.unlink()
+
+
+def overrun_slots(path):
+    """What each overrun slot of slots.csv held: its slot, the step's ms, the frame and its capture's ms."""
+    if not path.exists():
+        return []
+    with path.open() as f:
+        rows = list(csv.DictReader(f))
+    return ["slot %s: step %.1f ms%s, %+.1f ms" % (r["slot"], float(r["step_ms"]),
+                                                  ", " + r["frame"] + " %.1f ms" % float(r["capture_ms"]) if r["frame"] else "",
+                                                  float(r["end_after_slot_ms"]))
+            for r in rows if float(r["end_after_slot_ms"]) > 0]
 
 
 def print_table(rows):

@@ -620,6 +620,97 @@ TEST(TissueFmu, TheRenderSurfaceIsDrawnWholeAndClosedAfterTheCut) {
   EXPECT_EQ(warnings, 1);
 }
 
+// surface.prepareAfterStep (issue 42): after a step that cuts, the FMU prepares surface.embedding in
+// a thread of its own while the importer goes on; what a read then gives is bitwise what the same
+// session gives on demand, at every step of the stroke, whatever is read in between (the contact
+// outputs and counters while the work may run, the surface arrays, which wait for it), and after a
+// restore to a state before the cut, whose revision number the cut steps had used.
+TEST(TissueFmu, ASurfacePreparedAfterTheStepIsTheSurfaceReadOnDemand) {
+  const FrogGeometry g = rest_geometry();
+  Session plain("plain"), prepared("prepared");
+  for (Session* s : {&plain, &prepared}) {
+    ASSERT_EQ(s->fmu().set_string("surface.renderSurface", {"frog"}), fmi3OK);
+    s->start();
+  }
+  ASSERT_EQ(prepared.fmu().set_boolean("surface.prepareAfterStep", {true}), fmi3OK) << prepared.fmu().log_text();
+  run(plain, g, 0, 34);
+  run(prepared, g, 0, 34);
+  ASSERT_FALSE(HasFatalFailure());
+  fmi3FMUState before_cut = nullptr;
+  ASSERT_EQ(prepared.fmu().get_fmu_state(before_cut), fmi3OK);
+  const std::vector<std::uint8_t> embedding_before_cut = binary(prepared.fmu(), "surface.embedding");
+  int remeshed = 0;
+  std::uint64_t last_revision = 0;
+  for (int n = 34; n < 60; ++n) {
+    for (Session* s : {&plain, &prepared}) {
+      drive(*s, g, n);
+      s->step();
+    }
+    ASSERT_FALSE(HasFatalFailure());
+    std::vector<double> force_plain, force_prepared;  // read while the preparation may still run
+    ASSERT_EQ(prepared.fmu().get_float64("contact.force", force_prepared), fmi3OK);
+    ASSERT_EQ(plain.fmu().get_float64("contact.force", force_plain), fmi3OK);
+    EXPECT_EQ(force_plain, force_prepared);
+    const Outputs out = prepared.outputs();
+    remeshed += out.counters.at(2) != last_revision ? 1 : 0;
+    last_revision = out.counters.at(2);
+    // The plain session reads at every step, so that it re-meshes where the prepared one does (an
+    // incremental re-mesh keeps the split points of the earlier ones: the numbering follows the reads);
+    // the prepared one skips some reads, and the next step waits for the work.
+    const std::vector<std::uint8_t> embedding = binary(plain.fmu(), "surface.embedding");
+    const std::vector<std::uint8_t> nodes = binary(plain.fmu(), "surface.nodes");
+    if (n % 3 == 0) continue;
+    EXPECT_EQ(embedding, binary(prepared.fmu(), "surface.embedding")) << "step " << n;
+    EXPECT_EQ(nodes, binary(prepared.fmu(), "surface.nodes")) << "step " << n;
+  }
+  EXPECT_GT(remeshed, 3);
+  // Back before the cut: the embedding of that state.
+  ASSERT_EQ(prepared.fmu().set_fmu_state(before_cut), fmi3OK) << prepared.fmu().log_text();
+  EXPECT_EQ(binary(prepared.fmu(), "surface.embedding"), embedding_before_cut);
+  ASSERT_EQ(prepared.fmu().free_fmu_state(before_cut), fmi3OK);
+}
+
+// A restore numbers the surface's revisions again from the saved one: a cut made another way after
+// it reaches a revision number the prepared surface already had, with another surface. What is read
+// is the new one (the prepared bytes are forgotten at a restore; kept, the read gave the old cut's).
+TEST(TissueFmu, ACutAfterARestoreIsNotTheSurfacePreparedBeforeIt) {
+  const FrogGeometry g = rest_geometry();
+  Session plain("plain"), prepared("prepared");
+  std::array<fmi3FMUState, 2> saved{};
+  std::array<Session*, 2> sessions{&plain, &prepared};
+  for (Session* s : sessions) {
+    ASSERT_EQ(s->fmu().set_string("surface.renderSurface", {"frog"}), fmi3OK);
+    s->start();
+  }
+  ASSERT_EQ(prepared.fmu().set_boolean("surface.prepareAfterStep", {true}), fmi3OK);
+  const auto stroke_until_revision = [&](Session& s, double x_fraction, std::uint64_t revision) {
+    for (int n = 0; n < 60; ++n) {
+      const double y = g.lower[1] - 0.01 + (n / 59.0) * (g.upper[1] - g.lower[1] + 0.02);
+      s.tool({g.lower[0] + x_fraction * (g.upper[0] - g.lower[0]), y, g.lower[2] - 0.01}, 2);
+      s.step();
+      std::vector<std::uint64_t> now;
+      EXPECT_EQ(s.fmu().get_uint64("surface.revision", now), fmi3OK);
+      if (now.at(0) >= revision) return;
+    }
+    ADD_FAILURE() << "the stroke never reached surface revision " << revision;
+  };
+  for (std::size_t k = 0; k < 2; ++k) ASSERT_EQ(sessions[k]->fmu().get_fmu_state(saved[k]), fmi3OK);
+  std::vector<std::uint64_t> start_revision;
+  ASSERT_EQ(prepared.fmu().get_uint64("surface.revision", start_revision), fmi3OK);
+  for (Session* s : sessions) stroke_until_revision(*s, 0.5, start_revision[0] + 1);
+  const std::vector<std::uint8_t> first_cut = binary(prepared.fmu(), "surface.embedding");
+  EXPECT_EQ(first_cut, binary(plain.fmu(), "surface.embedding"));
+  for (std::size_t k = 0; k < 2; ++k) {
+    ASSERT_EQ(sessions[k]->fmu().set_fmu_state(saved[k]), fmi3OK);
+    sessions[k]->set_time(0.0);
+    stroke_until_revision(*sessions[k], 0.3, start_revision[0] + 1);
+  }
+  const std::vector<std::uint8_t> other_cut = binary(prepared.fmu(), "surface.embedding");
+  EXPECT_NE(other_cut, first_cut);
+  EXPECT_EQ(other_cut, binary(plain.fmu(), "surface.embedding"));
+  for (std::size_t k = 0; k < 2; ++k) ASSERT_EQ(sessions[k]->fmu().free_fmu_state(saved[k]), fmi3OK);
+}
+
 class BadUse : public ::testing::Test {
  protected:
   void expect_error(fmi3Status status, const std::string& what) {

@@ -1,5 +1,6 @@
 // FrameBudget (issue 42): a due frame is captured in the time the step left over in its slot, else
-// left to a later slot, never more than MAX_DEFERRALS in a row. Times in ns, no clock.
+// left to a later slot (taken at its start when it and the step fit), never more than MAX_DEFERRALS
+// in a row. Times in ns, no clock.
 #include "schedule/frame_budget.hpp"
 
 #include <gtest/gtest.h>
@@ -60,6 +61,31 @@ TEST(FrameBudget, ACaptureAfterACutIsJudgedByCapturesAfterCuts) {
   EXPECT_TRUE(frames.capture_now(5 * MS, 10 * MS, P));   // one of the positions goes ahead
   frames.seed(P, -MS);                                    // a negative seed is none
   EXPECT_EQ(frames.capture_estimate_ns(P), 0);
+}
+
+// A frame of a re-meshed surface is never captured right after the step that re-meshed it (the Tissue
+// prepares it meanwhile): it waits for the next slot's start, where it goes ahead of the step when the
+// capture and the step (the longest recent one) fit, and when forced whatever they take. A frame of
+// the positions goes after the step as before, and before it when left to the slot.
+TEST(FrameBudget, AReMeshedFrameIsTakenAtTheNextSlotsStartBeforeTheStep) {
+  using Point = FrameBudget::Point;
+  FrameBudget frames;
+  EXPECT_FALSE(frames.capture_at(Point::after_step, 1 * MS, 10 * MS, R));  // plenty of time: it still waits
+  EXPECT_TRUE(frames.capture_at(Point::after_step, 1 * MS, 10 * MS, P));
+  frames.stepped(4 * MS);
+  frames.captured(2 * MS, R);
+  EXPECT_TRUE(frames.capture_at(Point::before_step, 0, 10 * MS, R));       // 2 + 4 ms in 10
+  EXPECT_FALSE(frames.capture_at(Point::before_step, 5 * MS, 10 * MS, R));  // a late start: 5 + 2 + 4 > 10
+  frames.stepped(9 * MS);  // a long step: the capture would push it past the slot
+  EXPECT_FALSE(frames.capture_at(Point::before_step, 0, 10 * MS, R));
+  for (int k = 0; k < FrameBudget::MAX_DEFERRALS; ++k) {
+    ASSERT_FALSE(frames.capture_at(Point::after_step, 1 * MS, 10 * MS, R)) << k;
+    frames.deferred();
+  }
+  EXPECT_FALSE(frames.capture_at(Point::after_step, 1 * MS, 10 * MS, R));  // forced at the slot's start only
+  EXPECT_TRUE(frames.capture_at(Point::before_step, 5 * MS, 10 * MS, R));
+  frames.captured(1 * MS, R);
+  EXPECT_FALSE(frames.forced());
 }
 
 }  // namespace

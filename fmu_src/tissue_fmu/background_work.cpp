@@ -1,0 +1,69 @@
+// BackgroundWork (see background_work.hpp).
+#include "tissue_fmu/background_work.hpp"
+
+#include <pthread.h>
+#include <sched.h>
+
+#include <system_error>
+#include <utility>
+
+namespace tissue::tissue_fmu {
+
+BackgroundWork::~BackgroundWork() {
+  if (!m_thread.joinable()) return;
+  {
+    std::unique_lock lock(m_mutex);
+    m_changed.wait(lock, [this] { return !m_running; });
+    m_stop = true;
+  }
+  m_changed.notify_all();
+  m_thread.join();
+}
+
+void BackgroundWork::start(std::function<void()> job) {
+  wait();
+  if (!m_thread.joinable()) {
+    try {
+      m_thread = std::thread([this] { serve(); });
+    } catch (const std::system_error&) {
+      job();  // no thread to be had: the work is done all the same, here
+      return;
+    }
+  }
+  {
+    std::lock_guard lock(m_mutex);
+    m_job = std::move(job);
+    m_running = true;
+  }
+  m_pending = true;
+  m_changed.notify_all();
+}
+
+void BackgroundWork::wait() {
+  if (!m_pending) return;
+  std::unique_lock lock(m_mutex);
+  m_changed.wait(lock, [this] { return !m_running; });
+  m_pending = false;
+}
+
+void BackgroundWork::serve() noexcept {
+  // A thread inherits its creator's policy: leave a real-time one for the normal policy, so that
+  // the job runs in the time the real-time threads leave idle (lowering needs no privilege).
+  sched_param normal{};
+  normal.sched_priority = 0;
+  (void)pthread_setschedparam(pthread_self(), SCHED_OTHER, &normal);
+  std::unique_lock lock(m_mutex);
+  for (;;) {
+    m_changed.wait(lock, [this] { return m_stop || static_cast<bool>(m_job); });
+    if (m_stop) return;
+    std::function<void()> job = std::move(m_job);
+    m_job = nullptr;
+    lock.unlock();
+    job();
+    lock.lock();
+    m_running = false;
+    m_changed.notify_all();
+  }
+}
+
+}  // namespace tissue::tissue_fmu

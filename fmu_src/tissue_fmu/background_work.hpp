@@ -1,0 +1,44 @@
+// BackgroundWork: one job at a time on a thread of its own, at the operating system's normal
+// priority (SCHED_OTHER), whatever the priority of the thread that hands it over. The Tissue FMU
+// prepares the re-meshed surface with it after a step that cut (docs/DESIGN.md, "The surface is
+// prepared after a cut"): a real-time importer's threads run at SCHED_FIFO and take their cores
+// whenever they want them, so the job uses only the time they leave idle and never delays them.
+// The thread is made at the first job and lives until destruction. Not thread-safe: one owner
+// calls start() and wait().
+#pragma once
+
+#include <condition_variable>
+#include <functional>
+#include <mutex>
+#include <thread>
+
+namespace tissue::tissue_fmu {
+
+class BackgroundWork {
+ public:
+  BackgroundWork() = default;
+  ~BackgroundWork();  ///< waits for a running job, then ends the thread
+  BackgroundWork(const BackgroundWork&) = delete;
+  BackgroundWork& operator=(const BackgroundWork&) = delete;
+
+  /// Hands `job` to the thread (waits for a running one first). The job must not throw (it runs
+  /// in a noexcept frame). Without a thread to be had, the job runs here, now.
+  void start(std::function<void()> job);
+  /// Returns when no job runs (at once when none was started).
+  void wait();
+  /// Whether a job was handed over and has not been waited for.
+  [[nodiscard]] bool pending() const { return m_pending; }
+
+ private:
+  void serve() noexcept;
+
+  std::thread m_thread;
+  std::mutex m_mutex;
+  std::condition_variable m_changed;
+  std::function<void()> m_job;  // the job to run (empty: none)
+  bool m_running = false;       // a job was handed over and has not finished
+  bool m_stop = false;
+  bool m_pending = false;       // owner's view: started and not waited for
+};
+
+}  // namespace tissue::tissue_fmu
