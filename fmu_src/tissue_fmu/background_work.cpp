@@ -1,8 +1,7 @@
 // BackgroundWork (see background_work.hpp).
 #include "tissue_fmu/background_work.hpp"
 
-#include <pthread.h>
-#include <sched.h>
+#include "core/system/background_policy.hpp"
 
 #include <system_error>
 #include <utility>
@@ -47,11 +46,7 @@ void BackgroundWork::wait() {
 }
 
 void BackgroundWork::serve() noexcept {
-  // A thread inherits its creator's policy: leave a real-time one for the normal policy, so that
-  // the job runs in the time the real-time threads leave idle (lowering needs no privilege).
-  sched_param normal{};
-  normal.sched_priority = 0;
-  (void)pthread_setschedparam(pthread_self(), SCHED_OTHER, &normal);
+  leave_realtime_policy();  // the job runs in the time the real-time threads leave idle
   std::unique_lock lock(m_mutex);
   for (;;) {
     m_changed.wait(lock, [this] { return m_stop || static_cast<bool>(m_job); });

@@ -1,5 +1,6 @@
 // BackgroundWork: one job at a time on a thread of its own, at the operating system's normal
-// priority (SCHED_OTHER), whatever the priority of the thread that hands it over. The Tissue FMU
+// priority (SCHED_OTHER), whatever the priority of the thread that hands it over
+// (core/system/background_policy.hpp). The Tissue FMU
 // prepares the re-meshed surface with it after a step that cut (docs/DESIGN.md, "The surface is
 // prepared after a cut"): a real-time importer's threads run at SCHED_FIFO and take their cores
 // whenever they want them, so the job uses only the time they leave idle and never delays them.

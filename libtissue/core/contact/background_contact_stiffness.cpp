@@ -1,6 +1,8 @@
 // BackgroundContactStiffness (see background_contact_stiffness.hpp).
 #include "core/contact/background_contact_stiffness.hpp"
 
+#include "core/system/background_policy.hpp"
+
 #include <system_error>
 
 namespace tissue {
@@ -32,7 +34,10 @@ void BackgroundContactStiffness::start(const ShiftedSystem& system, const Contac
     return;
   }
   try {
-    m_worker = std::thread([this] { compute(); });
+    m_worker = std::thread([this] {
+      leave_realtime_policy();
+      compute();
+    });
   } catch (const std::system_error&) {
     // No thread to be had: wait() computes it in the caller, with the same result.
   }

@@ -13,6 +13,7 @@
 #include "core/solve/cholmod_factor.hpp"
 #include "core/solve/linear_solver.hpp"
 #include "core/solve/pcg_iteration.hpp"
+#include "core/system/background_policy.hpp"
 
 #include <atomic>
 #include <span>
@@ -83,6 +84,7 @@ struct CholeskyPcgSolver::Impl {
     worker_done.store(false, std::memory_order_relaxed);
     try {
       worker = std::thread([factor = spare.get(), done = &worker_done] {
+        leave_realtime_policy();
         factor->factorize();  // noexcept: the status is read after the join
         done->store(true, std::memory_order_release);
       });
