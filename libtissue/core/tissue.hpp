@@ -222,6 +222,8 @@ class Tissue {
 
   /// How many times K_c fell back to the spring alone (no matrix could be condensed).
   [[nodiscard]] int contact_stiffness_fallbacks() const { return m_contact.stiffness_fallbacks(); }
+  /// How many times K_c's matrix was factorized (InteractionSettings::contact.stiffness_refactor_refreshes).
+  [[nodiscard]] int contact_stiffness_factorizations() const { return m_contact.stiffness_factorizations(); }
   /// The integrator of the settings (backward Euler or IDA).
   [[nodiscard]] const Integrator& integrator() const { return *m_integrator; }
   /// The spring stiffness the contact uses (resolved from the settings) [N/m].

@@ -61,9 +61,11 @@ def main():
             for label, host, overrides in variants:
                 runs[label].append(run_once(host, scenario, overrides))
                 r = runs[label][-1]
-                print("  %s%s run %d/%d: overruns %d, misses %d of %d, step p99 %.2f ms, SCHED_FIFO %s"
+                print("  %s%s run %d/%d: overruns %d (steps %d, slots skipped %d), misses %d of %d, step p99 %.2f ms, "
+                      "SCHED_FIFO %s"
                       % (scenario.stem, " (" + label + ")" if label else "", k + 1, args.runs, r["tissue_overruns"],
-                         r["deadline_misses"], r["haptic_ticks"], r["tissue_step_ms"]["p99"], r["realtime_priority"]),
+                         r["tissue_steps"], r["skipped_slots"], r["deadline_misses"], r["haptic_ticks"],
+                         r["tissue_step_ms"]["p99"], r["realtime_priority"]),
                       file=sys.stderr)
                 for slot in r["overrun_slots"]:
                     print("    overrun at " + slot, file=sys.stderr)

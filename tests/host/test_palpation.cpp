@@ -130,8 +130,9 @@ std::unique_ptr<Tissue> scenario_tissue(const Scenario& scenario) {
       const char* path = std::get<std::string>(p.value).c_str();
       values.write<const char*>(*description.find("mesh"), std::span<const char* const>(&path, 1));
     } else {
-      EXPECT_TRUE(p.name == "stepSize" || p.name.starts_with("integrator.") ||
-                  p.name == "contact.stiffnessInBackground")
+      // K_c's settings (contact.stiffness*) change what the haptic loop renders between samples,
+      // not the tissue's equilibrium.
+      EXPECT_TRUE(p.name == "stepSize" || p.name.starts_with("integrator.") || p.name.starts_with("contact.stiffness"))
           << p.name << " may change the statics";
     }
   }

@@ -13,7 +13,7 @@ BackgroundContactStiffness::~BackgroundContactStiffness() {
 
 void BackgroundContactStiffness::compute() noexcept {
   try {
-    m_result = condense_loaded(m_effective, m_request);
+    m_result = m_condense_only ? condense_factored(m_effective, m_request) : condense_loaded(m_effective, m_request);
   } catch (...) {  // a request that does not fit, no memory: no K_c (the caller falls back)
     m_result = std::nullopt;
   }
@@ -25,6 +25,7 @@ void BackgroundContactStiffness::start(const ShiftedSystem& system, const Contac
   m_request = request;
   m_result = std::nullopt;
   m_computed = false;
+  m_condense_only = false;
   m_state = State::running;
   try {
     m_effective.load(system);
@@ -33,6 +34,20 @@ void BackgroundContactStiffness::start(const ShiftedSystem& system, const Contac
     m_state = State::done;
     return;
   }
+  launch();
+}
+
+void BackgroundContactStiffness::start_condense(const ContactStiffnessRequest& request) {
+  cancel();
+  m_request = request;
+  m_result = std::nullopt;
+  m_computed = false;
+  m_condense_only = true;
+  m_state = State::running;
+  launch();
+}
+
+void BackgroundContactStiffness::launch() {
   try {
     m_worker = std::thread([this] {
       leave_realtime_policy();

@@ -31,6 +31,13 @@ class BackgroundContactStiffness {
   /// Copies `system`'s matrix and starts the worker on it (a running one is joined and dropped
   /// first). A matrix that cannot be copied gives a done, failed result.
   void start(const ShiftedSystem& system, const ContactStiffnessRequest& request);
+  /// Starts the worker on K_c of `request` from the factor the last start() made, without loading
+  /// or factorizing (condense_factored: forward solves); `request`'s spring fields must be that
+  /// factorization's. Call when idle or done; without a factor the result is nothing.
+  void start_condense(const ContactStiffnessRequest& request);
+  /// Whether the object holds a factor to condense from (the last start() factorized). Call when
+  /// not running.
+  [[nodiscard]] bool factored() const { return m_effective.rows() > 0; }
   /// Joins a running worker (running -> done); the result stays to be taken.
   void wait();
   /// Waits, then hands over the result (done -> idle): K_c, or nothing when it could not be condensed
@@ -47,12 +54,14 @@ class BackgroundContactStiffness {
 
  private:
   void compute() noexcept;  // the worker's job (or the caller's, without a thread)
+  void launch();            // runs compute() in a new worker (or leaves it to wait())
 
   EffectiveContactStiffness m_effective;
   ContactStiffnessRequest m_request;
   std::optional<Eigen::Matrix3d> m_result;
   std::thread m_worker;
   bool m_computed = false;  // m_result holds the job's outcome (false: loaded, no thread ran it)
+  bool m_condense_only = false;  // the job condenses from the factor held (start_condense)
   State m_state = State::idle;
 };
 

@@ -101,14 +101,14 @@ void ContactModel::refresh_stiffness(int triangle) {
   // until then the one before stands, and no other starts.
   const bool new_contact = m_steps_since_stiffness < 0;
   if (m_stiffness_refresh.state() != BackgroundContactStiffness::State::idle) {
-    if (!new_contact && m_steps_since_stiffness < m_settings.stiffness_latency_steps) {
+    if (!new_contact && m_steps_since_stiffness < m_pending_latency_steps) {
       ++m_steps_since_stiffness;
       return;
     }
     out.stiffness_n_per_m = landed_stiffness(m_stiffness_refresh.take(), triangle);
   }
   const int period = m_settings.stiffness_in_background
-                         ? std::max(m_settings.stiffness_refresh_steps, m_settings.stiffness_latency_steps)
+                         ? std::max(m_settings.stiffness_refresh_steps, m_pending_latency_steps)
                          : m_settings.stiffness_refresh_steps;
   if (!new_contact && m_steps_since_stiffness < period) {
     ++m_steps_since_stiffness;
@@ -123,14 +123,42 @@ void ContactModel::refresh_stiffness(int triangle) {
                                     : m_integrator.newton_stiffness(m_body, m_step_size_s, m_system_diagonal);
   const ContactStiffnessRequest request = stiffness_request_at(
       system, triangle, held ? FREE_PIECE_STIFFNESS_FRACTION * m_stiffness_scale_n_per_m : 0.0);
-  if (m_settings.stiffness_in_background) {
+  // Between factorizations (stiffness_refactor_refreshes), the current point from the last factor:
+  // the spring taken out is the one its matrix holds.
+  const bool background = m_settings.stiffness_in_background;
+  const bool condense_only =
+      m_factor_usable && m_refreshes_since_factor < m_settings.stiffness_refactor_refreshes &&
+      m_factor_pattern == system.stiffness->pattern_revision() && m_factor_rows == system.rows() &&
+      (background ? m_stiffness_refresh.factored() : m_effective_stiffness.rows() > 0);
+  ContactStiffnessRequest from_factor = request;
+  if (condense_only) {
+    from_factor.spring_point = m_factor_request.spring_point;
+    from_factor.spring_in_matrix_n_per_m = m_factor_request.spring_in_matrix_n_per_m;
+    from_factor.spring_direction = m_factor_request.spring_direction;
+    ++m_refreshes_since_factor;
+  } else {
+    m_factor_usable = true;
+    m_factor_request = request;
+    m_factor_pattern = system.stiffness->pattern_revision();
+    m_factor_rows = system.rows();
+    m_refreshes_since_factor = 1;
+    ++m_stiffness_factorizations;
+  }
+  if (background) {
     if (new_contact) out.stiffness_n_per_m = element_local_contact_stiffness(m_body.elasticity(), m_surface, triangle);
-    m_stiffness_refresh.start(system, request);
+    // A factorization lands stiffness_latency_steps later; forward solves from the factor, the next step.
+    m_pending_latency_steps = condense_only ? 1 : m_settings.stiffness_latency_steps;
+    if (condense_only) {
+      m_stiffness_refresh.start_condense(from_factor);
+    } else {
+      m_stiffness_refresh.start(system, request);
+    }
     return;
   }
   try {
-    out.stiffness_n_per_m =
-        landed_stiffness(condensed_contact_stiffness(m_effective_stiffness, system, request), triangle);
+    out.stiffness_n_per_m = landed_stiffness(condense_only ? condense_factored(m_effective_stiffness, from_factor)
+                                                           : condensed_contact_stiffness(m_effective_stiffness, system, request),
+                                             triangle);
   } catch (const std::exception&) {
     // Neither matrix could be factorized (non-finite values): render the spring alone, counted.
     ++m_stiffness_fallbacks;
@@ -148,6 +176,7 @@ ContactStiffnessRequest ContactModel::stiffness_request_at(const ShiftedSystem& 
 
 Eigen::Matrix3d ContactModel::landed_stiffness(const std::optional<Eigen::Matrix3d>& landed, int triangle) {
   if (landed) return *landed;
+  m_factor_usable = false;  // the next refresh factorizes (and the fallback below loads another matrix)
   // The static K failed where a cut set the contacted piece free (K singular there; issue 10): the
   // step's Newton matrix, now.
   if (!m_body.settings().fixed_vertices.empty()) {
@@ -196,6 +225,10 @@ ContactModel::State ContactModel::state() const {
   state.contact = m_contact.state();
   state.output = m_output;
   state.steps_since_stiffness = m_steps_since_stiffness;
+  // A save point: the next refresh factorizes and the one under way lands at the next step, as in a
+  // run restored to it (the factor and the kind of the refresh are not saved).
+  m_factor_usable = false;
+  if (m_settings.stiffness_refactor_refreshes > 1) m_pending_latency_steps = 1;
   m_stiffness_refresh.wait();
   if (m_stiffness_refresh.state() == BackgroundContactStiffness::State::done) {
     const std::optional<Eigen::Matrix3d>& result = m_stiffness_refresh.result();
@@ -218,6 +251,8 @@ void ContactModel::restore(const State& state) {
   m_contact.restore(state.contact);
   m_output = state.output;
   m_steps_since_stiffness = state.steps_since_stiffness;
+  m_factor_usable = false;  // the factor is not saved: the next refresh factorizes
+  m_pending_latency_steps = m_settings.stiffness_refactor_refreshes > 1 ? 1 : m_settings.stiffness_latency_steps;
   switch (state.pending_stiffness) {
     case State::PendingStiffness::none: m_stiffness_refresh.cancel(); break;
     case State::PendingStiffness::failed: m_stiffness_refresh.set_done(std::nullopt); break;

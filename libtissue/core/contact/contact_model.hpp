@@ -45,6 +45,13 @@ struct ContactSettings {
   /// refreshed every max(stiffness_refresh_steps, this) steps. A fixed step, not "when ready": a run
   /// gives the same K_c whatever the machine.
   int stiffness_latency_steps = 1;
+  /// The effective K_c's matrix is factorized at every this many refreshes (>= 1; and after a cut
+  /// changed its pattern, or a save point or a restore); the refreshes between condense the contact's
+  /// current point from the last factor (EffectiveContactStiffness keeps it): forward solves instead
+  /// of a factorization, the body's stiffness as it was when factorized. In the background such a
+  /// refresh lands at the next step, a factorization stiffness_latency_steps later. Above 1, a save
+  /// point lets the refresh under way land at the next step (as a restored run does).
+  int stiffness_refactor_refreshes = 1;
   /// A probe not in contact but this close to the surface reports it (ToolContact::near) [m];
   /// 0: never.
   double near_surface_margin_m = 0.01;
@@ -126,7 +133,13 @@ class ContactModel {
   /// How many times K_c fell back to the spring alone (no matrix could be condensed).
   [[nodiscard]] int stiffness_fallbacks() const { return m_stiffness_fallbacks; }
 
-  /// Waits for a running K_c refresh (its result is part of the state).
+  /// How many times K_c's matrix was factorized (a refresh that condensed from the last factor does
+  /// not count; ContactSettings::stiffness_refactor_refreshes).
+  [[nodiscard]] int stiffness_factorizations() const { return m_stiffness_factorizations; }
+
+  /// Waits for a running K_c refresh (its result is part of the state). A save point, like a restore,
+  /// lets the next refresh factorize (the factor is not saved), so that a run continuing from it and a
+  /// run restored to it render the same K_c.
   [[nodiscard]] State state() const;
   /// Throws StateError for a state restore() refuses: a contact on a triangle the mesh's surface
   /// does not have.
@@ -156,6 +169,15 @@ class ContactModel {
   int m_steps_since_stiffness = 0;
   mutable BackgroundContactStiffness m_stiffness_refresh;  // state() waits for a running one
   int m_stiffness_fallbacks = 0;
+  // The last factorization K_c's refreshes may condense from (stiffness_refactor_refreshes): its
+  // request (the spring its matrix holds), the matrix's pattern and rows, the refreshes since.
+  mutable bool m_factor_usable = false;  // false: the next refresh factorizes (state() clears it)
+  ContactStiffnessRequest m_factor_request;
+  std::uint64_t m_factor_pattern = 0;
+  int m_factor_rows = 0;
+  int m_refreshes_since_factor = 0;
+  mutable int m_pending_latency_steps = 1;  // when the refresh under way lands (state() may shorten it)
+  int m_stiffness_factorizations = 0;
   ContactOutput m_output;
   std::optional<NearSurface> m_near;
   std::vector<SurfaceBvh::SphereHit> m_near_hits;  // scratch of sample_near_surface()

@@ -279,10 +279,9 @@ ContactStiffnessRequest contact_stiffness_request(const ShiftedSystem& system, c
   return request;
 }
 
-std::optional<Eigen::Matrix3d> condense_loaded(EffectiveContactStiffness& effective,
-                                               const ContactStiffnessRequest& request) {
+std::optional<Eigen::Matrix3d> condense_factored(EffectiveContactStiffness& effective,
+                                                 const ContactStiffnessRequest& request) {
   try {
-    effective.factorize_loaded();
     const std::optional<Eigen::Matrix3d> stiffness =
         request.spring_point
             ? effective.stiffness_n_per_m(request.point, *request.spring_point, request.spring_in_matrix_n_per_m,
@@ -295,6 +294,16 @@ std::optional<Eigen::Matrix3d> condense_loaded(EffectiveContactStiffness& effect
   } catch (const SolverError&) {
     return std::nullopt;
   }
+}
+
+std::optional<Eigen::Matrix3d> condense_loaded(EffectiveContactStiffness& effective,
+                                               const ContactStiffnessRequest& request) {
+  try {
+    effective.factorize_loaded();
+  } catch (const SolverError&) {
+    return std::nullopt;
+  }
+  return condense_factored(effective, request);
 }
 
 std::optional<Eigen::Matrix3d> condensed_contact_stiffness(EffectiveContactStiffness& effective,

@@ -158,6 +158,12 @@ ContactStiffnessRequest contact_stiffness_request(const ShiftedSystem& system, c
 std::optional<Eigen::Matrix3d> condense_loaded(EffectiveContactStiffness& effective,
                                                const ContactStiffnessRequest& request);
 
+/// K_c of `request` from the factor `effective` already holds (no factorization: forward solves),
+/// the spring taken out as the request says, so its spring fields must be those of the factorized
+/// matrix. Nothing as condense_loaded, and without a factor.
+std::optional<Eigen::Matrix3d> condense_factored(EffectiveContactStiffness& effective,
+                                                 const ContactStiffnessRequest& request);
+
 /// K_c of `request` from `system`, loaded into `effective` and condensed (condense_loaded); nothing
 /// when `system` cannot be loaded either.
 std::optional<Eigen::Matrix3d> condensed_contact_stiffness(EffectiveContactStiffness& effective,

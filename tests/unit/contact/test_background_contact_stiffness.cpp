@@ -37,6 +37,36 @@ struct Frog {
   }
 };
 
+// start_condense (contact.stiffnessRefactorRefreshes): K_c at another point from the factor the last
+// start() made, without a factorization: bitwise what a fresh factorization of that same matrix gives
+// there, although the body's K changed since; without a factor, nothing.
+TEST(BackgroundContactStiffness, CondensesAnotherPointFromTheFactorItHolds) {
+  Frog frog;
+  BackgroundContactStiffness fresh_object;
+  fresh_object.start_condense(frog.request(back_points(frog.surface, rest_positions(frog.mesh))[0]));
+  EXPECT_FALSE(fresh_object.take().has_value());  // no factor yet
+  EXPECT_FALSE(fresh_object.factored());
+
+  frog.evaluate_at(1e-3);
+  const std::vector<SurfacePoint> points = back_points(frog.surface, rest_positions(frog.mesh));
+  ASSERT_GE(points.size(), 2u);
+  const ContactStiffnessRequest first = frog.request(points[0]), second = frog.request(points[1]);
+  EffectiveContactStiffness here;
+  here.load(static_contact_system(frog.body.tangent(), frog.zero_diagonal));
+  const std::optional<Eigen::Matrix3d> expected = condense_loaded(here, second);
+  ASSERT_TRUE(expected.has_value());
+
+  BackgroundContactStiffness background;
+  background.start(static_contact_system(frog.body.tangent(), frog.zero_diagonal), first);
+  ASSERT_TRUE(background.take().has_value());
+  EXPECT_TRUE(background.factored());
+  frog.evaluate_at(3e-3);  // the body goes on: the factor is of the matrix as it was
+  background.start_condense(second);
+  const std::optional<Eigen::Matrix3d> landed = background.take();
+  ASSERT_TRUE(landed.has_value());
+  EXPECT_TRUE(*landed == *expected) << "max difference " << (*landed - *expected).cwiseAbs().maxCoeff();
+}
+
 TEST(BackgroundContactStiffness, GivesWhatTheCallerComputesFromTheMatrixAtStart) {
   Frog frog;
   frog.evaluate_at(1e-3);  // a deformed, rotated state: K is not the rest stiffness
