@@ -5,9 +5,9 @@
 
 #include "core/mesh/tet_mesh.hpp"
 #include "core/tissue.hpp"
-#include "tissue_fmu/background_work.hpp"
 #include "fmi3/model.hpp"
 #include "ports/surface_binary.hpp"
+#include "tissue_fmu/background_work.hpp"
 #include "tissue_fmu/variables.hpp"
 
 #include <cstdint>
