@@ -127,21 +127,21 @@ void ContactModel::refresh_stiffness(int triangle) {
   // the spring taken out is the one its matrix holds.
   const bool background = m_settings.stiffness_in_background;
   const bool condense_only =
-      m_factor_usable && m_refreshes_since_factor < m_settings.stiffness_refactor_refreshes &&
-      m_factor_pattern == system.stiffness->pattern_revision() && m_factor_rows == system.rows() &&
+      m_last_factor.usable && m_last_factor.refreshes_since < m_settings.stiffness_refactor_refreshes &&
+      m_last_factor.pattern == system.stiffness->pattern_revision() && m_last_factor.rows == system.rows() &&
       (background ? m_stiffness_refresh.factored() : m_effective_stiffness.rows() > 0);
   ContactStiffnessRequest from_factor = request;
   if (condense_only) {
-    from_factor.spring_point = m_factor_request.spring_point;
-    from_factor.spring_in_matrix_n_per_m = m_factor_request.spring_in_matrix_n_per_m;
-    from_factor.spring_direction = m_factor_request.spring_direction;
-    ++m_refreshes_since_factor;
+    from_factor.spring_point = m_last_factor.request.spring_point;
+    from_factor.spring_in_matrix_n_per_m = m_last_factor.request.spring_in_matrix_n_per_m;
+    from_factor.spring_direction = m_last_factor.request.spring_direction;
+    ++m_last_factor.refreshes_since;
   } else {
-    m_factor_usable = true;
-    m_factor_request = request;
-    m_factor_pattern = system.stiffness->pattern_revision();
-    m_factor_rows = system.rows();
-    m_refreshes_since_factor = 1;
+    m_last_factor.usable = true;
+    m_last_factor.request = request;
+    m_last_factor.pattern = system.stiffness->pattern_revision();
+    m_last_factor.rows = system.rows();
+    m_last_factor.refreshes_since = 1;
     ++m_stiffness_factorizations;
   }
   if (background) {
@@ -176,7 +176,7 @@ ContactStiffnessRequest ContactModel::stiffness_request_at(const ShiftedSystem& 
 
 Eigen::Matrix3d ContactModel::landed_stiffness(const std::optional<Eigen::Matrix3d>& landed, int triangle) {
   if (landed) return *landed;
-  m_factor_usable = false;  // the next refresh factorizes (and the fallback below loads another matrix)
+  m_last_factor.usable = false;  // the next refresh factorizes (and the fallback below loads another matrix)
   // The static K failed where a cut set the contacted piece free (K singular there; issue 10): the
   // step's Newton matrix, now.
   if (!m_body.settings().fixed_vertices.empty()) {
@@ -227,7 +227,7 @@ ContactModel::State ContactModel::state() const {
   state.steps_since_stiffness = m_steps_since_stiffness;
   // A save point: the next refresh factorizes and the one under way lands at the next step, as in a
   // run restored to it (the factor and the kind of the refresh are not saved).
-  m_factor_usable = false;
+  m_last_factor.usable = false;
   if (m_settings.stiffness_refactor_refreshes > 1) m_pending_latency_steps = 1;
   m_stiffness_refresh.wait();
   if (m_stiffness_refresh.state() == BackgroundContactStiffness::State::done) {
@@ -251,7 +251,7 @@ void ContactModel::restore(const State& state) {
   m_contact.restore(state.contact);
   m_output = state.output;
   m_steps_since_stiffness = state.steps_since_stiffness;
-  m_factor_usable = false;  // the factor is not saved: the next refresh factorizes
+  m_last_factor.usable = false;  // the factor is not saved: the next refresh factorizes
   m_pending_latency_steps = m_settings.stiffness_refactor_refreshes > 1 ? 1 : m_settings.stiffness_latency_steps;
   switch (state.pending_stiffness) {
     case State::PendingStiffness::none: m_stiffness_refresh.cancel(); break;

@@ -169,13 +169,15 @@ class ContactModel {
   int m_steps_since_stiffness = 0;
   mutable BackgroundContactStiffness m_stiffness_refresh;  // state() waits for a running one
   int m_stiffness_fallbacks = 0;
-  // The last factorization K_c's refreshes may condense from (stiffness_refactor_refreshes): its
-  // request (the spring its matrix holds), the matrix's pattern and rows, the refreshes since.
-  mutable bool m_factor_usable = false;  // false: the next refresh factorizes (state() clears it)
-  ContactStiffnessRequest m_factor_request;
-  std::uint64_t m_factor_pattern = 0;
-  int m_factor_rows = 0;
-  int m_refreshes_since_factor = 0;
+  // The last factorization K_c's refreshes may condense from (stiffness_refactor_refreshes).
+  struct LastFactor {
+    bool usable = false;              // false: the next refresh factorizes (state() clears it)
+    ContactStiffnessRequest request;  // of the factorization: the spring its matrix holds
+    std::uint64_t pattern = 0;        // the matrix's pattern revision and rows
+    int rows = 0;
+    int refreshes_since = 0;
+  };
+  mutable LastFactor m_last_factor;
   mutable int m_pending_latency_steps = 1;  // when the refresh under way lands (state() may shorten it)
   int m_stiffness_factorizations = 0;
   ContactOutput m_output;
