@@ -240,11 +240,13 @@ void TissueModel::drawn_nodes(ports::SurfaceNodes& nodes) {
   nodes.positions_m = drawn_mesh().positions_m;
 }
 
+bool TissueModel::embedding_encoded(bool mesh_output) const {
+  return m_encoded_embedding && m_encoded_embedding->revision == m_surface_revision &&
+         m_encoded_embedding->mesh_output == mesh_output;
+}
+
 const std::vector<std::uint8_t>& TissueModel::embedding_bytes(bool mesh_output) {
-  if (m_encoded_embedding && m_encoded_embedding->revision == m_surface_revision &&
-      m_encoded_embedding->mesh_output == mesh_output) {
-    return m_embedding_bytes;
-  }
+  if (embedding_encoded(mesh_output)) return m_embedding_bytes;
   m_encoded_embedding.reset();
   if (mesh_output) {
     drawn_embedding(m_embedding);
@@ -259,8 +261,7 @@ const std::vector<std::uint8_t>& TissueModel::embedding_bytes(bool mesh_output) 
 
 void TissueModel::prepare_surface() {
   const bool mesh_output = m_values.boolean(vr(Vr::mesh_output_enabled));
-  if (!m_values.boolean(vr(Vr::surface_prepare)) || !mesh_output) return;
-  if (m_encoded_embedding && m_encoded_embedding->revision == m_surface_revision) return;
+  if (!m_values.boolean(vr(Vr::surface_prepare)) || !mesh_output || embedding_encoded(true)) return;
   // The job reads the tissue (const) and writes the render surface's and the embedding's members,
   // which every other call leaves alone until settle(); noexcept: a failure leaves the bytes stale,
   // so the read that follows computes them again and reports it.

@@ -74,6 +74,8 @@ class TissueModel final : public fmi3::Model {
   const ports::SurfaceMesh& drawn_mesh();
   void drawn_embedding(ports::SurfaceEmbedding& embedding);
   void drawn_nodes(ports::SurfaceNodes& nodes);
+  /// Whether m_embedding_bytes hold the current revision's surface.embedding for this output switch.
+  [[nodiscard]] bool embedding_encoded(bool mesh_output) const;
   /// surface.embedding's bytes for the current revision (encoded once per revision and output switch).
   const std::vector<std::uint8_t>& embedding_bytes(bool mesh_output);
   /// After a step: when surface.prepareAfterStep is set and the revision changed, embedding_bytes()

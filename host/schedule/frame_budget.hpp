@@ -46,7 +46,7 @@ class FrameBudget {
   /// it: a re-meshed surface waits for the next slot's start (forced there); the positions as
   /// capture_now().
   [[nodiscard]] bool capture_at(Point point, Nanoseconds now, Nanoseconds slot_end, CaptureKind kind) const {
-    if (point == Point::before_step) return forced() || now + capture_estimate_ns(kind) + m_step_estimate_ns <= slot_end;
+    if (point == Point::before_step) return forced() || fits_before_step(now, slot_end, kind);
     return kind != CaptureKind::remeshed && capture_now(now, slot_end, kind);
   }
   /// Whether a frame of a re-meshed surface due after the coming step is worth preparing meanwhile
@@ -54,8 +54,7 @@ class FrameBudget {
   /// and a step fit in `slot`, or it will be forced. Else the preparation would go to waste and the
   /// next step wait for it (a piece coming free: steps of 10-16 ms each waited for the last one's).
   [[nodiscard]] bool worth_preparing(Nanoseconds slot) const {
-    return m_deferred_in_row + 1 >= MAX_DEFERRALS ||
-           capture_estimate_ns(CaptureKind::remeshed) + m_step_estimate_ns <= slot;
+    return m_deferred_in_row + 1 >= MAX_DEFERRALS || fits_before_step(0, slot, CaptureKind::remeshed);
   }
   /// Whether a due frame has waited the most slots it may: it is captured at the next chance, whatever it costs.
   [[nodiscard]] bool forced() const { return m_deferred_in_row >= MAX_DEFERRALS; }
@@ -77,6 +76,10 @@ class FrameBudget {
 
  private:
   Nanoseconds& estimate_of(CaptureKind kind) { return m_estimate_ns[static_cast<std::size_t>(kind)]; }
+  /// Whether a capture of `kind` from `now` and then a step (the longest recent one) end by `slot_end`.
+  [[nodiscard]] bool fits_before_step(Nanoseconds now, Nanoseconds slot_end, CaptureKind kind) const {
+    return now + capture_estimate_ns(kind) + m_step_estimate_ns <= slot_end;
+  }
 
   std::array<Nanoseconds, 2> m_estimate_ns{};
   Nanoseconds m_step_estimate_ns = 0;

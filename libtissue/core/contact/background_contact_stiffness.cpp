@@ -21,12 +21,7 @@ void BackgroundContactStiffness::compute() noexcept {
 }
 
 void BackgroundContactStiffness::start(const ShiftedSystem& system, const ContactStiffnessRequest& request) {
-  cancel();
-  m_request = request;
-  m_result = std::nullopt;
-  m_computed = false;
-  m_condense_only = false;
-  m_state = State::running;
+  begin(request, false);
   try {
     m_effective.load(system);
   } catch (const SolverError&) {
@@ -38,13 +33,17 @@ void BackgroundContactStiffness::start(const ShiftedSystem& system, const Contac
 }
 
 void BackgroundContactStiffness::start_condense(const ContactStiffnessRequest& request) {
+  begin(request, true);
+  launch();
+}
+
+void BackgroundContactStiffness::begin(const ContactStiffnessRequest& request, bool condense_only) {
   cancel();
   m_request = request;
   m_result = std::nullopt;
   m_computed = false;
-  m_condense_only = true;
+  m_condense_only = condense_only;
   m_state = State::running;
-  launch();
 }
 
 void BackgroundContactStiffness::launch() {

@@ -54,7 +54,8 @@ class BackgroundContactStiffness {
 
  private:
   void compute() noexcept;  // the worker's job (or the caller's, without a thread)
-  void launch();            // runs compute() in a new worker (or leaves it to wait())
+  void begin(const ContactStiffnessRequest& request, bool condense_only);  // a job's state, running
+  void launch();  // runs compute() in a new worker (or leaves it to wait())
 
   EffectiveContactStiffness m_effective;
   ContactStiffnessRequest m_request;

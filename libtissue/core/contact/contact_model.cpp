@@ -45,7 +45,8 @@ ContactModel::ContactModel(const ContactSettings& settings, bool enabled, double
       m_spring(spring),
       m_surface(surface),
       m_contact(point_contact_settings(settings, step_size_s, stiffness_damping_s, body, surface, integrator)),
-      m_stiffness_scale_n_per_m(contact_stiffness_scale_n_per_m(body, surface)) {}
+      m_stiffness_scale_n_per_m(contact_stiffness_scale_n_per_m(body, surface)),
+      m_pending_latency_steps(settings.stiffness_latency_steps) {}
 
 void ContactModel::probe(const Eigen::Vector3d& previous_m, const Eigen::Vector3d& current_m,
                          const LazySurfaceBvh& bvh) {
@@ -225,10 +226,7 @@ ContactModel::State ContactModel::state() const {
   state.contact = m_contact.state();
   state.output = m_output;
   state.steps_since_stiffness = m_steps_since_stiffness;
-  // A save point: the next refresh factorizes and the one under way lands at the next step, as in a
-  // run restored to it (the factor and the kind of the refresh are not saved).
-  m_last_factor.usable = false;
-  if (m_settings.stiffness_refactor_refreshes > 1) m_pending_latency_steps = 1;
+  forget_factor();  // a save point, as in a run restored to it
   m_stiffness_refresh.wait();
   if (m_stiffness_refresh.state() == BackgroundContactStiffness::State::done) {
     const std::optional<Eigen::Matrix3d>& result = m_stiffness_refresh.result();
@@ -247,12 +245,16 @@ void ContactModel::check(const State& state) const {
   }
 }
 
+void ContactModel::forget_factor() const {
+  m_last_factor.usable = false;
+  if (m_settings.stiffness_refactor_refreshes > 1) m_pending_latency_steps = 1;
+}
+
 void ContactModel::restore(const State& state) {
   m_contact.restore(state.contact);
   m_output = state.output;
   m_steps_since_stiffness = state.steps_since_stiffness;
-  m_last_factor.usable = false;  // the factor is not saved: the next refresh factorizes
-  m_pending_latency_steps = m_settings.stiffness_refactor_refreshes > 1 ? 1 : m_settings.stiffness_latency_steps;
+  forget_factor();
   switch (state.pending_stiffness) {
     case State::PendingStiffness::none: m_stiffness_refresh.cancel(); break;
     case State::PendingStiffness::failed: m_stiffness_refresh.set_done(std::nullopt); break;

@@ -153,6 +153,10 @@ class ContactModel {
   /// the step's Newton matrix where the static K failed, else the spring alone (counted).
   Eigen::Matrix3d landed_stiffness(const std::optional<Eigen::Matrix3d>& landed, int triangle);
   void refresh_stiffness(int triangle);
+  /// At a save point and a restore (the factor and the kind of the refresh under way are not saved):
+  /// the next refresh factorizes, and with stiffness_refactor_refreshes above 1 the refresh under way
+  /// lands at the next step, so that a run continuing from a save point and one restored to it agree.
+  void forget_factor() const;
 
   ContactSettings m_settings;
   bool m_enabled;
@@ -178,7 +182,7 @@ class ContactModel {
     int refreshes_since = 0;
   };
   mutable LastFactor m_last_factor;
-  mutable int m_pending_latency_steps = 1;  // when the refresh under way lands (state() may shorten it)
+  mutable int m_pending_latency_steps;  // when the refresh under way lands (forget_factor() may shorten it)
   int m_stiffness_factorizations = 0;
   ContactOutput m_output;
   std::optional<NearSurface> m_near;
