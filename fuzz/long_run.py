@@ -46,14 +46,25 @@ def cpu_seconds(pid):
         return None
 
 
+def ledger_runs(path):
+    """The ledger's runs that count, as (door, CPU seconds, executions, edges). A run whose note
+    starts with "not counted" (it fuzzed nothing real, e.g. on seeds the target refused) is kept in
+    the ledger for the record but counts toward neither a door's budget nor its summary."""
+    runs = []
+    for line in path.read_text().splitlines() if path.exists() else []:
+        if line.startswith("#") or not line.strip():
+            continue
+        fields = line.split("\t")
+        if len(fields) > 6 and fields[6].startswith("not counted"):
+            continue
+        runs.append((fields[0], float(fields[1]), int(fields[2]), int(fields[3])))
+    return runs
+
+
 def read_ledger(path):
     done = {}
-    if path.exists():
-        for line in path.read_text().splitlines():
-            if line.startswith("#") or not line.strip():
-                continue
-            door, seconds = line.split("\t")[:2]
-            done[door] = done.get(door, 0.0) + float(seconds)
+    for door, seconds, _, _ in ledger_runs(path):
+        done[door] = done.get(door, 0.0) + seconds
     return done
 
 
@@ -136,16 +147,12 @@ def replay(args):
 
 
 def summary(args):
-    ledger = pathlib.Path(args.ledger)
     totals = {}
-    for line in ledger.read_text().splitlines() if ledger.exists() else []:
-        if line.startswith("#") or not line.strip():
-            continue
-        door, seconds, executions, edges = line.split("\t")[:4]
+    for door, seconds, executions, edges in ledger_runs(pathlib.Path(args.ledger)):
         t = totals.setdefault(door, [0.0, 0, 0, 0])
-        t[0] += float(seconds)
-        t[1] += int(executions)
-        t[2] = max(t[2], int(edges))
+        t[0] += seconds
+        t[1] += executions
+        t[2] = max(t[2], edges)
         t[3] += 1
     print("| door | CPU seconds | executions | edges (largest run) | runs |")
     print("|---|---:|---:|---:|---:|")
