@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <limits>
 #include <optional>
 #include <string>
 
@@ -118,20 +119,19 @@ StepReport BackwardEuler::step(DynamicsModel& model, DynamicState& state, double
   report.assembly_s = seconds_since(assembly_start);
 
   const auto solve_start = std::chrono::steady_clock::now();
-  // The initial guess: zero (as Vega and the dissertation), or the previous step's dv. The warm
-  // start saves iterations at a strict tolerance, but under an iteration cap the error it leaves in
-  // the slow modes repeats last step's acceleration and can pump energy in (docs/BENCHMARKS.md).
-  if (!m_settings.warm_start || m_velocity_change.size() != n) m_velocity_change.setZero(n);
+  start_velocity_change(system);
   try {
     report.solve = m_solver->solve(system, m_rhs, m_velocity_change);
   } catch (const SolverError& error) {
     m_velocity_change.setZero();
+    m_past_velocity_changes.resize(0);
     throw IntegrationError(std::string("backward Euler: linear solve failed: ") + error.what());
   }
   report.solve_s = seconds_since(solve_start);
   report.linear_iterations = report.solve.iterations;
   if (!m_velocity_change.allFinite()) {
     m_velocity_change.setZero();
+    m_past_velocity_changes.resize(0);
     throw IntegrationError("backward Euler: the velocity update is not finite; state kept");
   }
   m_end_velocity.noalias() = state.velocity_m_per_s + m_velocity_change;
@@ -146,6 +146,7 @@ StepReport BackwardEuler::step(DynamicsModel& model, DynamicState& state, double
     m_end_displacement.noalias() = h * m_end_velocity;
     turn_rad = model.largest_turn_rad(m_end_displacement, newton.energy_guard_angle_rad);
   }
+  remember_velocity_change();
   const bool guard = turn_rad > newton.energy_guard_angle_rad;
   state.displacement_m += h * m_end_velocity;
   if (guard) {
@@ -156,6 +157,31 @@ StepReport BackwardEuler::step(DynamicsModel& model, DynamicState& state, double
   state.velocity_m_per_s = m_end_velocity;
   state.time_s += h;
   return report;
+}
+
+// The initial guess: zero (as Vega and the dissertation), or galerkin_start over the last steps'
+// velocity changes (a grown system drops them: their length no longer divides).
+void BackwardEuler::start_velocity_change(const ShiftedSystem& system) {
+  const Eigen::Index n = system.rows();
+  m_velocity_change.setZero(n);
+  if (!m_settings.warm_start || n == 0 || m_past_velocity_changes.size() % n != 0) return;
+  const Eigen::Index past = std::min<Eigen::Index>(m_past_velocity_changes.size() / n, WARM_START_STEPS);
+  if (past == 0) return;
+  galerkin_start(system, m_rhs, Eigen::Map<const Eigen::MatrixXd>(m_past_velocity_changes.data(), n, past),
+                 m_velocity_change, m_warm_start);
+}
+
+void BackwardEuler::remember_velocity_change() {
+  const Eigen::Index n = m_velocity_change.size();
+  const Eigen::Index kept = m_settings.warm_start && n > 0 && m_past_velocity_changes.size() % n == 0
+                                ? std::min<Eigen::Index>(m_past_velocity_changes.size() / n, WARM_START_STEPS - 1)
+                                : 0;
+  // In place, oldest kept first; allocates only while the history fills.
+  m_past_velocity_changes.conservativeResize(n * (kept + 1));
+  for (Eigen::Index k = kept; k > 0; --k) {
+    m_past_velocity_changes.segment(n * k, n) = m_past_velocity_changes.segment(n * (k - 1), n);
+  }
+  m_past_velocity_changes.head(n) = m_velocity_change;
 }
 
 // Energy projection (Dinev et al. 2018): E = 1/2 v^T M v + potential. If the step's end holds more
@@ -200,6 +226,8 @@ void BackwardEuler::correct(DynamicsModel& model, const DynamicState& state, dou
                             WorkTeam* team) {
   const int n = model.dof_count();
   const Eigen::VectorXd& mass = model.mass_kg();
+  // The model's potential energy at the iterate, when the last line search measured it there.
+  bool start_potential_known = false;
   for (int iteration = 0; iteration < m_settings.newton.max_iterations; ++iteration) {
     const auto assembly_start = std::chrono::steady_clock::now();
     m_end_displacement.noalias() = state.displacement_m + h * m_end_velocity;
@@ -226,11 +254,14 @@ void BackwardEuler::correct(DynamicsModel& model, const DynamicState& state, dou
     if (!m_correction.allFinite()) throw IntegrationError("backward Euler: a Newton correction is not finite; state kept");
     ++report.newton_iterations;
     if (m_settings.newton.line_search) {
-      const double share = line_search(model, state, h, team);
+      const double share = line_search(model, state, h, team, start_potential_known ? &m_trial_potential_j : nullptr);
       if (share == 0.0) break;
       m_correction *= share;
+      m_end_velocity = m_trial_velocity;  // v1 + share correction, as the search measured it
+      start_potential_known = std::isfinite(m_trial_potential_j);
+    } else {
+      m_end_velocity += m_correction;
     }
-    m_end_velocity += m_correction;
     if (iteration + 1 == m_settings.newton.max_iterations) break;  // no later iteration to stop
     m_end_displacement.noalias() = h * m_correction;
     const double converged_rad = 0.01 * m_settings.newton.trigger_angle_rad;
@@ -245,7 +276,7 @@ void BackwardEuler::correct(DynamicsModel& model, const DynamicState& state, dou
 // correction descends Phi; the line search keeps the iterates from overshooting it.
 double BackwardEuler::incremental_potential_j(DynamicsModel& model, const DynamicState& state, double h,
                                               const BlockSparseMatrix& stiffness, const Eigen::VectorXd& v1,
-                                              WorkTeam* team) {
+                                              WorkTeam* team, const double* known_potential_j) {
   m_trial_displacement.noalias() = state.displacement_m + h * v1;
   stiffness.multiply(v1, m_trial_product, team);
   const Eigen::VectorXd& mass = model.mass_kg();
@@ -257,14 +288,20 @@ double BackwardEuler::incremental_potential_j(DynamicsModel& model, const Dynami
     damping_j += model.mass_damping_kg_per_s()[i] * v1[i] * v1[i];
   }
   damping_j += model.stiffness_damping_s() * v1.dot(m_trial_product);
-  return 0.5 * kinetic_j + 0.5 * h * damping_j + model.potential_energy_j(m_trial_displacement);
+  m_trial_potential_j = known_potential_j != nullptr ? *known_potential_j : model.potential_energy_j(m_trial_displacement);
+  return 0.5 * kinetic_j + 0.5 * h * damping_j + m_trial_potential_j;
 }
 
-double BackwardEuler::line_search(DynamicsModel& model, const DynamicState& state, double h, WorkTeam* team) {
+double BackwardEuler::line_search(DynamicsModel& model, const DynamicState& state, double h, WorkTeam* team,
+                                  const double* start_potential_j) {
   const BlockSparseMatrix& stiffness = model.tangent();
   m_trial_product.resize(m_correction.size());
-  const double start_j = incremental_potential_j(model, state, h, stiffness, m_end_velocity, team);
-  if (!std::isfinite(start_j)) return 1.0;  // the model cannot say: the full correction, as without the search
+  const double start_j = incremental_potential_j(model, state, h, stiffness, m_end_velocity, team, start_potential_j);
+  if (!std::isfinite(start_j)) {  // the model cannot say: the full correction, as without the search
+    m_trial_velocity.noalias() = m_end_velocity + m_correction;
+    m_trial_potential_j = std::numeric_limits<double>::quiet_NaN();
+    return 1.0;
+  }
   double share = 1.0;
   for (int halving = 0; halving <= LINE_SEARCH_HALVINGS; ++halving, share *= 0.5) {
     m_trial_velocity.noalias() = m_end_velocity + share * m_correction;

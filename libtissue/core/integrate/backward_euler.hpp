@@ -7,6 +7,7 @@
 // lines, which the co-rotational energy reads as stretch, and an exact solve then gains energy.
 #pragma once
 
+#include "core/integrate/galerkin_start.hpp"
 #include "core/integrate/integrator.hpp"
 #include "core/solve/linear_solver.hpp"
 
@@ -42,8 +43,12 @@ class BackwardEuler final : public Integrator {
   };
   /// Halvings of a correction before the line search gives up on it.
   static constexpr int LINE_SEARCH_HALVINGS = 6;
+  /// The steps' velocity changes a warm start combines (each costs one product with the matrix).
+  static constexpr int WARM_START_STEPS = 4;
   struct Settings {
-    /// Start each solve from the previous step's dv instead of zero (matters for iterative solvers).
+    /// Start each solve from the combination of the last WARM_START_STEPS steps' dv nearest the
+    /// solution in the energy norm of the step's matrix, instead of from zero (matters for
+    /// iterative solvers; docs/DESIGN.md, "The warm start").
     bool warm_start = false;
     NewtonCorrections newton;
     /// Threads of a step (1 or 2; see IntegratorSettings::threads): a WorkTeam made and joined by each step.
@@ -55,10 +60,12 @@ class BackwardEuler final : public Integrator {
   [[nodiscard]] const Settings& settings() const { return m_settings; }
   [[nodiscard]] std::string_view name() const override { return "backwardEuler"; }
   [[nodiscard]] const LinearSolver& solver() const { return *m_solver; }
-  /// The last velocity change (the next solve's warm start when enabled).
-  [[nodiscard]] Eigen::VectorXd internal_state() const override { return m_velocity_change; }
+  /// The last steps' velocity changes, newest first, one after the other (the next solve's warm
+  /// start when enabled; the last one alone without it).
+  [[nodiscard]] Eigen::VectorXd internal_state() const override { return m_past_velocity_changes; }
+  /// Takes any vector: a step uses it only when its length is a multiple of the unknowns' count.
   void restore_internal_state(const Eigen::VectorXd& internal_state) override {
-    m_velocity_change = internal_state;
+    m_past_velocity_changes = internal_state;
   }
   /// One step depends on the state alone (a grown system drops the warm start); a save or a restore
   /// makes the solver forget its lagged factor (LinearSolver::forget_earlier_setups).
@@ -75,13 +82,23 @@ class BackwardEuler final : public Integrator {
  private:
   void correct(DynamicsModel& model, const DynamicState& state, double h, StepReport& report, WorkTeam* team);
   ShiftedSystem step_system(const DynamicsModel& model, double h, const Eigen::VectorXd& displacement_m);
+  // m_velocity_change = the warm start of the solve of `system` x = m_rhs (zero without one).
+  void start_velocity_change(const ShiftedSystem& system);
+  // Puts m_velocity_change first among the past velocity changes.
+  void remember_velocity_change();
   // Scales v1 (m_end_velocity) so that the step's energy does not rise; true if it did.
   bool guard_energy(DynamicsModel& model, const DynamicState& state, double h);
   // The step's incremental potential at v1 (backward_euler.cpp); `stiffness` is the damping's K.
+  // The model's potential energy at u0 + h v1 is `known_potential_j` when given (a pass over the
+  // elements saved), else computed; either way it is left in m_trial_potential_j.
   double incremental_potential_j(DynamicsModel& model, const DynamicState& state, double h,
-                                 const BlockSparseMatrix& stiffness, const Eigen::VectorXd& v1, WorkTeam* team);
-  // The share t of m_correction to take (0: none lowers the incremental potential).
-  double line_search(DynamicsModel& model, const DynamicState& state, double h, WorkTeam* team);
+                                 const BlockSparseMatrix& stiffness, const Eigen::VectorXd& v1, WorkTeam* team,
+                                 const double* known_potential_j = nullptr);
+  // The share t of m_correction to take (0: none lowers the incremental potential); the trial taken
+  // is left in m_trial_velocity, its potential energy in m_trial_potential_j. `start_potential_j`:
+  // the model's potential energy at the iterate when known (the last search's accepted trial).
+  double line_search(DynamicsModel& model, const DynamicState& state, double h, WorkTeam* team,
+                     const double* start_potential_j);
 
   std::unique_ptr<LinearSolver> m_solver;
   Settings m_settings;
@@ -89,13 +106,16 @@ class BackwardEuler final : public Integrator {
   Eigen::VectorXd m_stiffness_times_velocity;
   Eigen::VectorXd m_rhs;
   Eigen::VectorXd m_system_diagonal;
-  Eigen::VectorXd m_velocity_change;  // kept: the warm start of the next solve
+  Eigen::VectorXd m_velocity_change;        // the step's solve's
+  Eigen::VectorXd m_past_velocity_changes;  // kept: the last steps', newest first (internal_state)
+  GalerkinStartWork m_warm_start;
   Eigen::VectorXd m_end_displacement;  // the Newton iterate u0 + h v1
   Eigen::VectorXd m_end_velocity;      // v1
   Eigen::VectorXd m_correction;        // a Newton correction of v1
   Eigen::VectorXd m_trial_velocity;    // v1 + t correction, in the line search
   Eigen::VectorXd m_trial_displacement;
   Eigen::VectorXd m_trial_product;     // K v of a trial
+  double m_trial_potential_j = 0.0;    // the model's potential energy at the last trial's u1
 };
 
 /// Throws ParameterError unless the trigger angle is > 0 (infinity: off) and 1 to 100 iterations.
