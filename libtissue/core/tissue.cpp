@@ -241,11 +241,10 @@ void Tissue::restore(const TissueSnapshot& snapshot) {
   const ToolKinematics::State tool{snapshot.tool, snapshot.previous_tool, snapshot.applied_tool_position_m};
   ToolKinematics::check(tool);
   const DeformableBody::Rotations& rotations = snapshot.rotations;
-  const size_t tets = static_cast<size_t>(m_body.mesh().tet_count());
-  if (rotations.tets.size() != tets || rotations.tet_warm_starts.size() != tets ||
-      rotations.pieces.size() != m_body.xfem().piece_rotations().size() ||
-      rotations.piece_warm_starts.size() != m_body.xfem().piece_warm_starts().size()) {
-    throw StateError("the state's rotations do not match the mesh and its cuts");
+  try {
+    m_body.check_rotations(rotations);
+  } catch (const std::invalid_argument& error) {
+    throw StateError(std::string("the state's rotations do not fit: ") + error.what());
   }
   const ContactModel::State contact{snapshot.contact, snapshot.contact_output, snapshot.steps_since_stiffness,
                                     snapshot.pending_stiffness, snapshot.pending_stiffness_n_per_m};

@@ -3,6 +3,7 @@
 // is in deformable_body_enrich.cpp and deformable_body_ghosts.cpp.
 #include "core/fem/deformable_body.hpp"
 
+#include "core/fem/rotation.hpp"
 #include "core/mesh/topology.hpp"
 #include "core/system/hot_kernel.hpp"
 
@@ -342,12 +343,28 @@ void DeformableBody::save_rotations(Rotations& rotations) const {
   rotations.piece_warm_starts = m_xfem.piece_warm_starts();
 }
 
-void DeformableBody::restore_rotations(const Rotations& rotations) {
-  if (rotations.pieces.size() != m_xfem.piece_rotations().size() ||
+void DeformableBody::check_rotations(const Rotations& rotations) const {
+  const size_t tets = static_cast<size_t>(m_mesh.tet_count());
+  if (rotations.tets.size() != tets || rotations.tet_warm_starts.size() != tets ||
+      rotations.pieces.size() != m_xfem.piece_rotations().size() ||
       rotations.piece_warm_starts.size() != m_xfem.piece_warm_starts().size()) {
-    throw std::invalid_argument("body: the saved rotations are of " + std::to_string(rotations.pieces.size()) +
-                                " cut-tet pieces, the body has " + std::to_string(m_xfem.piece_rotations().size()));
+    throw std::invalid_argument("body: the saved rotations are of " + std::to_string(rotations.tets.size()) +
+                                " tets and " + std::to_string(rotations.pieces.size()) + " cut-tet pieces, the body has " +
+                                std::to_string(tets) + " and " + std::to_string(m_xfem.piece_rotations().size()));
   }
+  const auto check_all = [](const auto& values, const auto& is_one, const char* what) {
+    for (size_t k = 0; k < values.size(); ++k) {
+      if (!is_one(values[k])) throw std::invalid_argument("body: saved " + std::string(what) + " " + std::to_string(k) + " is not one");
+    }
+  };
+  check_all(rotations.tets, is_rotation, "tet rotation");
+  check_all(rotations.tet_warm_starts, is_unit_quaternion, "tet warm start (a unit quaternion)");
+  check_all(rotations.pieces, is_rotation, "piece rotation");
+  check_all(rotations.piece_warm_starts, is_unit_quaternion, "piece warm start (a unit quaternion)");
+}
+
+void DeformableBody::restore_rotations(const Rotations& rotations) {
+  check_rotations(rotations);
   m_elasticity.restore_rotations(rotations.tets, rotations.tet_warm_starts);
   m_xfem.restore_rotations(rotations.pieces, rotations.piece_warm_starts);
 }

@@ -260,7 +260,11 @@ class DeformableBody final : public DynamicsModel {
     std::vector<Eigen::Quaterniond> piece_warm_starts;
   };
   void save_rotations(Rotations& rotations) const;
-  /// Throws std::invalid_argument (nothing changed) when the sizes do not match the mesh and cuts.
+  /// Throws std::invalid_argument unless the sizes match the mesh and cuts and every rotation is one
+  /// and every warm start a unit quaternion (is_rotation, is_unit_quaternion: a NaN warm start makes
+  /// the next step's matrix NaN; found by fuzzing the FMU state).
+  void check_rotations(const Rotations& rotations) const;
+  /// check_rotations(), then takes them. Throws std::invalid_argument (nothing changed).
   void restore_rotations(const Rotations& rotations);
   /// Elastic energy at displacement u (cut tets: w_a E_a + w_b E_b). [J]
   [[nodiscard]] double elastic_energy_j(const Eigen::VectorXd& displacement_m);

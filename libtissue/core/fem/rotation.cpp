@@ -73,6 +73,15 @@ Eigen::Matrix3d rotation_by_svd(const Eigen::Matrix3d& deformation_gradient) {
   return u * v.transpose();
 }
 
+bool is_rotation(const Eigen::Matrix3d& r) {
+  return r.allFinite() && (r.transpose() * r - Eigen::Matrix3d::Identity()).norm() <= ROTATION_TOLERANCE &&
+         r.determinant() > 0.0;
+}
+
+bool is_unit_quaternion(const Eigen::Quaterniond& q) {
+  return q.coeffs().allFinite() && std::abs(q.norm() - 1.0) <= ROTATION_TOLERANCE;
+}
+
 Eigen::Matrix3d extract_rotation(const Eigen::Matrix3d& f, Eigen::Quaterniond& warm_start,
                                  const RotationSettings& settings) {
   const double scale = f.cwiseAbs().maxCoeff();

@@ -48,6 +48,14 @@ inline constexpr int ROTATION_BATCH = 4;
 void extract_rotations(int count, const Eigen::Matrix3d* f, Eigen::Quaterniond* const* warm_starts,
                        Eigen::Matrix3d* const* rotations, const RotationSettings& settings = {});
 
+/// How far from orthonormal (Frobenius norm of R^T R - I) or from unit length a rotation or a warm
+/// start may be and still count as one: far above the rounding of the ones the engine makes.
+inline constexpr double ROTATION_TOLERANCE = 1e-6;
+/// Whether `r` is a proper rotation to ROTATION_TOLERANCE: finite, R^T R = I, det R > 0.
+[[nodiscard]] bool is_rotation(const Eigen::Matrix3d& r);
+/// Whether `q` is a unit quaternion to ROTATION_TOLERANCE (finite): a warm start extract_rotation takes.
+[[nodiscard]] bool is_unit_quaternion(const Eigen::Quaterniond& q);
+
 /// The reference: R = U diag(1, 1, det(U V^T)) V^T from a full SVD. Slow; used as the fallback and in tests.
 Eigen::Matrix3d rotation_by_svd(const Eigen::Matrix3d& deformation_gradient);
 

@@ -490,26 +490,41 @@ TEST(TissueState, KcFromTheLastFactorBetweenFactorizations) {
 // 1e300 m restored, and the next step's stiffness was NaN): displacements and velocities are bounded
 // as mesh coordinates are (MAX_ABS_COORDINATE, per second for a velocity) and refused beyond; a state
 // far out but within the bound restores and steps on with a finite state.
-TEST(TissueState, RefusesDisplacementsAndVelocitiesBeyondTheLargestCoordinate) {
-  const TetMesh mesh = frog();
-  Session session(mesh);
-  Tissue tissue(mesh, frog_settings(mesh));
-  session.set_top(top_of_back(tissue, session));
-  run(tissue, session, 0, 30);
+// The frog pressed for 30 steps and its saved state, which the refusal tests poison one field at a
+// time: each poisoned state, through its bytes, is refused and leaves the tissue as it was.
+struct PressedFrog {
+  TetMesh mesh = frog();
+  Session session{mesh};
+  Tissue tissue{mesh, frog_settings(mesh)};
   TissueSnapshot saved;
-  tissue.save(saved);
-  const DynamicState kept = tissue.state();
-  const Eigen::Index free_row = saved.dynamics.displacement_m.size() - 1;
-  for (const auto& poison : std::vector<std::function<void(TissueSnapshot&)>>{
-           [&](TissueSnapshot& s) { s.dynamics.displacement_m(free_row) = 1e300; },
-           [&](TissueSnapshot& s) { s.dynamics.displacement_m(free_row) = -2.0 * MAX_ABS_COORDINATE; },
-           [&](TissueSnapshot& s) { s.dynamics.velocity_m_per_s(free_row) = 1e300; },
-           [&](TissueSnapshot& s) { s.dynamics.velocity_m_per_s(free_row) = -2.0 * MAX_ABS_COORDINATE; }}) {
-    TissueSnapshot poisoned = saved;
-    poison(poisoned);
-    EXPECT_THROW(tissue.restore(deserialize_snapshot(serialize_snapshot(poisoned))), StateError);
-    EXPECT_TRUE(bitwise_equal(tissue.state().displacement_m, kept.displacement_m));
+  DynamicState kept;
+
+  PressedFrog() {
+    session.set_top(top_of_back(tissue, session));
+    run(tissue, session, 0, 30);
+    tissue.save(saved);
+    kept = tissue.state();
   }
+  void expect_refused(const std::vector<std::function<void(TissueSnapshot&)>>& poisons) {
+    for (size_t k = 0; k < poisons.size(); ++k) {
+      TissueSnapshot poisoned = saved;
+      poisons[k](poisoned);
+      EXPECT_THROW(tissue.restore(deserialize_snapshot(serialize_snapshot(poisoned))), StateError) << "poison " << k;
+      EXPECT_TRUE(bitwise_equal(tissue.state().displacement_m, kept.displacement_m)) << "poison " << k;
+    }
+  }
+};
+
+TEST(TissueState, RefusesDisplacementsAndVelocitiesBeyondTheLargestCoordinate) {
+  PressedFrog pressed;
+  Tissue& tissue = pressed.tissue;
+  Session& session = pressed.session;
+  const TissueSnapshot& saved = pressed.saved;
+  const Eigen::Index free_row = saved.dynamics.displacement_m.size() - 1;
+  pressed.expect_refused({[&](TissueSnapshot& s) { s.dynamics.displacement_m(free_row) = 1e300; },
+                          [&](TissueSnapshot& s) { s.dynamics.displacement_m(free_row) = -2.0 * MAX_ABS_COORDINATE; },
+                          [&](TissueSnapshot& s) { s.dynamics.velocity_m_per_s(free_row) = 1e300; },
+                          [&](TissueSnapshot& s) { s.dynamics.velocity_m_per_s(free_row) = -2.0 * MAX_ABS_COORDINATE; }});
   for (const double far_m : {0.5, 1e3, 0.5 * MAX_ABS_COORDINATE}) {
     TissueSnapshot far = saved;
     far.dynamics.displacement_m(free_row) = far_m;
@@ -520,6 +535,31 @@ TEST(TissueState, RefusesDisplacementsAndVelocitiesBeyondTheLargestCoordinate) {
       EXPECT_NO_THROW(tissue.step()) << far_m;
       EXPECT_TRUE(tissue.state().displacement_m.allFinite()) << far_m;
     }
+  }
+}
+
+// A state whose saved rotations are not rotations (a NaN or non-unit warm start, a rotation
+// stretched, mirrored or NaN) is refused before anything changes: restored, a NaN warm start made
+// the next step's matrix NaN (found by fuzzing the FMU state: "A is not positive definite: diagonal
+// entry 9 is -nan"). A warm start turned to another unit quaternion is a warm start still.
+TEST(TissueState, RefusesRotationsAndWarmStartsThatAreNone) {
+  PressedFrog pressed;
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  const size_t tet = 3;
+  pressed.expect_refused({[&](TissueSnapshot& s) { s.rotations.tet_warm_starts[tet] = Eigen::Quaterniond(nan, 0.0, 0.0, 0.0); },
+                          [&](TissueSnapshot& s) { s.rotations.tet_warm_starts[tet] = Eigen::Quaterniond(0.0, 0.0, 0.0, 0.0); },
+                          [&](TissueSnapshot& s) { s.rotations.tet_warm_starts[tet].coeffs() *= 2.0; },
+                          [&](TissueSnapshot& s) { s.rotations.tets[tet](1, 2) = nan; },
+                          [&](TissueSnapshot& s) { s.rotations.tets[tet] *= 1.01; },
+                          [&](TissueSnapshot& s) { s.rotations.tets[tet] = -s.rotations.tets[tet]; }});
+  Tissue& tissue = pressed.tissue;
+  TissueSnapshot turned = pressed.saved;
+  turned.rotations.tet_warm_starts[tet] = Eigen::Quaterniond(Eigen::AngleAxisd(0.3, Eigen::Vector3d::UnitZ()));
+  tissue.restore(turned);
+  for (int n = 0; n < 3; ++n) {
+    tissue.set_tool(pressed.session.pose(30 + n));
+    EXPECT_NO_THROW(tissue.step());
+    EXPECT_TRUE(tissue.state().displacement_m.allFinite());
   }
 }
 
