@@ -9,8 +9,9 @@ executions, edges, features, the date) already holds for it, so a run stopped ea
 end) is continued by running the same command again. CPU time, not wall time: the machine may
 build or measure meanwhile (stop the targets with SIGSTOP while timing something; SIGCONT after).
 
-Stop early with SIGINT to the targets (`pkill -INT -f build/fuzz/fuzz/fuzz_`): each run is written to the
-ledger as interrupted, with the CPU it used. Wall-clock pauses (SIGSTOP, a build at nice 0) would read as hangs under -timeout=1, so the runs use
+Stop early with SIGTERM to the script (`pkill -TERM -f fuzz/long_run.py`): it interrupts its targets,
+writes each run to the ledger as interrupted with the CPU it used, and exits (a SIGINT to a target
+alone ends that run the same way, and the script starts the next door). Wall-clock pauses (SIGSTOP, a build at nice 0) would read as hangs under -timeout=1, so the runs use
 -timeout=60 and --replay runs every slow or timed-out input kept in WORK/art again under -timeout=1
 (with -runs=3): a real hang fails there.
 
@@ -102,19 +103,27 @@ def run(args):
     pending = [(d, args.cpu_seconds - done.get(d, 0.0)) for d in args.doors.split(",")]
     pending = [(d, budget) for d, budget in pending if budget > 0]
     running = {}
+    # SIGTERM (a session's end): interrupt the targets and write their runs to the ledger, then exit.
+    stop = {"requested": False}
+    signal.signal(signal.SIGTERM, lambda *_: stop.update(requested=True))
     while pending or running:
+        if stop["requested"]:
+            pending.clear()
+            for process, *_ in running.values():
+                if process.poll() is None:
+                    process.send_signal(signal.SIGINT)
         while pending and len(running) < args.jobs:
             door, budget = pending.pop(0)
             process, log_path = start(door, work)
             running[door] = (process, log_path, budget, 0.0)
             print("%s %s started, %.0f s of CPU to go" % (time.strftime("%T"), door, budget), flush=True)
-        time.sleep(10)
+        time.sleep(1 if stop["requested"] else 10)
         for door, (process, log_path, budget, used) in list(running.items()):
             now = cpu_seconds(process.pid)
             if now is not None and process.poll() is None:
                 used = now
                 running[door] = (process, log_path, budget, used)
-                if used < budget:
+                if used < budget or stop["requested"]:
                     continue
                 process.send_signal(signal.SIGINT)
                 stopped = True
