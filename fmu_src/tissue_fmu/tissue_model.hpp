@@ -7,7 +7,7 @@
 #include "core/tissue.hpp"
 #include "fmi3/model.hpp"
 #include "ports/surface_binary.hpp"
-#include "tissue_fmu/background_work.hpp"
+#include "core/system/background_work.hpp"
 #include "tissue_fmu/variables.hpp"
 
 #include <cstdint>

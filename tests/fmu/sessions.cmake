@@ -58,6 +58,3 @@ add_executable(z_width ${CMAKE_CURRENT_LIST_DIR}/z_width.cpp)
 target_link_libraries(z_width PRIVATE tissue_hand_on_tissue tissue::host_compare tissue::host_output tissue::warnings)
 
 # The Tissue FMU's background job (its thread and policy), linked from the model's library.
-add_executable(test_background_work ${CMAKE_CURRENT_LIST_DIR}/test_background_work.cpp)
-target_link_libraries(test_background_work PRIVATE tissue::tissue_fmu_model tissue::warnings GTest::gtest GTest::gtest_main)
-gtest_discover_tests(test_background_work PROPERTIES LABELS "fmu" DISCOVERY_TIMEOUT 60)

@@ -1,15 +1,9 @@
 // BackgroundContactStiffness (see background_contact_stiffness.hpp).
 #include "core/contact/background_contact_stiffness.hpp"
 
-#include "core/system/background_policy.hpp"
-
-#include <system_error>
-
 namespace tissue {
 
-BackgroundContactStiffness::~BackgroundContactStiffness() {
-  if (m_worker.joinable()) m_worker.join();
-}
+BackgroundContactStiffness::~BackgroundContactStiffness() { m_work.wait(); }
 
 void BackgroundContactStiffness::compute() noexcept {
   try {
@@ -47,19 +41,12 @@ void BackgroundContactStiffness::begin(const ContactStiffnessRequest& request, b
 }
 
 void BackgroundContactStiffness::launch() {
-  try {
-    m_worker = std::thread([this] {
-      leave_realtime_policy();
-      compute();
-    });
-  } catch (const std::system_error&) {
-    // No thread to be had: wait() computes it in the caller, with the same result.
-  }
+  m_work.start([this] { compute(); });  // without a thread to be had, computed here, now
 }
 
 void BackgroundContactStiffness::wait() {
   if (m_state != State::running) return;
-  if (m_worker.joinable()) m_worker.join();
+  m_work.wait();
   if (!m_computed) compute();
   m_state = State::done;
 }

@@ -1,21 +1,21 @@
-// BackgroundContactStiffness: the effective contact stiffness K_c computed in a worker thread, so
-// that the factorization it costs (the frog: ~7 ms, most of a 10 ms step slot) leaves the step's
-// critical path. start() copies the matrix and the request in the caller's thread; the worker
-// factorizes the copy and condenses it (condense_loaded), touching nothing of the body; take()
-// joins and hands the result over.
+// BackgroundContactStiffness: the effective contact stiffness K_c computed beside the steps (a
+// BackgroundWork thread, core/system/background_work.hpp), so that the factorization it costs (the
+// frog: ~7 ms, most of a 10 ms step slot) leaves the step's critical path. start() copies the
+// matrix and the request in the caller's thread; the worker factorizes the copy and condenses it
+// (condense_loaded), touching nothing of the body; take() waits for it and hands the result over.
 //
 // Determinism: the caller takes the result at a fixed step (Tissue: the next one), never "when
-// ready", so a run gives the same K_c with or without the thread (no thread to be had: take()
+// ready", so a run gives the same K_c with or without the thread (no thread to be had: start()
 // computes it in the caller). A finished result can be set from a saved state (restore), so that a
 // restored run takes what the original took.
 #pragma once
 
 #include "core/contact/contact_stiffness.hpp"
+#include "core/system/background_work.hpp"
 
 #include <Eigen/Core>
 
 #include <optional>
-#include <thread>
 
 namespace tissue {
 
@@ -60,10 +60,10 @@ class BackgroundContactStiffness {
   EffectiveContactStiffness m_effective;
   ContactStiffnessRequest m_request;
   std::optional<Eigen::Matrix3d> m_result;
-  std::thread m_worker;
   bool m_computed = false;  // m_result holds the job's outcome (false: loaded, no thread ran it)
   bool m_condense_only = false;  // the job condenses from the factor held (start_condense)
   State m_state = State::idle;
+  BackgroundWork m_work;  // last: its job (compute) uses the members above
 };
 
 }  // namespace tissue

@@ -8,18 +8,16 @@
 // Determinism: the worker factorizes a copy of A's values (CholmodFactor::load, in the caller's
 // thread) with its own cholmod_common, and the result is installed at a fixed setup count, never
 // "when ready"; so every solve sees the same preconditioner in every run, with or without the thread.
-// The worker shares nothing with the caller but the CholmodFactor it owns until the join (plus an
-// atomic flag that only feeds the timing counter `pickups_waited`).
+// The worker (a BackgroundWork thread) shares nothing with the caller but the CholmodFactor it owns
+// until the wait (plus an atomic flag that only feeds the timing counter `pickups_waited`).
 #include "core/solve/cholmod_factor.hpp"
 #include "core/solve/linear_solver.hpp"
 #include "core/solve/pcg_iteration.hpp"
-#include "core/system/background_policy.hpp"
+#include "core/system/background_work.hpp"
 
 #include <atomic>
 #include <span>
 #include <string>
-#include <system_error>
-#include <thread>
 #include <utility>
 #include <vector>
 
@@ -36,8 +34,8 @@ struct CholeskyPcgSolver::Impl {
   // Solves without BLAS: a refresh's factorization (BLAS) may run beside them (cholmod_factor.hpp).
   std::unique_ptr<CholmodFactor> active = std::make_unique<CholmodFactor>(CholmodFactor::Solves::without_blas);
   std::unique_ptr<CholmodFactor> spare = std::make_unique<CholmodFactor>(CholmodFactor::Solves::without_blas);
-  std::thread worker;
-  std::atomic<bool> worker_done{false};
+  BackgroundWork worker;                 // the refactorization beside the steps (refresh.background_refactor)
+  std::atomic<bool> worker_done{false};  // its job has finished (a pick-up that had to wait is counted)
   bool in_flight = false;
   int setups_since_start = 0;
   bool refresh_wanted = false;  // the last solve asked for a new factor
@@ -60,9 +58,9 @@ struct CholeskyPcgSolver::Impl {
   Impl& operator=(const Impl&) = delete;
 
   void join() {
-    if (!worker.joinable()) return;
+    if (!worker.pending()) return;
     if (!worker_done.load(std::memory_order_acquire)) ++counters.pickups_waited;
-    worker.join();
+    worker.wait();
   }
 
   // The factor in use can precondition A (or its leading block): same matrix, not more rows.
@@ -82,22 +80,18 @@ struct CholeskyPcgSolver::Impl {
     refresh_wanted = false;
     if (!refresh.background_refactor) return;
     worker_done.store(false, std::memory_order_relaxed);
-    try {
-      worker = std::thread([factor = spare.get(), done = &worker_done] {
-        leave_realtime_policy();
-        factor->factorize();  // noexcept: the status is read after the join
-        done->store(true, std::memory_order_release);
-      });
-    } catch (const std::system_error&) {
-      // No thread to be had: the pick-up factorizes instead, with the same result.
-    }
+    // Without a thread to be had, factorized here, now: the same result.
+    worker.start([factor = spare.get(), done = &worker_done] {
+      factor->factorize();  // noexcept: the status is read after the wait
+      done->store(true, std::memory_order_release);
+    });
   }
 
   // Installs the refresh started pickup_setups setups ago (factorizing it now without a worker).
   void pick_up(long rows) {
-    if (worker.joinable()) {
+    if (worker.pending()) {
       join();
-    } else {
+    } else if (!refresh.background_refactor) {
       spare->factorize();
     }
     in_flight = false;
@@ -195,7 +189,7 @@ const std::string& CholeskyPcgSolver::last_refresh_failure() const { return m_im
 int CholeskyPcgSolver::symbolic_analysis_count() const {
   // The spare's count is read only when no worker holds it.
   Impl& impl = *m_impl;
-  return impl.active->analysis_count() + (impl.worker.joinable() ? 0 : impl.spare->analysis_count());
+  return impl.active->analysis_count() + (impl.worker.pending() ? 0 : impl.spare->analysis_count());
 }
 
 void CholeskyPcgSolver::forget_earlier_setups() {

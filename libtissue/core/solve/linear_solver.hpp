@@ -222,7 +222,7 @@ class CholeskyPcgSolver final : public LinearSolver {
     /// 2 leaves the worker a whole step (on another core) for a ~4.5 ms frog factorization; the
     /// swinging frog's A changes so fast that a factor 4 steps old already needs 60+ iterations.
     int pickup_setups = 2;
-    /// Factorize in a std::thread (joined at pick-up and in the destructor): the core starts a thread
+    /// Factorize in a BackgroundWork thread (waited for at pick-up and in the destructor): the core starts a thread
     /// only when asked (docs/DESIGN.md, "Overview"). false: at pick-up, in the caller's thread (same results).
     bool background_refactor = false;
     /// Turn the factor with the rows' rotations since it was made: P^-1 = Q (L L^T)^-1 Q^T with Q

@@ -1,12 +1,12 @@
 // BackgroundWork (see background_work.hpp).
-#include "tissue_fmu/background_work.hpp"
+#include "core/system/background_work.hpp"
 
 #include "core/system/background_policy.hpp"
 
 #include <system_error>
 #include <utility>
 
-namespace tissue::tissue_fmu {
+namespace tissue {
 
 BackgroundWork::~BackgroundWork() {
   if (!m_thread.joinable()) return;
@@ -61,4 +61,4 @@ void BackgroundWork::serve() noexcept {
   }
 }
 
-}  // namespace tissue::tissue_fmu
+}  // namespace tissue

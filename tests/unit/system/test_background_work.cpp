@@ -1,8 +1,7 @@
-// BackgroundWork (fmu_src/tissue_fmu/background_work.hpp): the Tissue FMU's one job at a time on a
-// thread of its own. A job runs once, wait() returns after it, and a job handed over from a
+// BackgroundWork (core/system/background_work.hpp): one job at a time on a thread of its own. A job runs once, wait() returns after it, and a job handed over from a
 // real-time (SCHED_FIFO) thread runs at the normal policy, so that it only takes what the real-time
 // threads leave idle (inherited, it would take a core from the dynamics team).
-#include "tissue_fmu/background_work.hpp"
+#include "core/system/background_work.hpp"
 
 #include <gtest/gtest.h>
 
@@ -14,7 +13,7 @@
 #include <thread>
 #include <vector>
 
-namespace tissue::tissue_fmu {
+namespace tissue {
 namespace {
 
 TEST(BackgroundWork, EachJobRunsOnceOnItsThreadAndWaitReturnsAfterIt) {
@@ -68,4 +67,4 @@ TEST(BackgroundWork, DestructionWaitsForARunningJob) {
 }
 
 }  // namespace
-}  // namespace tissue::tissue_fmu
+}  // namespace tissue

@@ -1,11 +1,12 @@
 // BackgroundWork: one job at a time on a thread of its own, at the operating system's normal
 // priority (SCHED_OTHER), whatever the priority of the thread that hands it over
-// (core/system/background_policy.hpp). The Tissue FMU
-// prepares the re-meshed surface with it after a step that cut (docs/DESIGN.md, "The surface is
-// prepared after a cut"): a real-time importer's threads run at SCHED_FIFO and take their cores
-// whenever they want them, so the job uses only the time they leave idle and never delays them.
-// The thread is made at the first job and lives until destruction. Not thread-safe: one owner
-// calls start() and wait().
+// (core/system/background_policy.hpp): a real-time importer's or tissue-host's threads run at
+// SCHED_FIFO and take their cores whenever they want them, so the job uses only the time they leave
+// idle and never delays them. The one mechanism for work beside the steps: the Tissue FMU's surface
+// prepared after a cut (docs/DESIGN.md, "The surface is prepared after a cut"), the contact
+// stiffness K_c (BackgroundContactStiffness) and the lagged Cholesky factor's refactorization
+// (CholeskyPcgSolver). The thread is made at the first job and lives until destruction. Not
+// thread-safe: one owner calls start() and wait().
 #pragma once
 
 #include <condition_variable>
@@ -13,7 +14,7 @@
 #include <mutex>
 #include <thread>
 
-namespace tissue::tissue_fmu {
+namespace tissue {
 
 class BackgroundWork {
  public:
@@ -42,4 +43,4 @@ class BackgroundWork {
   bool m_pending = false;       // owner's view: started and not waited for
 };
 
-}  // namespace tissue::tissue_fmu
+}  // namespace tissue
