@@ -160,7 +160,10 @@ StepReport BackwardEuler::step(DynamicsModel& model, DynamicState& state, double
 }
 
 // The initial guess: zero (as Vega and the dissertation), or galerkin_start over the last steps'
-// velocity changes (a grown system drops them: their length no longer divides).
+// velocity changes (a grown system drops them: their length no longer divides). Off by default: it
+// pays at strict tolerances; under the real-time iteration cap its products cost 40% of the solve,
+// and a start from earlier steps leaves their error in the slow modes that the cap does not remove
+// (the raw last dv pumped energy in: docs/BENCHMARKS.md).
 void BackwardEuler::start_velocity_change(const ShiftedSystem& system) {
   const Eigen::Index n = system.rows();
   m_velocity_change.setZero(n);
