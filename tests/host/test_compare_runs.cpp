@@ -153,7 +153,7 @@ TEST(CompareRuns, TheDefaultListOnTheBeam) {
   std::vector<std::string> header;
   const std::vector<CsvRow> rows = read_csv(dir.path() / "compare.csv", &header);
   EXPECT_EQ(header, COLUMNS);
-  ASSERT_EQ(rows.size(), 1u + 8u * 2u);
+  ASSERT_EQ(rows.size(), 1u + 9u * 2u);
   EXPECT_EQ(report.rows.size(), rows.size());
   EXPECT_EQ(rows[0].at("setting"), "reference");
   for (const char* column : {"rms_error_m", "max_error_m", "force_error_n", "energy_drift_j"}) {
@@ -162,7 +162,8 @@ TEST(CompareRuns, TheDefaultListOnTheBeam) {
   EXPECT_EQ(rows[0].at("pareto"), "0");
   const std::vector<std::string> settings{"be-pcgTwoLevel-tol1e-3-cap10", "be-pcg-tol1e-3-cap10",
                                           "be-pcg-tol1e-6-cap1000",       "be-pcgCholesky-tol1e-5-cap25",
-                                          "be-cholmod",                   "ida-klu-rtol1e-3",
+                                          "be-pcgTwoLevel-tol1e-6-warm",  "be-cholmod",
+                                          "ida-klu-rtol1e-3",
                                           "ida-klu-rtol1e-5",             "ida-krylov-rtol1e-3"};
   int on_front = 0;
   for (std::size_t k = 0; k < settings.size(); ++k) {
@@ -190,8 +191,8 @@ TEST(CompareRuns, TheDefaultListOnTheBeam) {
   EXPECT_EQ(rows[1].at("iteration_cap"), "10");
   EXPECT_EQ(std::stod(rows[1].at("tolerance")), 1e-3);
   EXPECT_EQ(rows[7].at("linear_solver"), "pcgCholesky");
-  EXPECT_EQ(rows[11].at("integrator"), "ida");
-  EXPECT_EQ(rows[11].at("linear_solver"), "klu");
+  EXPECT_EQ(rows[13].at("integrator"), "ida");
+  EXPECT_EQ(rows[13].at("linear_solver"), "klu");
 
   const auto rms = [&](const std::string& setting, const std::string& step) {
     return number(row_of(rows, setting, step), "rms_error_m");
@@ -207,6 +208,9 @@ TEST(CompareRuns, TheDefaultListOnTheBeam) {
   // A converged PCG solves the same equations as CHOLMOD; so does CG on the lagged factor at 1e-5.
   EXPECT_NEAR(rms("be-pcg-tol1e-6-cap1000", "0.001"), rms("be-cholmod", "0.001"), 1e-3 * rms("be-cholmod", "0.001"));
   EXPECT_NEAR(rms("be-pcgCholesky-tol1e-5-cap25", "0.01"), rms("be-cholmod", "0.01"), 1e-3 * rms("be-cholmod", "0.01"));
+  // The converged two-level step from the Galerkin warm start solves them too, at both steps.
+  EXPECT_NEAR(rms("be-pcgTwoLevel-tol1e-6-warm", "0.01"), rms("be-cholmod", "0.01"), 1e-3 * rms("be-cholmod", "0.01"));
+  EXPECT_NEAR(rms("be-pcgTwoLevel-tol1e-6-warm", "0.001"), rms("be-cholmod", "0.001"), 1e-3 * rms("be-cholmod", "0.001"));
   // IDA's error control: a tighter tolerance is closer to the (tighter still) reference.
   EXPECT_LT(rms("ida-klu-rtol1e-5", "0.001"), 0.1 * rms("ida-klu-rtol1e-3", "0.001"));
 
