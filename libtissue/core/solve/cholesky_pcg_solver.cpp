@@ -13,6 +13,7 @@
 #include "core/solve/cholmod_factor.hpp"
 #include "core/solve/linear_solver.hpp"
 #include "core/solve/pcg_iteration.hpp"
+#include "core/solve/turned_factor.hpp"
 #include "core/system/background_work.hpp"
 
 #include <atomic>
@@ -49,8 +50,8 @@ struct CholeskyPcgSolver::Impl {
   WorkTeam* team = nullptr;  // lent for a step: CG's products and updates (the factor solve stays on one thread)
   // The rows' frames when each factor's matrix was copied (empty: made without frames), and per
   // block row of the active factor the turn since then, Q = F_now F_then^T (empty: no turn).
-  std::vector<Eigen::Matrix3d> active_frames, spare_frames, turns;
-  Eigen::VectorXd turned_residual, turned_solution;  // Q^T r and (L L^T)^-1 Q^T r on the factor's rows
+  TurnedFactor turned;                        // the active factor's frames and turns (turned_factor.hpp)
+  std::vector<Eigen::Matrix3d> spare_frames;  // the spare's, swapped in with it
 
   Impl(PcgSolver::Settings p, Refresh r) : pcg(p), refresh(r) { work.matrix = HalfMatrix(resolved_precision(p.matrix_precision, p.tolerance)); }
   ~Impl() { join(); }
@@ -97,7 +98,7 @@ struct CholeskyPcgSolver::Impl {
     in_flight = false;
     if (spare->factored() && spare->rows() <= rows) {
       std::swap(active, spare);
-      std::swap(active_frames, spare_frames);
+      std::swap(turned.frames, spare_frames);
       ++counters.refreshes_picked_up;
       refresh_wanted = false;  // the next solve says whether this factor does (after a failure: still wanted)
     } else {
@@ -114,48 +115,21 @@ struct CholeskyPcgSolver::Impl {
     ++counters.refreshes_discarded;
   }
 
-  static void copy_frames(const ShiftedSystem& a, std::vector<Eigen::Matrix3d>& frames) {
-    if (a.block_frames == nullptr) {
-      frames.clear();
-    } else {
-      frames.assign(a.block_frames->begin(), a.block_frames->begin() + a.stiffness->block_rows());
-    }
-  }
-
   // The turn of each of the active factor's block rows since its matrix was copied; none unless
-  // both that copy and `a` have frames.
+  // following rotations and both that copy and `a` have frames.
   void update_turns(const ShiftedSystem& a) {
-    const auto block_rows = static_cast<size_t>(active->rows() / 3);
-    if (!refresh.follow_rotations || a.block_frames == nullptr || active_frames.size() < block_rows ||
-        a.block_frames->size() < block_rows) {
-      turns.clear();
-      return;
+    if (refresh.follow_rotations) {
+      turned.update_turns(a, active->rows());
+    } else {
+      turned.turns.clear();
     }
-    turns.resize(block_rows);
-    for (size_t i = 0; i < block_rows; ++i) turns[i].noalias() = (*a.block_frames)[i] * active_frames[i].transpose();
-    turned_residual.resize(active->rows());
-    turned_solution.resize(active->rows());
   }
 
   // z = P^-1 r: the (turned) factor on its rows, Jacobi on the rows appended since.
   void precondition(const Eigen::VectorXd& r, Eigen::VectorXd& z) {
     const long n = r.size();
     const long m = active->rows();
-    if (turns.empty()) {
-      active->solve(std::span<const double>(r.data(), static_cast<size_t>(m)),
-                    std::span<double>(z.data(), static_cast<size_t>(m)));
-    } else {
-      for (size_t i = 0; i < turns.size(); ++i) {
-        const auto row = static_cast<Eigen::Index>(3 * i);
-        turned_residual.segment<3>(row).noalias() = turns[i].transpose() * r.segment<3>(row);
-      }
-      active->solve(std::span<const double>(turned_residual.data(), static_cast<size_t>(m)),
-                    std::span<double>(turned_solution.data(), static_cast<size_t>(m)));
-      for (size_t i = 0; i < turns.size(); ++i) {
-        const auto row = static_cast<Eigen::Index>(3 * i);
-        z.segment<3>(row).noalias() = turns[i] * turned_solution.segment<3>(row);
-      }
-    }
+    turned.solve(*active, r, z);
     if (m < n) z.tail(n - m) = inverse_diagonal.tail(n - m).cwiseProduct(r.tail(n - m));
   }
 };
@@ -213,7 +187,7 @@ void CholeskyPcgSolver::setup(const ShiftedSystem& system) {
     impl.discard_refresh();  // older than what we factorize now
     impl.forgotten = false;
     impl.active->load(system);
-    Impl::copy_frames(system, impl.active_frames);
+    impl.turned.record_frames(system);
     ++impl.counters.factorizations;
     if (impl.active->factorize() != CholmodFactor::Status::ok) {
       impl.counters.factor_rows = 0;

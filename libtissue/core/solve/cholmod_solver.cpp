@@ -5,6 +5,7 @@
 #include "core/solve/cholmod_factor.hpp"
 #include "core/solve/linear_solver.hpp"
 #include "core/solve/pcg_iteration.hpp"
+#include "core/solve/turned_factor.hpp"
 
 #include <cmath>
 #include <span>
@@ -21,6 +22,7 @@ struct CholmodSolver::Impl {
   ShiftedSystem nearby_system{nullptr, 1.0, nullptr};
   PcgWorkspace work;
   WorkTeam* team = nullptr;
+  TurnedFactor turned;  // the factor turned with the rows' rotations since it was made
 
   void factorize(const ShiftedSystem& system) {
     const ShiftedSystem a = system;  // a copy: it may be nearby_system, cleared here
@@ -29,6 +31,7 @@ struct CholmodSolver::Impl {
     factor.load(a);
     if (factor.factorize() != CholmodFactor::Status::ok) throw SolverError(factor.failure_message("CholmodSolver"));
     factored_system = a;
+    turned.record_frames(a);
   }
 };
 
@@ -62,6 +65,7 @@ void CholmodSolver::setup_nearby(const ShiftedSystem& system) {
   impl.nearby_system = ShiftedSystem{nullptr, 1.0, nullptr};
   impl.work.resize(system.rows());
   impl.work.matrix.assign(system, impl.team);
+  impl.turned.update_turns(system, impl.factor.rows());
   impl.nearby_system = system;
 }
 
@@ -73,10 +77,7 @@ SolveReport CholmodSolver::solve(const Eigen::VectorXd& b, Eigen::VectorXd& x) {
     impl.nearby_system.check_sizes(b, x);
     const SolveReport report = preconditioned_cg</*ROW_WISE=*/false>(
         impl.nearby_system, b, x, NEARBY_TOLERANCE, NEARBY_ITERATIONS, impl.work, impl.team,
-        [&impl](const Eigen::VectorXd& r, Eigen::VectorXd& z, long, long) {
-          impl.factor.solve(std::span<const double>(r.data(), static_cast<size_t>(r.size())),
-                            std::span<double>(z.data(), static_cast<size_t>(z.size())));
-        });
+        [&impl](const Eigen::VectorXd& r, Eigen::VectorXd& z, long, long) { impl.turned.solve(impl.factor, r, z); });
     if (report.converged && x.allFinite()) return report;
     impl.factorize(impl.nearby_system);  // too far after all: the exact solve below
   }
