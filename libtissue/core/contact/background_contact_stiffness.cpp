@@ -11,15 +11,13 @@ void BackgroundContactStiffness::compute() noexcept {
   } catch (...) {  // a request that does not fit, no memory: no K_c (the caller falls back)
     m_result = std::nullopt;
   }
-  m_computed = true;
 }
 
 void BackgroundContactStiffness::start(const ShiftedSystem& system, const ContactStiffnessRequest& request) {
   begin(request, false);
   try {
     m_effective.load(system);
-  } catch (const SolverError&) {
-    m_computed = true;  // nothing to factorize: a failed result
+  } catch (const SolverError&) {  // nothing to factorize: a failed result
     m_state = State::done;
     return;
   }
@@ -35,7 +33,6 @@ void BackgroundContactStiffness::begin(const ContactStiffnessRequest& request, b
   cancel();
   m_request = request;
   m_result = std::nullopt;
-  m_computed = false;
   m_condense_only = condense_only;
   m_state = State::running;
 }
@@ -46,8 +43,7 @@ void BackgroundContactStiffness::launch() {
 
 void BackgroundContactStiffness::wait() {
   if (m_state != State::running) return;
-  m_work.wait();
-  if (!m_computed) compute();
+  m_work.wait();  // the job has run (here, at launch(), when no thread was to be had)
   m_state = State::done;
 }
 
@@ -67,7 +63,6 @@ void BackgroundContactStiffness::cancel() {
 void BackgroundContactStiffness::set_done(const std::optional<Eigen::Matrix3d>& result) {
   cancel();
   m_result = result;
-  m_computed = true;
   m_state = State::done;
 }
 

@@ -24,11 +24,11 @@ class BackgroundContactStiffness {
   enum class State { idle, running, done };
 
   BackgroundContactStiffness() = default;
-  ~BackgroundContactStiffness();  ///< joins a running worker
+  ~BackgroundContactStiffness();  ///< waits for a running worker
   BackgroundContactStiffness(const BackgroundContactStiffness&) = delete;
   BackgroundContactStiffness& operator=(const BackgroundContactStiffness&) = delete;
 
-  /// Copies `system`'s matrix and starts the worker on it (a running one is joined and dropped
+  /// Copies `system`'s matrix and starts the worker on it (a running one is waited for and dropped
   /// first). A matrix that cannot be copied gives a done, failed result.
   void start(const ShiftedSystem& system, const ContactStiffnessRequest& request);
   /// Starts the worker on K_c of `request` from the factor the last start() made, without loading
@@ -38,7 +38,7 @@ class BackgroundContactStiffness {
   /// Whether the object holds a factor to condense from (the last start() factorized). Call when
   /// not running.
   [[nodiscard]] bool factored() const { return m_effective.rows() > 0; }
-  /// Joins a running worker (running -> done); the result stays to be taken.
+  /// Waits for a running worker (running -> done); the result stays to be taken.
   void wait();
   /// Waits, then hands over the result (done -> idle): K_c, or nothing when it could not be condensed
   /// (condense_loaded). Nothing as well when idle.
@@ -55,12 +55,11 @@ class BackgroundContactStiffness {
  private:
   void compute() noexcept;  // the worker's job (or the caller's, without a thread)
   void begin(const ContactStiffnessRequest& request, bool condense_only);  // a job's state, running
-  void launch();  // runs compute() in a new worker (or leaves it to wait())
+  void launch();  // runs compute() on m_work's thread (here, now, without a thread to be had)
 
   EffectiveContactStiffness m_effective;
   ContactStiffnessRequest m_request;
   std::optional<Eigen::Matrix3d> m_result;
-  bool m_computed = false;  // m_result holds the job's outcome (false: loaded, no thread ran it)
   bool m_condense_only = false;  // the job condenses from the factor held (start_condense)
   State m_state = State::idle;
   BackgroundWork m_work;  // last: its job (compute) uses the members above

@@ -164,21 +164,23 @@ StepReport BackwardEuler::step(DynamicsModel& model, DynamicState& state, double
 // pays at strict tolerances; under the real-time iteration cap its products cost 40% of the solve,
 // and a start from earlier steps leaves their error in the slow modes that the cap does not remove
 // (the raw last dv pumped energy in: docs/BENCHMARKS.md).
+Eigen::Index BackwardEuler::past_velocity_changes(Eigen::Index n) const {
+  return n > 0 && m_past_velocity_changes.size() % n == 0 ? m_past_velocity_changes.size() / n : 0;
+}
+
 void BackwardEuler::start_velocity_change(const ShiftedSystem& system) {
   const Eigen::Index n = system.rows();
   m_velocity_change.setZero(n);
-  if (!m_settings.warm_start || n == 0 || m_past_velocity_changes.size() % n != 0) return;
-  const Eigen::Index past = std::min<Eigen::Index>(m_past_velocity_changes.size() / n, WARM_START_STEPS);
-  if (past == 0) return;
+  const Eigen::Index past = std::min<Eigen::Index>(past_velocity_changes(n), WARM_START_STEPS);
+  if (!m_settings.warm_start || past == 0) return;
   galerkin_start(system, m_rhs, Eigen::Map<const Eigen::MatrixXd>(m_past_velocity_changes.data(), n, past),
                  m_velocity_change, m_warm_start);
 }
 
 void BackwardEuler::remember_velocity_change() {
   const Eigen::Index n = m_velocity_change.size();
-  const Eigen::Index kept = m_settings.warm_start && n > 0 && m_past_velocity_changes.size() % n == 0
-                                ? std::min<Eigen::Index>(m_past_velocity_changes.size() / n, WARM_START_STEPS - 1)
-                                : 0;
+  const Eigen::Index kept =
+      m_settings.warm_start ? std::min<Eigen::Index>(past_velocity_changes(n), WARM_START_STEPS - 1) : 0;
   // In place, oldest kept first; allocates only while the history fills.
   m_past_velocity_changes.conservativeResize(n * (kept + 1));
   for (Eigen::Index k = kept; k > 0; --k) {

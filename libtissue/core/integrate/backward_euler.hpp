@@ -82,6 +82,9 @@ class BackwardEuler final : public Integrator {
  private:
   void correct(DynamicsModel& model, const DynamicState& state, double h, StepReport& report, WorkTeam* team);
   ShiftedSystem step_system(const DynamicsModel& model, double h, const Eigen::VectorXd& displacement_m);
+  // How many whole velocity changes of `n` unknowns the history holds (0 when its length does not
+  // divide by n: the system grew since).
+  [[nodiscard]] Eigen::Index past_velocity_changes(Eigen::Index n) const;
   // m_velocity_change = the warm start of the solve of `system` x = m_rhs (zero without one).
   void start_velocity_change(const ShiftedSystem& system);
   // Puts m_velocity_change first among the past velocity changes.

@@ -3,6 +3,8 @@
 // it takes only what the real-time threads leave idle. A thread at the normal policy keeps it.
 #include "core/system/background_policy.hpp"
 
+#include "fifo_thread.hpp"
+
 #include <gtest/gtest.h>
 
 #include <pthread.h>
@@ -15,12 +17,7 @@ namespace {
 
 TEST(BackgroundPolicy, AThreadMadeByARealTimeThreadLeavesItsPolicy) {
   int inherited = -1, after = -1;
-  bool fifo = false;
-  std::thread creator([&] {
-    sched_param priority{};
-    priority.sched_priority = 10;
-    fifo = pthread_setschedparam(pthread_self(), SCHED_FIFO, &priority) == 0;
-    if (!fifo) return;
+  const bool fifo = test::run_on_a_fifo_thread([&] {
     std::thread background([&] {
       inherited = sched_getscheduler(0);
       leave_realtime_policy();
@@ -28,7 +25,6 @@ TEST(BackgroundPolicy, AThreadMadeByARealTimeThreadLeavesItsPolicy) {
     });
     background.join();
   });
-  creator.join();
   if (!fifo) GTEST_SKIP() << "SCHED_FIFO not permitted here (not root, no CAP_SYS_NICE)";
   EXPECT_EQ(inherited, SCHED_FIFO);
   EXPECT_EQ(after, SCHED_OTHER);

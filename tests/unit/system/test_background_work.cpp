@@ -1,7 +1,10 @@
-// BackgroundWork (core/system/background_work.hpp): one job at a time on a thread of its own. A job runs once, wait() returns after it, and a job handed over from a
-// real-time (SCHED_FIFO) thread runs at the normal policy, so that it only takes what the real-time
-// threads leave idle (inherited, it would take a core from the dynamics team).
+// BackgroundWork (core/system/background_work.hpp): one job at a time on a thread of its own. A job
+// runs once, wait() returns after it, and a job handed over from a real-time (SCHED_FIFO) thread
+// runs at the normal policy, so that it only takes what the real-time threads leave idle
+// (inherited, it would take a core from the dynamics team).
 #include "core/system/background_work.hpp"
+
+#include "fifo_thread.hpp"
 
 #include <gtest/gtest.h>
 
@@ -39,17 +42,11 @@ TEST(BackgroundWork, EachJobRunsOnceOnItsThreadAndWaitReturnsAfterIt) {
 
 TEST(BackgroundWork, AJobHandedOverFromARealTimeThreadRunsAtTheNormalPolicy) {
   int policy_in_job = -1;
-  bool fifo = false;
-  std::thread owner([&] {
-    sched_param fifo_priority{};
-    fifo_priority.sched_priority = 10;
-    fifo = pthread_setschedparam(pthread_self(), SCHED_FIFO, &fifo_priority) == 0;
-    if (!fifo) return;
+  const bool fifo = test::run_on_a_fifo_thread([&] {
     BackgroundWork work;  // its thread is made by this (real-time) thread at the first job
     work.start([&] { policy_in_job = sched_getscheduler(0); });
     work.wait();
   });
-  owner.join();
   if (!fifo) GTEST_SKIP() << "SCHED_FIFO not permitted here (not root, no CAP_SYS_NICE)";
   EXPECT_EQ(policy_in_job, SCHED_OTHER);
 }
