@@ -6,7 +6,9 @@ wall times, ms), how often the tangent was re-laid out and the mean Newton corre
 turns an element far is corrected: a cost that follows the trajectory, not the code):
 
 * before: 40 steps with the scalpel beside the body, before any cut;
-* enriching: the stroke's steps that cut tets (the volume cutter's new cuts, enriched at once);
+* enriching: the stroke's steps that cut tets (the volume cutter's new cuts, enriched at once)
+  without moving the tangent's storage;
+* re-layout: those whose cuts needed room the rows did not have (the tangent re-laid out);
 * plain: the stroke's other steps.
 
 With --organ: the 52k-tet organ of host/scenarios/cut_organ.toml (meshes/liver.veg hung by its
@@ -41,7 +43,7 @@ def stroke(tissue, solver, organ):
     body.step(5 if organ else 20)  # settle under gravity
     x = lower[0] + (0.8 if organ else 0.6) * size[0]
     tip_z = lower[2] - (0.02 if organ else 0.05)
-    kinds = {"before": [], "enriching": [], "plain": []}
+    kinds = {"before": [], "enriching": [], "re-layout": [], "plain": []}
     for _ in range(20 if organ else 40):
         body.set_tool((x, lower[1] - 0.05, tip_z), mode="scalpel")
         kinds["before"].append(body.step())
@@ -53,7 +55,10 @@ def stroke(tissue, solver, organ):
             y = lower[1] - 0.01 + n / steps * (size[1] + 0.02)
         body.set_tool((x, y, tip_z), mode="scalpel")
         report = body.step()
-        kinds["enriching" if report["newly_cut_tets"] > 0 else "plain"].append(report)
+        if report["newly_cut_tets"] == 0:
+            kinds["plain"].append(report)
+        else:
+            kinds["re-layout" if report.get("matrix_relayout") else "enriching"].append(report)
     if organ:
         kinds["after"] = []
         body.set_tool((x, lower[1] - 0.1, upper[2] + 0.1), mode="none")
@@ -79,6 +84,8 @@ def main():
         kinds = stroke(tissue, args.solver, args.organ)
         before_ms = 1e3 * statistics.median(r["total_s"] for r in kinds["before"])
         for name, reports in kinds.items():
+            if not reports:
+                continue
             # A module from before a part was reported (--module of an older build) leaves it "-".
             medians = [1e3 * statistics.median(r[p] for r in reports) if p in reports[0] else None for p in PARTS]
             relayouts = sum(bool(r["matrix_relayout"]) for r in reports) if "matrix_relayout" in reports[0] else "-"

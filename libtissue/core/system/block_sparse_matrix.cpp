@@ -212,6 +212,11 @@ void BlockSparseMatrix::diagonal(Eigen::VectorXd& diagonal) const {
   for (int r = 0; r < n; ++r) diagonal.segment<3>(3 * r) = block(m_diagonal_slot[to_size(r)]).diagonal();
 }
 
+// In place, from the last row to the first: a row's room never shrinks, so each row moves to a slot
+// at or after its old first one and its new room ends where the next row's, already moved, begins;
+// its blocks are read out (sorted by column) before they are written back. A second buffer (as
+// before) cost fresh pages or a copy of the older layout whenever the storage grew: the frog's
+// re-layouts took 1.3-1.7 ms, ~0.2 of them the copy itself (docs/BENCHMARKS.md).
 void BlockSparseMatrix::relayout(const std::vector<std::pair<int, int>>& min_capacity, int spare_rows) {
   const int n = block_rows();
   if (m_spare_row_capacity < 1) m_spare_row_capacity = DEFAULT_SPARE_ROW_CAPACITY;
@@ -227,42 +232,56 @@ void BlockSparseMatrix::relayout(const std::vector<std::pair<int, int>>& min_cap
   slot_count += static_cast<long>(spare_rows) * m_spare_row_capacity;
   if (slot_count > (1L << 31) / 9 - 1)
     throw std::length_error("BlockSparseMatrix: too many blocks for int slot indices");
-
   std::vector<int> row_begin(to_size(n));
-  // Written into the storage of the re-layout before, with a quarter to spare when it must grow:
-  // each cut re-lays out a little larger, and fresh pages cost more than the copy.
-  std::vector<int>& column = m_spare_column;
-  std::vector<double>& values = m_spare_values;
-  if (column.capacity() < static_cast<size_t>(slot_count)) {
-    column.reserve(static_cast<size_t>(slot_count) + static_cast<size_t>(slot_count) / 4);
-    values.reserve(9 * column.capacity());
+  for (int r = 1; r < n; ++r) row_begin[to_size(r)] = row_begin[to_size(r - 1)] + capacity[to_size(r - 1)];
+
+  // The old rows end here; every slot after it is unused (zero), and so is storage added below.
+  const int old_rows_end = n == 0 ? 0 : m_row_begin[to_size(n - 1)] + m_row_capacity[to_size(n - 1)];
+  const size_t old_slots = m_column.size();
+  const auto slots = static_cast<size_t>(slot_count);
+  if (slots > old_slots) {
+    if (m_column.capacity() < slots) {  // a quarter to spare: each cut re-lays out a little larger
+      m_column.reserve(slots + slots / 4);
+      m_values.reserve(9 * m_column.capacity());
+    }
+    m_column.resize(slots, -1);
+    m_values.resize(9 * slots, 0.0);
   }
-  column.assign(static_cast<size_t>(slot_count), -1);
-  values.assign(9 * static_cast<size_t>(slot_count), 0.0);
+  m_relayout_slot_map.assign(old_slots, -1);
   std::vector<std::pair<int, int>> order;  // (column, old slot) of one row
-  m_relayout_slot_map.assign(m_column.size(), -1);
-  int begin = 0;
-  for (int r = 0; r < n; ++r) {
-    row_begin[to_size(r)] = begin;
+  std::vector<double> row_values;          // its blocks in that order
+  for (int r = n - 1; r >= 0; --r) {
     const int old_begin = m_row_begin[to_size(r)];
     const int size = m_row_size[to_size(r)];
     order.clear();
     for (int k = 0; k < size; ++k) order.emplace_back(m_column[to_size(old_begin + k)], old_begin + k);
     std::sort(order.begin(), order.end());  // appended blocks return to column order: better locality
+    row_values.resize(9 * to_size(size));
+    for (int k = 0; k < size; ++k) {
+      std::copy_n(&m_values[9 * to_size(order[to_size(k)].second)], 9, &row_values[9 * to_size(k)]);
+    }
+    const int begin = row_begin[to_size(r)];
     for (int k = 0; k < size; ++k) {
       const int slot = begin + k;
-      column[to_size(slot)] = order[to_size(k)].first;
-      std::copy_n(&m_values[9 * to_size(order[to_size(k)].second)], 9, &values[9 * to_size(slot)]);
+      m_column[to_size(slot)] = order[to_size(k)].first;
+      std::copy_n(&row_values[9 * to_size(k)], 9, &m_values[9 * to_size(slot)]);
       m_relayout_slot_map[to_size(order[to_size(k)].second)] = slot;
       if (order[to_size(k)].first == r) m_diagonal_slot[to_size(r)] = slot;
     }
-    begin += capacity[to_size(r)];
+    // The rest of its room may hold blocks of the old layout (its own, the next rows'): cleared.
+    const int clear_end = std::min(begin + capacity[to_size(r)], old_rows_end);
+    for (int slot = begin + size; slot < clear_end; ++slot) m_column[to_size(slot)] = -1;
+    if (clear_end > begin + size) {
+      std::fill(m_values.begin() + 9 * static_cast<long>(begin + size), m_values.begin() + 9 * static_cast<long>(clear_end), 0.0);
+    }
+  }
+  if (slots < old_slots) {  // fewer spare rows: the tail is unused
+    m_column.resize(slots);
+    m_values.resize(9 * slots);
   }
 
   m_row_begin = std::move(row_begin);
   m_row_capacity = std::move(capacity);
-  m_column.swap(column);
-  m_values.swap(values);
   m_block_row_capacity = n + spare_rows;
   ++m_layout_revision;
   ++m_pattern_revision;

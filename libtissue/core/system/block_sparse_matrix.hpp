@@ -128,9 +128,6 @@ class BlockSparseMatrix {
   std::vector<double> m_values;      // 9 per slot, column-major 3x3
   std::vector<int> m_diagonal_slot;  // slot of the diagonal block of each row (always present)
   std::vector<int> m_relayout_slot_map;  // old slot -> new slot of the last re-layout
-  // The storage before the last re-layout, written over by the next one (relayout).
-  std::vector<int> m_spare_column;
-  std::vector<double> m_spare_values;
   int m_nonzero_blocks = 0;
   int m_spare_row_capacity = 0;  // slots reserved per spare row (appended rows take at least this)
   int m_block_row_capacity = 0;

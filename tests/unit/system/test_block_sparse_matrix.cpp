@@ -403,5 +403,60 @@ TEST(BlockSparseMatrix, AppendedRowTakesItsRoomFromTheSparePool) {
   EXPECT_EQ(matrix.layout_revision(), layout_after + 1);
 }
 
+// reserve_room re-lays the rows out in place (no second buffer): rows in the middle that grow push
+// the later ones past where the earlier ones lay, blocks appended out of column order come back in
+// order, every value and the slot map survive, and every slot no block uses is clear (-1, zero), as
+// insert_block and the product rely on.
+TEST(BlockSparseMatrix, ReservingRoomInPlaceKeepsEveryBlockAndClearsTheRest) {
+  std::mt19937 rng(17);
+  const Pattern pattern = random_symmetric_pattern(30, 2, rng);
+  BlockSparseMatrix matrix(pattern, {0.5, 1});  // compact rows
+  BlockMap blocks = fill_random(matrix, pattern, rng);
+  std::uniform_int_distribution<int> pick(0, 29);
+  for (int round = 0; round < 6; ++round) {
+    // A few rows (the first, the last, some between) gain blocks beyond their room; first the room.
+    std::vector<std::pair<int, int>> extra{{0, 3}, {29, 2}, {pick(rng), 12}, {pick(rng), 5}};
+    std::map<int, int> slot_of_block_before;  // old slot -> (row * 30 + column)
+    for (const auto& [key, value] : blocks) slot_of_block_before[matrix.find_slot(key.first, key.second)] = key.first * 30 + key.second;
+    const int capacity_before = matrix.slot_capacity();
+    const auto layout = matrix.layout_revision();
+    const bool moved = matrix.reserve_room(extra);
+    ASSERT_TRUE(moved);
+    EXPECT_EQ(matrix.layout_revision(), layout + 1);
+    const std::vector<int>& map = matrix.relayout_slot_map();
+    ASSERT_EQ(static_cast<int>(map.size()), capacity_before);
+    for (const auto& [old_slot, key] : slot_of_block_before) {
+      EXPECT_EQ(map[static_cast<size_t>(old_slot)], matrix.find_slot(key / 30, key % 30));
+    }
+    for (int r = 0; r < matrix.block_rows(); ++r) {  // each row back in column order
+      for (int k = 1; k < matrix.row_size(r); ++k) {
+        EXPECT_LT(matrix.slot_column(matrix.row_begin(r) + k - 1), matrix.slot_column(matrix.row_begin(r) + k));
+      }
+    }
+    // Then the blocks, in descending column order (the room holds them: nothing moves).
+    for (const auto& [row, count] : extra) {
+      for (int c = 29, added = 0; c >= 0 && added < count; --c) {
+        if (matrix.find_slot(row, c) >= 0) continue;
+        const Eigen::Matrix3d value = random_block(rng);
+        matrix.block(matrix.insert_block(row, c)) = value;
+        blocks[{row, c}] = value;
+        ++added;
+      }
+    }
+    EXPECT_EQ(matrix.layout_revision(), layout + 1);
+    expect_values(matrix, blocks);
+    expect_product_matches(matrix, blocks, rng);
+    int used = 0;
+    for (int r = 0; r < matrix.block_rows(); ++r) used += matrix.row_size(r);
+    int clear = 0;
+    for (int slot = 0; slot < matrix.slot_capacity(); ++slot) {
+      if (matrix.slot_column(slot) >= 0) continue;
+      ++clear;
+      EXPECT_TRUE(matrix.block(slot).isZero()) << "slot " << slot << " of round " << round;
+    }
+    EXPECT_EQ(used + clear, matrix.slot_capacity());
+  }
+}
+
 }  // namespace
 }  // namespace tissue
