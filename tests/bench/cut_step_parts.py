@@ -15,8 +15,12 @@ With --organ: the 52k-tet organ of host/scenarios/cut_organ.toml (meshes/liver.v
 ridge, E 300 kPa) and a vertical scalpel through its left lobe at 80% of its length in 150 steps,
 20 steps before, and 40 "after" steps with the tool put away.
 
+With --scenario FILE: a tissue-host scenario's tissue and tool path (`tissue.Scenario`, its settings,
+threads included), stepped offline: "before" is the steps before its first cut, "plain" the steps
+after it that cut nothing (e.g. host/scenarios/cut_organ.toml: the 6.1k-tet organ on two threads).
+
 Usage: /usr/bin/python3 tests/bench/cut_step_parts.py [--runs 3] [--solver pcgTwoLevel] [--organ]
-       [--module DIR]
+       [--scenario FILE] [--module DIR]
 (DIR: where tissue*.so is, default build/release/python). One thread; run nothing else meanwhile.
 """
 import argparse
@@ -67,11 +71,31 @@ def stroke(tissue, solver, organ):
     return kinds
 
 
+def scenario_steps(tissue, path):
+    scenario = tissue.Scenario(path)
+    body = scenario.tissue()
+    kinds = {"before": [], "enriching": [], "re-layout": [], "plain": []}
+    cut = False
+    n = 0
+    while n * scenario.tissue_step_s < scenario.duration_s:
+        position, orientation, mode = scenario.tool_at(n * scenario.tissue_step_s)
+        body.set_tool(position, orientation, mode=mode)
+        report = body.step()
+        if report["newly_cut_tets"] > 0:
+            cut = True
+            kinds["re-layout" if report["matrix_relayout"] else "enriching"].append(report)
+        else:
+            kinds["plain" if cut else "before"].append(report)
+        n += 1
+    return kinds
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("--runs", type=int, default=3)
     parser.add_argument("--solver", default="")
     parser.add_argument("--organ", action="store_true")
+    parser.add_argument("--scenario", default="")
     parser.add_argument("--module", default=os.path.join(ROOT, "build", "release", "python"))
     args = parser.parse_args()
     sys.path.insert(0, args.module)
@@ -81,7 +105,7 @@ def main():
           "| Newton corrections (mean) | total / before |")
     print("|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|")
     for run in range(args.runs):
-        kinds = stroke(tissue, args.solver, args.organ)
+        kinds = scenario_steps(tissue, args.scenario) if args.scenario else stroke(tissue, args.solver, args.organ)
         before_ms = 1e3 * statistics.median(r["total_s"] for r in kinds["before"])
         for name, reports in kinds.items():
             if not reports:

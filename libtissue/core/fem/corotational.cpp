@@ -191,14 +191,21 @@ void CorotationalElasticity::reset_rotations() {
 }
 
 void CorotationalElasticity::evaluate(const Eigen::VectorXd& positions_m, Eigen::VectorXd& internal_forces_n,
-                                      BlockSparseMatrix* tangent, const std::vector<TetSlots>* slots, WorkTeam* team) {
+                                      BlockSparseMatrix* tangent, const std::vector<TetSlots>* slots, WorkTeam* team,
+                                      double* elastic_energy_j) {
   assert(tangent == nullptr || (slots != nullptr && slots->size() == m_tets.size()));
+  // Each part's energy apart, added in part order: bitwise the same with a team or without.
+  double energy = 0.0;
   for (const AssemblyPhase& phase : m_phases) {
+    std::array<double, ASSEMBLY_PARTS> part_energy{};
     run_parts(team, ASSEMBLY_PARTS, [&](int part) {
-      add_tets(phase[static_cast<size_t>(part)], positions_m, internal_forces_n, tangent, slots);
+      add_tets(phase[static_cast<size_t>(part)], positions_m, internal_forces_n, tangent, slots,
+               elastic_energy_j != nullptr ? &part_energy[static_cast<size_t>(part)] : nullptr);
     });
+    for (const double part : part_energy) energy += part;
   }
-  add_tets(m_serial_tets, positions_m, internal_forces_n, tangent, slots);
+  add_tets(m_serial_tets, positions_m, internal_forces_n, tangent, slots, elastic_energy_j != nullptr ? &energy : nullptr);
+  if (elastic_energy_j != nullptr) *elastic_energy_j = energy;
 }
 
 template <class TetAt, class Visit>
@@ -238,12 +245,15 @@ void CorotationalElasticity::in_rotation_batches(size_t count, TetAt tet_at, con
 
 TISSUE_HOT_KERNEL void CorotationalElasticity::add_tets(const std::vector<int>& tets, const Eigen::VectorXd& positions_m,
                                                         Eigen::VectorXd& internal_forces_n, BlockSparseMatrix* tangent,
-                                                        const std::vector<TetSlots>* slots) {
+                                                        const std::vector<TetSlots>* slots, double* energy_j) {
+  double energy = 0.0;
   in_rotation_batches(
       tets.size(), [&tets](size_t k) { return tets[k]; }, positions_m, &m_warm_starts, &m_rotations,
-      [&](size_t t, const Eigen::Matrix3d& f, const Eigen::Matrix3d& /*rotation: m_rotations[t]*/) {
+      [&](size_t t, const Eigen::Matrix3d& f, const Eigen::Matrix3d& rotation) {
         add_tet(t, f, internal_forces_n, tangent, slots);
+        if (energy_j != nullptr) energy += m_elements.energy_j(m_rest[t], rotation, f);
       });
+  if (energy_j != nullptr) *energy_j += energy;
 }
 
 namespace {

@@ -74,8 +74,10 @@ class CorotationalElasticity {
   /// of those (the separator, split the same way), and once more; then what separates these. With a team
   /// of two the halves of a phase run side by side: they write disjoint entries, and every entry
   /// receives its terms in the same order as with one thread, so the result is bitwise the same.
+  /// With `elastic_energy_j`, also the elastic energy at these positions with the rotations just
+  /// extracted (elastic_energy_j() there, to round-off: the terms are added in assembly order). [J]
   void evaluate(const Eigen::VectorXd& positions_m, Eigen::VectorXd& internal_forces_n, BlockSparseMatrix* tangent,
-                const std::vector<TetSlots>* slots, WorkTeam* team = nullptr);
+                const std::vector<TetSlots>* slots, WorkTeam* team = nullptr, double* elastic_energy_j = nullptr);
 
   /// How many parts the assembly runs side by side (a team's members beyond this wait).
   static constexpr int ASSEMBLY_PARTS = MAX_STEP_THREADS;
@@ -125,9 +127,10 @@ class CorotationalElasticity {
                            std::vector<Eigen::Quaterniond>* warm_starts, std::vector<Eigen::Matrix3d>* rotations,
                            Visit visit) const;
 
-  /// Adds the forces and blocks of `tets` (skipping excluded ones), rotations in batches.
+  /// Adds the forces and blocks of `tets` (skipping excluded ones), rotations in batches, and their
+  /// energy into `energy_j` when given.
   void add_tets(const std::vector<int>& tets, const Eigen::VectorXd& positions_m, Eigen::VectorXd& internal_forces_n,
-                BlockSparseMatrix* tangent, const std::vector<TetSlots>* slots);
+                BlockSparseMatrix* tangent, const std::vector<TetSlots>* slots, double* energy_j);
 
   /// Splits the tets into the parts and the separator (see evaluate()).
   /// Then stores the per-tet data in assembly order (m_tet_id, m_storage).

@@ -296,22 +296,30 @@ void DeformableBody::check_unknowns(const Eigen::VectorXd& displacement_m) const
   }
 }
 
-void DeformableBody::evaluate(const Eigen::VectorXd& displacement_m, Eigen::VectorXd& internal_force_n,
-                              bool update_tangent) {
+void DeformableBody::evaluate_pass(const Eigen::VectorXd& displacement_m, Eigen::VectorXd& internal_force_n,
+                                   bool update_tangent, bool with_potential) {
   check_unknowns(displacement_m);
   positions(displacement_m, m_positions_m);
   m_vertex_forces_n.setZero();
   if (update_tangent) m_tangent.set_zero(m_team);
   BlockSparseMatrix* tangent = update_tangent ? &m_tangent : nullptr;
-  m_elasticity.evaluate(m_positions_m, m_vertex_forces_n, tangent, &m_slots, m_team);
+  double uncut_energy_j = 0.0;
+  double cut_energy_j = 0.0;
+  m_elasticity.evaluate(m_positions_m, m_vertex_forces_n, tangent, &m_slots, m_team,
+                        with_potential ? &uncut_energy_j : nullptr);
   internal_force_n.resize(dof_count());
   const int u_rows = m_dofs.free_vertex_count();
   internal_force_n.tail(3 * enriched_dof_count()).setZero();
-  m_xfem.evaluate(m_positions_m, displacement_m, m_vertex_forces_n, internal_force_n, tangent);
+  m_xfem.evaluate(m_positions_m, displacement_m, m_vertex_forces_n, internal_force_n, tangent,
+                  with_potential ? &cut_energy_j : nullptr);
 
+  // potential_energy_j's sum, from this pass's rotations.
+  m_evaluated_potential_j = with_potential ? uncut_energy_j + cut_energy_j - m_external_force_n.dot(displacement_m)
+                                           : std::numeric_limits<double>::quiet_NaN();
   for (ForceTerm* term : m_force_terms) {
     term->add_force(m_positions_m, m_vertex_forces_n);
     if (tangent != nullptr) term->add_tangent(*tangent);
+    if (with_potential) m_evaluated_potential_j += term->energy_j(m_positions_m);
   }
 
   for (int row = 0; row < u_rows; ++row) {
@@ -500,12 +508,16 @@ double DeformableBody::piece_mass_kg(int cut_tet_index, int piece) const {
 // --- Force terms ---
 
 void DeformableBody::attach(ForceTerm& term) {
+  m_evaluated_potential_j = std::numeric_limits<double>::quiet_NaN();
   if (std::find(m_force_terms.begin(), m_force_terms.end(), &term) == m_force_terms.end()) {
     m_force_terms.push_back(&term);
   }
   term.locate(term_layout());
 }
 
-void DeformableBody::detach(ForceTerm& term) { std::erase(m_force_terms, &term); }
+void DeformableBody::detach(ForceTerm& term) {
+  m_evaluated_potential_j = std::numeric_limits<double>::quiet_NaN();
+  std::erase(m_force_terms, &term);
+}
 
 }  // namespace tissue

@@ -108,7 +108,15 @@ class DeformableBody final : public DynamicsModel {
   [[nodiscard]] const Eigen::VectorXd& mass_damping_kg_per_s() const override { return m_mass_damping_kg_per_s; }
   [[nodiscard]] double stiffness_damping_s() const override { return m_settings.damping.stiffness_damping_s; }
   [[nodiscard]] const Eigen::VectorXd& external_force_n() const override { return m_external_force_n; }
-  void evaluate(const Eigen::VectorXd& displacement_m, Eigen::VectorXd& internal_force_n, bool update_tangent) override;
+  void evaluate(const Eigen::VectorXd& displacement_m, Eigen::VectorXd& internal_force_n, bool update_tangent) override {
+    evaluate_pass(displacement_m, internal_force_n, update_tangent, /*with_potential=*/false);
+  }
+  /// The elements' energies are summed in the same pass (4-7% of it; docs/DESIGN.md, "Backward Euler
+  /// on steps that turn elements far").
+  void evaluate_with_potential(const Eigen::VectorXd& displacement_m, Eigen::VectorXd& internal_force_n,
+                               bool update_tangent) override {
+    evaluate_pass(displacement_m, internal_force_n, update_tangent, /*with_potential=*/true);
+  }
   /// The uncut tets' forces and blocks are then assembled by the team (bitwise the same result).
   void lend_work_team(WorkTeam* team) override { m_team = team; }
   [[nodiscard]] const BlockSparseMatrix& tangent() const override { return m_tangent; }
@@ -123,6 +131,10 @@ class DeformableBody final : public DynamicsModel {
   [[nodiscard]] double largest_turn_rad(const Eigen::VectorXd& increment_m, double resolution_rad) const override;
   /// elastic_energy_j + the attached terms' energies - f_ext . u. [J]
   [[nodiscard]] double potential_energy_j(const Eigen::VectorXd& displacement_m) override;
+  /// The same sum at the last evaluate_with_potential()'s displacement, made in that pass (NaN after
+  /// a plain evaluate(), a cut, a part parked, a term attached or detached; a term's own parameters
+  /// changed since are not in it: read it right after the evaluate).
+  [[nodiscard]] double potential_energy_at_last_evaluate_j() const override { return m_evaluated_potential_j; }
 
   [[nodiscard]] const TetMesh& mesh() const { return m_mesh; }
   /// The mesh's faces, edges and vertex stars (build_adjacency), made once here.
@@ -272,6 +284,9 @@ class DeformableBody final : public DynamicsModel {
   [[nodiscard]] double kinetic_energy_j(const Eigen::VectorXd& velocity_m_per_s) const;
 
  private:
+  void evaluate_pass(const Eigen::VectorXd& displacement_m, Eigen::VectorXd& internal_force_n, bool update_tangent,
+                     bool with_potential);
+
   TetMesh m_mesh;
   TetAdjacency m_adjacency;         // faces and vertex stars, for grouping the pieces' ghosts
   std::vector<int> m_vertex_order;  // locality_order(): the block rows' and the assembly's sequence
@@ -368,6 +383,7 @@ class DeformableBody final : public DynamicsModel {
   // change how they join): the union-find over the organ's 52k tets is milliseconds, and the look
   // every 10 steps should not be.
   BodyParts m_parts;
+  double m_evaluated_potential_j = std::numeric_limits<double>::quiet_NaN();  // at the last evaluate()
   long m_element_revision = 0;  // counts enrichments
   long m_parts_revision = -1;   // m_element_revision when m_parts was found
 

@@ -21,6 +21,7 @@ struct PartSummary {
 }  // namespace
 
 std::vector<int> DeformableBody::park_parts_outside(const Eigen::AlignedBox3d& field, DynamicState& state) {
+  m_evaluated_potential_j = std::numeric_limits<double>::quiet_NaN();
   check_unknowns(state.displacement_m);
   if (state.velocity_m_per_s.size() != dof_count()) {
     throw std::invalid_argument("park_parts_outside: the state has " + std::to_string(state.velocity_m_per_s.size()) +

@@ -176,8 +176,9 @@ TetPositions piece_positions(const CutPiece& piece, const TetPositions& real_pos
 
 void XfemElasticity::evaluate(const Eigen::VectorXd& positions_m, const Eigen::VectorXd& displacement_m,
                               Eigen::VectorXd& vertex_forces_n, Eigen::VectorXd& internal_force_n,
-                              BlockSparseMatrix* tangent) {
+                              BlockSparseMatrix* tangent, double* elastic_energy_j) {
   TetPositions real_m;
+  double energy = 0.0;
   for (size_t k = 0; k < m_cut_tets.size(); ++k) {
     if (m_retired[k] != 0 || all_parked(static_cast<int>(k))) continue;
     const CutTet& cut_tet = m_cut_tets[k];
@@ -195,6 +196,7 @@ void XfemElasticity::evaluate(const Eigen::VectorXd& positions_m, const Eigen::V
           deformation_gradient(rest, piece_positions(piece, real_m, cut_tet.rest_m, displacement_m));
       const Eigen::Matrix3d& r = m_rotations[p] = extract_rotation(f, m_warm_starts[p], m_rotation_settings);
       const Eigen::Matrix<double, 3, 4> forces = m_elements.forces(rest, r, f);
+      if (elastic_energy_j != nullptr) energy += piece.weight * m_elements.energy_j(rest, r, f);
       for (size_t i = 0; i < 4; ++i) {
         if (piece.ghost_row[i] < 0) {
           vertex_sum.col(to_int(i)) += piece.weight * forces.col(to_int(i));
@@ -255,6 +257,7 @@ void XfemElasticity::evaluate(const Eigen::VectorXd& positions_m, const Eigen::V
       }
     }
   }
+  if (elastic_energy_j != nullptr) *elastic_energy_j = energy;
 }
 
 double XfemElasticity::elastic_energy_j(const Eigen::VectorXd& positions_m,

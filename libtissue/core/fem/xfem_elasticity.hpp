@@ -174,8 +174,11 @@ class XfemElasticity {
   /// `displacement_m`: the unknowns (the ghosts' c are read from their rows). Adds the forces on the
   /// real vertices into `vertex_forces_n` (3 per vertex), those on the ghosts into their rows of
   /// `internal_force_n` (3 per unknown) and, when `tangent` is given, the blocks through the slots.
+  /// With `elastic_energy_j`, also their elastic energy with the rotations just extracted
+  /// (elastic_energy_j() there, to round-off). [J]
   void evaluate(const Eigen::VectorXd& positions_m, const Eigen::VectorXd& displacement_m,
-                Eigen::VectorXd& vertex_forces_n, Eigen::VectorXd& internal_force_n, BlockSparseMatrix* tangent);
+                Eigen::VectorXd& vertex_forces_n, Eigen::VectorXd& internal_force_n, BlockSparseMatrix* tangent,
+                double* elastic_energy_j = nullptr);
 
   /// Sum over the cut tets of w_a E(part a) + w_b E(part b), with the rotations of these
   /// positions (warm starts unchanged). [J]

@@ -105,7 +105,14 @@ StepReport BackwardEuler::step(DynamicsModel& model, DynamicState& state, double
   if (m_settings.threads > 1) team.emplace(m_settings.threads);
   const TeamLoan loan(model, *m_solver, team ? &*team : nullptr);
   const auto assembly_start = std::chrono::steady_clock::now();
-  model.evaluate(state.displacement_m, m_internal_force_n, /*update_tangent=*/true);
+  // The energy guard's start, found in the same pass when the guard may act.
+  if (std::isfinite(m_settings.newton.energy_guard_angle_rad)) {
+    model.evaluate_with_potential(state.displacement_m, m_internal_force_n, /*update_tangent=*/true);
+    m_start_potential_j = model.potential_energy_at_last_evaluate_j();
+  } else {
+    model.evaluate(state.displacement_m, m_internal_force_n, /*update_tangent=*/true);
+    m_start_potential_j = std::numeric_limits<double>::quiet_NaN();
+  }
   const BlockSparseMatrix& stiffness = model.tangent();
 
   // rhs = h (f_ext - f_int - alpha M v - (beta + h) K v)
@@ -204,8 +211,12 @@ bool BackwardEuler::guard_energy(DynamicsModel& model, const DynamicState& state
   }
   const Eigen::Vector3d mean_velocity = momentum.cwiseQuotient(mass_sum.cwiseMax(1e-300));
   const double kinetic_before_j = 0.5 * state.velocity_m_per_s.dot(mass.cwiseProduct(state.velocity_m_per_s));
-  m_end_displacement.noalias() = state.displacement_m - h * m_end_velocity;  // u0
-  const double before_j = kinetic_before_j + model.potential_energy_j(m_end_displacement);
+  double potential_before_j = m_start_potential_j;  // a pass over the elements saved
+  if (!std::isfinite(potential_before_j)) {
+    m_end_displacement.noalias() = state.displacement_m - h * m_end_velocity;  // u0
+    potential_before_j = model.potential_energy_j(m_end_displacement);
+  }
+  const double before_j = kinetic_before_j + potential_before_j;
   const double potential_after_j = model.potential_energy_j(state.displacement_m);
   if (!std::isfinite(before_j) || !std::isfinite(potential_after_j)) return false;  // the model cannot say
   const double mean_kinetic_j = 0.5 * mass_sum.dot(mean_velocity.cwiseProduct(mean_velocity));

@@ -89,7 +89,8 @@ class BackwardEuler final : public Integrator {
   void start_velocity_change(const ShiftedSystem& system);
   // Puts m_velocity_change first among the past velocity changes.
   void remember_velocity_change();
-  // Scales v1 (m_end_velocity) so that the step's energy does not rise; true if it did.
+  // Scales v1 (m_end_velocity) so that the step's energy does not rise; true if it did. The
+  // potential energy at the start is m_start_potential_j when the step's evaluate found it.
   bool guard_energy(DynamicsModel& model, const DynamicState& state, double h);
   // The step's incremental potential at v1 (backward_euler.cpp); `stiffness` is the damping's K.
   // The model's potential energy at u0 + h v1 is `known_potential_j` when given (a pass over the
@@ -119,6 +120,7 @@ class BackwardEuler final : public Integrator {
   Eigen::VectorXd m_trial_displacement;
   Eigen::VectorXd m_trial_product;     // K v of a trial
   double m_trial_potential_j = 0.0;    // the model's potential energy at the last trial's u1
+  double m_start_potential_j = 0.0;    // at u0, from the step's evaluate (NaN: the model keeps none)
 };
 
 /// Throws ParameterError unless the trigger angle is > 0 (infinity: off) and 1 to 100 iterations.

@@ -66,6 +66,18 @@ class DynamicsModel {
   [[nodiscard]] virtual double potential_energy_j(const Eigen::VectorXd& /*displacement_m*/) {
     return std::numeric_limits<double>::quiet_NaN();
   }
+  /// evaluate(), and potential_energy_j at u found in the same pass where the model can (then
+  /// potential_energy_at_last_evaluate_j() gives it): the energy guard's start without a pass of
+  /// its own. A model that cannot: evaluate() alone.
+  virtual void evaluate_with_potential(const Eigen::VectorXd& displacement_m, Eigen::VectorXd& internal_force_n,
+                                       bool update_tangent) {
+    evaluate(displacement_m, internal_force_n, update_tangent);
+  }
+  /// The potential energy evaluate_with_potential() found; NaN when the last evaluate was not one,
+  /// the model keeps none or has changed since.
+  [[nodiscard]] virtual double potential_energy_at_last_evaluate_j() const {
+    return std::numeric_limits<double>::quiet_NaN();
+  }
 };
 
 /// The state an integrator advances: displacement and velocity per unknown, and time.
