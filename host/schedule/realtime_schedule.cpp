@@ -20,9 +20,6 @@ namespace {
 
 double ms_between(Nanoseconds from, Nanoseconds to) { return static_cast<double>(to - from) / 1e6; }
 
-// The nice value of the thread that maps and writes the frames during a real-time run (below).
-constexpr int WRITER_NICE = 10;
-
 // What the two real-time threads and the calling thread share during a run.
 struct RealtimeRun {
   std::atomic<int> ready{0};
@@ -208,12 +205,6 @@ void RealtimeScheduler::run() {
   RealtimeRun run;
   std::thread haptic([&] { haptic_thread(run); });
   std::thread dynamics([&] { dynamics_thread(run, pipe); });
-  // This thread maps and writes the frames (most of a core for the organ's 82k-triangle surface)
-  // beside the surface's preparation after a cut, which runs at SCHED_OTHER in the time the slot
-  // leaves idle and must be done by the next slot's capture (docs/DESIGN.md, "Frames wait for the
-  // physics"): the writer yields to it. Frames are late at worst; the pipe holds them.
-  const int nice_before = thread_nice();
-  (void)set_thread_nice(WRITER_NICE);
 
   while (run.ready.load() < 2) std::this_thread::yield();
   if (m_options.realtime_priority) {
@@ -251,7 +242,6 @@ void RealtimeScheduler::run() {
   }
   haptic.join();
   dynamics.join();
-  (void)set_thread_nice(nice_before);  // back for what follows the run (refused without the right: kept)
   m_summary.haptic_ticks = run.stopped_at ? *run.stopped_at : m_schedule.ticks;
   m_summary.wall_time_s = static_cast<double>(run.haptic_end - run.start) * 1e-9;
   drain(std::chrono::milliseconds(0));

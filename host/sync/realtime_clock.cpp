@@ -3,10 +3,7 @@
 
 #include <pthread.h>
 #include <sched.h>
-#include <sys/resource.h>
-#include <sys/syscall.h>
 #include <time.h>
-#include <unistd.h>
 
 #include <cerrno>
 #include <cmath>
@@ -45,11 +42,5 @@ Priority try_fifo_priority(int priority) {
                      "): running at normal priority; run as root, or grant rtprio in /etc/security/limits.conf "
                      "or CAP_SYS_NICE"};
 }
-
-bool set_thread_nice(int nice) {
-  return setpriority(PRIO_PROCESS, static_cast<id_t>(syscall(SYS_gettid)), nice) == 0;
-}
-
-int thread_nice() { return getpriority(PRIO_PROCESS, static_cast<id_t>(syscall(SYS_gettid))); }
 
 }  // namespace tissue::host

@@ -26,10 +26,5 @@ struct Priority {
 
 /// Gives the calling thread SCHED_FIFO at `priority`, if the system permits it.
 Priority try_fifo_priority(int priority);
-/// Sets the calling thread's nice value (Linux: per thread; 0..19 lowers it among the SCHED_OTHER
-/// threads, which any thread may do; raising it back may need CAP_SYS_NICE). Returns whether it was set.
-bool set_thread_nice(int nice);
-/// The calling thread's nice value.
-int thread_nice();
 
 }  // namespace tissue::host
