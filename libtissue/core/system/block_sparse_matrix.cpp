@@ -215,8 +215,8 @@ void BlockSparseMatrix::diagonal(Eigen::VectorXd& diagonal) const {
 // In place, from the last row to the first: a row's room never shrinks, so each row moves to a slot
 // at or after its old first one and its new room ends where the next row's, already moved, begins;
 // its blocks are read out (sorted by column) before they are written back. A second buffer (as
-// before) cost fresh pages or a copy of the older layout whenever the storage grew: the frog's
-// re-layouts took 1.3-1.7 ms, ~0.2 of them the copy itself (docs/BENCHMARKS.md).
+// before) meant, whenever the storage grew, fresh pages and a useless copy of the layout before the
+// last: a frog's re-layout took 1.3-1.7 ms, of which 0.16 ms moved its blocks (docs/BENCHMARKS.md).
 void BlockSparseMatrix::relayout(const std::vector<std::pair<int, int>>& min_capacity, int spare_rows) {
   const int n = block_rows();
   if (m_spare_row_capacity < 1) m_spare_row_capacity = DEFAULT_SPARE_ROW_CAPACITY;
