@@ -27,7 +27,12 @@ Eigen::Matrix3d cross_matrix(const Eigen::Vector3d& v) {
 
 void TwoLevelPreconditioner::setup(const ShiftedSystem& system, const Eigen::VectorXd& inverse_diagonal) {
   m_inverse_diagonal = &inverse_diagonal;
-  const bool aggregated = !aggregates_fit(system);
+  bool aggregated = !aggregates_fit(system);
+  const bool refresh_due = m_setups_since_coarse + 1 >= COARSE_REFRESH_SETUPS;
+  if (aggregated && !refresh_due && (patch_fits(system) || (patchable(system) && patch(system)))) {
+    ++m_setups_since_coarse;  // the coarse level made before serves, with the local level beside it
+    return;
+  }
   if (aggregated) {
     m_with_rotations = system.block_positions != nullptr;
     aggregate(system);  // with this setup's basis
@@ -37,10 +42,11 @@ void TwoLevelPreconditioner::setup(const ShiftedSystem& system, const Eigen::Vec
   m_setups_since_coarse = 0;
   if (!aggregated) make_basis(system, /*count_rotations=*/false);
   assemble_and_factorize(system);
+  m_can_patch = m_coarse_ok;
 }
 
 void TwoLevelPreconditioner::setup_nearby(const ShiftedSystem& system, const Eigen::VectorXd& inverse_diagonal) {
-  if (!aggregates_fit(system)) {
+  if (!aggregates_fit(system) && !patch_fits(system)) {
     setup(system, inverse_diagonal);
     return;
   }
@@ -58,14 +64,15 @@ bool TwoLevelPreconditioner::aggregates_fit(const ShiftedSystem& system) const {
 // neighbour that has one (else the aggregate of a neighbour taken in this phase, else its own).
 int TwoLevelPreconditioner::aggregate_within(int reach, int rows, const std::vector<int>& strong_begin,
                                              const std::vector<int>& strong_column,
-                                             const std::vector<double>& strong_weight) {
-  m_aggregate_of_row.assign(static_cast<size_t>(rows), -1);
+                                             const std::vector<double>& strong_weight,
+                                             std::vector<int>& aggregate_of_row) {
+  aggregate_of_row.assign(static_cast<size_t>(rows), -1);
   std::vector<int> reached;
   std::vector<int> mark(static_cast<size_t>(rows), -1);
   int count = 0;
   const auto alone = [&](int i) { return strong_begin[static_cast<size_t>(i)] == strong_begin[static_cast<size_t>(i) + 1]; };
   for (int root = 0; root < rows; ++root) {
-    if (m_aggregate_of_row[static_cast<size_t>(root)] >= 0 || alone(root)) continue;
+    if (aggregate_of_row[static_cast<size_t>(root)] >= 0 || alone(root)) continue;
     reached.assign(1, root);
     mark[static_cast<size_t>(root)] = root;
     bool free = true;
@@ -77,7 +84,7 @@ int TwoLevelPreconditioner::aggregate_within(int reach, int rows, const std::vec
         for (int e = strong_begin[static_cast<size_t>(i)]; e < strong_begin[static_cast<size_t>(i) + 1]; ++e) {
           const int j = strong_column[static_cast<size_t>(e)];
           if (mark[static_cast<size_t>(j)] == root) continue;
-          if (m_aggregate_of_row[static_cast<size_t>(j)] >= 0) {
+          if (aggregate_of_row[static_cast<size_t>(j)] >= 0) {
             free = false;
             break;
           }
@@ -88,10 +95,10 @@ int TwoLevelPreconditioner::aggregate_within(int reach, int rows, const std::vec
       level_begin = level_end;
     }
     if (!free) continue;
-    for (const int i : reached) m_aggregate_of_row[static_cast<size_t>(i)] = count;
+    for (const int i : reached) aggregate_of_row[static_cast<size_t>(i)] = count;
     ++count;
   }
-  const std::vector<int> phase_one = m_aggregate_of_row;
+  const std::vector<int> phase_one = aggregate_of_row;
   for (int i = 0; i < rows; ++i) {
     if (phase_one[static_cast<size_t>(i)] >= 0 || alone(i)) continue;
     double strongest = -1.0;
@@ -100,18 +107,18 @@ int TwoLevelPreconditioner::aggregate_within(int reach, int rows, const std::vec
       const int a = phase_one[static_cast<size_t>(j)] >= 0 ? phase_one[static_cast<size_t>(j)] : -1;
       if (a >= 0 && strong_weight[static_cast<size_t>(e)] > strongest) {
         strongest = strong_weight[static_cast<size_t>(e)];
-        m_aggregate_of_row[static_cast<size_t>(i)] = a;
+        aggregate_of_row[static_cast<size_t>(i)] = a;
       }
     }
-    if (m_aggregate_of_row[static_cast<size_t>(i)] >= 0) continue;
+    if (aggregate_of_row[static_cast<size_t>(i)] >= 0) continue;
     for (int e = strong_begin[static_cast<size_t>(i)]; e < strong_begin[static_cast<size_t>(i) + 1]; ++e) {
-      const int a = m_aggregate_of_row[static_cast<size_t>(strong_column[static_cast<size_t>(e)])];
+      const int a = aggregate_of_row[static_cast<size_t>(strong_column[static_cast<size_t>(e)])];
       if (a >= 0) {
-        m_aggregate_of_row[static_cast<size_t>(i)] = a;
+        aggregate_of_row[static_cast<size_t>(i)] = a;
         break;
       }
     }
-    if (m_aggregate_of_row[static_cast<size_t>(i)] < 0) m_aggregate_of_row[static_cast<size_t>(i)] = count++;
+    if (aggregate_of_row[static_cast<size_t>(i)] < 0) aggregate_of_row[static_cast<size_t>(i)] = count++;
   }
   return count;
 }
@@ -143,7 +150,10 @@ void TwoLevelPreconditioner::aggregate(const ShiftedSystem& system) {
     }
     strong_begin[static_cast<size_t>(i) + 1] = static_cast<int>(strong_column.size());
   }
-  const int count = aggregate_within(AGGREGATE_REACH, rows, strong_begin, strong_column, strong_weight);
+  const int count = aggregate_within(AGGREGATE_REACH, rows, strong_begin, strong_column, strong_weight, m_aggregate_of_row);
+  m_aggregated_row_size.resize(static_cast<size_t>(rows));
+  for (int i = 0; i < rows; ++i) m_aggregated_row_size[static_cast<size_t>(i)] = k.row_size(i);
+  m_local.ok = false;
   // Rows of each aggregate, in row order.
   m_aggregate_rows_begin.assign(static_cast<size_t>(count) + 1, 0);
   for (const int a : m_aggregate_of_row) {
@@ -261,23 +271,26 @@ void TwoLevelPreconditioner::make_basis(const ShiftedSystem& system, bool count_
       moment += r.squaredNorm() * Eigen::Matrix3d::Identity() - r * r.transpose();
     }
     m_centroid[static_cast<size_t>(a)] = centroid;
-    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eigen(moment);
-    const Eigen::Vector3d moments = eigen.eigenvalues();  // increasing
-    const double largest = moments[2];
-    int& rotations = m_rotation_count[static_cast<size_t>(a)];
-    if (count_rotations) {
-      rotations = 0;
-      for (int c = 0; c < 3; ++c) {
-        if (largest > 0.0 && moments[c] > ROTATION_RANK_TOLERANCE * largest) ++rotations;
-      }
+    rotation_axes(moment, count_rotations, m_rotation_count[static_cast<size_t>(a)], m_rotation_axes[static_cast<size_t>(a)]);
+  }
+}
+
+void TwoLevelPreconditioner::rotation_axes(const Eigen::Matrix3d& moment, bool count_rotations, int& rotations,
+                                           Eigen::Matrix3d& axes) {
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eigen(moment);
+  const Eigen::Vector3d moments = eigen.eigenvalues();  // increasing
+  const double largest = moments[2];
+  if (count_rotations) {
+    rotations = 0;
+    for (int c = 0; c < 3; ++c) {
+      if (largest > 0.0 && moments[c] > ROTATION_RANK_TOLERANCE * largest) ++rotations;
     }
-    Eigen::Matrix3d& axes = m_rotation_axes[static_cast<size_t>(a)];
-    axes.setZero();
-    for (int c = 0; c < rotations; ++c) {
-      const int e = 2 - c;  // the largest moments first
-      const double moment_e = std::max(moments[e], ROTATION_RANK_TOLERANCE * largest);
-      axes.col(c) = eigen.eigenvectors().col(e) / std::sqrt(moment_e);
-    }
+  }
+  axes.setZero();
+  for (int c = 0; c < rotations; ++c) {
+    const int e = 2 - c;  // the largest moments first
+    const double moment_e = std::max(moments[e], ROTATION_RANK_TOLERANCE * largest);
+    axes.col(c) = eigen.eigenvectors().col(e) / std::sqrt(moment_e);
   }
 }
 
@@ -341,6 +354,7 @@ void TwoLevelPreconditioner::assemble_and_factorize(const ShiftedSystem& system)
 
 void TwoLevelPreconditioner::apply(const Eigen::VectorXd& r, Eigen::VectorXd& z) {
   z = m_inverse_diagonal->cwiseProduct(r);
+  if (m_local.ok) add_local(r, z);
   if (!m_coarse_ok) return;
   const int count = aggregate_count();
   for (int a = 0; a < count; ++a) {

@@ -24,6 +24,7 @@
 #include "core/solve/linear_solver.hpp"
 
 #include <Eigen/Core>
+#include <Eigen/Cholesky>
 #include <Eigen/SparseCholesky>
 #include <Eigen/SparseCore>
 
@@ -68,6 +69,8 @@ class TwoLevelPreconditioner {
   void forget() {
     m_pattern_revision = UINT64_MAX;
     m_setups_since_coarse = 0;
+    m_can_patch = false;
+    m_local.ok = false;
   }
 
   [[nodiscard]] int aggregate_count() const { return static_cast<int>(m_aggregate_rows_begin.size()) - 1; }
@@ -81,8 +84,28 @@ class TwoLevelPreconditioner {
   /// points given as when they were made.
   [[nodiscard]] bool aggregates_fit(const ShiftedSystem& system) const;
   void aggregate(const ShiftedSystem& system);
-  int aggregate_within(int reach, int rows, const std::vector<int>& strong_begin, const std::vector<int>& strong_column,
-                       const std::vector<double>& strong_weight);
+  /// Phases 1 and 2 of the aggregation over a graph of `rows` rows (CSR of strong edges): the
+  /// aggregate of each row into `aggregate_of_row` (-1: no strong neighbour); returns the count.
+  static int aggregate_within(int reach, int rows, const std::vector<int>& strong_begin,
+                              const std::vector<int>& strong_column, const std::vector<double>& strong_weight,
+                              std::vector<int>& aggregate_of_row);
+  /// The rotation columns of an aggregate from the second moment of its points about their
+  /// centroid: principal axes over sqrt(moment), the largest first; `rotations` counted anew when
+  /// `count_rotations` (those whose moment is above ROTATION_RANK_TOLERANCE of the largest).
+  static void rotation_axes(const Eigen::Matrix3d& moment, bool count_rotations, int& rotations, Eigen::Matrix3d& axes);
+  /// Between coarse refreshes, a cut's rows get a local level (patch()) when patchable().
+  [[nodiscard]] bool patchable(const ShiftedSystem& system) const;
+  /// Whether the local level is of `system`'s K as it is (no cut since the patch).
+  [[nodiscard]] bool patch_fits(const ShiftedSystem& system) const;
+  /// Makes the local level for the rows added or changed (in block count) since the aggregation;
+  /// false (nothing made) when they are too many for it.
+  bool patch(const ShiftedSystem& system);
+  /// The local level's matrix over `local_rows` (local_of, aggregate_of, position_of: patch()'s
+  /// maps), assembled and factorized into m_local.
+  void factorize_local(const ShiftedSystem& system, const std::vector<int>& local_rows, const std::vector<int>& local_of,
+                       const std::vector<int>& aggregate_of, const std::vector<int>& position_of);
+  /// z += Pl Al^-1 Pl^T r of the local level.
+  void add_local(const Eigen::VectorXd& r, Eigen::VectorXd& z);
   void make_coarse_pattern(const BlockSparseMatrix& k);
   void make_basis(const ShiftedSystem& system, bool count_rotations);
   void assemble_and_factorize(const ShiftedSystem& system);
@@ -117,6 +140,7 @@ class TwoLevelPreconditioner {
   std::vector<double> m_translation_scale;      // 1 / sqrt(rows)
   std::vector<Eigen::Matrix3d> m_rotation_axes;  // columns: axis / sqrt(moment), as many as used
   std::vector<int> m_rotation_count;
+  std::vector<int> m_aggregated_row_size;  // each row's block count when aggregated
   std::vector<Eigen::Vector3d> m_offset;  // per block row: its point minus its aggregate's centroid
   int m_coarse_size = 0;
   // Coarse matrix: dense blocks of (aggregate, aggregate) pairs, CSR by aggregate; each fine slot's
@@ -145,6 +169,26 @@ class TwoLevelPreconditioner {
   int m_rows = -1;
   int m_setups_since_coarse = 0;
   bool m_with_rotations = false;
+  // The rows a cut made or changed since the aggregation, between coarse refreshes: the rigid
+  // motions of small aggregates of them, with their own (dense) coarse matrix from the setup that
+  // made them, added to the coarse level made before (additive, so P stays positive definite).
+  struct LocalLevel {
+    std::vector<int> rows;             // grouped by aggregate
+    std::vector<int> aggregate_begin;  // into rows, aggregates + 1
+    std::vector<int> column_begin;     // aggregates + 1
+    std::vector<Eigen::Vector3d> offset;  // per entry of rows: its point minus its aggregate's centroid
+    std::vector<double> translation_scale;
+    std::vector<Eigen::Matrix3d> axes;
+    std::vector<int> rotation_count;
+    Eigen::LDLT<Eigen::MatrixXd> factor;
+    Eigen::VectorXd rhs, solution;
+    bool ok = false;
+    std::uint64_t pattern_revision = UINT64_MAX;
+    std::uint64_t layout_revision = UINT64_MAX;
+    int rows_of_k = -1;
+  };
+  LocalLevel m_local;
+  bool m_can_patch = false;  // a coarse level of a full aggregation serves (not after forget())
 };
 
 }  // namespace tissue
