@@ -140,17 +140,29 @@ TEST(TwoLevelPcg, AggregatesNeverJoinRowsACutDecoupled) {
   for (const std::set<bool>& s : sides) EXPECT_EQ(s.size(), 1u);
 }
 
+// A 10 x 2 x 2 cm beam of 1 cm cubes held at x = 0, at rest.
+struct HeldBeam {
+  TetMesh mesh = make_box_mesh(10, 2, 2, 0.01);
+  DeformableBody body{mesh, settings_of(mesh)};
+  DynamicState state{Eigen::VectorXd::Zero(body.dof_count()), Eigen::VectorXd::Zero(body.dof_count())};
+
+  static BodySettings settings_of(const TetMesh& mesh) {
+    BodySettings settings;
+    settings.fixed_vertices = vertices_at_minimum(mesh, 0, 1e-6);
+    return settings;
+  }
+};
+
 // A 10 x 2 x 2 cm beam held at x = 0 and cut through at x = 5.5 cm, its free end parked
 // (DeformableBody::park_rows, as a part fallen out of the operating field): the end's rows keep
 // only their mass, each a row alone. They join no aggregate (a singleton's coarse columns would only
 // repeat Jacobi's exact solve of it; a hatched body has thousands), and CG still reaches CHOLMOD's
 // solution (to the tolerance times the system's condition, ~1e3 here).
 TEST(TwoLevelPcg, RowsAloneJoinNoAggregate) {
-  const TetMesh mesh = make_box_mesh(10, 2, 2, 0.01);
-  BodySettings settings;
-  settings.fixed_vertices = vertices_at_minimum(mesh, 0, 1e-6);
-  DeformableBody body(mesh, settings);
-  DynamicState state{Eigen::VectorXd::Zero(body.dof_count()), Eigen::VectorXd::Zero(body.dof_count())};
+  HeldBeam beam;
+  const TetMesh& mesh = beam.mesh;
+  DeformableBody& body = beam.body;
+  DynamicState& state = beam.state;
   body.enrich(xfem_test::plane_cuts(mesh, xfem_test::Plane{Eigen::Vector3d::UnitX(), 0.055}), state);
   std::vector<int> free_rows;
   for (const xfem_test::BodyPiece& piece : xfem_test::body_pieces(body)) {
@@ -189,11 +201,10 @@ TEST(TwoLevelPcg, RowsAloneJoinNoAggregate) {
 // whole matrix anew). P stays symmetric positive definite, CG reaches CHOLMOD's solution, and the
 // next refresh aggregates the grown matrix. A 10 x 2 x 2 cm beam held at x = 0, cut at x = 5.5 cm.
 TEST(TwoLevelPcg, ACutBetweenRefreshesAddsALocalLevelAndKeepsPPositiveDefinite) {
-  const TetMesh mesh = make_box_mesh(10, 2, 2, 0.01);
-  BodySettings settings;
-  settings.fixed_vertices = vertices_at_minimum(mesh, 0, 1e-6);
-  DeformableBody body(mesh, settings);
-  DynamicState state{Eigen::VectorXd::Zero(body.dof_count()), Eigen::VectorXd::Zero(body.dof_count())};
+  HeldBeam beam;
+  const TetMesh& mesh = beam.mesh;
+  DeformableBody& body = beam.body;
+  DynamicState& state = beam.state;
   Eigen::VectorXd forces;
   Eigen::VectorXd diagonal;
   Eigen::VectorXd inverse_diagonal;
