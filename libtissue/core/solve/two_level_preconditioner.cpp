@@ -27,7 +27,7 @@ Eigen::Matrix3d cross_matrix(const Eigen::Vector3d& v) {
 
 void TwoLevelPreconditioner::setup(const ShiftedSystem& system, const Eigen::VectorXd& inverse_diagonal) {
   m_inverse_diagonal = &inverse_diagonal;
-  bool aggregated = !aggregates_fit(system);
+  const bool aggregated = !aggregates_fit(system);
   const bool refresh_due = m_setups_since_coarse + 1 >= COARSE_REFRESH_SETUPS;
   if (aggregated && !refresh_due && (patch_fits(system) || (patchable(system) && patch(system)))) {
     ++m_setups_since_coarse;  // the coarse level made before serves, with the local level beside it

@@ -11,7 +11,9 @@
 // a part taken out of the dynamics: nothing but its mass) joins none: its coarse columns would only
 // repeat Jacobi's solve of it, and the thousands a hatched body leaves grew the coarse level. A coupling is strong when ||A_ij||_F > STRENGTH sqrt(||A_ii||_F ||A_jj||_F):
 // the blocks a cut left in the pattern at zero never join the two sides of a cut. Made at the
-// first setup and again whenever K's pattern or layout changes (a cut), from that setup's values.
+// first setup and again at the first coarse refresh after K's pattern or layout changed (a cut),
+// from that setup's values; a cut between refreshes gets a local level meanwhile (the rows it
+// changed aggregated anew beside the coarse level made before: two_level_local_level.cpp).
 //
 // Coarse space: per aggregate, the translations and the rotations about its centroid of the rows'
 // points (ShiftedSystem::block_positions at each setup; translations only without them),
