@@ -313,14 +313,13 @@ void DeformableBody::evaluate_pass(const Eigen::VectorXd& displacement_m, Eigen:
   m_xfem.evaluate(m_positions_m, displacement_m, m_vertex_forces_n, internal_force_n, tangent,
                   with_potential ? &cut_energy_j : nullptr);
 
-  // potential_energy_j's sum, from this pass's rotations.
-  m_evaluated_potential_j = with_potential ? uncut_energy_j + cut_energy_j - m_external_force_n.dot(displacement_m)
-                                           : std::numeric_limits<double>::quiet_NaN();
   for (ForceTerm* term : m_force_terms) {
     term->add_force(m_positions_m, m_vertex_forces_n);
     if (tangent != nullptr) term->add_tangent(*tangent);
-    if (with_potential) m_evaluated_potential_j += term->energy_j(m_positions_m);
   }
+  // potential_energy_j's sum, from this pass's rotations.
+  m_evaluated_potential_j = with_potential ? potential_with_elastic_j(uncut_energy_j + cut_energy_j, displacement_m)
+                                           : std::numeric_limits<double>::quiet_NaN();
 
   for (int row = 0; row < u_rows; ++row) {
     internal_force_n.segment<3>(3 * row) =
@@ -335,7 +334,11 @@ double DeformableBody::elastic_energy_j(const Eigen::VectorXd& displacement_m) {
 }
 
 double DeformableBody::potential_energy_j(const Eigen::VectorXd& displacement_m) {
-  double energy = elastic_energy_j(displacement_m) - m_external_force_n.dot(displacement_m);  // positions set
+  return potential_with_elastic_j(elastic_energy_j(displacement_m), displacement_m);  // positions set
+}
+
+double DeformableBody::potential_with_elastic_j(double elastic_energy_j, const Eigen::VectorXd& displacement_m) const {
+  double energy = elastic_energy_j - m_external_force_n.dot(displacement_m);
   for (const ForceTerm* term : m_force_terms) energy += term->energy_j(m_positions_m);
   return energy;
 }

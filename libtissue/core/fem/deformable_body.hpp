@@ -286,6 +286,8 @@ class DeformableBody final : public DynamicsModel {
  private:
   void evaluate_pass(const Eigen::VectorXd& displacement_m, Eigen::VectorXd& internal_force_n, bool update_tangent,
                      bool with_potential);
+  /// potential_energy_j's sum from the elastic energy (m_positions_m set for `displacement_m`).
+  [[nodiscard]] double potential_with_elastic_j(double elastic_energy_j, const Eigen::VectorXd& displacement_m) const;
 
   TetMesh m_mesh;
   TetAdjacency m_adjacency;         // faces and vertex stars, for grouping the pieces' ghosts
