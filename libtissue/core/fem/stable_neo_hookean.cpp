@@ -1,5 +1,6 @@
 // Stable Neo-Hookean: energy, stress, stress derivative and the per-tet forces and tangent.
 #include "core/fem/stable_neo_hookean.hpp"
+#include "core/system/cross_matrix.hpp"
 
 #include <Eigen/Cholesky>
 #include <Eigen/Eigenvalues>
@@ -10,11 +11,6 @@
 namespace tissue {
 namespace {
 
-Eigen::Matrix3d cross_matrix(const Eigen::Vector3d& a) {
-  Eigen::Matrix3d m;
-  m << 0.0, -a.z(), a.y(), a.z(), 0.0, -a.x(), -a.y(), a.x(), 0.0;
-  return m;
-}
 
 // dJ/dF: the cofactor matrix, columns f1 x f2, f2 x f0, f0 x f1.
 Eigen::Matrix3d cofactor(const Eigen::Matrix3d& f) {

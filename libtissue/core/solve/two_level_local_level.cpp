@@ -6,6 +6,7 @@
 // each term positive (semi)definite, so P stays positive definite. The full aggregation waits for
 // the next coarse refresh (every COARSE_REFRESH_SETUPS setups).
 #include "core/solve/two_level_preconditioner.hpp"
+#include "core/system/cross_matrix.hpp"
 
 #include <Eigen/Geometry>
 
@@ -19,11 +20,6 @@ namespace {
 constexpr int MIN_PATCH_ROWS_LIMIT = 64;
 constexpr int PATCH_ROWS_DIVISOR = 2;  // ... or half the rows, if more
 
-Eigen::Matrix3d cross_matrix(const Eigen::Vector3d& v) {
-  Eigen::Matrix3d m;
-  m << 0.0, -v.z(), v.y(), v.z(), 0.0, -v.x(), -v.y(), v.x(), 0.0;
-  return m;
-}
 
 Eigen::Matrix3d system_block(const ShiftedSystem& system, int slot, int row, int column) {
   Eigen::Matrix3d block = system.stiffness_scale * system.stiffness->block(slot);

@@ -1,6 +1,7 @@
 // TwoLevelPreconditioner: aggregates, their rigid-motion coarse space, the coarse matrix and its
 // factor, and the additive two-level application (two_level_preconditioner.hpp).
 #include "core/solve/two_level_preconditioner.hpp"
+#include "core/system/cross_matrix.hpp"
 
 #include <Eigen/Eigenvalues>
 #include <Eigen/Geometry>
@@ -17,11 +18,6 @@ double frobenius(const ShiftedSystem& system, int slot, int row, int column) {
   return block.norm();
 }
 
-Eigen::Matrix3d cross_matrix(const Eigen::Vector3d& v) {
-  Eigen::Matrix3d m;
-  m << 0.0, -v.z(), v.y(), v.z(), 0.0, -v.x(), -v.y(), v.x(), 0.0;
-  return m;
-}
 
 }  // namespace
 
