@@ -10,16 +10,6 @@
 #include <cmath>
 
 namespace tissue {
-namespace {
-
-double frobenius(const ShiftedSystem& system, int slot, int row, int column) {
-  Eigen::Matrix3d block = system.stiffness_scale * system.stiffness->block(slot);
-  if (row == column) block.diagonal() += system.diagonal->segment<3>(3L * row);
-  return block.norm();
-}
-
-
-}  // namespace
 
 void TwoLevelPreconditioner::setup(const ShiftedSystem& system, const Eigen::VectorXd& inverse_diagonal) {
   m_inverse_diagonal = &inverse_diagonal;
@@ -36,7 +26,7 @@ void TwoLevelPreconditioner::setup(const ShiftedSystem& system, const Eigen::Vec
   }
   if (++m_setups_since_coarse < COARSE_REFRESH_SETUPS) return;
   m_setups_since_coarse = 0;
-  if (!aggregated) make_basis(system, /*count_rotations=*/false);
+  if (!aggregated) m_coarse.make_basis(system.block_positions, /*count_rotations=*/false);
   assemble_and_factorize(system);
   m_can_patch = m_coarse_ok;
 }
@@ -55,126 +45,18 @@ bool TwoLevelPreconditioner::aggregates_fit(const ShiftedSystem& system) const {
          k.block_rows() == m_rows && (system.block_positions != nullptr) == m_with_rotations;
 }
 
-// Phase 1: in row order, a row whose rows within `reach` strong edges are all free becomes a root
-// and takes them. Phase 2: a row left over joins the phase-1 aggregate of its strongest strong
-// neighbour that has one (else the aggregate of a neighbour taken in this phase, else its own).
-int TwoLevelPreconditioner::aggregate_within(int reach, int rows, const std::vector<int>& strong_begin,
-                                             const std::vector<int>& strong_column,
-                                             const std::vector<double>& strong_weight,
-                                             std::vector<int>& aggregate_of_row) {
-  aggregate_of_row.assign(static_cast<size_t>(rows), -1);
-  std::vector<int> reached;
-  std::vector<int> mark(static_cast<size_t>(rows), -1);
-  int count = 0;
-  const auto alone = [&](int i) { return strong_begin[static_cast<size_t>(i)] == strong_begin[static_cast<size_t>(i) + 1]; };
-  for (int root = 0; root < rows; ++root) {
-    if (aggregate_of_row[static_cast<size_t>(root)] >= 0 || alone(root)) continue;
-    reached.assign(1, root);
-    mark[static_cast<size_t>(root)] = root;
-    bool free = true;
-    size_t level_begin = 0;
-    for (int level = 0; level < reach && free; ++level) {
-      const size_t level_end = reached.size();
-      for (size_t front = level_begin; front < level_end && free; ++front) {
-        const int i = reached[front];
-        for (int e = strong_begin[static_cast<size_t>(i)]; e < strong_begin[static_cast<size_t>(i) + 1]; ++e) {
-          const int j = strong_column[static_cast<size_t>(e)];
-          if (mark[static_cast<size_t>(j)] == root) continue;
-          if (aggregate_of_row[static_cast<size_t>(j)] >= 0) {
-            free = false;
-            break;
-          }
-          mark[static_cast<size_t>(j)] = root;
-          reached.push_back(j);
-        }
-      }
-      level_begin = level_end;
-    }
-    if (!free) continue;
-    for (const int i : reached) aggregate_of_row[static_cast<size_t>(i)] = count;
-    ++count;
-  }
-  const std::vector<int> phase_one = aggregate_of_row;
-  for (int i = 0; i < rows; ++i) {
-    if (phase_one[static_cast<size_t>(i)] >= 0 || alone(i)) continue;
-    double strongest = -1.0;
-    for (int e = strong_begin[static_cast<size_t>(i)]; e < strong_begin[static_cast<size_t>(i) + 1]; ++e) {
-      const int j = strong_column[static_cast<size_t>(e)];
-      const int a = phase_one[static_cast<size_t>(j)] >= 0 ? phase_one[static_cast<size_t>(j)] : -1;
-      if (a >= 0 && strong_weight[static_cast<size_t>(e)] > strongest) {
-        strongest = strong_weight[static_cast<size_t>(e)];
-        aggregate_of_row[static_cast<size_t>(i)] = a;
-      }
-    }
-    if (aggregate_of_row[static_cast<size_t>(i)] >= 0) continue;
-    for (int e = strong_begin[static_cast<size_t>(i)]; e < strong_begin[static_cast<size_t>(i) + 1]; ++e) {
-      const int a = aggregate_of_row[static_cast<size_t>(strong_column[static_cast<size_t>(e)])];
-      if (a >= 0) {
-        aggregate_of_row[static_cast<size_t>(i)] = a;
-        break;
-      }
-    }
-    if (aggregate_of_row[static_cast<size_t>(i)] < 0) aggregate_of_row[static_cast<size_t>(i)] = count++;
-  }
-  return count;
-}
-
 void TwoLevelPreconditioner::aggregate(const ShiftedSystem& system) {
   const BlockSparseMatrix& k = *system.stiffness;
   const int rows = k.block_rows();
-  std::vector<double> diagonal_norm(static_cast<size_t>(rows));
-  for (int i = 0; i < rows; ++i) {
-    diagonal_norm[static_cast<size_t>(i)] = frobenius(system, k.diagonal_slot(i), i, i);
-  }
-  // The strong neighbours of each row (CSR).
-  std::vector<int> strong_begin(static_cast<size_t>(rows) + 1, 0);
-  std::vector<int> strong_column;
-  std::vector<double> strong_weight;
-  strong_column.reserve(static_cast<size_t>(k.nonzero_blocks()));
-  strong_weight.reserve(static_cast<size_t>(k.nonzero_blocks()));
-  for (int i = 0; i < rows; ++i) {
-    for (int s = k.row_begin(i); s < k.row_begin(i) + k.row_size(i); ++s) {
-      const int j = k.slot_column(s);
-      if (j < 0 || j == i) continue;
-      // Off the diagonal A_ij = s K_ij: compared squared, without forming the block.
-      const double coupling_squared = system.stiffness_scale * system.stiffness_scale * k.block(s).squaredNorm();
-      if (coupling_squared >
-          STRENGTH * STRENGTH * diagonal_norm[static_cast<size_t>(i)] * diagonal_norm[static_cast<size_t>(j)]) {
-        strong_column.push_back(j);
-        strong_weight.push_back(coupling_squared);  // only compared
-      }
-    }
-    strong_begin[static_cast<size_t>(i) + 1] = static_cast<int>(strong_column.size());
-  }
-  const int count = aggregate_within(AGGREGATE_REACH, rows, strong_begin, strong_column, strong_weight, m_aggregate_of_row);
+  std::vector<int> every_row(static_cast<size_t>(rows));
+  for (int i = 0; i < rows; ++i) every_row[static_cast<size_t>(i)] = i;
+  const StrongGraph graph(system, every_row, every_row, STRENGTH);
+  const int count = aggregate_rows(AGGREGATE_REACH, graph, m_aggregate_of_row);
   m_aggregated_row_size.resize(static_cast<size_t>(rows));
   for (int i = 0; i < rows; ++i) m_aggregated_row_size[static_cast<size_t>(i)] = k.row_size(i);
   m_local.ok = false;
-  // Rows of each aggregate, in row order.
-  m_aggregate_rows_begin.assign(static_cast<size_t>(count) + 1, 0);
-  for (const int a : m_aggregate_of_row) {
-    if (a >= 0) ++m_aggregate_rows_begin[static_cast<size_t>(a) + 1];
-  }
-  for (int a = 0; a < count; ++a) m_aggregate_rows_begin[static_cast<size_t>(a) + 1] += m_aggregate_rows_begin[static_cast<size_t>(a)];
-  m_aggregate_rows.resize(static_cast<size_t>(m_aggregate_rows_begin.back()));
-  std::vector<int> fill(m_aggregate_rows_begin.begin(), m_aggregate_rows_begin.end() - 1);
-  for (int i = 0; i < rows; ++i) {
-    const int a = m_aggregate_of_row[static_cast<size_t>(i)];
-    if (a >= 0) m_aggregate_rows[static_cast<size_t>(fill[static_cast<size_t>(a)]++)] = i;
-  }
-
-  // Columns per aggregate: 3 translations, and the rotations the points then span.
-  m_centroid.assign(static_cast<size_t>(count), Eigen::Vector3d::Zero());
-  m_translation_scale.assign(static_cast<size_t>(count), 0.0);
-  m_rotation_axes.assign(static_cast<size_t>(count), Eigen::Matrix3d::Zero());
-  m_rotation_count.assign(static_cast<size_t>(count), 0);
-  m_offset.assign(static_cast<size_t>(rows), Eigen::Vector3d::Zero());
-  m_column_begin.assign(static_cast<size_t>(count) + 1, 0);
-  make_basis(system, /*count_rotations=*/true);
-  for (int a = 0; a < count; ++a) {
-    m_column_begin[static_cast<size_t>(a) + 1] = m_column_begin[static_cast<size_t>(a)] + 3 + m_rotation_count[static_cast<size_t>(a)];
-  }
-  m_coarse_size = m_column_begin.back();
+  m_coarse.group(every_row, m_aggregate_of_row, count, m_entry_of_row);
+  m_coarse.make_basis(system.block_positions, /*count_rotations=*/true);
 
   make_coarse_pattern(k);
   m_matrix = &k;
@@ -187,7 +69,7 @@ void TwoLevelPreconditioner::aggregate(const ShiftedSystem& system) {
 // the scalar lower triangle of the coarse matrix with its symbolic analysis.
 void TwoLevelPreconditioner::make_coarse_pattern(const BlockSparseMatrix& k) {
   const int count = aggregate_count();
-  // Per aggregate a (its rows in m_aggregate_rows): the aggregates its rows' blocks reach, in
+  // Per aggregate a (its rows in m_coarse.rows): the aggregates its rows' blocks reach, in
   // ascending order, and each of those slots' coarse block; `position[b]` is b's block in a's row
   // while `seen[b] == a`.
   std::vector<int> seen(static_cast<size_t>(count), -1);
@@ -197,8 +79,8 @@ void TwoLevelPreconditioner::make_coarse_pattern(const BlockSparseMatrix& k) {
   m_coarse_block_of_slot.assign(static_cast<size_t>(k.slot_capacity()), -1);
   for (int a = 0; a < count; ++a) {
     const size_t first = m_coarse_column.size();
-    for (int p = m_aggregate_rows_begin[static_cast<size_t>(a)]; p < m_aggregate_rows_begin[static_cast<size_t>(a) + 1]; ++p) {
-      const int i = m_aggregate_rows[static_cast<size_t>(p)];
+    for (int p = m_coarse.aggregate_begin[static_cast<size_t>(a)]; p < m_coarse.aggregate_begin[static_cast<size_t>(a) + 1]; ++p) {
+      const int i = m_coarse.rows[static_cast<size_t>(p)];
       for (int s = k.row_begin(i); s < k.row_begin(i) + k.row_size(i); ++s) {
         const int j = k.slot_column(s);
         if (j < 0) continue;
@@ -210,8 +92,8 @@ void TwoLevelPreconditioner::make_coarse_pattern(const BlockSparseMatrix& k) {
     }
     std::sort(m_coarse_column.begin() + static_cast<long>(first), m_coarse_column.end());
     for (size_t q = first; q < m_coarse_column.size(); ++q) position[static_cast<size_t>(m_coarse_column[q])] = static_cast<int>(q);
-    for (int p = m_aggregate_rows_begin[static_cast<size_t>(a)]; p < m_aggregate_rows_begin[static_cast<size_t>(a) + 1]; ++p) {
-      const int i = m_aggregate_rows[static_cast<size_t>(p)];
+    for (int p = m_coarse.aggregate_begin[static_cast<size_t>(a)]; p < m_coarse.aggregate_begin[static_cast<size_t>(a) + 1]; ++p) {
+      const int i = m_coarse.rows[static_cast<size_t>(p)];
       for (int s = k.row_begin(i); s < k.row_begin(i) + k.row_size(i); ++s) {
         const int j = k.slot_column(s);
         const int b = j >= 0 ? m_aggregate_of_row[static_cast<size_t>(j)] : -1;
@@ -226,7 +108,8 @@ void TwoLevelPreconditioner::make_coarse_pattern(const BlockSparseMatrix& k) {
   // for_each_lower_entry visits it.
   long entries = 0;
   for_each_lower_entry([&](int, int, int, int, int) { ++entries; });
-  m_coarse_matrix = Eigen::SparseMatrix<double>(m_coarse_size, m_coarse_size);
+  const int columns = m_coarse.columns();
+  m_coarse_matrix = Eigen::SparseMatrix<double>(columns, columns);
   m_coarse_matrix.makeCompressed();
   m_coarse_matrix.resizeNonZeros(entries);
   int* column_start = m_coarse_matrix.outerIndexPtr();
@@ -236,58 +119,12 @@ void TwoLevelPreconditioner::make_coarse_pattern(const BlockSparseMatrix& k) {
     column_start[column + 1] = static_cast<int>(++next);
     row[next - 1] = entry_row;
   });
-  for (int column = 0; column < m_coarse_size; ++column) {  // a column without entries (none here) keeps its start
+  for (int column = 0; column < columns; ++column) {  // a column without entries (none here) keeps its start
     column_start[column + 1] = std::max(column_start[column + 1], column_start[column]);
   }
   m_coarse_factor.analyzePattern(m_coarse_matrix);
-  m_coarse_rhs.resize(m_coarse_size);
-  m_coarse_solution.resize(m_coarse_size);
-}
-
-// Per aggregate: the centroid of its points, 1/sqrt(rows) for the translations, and the rotation
-// axes (principal axes of the points' second moment J = sum |r|^2 I - r r^T, scaled by 1/sqrt of
-// the moment so that each column has unit norm). The number of rotations is fixed at aggregation
-// (the coarse matrix's pattern); later setups keep the largest ones.
-void TwoLevelPreconditioner::make_basis(const ShiftedSystem& system, bool count_rotations) {
-  const int count = static_cast<int>(m_centroid.size());
-  for (int a = 0; a < count; ++a) {
-    const int begin = m_aggregate_rows_begin[static_cast<size_t>(a)];
-    const int end = m_aggregate_rows_begin[static_cast<size_t>(a) + 1];
-    m_translation_scale[static_cast<size_t>(a)] = 1.0 / std::sqrt(static_cast<double>(end - begin));
-    if (!m_with_rotations) continue;
-    const std::vector<Eigen::Vector3d>& points = *system.block_positions;
-    Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
-    for (int p = begin; p < end; ++p) centroid += points[static_cast<size_t>(m_aggregate_rows[static_cast<size_t>(p)])];
-    centroid /= static_cast<double>(end - begin);
-    Eigen::Matrix3d moment = Eigen::Matrix3d::Zero();
-    for (int p = begin; p < end; ++p) {
-      const int row = m_aggregate_rows[static_cast<size_t>(p)];
-      const Eigen::Vector3d r = points[static_cast<size_t>(row)] - centroid;
-      m_offset[static_cast<size_t>(row)] = r;
-      moment += r.squaredNorm() * Eigen::Matrix3d::Identity() - r * r.transpose();
-    }
-    m_centroid[static_cast<size_t>(a)] = centroid;
-    rotation_axes(moment, count_rotations, m_rotation_count[static_cast<size_t>(a)], m_rotation_axes[static_cast<size_t>(a)]);
-  }
-}
-
-void TwoLevelPreconditioner::rotation_axes(const Eigen::Matrix3d& moment, bool count_rotations, int& rotations,
-                                           Eigen::Matrix3d& axes) {
-  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eigen(moment);
-  const Eigen::Vector3d moments = eigen.eigenvalues();  // increasing
-  const double largest = moments[2];
-  if (count_rotations) {
-    rotations = 0;
-    for (int c = 0; c < 3; ++c) {
-      if (largest > 0.0 && moments[c] > ROTATION_RANK_TOLERANCE * largest) ++rotations;
-    }
-  }
-  axes.setZero();
-  for (int c = 0; c < rotations; ++c) {
-    const int e = 2 - c;  // the largest moments first
-    const double moment_e = std::max(moments[e], ROTATION_RANK_TOLERANCE * largest);
-    axes.col(c) = eigen.eigenvectors().col(e) / std::sqrt(moment_e);
-  }
+  m_coarse_rhs.resize(columns);
+  m_coarse_solution.resize(columns);
 }
 
 // Coarse block (a, b), a <= b, is the sum over rows i of a and j of b of P_i^T A_ij P_j, with
@@ -319,22 +156,22 @@ void TwoLevelPreconditioner::assemble_and_factorize(const ShiftedSystem& system)
         m_touched.push_back(coarse_block);
       }
       sums.force += block;
-      if (m_with_rotations) sums.moment -= block * cross_matrix(m_offset[static_cast<size_t>(j)]);
+      if (m_with_rotations) sums.moment -= block * cross_matrix(offset_of_row(j));
     }
-    const double t_a = m_translation_scale[static_cast<size_t>(a)];
-    const int rotations_a = m_rotation_count[static_cast<size_t>(a)];
-    const Eigen::Matrix3d c_i_transpose = cross_matrix(m_offset[static_cast<size_t>(i)]);  // C_i^T = [r_i]x
+    const double t_a = m_coarse.translation_scale[static_cast<size_t>(a)];
+    const int rotations_a = m_coarse.rotation_count[static_cast<size_t>(a)];
+    const Eigen::Matrix3d c_i_transpose = cross_matrix(offset_of_row(i));  // C_i^T = [r_i]x
     for (const int coarse_block : m_touched) {
       RowSums& sums = m_row_sums[static_cast<size_t>(coarse_block - first_block)];
       sums.used = false;
       const int b = m_coarse_column[static_cast<size_t>(coarse_block)];
       Eigen::Matrix<double, 3, 6> reached = Eigen::Matrix<double, 3, 6>::Zero();  // sum_j A_ij P_j
-      reached.leftCols<3>() = m_translation_scale[static_cast<size_t>(b)] * sums.force;
-      if (m_with_rotations) reached.rightCols<3>() = sums.moment * m_rotation_axes[static_cast<size_t>(b)];
+      reached.leftCols<3>() = m_coarse.translation_scale[static_cast<size_t>(b)] * sums.force;
+      if (m_with_rotations) reached.rightCols<3>() = sums.moment * m_coarse.axes[static_cast<size_t>(b)];
       Eigen::Map<Eigen::Matrix<double, 6, 6>> coarse(m_coarse_blocks[static_cast<size_t>(coarse_block)].data());
       coarse.topRows<3>() += t_a * reached;
       if (rotations_a > 0) {
-        coarse.bottomRows<3>() += m_rotation_axes[static_cast<size_t>(a)].transpose() * (c_i_transpose * reached);
+        coarse.bottomRows<3>() += m_coarse.axes[static_cast<size_t>(a)].transpose() * (c_i_transpose * reached);
       }
     }
   }
@@ -350,39 +187,15 @@ void TwoLevelPreconditioner::assemble_and_factorize(const ShiftedSystem& system)
 
 void TwoLevelPreconditioner::apply(const Eigen::VectorXd& r, Eigen::VectorXd& z) {
   z = m_inverse_diagonal->cwiseProduct(r);
-  if (m_local.ok) add_local(r, z);
+  if (m_local.ok) {
+    m_local.aggregates.restrict_to(r, m_local.rhs);
+    m_local.solution = m_local.factor.solve(m_local.rhs);
+    m_local.aggregates.prolong_add(m_local.solution, z);
+  }
   if (!m_coarse_ok) return;
-  const int count = aggregate_count();
-  for (int a = 0; a < count; ++a) {
-    Eigen::Vector3d force = Eigen::Vector3d::Zero();
-    Eigen::Vector3d moment = Eigen::Vector3d::Zero();
-    for (int p = m_aggregate_rows_begin[static_cast<size_t>(a)]; p < m_aggregate_rows_begin[static_cast<size_t>(a) + 1]; ++p) {
-      const int row = m_aggregate_rows[static_cast<size_t>(p)];
-      const Eigen::Vector3d r_i = r.segment<3>(3L * row);
-      force += r_i;
-      if (m_with_rotations) moment += m_offset[static_cast<size_t>(row)].cross(r_i);
-    }
-    const int first = m_column_begin[static_cast<size_t>(a)];
-    m_coarse_rhs.segment<3>(first) = m_translation_scale[static_cast<size_t>(a)] * force;
-    const int rotations = m_column_begin[static_cast<size_t>(a) + 1] - first - 3;
-    // (-[r]x W)^T v = W^T (r x v)
-    for (int c = 0; c < rotations; ++c) {
-      m_coarse_rhs[first + 3 + c] = m_rotation_axes[static_cast<size_t>(a)].col(c).dot(moment);
-    }
-  }
+  m_coarse.restrict_to(r, m_coarse_rhs);
   m_coarse_solution = m_coarse_factor.solve(m_coarse_rhs);
-  for (int a = 0; a < count; ++a) {
-    const int first = m_column_begin[static_cast<size_t>(a)];
-    const int rotations = m_column_begin[static_cast<size_t>(a) + 1] - first - 3;
-    const Eigen::Vector3d translation = m_translation_scale[static_cast<size_t>(a)] * m_coarse_solution.segment<3>(first);
-    Eigen::Vector3d spin = Eigen::Vector3d::Zero();
-    for (int c = 0; c < rotations; ++c) spin += m_coarse_solution[first + 3 + c] * m_rotation_axes[static_cast<size_t>(a)].col(c);
-    for (int p = m_aggregate_rows_begin[static_cast<size_t>(a)]; p < m_aggregate_rows_begin[static_cast<size_t>(a) + 1]; ++p) {
-      const int row = m_aggregate_rows[static_cast<size_t>(p)];
-      // -[r]x w = w x r
-      z.segment<3>(3L * row) += translation + spin.cross(m_offset[static_cast<size_t>(row)]);
-    }
-  }
+  m_coarse.prolong_add(m_coarse_solution, z);
 }
 
 }  // namespace tissue

@@ -24,6 +24,7 @@
 #pragma once
 
 #include "core/solve/linear_solver.hpp"
+#include "core/solve/rigid_aggregates.hpp"
 
 #include <Eigen/Core>
 #include <Eigen/Cholesky>
@@ -40,9 +41,6 @@ class TwoLevelPreconditioner {
  public:
   /// A coupling weaker than this (relative, Frobenius norms) does not join two rows in an aggregate.
   static constexpr double STRENGTH = 0.08;
-  /// Rotations about an axis whose moment of the aggregate's points is below this share of the
-  /// largest are left out (the points lie (nearly) on a line through the centroid along it).
-  static constexpr double ROTATION_RANK_TOLERANCE = 1e-6;
   /// Aggregates take the rows within this many strong edges of their root (~40-60 rows on a tet
   /// mesh). The coarse solve (a scalar sparse triangular pair) costs ~10x a fine mat-vec's time per
   /// entry, and its factor fills faster than it grows: one edge gave the 2.4k-tet frog 408 columns
@@ -75,9 +73,9 @@ class TwoLevelPreconditioner {
     m_local.ok = false;
   }
 
-  [[nodiscard]] int aggregate_count() const { return static_cast<int>(m_aggregate_rows_begin.size()) - 1; }
+  [[nodiscard]] int aggregate_count() const { return m_coarse.count(); }
   /// Columns of the coarse space (0 after a failed coarse factorization).
-  [[nodiscard]] int coarse_size() const { return m_coarse_ok ? m_coarse_size : 0; }
+  [[nodiscard]] int coarse_size() const { return m_coarse_ok ? m_coarse.columns() : 0; }
   /// Aggregate of each block row of the last setup's A, or -1 for a row with no strong neighbour.
   [[nodiscard]] const std::vector<int>& aggregate_of_row() const { return m_aggregate_of_row; }
 
@@ -86,15 +84,6 @@ class TwoLevelPreconditioner {
   /// points given as when they were made.
   [[nodiscard]] bool aggregates_fit(const ShiftedSystem& system) const;
   void aggregate(const ShiftedSystem& system);
-  /// Phases 1 and 2 of the aggregation over a graph of `rows` rows (CSR of strong edges): the
-  /// aggregate of each row into `aggregate_of_row` (-1: no strong neighbour); returns the count.
-  static int aggregate_within(int reach, int rows, const std::vector<int>& strong_begin,
-                              const std::vector<int>& strong_column, const std::vector<double>& strong_weight,
-                              std::vector<int>& aggregate_of_row);
-  /// The rotation columns of an aggregate from the second moment of its points about their
-  /// centroid: principal axes over sqrt(moment), the largest first; `rotations` counted anew when
-  /// `count_rotations` (those whose moment is above ROTATION_RANK_TOLERANCE of the largest).
-  static void rotation_axes(const Eigen::Matrix3d& moment, bool count_rotations, int& rotations, Eigen::Matrix3d& axes);
   /// Between coarse refreshes, a cut's rows get a local level (patch()) when patchable().
   [[nodiscard]] bool patchable(const ShiftedSystem& system) const;
   /// Whether the local level is of `system`'s K as it is (no cut since the patch).
@@ -102,14 +91,15 @@ class TwoLevelPreconditioner {
   /// Makes the local level for the rows added or changed (in block count) since the aggregation;
   /// false (nothing made) when they are too many for it.
   bool patch(const ShiftedSystem& system);
-  /// The local level's matrix over `local_rows` (local_of, aggregate_of, position_of: patch()'s
+  /// The local level's matrix over `local_rows` (local_of, aggregate_of, entry_of: patch()'s
   /// maps), assembled and factorized into m_local.
   void factorize_local(const ShiftedSystem& system, const std::vector<int>& local_rows, const std::vector<int>& local_of,
-                       const std::vector<int>& aggregate_of, const std::vector<int>& position_of);
-  /// z += Pl Al^-1 Pl^T r of the local level.
-  void add_local(const Eigen::VectorXd& r, Eigen::VectorXd& z);
+                       const std::vector<int>& aggregate_of, const std::vector<int>& entry_of);
   void make_coarse_pattern(const BlockSparseMatrix& k);
-  void make_basis(const ShiftedSystem& system, bool count_rotations);
+  /// An aggregated row's point minus its aggregate's centroid.
+  [[nodiscard]] const Eigen::Vector3d& offset_of_row(int row) const {
+    return m_coarse.offset[static_cast<size_t>(m_entry_of_row[static_cast<size_t>(row)])];
+  }
   void assemble_and_factorize(const ShiftedSystem& system);
   /// visit(column, row, block, column in block, row in block) for each entry of the coarse matrix's
   /// lower triangle in compressed-column order: column j of aggregate b, then the blocks (b, a) of
@@ -118,13 +108,13 @@ class TwoLevelPreconditioner {
   void for_each_lower_entry(Visit&& visit) const {
     const int count = aggregate_count();
     for (int b = 0; b < count; ++b) {
-      const int b_first = m_column_begin[static_cast<size_t>(b)];
-      for (int column = b_first; column < m_column_begin[static_cast<size_t>(b) + 1]; ++column) {
+      const int b_first = m_coarse.column_begin[static_cast<size_t>(b)];
+      for (int column = b_first; column < m_coarse.column_begin[static_cast<size_t>(b) + 1]; ++column) {
         for (int p = m_coarse_row_begin[static_cast<size_t>(b)]; p < m_coarse_row_begin[static_cast<size_t>(b) + 1]; ++p) {
           const int a = m_coarse_column[static_cast<size_t>(p)];
           if (a < b) continue;
-          const int a_first = m_column_begin[static_cast<size_t>(a)];
-          for (int row = a == b ? column : a_first; row < m_column_begin[static_cast<size_t>(a) + 1]; ++row) {
+          const int a_first = m_coarse.column_begin[static_cast<size_t>(a)];
+          for (int row = a == b ? column : a_first; row < m_coarse.column_begin[static_cast<size_t>(a) + 1]; ++row) {
             visit(column, row, p, column - b_first, row - a_first);
           }
         }
@@ -132,19 +122,12 @@ class TwoLevelPreconditioner {
     }
   }
 
-  // Aggregates: rows of aggregate a are m_aggregate_rows[m_aggregate_rows_begin[a] ...].
+  // The aggregates of the whole matrix and their columns; per block row its aggregate and its
+  // entry in m_coarse.rows (-1: none).
+  RigidAggregates m_coarse;
   std::vector<int> m_aggregate_of_row;
-  std::vector<int> m_aggregate_rows_begin;
-  std::vector<int> m_aggregate_rows;
-  // Coarse space: per aggregate its first coarse column, translation columns (3) then rotations.
-  std::vector<int> m_column_begin;  // size aggregates + 1
-  std::vector<Eigen::Vector3d> m_centroid;
-  std::vector<double> m_translation_scale;      // 1 / sqrt(rows)
-  std::vector<Eigen::Matrix3d> m_rotation_axes;  // columns: axis / sqrt(moment), as many as used
-  std::vector<int> m_rotation_count;
+  std::vector<int> m_entry_of_row;
   std::vector<int> m_aggregated_row_size;  // each row's block count when aggregated
-  std::vector<Eigen::Vector3d> m_offset;  // per block row: its point minus its aggregate's centroid
-  int m_coarse_size = 0;
   // Coarse matrix: dense blocks of (aggregate, aggregate) pairs, CSR by aggregate; each fine slot's
   // coarse block.
   std::vector<int> m_coarse_row_begin;
@@ -175,13 +158,7 @@ class TwoLevelPreconditioner {
   // motions of small aggregates of them, with their own (dense) coarse matrix from the setup that
   // made them, added to the coarse level made before (additive, so P stays positive definite).
   struct LocalLevel {
-    std::vector<int> rows;             // grouped by aggregate
-    std::vector<int> aggregate_begin;  // into rows, aggregates + 1
-    std::vector<int> column_begin;     // aggregates + 1
-    std::vector<Eigen::Vector3d> offset;  // per entry of rows: its point minus its aggregate's centroid
-    std::vector<double> translation_scale;
-    std::vector<Eigen::Matrix3d> axes;
-    std::vector<int> rotation_count;
+    RigidAggregates aggregates;
     Eigen::LDLT<Eigen::MatrixXd> factor;
     Eigen::VectorXd rhs, solution;
     bool ok = false;
