@@ -267,7 +267,8 @@ TISSUE_HOT_KERNEL double DeformableBody::largest_element_turn_rad(const Eigen::V
         increment[j] = piece.ghost_row[j] < 0 ? vertex_increment(cut_tet.vertices[j])
                                               : Eigen::Vector3d(increment_m.segment<3>(3 * piece.ghost_row[j]));
       }
-      largest_rad = std::max(largest_rad, turn_angle_rad(m_xfem.rest(k), m_xfem.rotation(k, p), increment));
+      largest_rad = std::max(largest_rad, std::sqrt(piece.weight) *
+                                              turn_angle_rad(m_xfem.rest(k), m_xfem.rotation(k, p), increment));
     }
   }
   return largest_rad;

@@ -127,7 +127,10 @@ class DeformableBody final : public DynamicsModel {
   [[nodiscard]] const std::vector<Eigen::Vector3d>* block_positions(const Eigen::VectorXd& displacement_m) const override;
   /// First a bound, O(unknowns): no element (or cut part) turns further than 12 max|block of the
   /// increment| max|grad(phi)|; past `resolution_rad`, each tet and part: |axial(skew(R^T G))| with
-  /// G the gradient of the increment and R its rotation at the last evaluate().
+  /// G the gradient of the increment and R its rotation at the last evaluate(), a part's times the
+  /// square root of its share w of its tet's volume: the force by which a linearized step strays is
+  /// ~ V theta^2, so a part turning theta strays as a whole tet turning sqrt(w) theta (a sliver at a
+  /// cut's front spinning fast no longer sets off a Newton correction of the whole body).
   [[nodiscard]] double largest_turn_rad(const Eigen::VectorXd& increment_m, double resolution_rad) const override;
   /// elastic_energy_j + the attached terms' energies - f_ext . u. [J]
   [[nodiscard]] double potential_energy_j(const Eigen::VectorXd& displacement_m) override;
