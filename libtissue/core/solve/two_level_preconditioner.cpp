@@ -3,9 +3,6 @@
 #include "core/solve/two_level_preconditioner.hpp"
 #include "core/system/cross_matrix.hpp"
 
-#include <Eigen/Eigenvalues>
-#include <Eigen/Geometry>
-
 #include <algorithm>
 #include <cmath>
 
