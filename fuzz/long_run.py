@@ -90,7 +90,9 @@ def start(door, work):
     if dictionary.exists():
         command.append("-dict=%s" % dictionary)
     command += [str(corpus), str(ROOT / "fuzz" / "corpus" / door)]
-    log_path = work / "logs" / (door + ".log")
+    # One log per door and script: two scripts fuzzing the same door at once must not read each
+    # other's final stats.
+    log_path = work / "logs" / ("%s-%d.log" % (door, os.getpid()))
     with open(log_path, "a") as log:
         log.write("\n### %s %s\n" % (time.strftime("%F %T"), " ".join(command)))
     log = open(log_path, "a")
