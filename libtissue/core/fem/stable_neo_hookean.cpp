@@ -11,7 +11,6 @@
 namespace tissue {
 namespace {
 
-
 // dJ/dF: the cofactor matrix, columns f1 x f2, f2 x f0, f0 x f1.
 Eigen::Matrix3d cofactor(const Eigen::Matrix3d& f) {
   Eigen::Matrix3d c;

@@ -67,7 +67,7 @@ bool TwoLevelPreconditioner::patch(const ShiftedSystem& system) {
   const int aggregates = aggregate_rows(AGGREGATE_REACH, graph, aggregate_of);
   std::vector<int> entry_of;  // local row -> its entry in level.aggregates.rows
   level.aggregates.group(local_rows, aggregate_of, aggregates, entry_of);
-  level.aggregates.make_basis(m_with_rotations ? system.block_positions : nullptr, /*count_rotations=*/true);
+  level.aggregates.make_basis(system.block_positions, /*count_rotations=*/true);  // given as at the aggregation (patchable)
 
   factorize_local(system, local_rows, local_of, aggregate_of, entry_of);
   const int columns = level.aggregates.columns();
