@@ -49,6 +49,8 @@ class CorotationalElasticity {
   [[nodiscard]] const ElementModel& elements() const { return m_elements; }
   [[nodiscard]] const TetRest& rest(int tet) const { return m_rest[stored(tet)]; }
   [[nodiscard]] const Eigen::Matrix3d& rotation(int tet) const { return m_rotations[stored(tet)]; }
+  /// The same turn as a unit quaternion (the warm start of the next extraction is that rotation's).
+  [[nodiscard]] const Eigen::Quaterniond& turn(int tet) const { return m_warm_starts[stored(tet)]; }
 
   /// Hands `tet` over to another model (a cut tet, modelled by XfemElasticity): evaluate() and
   /// elastic_energy_j() skip it from now on. Throws ParameterError for an id out of range.

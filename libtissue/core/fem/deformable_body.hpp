@@ -397,7 +397,7 @@ class DeformableBody final : public DynamicsModel {
   mutable std::vector<Eigen::Matrix3d> m_block_frames;  // block_frames(): made on request
   mutable std::vector<Eigen::Vector3d> m_block_positions;  // block_positions(): made on request
   mutable std::vector<Eigen::Matrix3d> m_vertex_frames;
-  mutable std::vector<int> m_vertex_first_tet;
+  mutable std::vector<Eigen::Vector4d> m_vertex_turns;  // block_frames(): per vertex, its tets' quaternions summed
 };
 
 }  // namespace tissue

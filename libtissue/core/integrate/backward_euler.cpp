@@ -2,6 +2,7 @@
 #include "core/integrate/backward_euler.hpp"
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <limits>
@@ -147,6 +148,7 @@ StepReport BackwardEuler::step(DynamicsModel& model, DynamicState& state, double
   const NewtonCorrections& newton = m_settings.newton;
   double turn_rad =
       model.largest_turn_rad(m_end_displacement, std::min(newton.trigger_angle_rad, newton.energy_guard_angle_rad));
+  m_end_potential_j = std::numeric_limits<double>::quiet_NaN();
   if (turn_rad > newton.trigger_angle_rad) {
     correct(model, state, h, report, team ? &*team : nullptr);
     m_velocity_change.noalias() = m_end_velocity - state.velocity_m_per_s;
@@ -217,7 +219,9 @@ bool BackwardEuler::guard_energy(DynamicsModel& model, const DynamicState& state
     potential_before_j = model.potential_energy_j(m_end_displacement);
   }
   const double before_j = kinetic_before_j + potential_before_j;
-  const double potential_after_j = model.potential_energy_j(state.displacement_m);
+  // The end's potential: the corrections' last line search found it at the same u1, when it did.
+  const double potential_after_j =
+      std::isfinite(m_end_potential_j) ? m_end_potential_j : model.potential_energy_j(state.displacement_m);
   if (!std::isfinite(before_j) || !std::isfinite(potential_after_j)) return false;  // the model cannot say
   const double mean_kinetic_j = 0.5 * mass_sum.dot(mean_velocity.cwiseProduct(mean_velocity));
   const double kinetic_after_j = 0.5 * m_end_velocity.dot(mass.cwiseProduct(m_end_velocity));
@@ -238,50 +242,71 @@ bool BackwardEuler::guard_energy(DynamicsModel& model, const DynamicState& state
 // Newton on the backward-Euler equations in v1 (u1 = u0 + h v1):
 //   r(v1) = h (f_ext - f_int(u1) - alpha M v1 - beta K(u1) v1) - M (v1 - v0) = 0,
 // with the matrix of the step, (1 + h alpha) M + (h beta + h^2) K(u1), taken at each iterate.
+// A correction that will be followed by another has its full trial evaluated with the tangent by
+// the line search; when the search takes it whole, that evaluation is the next iterate's.
 void BackwardEuler::correct(DynamicsModel& model, const DynamicState& state, double h, StepReport& report,
                             WorkTeam* team) {
   const int n = model.dof_count();
   const Eigen::VectorXd& mass = model.mass_kg();
-  // The model's potential energy at the iterate, when the last line search measured it there.
-  bool start_potential_known = false;
+  const double beta_s = model.stiffness_damping_s();
+  const double converged_rad = 0.01 * m_settings.newton.trigger_angle_rad;
+  bool evaluated = false;  // the model's forces and tangent are at the iterate already
   for (int iteration = 0; iteration < m_settings.newton.max_iterations; ++iteration) {
     const auto assembly_start = std::chrono::steady_clock::now();
     m_end_displacement.noalias() = state.displacement_m + h * m_end_velocity;
-    model.evaluate(m_end_displacement, m_internal_force_n, /*update_tangent=*/true);
+    if (!evaluated) model.evaluate(m_end_displacement, m_internal_force_n, /*update_tangent=*/true);
     const BlockSparseMatrix& stiffness = model.tangent();
-    stiffness.multiply(m_end_velocity, m_stiffness_times_velocity, team);
     m_rhs.noalias() = h * (model.external_force_n() - m_internal_force_n -
-                           model.mass_damping_kg_per_s().cwiseProduct(m_end_velocity) -
-                           model.stiffness_damping_s() * m_stiffness_times_velocity) -
+                           model.mass_damping_kg_per_s().cwiseProduct(m_end_velocity)) -
                       mass.cwiseProduct(m_end_velocity - state.velocity_m_per_s);
+    if (beta_s != 0.0) {
+      stiffness.multiply(m_end_velocity, m_stiffness_times_velocity, team);
+      m_rhs.noalias() -= (h * beta_s) * m_stiffness_times_velocity;
+    }
     const ShiftedSystem system = step_system(model, h, m_end_displacement);
     report.assembly_s += seconds_since(assembly_start);
 
+    // Each correction is solved roughly (a forcing term: while the iterations go on, the linear
+    // error stays far below what the next correction redoes; at the cap, below the error of the
+    // iterate itself), and carried on to the step's own accuracy when it turns out converged: it
+    // turns no element further than converged_rad. The turn is linear in the correction, so a
+    // share t of it turns t times as far.
     const auto solve_start = std::chrono::steady_clock::now();
     m_correction.setZero(n);
+    double turn_rad = 0.0;
     try {
       m_solver->setup_nearby(system);  // the step's matrix moved a little
-      report.solve = m_solver->solve(m_rhs, m_correction);
+      report.solve = m_solver->solve_roughly(m_rhs, m_correction);
+      report.linear_iterations += report.solve.iterations;
+      const bool last = iteration + 1 == m_settings.newton.max_iterations;
+      if ((!last || m_solver->solves_roughly()) && m_correction.allFinite()) {
+        m_end_displacement.noalias() = h * m_correction;
+        turn_rad = model.largest_turn_rad(m_end_displacement, converged_rad);
+        if (turn_rad <= converged_rad) {
+          const SolveReport refined = m_solver->refine(m_rhs, m_correction);
+          report.linear_iterations += refined.iterations;
+          if (refined.iterations > 0) report.solve = refined;
+        }
+      }
     } catch (const SolverError& error) {
       throw IntegrationError(std::string("backward Euler: a Newton correction's solve failed: ") + error.what());
     }
     report.solve_s += seconds_since(solve_start);
-    report.linear_iterations += report.solve.iterations;
     if (!m_correction.allFinite()) throw IntegrationError("backward Euler: a Newton correction is not finite; state kept");
     ++report.newton_iterations;
+    const bool another = iteration + 1 < m_settings.newton.max_iterations && turn_rad > converged_rad;
+    double share = 1.0;
     if (m_settings.newton.line_search) {
-      const double share = line_search(model, state, h, team, start_potential_known ? &m_trial_potential_j : nullptr);
+      share = line_search(model, state, h, team, another);
       if (share == 0.0) break;
-      m_correction *= share;
       m_end_velocity = m_trial_velocity;  // v1 + share correction, as the search measured it
-      start_potential_known = std::isfinite(m_trial_potential_j);
+      m_end_potential_j = m_trial_potential_j;
+      evaluated = m_trial_evaluated;
     } else {
       m_end_velocity += m_correction;
+      m_end_potential_j = std::numeric_limits<double>::quiet_NaN();
     }
-    if (iteration + 1 == m_settings.newton.max_iterations) break;  // no later iteration to stop
-    m_end_displacement.noalias() = h * m_correction;
-    const double converged_rad = 0.01 * m_settings.newton.trigger_angle_rad;
-    if (model.largest_turn_rad(m_end_displacement, converged_rad) <= converged_rad) break;
+    if (!another || share * turn_rad <= converged_rad) break;
   }
 }
 
@@ -289,12 +314,12 @@ void BackwardEuler::correct(DynamicsModel& model, const DynamicState& state, dou
 //   Phi(v1) = 1/2 |v1 - v0|^2_M + h alpha/2 |v1|^2_M + h beta/2 v1^T K v1 + E(u1),
 // E the potential (elastic, the loads', the force terms'), K frozen at the iterate the correction
 // was solved at: grad Phi = -r(v1) of correct() there. The matrix is positive definite, so a
-// correction descends Phi; the line search keeps the iterates from overshooting it.
-double BackwardEuler::incremental_potential_j(DynamicsModel& model, const DynamicState& state, double h,
-                                              const BlockSparseMatrix& stiffness, const Eigen::VectorXd& v1,
-                                              WorkTeam* team, const double* known_potential_j) {
-  m_trial_displacement.noalias() = state.displacement_m + h * v1;
-  stiffness.multiply(v1, m_trial_product, team);
+// correction descends Phi; the line search keeps the iterates from overshooting it. Along v1 + t c
+// the stiffness damping's term is the quadratic v^T K v + 2 t c^T K v + t^2 c^T K c, its three
+// products taken before a trial's evaluation replaces the tangent.
+double BackwardEuler::incremental_potential_j(const DynamicsModel& model, const DynamicState& state, double h,
+                                              const Eigen::VectorXd& v1, double stiffness_damping_j,
+                                              double potential_j) const {
   const Eigen::VectorXd& mass = model.mass_kg();
   double kinetic_j = 0.0;
   double damping_j = 0.0;
@@ -303,16 +328,43 @@ double BackwardEuler::incremental_potential_j(DynamicsModel& model, const Dynami
     kinetic_j += mass[i] * change * change;
     damping_j += model.mass_damping_kg_per_s()[i] * v1[i] * v1[i];
   }
-  damping_j += model.stiffness_damping_s() * v1.dot(m_trial_product);
-  m_trial_potential_j = known_potential_j != nullptr ? *known_potential_j : model.potential_energy_j(m_trial_displacement);
-  return 0.5 * kinetic_j + 0.5 * h * damping_j + m_trial_potential_j;
+  return 0.5 * kinetic_j + 0.5 * h * (damping_j + stiffness_damping_j) + potential_j;
+}
+
+double BackwardEuler::trial_potential_j(DynamicsModel& model, const DynamicState& state, double h,
+                                        bool with_tangent) {
+  m_trial_displacement.noalias() = state.displacement_m + h * m_trial_velocity;
+  if (with_tangent) {
+    model.evaluate_with_potential(m_trial_displacement, m_internal_force_n, /*update_tangent=*/true);
+    const double potential_j = model.potential_energy_at_last_evaluate_j();
+    if (std::isfinite(potential_j)) return potential_j;
+  }
+  return model.potential_energy_j(m_trial_displacement);
 }
 
 double BackwardEuler::line_search(DynamicsModel& model, const DynamicState& state, double h, WorkTeam* team,
-                                  const double* start_potential_j) {
-  const BlockSparseMatrix& stiffness = model.tangent();
-  m_trial_product.resize(m_correction.size());
-  const double start_j = incremental_potential_j(model, state, h, stiffness, m_end_velocity, team, start_potential_j);
+                                  bool evaluate_whole) {
+  m_trial_evaluated = false;
+  const double beta_s = model.stiffness_damping_s();
+  std::array<double, 3> quadratic{0.0, 0.0, 0.0};  // v^T K v, c^T K v, c^T K c
+  if (beta_s != 0.0) {
+    const BlockSparseMatrix& stiffness = model.tangent();
+    m_trial_product.resize(m_correction.size());
+    stiffness.multiply(m_end_velocity, m_trial_product, team);
+    quadratic = {m_end_velocity.dot(m_trial_product), m_correction.dot(m_trial_product), 0.0};
+    stiffness.multiply(m_correction, m_trial_product, team);
+    quadratic[2] = m_correction.dot(m_trial_product);
+  }
+  const auto stiffness_damping_j = [&](double share) {
+    return beta_s * (quadratic[0] + 2.0 * share * quadratic[1] + share * share * quadratic[2]);
+  };
+  double start_potential_j = m_end_potential_j;
+  if (!std::isfinite(start_potential_j)) {
+    m_trial_displacement.noalias() = state.displacement_m + h * m_end_velocity;
+    start_potential_j = model.potential_energy_j(m_trial_displacement);
+  }
+  const double start_j =
+      incremental_potential_j(model, state, h, m_end_velocity, stiffness_damping_j(0.0), start_potential_j);
   if (!std::isfinite(start_j)) {  // the model cannot say: the full correction, as without the search
     m_trial_velocity.noalias() = m_end_velocity + m_correction;
     m_trial_potential_j = std::numeric_limits<double>::quiet_NaN();
@@ -321,7 +373,13 @@ double BackwardEuler::line_search(DynamicsModel& model, const DynamicState& stat
   double share = 1.0;
   for (int halving = 0; halving <= LINE_SEARCH_HALVINGS; ++halving, share *= 0.5) {
     m_trial_velocity.noalias() = m_end_velocity + share * m_correction;
-    if (incremental_potential_j(model, state, h, stiffness, m_trial_velocity, team) <= start_j) return share;
+    const bool whole = halving == 0 && evaluate_whole;
+    m_trial_potential_j = trial_potential_j(model, state, h, whole);
+    if (incremental_potential_j(model, state, h, m_trial_velocity, stiffness_damping_j(share), m_trial_potential_j) <=
+        start_j) {
+      m_trial_evaluated = whole;
+      return share;
+    }
   }
   return 0.0;
 }

@@ -92,17 +92,18 @@ class BackwardEuler final : public Integrator {
   // Scales v1 (m_end_velocity) so that the step's energy does not rise; true if it did. The
   // potential energy at the start is m_start_potential_j when the step's evaluate found it.
   bool guard_energy(DynamicsModel& model, const DynamicState& state, double h);
-  // The step's incremental potential at v1 (backward_euler.cpp); `stiffness` is the damping's K.
-  // The model's potential energy at u0 + h v1 is `known_potential_j` when given (a pass over the
-  // elements saved), else computed; either way it is left in m_trial_potential_j.
-  double incremental_potential_j(DynamicsModel& model, const DynamicState& state, double h,
-                                 const BlockSparseMatrix& stiffness, const Eigen::VectorXd& v1, WorkTeam* team,
-                                 const double* known_potential_j = nullptr);
+  // The step's incremental potential at v1 (backward_euler.cpp), given beta v1^T K v1 and the
+  // model's potential energy at u0 + h v1.
+  double incremental_potential_j(const DynamicsModel& model, const DynamicState& state, double h,
+                                 const Eigen::VectorXd& v1, double stiffness_damping_j, double potential_j) const;
+  // The model's potential energy at u0 + h m_trial_velocity; `with_tangent`: found by an evaluate
+  // with the tangent (m_internal_force_n and the model's tangent then are the trial's).
+  double trial_potential_j(DynamicsModel& model, const DynamicState& state, double h, bool with_tangent);
   // The share t of m_correction to take (0: none lowers the incremental potential); the trial taken
-  // is left in m_trial_velocity, its potential energy in m_trial_potential_j. `start_potential_j`:
-  // the model's potential energy at the iterate when known (the last search's accepted trial).
-  double line_search(DynamicsModel& model, const DynamicState& state, double h, WorkTeam* team,
-                     const double* start_potential_j);
+  // is left in m_trial_velocity, its potential energy in m_trial_potential_j. The iterate's
+  // potential energy is m_end_potential_j when known. `evaluate_whole`: the whole correction's trial
+  // is evaluated with the tangent (m_trial_evaluated tells whether the search took it).
+  double line_search(DynamicsModel& model, const DynamicState& state, double h, WorkTeam* team, bool evaluate_whole);
 
   std::unique_ptr<LinearSolver> m_solver;
   Settings m_settings;
@@ -121,6 +122,8 @@ class BackwardEuler final : public Integrator {
   Eigen::VectorXd m_trial_product;     // K v of a trial
   double m_trial_potential_j = 0.0;    // the model's potential energy at the last trial's u1
   double m_start_potential_j = 0.0;    // at u0, from the step's evaluate (NaN: the model keeps none)
+  double m_end_potential_j = 0.0;      // at u0 + h v1 when the corrections' line search found it, else NaN
+  bool m_trial_evaluated = false;      // the line search took a trial evaluated with the tangent
 };
 
 /// Throws ParameterError unless the trigger angle is > 0 (infinity: off) and 1 to 100 iterations.

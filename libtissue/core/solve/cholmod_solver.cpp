@@ -1,9 +1,11 @@
 // CholmodSolver: sparse Cholesky of A = s K + diag(d) with SuiteSparse CHOLMOD, the accurate
 // (reference) solver: every setup refactorizes (CholmodFactor, whose header and source give the
 // CHOLMOD choices), every solve back-substitutes and checks the true residual. A setup_nearby (a
-// Newton correction's matrix) keeps the factor and iterates on the new A with it.
+// Newton correction's matrix) keeps the factor and iterates on the new A with it, to a forcing term,
+// then corrects each part's translation (PartTranslations).
 #include "core/solve/cholmod_factor.hpp"
 #include "core/solve/linear_solver.hpp"
+#include "core/solve/part_translations.hpp"
 #include "core/solve/pcg_iteration.hpp"
 #include "core/solve/turned_factor.hpp"
 
@@ -23,6 +25,7 @@ struct CholmodSolver::Impl {
   PcgWorkspace work;
   WorkTeam* team = nullptr;
   TurnedFactor turned;  // the factor turned with the rows' rotations since it was made
+  PartTranslations parts;  // of the nearby system: its CG stops at a forcing term
 
   void factorize(const ShiftedSystem& system) {
     const ShiftedSystem a = system;  // a copy: it may be nearby_system, cleared here
@@ -66,7 +69,42 @@ void CholmodSolver::setup_nearby(const ShiftedSystem& system) {
   impl.work.resize(system.rows());
   impl.work.matrix.assign(system, impl.team);
   impl.turned.update_turns(system, impl.factor.rows());
+  impl.parts.setup(system);
   impl.nearby_system = system;
+}
+
+// CG on the nearby system from x with the turned factor, then each part's translation corrected.
+// Empty report (not converged) when CG did not get there: the caller factorizes.
+SolveReport CholmodSolver::iterate_nearby(const Eigen::VectorXd& b, Eigen::VectorXd& x, double tolerance) {
+  Impl& impl = *m_impl;
+  impl.nearby_system.check_sizes(b, x);
+  SolveReport report = preconditioned_cg</*ROW_WISE=*/false>(
+      impl.nearby_system, b, x, tolerance, NEARBY_ITERATIONS, impl.work, impl.team,
+      [&impl](const Eigen::VectorXd& r, Eigen::VectorXd& z, long, long) { impl.turned.solve(impl.factor, r, z); });
+  if (!report.converged || !x.allFinite()) return SolveReport{};
+  impl.work.matrix.multiply(x, impl.product);  // the true residual (CG's is recursive)
+  impl.product = b - impl.product;
+  impl.parts.correct(impl.product, x);
+  return report;
+}
+
+SolveReport CholmodSolver::solve_roughly(const Eigen::VectorXd& b, Eigen::VectorXd& x) {
+  Impl& impl = *m_impl;
+  if (impl.nearby_system.stiffness == nullptr) return solve(b, x);  // a factor of this A, or none
+  x.setZero(impl.nearby_system.rows());
+  const SolveReport report = iterate_nearby(b, x, NEARBY_FORCING_TERM);
+  if (report.converged) return report;
+  impl.factorize(impl.nearby_system);  // too far after all: solve() solves with the new factor
+  return solve(b, x);
+}
+
+SolveReport CholmodSolver::refine(const Eigen::VectorXd& b, Eigen::VectorXd& x) {
+  Impl& impl = *m_impl;
+  if (impl.nearby_system.stiffness == nullptr) return SolveReport{0, 0.0, true};  // solved directly
+  const SolveReport report = iterate_nearby(b, x, NEARBY_TOLERANCE);
+  if (report.converged) return report;
+  impl.factorize(impl.nearby_system);
+  return solve(b, x);
 }
 
 SolveReport CholmodSolver::solve(const Eigen::VectorXd& b, Eigen::VectorXd& x) {
@@ -74,11 +112,8 @@ SolveReport CholmodSolver::solve(const Eigen::VectorXd& b, Eigen::VectorXd& x) {
   if (!is_set_up()) throw SolverError("CholmodSolver: solve() without a factor (call setup())");
   if (impl.nearby_system.stiffness != nullptr) {
     x.setZero(impl.nearby_system.rows());
-    impl.nearby_system.check_sizes(b, x);
-    const SolveReport report = preconditioned_cg</*ROW_WISE=*/false>(
-        impl.nearby_system, b, x, NEARBY_TOLERANCE, NEARBY_ITERATIONS, impl.work, impl.team,
-        [&impl](const Eigen::VectorXd& r, Eigen::VectorXd& z, long, long) { impl.turned.solve(impl.factor, r, z); });
-    if (report.converged && x.allFinite()) return report;
+    const SolveReport report = iterate_nearby(b, x, NEARBY_TOLERANCE);
+    if (report.converged) return report;
     impl.factorize(impl.nearby_system);  // too far after all: the exact solve below
   }
   const long n = impl.factor.rows();

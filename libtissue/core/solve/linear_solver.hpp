@@ -66,13 +66,25 @@ class LinearSolver {
   /// setup() for an A close to the last setup's (a Newton correction's matrix within the step that
   /// set up): same K object, pattern and size, values moved a little. A direct solver may keep its
   /// factor and iterate on A with it as the preconditioner (CholmodSolver: to a relative residual
-  /// of 1e-6, which a Newton iteration's own stopping rule is far above); the others set up as usual.
+  /// of 1e-6, or a forcing term with solve_roughly()); the others set up as usual.
   virtual void setup_nearby(const ShiftedSystem& system) { setup(system); }
   /// Solves A x = b with the A of the last setup(). On entry x holds the initial guess (iterative
   /// solvers warm-start from it and need length A.rows(); a direct solver resizes it). Work buffers
   /// are kept between calls: no allocation while the size stays the same. Throws SolverError
   /// without a setup, for a wrong length or a non-finite direct solution.
   virtual SolveReport solve(const Eigen::VectorXd& b, Eigen::VectorXd& x) = 0;
+  /// After setup_nearby(), for a Newton correction that another will follow: a solve good to a
+  /// forcing term, which is all such a correction needs (x from zero). A solver that keeps its
+  /// factor across setup_nearby() stops there (CholmodSolver: a relative residual of 1e-2); the
+  /// others solve as solve() does.
+  virtual SolveReport solve_roughly(const Eigen::VectorXd& b, Eigen::VectorXd& x) { return solve(b, x); }
+  /// Carries x from solve_roughly() on to the accuracy of solve() (a correction that turned out to
+  /// be the last). Reports the iterations it added; for the others, none (x is solve()'s already).
+  virtual SolveReport refine(const Eigen::VectorXd& /*b*/, Eigen::VectorXd& /*x*/) {
+    return SolveReport{0, 0.0, true};
+  }
+  /// Whether solve_roughly() can stop short of solve() (then refine() has something to do).
+  [[nodiscard]] virtual bool solves_roughly() const { return false; }
   /// setup(system), then solve(b, x).
   SolveReport solve(const ShiftedSystem& system, const Eigen::VectorXd& b, Eigen::VectorXd& x) {
     setup(system);
@@ -302,15 +314,20 @@ class CholmodSolver final : public LinearSolver {
   /// (turned_factor.hpp; the block frames of both systems), to NEARBY_TOLERANCE, and factorize A
   /// after all if CG has not got there in NEARBY_ITERATIONS. A Newton correction then costs a few
   /// back-substitutions instead of a factorization (docs/DESIGN.md, "A correction's solve keeps the
-  /// step's factor"). Reports CG's residual. NEARBY_TOLERANCE keeps the corrections exact solves for
-  /// what CHOLMOD promises (a forcing term of 1e-3 would make the frog's protected step 1.96x its
-  /// unprotected one instead of 2.2x, but a piece freed by crossing cuts then falls at g only to
-  /// 4e-4: FreeFall.PiecesFreedByCrossingCutsFallAtG asks 1e-6).
+  /// step's factor"). solve_roughly() stops CG at NEARBY_FORCING_TERM (an inexact Newton step for a
+  /// correction that another follows: the co-rotational tangent leaves the corrections converging
+  /// linearly, 2-3x a correction, far above that); refine() carries it on to NEARBY_TOLERANCE. After
+  /// CG, each part's translation is corrected (PartTranslations): the momentum balance an exact
+  /// solve gives a free part holds whatever CG's stop. Reports CG's residual.
   void setup_nearby(const ShiftedSystem& system) override;
   /// x = A^-1 b with the factor; reports the true relative residual (one product with A).
   SolveReport solve(const Eigen::VectorXd& b, Eigen::VectorXd& x) override;
+  SolveReport solve_roughly(const Eigen::VectorXd& b, Eigen::VectorXd& x) override;
+  SolveReport refine(const Eigen::VectorXd& b, Eigen::VectorXd& x) override;
+  [[nodiscard]] bool solves_roughly() const override { return true; }
   void lend_work_team(WorkTeam* team) override;
   static constexpr double NEARBY_TOLERANCE = 1e-6;
+  static constexpr double NEARBY_FORCING_TERM = 1e-2;
   static constexpr int NEARBY_ITERATIONS = 40;
   [[nodiscard]] bool is_set_up() const override;
   [[nodiscard]] std::string_view name() const override { return "cholmod"; }
@@ -321,6 +338,7 @@ class CholmodSolver final : public LinearSolver {
   [[nodiscard]] int symbolic_analysis_count() const;
 
  private:
+  SolveReport iterate_nearby(const Eigen::VectorXd& b, Eigen::VectorXd& x, double tolerance);
   struct Impl;
   std::unique_ptr<Impl> m_impl;
 };
