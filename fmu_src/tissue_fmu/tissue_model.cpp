@@ -477,6 +477,10 @@ void TissueModel::get_uint64(const VariableInfo& info, std::span<std::uint64_t> 
 
 void TissueModel::get_boolean(const VariableInfo& info, std::span<bool> out) {
   const auto which = static_cast<Vr>(info.vr);
+  if (which == Vr::surface_preparing) {  // no settle(): it says whether a read would wait
+    out[0] = m_surface_work.busy();
+    return;
+  }
   if (which != Vr::contact_active && which != Vr::contact_near) Model::get_boolean(info, out);
   ensure_built();
   const ToolContact contact = m_tissue->tool_contact();

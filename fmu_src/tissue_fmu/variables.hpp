@@ -54,6 +54,7 @@ enum class Vr : std::uint32_t {
   surface_mesh = 56,  // issue 22: the Binary surface outputs
   surface_embedding = 57,
   surface_nodes = 58,
+  surface_preparing = 59,
   cut_tets = 60,
   enriched_vertices = 61,
   dofs = 62,
@@ -211,6 +212,10 @@ constexpr auto outputs() {
     output(Vr::surface_nodes, "surface.nodes", binary, discrete)
         .describe("The nodes' positions for surface.embedding (\"TSN1\"): a viewer maps the points itself, reading "
                   "the coarse nodes every step and the embedding once per revision"),
+    output(Vr::surface_preparing, "surface.preparing", boolean, discrete)
+        .describe("True while the preparation of surface.embedding after a step (surface.prepareAfterStep) "
+                  "still runs: reading the surface then waits for it, so a real-time importer may read it a "
+                  "slot later; reading this never waits"),
     output(Vr::cut_tets, "cutTets", uint64, discrete).describe("Number of tetrahedra cut so far"),
     output(Vr::enriched_vertices, "enrichedVertices", uint64, discrete)
         .describe("Number of enriched (XFEM) vertex unknowns the cuts added"),

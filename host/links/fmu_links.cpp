@@ -100,6 +100,9 @@ TissueLink::TissueLink(const Fmu3& fmu, const std::vector<ParameterSetting>& par
   if (const auto* prepare = m_instance.description().find_variable("surface.prepareAfterStep")) {
     m_prepare_vr = prepare->value_reference;
   }
+  if (const auto* preparing = m_instance.description().find_variable("surface.preparing")) {
+    m_preparing_vr = preparing->value_reference;
+  }
   apply_parameters(m_instance, parameters, "tissue.parameters");
   expect_ok(m_instance.enter_initialization_mode(std::nullopt, 0.0, std::nullopt), m_instance,
             "Tissue: enter initialization mode");
@@ -159,6 +162,13 @@ std::uint64_t TissueLink::surface_revision() {
 }
 
 bool TissueLink::surface_remeshed() { return !embedding_read_at(surface_revision()); }
+
+bool TissueLink::surface_preparing() {
+  if (!m_preparing_vr) return false;
+  std::array<fmi3Boolean, 1> preparing{false};
+  (void)m_instance.get_boolean(std::span<const fmi3ValueReference>(&*m_preparing_vr, 1), preparing);
+  return preparing[0];
+}
 
 void TissueLink::read_surface(SurfaceFrame& frame) {
   read_surface_unmapped(frame);

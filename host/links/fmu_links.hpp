@@ -83,6 +83,9 @@ class TissueLink {
   /// Whether surface.revision moved since the embedding was last read (a cut re-meshed the surface:
   /// the next read copies the embedding).
   [[nodiscard]] bool surface_remeshed();
+  /// Whether the Tissue still prepares its re-meshed surface after the last step (its
+  /// surface.preparing; false for an FMU without it): a read now would wait for it.
+  [[nodiscard]] bool surface_preparing();
   /// Gives `frame` room for twice the surface at rest, so that reading into it rarely allocates.
   void reserve(SurfaceFrame& frame) const;
   /// Axis-aligned box of the tet mesh at rest (after initialization), whichever surface is drawn.
@@ -101,7 +104,8 @@ class TissueLink {
   Fmu3Instance m_instance;
   fmi3ValueReference m_tool_position, m_tool_orientation, m_tool_mode;
   fmi3ValueReference m_revision, m_embedding_vr, m_nodes_vr, m_cut_tets, m_enriched;
-  std::optional<fmi3ValueReference> m_prepare_vr;  // surface.prepareAfterStep, when the FMU has it
+  std::optional<fmi3ValueReference> m_prepare_vr;    // surface.prepareAfterStep, when the FMU has it
+  std::optional<fmi3ValueReference> m_preparing_vr;  // surface.preparing, when the FMU has it
   bool m_prepare = false;                           // its value as last set
   std::shared_ptr<const std::vector<std::uint8_t>> m_embedding_bytes;  // of the last revision read
   RecycledBytes m_embedding_copies;  // m_embedding_bytes's buffers

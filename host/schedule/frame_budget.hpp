@@ -15,7 +15,10 @@
 // the step (the longest recent one, decaying alike) fit: the state is the one the frame was due for.
 // A frame of a re-meshed surface always waits for the next slot's start (forced there after
 // MAX_DEFERRALS): the Tissue FMU prepares the re-meshed surface in between, in the time the slot
-// leaves idle (surface.prepareAfterStep), so that its capture is a copy of ready bytes.
+// leaves idle (surface.prepareAfterStep), so that its capture is a copy of ready bytes; if the
+// preparation has not finished when the slot starts (surface.preparing), the frame waits another
+// slot rather than the slot for it (those captures waited 1-10 ms: most of the organ's overruns
+// left, issue 42).
 #pragma once
 
 #include "output/slot_timing.hpp"
@@ -42,11 +45,13 @@ class FrameBudget {
   /// Where in its slot a due frame is looked at: before the step (a frame left to this slot) or after it.
   enum class Point { before_step, after_step };
   /// Whether to capture a due frame of `kind` at `point`, `now` being then and `slot_end` the end of
-  /// the slots the step covers. Before the step: when the capture and the step fit, or forced. After
-  /// it: a re-meshed surface waits for the next slot's start (forced there); the positions as
+  /// the slots the step covers. Before the step: when the capture and the step fit and the surface
+  /// is not still being prepared (`preparing`: the capture would wait for it), or forced. After it:
+  /// a re-meshed surface waits for the next slot's start (forced there); the positions as
   /// capture_now().
-  [[nodiscard]] bool capture_at(Point point, Nanoseconds now, Nanoseconds slot_end, CaptureKind kind) const {
-    if (point == Point::before_step) return forced() || fits_before_step(now, slot_end, kind);
+  [[nodiscard]] bool capture_at(Point point, Nanoseconds now, Nanoseconds slot_end, CaptureKind kind,
+                                bool preparing = false) const {
+    if (point == Point::before_step) return forced() || (!preparing && fits_before_step(now, slot_end, kind));
     return kind != CaptureKind::remeshed && capture_now(now, slot_end, kind);
   }
   /// Whether a frame of a re-meshed surface due after the coming step is worth preparing meanwhile

@@ -102,7 +102,10 @@ void RealtimeScheduler::record_frame(FramePipe& pipe, FrameBudget& frames, Nanos
   const CaptureKind kind = m_steps.frame_remeshed() ? CaptureKind::remeshed : CaptureKind::positions;
   const Nanoseconds begin = now_ns();
   timing.capture_kind = kind;
-  if (!frames.capture_at(point, begin, slot_end, kind)) {
+  // Asked only where it matters: a re-meshed surface looked at before the step.
+  const bool preparing =
+      point == FrameBudget::Point::before_step && kind == CaptureKind::remeshed && m_steps.frame_preparing();
+  if (!frames.capture_at(point, begin, slot_end, kind, preparing)) {
     if (point == FrameBudget::Point::before_step) return;  // looked at again after the step
     frames.deferred();
     ++m_summary.frames_deferred;

@@ -44,6 +44,9 @@ class SessionSteps {
   [[nodiscard]] virtual bool frame_due(double time_s) const = 0;
   /// Whether a capture now reads a surface re-meshed since the last one (a cut): the costly kind.
   [[nodiscard]] virtual bool frame_remeshed() = 0;
+  /// Whether the re-meshed surface is still being prepared after the last step (the Tissue's
+  /// surface.preparing): a capture now would wait for it.
+  [[nodiscard]] virtual bool frame_preparing() = 0;
   /// The surface, tool and contact at tissue time `time_s` into `frame` (no allocation once reserved),
   /// the surface's mapping left to complete_frame().
   virtual void capture_frame(SurfaceFrame& frame, double time_s) = 0;

@@ -260,6 +260,7 @@ class Session final : public SessionSteps {
     return m_options.write_outputs && m_scenario.frame_rate_hz > 0.0 && time_s + 1e-9 >= m_next_frame_s;
   }
   bool frame_remeshed() override { return m_tissue.surface_remeshed(); }
+  bool frame_preparing() override { return m_tissue.surface_preparing(); }
   void capture_frame(SurfaceFrame& frame, double time_s) override {
     fill_frame(frame, time_s, Mapping::deferred);
     // The next recorded frame is the first one due after this one (not a period past it).

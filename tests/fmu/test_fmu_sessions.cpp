@@ -640,7 +640,7 @@ TEST(TissueFmu, ASurfacePreparedAfterTheStepIsTheSurfaceReadOnDemand) {
   fmi3FMUState before_cut = nullptr;
   ASSERT_EQ(prepared.fmu().get_fmu_state(before_cut), fmi3OK);
   const std::vector<std::uint8_t> embedding_before_cut = binary(prepared.fmu(), "surface.embedding");
-  int remeshed = 0;
+  int remeshed = 0, seen_preparing = 0;
   std::uint64_t last_revision = 0;
   for (int n = 34; n < 60; ++n) {
     for (Session* s : {&plain, &prepared}) {
@@ -652,6 +652,15 @@ TEST(TissueFmu, ASurfacePreparedAfterTheStepIsTheSurfaceReadOnDemand) {
     ASSERT_EQ(prepared.fmu().get_float64("contact.force", force_prepared), fmi3OK);
     ASSERT_EQ(plain.fmu().get_float64("contact.force", force_plain), fmi3OK);
     EXPECT_EQ(force_plain, force_prepared);
+    // surface.preparing, read at once: never in the plain session; in the prepared one, while the
+    // work runs (whether a read sees it depends on the machine's timing: counted, not asserted;
+    // BackgroundWork.BusyWhileAJobRuns is the deterministic check), and never once the surface was
+    // read (which waits for it).
+    std::vector<bool> preparing_plain, preparing;
+    ASSERT_EQ(plain.fmu().get_boolean("surface.preparing", preparing_plain), fmi3OK);
+    ASSERT_EQ(prepared.fmu().get_boolean("surface.preparing", preparing), fmi3OK);
+    EXPECT_FALSE(preparing_plain.at(0));
+    seen_preparing += preparing.at(0) ? 1 : 0;
     const Outputs out = prepared.outputs();
     remeshed += out.counters.at(2) != last_revision ? 1 : 0;
     last_revision = out.counters.at(2);
@@ -663,8 +672,11 @@ TEST(TissueFmu, ASurfacePreparedAfterTheStepIsTheSurfaceReadOnDemand) {
     if (n % 3 == 0) continue;
     EXPECT_EQ(embedding, binary(prepared.fmu(), "surface.embedding")) << "step " << n;
     EXPECT_EQ(nodes, binary(prepared.fmu(), "surface.nodes")) << "step " << n;
+    ASSERT_EQ(prepared.fmu().get_boolean("surface.preparing", preparing), fmi3OK);
+    EXPECT_FALSE(preparing.at(0)) << "step " << n;
   }
   EXPECT_GT(remeshed, 3);
+  std::printf("  surface.preparing read true after %d of %d steps\n", seen_preparing, 60 - 34);
   // Back before the cut: the embedding of that state.
   ASSERT_EQ(prepared.fmu().set_fmu_state(before_cut), fmi3OK) << prepared.fmu().log_text();
   EXPECT_EQ(binary(prepared.fmu(), "surface.embedding"), embedding_before_cut);

@@ -88,5 +88,21 @@ TEST(FrameBudget, AReMeshedFrameIsTakenAtTheNextSlotsStartBeforeTheStep) {
   EXPECT_FALSE(frames.forced());
 }
 
+// A re-meshed surface the Tissue still prepares when the slot starts (surface.preparing): reading it
+// would wait for the preparation, so the frame waits a slot instead, until it is forced.
+TEST(FrameBudget, AReMeshedFrameStillBeingPreparedWaitsASlotUnlessForced) {
+  using Point = FrameBudget::Point;
+  FrameBudget frames;
+  frames.stepped(4 * MS);
+  frames.captured(2 * MS, R);
+  EXPECT_TRUE(frames.capture_at(Point::before_step, 0, 10 * MS, R, /*preparing=*/false));
+  EXPECT_FALSE(frames.capture_at(Point::before_step, 0, 10 * MS, R, /*preparing=*/true));
+  for (int k = 0; k < FrameBudget::MAX_DEFERRALS; ++k) {
+    ASSERT_FALSE(frames.capture_at(Point::before_step, 0, 10 * MS, R, true)) << k;
+    frames.deferred();
+  }
+  EXPECT_TRUE(frames.capture_at(Point::before_step, 0, 10 * MS, R, true));  // forced: it waits for the preparation
+}
+
 }  // namespace
 }  // namespace tissue::host

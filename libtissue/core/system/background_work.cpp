@@ -45,6 +45,12 @@ void BackgroundWork::wait() {
   m_pending = false;
 }
 
+bool BackgroundWork::busy() {
+  if (!m_pending) return false;
+  std::lock_guard lock(m_mutex);  // the job holds it only to take the job and to say it finished
+  return m_running;
+}
+
 void BackgroundWork::serve() noexcept {
   leave_realtime_policy();  // the job runs in the time the real-time threads leave idle
   std::unique_lock lock(m_mutex);

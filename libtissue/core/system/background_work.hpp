@@ -30,6 +30,8 @@ class BackgroundWork {
   void wait();
   /// Whether a job was handed over and has not been waited for.
   [[nodiscard]] bool pending() const { return m_pending; }
+  /// Whether a job handed over still runs (wait() would block); never blocks on it.
+  [[nodiscard]] bool busy();
 
  private:
   void serve() noexcept;

@@ -63,5 +63,24 @@ TEST(BackgroundWork, DestructionWaitsForARunningJob) {
   EXPECT_TRUE(finished);
 }
 
+// busy(): true from start() while the job runs, false once it has finished (without a wait()), and
+// false with no job; it never blocks on the job (the job here cannot finish until the test lets it).
+TEST(BackgroundWork, BusyWhileAJobRuns) {
+  BackgroundWork work;
+  EXPECT_FALSE(work.busy());
+  std::atomic<bool> release{false}, finished{false};
+  work.start([&] {
+    while (!release) std::this_thread::yield();
+    finished = true;
+  });
+  EXPECT_TRUE(work.busy());  // the job waits for `release`: it cannot have finished
+  EXPECT_TRUE(work.busy());
+  release = true;
+  while (work.busy()) std::this_thread::yield();
+  EXPECT_TRUE(finished);
+  work.wait();
+  EXPECT_FALSE(work.busy());
+}
+
 }  // namespace
 }  // namespace tissue
