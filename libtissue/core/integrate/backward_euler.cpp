@@ -254,7 +254,13 @@ void BackwardEuler::correct(DynamicsModel& model, const DynamicState& state, dou
   for (int iteration = 0; iteration < m_settings.newton.max_iterations; ++iteration) {
     const auto assembly_start = std::chrono::steady_clock::now();
     m_end_displacement.noalias() = state.displacement_m + h * m_end_velocity;
-    if (!evaluated) model.evaluate(m_end_displacement, m_internal_force_n, /*update_tangent=*/true);
+    if (!evaluated && m_settings.newton.line_search && !std::isfinite(m_end_potential_j)) {
+      // The line search starts from the iterate's potential energy: found in the same pass.
+      model.evaluate_with_potential(m_end_displacement, m_internal_force_n, /*update_tangent=*/true);
+      m_end_potential_j = model.potential_energy_at_last_evaluate_j();
+    } else if (!evaluated) {
+      model.evaluate(m_end_displacement, m_internal_force_n, /*update_tangent=*/true);
+    }
     const BlockSparseMatrix& stiffness = model.tangent();
     m_rhs.noalias() = h * (model.external_force_n() - m_internal_force_n -
                            model.mass_damping_kg_per_s().cwiseProduct(m_end_velocity)) -

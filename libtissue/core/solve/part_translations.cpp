@@ -37,7 +37,11 @@ void PartTranslations::setup(const ShiftedSystem& a) {
       }
     }
   }
-  for (Eigen::Matrix3d& sum : block_sum) sum = sum.inverse().eval();
+  for (Eigen::Matrix3d& sum : block_sum) {
+    // Positive definite for a positive d; a part without (a row nothing weighs) is left as it is.
+    const Eigen::Matrix3d inverse = sum.determinant() > 0.0 ? sum.inverse().eval() : Eigen::Matrix3d::Zero();
+    sum = inverse.allFinite() ? inverse : Eigen::Matrix3d::Zero();
+  }
   m_sums.resize(m_inverse.size());
 }
 
