@@ -73,13 +73,14 @@ class LinearSolver {
   /// are kept between calls: no allocation while the size stays the same. Throws SolverError
   /// without a setup, for a wrong length or a non-finite direct solution.
   virtual SolveReport solve(const Eigen::VectorXd& b, Eigen::VectorXd& x) = 0;
-  /// After setup_nearby(), for a Newton correction that another will follow: a solve good to a
-  /// forcing term, which is all such a correction needs (x from zero). A solver that keeps its
-  /// factor across setup_nearby() stops there (CholmodSolver: a relative residual of 1e-2); the
-  /// others solve as solve() does.
+  /// After setup_nearby(), for a Newton correction: a solve good to a forcing term (x from zero),
+  /// which is all a correction needs while the iterations go on. A solver that keeps its factor
+  /// across setup_nearby() stops there (CholmodSolver: a relative residual of 1e-2); the others
+  /// solve as solve() does.
   virtual SolveReport solve_roughly(const Eigen::VectorXd& b, Eigen::VectorXd& x) { return solve(b, x); }
-  /// Carries x from solve_roughly() on to the accuracy of solve() (a correction that turned out to
-  /// be the last). Reports the iterations it added; for the others, none (x is solve()'s already).
+  /// Carries x from solve_roughly() on to the accuracy of solve() (a correction that turned out
+  /// converged, the step's last). Reports the iterations it added; for the others, none (x is
+  /// solve()'s already).
   virtual SolveReport refine(const Eigen::VectorXd& /*b*/, Eigen::VectorXd& /*x*/) {
     return SolveReport{0, 0.0, true};
   }
@@ -314,9 +315,9 @@ class CholmodSolver final : public LinearSolver {
   /// (turned_factor.hpp; the block frames of both systems), to NEARBY_TOLERANCE, and factorize A
   /// after all if CG has not got there in NEARBY_ITERATIONS. A Newton correction then costs a few
   /// back-substitutions instead of a factorization (docs/DESIGN.md, "A correction's solve keeps the
-  /// step's factor"). solve_roughly() stops CG at NEARBY_FORCING_TERM (an inexact Newton step for a
-  /// correction that another follows: the co-rotational tangent leaves the corrections converging
-  /// linearly, 2-3x a correction, far above that); refine() carries it on to NEARBY_TOLERANCE. After
+  /// step's factor"). solve_roughly() stops CG at NEARBY_FORCING_TERM (an inexact Newton step: the
+  /// co-rotational tangent leaves the corrections converging linearly, 2-3x a correction, far above
+  /// that); refine() carries a converged correction on to NEARBY_TOLERANCE. After
   /// CG, each part's translation is corrected (PartTranslations): the momentum balance an exact
   /// solve gives a free part holds whatever CG's stop. Reports CG's residual.
   void setup_nearby(const ShiftedSystem& system) override;
