@@ -277,6 +277,7 @@ void BackwardEuler::correct(DynamicsModel& model, const DynamicState& state, dou
     // iterate itself), and carried on to the step's own accuracy when it turns out converged: it
     // turns no element further than converged_rad. The turn is linear in the correction, so a
     // share t of it turns t times as far.
+    const bool last = iteration + 1 == m_settings.newton.max_iterations;
     const auto solve_start = std::chrono::steady_clock::now();
     m_correction.setZero(n);
     double turn_rad = 0.0;
@@ -284,7 +285,6 @@ void BackwardEuler::correct(DynamicsModel& model, const DynamicState& state, dou
       m_solver->setup_nearby(system);  // the step's matrix moved a little
       report.solve = m_solver->solve_roughly(m_rhs, m_correction);
       report.linear_iterations += report.solve.iterations;
-      const bool last = iteration + 1 == m_settings.newton.max_iterations;
       if ((!last || m_solver->solves_roughly()) && m_correction.allFinite()) {
         m_end_displacement.noalias() = h * m_correction;
         turn_rad = model.largest_turn_rad(m_end_displacement, converged_rad);
@@ -300,7 +300,7 @@ void BackwardEuler::correct(DynamicsModel& model, const DynamicState& state, dou
     report.solve_s += seconds_since(solve_start);
     if (!m_correction.allFinite()) throw IntegrationError("backward Euler: a Newton correction is not finite; state kept");
     ++report.newton_iterations;
-    const bool another = iteration + 1 < m_settings.newton.max_iterations && turn_rad > converged_rad;
+    const bool another = !last && turn_rad > converged_rad;
     double share = 1.0;
     if (m_settings.newton.line_search) {
       share = line_search(model, state, h, team, another);

@@ -73,15 +73,18 @@ void CholmodSolver::setup_nearby(const ShiftedSystem& system) {
   impl.nearby_system = system;
 }
 
-// CG on the nearby system from x with the turned factor, then each part's translation corrected.
-// Empty report (not converged) when CG did not get there: the caller factorizes.
-SolveReport CholmodSolver::iterate_nearby(const Eigen::VectorXd& b, Eigen::VectorXd& x, double tolerance) {
+// From x: CG on the nearby system with the turned factor, then each part's translation corrected;
+// when CG does not get there, the nearby system factorized after all and solved directly.
+SolveReport CholmodSolver::solve_nearby(const Eigen::VectorXd& b, Eigen::VectorXd& x, double tolerance) {
   Impl& impl = *m_impl;
   impl.nearby_system.check_sizes(b, x);
-  SolveReport report = preconditioned_cg</*ROW_WISE=*/false>(
+  const SolveReport report = preconditioned_cg</*ROW_WISE=*/false>(
       impl.nearby_system, b, x, tolerance, NEARBY_ITERATIONS, impl.work, impl.team,
       [&impl](const Eigen::VectorXd& r, Eigen::VectorXd& z, long, long) { impl.turned.solve(impl.factor, r, z); });
-  if (!report.converged || !x.allFinite()) return SolveReport{};
+  if (!report.converged || !x.allFinite()) {
+    impl.factorize(impl.nearby_system);  // too far after all: solve() solves with the new factor
+    return solve(b, x);
+  }
   impl.work.matrix.multiply(x, impl.product);  // the true residual (CG's is recursive)
   impl.product = b - impl.product;
   impl.parts.correct(impl.product, x);
@@ -92,19 +95,12 @@ SolveReport CholmodSolver::solve_roughly(const Eigen::VectorXd& b, Eigen::Vector
   Impl& impl = *m_impl;
   if (impl.nearby_system.stiffness == nullptr) return solve(b, x);  // a factor of this A, or none
   x.setZero(impl.nearby_system.rows());
-  const SolveReport report = iterate_nearby(b, x, NEARBY_FORCING_TERM);
-  if (report.converged) return report;
-  impl.factorize(impl.nearby_system);  // too far after all: solve() solves with the new factor
-  return solve(b, x);
+  return solve_nearby(b, x, NEARBY_FORCING_TERM);
 }
 
 SolveReport CholmodSolver::refine(const Eigen::VectorXd& b, Eigen::VectorXd& x) {
-  Impl& impl = *m_impl;
-  if (impl.nearby_system.stiffness == nullptr) return SolveReport{0, 0.0, true};  // solved directly
-  const SolveReport report = iterate_nearby(b, x, NEARBY_TOLERANCE);
-  if (report.converged) return report;
-  impl.factorize(impl.nearby_system);
-  return solve(b, x);
+  if (m_impl->nearby_system.stiffness == nullptr) return SolveReport{0, 0.0, true};  // solved directly
+  return solve_nearby(b, x, NEARBY_TOLERANCE);
 }
 
 SolveReport CholmodSolver::solve(const Eigen::VectorXd& b, Eigen::VectorXd& x) {
@@ -112,9 +108,7 @@ SolveReport CholmodSolver::solve(const Eigen::VectorXd& b, Eigen::VectorXd& x) {
   if (!is_set_up()) throw SolverError("CholmodSolver: solve() without a factor (call setup())");
   if (impl.nearby_system.stiffness != nullptr) {
     x.setZero(impl.nearby_system.rows());
-    const SolveReport report = iterate_nearby(b, x, NEARBY_TOLERANCE);
-    if (report.converged) return report;
-    impl.factorize(impl.nearby_system);  // too far after all: the exact solve below
+    return solve_nearby(b, x, NEARBY_TOLERANCE);
   }
   const long n = impl.factor.rows();
   if (b.size() != n) {

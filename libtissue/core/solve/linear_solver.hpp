@@ -339,7 +339,7 @@ class CholmodSolver final : public LinearSolver {
   [[nodiscard]] int symbolic_analysis_count() const;
 
  private:
-  SolveReport iterate_nearby(const Eigen::VectorXd& b, Eigen::VectorXd& x, double tolerance);
+  SolveReport solve_nearby(const Eigen::VectorXd& b, Eigen::VectorXd& x, double tolerance);
   struct Impl;
   std::unique_ptr<Impl> m_impl;
 };
