@@ -81,6 +81,10 @@ void add_scene_options(CLI::App& app, SceneOptions& options) {
   app.add_option("--gravity", options.gravity, "Gravity GX,GY,GZ [m/s^2]")->capture_default_str();
   app.add_flag("!--no-large-turn-protection", options.large_turn_protection,
                "Backward Euler without Newton corrections and energy guard (the linearized step alone, as Vega's)");
+  app.add_option("--newton-max-iterations", options.newton_max_iterations,
+                 "Newton corrections at most in a step (0: the core's 5; the FMU, tissue-host and Python default to 1)")
+      ->check(CLI::Range(0, 100))
+      ->capture_default_str();
   app.add_option("--threads", options.threads, "Threads per step, 1 or 2 (a team made and joined by each step)")
       ->capture_default_str();
 }
@@ -105,6 +109,7 @@ Scene make_scene(const SceneOptions& options) {
   settings.body.material = options.material;
   settings.body.material_model = parse_material_model(options.material_model);
   settings.body.damping = options.damping;
+  if (options.newton_max_iterations > 0) settings.integrator.newton.max_iterations = options.newton_max_iterations;
   if (!options.large_turn_protection) {
     settings.integrator.newton.trigger_angle_rad = std::numeric_limits<double>::infinity();
     settings.integrator.newton.energy_guard_angle_rad = std::numeric_limits<double>::infinity();

@@ -40,6 +40,10 @@ struct SceneOptions {
   /// Backward Euler's large-turn protections (BackwardEuler::NewtonCorrections); "off" = the
   /// dissertation's (and Vega's) linearized step alone.
   bool large_turn_protection = true;
+  /// Newton corrections at most in a step (BackwardEuler::NewtonCorrections::max_iterations); 0 =
+  /// the core's own cap. The products (the FMU, tissue-host, Python) default to 1
+  /// (`integrator.newtonMaxIterations`).
+  int newton_max_iterations = 0;
   int threads = 1;  ///< IntegratorSettings::threads
 };
 

@@ -5,6 +5,7 @@
 #include "core/system/hot_kernel.hpp"
 
 #include <algorithm>
+#include <cstring>
 
 namespace tissue {
 
@@ -67,9 +68,11 @@ void HalfMatrix::assign(const ShiftedSystem& system, WorkTeam* team) {
   const size_t blocks = m_column.size();
   const double s = system.stiffness_scale;
   if (m_precision == MatrixPrecision::single) {
-    m_single.resize(9 * blocks);
+    m_single.resize(9 * blocks + 1);  // + 1: the padding (zero) the product's last column load reads
+    m_single.back() = 0.0F;
   } else {
-    m_double.resize(9 * blocks);
+    m_double.resize(9 * blocks + 1);
+    m_double.back() = 0.0;
   }
   run_parts(team, PARTS, [&](int part) {
     if (m_precision == MatrixPrecision::single) {
@@ -86,6 +89,36 @@ long HalfMatrix::streamed_bytes() const {
   return static_cast<long>(m_column.size()) * (9 * value_bytes + 4);
 }
 
+// The helpers are always inlined into the kernel's clones: -Wpsabi's note (a 32-byte vector
+// passed or returned without AVX) concerns calls that never happen. GCC issues it while it
+// generates the clones, at the end of the file, so it stays off to the end.
+#if defined(__GNUC__) && !defined(__clang__)
+#pragma GCC diagnostic ignored "-Wpsabi"
+#endif
+
+namespace {
+
+// Four doubles in one AVX2 register (two SSE registers in the baseline clone). A block's column is
+// loaded as four consecutive values: its three entries and the next one (the next column's first,
+// or the next block's, or the padding value after the last block), a lane whose results are never
+// used or, multiplied by x's zero fourth lane, add zero.
+using Lanes = double __attribute__((vector_size(32)));
+using SingleLanes = float __attribute__((vector_size(16)));
+
+[[gnu::always_inline]] inline Lanes load_lanes(const double* from) {
+  Lanes lanes;
+  std::memcpy(&lanes, from, sizeof(lanes));
+  return lanes;
+}
+
+[[gnu::always_inline]] inline Lanes load_lanes(const float* from) {
+  SingleLanes lanes;
+  std::memcpy(&lanes, from, sizeof(lanes));
+  return __builtin_convertvector(lanes, Lanes);
+}
+
+}  // namespace
+
 template <class Real>
 TISSUE_HOT_KERNEL void HalfMatrix::multiply_rows(const Real* __restrict values, const double* __restrict x,
                                                  double* __restrict y, int part) const {
@@ -99,28 +132,32 @@ TISSUE_HOT_KERNEL void HalfMatrix::multiply_rows(const Real* __restrict values, 
   if (part == 0) std::fill(spill + 3L * end, spill + 3L * m_spill_end, 0.0);
   for (int r = first; r < end; ++r) {
     const double x0 = x[3 * r], x1 = x[3 * r + 1], x2 = x[3 * r + 2];
+    const Lanes x_r = {x0, x1, x2, 0.0};
     const int begin = row_begin[r];
     const int stop = row_begin[r + 1];
     // The diagonal block (symmetric) and d.
     const Real* b = values + 9L * begin;
-    double y0 = b[0] * x0 + b[3] * x1 + b[6] * x2 + d[3 * r] * x0;
-    double y1 = b[1] * x0 + b[4] * x1 + b[7] * x2 + d[3 * r + 1] * x1;
-    double y2 = b[2] * x0 + b[5] * x1 + b[8] * x2 + d[3 * r + 2] * x2;
+    Lanes y_r = load_lanes(b) * x0 + load_lanes(b + 3) * x1 + load_lanes(b + 6) * x2;
+    y_r += Lanes{d[3 * r], d[3 * r + 1], d[3 * r + 2], 0.0} * x_r;
     for (int k = begin + 1; k < stop; ++k) {
       b = values + 9L * k;
       const int c = column[k];
       const double* xc = x + 3L * c;
-      y0 += b[0] * xc[0] + b[3] * xc[1] + b[6] * xc[2];
-      y1 += b[1] * xc[0] + b[4] * xc[1] + b[7] * xc[2];
-      y2 += b[2] * xc[0] + b[5] * xc[1] + b[8] * xc[2];
-      double* to = (c < end ? y : spill) + 3L * c;  // the transposed term, B^T x_r, for row c
-      to[0] += b[0] * x0 + b[1] * x1 + b[2] * x2;
-      to[1] += b[3] * x0 + b[4] * x1 + b[5] * x2;
-      to[2] += b[6] * x0 + b[7] * x1 + b[8] * x2;
+      const Lanes column0 = load_lanes(b), column1 = load_lanes(b + 3), column2 = load_lanes(b + 6);
+      y_r += column0 * xc[0] + column1 * xc[1] + column2 * xc[2];
+      // The transposed term, B^T x_r, for row c: the three columns' dots with x_r, summed across
+      // lanes pairwise (lane 3 of each product is zero).
+      const Lanes p0 = column0 * x_r, p1 = column1 * x_r, p2 = column2 * x_r;
+      const Lanes pairs01 = __builtin_shufflevector(p0, p1, 0, 4, 2, 6) + __builtin_shufflevector(p0, p1, 1, 5, 3, 7);
+      const Lanes sums = __builtin_shufflevector(pairs01, p2, 0, 1, 4, 5) + __builtin_shufflevector(pairs01, p2, 2, 3, 6, 7);
+      double* to = (c < end ? y : spill) + 3L * c;
+      to[0] += sums[0];
+      to[1] += sums[1];
+      to[2] += sums[2] + sums[3];
     }
-    y[3 * r] += y0;
-    y[3 * r + 1] += y1;
-    y[3 * r + 2] += y2;
+    y[3 * r] += y_r[0];
+    y[3 * r + 1] += y_r[1];
+    y[3 * r + 2] += y_r[2];
   }
 }
 
