@@ -62,18 +62,36 @@ void validate_step_threads(int threads) {
 
 WorkTeam::WorkTeam(int threads) : m_size(threads) {
   validate_step_threads(threads);
+  static_assert(MAX_STEP_THREADS < static_cast<int>(PART_SLOTS), "a job's parts fit in its slots");
   m_workers.reserve(static_cast<size_t>(threads - 1));
   for (int member = 1; member < threads; ++member) {
-    m_workers.emplace_back([this, member] { work(member); });
+    m_workers.emplace_back([this] { work(); });
     keep_off_callers_core(m_workers.back());
   }
 }
 
 WorkTeam::~WorkTeam() {
   m_stop.store(true, std::memory_order_release);
-  m_generation.fetch_add(1, std::memory_order_acq_rel);
-  m_generation.notify_all();
+  // A new generation with no part to claim: the workers wake, see the stop and return.
+  const std::uint64_t generation = m_job.load(std::memory_order_relaxed) / PART_SLOTS + 1;
+  m_job.store(generation * PART_SLOTS + static_cast<std::uint64_t>(m_size), std::memory_order_release);
+  m_job.notify_all();
   for (std::thread& worker : m_workers) worker.join();
+}
+
+int WorkTeam::run_claimed_parts(std::uint64_t generation) {
+  int ran = 0;
+  std::uint64_t job = m_job.load(std::memory_order_acquire);
+  while (job / PART_SLOTS == generation && job % PART_SLOTS < static_cast<std::uint64_t>(m_size)) {
+    if (!m_job.compare_exchange_weak(job, job + 1, std::memory_order_acq_rel, std::memory_order_acquire)) continue;
+    // Claimed: the job cannot end (nor m_context change) before this part reports done.
+    m_trampoline(m_context, static_cast<int>(job % PART_SLOTS));
+    ++ran;
+    m_parts_done.fetch_add(1, std::memory_order_acq_rel);
+    m_parts_done.notify_all();
+    job = m_job.load(std::memory_order_acquire);
+  }
+  return ran;
 }
 
 void WorkTeam::run_erased(void* context, Trampoline trampoline) {
@@ -83,25 +101,29 @@ void WorkTeam::run_erased(void* context, Trampoline trampoline) {
   }
   m_context = context;
   m_trampoline = trampoline;
-  m_finished.store(0, std::memory_order_relaxed);
-  m_generation.fetch_add(1, std::memory_order_acq_rel);  // publishes the job to the workers
-  m_generation.notify_all();
+  m_parts_done.store(0, std::memory_order_relaxed);
+  const std::uint64_t generation = m_job.load(std::memory_order_relaxed) / PART_SLOTS + 1;
+  m_job.store(generation * PART_SLOTS + 1, std::memory_order_release);  // publishes the job; part 0 is ours
+  m_job.notify_all();
   trampoline(context, 0);
-  for (int finished = m_finished.load(std::memory_order_acquire); finished != m_size - 1;
-       finished = m_finished.load(std::memory_order_acquire)) {
-    wait_while_equal(m_finished, finished);
+  m_parts_taken_over += run_claimed_parts(generation);
+  for (int done = m_parts_done.load(std::memory_order_acquire); done != m_size - 1;
+       done = m_parts_done.load(std::memory_order_acquire)) {
+    wait_while_equal(m_parts_done, done);
   }
 }
 
-void WorkTeam::work(int member) {
-  unsigned seen = 0;
+void WorkTeam::work() {
+  std::uint64_t seen = 0;  // the generation of the last job this worker looked at
   for (;;) {
-    wait_while_equal(m_generation, seen);
-    seen = m_generation.load(std::memory_order_acquire);
+    std::uint64_t job = m_job.load(std::memory_order_acquire);
+    while (job / PART_SLOTS == seen) {
+      wait_while_equal(m_job, job);
+      job = m_job.load(std::memory_order_acquire);
+    }
     if (m_stop.load(std::memory_order_acquire)) return;
-    m_trampoline(m_context, member);
-    m_finished.fetch_add(1, std::memory_order_acq_rel);
-    m_finished.notify_one();
+    seen = job / PART_SLOTS;
+    run_claimed_parts(seen);
   }
 }
 

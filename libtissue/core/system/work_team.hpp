@@ -4,9 +4,16 @@
 // wait for each other by spinning for up to 100 us (a hand-over then costs ~1 us instead of a
 // blocked thread's wake-up, tens of us on a virtual machine), then by blocking, so that members
 // sharing a core never spin away each other's time slice.
+//
+// A job's parts are claimed, not assigned: the caller runs part 0, then every part no worker has
+// started yet, and waits only for parts a worker is running. A worker the scheduler has not run
+// yet (preempted by the haptic thread, waking from a block) therefore never holds the step up; it
+// finds the job done when it comes. Each part is the same computation whoever runs it, so the
+// results stay bitwise those of one thread.
 #pragma once
 
 #include <atomic>
+#include <cstdint>
 #include <thread>
 #include <vector>
 
@@ -29,10 +36,14 @@ class WorkTeam {
   WorkTeam& operator=(const WorkTeam&) = delete;
 
   [[nodiscard]] int size() const { return m_size; }
+  /// Parts the caller ran because no worker had started them (since the team was made).
+  [[nodiscard]] long parts_taken_over() const { return m_parts_taken_over; }
 
-  /// Runs job(member) for every member 0 .. size() - 1 (member 0 on the calling thread) and returns
-  /// when all have finished. The job must not throw (the core's jobs are arithmetic on buffers that
-  /// exist already); one that does terminates the program, as in any thread.
+  /// Runs job(part) for every part 0 .. size() - 1 and returns when all have finished: part 0 on the
+  /// calling thread, each other part on the first member to claim it (a worker, or the caller once
+  /// it is done with its own). The parts must not wait for each other. The job must not throw (the
+  /// core's jobs are arithmetic on buffers that exist already); one that does terminates the
+  /// program, as in any thread.
   template <class Job>
   void run(Job& job) {
     run_erased(&job, [](void* context, int member) { (*static_cast<Job*>(context))(member); });
@@ -41,15 +52,22 @@ class WorkTeam {
  private:
   using Trampoline = void (*)(void*, int);
   void run_erased(void* context, Trampoline trampoline);
-  void work(int member);
+  void work();
+  /// Claims and runs parts of job `generation` until none is left; returns how many it ran.
+  int run_claimed_parts(std::uint64_t generation);
 
   int m_size = 1;
   std::vector<std::thread> m_workers;
   void* m_context = nullptr;
   Trampoline m_trampoline = nullptr;
-  std::atomic<unsigned> m_generation{0};  // bumped for each job; workers start when it changes
-  std::atomic<int> m_finished{0};         // workers done with the current job
+  // The current job: its generation (bumped for each job; workers start when it changes) times
+  // PART_SLOTS plus the next part to claim. One word, so that a late worker can claim a part only
+  // of the job it saw, never of one published since.
+  static constexpr std::uint64_t PART_SLOTS = 256;
+  std::atomic<std::uint64_t> m_job{0};
+  std::atomic<int> m_parts_done{0};  // parts 1 .. size() - 1 of the current job finished
   std::atomic<bool> m_stop{false};
+  long m_parts_taken_over = 0;
 };
 
 /// The parts a pass over a step's data is split into with `team` (nullptr: none): its size, else 1.
