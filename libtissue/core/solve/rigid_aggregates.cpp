@@ -182,8 +182,9 @@ Eigen::Matrix<double, 3, 6> RigidAggregates::basis(int a, int p) const {
   return columns;
 }
 
-void RigidAggregates::restrict_to(const Eigen::VectorXd& r, Eigen::VectorXd& rhs) const {
-  for (int a = 0; a < count(); ++a) {
+void RigidAggregates::restrict_to(const Eigen::VectorXd& r, Eigen::VectorXd& rhs, int first_aggregate,
+                                  int end_aggregate) const {
+  for (int a = first_aggregate; a < end_aggregate; ++a) {
     const int rotations = rotation_count[static_cast<size_t>(a)];
     Eigen::Vector3d force = Eigen::Vector3d::Zero();
     Eigen::Vector3d moment = Eigen::Vector3d::Zero();
@@ -199,8 +200,9 @@ void RigidAggregates::restrict_to(const Eigen::VectorXd& r, Eigen::VectorXd& rhs
   }
 }
 
-void RigidAggregates::prolong_add(const Eigen::VectorXd& x, Eigen::VectorXd& z) const {
-  for (int a = 0; a < count(); ++a) {
+void RigidAggregates::prolong_add(const Eigen::VectorXd& x, Eigen::VectorXd& z, int first_aggregate,
+                                  int end_aggregate) const {
+  for (int a = first_aggregate; a < end_aggregate; ++a) {
     const int first = column_begin[static_cast<size_t>(a)];
     const Eigen::Vector3d translation = translation_scale[static_cast<size_t>(a)] * x.segment<3>(first);
     Eigen::Vector3d spin = Eigen::Vector3d::Zero();
@@ -212,6 +214,14 @@ void RigidAggregates::prolong_add(const Eigen::VectorXd& x, Eigen::VectorXd& z) 
       z.segment<3>(3L * rows[static_cast<size_t>(p)]) += translation + spin.cross(offset[static_cast<size_t>(p)]);
     }
   }
+}
+
+int RigidAggregates::split(int part, int parts) const {
+  if (part >= parts) return count();
+  const long rows_before = static_cast<long>(rows.size()) * part / parts;
+  // The first aggregate that starts at or after the part's share of the rows.
+  const auto at = std::lower_bound(aggregate_begin.begin(), aggregate_begin.end() - 1, rows_before);
+  return static_cast<int>(at - aggregate_begin.begin());
 }
 
 }  // namespace tissue

@@ -59,10 +59,15 @@ struct RigidAggregates {
   void make_basis(const std::vector<Eigen::Vector3d>* points, bool count_rotations);
   /// P_p (3 x 6, its first 3 + rotation_count columns used) of entry p of aggregate a.
   [[nodiscard]] Eigen::Matrix<double, 3, 6> basis(int a, int p) const;
-  /// rhs = P^T r (length columns()).
-  void restrict_to(const Eigen::VectorXd& r, Eigen::VectorXd& rhs) const;
-  /// z += P x.
-  void prolong_add(const Eigen::VectorXd& x, Eigen::VectorXd& z) const;
+  /// rhs = P^T r (length columns()); the range form sets the entries of aggregates [first, end) only.
+  void restrict_to(const Eigen::VectorXd& r, Eigen::VectorXd& rhs) const { restrict_to(r, rhs, 0, count()); }
+  void restrict_to(const Eigen::VectorXd& r, Eigen::VectorXd& rhs, int first, int end) const;
+  /// z += P x; the range form adds to the rows of aggregates [first, end) only.
+  void prolong_add(const Eigen::VectorXd& x, Eigen::VectorXd& z) const { prolong_add(x, z, 0, count()); }
+  void prolong_add(const Eigen::VectorXd& x, Eigen::VectorXd& z, int first, int end) const;
+  /// The first aggregate of `part` of `parts`, the aggregates split in order so that each part holds
+  /// about as many rows (parts itself: count()).
+  [[nodiscard]] int split(int part, int parts) const;
 };
 
 }  // namespace tissue

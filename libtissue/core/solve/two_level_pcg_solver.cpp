@@ -44,7 +44,7 @@ SolveReport TwoLevelPcgSolver::solve(const Eigen::VectorXd& b, Eigen::VectorXd& 
   m_system.check_sizes(b, x);
   return preconditioned_cg</*ROW_WISE=*/false>(
       m_system, b, x, m_settings.tolerance, m_settings.max_iterations, m_work, m_team,
-      [this](const Eigen::VectorXd& r, Eigen::VectorXd& z, long, long) { m_preconditioner->apply(r, z); });
+      [this](const Eigen::VectorXd& r, Eigen::VectorXd& z, long, long) { m_preconditioner->apply(r, z, m_team); });
 }
 
 void TwoLevelPcgSolver::forget_earlier_setups() { m_preconditioner->forget(); }

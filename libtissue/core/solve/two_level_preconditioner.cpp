@@ -54,6 +54,9 @@ void TwoLevelPreconditioner::aggregate(const ShiftedSystem& system) {
   m_local.ok = false;
   m_coarse.group(every_row, m_aggregate_of_row, count, m_entry_of_row);
   m_coarse.make_basis(system.block_positions, /*count_rotations=*/true);
+  for (int part = 0; part <= MAX_STEP_THREADS; ++part) {
+    m_aggregate_split[static_cast<size_t>(part)] = m_coarse.split(part, MAX_STEP_THREADS);
+  }
 
   make_coarse_pattern(k);
   m_matrix = &k;
@@ -182,17 +185,31 @@ void TwoLevelPreconditioner::assemble_and_factorize(const ShiftedSystem& system)
   m_coarse_ok = m_coarse_factor.info() == Eigen::Success && m_coarse_factor.vectorD().minCoeff() > 0.0;
 }
 
-void TwoLevelPreconditioner::apply(const Eigen::VectorXd& r, Eigen::VectorXd& z) {
-  z = m_inverse_diagonal->cwiseProduct(r);
+void TwoLevelPreconditioner::apply(const Eigen::VectorXd& r, Eigen::VectorXd& z, WorkTeam* team) {
+  constexpr int PARTS = MAX_STEP_THREADS;
+  const long rows = r.size();
+  z.resize(rows);  // (no allocation when it has the size already)
+  // z's terms in one order whoever computes them: D^-1 r, the local level's, the coarse level's.
+  run_parts(team, PARTS, [&](int part) {
+    const long first = rows * part / PARTS;
+    const long end = rows * (part + 1) / PARTS;
+    z.segment(first, end - first) = m_inverse_diagonal->segment(first, end - first).cwiseProduct(r.segment(first, end - first));
+    if (m_coarse_ok) {
+      m_coarse.restrict_to(r, m_coarse_rhs, m_aggregate_split[static_cast<size_t>(part)],
+                           m_aggregate_split[static_cast<size_t>(part) + 1]);
+    }
+  });
   if (m_local.ok) {
     m_local.aggregates.restrict_to(r, m_local.rhs);
     m_local.solution = m_local.factor.solve(m_local.rhs);
     m_local.aggregates.prolong_add(m_local.solution, z);
   }
   if (!m_coarse_ok) return;
-  m_coarse.restrict_to(r, m_coarse_rhs);
   m_coarse_solution = m_coarse_factor.solve(m_coarse_rhs);
-  m_coarse.prolong_add(m_coarse_solution, z);
+  run_parts(team, PARTS, [&](int part) {
+    m_coarse.prolong_add(m_coarse_solution, z, m_aggregate_split[static_cast<size_t>(part)],
+                         m_aggregate_split[static_cast<size_t>(part) + 1]);
+  });
 }
 
 }  // namespace tissue

@@ -25,6 +25,7 @@
 
 #include "core/solve/linear_solver.hpp"
 #include "core/solve/rigid_aggregates.hpp"
+#include "core/system/work_team.hpp"
 
 #include <Eigen/Core>
 #include <Eigen/Cholesky>
@@ -63,8 +64,10 @@ class TwoLevelPreconditioner {
   /// pattern, layout and size, takes the new Jacobi diagonal and keeps the coarse level (its space
   /// and factor are the last setup's; still a positive definite P); else setup().
   void setup_nearby(const ShiftedSystem& system, const Eigen::VectorXd& inverse_diagonal);
-  /// z = P^-1 r (lengths rows() of the last setup). No allocation.
-  void apply(const Eigen::VectorXd& r, Eigen::VectorXd& z);
+  /// z = P^-1 r (lengths rows() of the last setup). No allocation. With `team`, its members share
+  /// the Jacobi rows and the coarse level's restriction and prolongation (halves of the aggregates);
+  /// the coarse solve and the local level run on the caller. Bitwise the same with a team or without.
+  void apply(const Eigen::VectorXd& r, Eigen::VectorXd& z, WorkTeam* team = nullptr);
   /// Aggregate anew at the next setup (a saved or restored run continues bitwise).
   void forget() {
     m_pattern_revision = UINT64_MAX;
@@ -142,6 +145,7 @@ class TwoLevelPreconditioner {
     bool used = false;
   };
   std::vector<RowSums> m_row_sums;
+  std::array<int, MAX_STEP_THREADS + 1> m_aggregate_split{};  // apply()'s parts: aggregates balanced by rows
   std::vector<int> m_touched;
   Eigen::SparseMatrix<double> m_coarse_matrix;           // lower triangle, pattern fixed per aggregation
   Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> m_coarse_factor;

@@ -36,10 +36,9 @@ TEST(WorkTeam, RunsEveryPartOncePerJobPartZeroOnTheCaller) {
     ASSERT_EQ(ids[0], std::this_thread::get_id());
     on_the_worker += ids[1] != std::this_thread::get_id() ? 1 : 0;
   }
-  // Part 1 goes to the worker unless the caller finds it unstarted after part 0; back to back, a
-  // spinning worker takes most of them.
+  // Part 1 goes to the worker unless the caller finds it unstarted after part 0 (on an idle machine
+  // a spinning worker takes most; on a busy one it may get none: the caller then runs them all).
   EXPECT_EQ(on_the_worker + team.parts_taken_over(), 1000);
-  EXPECT_GT(on_the_worker, 0);
 }
 
 // A worker the scheduler has not run yet (preempted by the haptic thread, or waking from a block)
