@@ -31,9 +31,9 @@ void TwoLevelPcgSolver::set_up(const ShiftedSystem& system, bool nearby) {
   m_work.resize(system.rows());
   jacobi_inverse_diagonal(system, m_inverse_diagonal, WHO);  // also refuses a diagonal <= 0
   if (nearby) {
-    m_preconditioner->setup_nearby(system, m_inverse_diagonal);
+    m_preconditioner->setup_nearby(system, m_inverse_diagonal, m_team);
   } else {
-    m_preconditioner->setup(system, m_inverse_diagonal);
+    m_preconditioner->setup(system, m_inverse_diagonal, m_team);
   }
   m_work.matrix.assign(system, m_team);
   m_system = system;

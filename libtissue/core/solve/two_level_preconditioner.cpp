@@ -8,7 +8,8 @@
 
 namespace tissue {
 
-void TwoLevelPreconditioner::setup(const ShiftedSystem& system, const Eigen::VectorXd& inverse_diagonal) {
+void TwoLevelPreconditioner::setup(const ShiftedSystem& system, const Eigen::VectorXd& inverse_diagonal,
+                                   WorkTeam* team) {
   m_inverse_diagonal = &inverse_diagonal;
   const bool aggregated = !aggregates_fit(system);
   const bool refresh_due = m_setups_since_coarse + 1 >= COARSE_REFRESH_SETUPS;
@@ -24,13 +25,14 @@ void TwoLevelPreconditioner::setup(const ShiftedSystem& system, const Eigen::Vec
   if (++m_setups_since_coarse < COARSE_REFRESH_SETUPS) return;
   m_setups_since_coarse = 0;
   if (!aggregated) m_coarse.make_basis(system.block_positions, /*count_rotations=*/false);
-  assemble_and_factorize(system);
+  assemble_and_factorize(system, team);
   m_can_patch = m_coarse_ok;
 }
 
-void TwoLevelPreconditioner::setup_nearby(const ShiftedSystem& system, const Eigen::VectorXd& inverse_diagonal) {
+void TwoLevelPreconditioner::setup_nearby(const ShiftedSystem& system, const Eigen::VectorXd& inverse_diagonal,
+                                          WorkTeam* team) {
   if (!aggregates_fit(system) && !patch_fits(system)) {
-    setup(system, inverse_diagonal);
+    setup(system, inverse_diagonal, team);
     return;
   }
   m_inverse_diagonal = &inverse_diagonal;
@@ -133,48 +135,62 @@ void TwoLevelPreconditioner::make_coarse_pattern(const BlockSparseMatrix& k) {
 // sum_j A_ij P_j = [t_b S_b, T_b W_b] and the block takes P_i^T that = [t_a (.); W_a^T C_i^T (.)]
 // once per (row, aggregate) pair instead of once per fine block. K's rows hold both halves, so
 // every pair (i, j) of a block with a <= b is met from row i.
-void TwoLevelPreconditioner::assemble_and_factorize(const ShiftedSystem& system) {
+void TwoLevelPreconditioner::assemble_coarse_rows(const ShiftedSystem& system, int first_aggregate,
+                                                  int end_aggregate, AssemblyScratch& scratch) {
   const BlockSparseMatrix& k = *system.stiffness;
-  for (auto& block : m_coarse_blocks) block.fill(0.0);
-  for (int i = 0; i < m_rows; ++i) {
-    const int a = m_aggregate_of_row[static_cast<size_t>(i)];
-    if (a < 0) continue;  // a row alone: Jacobi solves it
-    const int first_block = m_coarse_row_begin[static_cast<size_t>(a)];
-    const size_t reach = static_cast<size_t>(m_coarse_row_begin[static_cast<size_t>(a) + 1] - first_block);
-    if (m_row_sums.size() < reach) m_row_sums.resize(reach);
-    m_touched.clear();
-    for (int s = k.row_begin(i); s < k.row_begin(i) + k.row_size(i); ++s) {
-      const int j = k.slot_column(s);
-      if (j < 0) continue;
-      const int coarse_block = m_coarse_block_of_slot[static_cast<size_t>(s)];
-      if (coarse_block < 0 || m_coarse_column[static_cast<size_t>(coarse_block)] < a) continue;
-      Eigen::Matrix3d block = system.stiffness_scale * k.block(s);
-      if (j == i) block.diagonal() += system.diagonal->segment<3>(3L * i);
-      RowSums& sums = m_row_sums[static_cast<size_t>(coarse_block - first_block)];
-      if (!sums.used) {
-        sums = RowSums{Eigen::Matrix3d::Zero(), Eigen::Matrix3d::Zero(), true};
-        m_touched.push_back(coarse_block);
-      }
-      sums.force += block;
-      if (m_with_rotations) sums.moment -= block * cross_matrix(offset_of_row(j));
-    }
+  const auto first_block = static_cast<size_t>(m_coarse_row_begin[static_cast<size_t>(first_aggregate)]);
+  const auto end_block = static_cast<size_t>(m_coarse_row_begin[static_cast<size_t>(end_aggregate)]);
+  for (size_t block = first_block; block < end_block; ++block) m_coarse_blocks[block].fill(0.0);
+  for (int a = first_aggregate; a < end_aggregate; ++a) {
+    const int first_block_of_a = m_coarse_row_begin[static_cast<size_t>(a)];
+    const auto reach = static_cast<size_t>(m_coarse_row_begin[static_cast<size_t>(a) + 1] - first_block_of_a);
+    if (scratch.row_sums.size() < reach) scratch.row_sums.resize(reach);
     const double t_a = m_coarse.translation_scale[static_cast<size_t>(a)];
     const int rotations_a = m_coarse.rotation_count[static_cast<size_t>(a)];
-    const Eigen::Matrix3d c_i_transpose = cross_matrix(offset_of_row(i));  // C_i^T = [r_i]x
-    for (const int coarse_block : m_touched) {
-      RowSums& sums = m_row_sums[static_cast<size_t>(coarse_block - first_block)];
-      sums.used = false;
-      const int b = m_coarse_column[static_cast<size_t>(coarse_block)];
-      Eigen::Matrix<double, 3, 6> reached = Eigen::Matrix<double, 3, 6>::Zero();  // sum_j A_ij P_j
-      reached.leftCols<3>() = m_coarse.translation_scale[static_cast<size_t>(b)] * sums.force;
-      if (m_with_rotations) reached.rightCols<3>() = sums.moment * m_coarse.axes[static_cast<size_t>(b)];
-      Eigen::Map<Eigen::Matrix<double, 6, 6>> coarse(m_coarse_blocks[static_cast<size_t>(coarse_block)].data());
-      coarse.topRows<3>() += t_a * reached;
-      if (rotations_a > 0) {
-        coarse.bottomRows<3>() += m_coarse.axes[static_cast<size_t>(a)].transpose() * (c_i_transpose * reached);
+    for (int p = m_coarse.aggregate_begin[static_cast<size_t>(a)]; p < m_coarse.aggregate_begin[static_cast<size_t>(a) + 1];
+         ++p) {
+      const int i = m_coarse.rows[static_cast<size_t>(p)];
+      scratch.touched.clear();
+      for (int s = k.row_begin(i); s < k.row_begin(i) + k.row_size(i); ++s) {
+        const int j = k.slot_column(s);
+        if (j < 0) continue;
+        const int coarse_block = m_coarse_block_of_slot[static_cast<size_t>(s)];
+        if (coarse_block < 0 || m_coarse_column[static_cast<size_t>(coarse_block)] < a) continue;
+        Eigen::Matrix3d block = system.stiffness_scale * k.block(s);
+        if (j == i) block.diagonal() += system.diagonal->segment<3>(3L * i);
+        RowSums& sums = scratch.row_sums[static_cast<size_t>(coarse_block - first_block_of_a)];
+        if (!sums.used) {
+          sums = RowSums{Eigen::Matrix3d::Zero(), Eigen::Matrix3d::Zero(), true};
+          scratch.touched.push_back(coarse_block);
+        }
+        sums.force += block;
+        if (m_with_rotations) sums.moment -= block * cross_matrix(offset_of_row(j));
+      }
+      const Eigen::Matrix3d c_i_transpose = cross_matrix(offset_of_row(i));  // C_i^T = [r_i]x
+      for (const int coarse_block : scratch.touched) {
+        RowSums& sums = scratch.row_sums[static_cast<size_t>(coarse_block - first_block_of_a)];
+        sums.used = false;
+        const int b = m_coarse_column[static_cast<size_t>(coarse_block)];
+        Eigen::Matrix<double, 3, 6> reached = Eigen::Matrix<double, 3, 6>::Zero();  // sum_j A_ij P_j
+        reached.leftCols<3>() = m_coarse.translation_scale[static_cast<size_t>(b)] * sums.force;
+        if (m_with_rotations) reached.rightCols<3>() = sums.moment * m_coarse.axes[static_cast<size_t>(b)];
+        Eigen::Map<Eigen::Matrix<double, 6, 6>> coarse(m_coarse_blocks[static_cast<size_t>(coarse_block)].data());
+        coarse.topRows<3>() += t_a * reached;
+        if (rotations_a > 0) {
+          coarse.bottomRows<3>() += m_coarse.axes[static_cast<size_t>(a)].transpose() * (c_i_transpose * reached);
+        }
       }
     }
   }
+}
+
+void TwoLevelPreconditioner::assemble_and_factorize(const ShiftedSystem& system, WorkTeam* team) {
+  // Aggregate a's rows give only its blocks (a, b >= a): the halves of the aggregates write disjoint
+  // blocks, each block its rows' terms in row order, as one pass over all rows in order did.
+  run_parts(team, MAX_STEP_THREADS, [&](int part) {
+    assemble_coarse_rows(system, m_aggregate_split[static_cast<size_t>(part)],
+                         m_aggregate_split[static_cast<size_t>(part) + 1], m_assembly_scratch[static_cast<size_t>(part)]);
+  });
   double* values = m_coarse_matrix.valuePtr();
   long next = 0;
   for_each_lower_entry([&](int, int, int block, int column_in_block, int row_in_block) {

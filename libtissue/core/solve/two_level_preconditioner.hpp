@@ -59,11 +59,13 @@ class TwoLevelPreconditioner {
   /// setup) and, when due, makes the coarse level of `system` (aggregating anew when K's pattern,
   /// layout or size changed). Never throws for a positive definite A; if the coarse factorization
   /// fails all the same (rounding), the preconditioner is Jacobi alone until the next coarse level.
-  void setup(const ShiftedSystem& system, const Eigen::VectorXd& inverse_diagonal);
+  /// With `team`, its members share the coarse matrix's assembly (halves of the aggregates): bitwise
+  /// the same with a team or without.
+  void setup(const ShiftedSystem& system, const Eigen::VectorXd& inverse_diagonal, WorkTeam* team = nullptr);
   /// For an A near the last setup's (a Newton correction's): when it is of the same K object,
   /// pattern, layout and size, takes the new Jacobi diagonal and keeps the coarse level (its space
   /// and factor are the last setup's; still a positive definite P); else setup().
-  void setup_nearby(const ShiftedSystem& system, const Eigen::VectorXd& inverse_diagonal);
+  void setup_nearby(const ShiftedSystem& system, const Eigen::VectorXd& inverse_diagonal, WorkTeam* team = nullptr);
   /// z = P^-1 r (lengths rows() of the last setup). No allocation. With `team`, its members share
   /// the Jacobi rows and the coarse level's restriction and prolongation (halves of the aggregates);
   /// the coarse solve and the local level run on the caller. Bitwise the same with a team or without.
@@ -103,7 +105,11 @@ class TwoLevelPreconditioner {
   [[nodiscard]] const Eigen::Vector3d& offset_of_row(int row) const {
     return m_coarse.offset[static_cast<size_t>(m_entry_of_row[static_cast<size_t>(row)])];
   }
-  void assemble_and_factorize(const ShiftedSystem& system);
+  void assemble_and_factorize(const ShiftedSystem& system, WorkTeam* team);
+  struct AssemblyScratch;
+  /// The coarse blocks of aggregates [first, end): each row's terms, the rows in order.
+  void assemble_coarse_rows(const ShiftedSystem& system, int first_aggregate, int end_aggregate,
+                            AssemblyScratch& scratch);
   /// visit(column, row, block, column in block, row in block) for each entry of the coarse matrix's
   /// lower triangle in compressed-column order: column j of aggregate b, then the blocks (b, a) of
   /// b's block row with a >= b (rows ascending), `block` being (b, a), whose entry (j, row) it is.
@@ -137,16 +143,20 @@ class TwoLevelPreconditioner {
   std::vector<int> m_coarse_column;
   std::vector<int> m_coarse_block_of_slot;  // per fine slot (-1: unused slot)
   std::vector<std::array<double, 36>> m_coarse_blocks;  // 6x6 column-major, used up to the columns
-  // assemble_and_factorize's scratch for one row i: per coarse block (a, b) of its aggregate's row,
+  // assemble_coarse_rows's scratch for one row i: per coarse block (a, b) of its aggregate's row,
   // sum_j A_ij and sum_j A_ij C_j over the rows j of b; the blocks it touched.
   struct RowSums {
     Eigen::Matrix3d force;
     Eigen::Matrix3d moment;
     bool used = false;
   };
-  std::vector<RowSums> m_row_sums;
-  std::array<int, MAX_STEP_THREADS + 1> m_aggregate_split{};  // apply()'s parts: aggregates balanced by rows
-  std::vector<int> m_touched;
+  struct AssemblyScratch {
+    std::vector<RowSums> row_sums;
+    std::vector<int> touched;
+  };
+  std::array<AssemblyScratch, MAX_STEP_THREADS> m_assembly_scratch;  // one per part
+  // The parts of apply() and of the coarse assembly: aggregates in halves balanced by rows.
+  std::array<int, MAX_STEP_THREADS + 1> m_aggregate_split{};
   Eigen::SparseMatrix<double> m_coarse_matrix;           // lower triangle, pattern fixed per aggregation
   Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> m_coarse_factor;
   bool m_coarse_ok = false;
