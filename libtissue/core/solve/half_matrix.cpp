@@ -91,10 +91,8 @@ long HalfMatrix::streamed_bytes() const {
 
 // The helpers are always inlined into the kernel's clones: -Wpsabi's note (a 32-byte vector
 // passed or returned without AVX) concerns calls that never happen. GCC issues it while it
-// generates the clones, at the end of the file, so it stays off to the end.
-#if defined(__GNUC__) && !defined(__clang__)
-#pragma GCC diagnostic ignored "-Wpsabi"
-#endif
+// generates the clones, at the end of the file, so it stays off to the end (clang warns alike).
+#pragma GCC diagnostic ignored "-Wpsabi"  // (clang too)
 
 namespace {
 
