@@ -81,6 +81,7 @@ BlockSparseMatrix::BlockSparseMatrix(const std::vector<std::vector<int>>& patter
   m_row_size.resize(to_size(n));
   m_row_capacity.resize(to_size(n));
   m_diagonal_slot.resize(to_size(n));
+  reserve_slots(static_cast<size_t>(slot_count));
   m_column.assign(static_cast<size_t>(slot_count), -1);
   m_values.assign(9 * static_cast<size_t>(slot_count), 0.0);
 
@@ -217,6 +218,12 @@ void BlockSparseMatrix::diagonal(Eigen::VectorXd& diagonal) const {
 // its blocks are read out (sorted by column) before they are written back. A second buffer (as
 // before) meant, whenever the storage grew, fresh pages and a useless copy of the layout before the
 // last: a frog's re-layout took 1.3-1.7 ms, of which 0.16 ms moved its blocks (docs/BENCHMARKS.md).
+void BlockSparseMatrix::reserve_slots(size_t slots) {
+  if (m_column.capacity() >= slots) return;
+  m_column.reserve(2 * slots);
+  m_values.reserve(9 * m_column.capacity());
+}
+
 void BlockSparseMatrix::relayout(const std::vector<std::pair<int, int>>& min_capacity, int spare_rows) {
   const int n = block_rows();
   if (m_spare_row_capacity < 1) m_spare_row_capacity = DEFAULT_SPARE_ROW_CAPACITY;
@@ -240,10 +247,7 @@ void BlockSparseMatrix::relayout(const std::vector<std::pair<int, int>>& min_cap
   const size_t old_slots = m_column.size();
   const auto slots = static_cast<size_t>(slot_count);
   if (slots > old_slots) {
-    if (m_column.capacity() < slots) {  // a quarter to spare: each cut re-lays out a little larger
-      m_column.reserve(slots + slots / 4);
-      m_values.reserve(9 * m_column.capacity());
-    }
+    reserve_slots(slots);
     m_column.resize(slots, -1);
     m_values.resize(9 * slots, 0.0);
   }

@@ -120,6 +120,12 @@ class BlockSparseMatrix {
   /// empty rows of m_spare_row_capacity slots follow the last row. Rows come out sorted.
   /// `min_capacity` (row, capacity): rows that get at least that much.
   void relayout(const std::vector<std::pair<int, int>>& min_capacity, int spare_rows);
+  /// Storage for at least `slots` slots, twice that whenever it must grow (from the start too): a
+  /// re-layout (a cut's rows outgrowing their room) then stays in the storage it has, whose pages a
+  /// real-time host locked at its start, instead of moving megabytes into fresh pages within a step
+  /// (resect_lobe's re-layouts grow the coarse organ's slots 56k -> 68k -> 75k; moving them took
+  /// 2.9 ms of a 3.4 ms re-layout).
+  void reserve_slots(size_t slots);
 
   std::vector<int> m_row_begin;      // first slot of each block row
   std::vector<int> m_row_size;       // blocks in use in each row
