@@ -93,7 +93,10 @@ TEST(TissueRobustness, ProbingAPieceNothingHoldsRendersTheStepStiffness) {
       // m / h^2 with m a few tets' share of the box's 8 g, where the static K_c is zero.
       EXPECT_GT(min_eigenvalue(k_c), 1e-4 / (1e-3 * 1e-3)) << to_string(kind) << " step " << n;
       // The old rule condensed the static K, singular on this piece: either CHOLMOD refuses it
-      // (the error that ended the session) or its K_c is at rounding level.
+      // (the error that ended the session) or its K_c is rounding noise: at rounding level
+      // (1e-12 N/m here) or, where the factorization's last pivots come out larger, not even
+      // positive definite (-6.8 N/m at one step under the sanitizer build's summation order). Either
+      // way no stiffness to render: its smallest eigenvalue stays under 1e-3 of the step's.
       EffectiveContactStiffness static_stiffness;
       Eigen::VectorXd zero;
       try {
@@ -106,7 +109,7 @@ TEST(TissueRobustness, ProbingAPieceNothingHoldsRendersTheStepStiffness) {
             contact_interpolation(tissue.body().dofs(), spring.vertices, spring.weights),
             spring.tangent_fraction * spring.stiffness_n_per_m, spring.direction);
         if (k_static && k_static->allFinite()) {  // or not finite at all (the spring along the normal alone)
-          EXPECT_LT(std::abs(min_eigenvalue(*k_static)), 1e-3 * min_eigenvalue(k_c))
+          EXPECT_LT(min_eigenvalue(*k_static), 1e-3 * min_eigenvalue(k_c))
               << "static " << min_eigenvalue(*k_static) << ", step " << min_eigenvalue(k_c);
         }
       } catch (const SolverError&) {
