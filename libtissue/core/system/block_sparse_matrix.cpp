@@ -213,17 +213,17 @@ void BlockSparseMatrix::diagonal(Eigen::VectorXd& diagonal) const {
   for (int r = 0; r < n; ++r) diagonal.segment<3>(3 * r) = block(m_diagonal_slot[to_size(r)]).diagonal();
 }
 
-// In place, from the last row to the first: a row's room never shrinks, so each row moves to a slot
-// at or after its old first one and its new room ends where the next row's, already moved, begins;
-// its blocks are read out (sorted by column) before they are written back. A second buffer (as
-// before) meant, whenever the storage grew, fresh pages and a useless copy of the layout before the
-// last: a frog's re-layout took 1.3-1.7 ms, of which 0.16 ms moved its blocks (docs/BENCHMARKS.md).
 void BlockSparseMatrix::reserve_slots(size_t slots) {
   if (m_column.capacity() >= slots) return;
   m_column.reserve(2 * slots);
   m_values.reserve(9 * m_column.capacity());
 }
 
+// In place, from the last row to the first: a row's room never shrinks, so each row moves to a slot
+// at or after its old first one and its new room ends where the next row's, already moved, begins;
+// its blocks are read out (sorted by column) before they are written back. A second buffer (as
+// before) meant, whenever the storage grew, fresh pages and a useless copy of the layout before the
+// last: a frog's re-layout took 1.3-1.7 ms, of which 0.16 ms moved its blocks (docs/BENCHMARKS.md).
 void BlockSparseMatrix::relayout(const std::vector<std::pair<int, int>>& min_capacity, int spare_rows) {
   const int n = block_rows();
   if (m_spare_row_capacity < 1) m_spare_row_capacity = DEFAULT_SPARE_ROW_CAPACITY;
