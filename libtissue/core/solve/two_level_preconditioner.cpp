@@ -68,7 +68,7 @@ void TwoLevelPreconditioner::aggregate(const ShiftedSystem& system) {
 }
 
 // The coarse block pattern (aggregate pairs that share a fine block), each fine slot's block, and
-// the scalar lower triangle of the coarse matrix with its symbolic analysis.
+// the coarse factor's analysis of it.
 void TwoLevelPreconditioner::make_coarse_pattern(const BlockSparseMatrix& k) {
   const int count = aggregate_count();
   // Per aggregate a (its rows in m_coarse.rows): the aggregates its rows' blocks reach, in
@@ -105,28 +105,9 @@ void TwoLevelPreconditioner::make_coarse_pattern(const BlockSparseMatrix& k) {
     m_coarse_row_begin[static_cast<size_t>(a) + 1] = static_cast<int>(m_coarse_column.size());
   }
   m_coarse_blocks.assign(m_coarse_column.size(), {});
-
-  // The scalar lower triangle of the coarse matrix (compressed columns), made in the order
-  // for_each_lower_entry visits it.
-  long entries = 0;
-  for_each_lower_entry([&](int, int, int, int, int) { ++entries; });
-  const int columns = m_coarse.columns();
-  m_coarse_matrix = Eigen::SparseMatrix<double>(columns, columns);
-  m_coarse_matrix.makeCompressed();
-  m_coarse_matrix.resizeNonZeros(entries);
-  int* column_start = m_coarse_matrix.outerIndexPtr();
-  int* row = m_coarse_matrix.innerIndexPtr();
-  long next = 0;
-  for_each_lower_entry([&](int column, int entry_row, int, int, int) {
-    column_start[column + 1] = static_cast<int>(++next);
-    row[next - 1] = entry_row;
-  });
-  for (int column = 0; column < columns; ++column) {  // a column without entries (none here) keeps its start
-    column_start[column + 1] = std::max(column_start[column + 1], column_start[column]);
-  }
-  m_coarse_factor.analyzePattern(m_coarse_matrix);
-  m_coarse_rhs.resize(columns);
-  m_coarse_solution.resize(columns);
+  m_coarse_factor.analyze(m_coarse_row_begin, m_coarse_column, m_coarse.column_begin);
+  m_coarse_rhs.resize(m_coarse.columns());
+  m_coarse_solution.resize(m_coarse.columns());
 }
 
 // Coarse block (a, b), a <= b, is the sum over rows i of a and j of b of P_i^T A_ij P_j, with
@@ -191,14 +172,7 @@ void TwoLevelPreconditioner::assemble_and_factorize(const ShiftedSystem& system,
     assemble_coarse_rows(system, m_aggregate_split[static_cast<size_t>(part)],
                          m_aggregate_split[static_cast<size_t>(part) + 1], m_assembly_scratch[static_cast<size_t>(part)]);
   });
-  double* values = m_coarse_matrix.valuePtr();
-  long next = 0;
-  for_each_lower_entry([&](int, int, int block, int column_in_block, int row_in_block) {
-    // Entry (row, column) of block (a, b) is entry (column, row) of its mirror (b, a), the one visited.
-    values[next++] = m_coarse_blocks[static_cast<size_t>(block)][static_cast<size_t>(6 * row_in_block + column_in_block)];
-  });
-  m_coarse_factor.factorize(m_coarse_matrix);
-  m_coarse_ok = m_coarse_factor.info() == Eigen::Success && m_coarse_factor.vectorD().minCoeff() > 0.0;
+  m_coarse_ok = m_coarse_factor.factorize(m_coarse_blocks);
 }
 
 void TwoLevelPreconditioner::apply(const Eigen::VectorXd& r, Eigen::VectorXd& z, WorkTeam* team) {
@@ -221,7 +195,7 @@ void TwoLevelPreconditioner::apply(const Eigen::VectorXd& r, Eigen::VectorXd& z,
     m_local.aggregates.prolong_add(m_local.solution, z);
   }
   if (!m_coarse_ok) return;
-  m_coarse_solution = m_coarse_factor.solve(m_coarse_rhs);
+  m_coarse_factor.solve(m_coarse_rhs, m_coarse_solution);
   run_parts(team, PARTS, [&](int part) {
     m_coarse.prolong_add(m_coarse_solution, z, m_aggregate_split[static_cast<size_t>(part)],
                          m_aggregate_split[static_cast<size_t>(part) + 1]);

@@ -19,18 +19,17 @@
 // points (ShiftedSystem::block_positions at each setup; translations only without them),
 // orthonormal over the aggregate (rotations along the principal axes of its points, those about
 // which the points do not all lie: a two-row aggregate keeps two), so at most 6 columns per
-// aggregate. The coarse matrix Pc^T A Pc is assembled and factorized (sparse LDL^T) after aggregating
-// and every COARSE_REFRESH_SETUPS setups.
+// aggregate. The coarse matrix Pc^T A Pc is assembled and factorized (BlockCholesky, on its 6 x 6
+// blocks of aggregate pairs) after aggregating and every COARSE_REFRESH_SETUPS setups.
 #pragma once
 
+#include "core/solve/block_cholesky.hpp"
 #include "core/solve/linear_solver.hpp"
 #include "core/solve/rigid_aggregates.hpp"
 #include "core/system/work_team.hpp"
 
 #include <Eigen/Core>
 #include <Eigen/Cholesky>
-#include <Eigen/SparseCholesky>
-#include <Eigen/SparseCore>
 
 #include <array>
 #include <cstdint>
@@ -110,27 +109,6 @@ class TwoLevelPreconditioner {
   /// The coarse blocks of aggregates [first, end): each row's terms, the rows in order.
   void assemble_coarse_rows(const ShiftedSystem& system, int first_aggregate, int end_aggregate,
                             AssemblyScratch& scratch);
-  /// visit(column, row, block, column in block, row in block) for each entry of the coarse matrix's
-  /// lower triangle in compressed-column order: column j of aggregate b, then the blocks (b, a) of
-  /// b's block row with a >= b (rows ascending), `block` being (b, a), whose entry (j, row) it is.
-  template <class Visit>
-  void for_each_lower_entry(Visit&& visit) const {
-    const int count = aggregate_count();
-    for (int b = 0; b < count; ++b) {
-      const int b_first = m_coarse.column_begin[static_cast<size_t>(b)];
-      for (int column = b_first; column < m_coarse.column_begin[static_cast<size_t>(b) + 1]; ++column) {
-        for (int p = m_coarse_row_begin[static_cast<size_t>(b)]; p < m_coarse_row_begin[static_cast<size_t>(b) + 1]; ++p) {
-          const int a = m_coarse_column[static_cast<size_t>(p)];
-          if (a < b) continue;
-          const int a_first = m_coarse.column_begin[static_cast<size_t>(a)];
-          for (int row = a == b ? column : a_first; row < m_coarse.column_begin[static_cast<size_t>(a) + 1]; ++row) {
-            visit(column, row, p, column - b_first, row - a_first);
-          }
-        }
-      }
-    }
-  }
-
   // The aggregates of the whole matrix and their columns; per block row its aggregate and its
   // entry in m_coarse.rows (-1: none).
   RigidAggregates m_coarse;
@@ -142,7 +120,7 @@ class TwoLevelPreconditioner {
   std::vector<int> m_coarse_row_begin;
   std::vector<int> m_coarse_column;
   std::vector<int> m_coarse_block_of_slot;  // per fine slot (-1: unused slot)
-  std::vector<std::array<double, 36>> m_coarse_blocks;  // 6x6 column-major, used up to the columns
+  std::vector<BlockCholesky::BlockValues> m_coarse_blocks;  // 6x6 column-major, used up to the columns
   // assemble_coarse_rows's scratch for one row i: per coarse block (a, b) of its aggregate's row,
   // sum_j A_ij and sum_j A_ij C_j over the rows j of b; the blocks it touched.
   struct RowSums {
@@ -157,8 +135,7 @@ class TwoLevelPreconditioner {
   std::array<AssemblyScratch, MAX_STEP_THREADS> m_assembly_scratch;  // one per part
   // The parts of apply() and of the coarse assembly: aggregates in halves balanced by rows.
   std::array<int, MAX_STEP_THREADS + 1> m_aggregate_split{};
-  Eigen::SparseMatrix<double> m_coarse_matrix;           // lower triangle, pattern fixed per aggregation
-  Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> m_coarse_factor;
+  BlockCholesky m_coarse_factor;  // of the blocks, its pattern fixed per aggregation
   bool m_coarse_ok = false;
   Eigen::VectorXd m_coarse_rhs, m_coarse_solution;
   const Eigen::VectorXd* m_inverse_diagonal = nullptr;
