@@ -70,7 +70,8 @@ void BlockCholesky::find_factor_pattern(const std::vector<int>& row_begin, const
   for (int j = 0; j < n; ++j) {
     std::vector<int>& rows = below[static_cast<size_t>(j)];
     for (const int child : children[static_cast<size_t>(j)]) {
-      for (int s = m_column_begin[static_cast<size_t>(child)] + 1; s < m_column_begin[static_cast<size_t>(child) + 1]; ++s) {
+      for (int s = m_column_begin[static_cast<size_t>(child)] + 1; s < m_column_begin[static_cast<size_t>(child) + 1];
+           ++s) {
         if (m_row[static_cast<size_t>(s)] != j) rows.push_back(m_row[static_cast<size_t>(s)]);
       }
     }
@@ -90,7 +91,8 @@ void BlockCholesky::find_factor_pattern(const std::vector<int>& row_begin, const
       ++m_row_slots_begin[static_cast<size_t>(m_row[static_cast<size_t>(s)]) + 1];
     }
   }
-  for (int j = 0; j < n; ++j) m_row_slots_begin[static_cast<size_t>(j) + 1] += m_row_slots_begin[static_cast<size_t>(j)];
+  for (int j = 0; j < n; ++j)
+    m_row_slots_begin[static_cast<size_t>(j) + 1] += m_row_slots_begin[static_cast<size_t>(j)];
   m_row_slots.assign(static_cast<size_t>(m_row_slots_begin.back()), -1);
   m_row_slot_column.assign(m_row_slots.size(), -1);
   std::vector<int> next(m_row_slots_begin.begin(), m_row_slots_begin.end() - 1);
@@ -101,7 +103,6 @@ void BlockCholesky::find_factor_pattern(const std::vector<int>& row_begin, const
       m_row_slot_column[at] = k;
     }
   }
-
 }
 
 void BlockCholesky::map_entries(const std::vector<int>& row_begin, const std::vector<int>& row_column) {
@@ -134,7 +135,8 @@ bool BlockCholesky::factorize(const std::vector<BlockValues>& blocks) {
   const int n = block_count();
   for (Block& block : m_factor) block.setZero();
   for (int j = 0; j < n; ++j) {  // the padding: the identity on the columns a block does not stand for
-    for (int c = m_used[static_cast<size_t>(j)]; c < BLOCK; ++c) m_factor[static_cast<size_t>(m_column_begin[static_cast<size_t>(j)])](c, c) = 1.0;
+    for (int c = m_used[static_cast<size_t>(j)]; c < BLOCK; ++c)
+      m_factor[static_cast<size_t>(m_column_begin[static_cast<size_t>(j)])](c, c) = 1.0;
   }
   for (size_t e = 0; e < m_entry_slot.size(); ++e) {
     const int slot = m_entry_slot[e];
@@ -198,7 +200,8 @@ void BlockCholesky::solve(const Eigen::VectorXd& b, Eigen::VectorXd& x) {
     const int first = m_column_begin[static_cast<size_t>(j)];
     Piece y = m_work.segment<BLOCK>(BLOCK * j);
     for (int s = first + 1; s < m_column_begin[static_cast<size_t>(j) + 1]; ++s) {
-      y.noalias() -= m_factor[static_cast<size_t>(s)].transpose() * m_work.segment<BLOCK>(BLOCK * m_row[static_cast<size_t>(s)]);
+      y.noalias() -=
+          m_factor[static_cast<size_t>(s)].transpose() * m_work.segment<BLOCK>(BLOCK * m_row[static_cast<size_t>(s)]);
     }
     m_factor[static_cast<size_t>(first)].triangularView<Eigen::Lower>().transpose().solveInPlace(y);
     m_work.segment<BLOCK>(BLOCK * j) = y;
