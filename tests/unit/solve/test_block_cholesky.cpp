@@ -107,5 +107,24 @@ TEST(BlockCholesky, RefusesAMatrixThatIsNotPositiveDefinite) {
   EXPECT_FALSE(factor.factorize(p.blocks));
 }
 
+TEST(BlockCholesky, AnEmptyMatrixAndASingleBlockOfOneColumn) {
+  BlockCholesky empty;
+  empty.analyze({0}, {}, {0});  // no aggregate (every row fixed or alone)
+  ASSERT_TRUE(empty.factorize({}));
+  Eigen::VectorXd x;
+  empty.solve(Eigen::VectorXd(0), x);
+  EXPECT_EQ(x.size(), 0);
+
+  BlockCholesky single;
+  single.analyze({0, 1}, {0}, {0, 1});
+  BlockCholesky::BlockValues block;
+  block.fill(7.0);  // past its one column: not read
+  block[0] = 4.0;
+  ASSERT_TRUE(single.factorize({block}));
+  single.solve(Eigen::VectorXd::Constant(1, 2.0), x);
+  ASSERT_EQ(x.size(), 1);
+  EXPECT_DOUBLE_EQ(x[0], 0.5);
+}
+
 }  // namespace
 }  // namespace tissue
