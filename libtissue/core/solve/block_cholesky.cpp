@@ -167,13 +167,16 @@ bool BlockCholesky::factorize(const std::vector<BlockValues>& blocks) {
       }
     }
     for (int s = first; s < end; ++s) m_slot_of_row[static_cast<size_t>(m_row[static_cast<size_t>(s)])] = -1;
+    // The diagonal block is kept as the inverse of its factor: the divisions below and the solves'
+    // diagonal steps are then products, which the fixed size unrolls, not substitutions.
     Block& diagonal = m_factor[static_cast<size_t>(first)];
     const Eigen::LLT<Block> llt(diagonal);
     if (llt.info() != Eigen::Success) return false;
-    diagonal = llt.matrixL();
+    diagonal = llt.matrixL().solve(Block::Identity());
+    const Block inverse_transpose = diagonal.transpose();
     for (int s = first + 1; s < end; ++s) {
       Block& block = m_factor[static_cast<size_t>(s)];
-      block = diagonal.triangularView<Eigen::Lower>().solve(block.transpose()).transpose();
+      block = (block * inverse_transpose).eval();
     }
   }
   return true;
@@ -190,8 +193,8 @@ void BlockCholesky::solve(const Eigen::VectorXd& b, Eigen::VectorXd& x) {
   for (int j = 0; j < n; ++j) {  // L y = b
     auto y_j = m_work.segment<BLOCK>(BLOCK * j);
     const int first = m_column_begin[static_cast<size_t>(j)];
-    m_factor[static_cast<size_t>(first)].triangularView<Eigen::Lower>().solveInPlace(y_j);
-    const Piece y = y_j;
+    const Piece y = m_factor[static_cast<size_t>(first)] * y_j;
+    y_j = y;
     for (int s = first + 1; s < m_column_begin[static_cast<size_t>(j) + 1]; ++s) {
       m_work.segment<BLOCK>(BLOCK * m_row[static_cast<size_t>(s)]).noalias() -= m_factor[static_cast<size_t>(s)] * y;
     }
@@ -203,8 +206,7 @@ void BlockCholesky::solve(const Eigen::VectorXd& b, Eigen::VectorXd& x) {
       y.noalias() -=
           m_factor[static_cast<size_t>(s)].transpose() * m_work.segment<BLOCK>(BLOCK * m_row[static_cast<size_t>(s)]);
     }
-    m_factor[static_cast<size_t>(first)].triangularView<Eigen::Lower>().transpose().solveInPlace(y);
-    m_work.segment<BLOCK>(BLOCK * j) = y;
+    m_work.segment<BLOCK>(BLOCK * j).noalias() = m_factor[static_cast<size_t>(first)].transpose() * y;
   }
   x.resize(b.size());
   for (int j = 0; j < n; ++j) {

@@ -51,8 +51,8 @@ class BlockCholesky {
   void find_factor_pattern(const std::vector<int>& row_begin, const std::vector<int>& row_column);
   void map_entries(const std::vector<int>& row_begin, const std::vector<int>& row_column);
 
-  // In elimination order: block column j of L holds its diagonal block at m_column_begin[j] and
-  // the blocks of rows m_row[s] > j (ascending) after it.
+  // In elimination order: block column j of L holds the inverse of its diagonal block at
+  // m_column_begin[j] and the blocks of rows m_row[s] > j (ascending) after it.
   std::vector<int> m_order;         // elimination position -> block
   std::vector<int> m_position;      // block -> elimination position
   std::vector<int> m_used;          // per elimination position: the block's scalar columns
