@@ -22,7 +22,7 @@ void BlockCholesky::analyze(const std::vector<int>& row_begin, const std::vector
 
 void BlockCholesky::order_blocks(const std::vector<int>& row_begin, const std::vector<int>& row_column,
                                  const std::vector<int>& column_begin) {
-  const int n = static_cast<int>(column_begin.size()) - 1;
+  const int n = std::max(0, static_cast<int>(column_begin.size()) - 1);
   // The blocks' graph, both triangles, for the ordering.
   std::vector<Eigen::Triplet<double>> links;
   for (int a = 0; a < n; ++a) {
