@@ -114,7 +114,6 @@ void BlockCholesky::map_entries(const std::vector<int>& row_begin, const std::ve
     return row == column ? m_column_begin[static_cast<size_t>(column)] : static_cast<int>(it - m_row.begin());
   };
   m_entry_slot.assign(row_column.size(), -1);
-  m_entry_transposed.assign(row_column.size(), 0);
   m_entry_row_block.assign(row_column.size(), -1);
   m_entry_column_block.assign(row_column.size(), -1);
   for (int a = 0; a < n; ++a) {
@@ -124,7 +123,6 @@ void BlockCholesky::map_entries(const std::vector<int>& row_begin, const std::ve
       const int pa = m_position[static_cast<size_t>(a)];
       const int pb = m_position[static_cast<size_t>(b)];
       m_entry_slot[static_cast<size_t>(e)] = slot_of(std::max(pa, pb), std::min(pa, pb));
-      m_entry_transposed[static_cast<size_t>(e)] = pa < pb ? 1 : 0;
       m_entry_row_block[static_cast<size_t>(e)] = pa;
       m_entry_column_block[static_cast<size_t>(e)] = pb;
     }
@@ -141,11 +139,13 @@ bool BlockCholesky::factorize(const std::vector<BlockValues>& blocks) {
   for (size_t e = 0; e < m_entry_slot.size(); ++e) {
     const int slot = m_entry_slot[e];
     if (slot < 0) continue;
-    const int rows = m_used[static_cast<size_t>(m_entry_row_block[e])];
-    const int columns = m_used[static_cast<size_t>(m_entry_column_block[e])];
+    const int row_block = m_entry_row_block[e];
+    const int column_block = m_entry_column_block[e];
+    const int rows = m_used[static_cast<size_t>(row_block)];
+    const int columns = m_used[static_cast<size_t>(column_block)];
     const Eigen::Map<const Block> value(blocks[e].data());
     Block& target = m_factor[static_cast<size_t>(slot)];
-    if (m_entry_transposed[e] != 0) {
+    if (row_block < column_block) {  // stored in the factor's lower triangle as its transpose
       target.topLeftCorner(columns, rows) = value.topLeftCorner(rows, columns).transpose();
     } else {
       target.topLeftCorner(rows, columns) = value.topLeftCorner(rows, columns);

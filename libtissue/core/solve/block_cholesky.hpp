@@ -63,9 +63,9 @@ class BlockCholesky {
   std::vector<int> m_row_slots_begin;
   std::vector<int> m_row_slots;
   std::vector<int> m_row_slot_column;  // the column k of each
-  // Per pattern entry (a, b >= a): its slot, and whether the slot holds its transpose; -1 below a.
+  // Per pattern entry (a, b >= a): its slot and a's and b's elimination positions (-1 below a); the
+  // slot holds its transpose when a's position comes first.
   std::vector<int> m_entry_slot;
-  std::vector<unsigned char> m_entry_transposed;
   std::vector<int> m_entry_row_block, m_entry_column_block;
   std::vector<Block> m_factor;
   std::vector<int> m_slot_of_row;  // factorize()'s scatter of one column: per position, its slot or -1
