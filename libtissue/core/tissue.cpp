@@ -82,7 +82,7 @@ TissueStepReport Tissue::step() {
   const auto contact_start = std::chrono::steady_clock::now();
   if (current.mode == ToolMode::probe && interaction.contact_enabled) {
     const ToolPose& from = previous.mode == ToolMode::probe ? previous : current;
-    m_contact.probe(from.tip_position_m, current.tip_position_m, m_surfaces.bvh());
+    m_contact.probe(from.tip_position_m, current.tip_position_m, m_surfaces.bvh(), tool_axis(current.orientation));
   } else {
     m_contact.withdraw();
   }
@@ -171,6 +171,7 @@ void Tissue::save(TissueSnapshot& snapshot) {
   snapshot.integrator_state = m_integrator->internal_state();
   m_cuts.save(snapshot.cutter);
   snapshot.point_spring = m_contact_spring.spring();
+  snapshot.pad_springs = m_contact_spring.pad();
   const ToolKinematics::State tool = m_tool.state();
   snapshot.tool = tool.tool;
   snapshot.previous_tool = tool.applied;
@@ -250,11 +251,12 @@ void Tissue::restore(const TissueSnapshot& snapshot) {
                                     snapshot.pending_stiffness, snapshot.pending_stiffness_n_per_m};
   m_contact.check(contact);
   const std::optional<PointSpring> old_spring = m_contact_spring.spring();
+  const std::vector<PointSpring> old_pad = m_contact_spring.pad();
   try {
-    m_contact_spring.set(snapshot.point_spring, m_body.term_layout());
+    m_contact_spring.set(snapshot.point_spring, m_body.term_layout(), snapshot.pad_springs);
     m_cuts.restore(snapshot.cutter);
   } catch (const std::invalid_argument& error) {
-    m_contact_spring.set(old_spring, m_body.term_layout());
+    m_contact_spring.set(old_spring, m_body.term_layout(), old_pad);
     throw StateError(std::string("the state is inconsistent: ") + error.what());
   }
   m_body.restore_rotations(rotations);

@@ -110,6 +110,7 @@ struct TissueSnapshot {
   VolumeCutter::SessionState cutter;
   PointContact::State contact;
   std::optional<PointSpring> point_spring;
+  std::vector<PointSpring> pad_springs;  ///< a pad probe's, beside point_spring
   ToolPose tool;
   ToolPose previous_tool;
   Eigen::Vector3d applied_tool_position_m = Eigen::Vector3d::Zero();

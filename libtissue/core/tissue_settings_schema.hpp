@@ -354,6 +354,18 @@ constexpr auto contact_settings() {
                     "with the tool, contact.stiffness the bonded one) until the force along the surface would "
                     "exceed mu times the normal force, then slips with that force against the tool's motion")
           .member(TISSUE_MEMBER(settings.interaction.contact.friction_coefficient)),
+      Setting("contact.padRadius", 91, real)
+          .python("contact_pad_radius_m")
+          .unit("m")
+          .start("0")
+          .at_least("0")
+          .at_most("0.05")
+          .describe("The probe ends in a flat pad of this radius across the surface's normal (a fingertip, a blunt "
+                    "palpation probe) instead of a point: the force no longer follows the mesh's edge length under "
+                    "the point, and a coarser mesh feels as the fine one does once its edges are shorter than the "
+                    "radius. The pad slides (frictionless: contact.friction must be 0) and needs the effectiveStatic "
+                    "contact.stiffnessModel (contact.stiffness is then the pad's, along the normal). 0: a point")
+          .member(TISSUE_MEMBER(settings.interaction.contact.pad_radius_m)),
       Setting("contact.stiffnessRefactorRefreshes", 90, integer)
           .python("contact_stiffness_refactor_refreshes")
           .start("1")

@@ -17,8 +17,9 @@ constexpr std::uint64_t MAGIC = 0x31305353'49535354ULL;  // "TSSISS01" read as l
 // fields, other meanings; 8: the cutter's per-vertex sides, distances and the blade's plane of the
 // open session (issue 41); 9: each cut's blade normal (TetCut::blade_normal); 10: how far the blade
 // had turned when each tet was cut and each edge crossed (a spiral cuts a tet once per turn);
-// 12: the contact spring's direction and constant force, the contact's sticking and friction (issue 42)
-constexpr std::uint32_t VERSION = 12;
+// 12: the contact spring's direction and constant force, the contact's sticking and friction (issue 42);
+// 13: a pad probe's springs (issue 42)
+constexpr std::uint32_t VERSION = 13;
 
 // The core's Eigen types and cut records on top of the shared byte stream.
 class Writer : public serial::ByteWriter {
@@ -140,6 +141,31 @@ ToolPose get_tool(Reader& r) {
   return tool;
 }
 
+void put_spring(Writer& w, const PointSpring& spring) {
+  w.put_item(spring.vertices);
+  w.put(spring.weights);
+  w.put(spring.target_m);
+  w.put(spring.stiffness_n_per_m);
+  w.put(spring.tangent_fraction);
+  w.put(spring.direction);
+  w.put(spring.constant_force_on_body_n);
+}
+
+PointSpring get_spring(Reader& r) {
+  PointSpring spring;
+  r.get(spring.vertices);
+  r.get(spring.weights);
+  r.get(spring.target_m);
+  r.get(spring.stiffness_n_per_m);
+  r.get(spring.tangent_fraction);
+  r.get(spring.direction);
+  r.get(spring.constant_force_on_body_n);
+  return spring;
+}
+
+// Bytes of a spring as put_spring writes it: 3 ints and 14 doubles.
+constexpr size_t SPRING_BYTES = 3 * sizeof(std::int32_t) + 14 * sizeof(double);
+
 }  // namespace
 
 std::vector<std::uint8_t> serialize_snapshot(const TissueSnapshot& s) {
@@ -193,15 +219,9 @@ std::vector<std::uint8_t> serialize_snapshot(const TissueSnapshot& s) {
   w.put(static_cast<std::uint8_t>(s.contact.sticking));
   w.put(s.contact.friction_on_body_n);
   w.put(static_cast<std::uint8_t>(s.point_spring.has_value()));
-  if (s.point_spring) {
-    w.put_item(s.point_spring->vertices);
-    w.put(s.point_spring->weights);
-    w.put(s.point_spring->target_m);
-    w.put(s.point_spring->stiffness_n_per_m);
-    w.put(s.point_spring->tangent_fraction);
-    w.put(s.point_spring->direction);
-    w.put(s.point_spring->constant_force_on_body_n);
-  }
+  if (s.point_spring) put_spring(w, *s.point_spring);
+  w.put(static_cast<std::uint64_t>(s.pad_springs.size()));
+  for (const PointSpring& spring : s.pad_springs) put_spring(w, spring);
   put_tool(w, s.tool);
   put_tool(w, s.previous_tool);
   w.put(s.applied_tool_position_m);
@@ -273,17 +293,9 @@ TissueSnapshot read_snapshot(std::span<const std::uint8_t> bytes) {
   r.get(s.contact.depth_m);
   s.contact.sticking = r.get_bool();
   r.get(s.contact.friction_on_body_n);
-  if (r.get_bool()) {
-    PointSpring spring;
-    r.get(spring.vertices);
-    r.get(spring.weights);
-    r.get(spring.target_m);
-    r.get(spring.stiffness_n_per_m);
-    r.get(spring.tangent_fraction);
-    r.get(spring.direction);
-    r.get(spring.constant_force_on_body_n);
-    s.point_spring = spring;
-  }
+  if (r.get_bool()) s.point_spring = get_spring(r);
+  s.pad_springs.resize(r.count(SPRING_BYTES));
+  for (PointSpring& spring : s.pad_springs) spring = get_spring(r);
   s.tool = get_tool(r);
   s.previous_tool = get_tool(r);
   r.get(s.applied_tool_position_m);

@@ -2,9 +2,11 @@
 #include "core/contact/contact_model.hpp"
 
 #include "core/contact/surface_point.hpp"
+#include "core/parameter_error.hpp"
 #include "core/state_error.hpp"
 
 #include <algorithm>
+#include <string>
 
 namespace tissue {
 
@@ -28,6 +30,11 @@ PointContactSettings point_contact_settings(const ContactSettings& settings, dou
   // The spring stands for the rigid tool: the step must not damp it (issue 9).
   contact.spring_tangent_fraction = integrator.undamped_tangent_share(step_size_s, stiffness_damping_s);
   contact.friction_coefficient = settings.friction_coefficient;
+  contact.pad_radius_m = settings.pad_radius_m;
+  if (settings.pad_radius_m > 0.0 && settings.stiffness_model == ContactStiffnessModel::element_local) {
+    throw ParameterError("a probe with a pad (contact pad radius " + std::to_string(settings.pad_radius_m) +
+                         " m) needs the effectiveStatic contact stiffness: elementLocal is a point's");
+  }
   return contact;
 }
 
@@ -46,10 +53,13 @@ ContactModel::ContactModel(const ContactSettings& settings, bool enabled, double
       m_surface(surface),
       m_contact(point_contact_settings(settings, step_size_s, stiffness_damping_s, body, surface, integrator)),
       m_stiffness_scale_n_per_m(contact_stiffness_scale_n_per_m(body, surface)),
-      m_pending_latency_steps(settings.stiffness_latency_steps) {}
+      m_pending_latency_steps(settings.stiffness_latency_steps) {
+  m_contact.set_pad_triangle_limit(static_cast<int>(m_surface.triangles.size()));
+}
 
 void ContactModel::probe(const Eigen::Vector3d& previous_m, const Eigen::Vector3d& current_m,
-                         const LazySurfaceBvh& bvh) {
+                         const LazySurfaceBvh& bvh, const Eigen::Vector3d& tool_axis) {
+  m_contact.set_pad_axis(tool_axis);
   const bool was_in_contact = m_contact.in_contact();
   // How far the pressed surface rises to a tool drawn back (PointContact::update): the last step's
   // normal force over its normal contact stiffness.
@@ -136,6 +146,7 @@ void ContactModel::refresh_stiffness(int triangle) {
     from_factor.spring_point = m_last_factor.request.spring_point;
     from_factor.spring_in_matrix_n_per_m = m_last_factor.request.spring_in_matrix_n_per_m;
     from_factor.spring_direction = m_last_factor.request.spring_direction;
+    from_factor.pad_in_matrix = m_last_factor.request.pad_in_matrix;
     ++m_last_factor.refreshes_since;
   } else {
     m_last_factor.usable = true;
@@ -172,7 +183,7 @@ ContactStiffnessRequest ContactModel::stiffness_request_at(const ShiftedSystem& 
   const std::array<int, 3>& corners = m_surface.triangles[static_cast<std::size_t>(triangle)];
   const ContactInterpolation point = contact_interpolation(m_body.dofs(), corners, m_contact.proxy().barycentric);
   return contact_stiffness_request(system, m_body.dofs(), point, m_spring.spring(), spring_stiffness_n_per_m(),
-                                   floor_n_per_m);
+                                   floor_n_per_m, m_settings.pad_radius_m > 0.0 ? &m_spring.pad() : nullptr);
 }
 
 Eigen::Matrix3d ContactModel::landed_stiffness(const std::optional<Eigen::Matrix3d>& landed, int triangle) {

@@ -58,6 +58,9 @@ struct ContactSettings {
   /// Coulomb friction coefficient of the probe on the tissue, >= 0; 0: frictionless (the contact
   /// slides; point_contact.hpp).
   double friction_coefficient = 0.0;
+  /// The probe's pad radius, >= 0 [m]; 0: a point (point_contact.hpp, "A pad"). A pad is
+  /// frictionless and its K_c effectiveStatic (the pad's along its normal: pad_stiffness_n_per_m).
+  double pad_radius_m = 0.0;
 };
 
 /// The contact outputs of the last step, as the contact point is (the haptic loop's input).
@@ -110,8 +113,10 @@ class ContactModel {
   ContactModel& operator=(const ContactModel&) = delete;
 
   /// The probe's touching point moved from `previous_m` to `current_m`: the god-object follows it
-  /// over the surface in `bvh` and the spring acts on the body.
-  void probe(const Eigen::Vector3d& previous_m, const Eigen::Vector3d& current_m, const LazySurfaceBvh& bvh);
+  /// over the surface in `bvh` and the spring acts on the body. `tool_axis`: the tool's axis (a
+  /// pad's face is across it).
+  void probe(const Eigen::Vector3d& previous_m, const Eigen::Vector3d& current_m, const LazySurfaceBvh& bvh,
+             const Eigen::Vector3d& tool_axis = Eigen::Vector3d::UnitZ());
   /// No probe this step: a contact ends and the spring is taken away.
   void withdraw();
   /// After the dynamics step, at the new positions: the contact outputs (K_c refreshed as the

@@ -125,6 +125,64 @@ const EffectiveContactStiffness::ResponseMatrix& EffectiveContactStiffness::unit
   return m_response;
 }
 
+Eigen::MatrixXd EffectiveContactStiffness::gram_of_columns() {
+  m_factor->lower_solve(m_columns, m_lower->solution);
+  const Eigen::MatrixXd& y = m_lower->solution.values;
+  return y.transpose() * y;
+}
+
+Eigen::MatrixXd EffectiveContactStiffness::directed_gram(const DirectedSprings& first, const DirectedSprings& second) {
+  m_columns.resize(first.points.size() + second.points.size());
+  size_t c = 0;
+  for (const DirectedSprings* springs : {&first, &second}) {
+    for (const ContactInterpolation& point : springs->points) {
+      (void)check(point);
+      auto& column = m_columns[c++];
+      column.clear();
+      for (size_t k = 0; k < 3; ++k) {
+        if (point.rows[k] < 0) continue;
+        for (int axis = 0; axis < 3; ++axis) {
+          column.emplace_back(3 * point.rows[k] + axis,
+                              point.weights[static_cast<Eigen::Index>(k)] * springs->direction[axis]);
+        }
+      }
+    }
+  }
+  return gram_of_columns();
+}
+
+double EffectiveContactStiffness::pad_stiffness_n_per_m(const DirectedSprings& tool, const DirectedSprings& in_matrix) {
+  for (const DirectedSprings* springs : {&tool, &in_matrix}) {
+    if (springs->points.size() != springs->stiffness_n_per_m.size()) {
+      throw std::invalid_argument("pad contact stiffness: as many springs as points");
+    }
+    for (const double k : springs->stiffness_n_per_m) {
+      if (!(k >= 0.0) || !std::isfinite(k)) {
+        throw std::invalid_argument("pad contact stiffness: the springs' stiffness must be finite and >= 0");
+      }
+    }
+  }
+  // The factorized matrix is A'' = A + V C V^T (V: in_matrix's columns); the tool meets A + U K U^T.
+  // With W = [U V] and D = diag(K, -C): A + U K U^T = A'' + W D W^T, so (Woodbury)
+  //   W^T (A + U K U^T)^-1 W = G (I + D G)^-1,   G = W^T A''^-1 W,
+  // whose first block is S = U^T (A + U K U^T)^-1 U; the force per unit motion along d is
+  // sum k - (K 1)^T S (K 1) (each spring stretched by the motion less its point's).
+  const auto n = static_cast<Eigen::Index>(tool.points.size());
+  const auto m = static_cast<Eigen::Index>(in_matrix.points.size());
+  const Eigen::MatrixXd g = directed_gram(tool, in_matrix);
+  Eigen::VectorXd d(n + m);
+  for (Eigen::Index j = 0; j < n; ++j) d[j] = tool.stiffness_n_per_m[static_cast<size_t>(j)];
+  for (Eigen::Index j = 0; j < m; ++j) d[n + j] = -in_matrix.stiffness_n_per_m[static_cast<size_t>(j)];
+  const Eigen::MatrixXd system = Eigen::MatrixXd::Identity(n + m, n + m) + d.asDiagonal() * g;
+  // S (K 1) = first block of G (I + D G)^-1 [K 1; 0], i.e. G y with (I + D G) y = [K 1; 0].
+  Eigen::VectorXd right(n + m);
+  right.head(n) = d.head(n);
+  right.tail(m).setZero();
+  const Eigen::VectorXd y = system.partialPivLu().solve(right);
+  const Eigen::VectorXd s_k1 = (g * y).head(n);
+  return d.head(n).sum() - d.head(n).dot(s_k1);
+}
+
 Eigen::MatrixXd EffectiveContactStiffness::gram(std::span<const ContactInterpolation> points) {
   m_columns.resize(3 * points.size());
   for (size_t p = 0; p < points.size(); ++p) {
@@ -138,9 +196,7 @@ Eigen::MatrixXd EffectiveContactStiffness::gram(std::span<const ContactInterpola
       }
     }
   }
-  m_factor->lower_solve(m_columns, m_lower->solution);
-  const Eigen::MatrixXd& y = m_lower->solution.values;
-  return y.transpose() * y;
+  return gram_of_columns();
 }
 
 namespace {
@@ -266,7 +322,8 @@ double contact_stiffness_scale_n_per_m(const DeformableBody& body, const Surface
 ContactStiffnessRequest contact_stiffness_request(const ShiftedSystem& system, const DofMap& dofs,
                                                   const ContactInterpolation& point,
                                                   const std::optional<PointSpring>& spring,
-                                                  double rigid_support_n_per_m, double floor_n_per_m) {
+                                                  double rigid_support_n_per_m, double floor_n_per_m,
+                                                  const std::vector<PointSpring>* pad) {
   ContactStiffnessRequest request;
   request.point = point;
   if (spring) {
@@ -276,12 +333,32 @@ ContactStiffnessRequest contact_stiffness_request(const ShiftedSystem& system, c
   }
   request.rigid_support_n_per_m = rigid_support_n_per_m;
   request.floor_n_per_m = floor_n_per_m;
+  if (pad != nullptr) {
+    if (!spring) throw std::invalid_argument("contact stiffness request: a pad without its centre's spring");
+    request.pad.direction = spring->direction;
+    request.pad_in_matrix.direction = spring->direction;
+    const double in_matrix = system.stiffness_scale * spring->tangent_fraction;
+    auto add = [&](const PointSpring& s) {
+      const ContactInterpolation at = contact_interpolation(dofs, s.vertices, s.weights);
+      request.pad.points.push_back(at);
+      request.pad.stiffness_n_per_m.push_back(s.stiffness_n_per_m);
+      request.pad_in_matrix.points.push_back(at);
+      request.pad_in_matrix.stiffness_n_per_m.push_back(in_matrix * s.stiffness_n_per_m);
+    };
+    add(*spring);
+    for (const PointSpring& s : *pad) add(s);
+  }
   return request;
 }
 
 std::optional<Eigen::Matrix3d> condense_factored(EffectiveContactStiffness& effective,
                                                  const ContactStiffnessRequest& request) {
   try {
+    if (!request.pad.points.empty()) {
+      const double pad_n_per_m = effective.pad_stiffness_n_per_m(request.pad, request.pad_in_matrix);
+      if (!std::isfinite(pad_n_per_m) || !(pad_n_per_m > request.floor_n_per_m)) return std::nullopt;
+      return Eigen::Matrix3d(pad_n_per_m * request.pad.direction * request.pad.direction.transpose());
+    }
     const std::optional<Eigen::Matrix3d> stiffness =
         request.spring_point
             ? effective.stiffness_n_per_m(request.point, *request.spring_point, request.spring_in_matrix_n_per_m,

@@ -68,6 +68,14 @@ struct ContactInterpolation {
 ContactInterpolation contact_interpolation(const DofMap& dofs, const std::array<int, 3>& vertices,
                                            const Eigen::Vector3d& weights);
 
+/// Springs along one unit direction d at several points (a pad's: point_contact.hpp, "A pad"):
+/// spring j pulls points[j] along d with stiffness_n_per_m[j].
+struct DirectedSprings {
+  std::vector<ContactInterpolation> points;
+  std::vector<double> stiffness_n_per_m;
+  Eigen::Vector3d direction = Eigen::Vector3d::Zero();
+};
+
 /// The matrix K_c is condensed from, for a body with fixed vertices: A = K (the tangent; SPD).
 /// `diagonal` is the zero shift it points to (resized here; keep it alive with the result).
 ShiftedSystem static_contact_system(const BlockSparseMatrix& tangent, Eigen::VectorXd& diagonal);
@@ -108,6 +116,16 @@ class EffectiveContactStiffness {
   [[nodiscard]] std::optional<Eigen::Matrix3d> stiffness_n_per_m(
       const ContactInterpolation& point, const ContactInterpolation& spring_point, double spring_stiffness_n_per_m,
       const Eigen::Vector3d& spring_direction = Eigen::Vector3d::Zero());
+  /// A pad's K_c along its normal d (point_contact.hpp, "A pad"): the force on the tool along d per
+  /// unit motion of the tool along d, the body settling, through the springs `tool` (the pad's, the
+  /// centre's first): sum k - (K 1)^T U^T (A + U K U^T)^-1 U (K 1), U the springs' points along d and
+  /// A the tissue alone, the factorized matrix with the springs `in_matrix` (what it holds of the
+  /// pad's, possibly of an earlier pad: DeformableBody's point springs are in its tangent while set)
+  /// taken out exactly (Woodbury). The pad's springs are in series with the tissue, so it is finite
+  /// wherever the pad presses, on fixed vertices too (the springs alone). Throws as
+  /// stiffness_n_per_m, and std::invalid_argument for springs of negative or non-finite stiffness or
+  /// lists of different lengths.
+  [[nodiscard]] double pad_stiffness_n_per_m(const DirectedSprings& tool, const DirectedSprings& in_matrix);
   using ResponseMatrix = Eigen::Matrix<double, Eigen::Dynamic, 3>;
   /// A^-1 P (rows() x 3): the displacement field of a unit force at `point` along each axis, by three
   /// full solves (stiffness_n_per_m needs only the forward halves). Throws as stiffness_n_per_m.
@@ -123,6 +141,10 @@ class EffectiveContactStiffness {
   /// The Gram matrix (L^-1 Q)^T (L^-1 Q) = Q^T A'^-1 Q of Q = [P of each point] (A' the factorized
   /// matrix) by one sparse forward solve: the rows of the elimination tree the points reach.
   [[nodiscard]] Eigen::MatrixXd gram(std::span<const ContactInterpolation> points);
+  /// The same for the columns of DirectedSprings: each point along its springs' direction.
+  [[nodiscard]] Eigen::MatrixXd directed_gram(const DirectedSprings& first, const DirectedSprings& second);
+  /// Factors the columns in m_columns into a Gram matrix (lower_solve).
+  [[nodiscard]] Eigen::MatrixXd gram_of_columns();
 
   std::unique_ptr<CholmodFactor> m_factor;
   bool m_loaded = false;  ///< the factor holds a matrix the last load() copied (not one before a failed load)
@@ -142,14 +164,21 @@ struct ContactStiffnessRequest {
   Eigen::Vector3d spring_direction = Eigen::Vector3d::Zero();  ///< the spring's (PointSpring::direction)
   double rigid_support_n_per_m = 0.0;                ///< K_c = this I at a point on fixed vertices only
   double floor_n_per_m = 0.0;                        ///< K_c's smallest eigenvalue must be above this
+  /// A pad's springs (the centre's first) as the tool has them, and as the matrix holds them: K_c is
+  /// then the pad's, k d d^T (pad_stiffness_n_per_m; above the floor), and the point's fields are
+  /// not used. Empty: a point.
+  DirectedSprings pad;
+  DirectedSprings pad_in_matrix;
 };
 
 /// The request for `point` on `system`: the contact spring, if set, is in the matrix as its tangent
-/// share times the system's scale.
+/// share times the system's scale. With `pad` (a pad probe's springs beside the spring, which must
+/// be set), the pad's request.
 ContactStiffnessRequest contact_stiffness_request(const ShiftedSystem& system, const DofMap& dofs,
                                                   const ContactInterpolation& point,
                                                   const std::optional<PointSpring>& spring,
-                                                  double rigid_support_n_per_m, double floor_n_per_m);
+                                                  double rigid_support_n_per_m, double floor_n_per_m,
+                                                  const std::vector<PointSpring>* pad = nullptr);
 
 /// K_c of the tissue alone from the matrix loaded into `effective`: factorizes it, the spring taken out
 /// exactly. Nothing when the factor fails, or when K_c is not finite or its smallest eigenvalue is not

@@ -33,6 +33,24 @@ void validate(const PointContactSettings& settings) {
     throw ParameterError("contact friction coefficient must be finite and >= 0, got " +
                          std::to_string(settings.friction_coefficient));
   }
+  if (!(settings.pad_radius_m >= 0.0) || !std::isfinite(settings.pad_radius_m)) {
+    throw ParameterError("contact pad radius must be finite and >= 0 m, got " + std::to_string(settings.pad_radius_m));
+  }
+  if (settings.pad_radius_m > 0.0 && settings.friction_coefficient > 0.0) {
+    throw ParameterError("a probe with a pad (contact pad radius " + std::to_string(settings.pad_radius_m) +
+                         " m) is frictionless: set the contact friction to 0 or the pad radius to 0");
+  }
+}
+
+Eigen::Vector3d pad_sample_offset(int k, const Eigen::Vector3d& u, const Eigen::Vector3d& v) {
+  // Equal areas: the centre's disc holds 1/19 of the area, the rings' annuli 6/19 and 12/19; each
+  // ring's samples sit on the radius that halves its annulus's area, the outer ring turned by half
+  // a step.
+  if (k <= 0) return Eigen::Vector3d::Zero();
+  const bool inner = k <= 6;
+  const double radius = inner ? std::sqrt(4.0 / PAD_SAMPLES) : std::sqrt(13.0 / PAD_SAMPLES);
+  const double angle = inner ? 2.0 * M_PI * (k - 1) / 6.0 : 2.0 * M_PI * (k - 7 + 0.5) / 12.0;
+  return radius * (std::cos(angle) * u + std::sin(angle) * v);
 }
 
 bool PointContact::inside_by_parity(const Eigen::Vector3d& point_m, const Eigen::VectorXd& positions_m,
@@ -113,6 +131,12 @@ bool PointContact::update(const Eigen::Vector3d& hip_previous_m, const Eigen::Ve
   // faces around the vertex it presses) throws the proxy from face to face, 1.4 mm at a time, the
   // force swinging by +-1.7 N on 1.8 N (a 5 mm box swept at 15 mm/s).
   m_normal = smooth_normal(projection.point, surface.triangles(), m_adjacency, positions_m);
+  if (m_settings.pad_radius_m > 0.0 && !m_pad_axis.isZero(0.0)) {
+    // A pad's face is across the tool's axis, whatever the surface under it does: the smooth normal
+    // at the centre of a pit tilts with any asymmetry of the pit, the disc would tilt with it and
+    // press the low side deeper (a 4 mm grid pressed 2 mm by an 8 mm pad: 20 degrees).
+    m_normal = m_pad_axis.dot(m_normal) >= 0.0 ? m_pad_axis : Eigen::Vector3d(-m_pad_axis);
+  }
   if (m_settings.friction_coefficient > 0.0 && was_in_contact) {
     // The normal force's change the HIP's motion along -m asks for: the contact's normal stiffness
     // in series with the spring.
@@ -129,8 +153,38 @@ bool PointContact::update(const Eigen::Vector3d& hip_previous_m, const Eigen::Ve
     m_friction_on_body_n.setZero();
   }
   m_depth_m = (m_proxy_position_m - hip_m).norm();
+  sample_pad(positions_m, surface);
   return true;
 }
+
+double PointContact::centre_stiffness_n_per_m() const {
+  const double k = m_settings.spring_stiffness_n_per_m;
+  return m_settings.pad_radius_m > 0.0 ? k / PAD_SAMPLES : k;
+}
+
+void PointContact::sample_pad(const Eigen::VectorXd& positions_m, const SurfaceBvh& surface) {
+  m_pad.clear();
+  if (!(m_settings.pad_radius_m > 0.0)) return;
+  // The disc's axes: the one of the coordinate axes least along n, made orthogonal to it.
+  const Eigen::Vector3d& n = m_normal;
+  Eigen::Index least = 0;
+  n.cwiseAbs().minCoeff(&least);
+  const Eigen::Vector3d u = (Eigen::Vector3d::Unit(least) - n[least] * n).normalized();
+  const Eigen::Vector3d v = n.cross(u);
+  for (int k = 1; k < PAD_SAMPLES; ++k) {
+    const Eigen::Vector3d target_m = m_hip_m + m_settings.pad_radius_m * pad_sample_offset(k, u, v);
+    const SurfaceProjection closest =
+        slide_to_closest_point(target_m, m_proxy, surface.triangles(), m_adjacency, positions_m);
+    // Pressed: the surface point lies beyond the disc's plane, on a face turned towards the disc (not
+    // the side of a rim the disc overhangs).
+    if (closest.point.triangle >= m_pad_triangle_limit) continue;  // a cut face
+    if ((closest.position_m - target_m).dot(n) <= 0.0 || closest.normal.dot(n) < 0.5) continue;
+    m_pad.push_back(PointSpring{surface.triangle(closest.point.triangle), closest.point.barycentric, target_m,
+                                centre_stiffness_n_per_m(), m_settings.spring_tangent_fraction, n,
+                                Eigen::Vector3d::Zero()});
+  }
+}
+
 
 void PointContact::stick_or_slip(const SurfaceProjection& closest, const Eigen::Vector3d& last_force_on_tool_n,
                                  double normal_force_change_n, const Eigen::VectorXd& positions_m,
@@ -166,19 +220,24 @@ std::optional<PointSpring> PointContact::spring(const SurfaceBvh& surface) const
   if (!m_in_contact) return std::nullopt;
   return PointSpring{surface.triangle(m_proxy.triangle),   m_proxy.barycentric,
                      m_hip_m,
-                     m_settings.spring_stiffness_n_per_m,
+                     centre_stiffness_n_per_m(),
                      m_settings.spring_tangent_fraction,
                      m_sticking ? Eigen::Vector3d::Zero() : m_normal,
                      m_friction_on_body_n};
 }
 
 void PointContact::apply(const SurfaceBvh& surface, PointSpringTerm& term, const TermLayout& layout) const {
-  term.set(spring(surface), layout);
+  term.set(spring(surface), layout, m_pad);
 }
 
 Eigen::Vector3d PointContact::force_on_tool_n(const SurfaceBvh& surface, const Eigen::VectorXd& positions_m) const {
   if (!m_in_contact) return Eigen::Vector3d::Zero();
-  return -spring_force_on_body_n(*spring(surface), surface_point_position_m(m_proxy, surface.triangles(), positions_m));
+  Eigen::Vector3d force_on_body_n =
+      spring_force_on_body_n(*spring(surface), surface_point_position_m(m_proxy, surface.triangles(), positions_m));
+  for (const PointSpring& sample : m_pad) {
+    force_on_body_n += spring_force_on_body_n(sample, spring_material_point_m(sample, positions_m));
+  }
+  return -force_on_body_n;
 }
 
 }  // namespace tissue

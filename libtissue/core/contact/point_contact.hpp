@@ -50,6 +50,21 @@
 // |f_t| > mu f_n, along t = -f_t / |f_t|; a slipping one sticks, held from the point under the
 // tool, when the tool is no longer ahead of the surface point it was over along t by more than the
 // cone's reach mu f_n / k (it stopped or turned). A new contact starts sticking.
+//
+// A pad (PointContactSettings::pad_radius_m > 0): the probe ends in a flat disc of that radius
+// through the HIP, across the normal at the proxy (a fingertip, a blunt palpation probe). Under a
+// point the force follows the mesh, not the tissue: a point load has no finite stiffness in a
+// continuum, and on a mesh the stiffness under a point is ~ E h (h the local edge length; the
+// 6.1k-tet organ felt twice as stiff as the 52k-tet one, docs/BENCHMARKS.md, "The physics
+// resolution chosen for the slot"), while under a disc of radius a it tends to the continuum's
+// ~ 2 a E / (1 - nu^2) (Boussinesq's flat punch) once h < a. The disc is sampled at PAD_SAMPLES
+// points of equal area (the centre, rings of 6 and 12); each sample is the surface point closest to
+// it, and where the disc has pressed into the surface (the point outside the disc's plane, on a face
+// that faces the disc) a spring of stiffness k / PAD_SAMPLES pulls it along the normal to the disc:
+// a layer of uniform stiffness per area between the rigid tool and the tissue, k in all when the
+// whole disc presses. The proxy is the centre sample (its spring is the point contact's, with that
+// share of k). Like the point, the pad slides (the samples are found anew at every update); it is
+// frictionless (a pad with friction is refused).
 #pragma once
 
 #include "core/collide/surface_bvh.hpp"
@@ -59,6 +74,7 @@
 
 #include <Eigen/Core>
 
+#include <limits>
 #include <optional>
 #include <vector>
 
@@ -77,10 +93,19 @@ struct PointContactSettings {
   double passed_over_depth_m = 0.0;
   /// Coulomb friction coefficient mu of the tool on the surface, finite and >= 0 (0: frictionless).
   double friction_coefficient = 0.0;
+  /// The probe's pad radius (the header), finite and >= 0 [m]; 0: a point.
+  double pad_radius_m = 0.0;
 };
 
-/// Throws ParameterError unless the spring stiffness is finite and > 0, its tangent fraction in (0, 1]
-/// and the friction coefficient finite and >= 0.
+/// The samples of a pad: the centre, then rings of 6 and 12 (equal areas of the disc).
+inline constexpr int PAD_SAMPLES = 19;
+/// Sample k's offset from the pad's centre in the disc's plane, in units of its radius (the first is
+/// the centre), along the unit axes `u`, `v` of that plane.
+Eigen::Vector3d pad_sample_offset(int k, const Eigen::Vector3d& u, const Eigen::Vector3d& v);
+
+/// Throws ParameterError unless the spring stiffness is finite and > 0, its tangent fraction in (0, 1],
+/// the friction coefficient finite and >= 0 and the pad radius finite and >= 0, and for a pad with
+/// friction.
 void validate(const PointContactSettings& settings);
 
 class PointContact {
@@ -113,15 +138,26 @@ class PointContact {
   bool update(const Eigen::Vector3d& hip_previous_m, const Eigen::Vector3d& hip_m, const Eigen::VectorXd& positions_m,
               const SurfaceBvh& surface, double follow_distance_m = 0.0, double normal_stiffness_n_per_m = 0.0);
   /// Ends a contact (e.g. the tool mode changed).
-  void release() { m_in_contact = false; }
+  void release() {
+    m_in_contact = false;
+    m_pad.clear();
+  }
+  /// The tool's axis for the next update (unit, or zero: none): a pad's face is across it, and the
+  /// contact's normal is the axis turned out of the surface (the header).
+  void set_pad_axis(const Eigen::Vector3d& axis) {
+    m_pad_axis = axis.allFinite() && axis.norm() > 0.0 ? Eigen::Vector3d(axis.normalized()) : Eigen::Vector3d::Zero();
+  }
+  /// A pad's samples leave out the triangles from `triangle_count` on (faces the probe must not act
+  /// on, a cut's; the caller releases a contact whose proxy is on one). All by default.
+  void set_pad_triangle_limit(int triangle_count) { m_pad_triangle_limit = triangle_count; }
 
   [[nodiscard]] bool in_contact() const { return m_in_contact; }
   /// The proxy as a material point (meaningful while in contact).
   [[nodiscard]] const SurfacePoint& proxy() const { return m_proxy; }
   /// The proxy's position at the last update [m].
   [[nodiscard]] const Eigen::Vector3d& proxy_position_m() const { return m_proxy_position_m; }
-  /// Unit outward smooth normal of the surface at the proxy at the last update (smooth_normal): the
-  /// direction the spring pulls along.
+  /// Unit outward smooth normal of the surface at the proxy at the last update (smooth_normal), or
+  /// for a pad its face's normal (the tool's axis): the direction the springs pull along.
   [[nodiscard]] const Eigen::Vector3d& normal() const { return m_normal; }
   /// The HIP of the last update [m].
   [[nodiscard]] const Eigen::Vector3d& hip_m() const { return m_hip_m; }
@@ -135,6 +171,9 @@ class PointContact {
   /// The spring from the proxy's material point to the HIP, for the body's PointSpringTerm;
   /// nothing when not in contact.
   [[nodiscard]] std::optional<PointSpring> spring(const SurfaceBvh& surface) const;
+  /// A pad's springs besides it, those of the samples pressed at the last update (empty for a point,
+  /// or out of contact).
+  [[nodiscard]] const std::vector<PointSpring>& pad_springs() const { return m_pad; }
 
   /// What the contact carries from step to step (the work buffers and the adjacency are rebuilt).
   struct State {
@@ -160,16 +199,23 @@ class PointContact {
     m_depth_m = state.depth_m;
     m_sticking = state.sticking;
     m_friction_on_body_n = state.friction_on_body_n;
+    m_pad.clear();  // the pad's springs are the body's term's (saved with it); the next update samples anew
   }
-  /// term.set(spring(surface), layout): `term` attached to the body whose term_layout() is `layout`.
+  /// term.set(spring(surface), layout, pad_springs()): `term` attached to the body whose
+  /// term_layout() is `layout`.
   void apply(const SurfaceBvh& surface, PointSpringTerm& term, const TermLayout& layout) const;
-  /// The force on the tool, k D (x_p - HIP) - F (PointSpring; D = n n^T unless sticking), the proxy's material point at `positions_m` (e.g.
-  /// after the step), i.e. minus the spring's force on the body; zero when not in contact. [N]
+  /// The force on the tool, k D (x_p - HIP) - F (PointSpring; D = n n^T unless sticking), the proxy's
+  /// material point at `positions_m` (e.g. after the step), i.e. minus the spring's force on the body,
+  /// a pad's springs' included; zero when not in contact. [N]
   [[nodiscard]] Eigen::Vector3d force_on_tool_n(const SurfaceBvh& surface, const Eigen::VectorXd& positions_m) const;
 
  private:
   /// Whether `point_m` is inside the surface by a ray's parity (the ray's hits stay in m_segment_hits).
   bool inside_by_parity(const Eigen::Vector3d& point_m, const Eigen::VectorXd& positions_m, const SurfaceBvh& surface);
+  /// A pad's springs for the contact as updated (the header).
+  void sample_pad(const Eigen::VectorXd& positions_m, const SurfaceBvh& surface);
+  /// The stiffness of the proxy's spring: k, or its share for a pad [N/m].
+  [[nodiscard]] double centre_stiffness_n_per_m() const;
   /// With friction, a contact that goes on sticks or slips (the header); sets the proxy.
   void stick_or_slip(const SurfaceProjection& closest, const Eigen::Vector3d& last_force_on_tool_n,
                      double normal_force_change_n, const Eigen::VectorXd& positions_m, const SurfaceBvh& surface);
@@ -182,6 +228,9 @@ class PointContact {
   double m_depth_m = 0.0;
   bool m_sticking = false;
   Eigen::Vector3d m_friction_on_body_n = Eigen::Vector3d::Zero();
+  std::vector<PointSpring> m_pad;                      // a pad's springs (sample_pad)
+  int m_pad_triangle_limit = std::numeric_limits<int>::max();
+  Eigen::Vector3d m_pad_axis = Eigen::Vector3d::Zero();
   VertexTriangles m_adjacency;                         // rebuilt when the surface grows (a cut)
   std::vector<SurfaceBvh::SegmentHit> m_segment_hits;  // work buffer
 };

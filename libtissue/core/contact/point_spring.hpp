@@ -1,6 +1,7 @@
 // The god-object contact's spring as a force term of the body: from a material point of the body
 // (a point of a surface triangle) to the tool's interaction point (point_contact.hpp says why a
-// spring, and why its tangent share is below 1).
+// spring, and why its tangent share is below 1); for a pad probe, the pad's springs beside it, one per
+// sample of the pad (point_contact.hpp, "A pad").
 #pragma once
 
 #include "core/system/force_term.hpp"
@@ -9,6 +10,7 @@
 
 #include <array>
 #include <optional>
+#include <vector>
 
 namespace tissue {
 
@@ -35,24 +37,31 @@ struct PointSpring {
 
 /// D (see PointSpring): the identity, or d d^T for a spring with a direction.
 Eigen::Matrix3d spring_projector(const PointSpring& spring);
+/// The spring's material point sum_i w_i x_i with the vertices at `positions_m` (3 per vertex) [m].
+Eigen::Vector3d spring_material_point_m(const PointSpring& spring, const Eigen::VectorXd& positions_m);
 /// The force the spring applies to the body with its material point at `material_point_m`:
 /// k D (target - x_p) + F [N] (the force on the tool is its opposite).
 Eigen::Vector3d spring_force_on_body_n(const PointSpring& spring, const Eigen::Vector3d& material_point_m);
 
-/// The body's point spring, or none. Attach it to the body (DeformableBody::attach) once; set() it
-/// as the contact starts, moves and ends.
+/// The body's point spring and a pad's springs, or none. Attach it to the body (DeformableBody::attach)
+/// once; set() it as the contact starts, moves and ends.
 class PointSpringTerm final : public ForceTerm {
  public:
-  /// Sets (or clears) the spring: f_int gains w_i (k D (x_p - target) - F) on each vertex i, the
-  /// tangent c k w_i w_j D between free vertices (c its tangent_fraction). Throws ParameterError
-  /// (spring unchanged) unless the vertices are in range, every pair of free ones shares a tet,
-  /// weights, target and F are finite with |sum w - 1| <= 1e-6, 0 <= k < inf, 0 < c <= 1 and the
-  /// direction zero or of length 1 within 1e-6. `layout` is the body's (DeformableBody::term_layout).
-  void set(std::optional<PointSpring> spring, const TermLayout& layout);
+  /// Sets (or clears) the spring and the pad's (none unless `spring` is set): each gives f_int
+  /// w_i (k D (x_p - target) - F) on each of its vertices i, the tangent c k w_i w_j D between free
+  /// vertices (c its tangent_fraction). Throws ParameterError (springs unchanged) unless, for each,
+  /// the vertices are in range, every pair of free ones shares a tet, weights, target and F are
+  /// finite with |sum w - 1| <= 1e-6, 0 <= k < inf, 0 < c <= 1 and the direction zero or of length 1
+  /// within 1e-6, or for a pad without a spring. `layout` is the body's (DeformableBody::term_layout).
+  void set(std::optional<PointSpring> spring, const TermLayout& layout, std::vector<PointSpring> pad = {});
   [[nodiscard]] const std::optional<PointSpring>& spring() const { return m_spring; }
-  /// k D (target - x_p) + F at the last add_force(): the force the spring applies to the body (zero
-  /// without a spring) [N].
+  /// The pad's springs (empty for a point probe).
+  [[nodiscard]] const std::vector<PointSpring>& pad() const { return m_pad; }
+  /// k D (target - x_p) + F at the last add_force(): the force the spring and the pad's apply to the
+  /// body (zero without a spring) [N].
   [[nodiscard]] const Eigen::Vector3d& force_on_body_n() const { return m_force_on_body_n; }
+  /// The force the pad's springs apply to the body with its vertices at `positions_m` [N].
+  [[nodiscard]] Eigen::Vector3d pad_force_on_body_n(const Eigen::VectorXd& positions_m) const;
 
   void add_force(const Eigen::VectorXd& positions_m, Eigen::VectorXd& vertex_forces_n) override;
   void add_tangent(BlockSparseMatrix& tangent) const override;
@@ -60,10 +69,12 @@ class PointSpringTerm final : public ForceTerm {
   void locate(const TermLayout& layout) override;
 
  private:
-  [[nodiscard]] Eigen::Vector3d material_point_m(const Eigen::VectorXd& positions_m) const;
+  using Slots = std::array<int, 9>;  // [3 i + j]: block (row of vertex i, row of vertex j), -1 if fixed
 
   std::optional<PointSpring> m_spring;
-  std::array<int, 9> m_slots{};  // [3 i + j]: block (row of vertex i, row of vertex j), -1 if fixed
+  Slots m_slots{};
+  std::vector<PointSpring> m_pad;
+  std::vector<Slots> m_pad_slots;
   Eigen::Vector3d m_force_on_body_n = Eigen::Vector3d::Zero();
 };
 

@@ -344,3 +344,28 @@ TEST(PointContact, TheProxyStaysOnTheSurfaceWhileTheSurfaceMoves) {
 
 }  // namespace
 }  // namespace tissue
+
+namespace tissue {
+namespace {
+
+// A pad's samples (point_contact.hpp, "A pad") split the disc into equal areas: their offsets sum to
+// zero and their mean squared radius is the disc's, a^2 / 2 (to the rings' placement, 0.3 %).
+TEST(PadSamples, CoverTheDiscInEqualAreas) {
+  const Eigen::Vector3d u = Eigen::Vector3d(1.0, 1.0, 0.0).normalized();
+  const Eigen::Vector3d v = Eigen::Vector3d(-1.0, 1.0, 0.0).normalized();
+  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+  double squared_radius = 0.0;
+  for (int k = 0; k < PAD_SAMPLES; ++k) {
+    const Eigen::Vector3d offset = pad_sample_offset(k, u, v);
+    EXPECT_LE(offset.norm(), 1.0);
+    EXPECT_NEAR(offset.z(), 0.0, 1e-15);
+    sum += offset;
+    squared_radius += offset.squaredNorm() / PAD_SAMPLES;
+  }
+  EXPECT_EQ(pad_sample_offset(0, u, v), Eigen::Vector3d::Zero());
+  EXPECT_LT(sum.norm(), 1e-14);
+  EXPECT_NEAR(squared_radius, 0.5, 0.005);
+}
+
+}  // namespace
+}  // namespace tissue

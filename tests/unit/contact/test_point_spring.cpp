@@ -14,6 +14,7 @@
 #include <iostream>
 #include <limits>
 #include <optional>
+#include <vector>
 
 namespace tissue {
 namespace {
@@ -173,6 +174,59 @@ TEST(PointSpring, ForceAndTangentMatchTheDefinitionAndFiniteDifferences) {
     ASSERT_TRUE(bar.spring_term.spring().has_value());
     EXPECT_EQ(bar.spring_term.spring()->direction, along.direction / 1.01);
   }
+}
+
+// A pad's springs (point_contact.hpp, "A pad") beside the point's: each acts as if it were alone, so
+// force, tangent, energy and the force on the body are the sums of the springs' own.
+TEST(PointSpring, APadsSpringsActAsIfEachWereAlone) {
+  Bar bar(3, 1e5);
+  const PointSpring centre{
+      bar.face_at(0.02),       Eigen::Vector3d(0.2, 0.3, 0.5), Eigen::Vector3d(0.02, 0.013, 0.007), 250.0, 0.5,
+      Eigen::Vector3d::UnitX()};
+  PointSpring sample = centre;
+  sample.vertices = bar.face_at(0.03);
+  sample.weights = Eigen::Vector3d(0.6, 0.1, 0.3);
+  sample.target_m = Eigen::Vector3d(0.031, 0.012, 0.009);
+  sample.stiffness_n_per_m = 120.0;
+  Eigen::VectorXd u(bar.body.dof_count());
+  for (Eigen::Index k = 0; k < u.size(); ++k) u(k) = 3e-4 * std::cos(0.7 * static_cast<double>(k));
+  Eigen::VectorXd positions;
+  bar.body.positions(u, positions);
+  struct Effect {
+    Eigen::VectorXd force;
+    Eigen::MatrixXd tangent;
+    double energy_j;
+    Eigen::Vector3d on_body_n;
+  };
+  const auto effect = [&](std::optional<PointSpring> spring, std::vector<PointSpring> pad) {
+    bar.spring_term.set(std::move(spring), bar.body.term_layout(), std::move(pad));
+    Effect e;
+    bar.body.evaluate(u, e.force, true);
+    e.tangent = dense(bar.body.tangent());
+    e.energy_j = bar.spring_term.energy_j(positions);
+    e.on_body_n = bar.spring_term.force_on_body_n();
+    return e;
+  };
+  const Effect none = effect(std::nullopt, {});
+  const Effect centre_alone = effect(centre, {});
+  const Effect sample_alone = effect(sample, {});
+  const Effect both = effect(centre, {sample});
+  EXPECT_LT(((both.force - none.force) - (centre_alone.force - none.force) - (sample_alone.force - none.force)).norm(),
+            1e-12 * both.force.norm());
+  EXPECT_LT(
+      ((both.tangent - none.tangent) - (centre_alone.tangent - none.tangent) - (sample_alone.tangent - none.tangent))
+          .norm(),
+      1e-9 * (both.tangent - none.tangent).norm());
+  EXPECT_NEAR(both.energy_j, centre_alone.energy_j + sample_alone.energy_j, 1e-15);
+  EXPECT_LT((both.on_body_n - centre_alone.on_body_n - sample_alone.on_body_n).norm(), 1e-12);
+  EXPECT_LT((bar.spring_term.pad_force_on_body_n(positions) - sample_alone.on_body_n).norm(), 1e-12);
+  // A pad without the point's spring, or with a bad spring, is refused and the springs kept.
+  EXPECT_THROW(bar.spring_term.set(std::nullopt, bar.body.term_layout(), {sample}), ParameterError);
+  PointSpring bad = sample;
+  bad.weights = Eigen::Vector3d(0.6, 0.6, 0.3);
+  EXPECT_THROW(bar.spring_term.set(centre, bar.body.term_layout(), {sample, bad}), ParameterError);
+  ASSERT_EQ(bar.spring_term.pad().size(), 1U);
+  EXPECT_EQ(bar.spring_term.pad()[0].target_m, sample.target_m);
 }
 
 TEST(PointSpring, PullOnAClampedBarIsTwoSpringsInSeries) {
