@@ -2,7 +2,7 @@
 """Builds the organ-scale specimens (issues 23, 42): a liver-sized organ as a 52k-tet reference, as the
 6k-tet physics mesh of the real-time scenes, and its fine render surface.
 
-    /usr/bin/python3 meshes/make_liver.py [--gmsh gmsh]
+    /usr/bin/python3 meshes/make_liver.py [--gmsh gmsh] [--only NAME]
 
 The shape is one smooth closed surface: the unit sphere mapped by a smooth function into a
 liver-like wedge (a thick right lobe tapering to a thin left lobe, domed on top, 22 cm across),
@@ -38,10 +38,12 @@ MIN_RENDER_TRIANGLES = 50000
 
 class Variant:
     """A committed tet mesh of the organ: its name (name.veg, name.bou, name.geo), largest tet edge,
-    Gmsh's curvature sizing (elements per 2 pi of radius; 0: none) and the tet count it must land near."""
+    Gmsh's curvature sizing (elements per 2 pi of radius; 0: none), the tet count it must land near,
+    and optionally a box meshed finer: (edge [m], (x0, x1, y0, y1, z0, z1) [m], grading distance [m])."""
 
-    def __init__(self, name, mesh_size_m, curvature, target_tets):
+    def __init__(self, name, mesh_size_m, curvature, target_tets, fine_box=None):
         self.name, self.mesh_size_m, self.curvature, self.target_tets = name, mesh_size_m, curvature, target_tets
+        self.fine_box = fine_box
 
 
 # The 52k-tet reference (issue 23), uniform; and the physics mesh of the real-time scenes (issue 42):
@@ -50,7 +52,14 @@ class Variant:
 # the tets, as the embedding requires).
 REFERENCE = Variant("liver", 0.0046, 0, 50000)
 COARSE = Variant("liver_coarse", 0.014, 12, 6000)
-VARIANTS = (REFERENCE, COARSE)
+# The palpation scene's physics mesh (issue 42): the coarse mesh, and the top of the thick right lobe
+# where the hand palpates (make_palpation.py's sweep over x in [-7.5, -1.5] cm and the inclusion under
+# it) meshed at FINE_BOX_EDGE_M, graded to the coarse size over 2 cm: a pad of 1 cm radius then spans
+# several edges there (point_contact.hpp, "A pad").
+FINE_BOX_EDGE_M = 0.006
+PALPATION = Variant("liver_palpation", 0.014, 16, 11500,
+                    (FINE_BOX_EDGE_M, (-0.09, 0.0, -0.025, 0.025, 0.0, 0.08), 0.02))
+VARIANTS = (REFERENCE, COARSE, PALPATION)
 
 HALF_LENGTH_M = 0.11  # x: right lobe tip to left lobe tip, 22 cm
 HALF_DEPTH_M = 0.075  # y: back to front at mid length
@@ -124,7 +133,25 @@ def write_stl(path, points, faces):
         out.write("\n".join(lines) + "\n")
 
 
-def geo_text(stl_name, mesh_size_m, curvature):
+def fine_box_text(mesh_size_m, fine_box):
+    """Gmsh's Box field for a variant's fine box, as the background size (none: no lines)."""
+    if fine_box is None:
+        return []
+    edge_m, (x0, x1, y0, y1, z0, z1), grading_m = fine_box
+    return [
+        "// The fine box: this edge inside, the coarse size beyond the grading distance.",
+        "Field[1] = Box;",
+        "Field[1].VIn = %r;" % edge_m,
+        "Field[1].VOut = %r;" % mesh_size_m,
+        "Field[1].XMin = %r; Field[1].XMax = %r;" % (x0, x1),
+        "Field[1].YMin = %r; Field[1].YMax = %r;" % (y0, y1),
+        "Field[1].ZMin = %r; Field[1].ZMax = %r;" % (z0, z1),
+        "Field[1].Thickness = %r;" % grading_m,
+        "Background Field = 1;",
+    ]
+
+
+def geo_text(stl_name, mesh_size_m, curvature, fine_box=None):
     options = [o.replace("Mesh.MeshSizeFromCurvature = 0;", "Mesh.MeshSizeFromCurvature = %d;" % curvature)
                for o in GMSH_OPTIONS]
     return "\n".join([
@@ -140,6 +167,7 @@ def geo_text(stl_name, mesh_size_m, curvature):
         "CreateGeometry;",
         "Surface Loop(1) = Surface{:};",
         "Volume(1) = {1};",
+        *fine_box_text(mesh_size_m, fine_box),
         "",
     ])
 
@@ -177,7 +205,7 @@ def renumbered_for_locality(coords, tets):
     return [coords[v] for v in order], tets
 
 
-def build(args, out_dir, name, mesh_size_m, curvature, target_tets):
+def build(args, out_dir, name, mesh_size_m, curvature, target_tets, fine_box=None):
     """Meshes the shape into out_dir/name.veg and name.bou (its work files, and name.geo unless target_tets
     is None, in out_dir too); target_tets None: no count check."""
     stl_name = "liver_shape.stl"  # temporary: removed after meshing
@@ -185,7 +213,7 @@ def build(args, out_dir, name, mesh_size_m, curvature, target_tets):
     write_stl(os.path.join(out_dir, stl_name), [liver_point(*p) for p in points], faces)
     geo_name = name + ".geo" if target_tets is not None else "liver_size_tmp.geo"
     with open(os.path.join(out_dir, geo_name), "w", newline="\n") as out:
-        out.write(geo_text(stl_name, mesh_size_m, curvature))
+        out.write(geo_text(stl_name, mesh_size_m, curvature, fine_box))
     tmp = os.path.join(out_dir, "liver.msh.tmp")
     result = subprocess.run([args.gmsh, geo_name, "-3", "-nt", "1", "-format", "msh41", "-o",
                              os.path.basename(tmp)], cwd=out_dir, capture_output=True, text=True)
@@ -257,6 +285,7 @@ def main():
     parser.add_argument("--curvature", type=int, default=0,
                         help="with --mesh-size: Gmsh's curvature sizing, elements per 2 pi of radius (0: none)")
     parser.add_argument("--output-dir", default=None, help="where the files go (default: meshes/)")
+    parser.add_argument("--only", default=None, help="build only the variant of this name (and no render surface)")
     args = parser.parse_args()
 
     here = os.path.dirname(os.path.abspath(__file__))
@@ -265,8 +294,12 @@ def main():
         build(args, out_dir, "liver", args.mesh_size, args.curvature, None)
         return 0
     for variant in VARIANTS:
-        build(args, out_dir, variant.name, variant.mesh_size_m, variant.curvature, variant.target_tets)
-    write_render_surface(out_dir)
+        if args.only is not None and variant.name != args.only:
+            continue
+        build(args, out_dir, variant.name, variant.mesh_size_m, variant.curvature, variant.target_tets,
+              variant.fine_box)
+    if args.only is None:
+        write_render_surface(out_dir)
     return 0
 
 

@@ -3,7 +3,8 @@
 
     /usr/bin/python3 meshes/make_palpation.py
 
-Reads meshes/liver.veg and writes meshes/liver_tumour.veg: the same vertices and tets in two
+Reads meshes/liver.veg and writes meshes/liver_tumour.veg (and liver_palpation.veg, the palpation scene's
+physics mesh, into liver_palpation_tumour.veg): the same vertices and tets in two
 regions (Vega *SET / *MATERIAL / *REGION): "tumour", the tets whose centroid lies within a sphere of
 RADIUS_M under the top of the thick right lobe, its top DEPTH_M below the surface, with E ten times
 the rest; and "liver", every other tet. It prints the probe's sweep for host/scenarios/palpate_liver.toml:
@@ -69,12 +70,23 @@ def top_height(vertices, triangles, x, y):
     return best
 
 
-def main():
-    here = os.path.dirname(os.path.abspath(__file__))
-    lines, vertices, tets = read_veg(os.path.join(here, "liver.veg"))
-    triangles = boundary_triangles(tets)
-    top = top_height(vertices, triangles, *CENTRE_XY_M)
-    centre = (CENTRE_XY_M[0], CENTRE_XY_M[1], top - DEPTH_M - RADIUS_M)
+def top_normal(vertices, triangles, x, y, step=0.002):
+    """The top surface's upward unit normal at (x, y), from its heights +-step around."""
+    dz_dx = (top_height(vertices, triangles, x + step, y) - top_height(vertices, triangles, x - step, y)) / (2 * step)
+    dz_dy = (top_height(vertices, triangles, x, y + step) - top_height(vertices, triangles, x, y - step)) / (2 * step)
+    length = math.sqrt(dz_dx * dz_dx + dz_dy * dz_dy + 1.0)
+    return (-dz_dx / length, -dz_dy / length, 1.0 / length)
+
+
+# The meshes tagged: the 52k-tet reference and the palpation scene's physics mesh (make_liver.py's
+# liver_palpation, meshed finer over the sweep), each with the same inclusion (its centre from the
+# reference's surface).
+MESHES = (("liver.veg", "liver_tumour.veg"), ("liver_palpation.veg", "liver_palpation_tumour.veg"))
+
+
+def tag(here, source, output, centre):
+    """Writes meshes/output: meshes/source's vertices and tets in the regions liver and tumour."""
+    lines, vertices, tets = read_veg(os.path.join(here, source))
     tumour = []
     volume = 0.0
     for n, tet in enumerate(tets):
@@ -86,8 +98,8 @@ def main():
             volume += abs(e[0][0] * (e[1][1] * e[2][2] - e[1][2] * e[2][1]) -
                           e[0][1] * (e[1][0] * e[2][2] - e[1][2] * e[2][0]) +
                           e[0][2] * (e[1][0] * e[2][1] - e[1][1] * e[2][0])) / 6.0
-    if not 50 <= len(tumour) <= 2000:
-        raise SystemExit("the inclusion has %d tets: check RADIUS_M against the mesh size" % len(tumour))
+    if not 30 <= len(tumour) <= 2000:
+        raise SystemExit("the inclusion has %d tets in %s: check RADIUS_M against the mesh size" % (len(tumour), source))
     tumour_set = set(tumour)
     liver = [n for n in range(1, len(tets) + 1) if n not in tumour_set]
     diameter = 2.0 * (3.0 * volume / (4.0 * math.pi)) ** (1.0 / 3.0)
@@ -96,9 +108,9 @@ def main():
         return [", ".join(str(i) for i in ids[k:k + 16]) + "," for k in range(0, len(ids), 16)]
 
     header = lines[:3]
-    header[1] = ("# the organ of meshes/liver.veg with a stiff inclusion, by meshes/make_palpation.py: region tumour "
+    header[1] = ("# the organ of meshes/%s with a stiff inclusion, by meshes/make_palpation.py: region tumour "
                  "(%d tets, %.1f cm across, its top %.0f mm under the top surface at x = %g, y = %g m), E %gx the "
-                 "liver's" % (len(tumour), 100 * diameter, 1000 * DEPTH_M, CENTRE_XY_M[0], CENTRE_XY_M[1],
+                 "liver's" % (source, len(tumour), 100 * diameter, 1000 * DEPTH_M, CENTRE_XY_M[0], CENTRE_XY_M[1],
                               TUMOUR[2] / LIVER[2]))
     body = lines[3:]
     while body and body[-1] == "":
@@ -108,15 +120,27 @@ def main():
         out += ["*MATERIAL %s" % name, "ENU, %r, %r, %r" % (density, young, poisson), ""]
     out += ["*SET liver"] + id_lines(liver) + ["", "*SET tumour"] + id_lines(tumour) + [""]
     out += ["*REGION", "liver, %s" % LIVER[0], "tumour, %s" % TUMOUR[0]]
-    with open(os.path.join(here, "liver_tumour.veg"), "w", newline="\n") as f:
+    with open(os.path.join(here, output), "w", newline="\n") as f:
         f.write("\n".join(out) + "\n")
-    print("meshes/liver_tumour.veg: tumour %d tets (%.2f cm across, centre %s), liver %d tets" %
-          (len(tumour), 100 * diameter, tuple(round(c, 5) for c in centre), len(liver)))
-    print("sweep at %.0f mm below the top surface (x, y, z) [m]:" % (1000 * PROBE_DEPTH_M))
+    print("meshes/%s: tumour %d tets (%.2f cm across, centre %s), liver %d tets" %
+          (output, len(tumour), 100 * diameter, tuple(round(c, 5) for c in centre), len(liver)))
+
+
+def main():
+    here = os.path.dirname(os.path.abspath(__file__))
+    _, vertices, tets = read_veg(os.path.join(here, MESHES[0][0]))
+    triangles = boundary_triangles(tets)
+    top = top_height(vertices, triangles, *CENTRE_XY_M)
+    centre = (CENTRE_XY_M[0], CENTRE_XY_M[1], top - DEPTH_M - RADIUS_M)
+    for source, output in MESHES:
+        tag(here, source, output, centre)
+    print("sweep at %.0f mm below the top surface (x, y, z) [m], and the surface's normal there (a pad held "
+          "flat on it: the tool's axis):" % (1000 * PROBE_DEPTH_M))
     for k in range(SWEEP_POINTS):
         x = CENTRE_XY_M[0] - SWEEP_HALF_LENGTH_M + 2 * SWEEP_HALF_LENGTH_M * k / (SWEEP_POINTS - 1)
-        z = top_height(vertices, triangles, x, CENTRE_XY_M[1]) - PROBE_DEPTH_M
-        print("  [%.4f, %.4f, %.5f]," % (x, CENTRE_XY_M[1], z))
+        y = CENTRE_XY_M[1]
+        z = top_height(vertices, triangles, x, y) - PROBE_DEPTH_M
+        print("  [%.4f, %.4f, %.5f], axis [%.4f, %.4f, %.4f]" % ((x, y, z) + top_normal(vertices, triangles, x, y)))
 
 
 if __name__ == "__main__":

@@ -154,6 +154,23 @@ TEST(PadProbe, AFrictionalOrElementLocalPadIsRefused) {
   EXPECT_THROW(Tissue(mesh, settings), ParameterError);
 }
 
+// Found by the palpation scenario: a pad contact that ended (the tool drawn back out of the surface)
+// kept its samples, and the next step refused a pad's springs without the point's.
+TEST(PadProbe, AContactEndsWhenTheToolIsDrawnBack) {
+  const std::unique_ptr<Tissue> tissue = block(0.01, 0.012);
+  const double x_m = 0.5 * BLOCK_M + 0.0017;
+  const double y_m = 0.5 * BLOCK_M + 0.0029;
+  pressed_force_n(*tissue, x_m, y_m, PRESS_M);
+  ASSERT_FALSE(tissue->contact_spring().pad().empty());
+  for (int s = 0; s < 3; ++s) {  // drawn back 5 mm at once, as a hand lets go
+    tissue->set_tool(probe_at({x_m, y_m, DEPTH_M + 5e-3}));
+    ASSERT_NO_THROW(tissue->step());
+  }
+  EXPECT_FALSE(tissue->contact().active);
+  EXPECT_FALSE(tissue->contact_spring().spring().has_value());
+  EXPECT_TRUE(tissue->contact_spring().pad().empty());
+}
+
 TEST(PadProbe, ASavedPadContactContinuesBitwise) {
   const std::unique_ptr<Tissue> tissue = block(0.01, 0.012);
   const double x_m = 0.5 * BLOCK_M + 0.0017;

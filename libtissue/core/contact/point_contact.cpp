@@ -86,6 +86,7 @@ bool PointContact::update(const Eigen::Vector3d& hip_previous_m, const Eigen::Ve
                                            ? force_on_tool_n(surface, positions_m)
                                            : Eigen::Vector3d::Zero();
   m_hip_m = hip_m;
+  m_pad.clear();  // sampled anew below while the contact goes on
   SurfacePoint start = m_proxy;
   const bool was_in_contact = m_in_contact;
   if (!m_in_contact) {
@@ -171,15 +172,27 @@ void PointContact::sample_pad(const Eigen::VectorXd& positions_m, const SurfaceB
   n.cwiseAbs().minCoeff(&least);
   const Eigen::Vector3d u = (Eigen::Vector3d::Unit(least) - n[least] * n).normalized();
   const Eigen::Vector3d v = n.cross(u);
+  // Each sample presses the surface point in front of it along the axis (the nearest crossing of the
+  // line through it, on a face turned to the disc), not the closest one: under a pressed disc the
+  // closest point to a sample near the rim jumps onto the pit's wall as the disc slides.
+  const double reach_m = 2.0 * m_settings.pad_radius_m;
   for (int k = 1; k < PAD_SAMPLES; ++k) {
     const Eigen::Vector3d target_m = m_hip_m + m_settings.pad_radius_m * pad_sample_offset(k, u, v);
-    const SurfaceProjection closest =
-        slide_to_closest_point(target_m, m_proxy, surface.triangles(), m_adjacency, positions_m);
-    // Pressed: the surface point lies beyond the disc's plane, on a face turned towards the disc (not
-    // the side of a rim the disc overhangs).
-    if (closest.point.triangle >= m_pad_triangle_limit) continue;  // a cut face
-    if ((closest.position_m - target_m).dot(n) <= 0.0 || closest.normal.dot(n) < 0.5) continue;
-    m_pad.push_back(PointSpring{surface.triangle(closest.point.triangle), closest.point.barycentric, target_m,
+    surface.intersect_segment(target_m - reach_m * n, target_m + reach_m * n, positions_m, m_segment_hits);
+    const SurfaceBvh::SegmentHit* front = nullptr;
+    double front_distance_m = 0.0;
+    for (const SurfaceBvh::SegmentHit& hit : m_segment_hits) {
+      if (hit.triangle >= m_pad_triangle_limit) continue;  // a cut face
+      if (triangle_area_normal(surface.triangle(hit.triangle), positions_m).dot(n) <= 0.0) continue;
+      const double distance_m = std::abs(2.0 * hit.segment_parameter - 1.0) * reach_m;
+      if (front == nullptr || distance_m < front_distance_m) {
+        front = &hit;
+        front_distance_m = distance_m;
+      }
+    }
+    // Pressed: the surface point lies beyond the disc's plane.
+    if (front == nullptr || front->segment_parameter <= 0.5) continue;
+    m_pad.push_back(PointSpring{surface.triangle(front->triangle), front->barycentric, target_m,
                                 centre_stiffness_n_per_m(), m_settings.spring_tangent_fraction, n,
                                 Eigen::Vector3d::Zero()});
   }
@@ -227,7 +240,7 @@ std::optional<PointSpring> PointContact::spring(const SurfaceBvh& surface) const
 }
 
 void PointContact::apply(const SurfaceBvh& surface, PointSpringTerm& term, const TermLayout& layout) const {
-  term.set(spring(surface), layout, m_pad);
+  term.set(spring(surface), layout, m_in_contact ? m_pad : std::vector<PointSpring>());
 }
 
 Eigen::Vector3d PointContact::force_on_tool_n(const SurfaceBvh& surface, const Eigen::VectorXd& positions_m) const {
