@@ -18,7 +18,7 @@ constexpr std::uint64_t MAGIC = 0x31305353'49535354ULL;  // "TSSISS01" read as l
 // open session (issue 41); 9: each cut's blade normal (TetCut::blade_normal); 10: how far the blade
 // had turned when each tet was cut and each edge crossed (a spiral cuts a tet once per turn);
 // 12: the contact spring's direction and constant force, the contact's sticking and friction (issue 42);
-// 13: a pad probe's springs (issue 42)
+// 13: a pad probe's springs and its samples pressed (issue 42)
 constexpr std::uint32_t VERSION = 13;
 
 // The core's Eigen types and cut records on top of the shared byte stream.
@@ -218,6 +218,7 @@ std::vector<std::uint8_t> serialize_snapshot(const TissueSnapshot& s) {
   w.put(s.contact.depth_m);
   w.put(static_cast<std::uint8_t>(s.contact.sticking));
   w.put(s.contact.friction_on_body_n);
+  w.put(s.contact.pad_pressed);
   w.put(static_cast<std::uint8_t>(s.point_spring.has_value()));
   if (s.point_spring) put_spring(w, *s.point_spring);
   w.put(static_cast<std::uint64_t>(s.pad_springs.size()));
@@ -293,6 +294,8 @@ TissueSnapshot read_snapshot(std::span<const std::uint8_t> bytes) {
   r.get(s.contact.depth_m);
   s.contact.sticking = r.get_bool();
   r.get(s.contact.friction_on_body_n);
+  r.get(s.contact.pad_pressed);
+  if ((s.contact.pad_pressed >> PAD_SAMPLES) != 0) serial::ByteReader::fail("a pad sample beyond the pad's");
   if (r.get_bool()) s.point_spring = get_spring(r);
   s.pad_springs.resize(r.count(SPRING_BYTES));
   for (PointSpring& spring : s.pad_springs) spring = get_spring(r);

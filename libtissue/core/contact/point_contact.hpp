@@ -74,6 +74,7 @@
 
 #include <Eigen/Core>
 
+#include <cstdint>
 #include <limits>
 #include <optional>
 #include <vector>
@@ -99,6 +100,7 @@ struct PointContactSettings {
 
 /// The samples of a pad: the centre, then rings of 6 and 12 (equal areas of the disc).
 inline constexpr int PAD_SAMPLES = 19;
+static_assert(PAD_SAMPLES <= 32, "the samples pressed are kept as bits of a 32-bit mask");
 /// Sample k's offset from the pad's centre in the disc's plane, in units of its radius (the first is
 /// the centre), along the unit axes `u`, `v` of that plane.
 Eigen::Vector3d pad_sample_offset(int k, const Eigen::Vector3d& u, const Eigen::Vector3d& v);
@@ -141,6 +143,7 @@ class PointContact {
   void release() {
     m_in_contact = false;
     m_pad.clear();
+    m_pad_pressed = 0;
   }
   /// The tool's axis for the next update (unit, or zero: none): a pad's face is across it, and the
   /// contact's normal is the axis turned out of the surface (the header).
@@ -185,10 +188,11 @@ class PointContact {
     double depth_m = 0.0;
     bool sticking = false;
     Eigen::Vector3d friction_on_body_n = Eigen::Vector3d::Zero();  ///< slipping: mu f_n t
+    std::uint32_t pad_pressed = 0;  ///< a pad's samples pressed at the last update (bit k: sample k)
   };
   [[nodiscard]] State state() const {
-    return State{m_in_contact, m_proxy,    m_proxy_position_m, m_normal,
-                 m_hip_m,      m_depth_m, m_sticking,         m_friction_on_body_n};
+    return State{m_in_contact, m_proxy,    m_proxy_position_m,   m_normal,       m_hip_m,
+                 m_depth_m,    m_sticking, m_friction_on_body_n, m_pad_pressed};
   }
   void restore(const State& state) {
     m_in_contact = state.in_contact;
@@ -199,6 +203,7 @@ class PointContact {
     m_depth_m = state.depth_m;
     m_sticking = state.sticking;
     m_friction_on_body_n = state.friction_on_body_n;
+    m_pad_pressed = state.pad_pressed;
     m_pad.clear();  // the pad's springs are the body's term's (saved with it); the next update samples anew
   }
   /// term.set(spring(surface), layout, pad_springs()): `term` attached to the body whose
@@ -212,8 +217,11 @@ class PointContact {
  private:
   /// Whether `point_m` is inside the surface by a ray's parity (the ray's hits stay in m_segment_hits).
   bool inside_by_parity(const Eigen::Vector3d& point_m, const Eigen::VectorXd& positions_m, const SurfaceBvh& surface);
-  /// A pad's springs for the contact as updated (the header).
-  void sample_pad(const Eigen::VectorXd& positions_m, const SurfaceBvh& surface);
+  /// A pad's springs for the contact as updated (the header); `follows_m`: how far short of the
+  /// disc's plane a sample pressed at the last update still presses (the pressed surface's rebound,
+  /// as update() follows a tool); `drawn_back_m`: how far the plane moved out along the normal since.
+  void sample_pad(const Eigen::VectorXd& positions_m, const SurfaceBvh& surface, double follows_m,
+                  double drawn_back_m);
   /// The stiffness of the proxy's spring: k, or its share for a pad [N/m].
   [[nodiscard]] double centre_stiffness_n_per_m() const;
   /// With friction, a contact that goes on sticks or slips (the header); sets the proxy.
@@ -229,6 +237,7 @@ class PointContact {
   bool m_sticking = false;
   Eigen::Vector3d m_friction_on_body_n = Eigen::Vector3d::Zero();
   std::vector<PointSpring> m_pad;                      // a pad's springs (sample_pad)
+  std::uint32_t m_pad_pressed = 0;                     // bit k: sample k pressed at the last update
   int m_pad_triangle_limit = std::numeric_limits<int>::max();
   Eigen::Vector3d m_pad_axis = Eigen::Vector3d::Zero();
   VertexTriangles m_adjacency;                         // rebuilt when the surface grows (a cut)
