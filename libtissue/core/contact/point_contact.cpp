@@ -213,7 +213,6 @@ void PointContact::sample_pad(const Eigen::VectorXd& positions_m, const SurfaceB
   }
 }
 
-
 void PointContact::stick_or_slip(const SurfaceProjection& closest, const Eigen::Vector3d& last_force_on_tool_n,
                                  double normal_force_change_n, const Eigen::VectorXd& positions_m,
                                  const SurfaceBvh& surface) {
