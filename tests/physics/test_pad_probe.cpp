@@ -8,7 +8,7 @@
 //   four landing points off the grid, quasi-statically (exact solves, heavy damping, 40 long steps),
 //   on 10 and 6 mm grids. Over the landings a point's force spreads by 62 %, a 12 mm pad's by 11-13 %;
 //   from the 10 to the 6 mm grid a point's mean force falls as h does (x 1.93; h: x 1.67), the pad's
-//   by x 1.31, what the coarse grid's stiffer tets leave (linear tets at nu 0.45). Asserted: the pad's
+//   by x 1.33, what the coarse grid's stiffer tets leave (linear tets at nu 0.45). Asserted: the pad's
 //   spread under a third of the point's, and its change with h under half of the point's excess.
 // * K_c: the pad's contact stiffness (the condensation through its springs, the Woodbury form of
 //   pad_stiffness_n_per_m) against the slope of the held force between two depths of the full
