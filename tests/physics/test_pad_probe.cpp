@@ -13,11 +13,11 @@
 // * K_c: the pad's contact stiffness (the condensation through its springs, the Woodbury form of
 //   pad_stiffness_n_per_m) against the slope of the held force between two depths of the full
 //   nonlinear model at 0.2 and 0.25 mm, within 2 % (0.6 % measured).
-// * A pad with friction, or with the point's elementLocal K_c, is refused; a saved pad contact
-//   continues bitwise.
-#include "core/mesh/box_mesh.hpp"
+// * A pad with friction, or with the point's elementLocal K_c, is refused; the force is continuous
+//   when the pad is drawn back a little. (A pad contact's end and its saved state:
+//   tests/unit/contact/test_pad_contact.cpp, which the sanitizer builds run too.)
 #include "core/parameter_error.hpp"
-#include "core/tissue.hpp"
+#include "unit/contact/pad_block.hpp"
 
 #include <gtest/gtest.h>
 
@@ -33,48 +33,7 @@
 namespace tissue {
 namespace {
 
-constexpr double BLOCK_M = 0.06;
-constexpr double DEPTH_M = 0.03;
-constexpr double PRESS_M = 2e-3;
-
-ToolPose probe_at(const Eigen::Vector3d& position_m) {
-  return ToolPose{position_m, Eigen::Quaterniond::Identity(), ToolMode::probe};
-}
-
-TissueSettings block_settings(double pad_radius_m) {
-  TissueSettings settings;
-  settings.body.material = Material{1.0e5, 0.45, 1000.0};
-  settings.body.gravity_m_per_s2.setZero();
-  settings.body.damping.mass_damping_per_s = 20.0;  // quasi-static: the block settles within the hold
-  settings.body.damping.stiffness_damping_s = 0.0;
-  settings.solver.kind = LinearSolverKind::cholmod;
-  settings.step_size_s = 0.05;
-  settings.interaction.cutting_enabled = false;
-  settings.interaction.contact.pad_radius_m = pad_radius_m;
-  return settings;
-}
-
-std::unique_ptr<Tissue> block(double edge_m, double pad_radius_m) {
-  const int across = static_cast<int>(std::lround(BLOCK_M / edge_m));
-  const int deep = static_cast<int>(std::lround(DEPTH_M / edge_m));
-  const TetMesh mesh = make_box_mesh(across, across, deep, edge_m);
-  TissueSettings settings = block_settings(pad_radius_m);
-  for (int v = 0; v < mesh.vertex_count(); ++v) {
-    if (mesh.rest_positions_m[static_cast<size_t>(v)].z() < 1e-9) settings.body.fixed_vertices.push_back(v);
-  }
-  return std::make_unique<Tissue>(mesh, settings);
-}
-
-// The probe lowered over 10 steps to `press_m` below the top at (x, y), held 30 steps; the force along z.
-double pressed_force_n(Tissue& tissue, double x_m, double y_m, double press_m) {
-  for (int s = 0; s <= 10; ++s) {
-    tissue.set_tool(probe_at({x_m, y_m, DEPTH_M + 1e-3 - (1e-3 + press_m) * s / 10.0}));
-    tissue.step();
-  }
-  for (int s = 0; s < 30; ++s) tissue.step();
-  EXPECT_TRUE(tissue.contact().active);
-  return tissue.contact().force_on_tool_n.z();
-}
+using namespace pad_test;
 
 struct Landings {
   double mean_n = 0.0;
@@ -154,23 +113,6 @@ TEST(PadProbe, AFrictionalOrElementLocalPadIsRefused) {
   EXPECT_THROW(Tissue(mesh, settings), ParameterError);
 }
 
-// Found by the palpation scenario: a pad contact that ended (the tool drawn back out of the surface)
-// kept its samples, and the next step refused a pad's springs without the point's.
-TEST(PadProbe, AContactEndsWhenTheToolIsDrawnBack) {
-  const std::unique_ptr<Tissue> tissue = block(0.01, 0.012);
-  const double x_m = 0.5 * BLOCK_M + 0.0017;
-  const double y_m = 0.5 * BLOCK_M + 0.0029;
-  pressed_force_n(*tissue, x_m, y_m, PRESS_M);
-  ASSERT_FALSE(tissue->contact_spring().pad().empty());
-  for (int s = 0; s < 3; ++s) {  // drawn back 5 mm at once, as a hand lets go
-    tissue->set_tool(probe_at({x_m, y_m, DEPTH_M + 5e-3}));
-    ASSERT_NO_THROW(tissue->step());
-  }
-  EXPECT_FALSE(tissue->contact().active);
-  EXPECT_FALSE(tissue->contact_spring().spring().has_value());
-  EXPECT_TRUE(tissue->contact_spring().pad().empty());
-}
-
 // Found by the palpation scenario's hand: a pad drawn back by a few tens of microns left every sample
 // short of its plane, and the force fell to the centre sample's share for a step (the hand rang at
 // 50 Hz between 1 and 9 N). The samples follow as the contact does: drawn back by less than the
@@ -190,32 +132,6 @@ TEST(PadProbe, TheForceIsContinuousWhenThePadIsDrawnBackALittle) {
   // 0.5 %: the linear model's error over 50 um is second order (the held force's curvature, ~1e-5 of
   // it); without the samples following, the force fell 2 % below it within this damped 50 ms step.
   EXPECT_NEAR(tissue->contact().force_on_tool_n.z(), expected_n, 0.005 * held_n);
-}
-
-TEST(PadProbe, ASavedPadContactContinuesBitwise) {
-  const std::unique_ptr<Tissue> tissue = block(0.01, 0.012);
-  const double x_m = 0.5 * BLOCK_M + 0.0017;
-  const double y_m = 0.5 * BLOCK_M + 0.0029;
-  for (int s = 0; s <= 6; ++s) {
-    tissue->set_tool(probe_at({x_m, y_m, DEPTH_M + 1e-3 - 3e-3 * s / 10.0}));
-    tissue->step();
-  }
-  ASSERT_TRUE(tissue->contact().active);
-  ASSERT_FALSE(tissue->contact_spring().pad().empty());
-  TissueSnapshot snapshot;
-  tissue->save(snapshot);
-  const auto run_on = [&] {
-    std::vector<double> forces;
-    for (int s = 7; s <= 12; ++s) {
-      tissue->set_tool(probe_at({x_m + 1e-4 * s, y_m, DEPTH_M + 1e-3 - 3e-3 * std::min(s, 10) / 10.0}));
-      tissue->step();
-      forces.push_back(tissue->contact().force_on_tool_n.z());
-    }
-    return forces;
-  };
-  const std::vector<double> continued = run_on();
-  tissue->restore(snapshot);
-  EXPECT_EQ(run_on(), continued);
 }
 
 }  // namespace
