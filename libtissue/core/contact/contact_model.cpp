@@ -54,7 +54,7 @@ ContactModel::ContactModel(const ContactSettings& settings, bool enabled, double
       m_contact(point_contact_settings(settings, step_size_s, stiffness_damping_s, body, surface, integrator)),
       m_stiffness_scale_n_per_m(contact_stiffness_scale_n_per_m(body, surface)),
       m_pending_latency_steps(settings.stiffness_latency_steps) {
-  m_contact.set_pad_triangle_limit(static_cast<int>(m_surface.triangles.size()));
+  m_contact.set_touchable_triangles(static_cast<int>(m_surface.triangles.size()));
 }
 
 void ContactModel::probe(const Eigen::Vector3d& previous_m, const Eigen::Vector3d& current_m,
@@ -69,11 +69,6 @@ void ContactModel::probe(const Eigen::Vector3d& previous_m, const Eigen::Vector3
   const double follow_distance_m =
       pressed_n > 0.0 && normal_stiffness_n_per_m > 0.0 ? pressed_n / normal_stiffness_n_per_m : 0.0;
   m_contact.update(previous_m, current_m, bvh.positions_m(), bvh.fitted(), follow_distance_m, normal_stiffness_n_per_m);
-  // The probe touches the mesh's surface only: a cut face's corners are not vertices the spring can
-  // act on (they move with the enriched unknowns), so a probe reaching into a crack feels nothing.
-  if (m_contact.in_contact() && m_contact.proxy().triangle >= static_cast<int>(m_surface.triangles.size())) {
-    m_contact.release();
-  }
   m_contact.apply(bvh.fitted(), m_spring, m_body.term_layout());
   if (m_contact.in_contact() && !was_in_contact) m_steps_since_stiffness = -1;  // a new contact: refresh K_c
   if (m_contact.in_contact() != was_in_contact) m_integrator.restart(Restart::contact_changed);

@@ -156,6 +156,12 @@ bool PointContact::update(const Eigen::Vector3d& hip_previous_m, const Eigen::Ve
     m_friction_on_body_n.setZero();
   }
   m_depth_m = (m_proxy_position_m - hip_m).norm();
+  // The probe touches the mesh's surface only: a cut face's corners are not vertices the spring can
+  // act on (they move with the enriched unknowns), so a probe reaching into a crack feels nothing.
+  if (m_proxy.triangle >= m_touchable_triangles) {
+    release();
+    return false;
+  }
   sample_pad(positions_m, surface, follows_m, (hip_m - last_hip_m).dot(m_normal));
   return true;
 }
@@ -187,7 +193,7 @@ void PointContact::sample_pad(const Eigen::VectorXd& positions_m, const SurfaceB
     const SurfaceBvh::SegmentHit* front = nullptr;
     double front_distance_m = 0.0;
     for (const SurfaceBvh::SegmentHit& hit : m_segment_hits) {
-      if (hit.triangle >= m_pad_triangle_limit) continue;  // a cut face
+      if (hit.triangle >= m_touchable_triangles) continue;  // a cut face
       if (triangle_area_normal(surface.triangle(hit.triangle), positions_m).dot(n) <= 0.0) continue;
       const double distance_m = std::abs(2.0 * hit.segment_parameter - 1.0) * reach_m;
       if (front == nullptr || distance_m < front_distance_m) {
@@ -261,10 +267,7 @@ Eigen::Vector3d PointContact::force_on_tool_n(const SurfaceBvh& surface, const E
   if (!m_in_contact) return Eigen::Vector3d::Zero();
   Eigen::Vector3d force_on_body_n =
       spring_force_on_body_n(*spring(surface), surface_point_position_m(m_proxy, surface.triangles(), positions_m));
-  for (const PointSpring& sample : m_pad) {
-    force_on_body_n += spring_force_on_body_n(sample, spring_material_point_m(sample, positions_m));
-  }
-  return -force_on_body_n;
+  return -(force_on_body_n + springs_force_on_body_n(m_pad, positions_m));
 }
 
 }  // namespace tissue

@@ -150,9 +150,10 @@ class PointContact {
   void set_pad_axis(const Eigen::Vector3d& axis) {
     m_pad_axis = axis.allFinite() && axis.norm() > 0.0 ? Eigen::Vector3d(axis.normalized()) : Eigen::Vector3d::Zero();
   }
-  /// A pad's samples leave out the triangles from `triangle_count` on (faces the probe must not act
-  /// on, a cut's; the caller releases a contact whose proxy is on one). All by default.
-  void set_pad_triangle_limit(int triangle_count) { m_pad_triangle_limit = triangle_count; }
+  /// The probe touches the surface's triangles below `triangle_count` only (the mesh's own; those after
+  /// them are a cut's faces): update() ends a contact whose proxy is on another, and a pad's samples
+  /// leave them out. All by default.
+  void set_touchable_triangles(int triangle_count) { m_touchable_triangles = triangle_count; }
 
   [[nodiscard]] bool in_contact() const { return m_in_contact; }
   /// The proxy as a material point (meaningful while in contact).
@@ -238,7 +239,7 @@ class PointContact {
   Eigen::Vector3d m_friction_on_body_n = Eigen::Vector3d::Zero();
   std::vector<PointSpring> m_pad;                      // a pad's springs (sample_pad)
   std::uint32_t m_pad_pressed = 0;                     // bit k: sample k pressed at the last update
-  int m_pad_triangle_limit = std::numeric_limits<int>::max();
+  int m_touchable_triangles = std::numeric_limits<int>::max();
   Eigen::Vector3d m_pad_axis = Eigen::Vector3d::Zero();
   VertexTriangles m_adjacency;                         // rebuilt when the surface grows (a cut)
   std::vector<SurfaceBvh::SegmentHit> m_segment_hits;  // work buffer

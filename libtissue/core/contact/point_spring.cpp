@@ -26,6 +26,14 @@ Eigen::Vector3d spring_force_on_body_n(const PointSpring& spring, const Eigen::V
          spring.constant_force_on_body_n;
 }
 
+Eigen::Vector3d springs_force_on_body_n(const std::vector<PointSpring>& springs, const Eigen::VectorXd& positions_m) {
+  Eigen::Vector3d force_n = Eigen::Vector3d::Zero();
+  for (const PointSpring& spring : springs) {
+    force_n += spring_force_on_body_n(spring, spring_material_point_m(spring, positions_m));
+  }
+  return force_n;
+}
+
 namespace {
 
 // f_int gains (k D (x_p - target) - F) w_i on vertex i: minus the force on the body, which it returns.
@@ -114,14 +122,6 @@ void PointSpringTerm::add_force(const Eigen::VectorXd& positions_m, Eigen::Vecto
   if (!m_spring) return;
   m_force_on_body_n = add_spring_force(*m_spring, positions_m, vertex_forces_n);
   for (const PointSpring& spring : m_pad) m_force_on_body_n += add_spring_force(spring, positions_m, vertex_forces_n);
-}
-
-Eigen::Vector3d PointSpringTerm::pad_force_on_body_n(const Eigen::VectorXd& positions_m) const {
-  Eigen::Vector3d force_n = Eigen::Vector3d::Zero();
-  for (const PointSpring& spring : m_pad) {
-    force_n += spring_force_on_body_n(spring, spring_material_point_m(spring, positions_m));
-  }
-  return force_n;
 }
 
 void PointSpringTerm::add_tangent(BlockSparseMatrix& tangent) const {

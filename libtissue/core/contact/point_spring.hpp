@@ -39,6 +39,8 @@ struct PointSpring {
 Eigen::Matrix3d spring_projector(const PointSpring& spring);
 /// The spring's material point sum_i w_i x_i with the vertices at `positions_m` (3 per vertex) [m].
 Eigen::Vector3d spring_material_point_m(const PointSpring& spring, const Eigen::VectorXd& positions_m);
+/// The force the springs apply to the body with its vertices at `positions_m` (3 per vertex) [N].
+Eigen::Vector3d springs_force_on_body_n(const std::vector<PointSpring>& springs, const Eigen::VectorXd& positions_m);
 /// The force the spring applies to the body with its material point at `material_point_m`:
 /// k D (target - x_p) + F [N] (the force on the tool is its opposite).
 Eigen::Vector3d spring_force_on_body_n(const PointSpring& spring, const Eigen::Vector3d& material_point_m);
@@ -60,8 +62,6 @@ class PointSpringTerm final : public ForceTerm {
   /// k D (target - x_p) + F at the last add_force(): the force the spring and the pad's apply to the
   /// body (zero without a spring) [N].
   [[nodiscard]] const Eigen::Vector3d& force_on_body_n() const { return m_force_on_body_n; }
-  /// The force the pad's springs apply to the body with its vertices at `positions_m` [N].
-  [[nodiscard]] Eigen::Vector3d pad_force_on_body_n(const Eigen::VectorXd& positions_m) const;
 
   void add_force(const Eigen::VectorXd& positions_m, Eigen::VectorXd& vertex_forces_n) override;
   void add_tangent(BlockSparseMatrix& tangent) const override;

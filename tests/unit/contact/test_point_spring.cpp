@@ -219,7 +219,7 @@ TEST(PointSpring, APadsSpringsActAsIfEachWereAlone) {
       1e-9 * (both.tangent - none.tangent).norm());
   EXPECT_NEAR(both.energy_j, centre_alone.energy_j + sample_alone.energy_j, 1e-15);
   EXPECT_LT((both.on_body_n - centre_alone.on_body_n - sample_alone.on_body_n).norm(), 1e-12);
-  EXPECT_LT((bar.spring_term.pad_force_on_body_n(positions) - sample_alone.on_body_n).norm(), 1e-12);
+  EXPECT_LT((springs_force_on_body_n(bar.spring_term.pad(), positions) - sample_alone.on_body_n).norm(), 1e-12);
   // A pad without the point's spring, or with a bad spring, is refused and the springs kept.
   EXPECT_THROW(bar.spring_term.set(std::nullopt, bar.body.term_layout(), {sample}), ParameterError);
   PointSpring bad = sample;
