@@ -12,6 +12,7 @@
 #include "core/render/cut_render_surface.hpp"
 #include "core/render/embedded_surface.hpp"
 #include "core/solve/block_cholesky.hpp"
+#include "core/solve/half_matrix.hpp"
 #include "core/solve/two_level_preconditioner.hpp"
 #include "core/tissue.hpp"
 #include "resources/default_mesh.hpp"
@@ -27,6 +28,7 @@ namespace tissue {
 namespace {
 
 TetMesh bench_mesh(int which) {
+  if (which == 2) return read_mesh(std::string(TISSUE_MESH_DIR) + "/liver.veg");
   return which == 0 ? load_default_mesh() : read_mesh(std::string(TISSUE_MESH_DIR) + "/bar_40x8x8.veg");
 }
 
@@ -60,7 +62,7 @@ void BM_ForcesOnly(benchmark::State& state) {
   }
   f.count(state);
 }
-BENCHMARK(BM_ForcesOnly)->Arg(0)->Arg(1)->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_ForcesOnly)->Arg(0)->Arg(1)->Arg(2)->Unit(benchmark::kMicrosecond);
 
 void BM_ForcesAndTangent(benchmark::State& state) {
   Fixture f(static_cast<int>(state.range(0)));
@@ -70,7 +72,7 @@ void BM_ForcesAndTangent(benchmark::State& state) {
   }
   f.count(state);
 }
-BENCHMARK(BM_ForcesAndTangent)->Arg(0)->Arg(1)->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_ForcesAndTangent)->Arg(0)->Arg(1)->Arg(2)->Unit(benchmark::kMicrosecond);
 
 // The stable Neo-Hookean kernel alone (issue 25): per tet F, forces and the 12 x 12 tangent with
 // (range(1) = 1) or without the per-element PSD projection (a 9 x 9 eigendecomposition), at the same
@@ -109,7 +111,22 @@ void BM_BlockMultiply(benchmark::State& state) {
   }
   f.count(state);
 }
-BENCHMARK(BM_BlockMultiply)->Arg(0)->Arg(1)->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_BlockMultiply)->Arg(0)->Arg(1)->Arg(2)->Unit(benchmark::kMicrosecond);
+
+void BM_HalfMultiply(benchmark::State& state) {
+  Fixture f(static_cast<int>(state.range(0)));
+  const Eigen::VectorXd diagonal = f.body.mass_kg();
+  const ShiftedSystem system{&f.body.tangent(), 1e-4, &diagonal};
+  HalfMatrix half(state.range(1) == 1 ? MatrixPrecision::single : MatrixPrecision::double_precision);
+  half.assign(system);
+  Eigen::VectorXd y(f.body.dof_count());
+  for (auto _ : state) {
+    half.multiply(f.displacement, y);
+    benchmark::DoNotOptimize(y.data());
+  }
+  f.count(state);
+}
+BENCHMARK(BM_HalfMultiply)->ArgsProduct({{0, 2}, {0, 1}})->Unit(benchmark::kMicrosecond);
 
 void solve_benchmark(benchmark::State& state, LinearSolver& solver) {
   Fixture f(static_cast<int>(state.range(0)));

@@ -284,8 +284,8 @@ void add_tet_blocks(const TetSlots& tet_slots, BlockSparseMatrix& tangent, Block
       const int slot_ij = tet_slots[static_cast<size_t>(4 * i + j)];
       if (slot_ij < 0) continue;
       const Eigen::Matrix3d b = block(i, j);
-      tangent.block(slot_ij) += b;
-      if (i != j) tangent.block(tet_slots[static_cast<size_t>(4 * j + i)]) += b.transpose();
+      tangent.add_block(slot_ij, b);
+      if (i != j) tangent.add_block_transposed(tet_slots[static_cast<size_t>(4 * j + i)], b);
     }
   }
 }

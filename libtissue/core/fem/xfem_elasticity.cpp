@@ -243,8 +243,8 @@ void XfemElasticity::evaluate(const Eigen::VectorXd& positions_m, const Eigen::V
           const int slot = slots[dofs * a + b];
           if (slot < 0) continue;  // with a fixed vertex's u
           const Eigen::Matrix3d block = piece.weight * blocks[to_size(4 * i + j)];
-          tangent->block(slot) += block;
-          if (a != b) tangent->block(slots[dofs * b + a]) += block.transpose();
+          tangent->add_block(slot, block);
+          if (a != b) tangent->add_block_transposed(slots[dofs * b + a], block);
         }
       }
     }
@@ -252,8 +252,8 @@ void XfemElasticity::evaluate(const Eigen::VectorXd& positions_m, const Eigen::V
       for (int j = i; j < 4; ++j) {
         const int slot = slots[dofs * i + j];
         if (slot < 0) continue;  // a fixed vertex's u
-        tangent->block(slot) += uu[to_size(4 * i + j)];
-        if (i != j) tangent->block(slots[dofs * j + i]) += uu[to_size(4 * i + j)].transpose();
+        tangent->add_block(slot, uu[to_size(4 * i + j)]);
+        if (i != j) tangent->add_block_transposed(slots[dofs * j + i], uu[to_size(4 * i + j)]);
       }
     }
   }

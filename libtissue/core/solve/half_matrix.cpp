@@ -101,7 +101,6 @@ namespace {
 // or the next block's, or the padding value after the last block), a lane whose results are never
 // used or, multiplied by x's zero fourth lane, add zero.
 using Lanes = double __attribute__((vector_size(32)));
-using SingleLanes = float __attribute__((vector_size(16)));
 
 [[gnu::always_inline]] inline Lanes load_lanes(const double* from) {
   Lanes lanes;
@@ -109,10 +108,13 @@ using SingleLanes = float __attribute__((vector_size(16)));
   return lanes;
 }
 
+// Four floats widened one by one, which the AVX2 clone turns into one vcvtps2pd: a float vector
+// converted whole (__builtin_convertvector) is split into SSE2-sized halves before the function
+// is cloned, and the single-precision product took twice the double one's time (frog 24.5 against
+// 12.5 us; now 12-16 against 14-18 us, the organ's 215-227 against 215-237; docs/BENCHMARKS.md).
 [[gnu::always_inline]] inline Lanes load_lanes(const float* from) {
-  SingleLanes lanes;
-  std::memcpy(&lanes, from, sizeof(lanes));
-  return __builtin_convertvector(lanes, Lanes);
+  return Lanes{static_cast<double>(from[0]), static_cast<double>(from[1]), static_cast<double>(from[2]),
+               static_cast<double>(from[3])};
 }
 
 }  // namespace

@@ -54,6 +54,24 @@ class BlockSparseMatrix {
     return Eigen::Map<const Eigen::Matrix3d>(&m_values[9 * static_cast<size_t>(slot)]);
   }
 
+  /// Adds b (add_block) or b^T (add_block_transposed) to the block in `slot`, entry by entry in
+  /// storage order. An assembly adds to each block once per element that shares it, and these two
+  /// always load and store its nine values the same way, so one element's loads take the last
+  /// one's stores from the store buffer: Eigen's `+= b` and `+= b.transpose()` split the values
+  /// differently, and a load spanning two earlier stores waits for them to reach the cache (the
+  /// organ's forces and tangent 10-15% faster; docs/BENCHMARKS.md, issue 40).
+  void add_block(int slot, const Eigen::Matrix3d& b) {
+    double* __restrict to = &m_values[9 * static_cast<size_t>(slot)];
+    const double* __restrict from = b.data();
+    for (int k = 0; k < 9; ++k) to[k] += from[k];
+  }
+  void add_block_transposed(int slot, const Eigen::Matrix3d& b) {
+    double* __restrict to = &m_values[9 * static_cast<size_t>(slot)];
+    for (int column = 0; column < 3; ++column) {
+      for (int row = 0; row < 3; ++row) to[3 * column + row] += b(column, row);
+    }
+  }
+
   /// Zeroes all values (pattern kept).
   void set_zero();
   /// The same, the rows shared among `team`'s members (nullptr: this thread).
