@@ -170,20 +170,22 @@ TISSUE_HOT_KERNEL void extract_rotations(int count, const Eigen::Matrix3d* f_in,
   if (count > ROTATION_BATCH) {
     throw std::invalid_argument("extract_rotations: at most " + std::to_string(ROTATION_BATCH) + " at once");
   }
-  // Lanes beyond count repeat the first gradient (their results are dropped).
+  // Lanes beyond count repeat the first gradient (their results are dropped). Each vector is made
+  // whole from the four values in memory: set lane by lane it went through the stack as four
+  // stores that its load then waited for (a store-forwarding stall on every input).
+  static_assert(ROTATION_BATCH == 4, "the lanes below are written out");
+  const int k1 = count > 1 ? 1 : 0, k2 = count > 2 ? 2 : 0, k3 = count > 3 ? 3 : 0;
+  const Eigen::Matrix3d &f0 = f_in[0], &f1 = f_in[k1], &f2 = f_in[k2], &f3 = f_in[k3];
   Lanes f[9];
+  for (int e = 0; e < 9; ++e) f[e] = Lanes{f0(e), f1(e), f2(e), f3(e)};
+  const Eigen::Quaterniond &w0 = *warm_starts[0], &w1 = *warm_starts[k1], &w2 = *warm_starts[k2], &w3 = *warm_starts[k3];
   LaneQuaternion q{};
-  for (int l = 0; l < ROTATION_BATCH; ++l) {
-    const int k = l < count ? l : 0;
-    for (int e = 0; e < 9; ++e) f[e][l] = f_in[k](e);
-    const Eigen::Quaterniond& warm = *warm_starts[k];
-    q.w[l] = warm.w();
-    q.x[l] = warm.x();
-    q.y[l] = warm.y();
-    q.z[l] = warm.z();
-  }
-  Lanes scale = {};
-  for (int l = 0; l < ROTATION_BATCH; ++l) scale[l] = f_in[l < count ? l : 0].cwiseAbs().maxCoeff();
+  q.w = Lanes{w0.w(), w1.w(), w2.w(), w3.w()};
+  q.x = Lanes{w0.x(), w1.x(), w2.x(), w3.x()};
+  q.y = Lanes{w0.y(), w1.y(), w2.y(), w3.y()};
+  q.z = Lanes{w0.z(), w1.z(), w2.z(), w3.z()};
+  const Lanes scale{f0.cwiseAbs().maxCoeff(), f1.cwiseAbs().maxCoeff(), f2.cwiseAbs().maxCoeff(),
+                    f3.cwiseAbs().maxCoeff()};
   Lanes r[9];
   lane_rotation_matrix(q, r);
   // Lanes with F = 0 or not finite keep the warm start, as extract_rotation() does.
