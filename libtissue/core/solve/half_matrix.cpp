@@ -110,8 +110,8 @@ using Lanes = double __attribute__((vector_size(32)));
 
 // Four floats widened one by one, which the AVX2 clone turns into one vcvtps2pd: a float vector
 // converted whole (__builtin_convertvector) is split into SSE2-sized halves before the function
-// is cloned, and the single-precision product took twice the double one's time (frog 24.5 against
-// 12.5 us; now 12-16 against 14-18 us, the organ's 215-227 against 215-237; docs/BENCHMARKS.md).
+// is cloned, and the single-precision product took up to twice the double one's time (now about
+// the same; docs/BENCHMARKS.md, issue 40).
 [[gnu::always_inline]] inline Lanes load_lanes(const float* from) {
   return Lanes{static_cast<double>(from[0]), static_cast<double>(from[1]), static_cast<double>(from[2]),
                static_cast<double>(from[3])};

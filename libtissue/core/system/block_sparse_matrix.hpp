@@ -59,7 +59,8 @@ class BlockSparseMatrix {
   /// always load and store its nine values the same way, so one element's loads take the last
   /// one's stores from the store buffer: Eigen's `+= b` and `+= b.transpose()` split the values
   /// differently, and a load spanning two earlier stores waits for them to reach the cache (the
-  /// organ's forces and tangent 10-15% faster; docs/BENCHMARKS.md, issue 40).
+  /// frog's forces and tangent ~11% faster; docs/BENCHMARKS.md, issue 40). The co-rotational
+  /// kernel adds its blocks in lanes, always the same way too (corotational.cpp).
   void add_block(int slot, const Eigen::Matrix3d& b) {
     double* __restrict to = &m_values[9 * static_cast<size_t>(slot)];
     const double* __restrict from = b.data();
