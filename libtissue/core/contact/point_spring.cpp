@@ -149,6 +149,8 @@ void PointSpringTerm::set(std::optional<PointSpring> spring, const TermLayout& l
   if (!spring && !pad.empty()) throw ParameterError("point spring: a pad's springs without the point's spring");
   if (spring) validate_spring(*spring, layout);
   for (const PointSpring& s : pad) validate_spring(s, layout);
+  // No spring before or after: the force stays zero (a probe away from the body sets this every step).
+  if (m_spring || spring) changed();
   m_spring = std::move(spring);
   m_pad = std::move(pad);
   m_force_on_body_n.setZero();

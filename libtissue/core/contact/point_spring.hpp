@@ -67,6 +67,8 @@ class PointSpringTerm final : public ForceTerm {
   void add_tangent(BlockSparseMatrix& tangent) const override;
   [[nodiscard]] double energy_j(const Eigen::VectorXd& positions_m) const override;
   void locate(const TermLayout& layout) override;
+  /// No spring set (then no pad either).
+  [[nodiscard]] bool idle() const override { return !m_spring; }
 
  private:
   using Slots = std::array<int, 9>;  // [3 i + j]: block (row of vertex i, row of vertex j), -1 if fixed

@@ -55,6 +55,8 @@ CorotationalElasticity::CorotationalElasticity(const TetMesh& mesh, const std::v
   }
   m_rotations.assign(m_tets.size(), Eigen::Matrix3d::Identity());
   m_warm_starts.assign(m_tets.size(), Eigen::Quaterniond::Identity());
+  m_rotations_ahead = m_rotations;
+  m_warm_starts_ahead = m_warm_starts;
   m_excluded.assign(m_tets.size(), 0);
 }
 
@@ -160,7 +162,10 @@ void CorotationalElasticity::exclude(int tet) {
     throw ParameterError("CorotationalElasticity::exclude: tet " + std::to_string(tet) + " outside [0, " +
                          std::to_string(tet_count()) + ")");
   }
-  m_excluded[stored(tet)] = 1;
+  const size_t k = stored(tet);
+  m_excluded[k] = 1;
+  m_rotations_ahead[k] = m_rotations[k];  // frozen alike in both sets from now on
+  m_warm_starts_ahead[k] = m_warm_starts[k];
 }
 
 std::vector<Eigen::Matrix3d> CorotationalElasticity::rotations() const {
@@ -186,16 +191,20 @@ void CorotationalElasticity::restore_rotations(const std::vector<Eigen::Matrix3d
     m_rotations[stored(static_cast<int>(t))] = rotations[t];
     m_warm_starts[stored(static_cast<int>(t))] = warm_starts[t];
   }
+  m_rotations_ahead = m_rotations;
+  m_warm_starts_ahead = m_warm_starts;
 }
 
 void CorotationalElasticity::reset_rotations() {
   std::fill(m_rotations.begin(), m_rotations.end(), Eigen::Matrix3d::Identity());
   std::fill(m_warm_starts.begin(), m_warm_starts.end(), Eigen::Quaterniond::Identity());
+  m_rotations_ahead = m_rotations;
+  m_warm_starts_ahead = m_warm_starts;
 }
 
 void CorotationalElasticity::evaluate(const Eigen::VectorXd& positions_m, Eigen::VectorXd& internal_forces_n,
                                       BlockSparseMatrix* tangent, const std::vector<TetSlots>* slots, WorkTeam* team,
-                                      double* elastic_energy_j) {
+                                      double* elastic_energy_j, ExtractInto into) {
   assert(tangent == nullptr || (slots != nullptr && slots->size() == m_tets.size()));
   // Each part's energy apart, added in part order: bitwise the same with a team or without.
   double energy = 0.0;
@@ -203,11 +212,12 @@ void CorotationalElasticity::evaluate(const Eigen::VectorXd& positions_m, Eigen:
     std::array<double, ASSEMBLY_PARTS> part_energy{};
     run_parts(team, ASSEMBLY_PARTS, [&](int part) {
       add_tets(phase[static_cast<size_t>(part)], positions_m, internal_forces_n, tangent, slots,
-               elastic_energy_j != nullptr ? &part_energy[static_cast<size_t>(part)] : nullptr);
+               elastic_energy_j != nullptr ? &part_energy[static_cast<size_t>(part)] : nullptr, into);
     });
     for (const double part : part_energy) energy += part;
   }
-  add_tets(m_serial_tets, positions_m, internal_forces_n, tangent, slots, elastic_energy_j != nullptr ? &energy : nullptr);
+  add_tets(m_serial_tets, positions_m, internal_forces_n, tangent, slots,
+           elastic_energy_j != nullptr ? &energy : nullptr, into);
   if (elastic_energy_j != nullptr) *elastic_energy_j = energy;
 }
 
@@ -231,6 +241,7 @@ void CorotationalElasticity::in_rotation_batches(size_t count, TetAt tet_at, con
       batch[lane] = t;
       gradients[lane] = deformation_gradient(m_rest[t], gather(positions_m, m_tets[t]));
       if (warm_starts != nullptr) {
+        if (warm_starts != &m_warm_starts) (*warm_starts)[t] = m_warm_starts[t];  // the ahead set, from the own
         lane_warm_starts[lane] = &(*warm_starts)[t];
         lane_rotations[lane] = &(*rotations)[t];
       } else {
@@ -248,7 +259,8 @@ void CorotationalElasticity::in_rotation_batches(size_t count, TetAt tet_at, con
 
 TISSUE_HOT_KERNEL void CorotationalElasticity::add_tets(const std::vector<int>& tets, const Eigen::VectorXd& positions_m,
                                                         Eigen::VectorXd& internal_forces_n, BlockSparseMatrix* tangent,
-                                                        const std::vector<TetSlots>* slots, double* energy_j) {
+                                                        const std::vector<TetSlots>* slots, double* energy_j,
+                                                        ExtractInto into) {
   double energy = 0.0;
   // The tangent's blocks are scattered over K (10 MB on the 52k-tet organ): each visit asks for the
   // blocks of the tet PREFETCH_AHEAD places on in the list, so that they are in cache when it comes.
@@ -265,10 +277,12 @@ TISSUE_HOT_KERNEL void CorotationalElasticity::add_tets(const std::vector<int>& 
   };
   for (int k = 0; k < PREFETCH_AHEAD; ++k) prefetch_next();
   in_rotation_batches(
-      tets.size(), [&tets](size_t k) { return tets[k]; }, positions_m, &m_warm_starts, &m_rotations,
+      tets.size(), [&tets](size_t k) { return tets[k]; }, positions_m,
+      into == ExtractInto::ahead ? &m_warm_starts_ahead : &m_warm_starts,
+      into == ExtractInto::ahead ? &m_rotations_ahead : &m_rotations,
       [&](size_t t, const Eigen::Matrix3d& f, const Eigen::Matrix3d& rotation) {
         prefetch_next();
-        add_tet(t, f, internal_forces_n, tangent, slots);
+        add_tet(t, f, rotation, internal_forces_n, tangent, slots);
         if (energy_j != nullptr) energy += m_elements.energy_j(m_rest[t], rotation, f);
       });
   if (energy_j != nullptr) *energy_j += energy;
@@ -367,11 +381,11 @@ using Lanes = double __attribute__((vector_size(32)));
 
 }  // namespace
 
-TISSUE_HOT_KERNEL void CorotationalElasticity::add_tet(size_t k, const Eigen::Matrix3d& f, Eigen::VectorXd& internal_forces_n,
-                                     BlockSparseMatrix* tangent, const std::vector<TetSlots>* slots) const {
+TISSUE_HOT_KERNEL void CorotationalElasticity::add_tet(size_t k, const Eigen::Matrix3d& f, const Eigen::Matrix3d& r,
+                                                       Eigen::VectorXd& internal_forces_n, BlockSparseMatrix* tangent,
+                                                       const std::vector<TetSlots>* slots) const {
   const Tet& tet = m_tets[k];
   const TetRest& rest = m_rest[k];
-  const Eigen::Matrix3d& r = m_rotations[k];
 
   // Co-rotational: f_i = V R sigma g_i (equal to R K_e (R^T x - X), see docs/DESIGN.md, "Elasticity").
   const Eigen::Matrix<double, 3, 4> forces = m_elements.forces(rest, r, f);
@@ -390,27 +404,32 @@ TISSUE_HOT_KERNEL void CorotationalElasticity::add_tet(size_t k, const Eigen::Ma
   add_tet_blocks(tet_slots, *tangent, [&](int i, int j) { return blocks[static_cast<size_t>(4 * i + j)]; });
 }
 
-TISSUE_HOT_KERNEL double CorotationalElasticity::energy_of_range(const Eigen::VectorXd& positions_m, size_t first,
-                                                                   size_t end) const {
-  // Rotations in SIMD lanes as in a step (the energy guard evaluates this twice on a step that
-  // turns elements far), from copies of the warm starts; the terms are added in storage order.
+TISSUE_HOT_KERNEL double CorotationalElasticity::energy_of(const std::vector<int>& tets,
+                                                             const Eigen::VectorXd& positions_m) const {
+  // Rotations in SIMD lanes as in a step, from copies of the warm starts; the terms added in the
+  // list's order, as add_tets adds them.
   double energy = 0.0;
   in_rotation_batches(
-      end - first, [first](size_t k) { return first + k; }, positions_m, nullptr, nullptr,
+      tets.size(), [&tets](size_t k) { return tets[k]; }, positions_m, nullptr, nullptr,
       [&](size_t t, const Eigen::Matrix3d& f, const Eigen::Matrix3d& rotation) {
         energy += m_elements.energy_j(m_rest[t], rotation, f);
       });
   return energy;
 }
 
+// The sum evaluate() makes, in its order (each phase's parts apart, added in part order, then the
+// serial tets): the energy guard reads the same potential whichever pass found it, and a step kept
+// from the guard's evaluation continues as one evaluated anew after a restore (backward_euler.cpp).
 double CorotationalElasticity::elastic_energy_j(const Eigen::VectorXd& positions_m, WorkTeam* team) const {
-  std::array<double, 2> half{};
-  const size_t n = m_tets.size();
-  run_parts(team, 2, [&](int h) {
-    half[static_cast<size_t>(h)] =
-        energy_of_range(positions_m, n * static_cast<size_t>(h) / 2, n * static_cast<size_t>(h + 1) / 2);
-  });
-  return half[0] + half[1];
+  double energy = 0.0;
+  for (const AssemblyPhase& phase : m_phases) {
+    std::array<double, ASSEMBLY_PARTS> part_energy{};
+    run_parts(team, ASSEMBLY_PARTS, [&](int part) {
+      part_energy[static_cast<size_t>(part)] = energy_of(phase[static_cast<size_t>(part)], positions_m);
+    });
+    for (const double part : part_energy) energy += part;
+  }
+  return energy + energy_of(m_serial_tets, positions_m);
 }
 
 std::vector<double> lumped_vertex_sums(const TetMesh& mesh, std::span<const double> per_region_per_m3) {

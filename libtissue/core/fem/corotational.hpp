@@ -77,9 +77,17 @@ class CorotationalElasticity {
   /// of two the halves of a phase run side by side: they write disjoint entries, and every entry
   /// receives its terms in the same order as with one thread, so the result is bitwise the same.
   /// With `elastic_energy_j`, also the elastic energy at these positions with the rotations just
-  /// extracted (elastic_energy_j() there, to round-off: the terms are added in assembly order). [J]
+  /// extracted (elastic_energy_j() there, bitwise: both add the terms in assembly order). [J]
+  /// `into` ahead: the rotations go beside the tets' own (ExtractInto), which stay as they were.
   void evaluate(const Eigen::VectorXd& positions_m, Eigen::VectorXd& internal_forces_n, BlockSparseMatrix* tangent,
-                const std::vector<TetSlots>* slots, WorkTeam* team = nullptr, double* elastic_energy_j = nullptr);
+                const std::vector<TetSlots>* slots, WorkTeam* team = nullptr, double* elastic_energy_j = nullptr,
+                ExtractInto into = ExtractInto::own);
+  /// The rotations and warm starts of the last evaluate() ahead become the tets' own (an excluded
+  /// tet's are the same in both sets).
+  void take_ahead() {
+    m_rotations.swap(m_rotations_ahead);
+    m_warm_starts.swap(m_warm_starts_ahead);
+  }
 
   /// How many parts the assembly runs side by side (a team's members beyond this wait).
   static constexpr int ASSEMBLY_PARTS = MAX_STEP_THREADS;
@@ -96,8 +104,9 @@ class CorotationalElasticity {
 
   /// Elastic energy sum_e V_e (mu eps:eps + lambda/2 tr(eps)^2), eps = sym(R_e^T F_e) - I, with the
   /// rotations of these positions (the stored warm starts are not changed). [J]
-  /// The tets in two halves (side by side with a team of two), added half by half: bitwise the same
-  /// with one thread or two.
+  /// The terms added as evaluate() adds them (each assembly phase's parts side by side with a team
+  /// of two, part by part, then the serial tets): bitwise evaluate()'s energy from the same warm
+  /// starts, with one thread or two.
   [[nodiscard]] double elastic_energy_j(const Eigen::VectorXd& positions_m, WorkTeam* team = nullptr) const;
 
   /// Forgets the warm starts (rotations back to identity), e.g. after a state was restored.
@@ -112,17 +121,18 @@ class CorotationalElasticity {
 
  private:
   /// Adds the force of the tet at storage index k and (with `tangent`) its blocks, with F = f and
-  /// the rotation already extracted.
-  void add_tet(size_t k, const Eigen::Matrix3d& f, Eigen::VectorXd& internal_forces_n, BlockSparseMatrix* tangent,
-               const std::vector<TetSlots>* slots) const;
+  /// the rotation r just extracted (the own set's or the ahead one's).
+  void add_tet(size_t k, const Eigen::Matrix3d& f, const Eigen::Matrix3d& r, Eigen::VectorXd& internal_forces_n,
+               BlockSparseMatrix* tangent, const std::vector<TetSlots>* slots) const;
 
   /// visit(t, F, R) for the tets tet_at(0) .. tet_at(count - 1) that are not excluded, in order, their
   /// rotations extracted ROTATION_BATCH at a time side by side (SIMD lanes). From and into the tets'
-  /// own warm starts and rotations when given (a step); else from copies of the warm starts, the
+  /// own warm starts and rotations when given (a step; the ahead set: each lane's warm start copied
+  /// there from the own first); else from copies of the warm starts, the
   /// rotations kept in the batch (reporting must not change the dynamics). Defined in the .cpp, for
   /// the hot kernels there.
-  /// The energy of the tets at storage indices [first, end).
-  [[nodiscard]] double energy_of_range(const Eigen::VectorXd& positions_m, size_t first, size_t end) const;
+  /// The energy of the tets `tets` (storage indices) at the positions, added in their order.
+  [[nodiscard]] double energy_of(const std::vector<int>& tets, const Eigen::VectorXd& positions_m) const;
 
   template <class TetAt, class Visit>
   void in_rotation_batches(size_t count, TetAt tet_at, const Eigen::VectorXd& positions_m,
@@ -132,7 +142,7 @@ class CorotationalElasticity {
   /// Adds the forces and blocks of `tets` (skipping excluded ones), rotations in batches, and their
   /// energy into `energy_j` when given.
   void add_tets(const std::vector<int>& tets, const Eigen::VectorXd& positions_m, Eigen::VectorXd& internal_forces_n,
-                BlockSparseMatrix* tangent, const std::vector<TetSlots>* slots, double* energy_j);
+                BlockSparseMatrix* tangent, const std::vector<TetSlots>* slots, double* energy_j, ExtractInto into);
 
   /// Splits the tets into the parts and the separator (see evaluate()).
   /// Then stores the per-tet data in assembly order (m_tet_id, m_storage).
@@ -150,6 +160,8 @@ class CorotationalElasticity {
   std::vector<TetRest> m_rest;
   std::vector<Eigen::Matrix3d> m_rotations;
   std::vector<Eigen::Quaterniond> m_warm_starts;
+  std::vector<Eigen::Matrix3d> m_rotations_ahead;  // an evaluation ahead's (ExtractInto)
+  std::vector<Eigen::Quaterniond> m_warm_starts_ahead;
   std::vector<char> m_excluded;  // 1 = modelled elsewhere (cut)
   ElementModel m_elements;  // the model, Lame parameters per material
   RotationSettings m_rotation_settings;

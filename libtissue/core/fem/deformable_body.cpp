@@ -302,8 +302,10 @@ void DeformableBody::check_unknowns(const Eigen::VectorXd& displacement_m) const
 }
 
 void DeformableBody::evaluate_pass(const Eigen::VectorXd& displacement_m, Eigen::VectorXd& internal_force_n,
-                                   bool update_tangent, bool with_potential) {
+                                   bool update_tangent, bool with_potential, ExtractInto into) {
   check_unknowns(displacement_m);
+  ++m_changes;
+  m_ahead.pending = false;
   positions(displacement_m, m_positions_m);
   m_vertex_forces_n.setZero();
   if (update_tangent) m_tangent.set_zero(m_team);
@@ -311,12 +313,12 @@ void DeformableBody::evaluate_pass(const Eigen::VectorXd& displacement_m, Eigen:
   double uncut_energy_j = 0.0;
   double cut_energy_j = 0.0;
   m_elasticity.evaluate(m_positions_m, m_vertex_forces_n, tangent, &m_slots, m_team,
-                        with_potential ? &uncut_energy_j : nullptr);
+                        with_potential ? &uncut_energy_j : nullptr, into);
   internal_force_n.resize(dof_count());
   const int u_rows = m_dofs.free_vertex_count();
   internal_force_n.tail(3 * enriched_dof_count()).setZero();
   m_xfem.evaluate(m_positions_m, displacement_m, m_vertex_forces_n, internal_force_n, tangent,
-                  with_potential ? &cut_energy_j : nullptr);
+                  with_potential ? &cut_energy_j : nullptr, into);
 
   for (ForceTerm* term : m_force_terms) {
     term->add_force(m_positions_m, m_vertex_forces_n);
@@ -330,6 +332,29 @@ void DeformableBody::evaluate_pass(const Eigen::VectorXd& displacement_m, Eigen:
     internal_force_n.segment<3>(3 * row) =
         m_vertex_forces_n.segment<3>(3 * m_dofs.row_vertex[static_cast<size_t>(row)]);
   }
+}
+
+bool DeformableBody::evaluate_ahead(const Eigen::VectorXd& displacement_m, Eigen::VectorXd& internal_force_n) {
+  for (const ForceTerm* term : m_force_terms) {
+    if (!term->idle()) return false;  // the tool moves between steps: it would not be taken
+  }
+  evaluate_pass(displacement_m, internal_force_n, /*update_tangent=*/true, /*with_potential=*/true, ExtractInto::ahead);
+  m_ahead.pending = true;
+  m_ahead.revision = evaluation_revision();
+  m_ahead.displacement_m = displacement_m;
+  return true;
+}
+
+bool DeformableBody::take_evaluation_ahead(const Eigen::VectorXd& displacement_m) {
+  const bool taken = m_ahead.pending && m_ahead.revision == evaluation_revision() &&
+                     m_ahead.displacement_m.size() == displacement_m.size() &&
+                     (m_ahead.displacement_m.array() == displacement_m.array()).all();
+  m_ahead.pending = false;
+  if (taken) {
+    m_elasticity.take_ahead();
+    m_xfem.take_ahead();
+  }
+  return taken;
 }
 
 double DeformableBody::elastic_energy_j(const Eigen::VectorXd& displacement_m) {
@@ -381,11 +406,13 @@ void DeformableBody::check_rotations(const Rotations& rotations) const {
 
 void DeformableBody::restore_rotations(const Rotations& rotations) {
   check_rotations(rotations);
+  changed();
   m_elasticity.restore_rotations(rotations.tets, rotations.tet_warm_starts);
   m_xfem.restore_rotations(rotations.pieces, rotations.piece_warm_starts);
 }
 
 void DeformableBody::reset_rotations() {
+  changed();
   m_elasticity.reset_rotations();
   m_xfem.reset_rotations();
 }
@@ -454,6 +481,7 @@ bool DeformableBody::drop_retired_blocks() {
   }
   m_retired_slots = 0;
   if (!m_tangent.remove_blocks(keep)) return false;
+  changed();
   refresh_all_slots(/*one_relayout=*/true);
   return true;
 }
@@ -513,10 +541,16 @@ double DeformableBody::piece_mass_kg(int cut_tet_index, int piece) const {
          m_xfem.rest(cut_tet_index).volume_m3;
 }
 
+std::uint64_t DeformableBody::evaluation_revision() const {
+  std::uint64_t revision = m_changes;
+  for (const ForceTerm* term : m_force_terms) revision += term->revision();  // each only grows
+  return revision;
+}
+
 // --- Force terms ---
 
 void DeformableBody::attach(ForceTerm& term) {
-  m_evaluated_potential_j = std::numeric_limits<double>::quiet_NaN();
+  changed();
   if (std::find(m_force_terms.begin(), m_force_terms.end(), &term) == m_force_terms.end()) {
     m_force_terms.push_back(&term);
   }
@@ -524,7 +558,7 @@ void DeformableBody::attach(ForceTerm& term) {
 }
 
 void DeformableBody::detach(ForceTerm& term) {
-  m_evaluated_potential_j = std::numeric_limits<double>::quiet_NaN();
+  changed();
   std::erase(m_force_terms, &term);
 }
 

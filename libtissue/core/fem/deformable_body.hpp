@@ -109,14 +109,18 @@ class DeformableBody final : public DynamicsModel {
   [[nodiscard]] double stiffness_damping_s() const override { return m_settings.damping.stiffness_damping_s; }
   [[nodiscard]] const Eigen::VectorXd& external_force_n() const override { return m_external_force_n; }
   void evaluate(const Eigen::VectorXd& displacement_m, Eigen::VectorXd& internal_force_n, bool update_tangent) override {
-    evaluate_pass(displacement_m, internal_force_n, update_tangent, /*with_potential=*/false);
+    evaluate_pass(displacement_m, internal_force_n, update_tangent, /*with_potential=*/false, ExtractInto::own);
   }
   /// The elements' energies are summed in the same pass (4-7% of it; docs/DESIGN.md, "Backward Euler
   /// on steps that turn elements far").
   void evaluate_with_potential(const Eigen::VectorXd& displacement_m, Eigen::VectorXd& internal_force_n,
                                bool update_tangent) override {
-    evaluate_pass(displacement_m, internal_force_n, update_tangent, /*with_potential=*/true);
+    evaluate_pass(displacement_m, internal_force_n, update_tangent, /*with_potential=*/true, ExtractInto::own);
   }
+  /// The rotations go beside the elements' own (ExtractInto::ahead) and are swapped in when taken.
+  /// Declined while an attached force term is not idle.
+  bool evaluate_ahead(const Eigen::VectorXd& displacement_m, Eigen::VectorXd& internal_force_n) override;
+  bool take_evaluation_ahead(const Eigen::VectorXd& displacement_m) override;
   /// The uncut tets' forces and blocks are then assembled by the team (bitwise the same result).
   void lend_work_team(WorkTeam* team) override { m_team = team; }
   [[nodiscard]] const BlockSparseMatrix& tangent() const override { return m_tangent; }
@@ -288,7 +292,7 @@ class DeformableBody final : public DynamicsModel {
 
  private:
   void evaluate_pass(const Eigen::VectorXd& displacement_m, Eigen::VectorXd& internal_force_n, bool update_tangent,
-                     bool with_potential);
+                     bool with_potential, ExtractInto into);
   /// potential_energy_j's sum from the elastic energy (m_positions_m set for `displacement_m`).
   [[nodiscard]] double potential_with_elastic_j(double elastic_energy_j, const Eigen::VectorXd& displacement_m) const;
 
@@ -389,6 +393,21 @@ class DeformableBody final : public DynamicsModel {
   // every 10 steps should not be.
   BodyParts m_parts;
   double m_evaluated_potential_j = std::numeric_limits<double>::quiet_NaN();  // at the last evaluate()
+  // Moves on at every evaluate, enrich, park, re-layout, rotations' restore or reset and term
+  // attached or detached; with the terms' own ForceTerm::revision, evaluation_revision().
+  std::uint64_t m_changes = 1;
+  [[nodiscard]] std::uint64_t evaluation_revision() const;
+  struct EvaluationAhead {
+    bool pending = false;
+    std::uint64_t revision = 0;  // evaluation_revision() right after it
+    Eigen::VectorXd displacement_m;
+  };
+  EvaluationAhead m_ahead;
+  // What any change of the model does: the potential of the last evaluate is no longer the model's.
+  void changed() {
+    ++m_changes;
+    m_evaluated_potential_j = std::numeric_limits<double>::quiet_NaN();
+  }
   long m_element_revision = 0;  // counts enrichments
   long m_parts_revision = -1;   // m_element_revision when m_parts was found
 

@@ -188,7 +188,7 @@ EnrichmentResult DeformableBody::enrich_pieces(std::span<const TetCut> cuts,
                                                std::span<const std::vector<TetPositions>> offsets_m,
                                                const Eigen::VectorXd* displacement_m) {
   check_cuts(cuts);
-  m_evaluated_potential_j = std::numeric_limits<double>::quiet_NaN();
+  changed();
   EnrichBatch batch;
   plan_cuts(cuts, batch);
   ++m_element_revision;

@@ -21,7 +21,6 @@ struct PartSummary {
 }  // namespace
 
 std::vector<int> DeformableBody::park_parts_outside(const Eigen::AlignedBox3d& field, DynamicState& state) {
-  m_evaluated_potential_j = std::numeric_limits<double>::quiet_NaN();
   check_unknowns(state.displacement_m);
   if (state.velocity_m_per_s.size() != dof_count()) {
     throw std::invalid_argument("park_parts_outside: the state has " + std::to_string(state.velocity_m_per_s.size()) +
@@ -57,7 +56,7 @@ std::vector<int> DeformableBody::park_parts_outside(const Eigen::AlignedBox3d& f
     state.velocity_m_per_s.segment<3>(3 * row) = of.momentum / of.mass_kg;
     if (!parked(row)) chosen.push_back(row);
   }
-  if (!chosen.empty()) park_rows(chosen);
+  if (!chosen.empty()) park_rows(chosen);  // (a change of the model only then: park_rows)
   return chosen;
 }
 
@@ -69,6 +68,7 @@ void DeformableBody::park_rows(std::span<const int> rows) {
                                   std::to_string(row_count) + ")");
     }
   }
+  changed();
   m_row_parked.resize(static_cast<size_t>(row_count), 0);
   for (const int row : rows) {
     if (m_row_parked[static_cast<size_t>(row)] == 0) ++m_parked_rows;

@@ -20,6 +20,11 @@ struct RotationSettings {
   double max_error_rad = 1e-6;  ///< accepted rotation error (4e-18: the pre-issue-12 rule, steps < 1e-6 rad)
 };
 
+/// Where an elasticity's evaluate puts the rotations and warm starts it extracts: into the elements'
+/// own (a step), or into a second set beside them, from the own warm starts (an evaluation ahead of
+/// the next step, DeformableBody::evaluate_ahead), which take_ahead() makes the own.
+enum class ExtractInto { own, ahead };
+
 /// Throws ParameterError unless 1 <= max_iterations <= 100 and max_error_rad is finite and > 0.
 void validate(const RotationSettings& settings);
 

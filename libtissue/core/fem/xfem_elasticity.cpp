@@ -176,7 +176,14 @@ TetPositions piece_positions(const CutPiece& piece, const TetPositions& real_pos
 
 void XfemElasticity::evaluate(const Eigen::VectorXd& positions_m, const Eigen::VectorXd& displacement_m,
                               Eigen::VectorXd& vertex_forces_n, Eigen::VectorXd& internal_force_n,
-                              BlockSparseMatrix* tangent, double* elastic_energy_j) {
+                              BlockSparseMatrix* tangent, double* elastic_energy_j, ExtractInto into) {
+  // Ahead: every piece's as it is first (retired and parked ones keep theirs), then extracted there.
+  if (into == ExtractInto::ahead) {
+    m_rotations_ahead = m_rotations;
+    m_warm_starts_ahead = m_warm_starts;
+  }
+  std::vector<Eigen::Matrix3d>& rotations = into == ExtractInto::ahead ? m_rotations_ahead : m_rotations;
+  std::vector<Eigen::Quaterniond>& warm_starts = into == ExtractInto::ahead ? m_warm_starts_ahead : m_warm_starts;
   TetPositions real_m;
   double energy = 0.0;
   for (size_t k = 0; k < m_cut_tets.size(); ++k) {
@@ -194,7 +201,7 @@ void XfemElasticity::evaluate(const Eigen::VectorXd& positions_m, const Eigen::V
       const CutPiece& piece = m_pieces[p];
       const Eigen::Matrix3d f =
           deformation_gradient(rest, piece_positions(piece, real_m, cut_tet.rest_m, displacement_m));
-      const Eigen::Matrix3d& r = m_rotations[p] = extract_rotation(f, m_warm_starts[p], m_rotation_settings);
+      const Eigen::Matrix3d& r = rotations[p] = extract_rotation(f, warm_starts[p], m_rotation_settings);
       const Eigen::Matrix<double, 3, 4> forces = m_elements.forces(rest, r, f);
       if (elastic_energy_j != nullptr) energy += piece.weight * m_elements.energy_j(rest, r, f);
       for (size_t i = 0; i < 4; ++i) {
@@ -231,7 +238,7 @@ void XfemElasticity::evaluate(const Eigen::VectorXd& positions_m, const Eigen::V
               ? Eigen::Matrix3d::Identity()
               : deformation_gradient(rest, piece_positions(piece, real_m, cut_tet.rest_m, displacement_m));
       std::array<Eigen::Matrix3d, 16> blocks;
-      m_elements.blocks(rest, m_rotations[p], f, blocks);
+      m_elements.blocks(rest, rotations[p], f, blocks);
       for (int i = 0; i < 4; ++i) {
         for (int j = i; j < 4; ++j) {
           const int a = dof[to_size(i)];

@@ -176,9 +176,15 @@ class XfemElasticity {
   /// `internal_force_n` (3 per unknown) and, when `tangent` is given, the blocks through the slots.
   /// With `elastic_energy_j`, also their elastic energy with the rotations just extracted
   /// (elastic_energy_j() there, to round-off). [J]
+  /// `into` ahead: the pieces' rotations go beside their own (ExtractInto), which stay as they were.
   void evaluate(const Eigen::VectorXd& positions_m, const Eigen::VectorXd& displacement_m,
                 Eigen::VectorXd& vertex_forces_n, Eigen::VectorXd& internal_force_n, BlockSparseMatrix* tangent,
-                double* elastic_energy_j = nullptr);
+                double* elastic_energy_j = nullptr, ExtractInto into = ExtractInto::own);
+  /// The rotations and warm starts of the last evaluate() ahead become the pieces' own.
+  void take_ahead() {
+    m_rotations.swap(m_rotations_ahead);
+    m_warm_starts.swap(m_warm_starts_ahead);
+  }
 
   /// Sum over the cut tets of w_a E(part a) + w_b E(part b), with the rotations of these
   /// positions (warm starts unchanged). [J]
@@ -215,6 +221,8 @@ class XfemElasticity {
   std::vector<std::array<int, 4>> m_ghost_dofs;  // per piece and local vertex: its local DOF, -1 real
   std::vector<Eigen::Matrix3d> m_rotations;       // per piece (a single cut: above, below)
   std::vector<Eigen::Quaterniond> m_warm_starts;  // per piece
+  std::vector<Eigen::Matrix3d> m_rotations_ahead;  // an evaluation ahead's: all pieces', the ones it skips copied
+  std::vector<Eigen::Quaterniond> m_warm_starts_ahead;
   std::vector<int> m_ghost_begin{0};
   std::vector<int> m_ghost_rows;
   std::vector<std::size_t> m_slot_begin{0};

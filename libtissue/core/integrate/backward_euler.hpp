@@ -68,9 +68,12 @@ class BackwardEuler final : public Integrator {
     m_past_velocity_changes = internal_state;
   }
   /// One step depends on the state alone (a grown system drops the warm start); a save or a restore
-  /// makes the solver forget its lagged factor (LinearSolver::forget_earlier_setups).
+  /// makes the solver forget its lagged factor (LinearSolver::forget_earlier_setups). A step's start
+  /// evaluated ahead by the last step's energy guard is what the step would evaluate itself, bitwise
+  /// (DynamicsModel::evaluate_ahead): a save keeps it, a restore drops it.
   void restart(Restart why) override {
     if (why == Restart::state_saved || why == Restart::state_restored) m_solver->forget_earlier_setups();
+    if (why == Restart::state_restored) m_end_evaluated = false;
   }
   /// (1/h^2) times this step's matrix: newton_stiffness_system with c = 1/h.
   [[nodiscard]] ShiftedSystem newton_stiffness(const DynamicsModel& model, double step_size_s,
@@ -124,6 +127,9 @@ class BackwardEuler final : public Integrator {
   double m_start_potential_j = 0.0;    // at u0, from the step's evaluate (NaN: the model keeps none)
   double m_end_potential_j = 0.0;      // at u0 + h v1 when the corrections' line search found it, else NaN
   bool m_trial_evaluated = false;      // the line search took a trial evaluated with the tangent
+  // The energy guard evaluated the step's end ahead (DynamicsModel::evaluate_ahead): m_internal_force_n
+  // is its force, for the next step's start if the model lets it take the evaluation.
+  bool m_end_evaluated = false;
 };
 
 /// Throws ParameterError unless the trigger angle is > 0 (infinity: off) and 1 to 100 iterations.

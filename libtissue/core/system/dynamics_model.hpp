@@ -78,6 +78,20 @@ class DynamicsModel {
   [[nodiscard]] virtual double potential_energy_at_last_evaluate_j() const {
     return std::numeric_limits<double>::quiet_NaN();
   }
+  /// evaluate_with_potential(u, f, true) ahead of the next step, whose start u is: the model keeps
+  /// its state from before (what a save records) until the next step takes the evaluation
+  /// (take_evaluation_ahead), so that a step from a restored state, evaluating u itself, continues
+  /// bitwise as the one that took it. Returns false, with nothing done, where the model cannot or
+  /// expects a change before the next step (a force term in use: the tool moves between steps).
+  virtual bool evaluate_ahead(const Eigen::VectorXd& /*displacement_m*/, Eigen::VectorXd& /*internal_force_n*/) {
+    return false;
+  }
+  /// Whether the last evaluate_ahead() was at exactly (bitwise) `displacement_m` and nothing changed
+  /// the model since (no evaluate, cut, parked part, restore, force term attached, detached or set):
+  /// then it is taken (its forces, tangent, potential and rotations are the model's from now on) and
+  /// an evaluate there would give the same. Else false, and the model is as before the evaluation
+  /// ahead (its rotations; the tangent is that evaluation's until the next evaluate).
+  virtual bool take_evaluation_ahead(const Eigen::VectorXd& /*displacement_m*/) { return false; }
 };
 
 /// The state an integrator advances: displacement and velocity per unknown, and time.

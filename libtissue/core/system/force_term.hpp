@@ -9,6 +9,7 @@
 
 #include <Eigen/Core>
 
+#include <cstdint>
 #include <span>
 
 namespace tissue {
@@ -32,6 +33,17 @@ class ForceTerm {
   [[nodiscard]] virtual double energy_j(const Eigen::VectorXd& positions_m) const = 0;
   /// Finds its blocks in `layout`: when attached to a body and after the body's tangent was re-laid out.
   virtual void locate(const TermLayout& layout) = 0;
+  /// Whether the term adds nothing now (no force, stiffness or energy at any positions).
+  [[nodiscard]] virtual bool idle() const = 0;
+  /// Moves on whenever the term's force or stiffness at the same positions may have changed (its
+  /// setters call changed()): an evaluation ahead of a step is not taken after it moved.
+  [[nodiscard]] std::uint64_t revision() const { return m_revision; }
+
+ protected:
+  void changed() { ++m_revision; }
+
+ private:
+  std::uint64_t m_revision = 0;
 };
 
 }  // namespace tissue

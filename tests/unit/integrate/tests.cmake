@@ -3,3 +3,4 @@ tissue_add_test(test_integrate LABELS unit SOURCES integrate/test_backward_euler
 tissue_add_test(test_step_allocations LABELS unit SOURCES integrate/test_step_allocations.cpp)
 tissue_add_test(test_backward_euler_large_turns LABELS unit SOURCES integrate/test_backward_euler_large_turns.cpp)
 tissue_add_test(test_step_threads LABELS unit SOURCES integrate/test_step_threads.cpp)
+tissue_add_test(test_evaluation_ahead LABELS unit SOURCES integrate/test_evaluation_ahead.cpp)
