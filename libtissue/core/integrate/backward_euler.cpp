@@ -348,13 +348,17 @@ double BackwardEuler::incremental_potential_j(const DynamicsModel& model, const 
   return 0.5 * kinetic_j + 0.5 * h * (damping_j + stiffness_damping_j) + potential_j;
 }
 
-double BackwardEuler::trial_potential_j(DynamicsModel& model, const DynamicState& state, double h,
-                                        bool with_tangent) {
+double BackwardEuler::trial_potential_j(DynamicsModel& model, const DynamicState& state, double h, TrialPass pass) {
   m_trial_displacement.noalias() = state.displacement_m + h * m_trial_velocity;
-  if (with_tangent) {
+  m_end_evaluated = false;
+  if (pass == TrialPass::with_tangent) {
     model.evaluate_with_potential(m_trial_displacement, m_internal_force_n, /*update_tangent=*/true);
     const double potential_j = model.potential_energy_at_last_evaluate_j();
     if (std::isfinite(potential_j)) return potential_j;
+  } else if (pass == TrialPass::ahead && model.evaluate_ahead(m_trial_displacement, m_internal_force_n)) {
+    const double potential_j = model.potential_energy_at_last_evaluate_j();
+    m_end_evaluated = std::isfinite(potential_j);
+    if (m_end_evaluated) return potential_j;
   }
   return model.potential_energy_j(m_trial_displacement);
 }
@@ -390,8 +394,11 @@ double BackwardEuler::line_search(DynamicsModel& model, const DynamicState& stat
   double share = 1.0;
   for (int halving = 0; halving <= LINE_SEARCH_HALVINGS; ++halving, share *= 0.5) {
     m_trial_velocity.noalias() = m_end_velocity + share * m_correction;
+    // The first trial of the last correction is likely the step's end: evaluated ahead of the next
+    // step, which takes it as its start if the search does (else the next one is not at that u).
     const bool whole = halving == 0 && evaluate_whole;
-    m_trial_potential_j = trial_potential_j(model, state, h, whole);
+    const TrialPass pass = whole ? TrialPass::with_tangent : halving == 0 ? TrialPass::ahead : TrialPass::potential;
+    m_trial_potential_j = trial_potential_j(model, state, h, pass);
     if (incremental_potential_j(model, state, h, m_trial_velocity, stiffness_damping_j(share), m_trial_potential_j) <=
         start_j) {
       m_trial_evaluated = whole;

@@ -99,9 +99,12 @@ class BackwardEuler final : public Integrator {
   // model's potential energy at u0 + h v1.
   double incremental_potential_j(const DynamicsModel& model, const DynamicState& state, double h,
                                  const Eigen::VectorXd& v1, double stiffness_damping_j, double potential_j) const;
-  // The model's potential energy at u0 + h m_trial_velocity; `with_tangent`: found by an evaluate
-  // with the tangent (m_internal_force_n and the model's tangent then are the trial's).
-  double trial_potential_j(DynamicsModel& model, const DynamicState& state, double h, bool with_tangent);
+  // How a trial's potential is found: an energy pass, an evaluate with the tangent (m_internal_force_n
+  // and the model's tangent then are the trial's), or an evaluation ahead of the next step (the
+  // model's, DynamicsModel::evaluate_ahead; m_end_evaluated tells whether it made one).
+  enum class TrialPass { potential, with_tangent, ahead };
+  // The model's potential energy at u0 + h m_trial_velocity, by `pass`.
+  double trial_potential_j(DynamicsModel& model, const DynamicState& state, double h, TrialPass pass);
   // The share t of m_correction to take (0: none lowers the incremental potential); the trial taken
   // is left in m_trial_velocity, its potential energy in m_trial_potential_j. The iterate's
   // potential energy is m_end_potential_j when known. `evaluate_whole`: the whole correction's trial

@@ -14,6 +14,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 #include <optional>
 
 namespace tissue {
@@ -83,8 +84,9 @@ struct Swing {
   Forwarding model;
   BackwardEuler integrator{std::make_unique<PcgSolver>(PcgSolver::Settings{1e-8, 10000})};
   DynamicState state{Eigen::VectorXd::Zero(body.dof_count()), Eigen::VectorXd::Zero(body.dof_count()), 0.0};
+  double step_size_s = 0.01;
   explicit Swing(bool ahead) : model(body, ahead) { body.attach(spring); }
-  StepReport step() { return integrator.step(model, state, 0.01); }
+  StepReport step() { return integrator.step(model, state, step_size_s); }
 };
 
 bool bitwise_equal(const Eigen::VectorXd& a, const Eigen::VectorXd& b) {
@@ -129,6 +131,29 @@ TEST(EvaluationAhead, TheStepsAreBitwiseThoseOfAModelThatDeclines) {
   EXPECT_EQ(declines.model.taken(), 0);
   // The spring did pull: the tip moved toward +y.
   EXPECT_GT(ahead.spring.force_on_body_n().y(), 0.0);
+}
+
+TEST(EvaluationAhead, AfterANewtonCorrectionTheStepsAreBitwiseThoseOfAModelThatDeclines) {
+  // 50 ms steps turn the released beam's elements past the 0.05 rad trigger: each corrected step's
+  // last line search evaluates its first trial ahead, and the next step takes it when the search did.
+  Swing ahead(true), declines(false);
+  int corrected = 0, taken_after_corrected = 0;
+  bool last_corrected = false;
+  for (int n = 0; n < 30; ++n) {
+    ahead.step_size_s = declines.step_size_s = 0.05;
+    const int taken_before = ahead.model.taken();
+    const StepReport report = ahead.step();
+    declines.step();
+    taken_after_corrected += last_corrected && ahead.model.taken() > taken_before ? 1 : 0;
+    last_corrected = report.newton_iterations > 0;
+    corrected += last_corrected ? 1 : 0;
+    ASSERT_TRUE(bitwise_equal(ahead.state.displacement_m, declines.state.displacement_m)) << "step " << n;
+    ASSERT_TRUE(bitwise_equal(ahead.state.velocity_m_per_s, declines.state.velocity_m_per_s)) << "step " << n;
+  }
+  std::printf("  %d corrected steps, %d of the steps after them took the start evaluated ahead\n", corrected,
+              taken_after_corrected);
+  EXPECT_GE(corrected, 2);
+  EXPECT_GE(taken_after_corrected, 1);
 }
 
 TEST(EvaluationAhead, AStateSavedBeforeTheStepTakesItContinuesBitwiseInAFreshBody) {
