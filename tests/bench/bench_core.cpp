@@ -173,7 +173,7 @@ void BM_TwoLevelSetup(benchmark::State& state) {
   f.count(state);
   state.counters["coarse"] = preconditioner.coarse_size();
 }
-BENCHMARK(BM_TwoLevelSetup)->Args({0, 0})->Args({0, 1})->Args({1, 0})->Args({1, 1})->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_TwoLevelSetup)->Args({0, 0})->Args({0, 1})->Args({1, 0})->Args({1, 1})->Args({2, 0})->Unit(benchmark::kMicrosecond);
 
 // The two-level preconditioner's coarse factor (BlockCholesky) against Eigen's scalar simplicial
 // LDL^T, which it replaced, on a coarse matrix of the organ's size (its own: 159 aggregates, 950
