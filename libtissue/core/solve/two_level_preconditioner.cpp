@@ -2,6 +2,7 @@
 // factor, and the additive two-level application (two_level_preconditioner.hpp).
 #include "core/solve/two_level_preconditioner.hpp"
 #include "core/system/cross_matrix.hpp"
+#include "core/system/hot_kernel.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -110,14 +111,37 @@ void TwoLevelPreconditioner::make_coarse_pattern(const BlockSparseMatrix& k) {
   m_coarse_solution.resize(m_coarse.columns());
 }
 
+namespace {
+
+// to -= b [r]x, column by column: ([r]x)'s columns are (0, rz, -ry), (-rz, 0, rx), (ry, -rx, 0).
+[[gnu::always_inline]] inline void subtract_times_cross(const Eigen::Matrix3d& b, const Eigen::Vector3d& r,
+                                                        Eigen::Matrix3d& to) {
+  to.col(0) -= r.z() * b.col(1) - r.y() * b.col(2);
+  to.col(1) -= r.x() * b.col(2) - r.z() * b.col(0);
+  to.col(2) -= r.y() * b.col(0) - r.x() * b.col(1);
+}
+
+// to += [r]x m, column by column (r cross each column).
+[[gnu::always_inline]] inline void add_cross_times(const Eigen::Vector3d& r, const Eigen::Matrix3d& m,
+                                                   Eigen::Matrix3d& to) {
+  for (int c = 0; c < 3; ++c) {
+    to(0, c) += r.y() * m(2, c) - r.z() * m(1, c);
+    to(1, c) += r.z() * m(0, c) - r.x() * m(2, c);
+    to(2, c) += r.x() * m(1, c) - r.y() * m(0, c);
+  }
+}
+
+}  // namespace
+
 // Coarse block (a, b), a <= b, is the sum over rows i of a and j of b of P_i^T A_ij P_j, with
 // P_j = [t_b I, C_j W_b] and C_j = -[r_j]x. Row by row, over the aggregates b >= a its blocks reach:
-// S_b = sum_j A_ij and T_b = sum_j A_ij C_j (27 multiply-adds a block), so that
-// sum_j A_ij P_j = [t_b S_b, T_b W_b] and the block takes P_i^T that = [t_a (.); W_a^T C_i^T (.)]
-// once per (row, aggregate) pair instead of once per fine block. K's rows hold both halves, so
-// every pair (i, j) of a block with a <= b is met from row i.
-void TwoLevelPreconditioner::assemble_coarse_rows(const ShiftedSystem& system, int first_aggregate,
-                                                  int end_aggregate, AssemblyScratch& scratch) {
+// S = sum_j A_ij and T = sum_j A_ij C_j (of K's blocks, 18 multiply-adds each; s and row i's d_i,
+// in (a, a), once per pair); over a's rows, per block: F = sum_i S, M = sum_i T, G = sum_i C_i^T S
+// and H = sum_i C_i^T T (C_i^T = [r_i]x), so that each block is made once:
+//   [t_a t_b F, t_a M W_b; t_b W_a^T G, W_a^T H W_b].
+// K's rows hold both halves, so every pair (i, j) of a block with a <= b is met from row i.
+TISSUE_HOT_KERNEL void TwoLevelPreconditioner::assemble_coarse_rows(const ShiftedSystem& system, int first_aggregate,
+                                                                    int end_aggregate, AssemblyScratch& scratch) {
   const BlockSparseMatrix& k = *system.stiffness;
   const auto first_block = static_cast<size_t>(m_coarse_row_begin[static_cast<size_t>(first_aggregate)]);
   const auto end_block = static_cast<size_t>(m_coarse_row_begin[static_cast<size_t>(end_aggregate)]);
@@ -126,8 +150,14 @@ void TwoLevelPreconditioner::assemble_coarse_rows(const ShiftedSystem& system, i
     const int first_block_of_a = m_coarse_row_begin[static_cast<size_t>(a)];
     const auto reach = static_cast<size_t>(m_coarse_row_begin[static_cast<size_t>(a) + 1] - first_block_of_a);
     if (scratch.row_sums.size() < reach) scratch.row_sums.resize(reach);
-    const double t_a = m_coarse.translation_scale[static_cast<size_t>(a)];
-    const int rotations_a = m_coarse.rotation_count[static_cast<size_t>(a)];
+    if (scratch.aggregate_sums.size() < reach) scratch.aggregate_sums.resize(reach);
+    for (size_t q = 0; q < reach; ++q) {
+      AggregateSums& total = scratch.aggregate_sums[q];
+      total.force.setZero();
+      total.moment.setZero();
+      total.turned_force.setZero();
+      total.turned_moment.setZero();
+    }
     for (int p = m_coarse.aggregate_begin[static_cast<size_t>(a)]; p < m_coarse.aggregate_begin[static_cast<size_t>(a) + 1];
          ++p) {
       const int i = m_coarse.rows[static_cast<size_t>(p)];
@@ -137,29 +167,51 @@ void TwoLevelPreconditioner::assemble_coarse_rows(const ShiftedSystem& system, i
         if (j < 0) continue;
         const int coarse_block = m_coarse_block_of_slot[static_cast<size_t>(s)];
         if (coarse_block < 0 || m_coarse_column[static_cast<size_t>(coarse_block)] < a) continue;
-        Eigen::Matrix3d block = system.stiffness_scale * k.block(s);
-        if (j == i) block.diagonal() += system.diagonal->segment<3>(3L * i);
+        const Eigen::Matrix3d& block = k.block(s);  // K's; s K + diag(d) applied once per pair below
         RowSums& sums = scratch.row_sums[static_cast<size_t>(coarse_block - first_block_of_a)];
         if (!sums.used) {
           sums = RowSums{Eigen::Matrix3d::Zero(), Eigen::Matrix3d::Zero(), true};
           scratch.touched.push_back(coarse_block);
         }
         sums.force += block;
-        if (m_with_rotations) sums.moment -= block * cross_matrix(offset_of_row(j));
+        if (m_with_rotations) subtract_times_cross(block, offset_of_row(j), sums.moment);
       }
-      const Eigen::Matrix3d c_i_transpose = cross_matrix(offset_of_row(i));  // C_i^T = [r_i]x
+      const Eigen::Vector3d& r_i = offset_of_row(i);
       for (const int coarse_block : scratch.touched) {
         RowSums& sums = scratch.row_sums[static_cast<size_t>(coarse_block - first_block_of_a)];
         sums.used = false;
-        const int b = m_coarse_column[static_cast<size_t>(coarse_block)];
-        Eigen::Matrix<double, 3, 6> reached = Eigen::Matrix<double, 3, 6>::Zero();  // sum_j A_ij P_j
-        reached.leftCols<3>() = m_coarse.translation_scale[static_cast<size_t>(b)] * sums.force;
-        if (m_with_rotations) reached.rightCols<3>() = sums.moment * m_coarse.axes[static_cast<size_t>(b)];
-        Eigen::Map<Eigen::Matrix<double, 6, 6>> coarse(m_coarse_blocks[static_cast<size_t>(coarse_block)].data());
-        coarse.topRows<3>() += t_a * reached;
-        if (rotations_a > 0) {
-          coarse.bottomRows<3>() += m_coarse.axes[static_cast<size_t>(a)].transpose() * (c_i_transpose * reached);
+        sums.force *= system.stiffness_scale;
+        sums.moment *= system.stiffness_scale;
+        if (m_coarse_column[static_cast<size_t>(coarse_block)] == a) {  // row i's diagonal block is in (a, a)
+          const Eigen::Matrix3d d = system.diagonal->segment<3>(3L * i).asDiagonal();
+          sums.force += d;
+          if (m_with_rotations) subtract_times_cross(d, r_i, sums.moment);
         }
+        AggregateSums& total = scratch.aggregate_sums[static_cast<size_t>(coarse_block - first_block_of_a)];
+        total.force += sums.force;
+        add_cross_times(r_i, sums.force, total.turned_force);
+        if (m_with_rotations) {
+          total.moment += sums.moment;
+          add_cross_times(r_i, sums.moment, total.turned_moment);
+        }
+      }
+    }
+    // The blocks (a, b): [t_a t_b F, t_a M W_b; t_b W_a^T G, W_a^T H W_b].
+    const double t_a = m_coarse.translation_scale[static_cast<size_t>(a)];
+    const int rotations_a = m_coarse.rotation_count[static_cast<size_t>(a)];
+    const Eigen::Matrix3d& w_a = m_coarse.axes[static_cast<size_t>(a)];
+    for (size_t q = 0; q < reach; ++q) {
+      const size_t coarse_block = static_cast<size_t>(first_block_of_a) + q;
+      const auto b = static_cast<size_t>(m_coarse_column[coarse_block]);
+      const double t_b = m_coarse.translation_scale[b];
+      const Eigen::Matrix3d& w_b = m_coarse.axes[b];
+      const AggregateSums& total = scratch.aggregate_sums[q];
+      Eigen::Map<Eigen::Matrix<double, 6, 6>> coarse(m_coarse_blocks[coarse_block].data());
+      coarse.topLeftCorner<3, 3>() = (t_a * t_b) * total.force;
+      if (m_with_rotations) coarse.topRightCorner<3, 3>() = t_a * (total.moment * w_b);
+      if (rotations_a > 0) {
+        coarse.bottomLeftCorner<3, 3>() = t_b * (w_a.transpose() * total.turned_force);
+        if (m_with_rotations) coarse.bottomRightCorner<3, 3>() = w_a.transpose() * (total.turned_moment * w_b);
       }
     }
   }

@@ -128,8 +128,13 @@ class TwoLevelPreconditioner {
     Eigen::Matrix3d moment;
     bool used = false;
   };
+  // ... and over the rows i of a, per coarse block: those two sums, and each with C_i^T in front.
+  struct AggregateSums {
+    Eigen::Matrix3d force, moment, turned_force, turned_moment;
+  };
   struct AssemblyScratch {
     std::vector<RowSums> row_sums;
+    std::vector<AggregateSums> aggregate_sums;
     std::vector<int> touched;
   };
   std::array<AssemblyScratch, MAX_STEP_THREADS> m_assembly_scratch;  // one per part
