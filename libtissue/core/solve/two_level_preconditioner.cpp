@@ -121,16 +121,6 @@ namespace {
   to.col(2) -= r.y() * b.col(0) - r.x() * b.col(1);
 }
 
-// to += [r]x m, column by column (r cross each column).
-[[gnu::always_inline]] inline void add_cross_times(const Eigen::Vector3d& r, const Eigen::Matrix3d& m,
-                                                   Eigen::Matrix3d& to) {
-  for (int c = 0; c < 3; ++c) {
-    to(0, c) += r.y() * m(2, c) - r.z() * m(1, c);
-    to(1, c) += r.z() * m(0, c) - r.x() * m(2, c);
-    to(2, c) += r.x() * m(1, c) - r.y() * m(0, c);
-  }
-}
-
 }  // namespace
 
 // Coarse block (a, b), a <= b, is the sum over rows i of a and j of b of P_i^T A_ij P_j, with
@@ -177,6 +167,7 @@ TISSUE_HOT_KERNEL void TwoLevelPreconditioner::assemble_coarse_rows(const Shifte
         if (m_with_rotations) subtract_times_cross(block, offset_of_row(j), sums.moment);
       }
       const Eigen::Vector3d& r_i = offset_of_row(i);
+      const Eigen::Matrix3d c_i_transpose = cross_matrix(r_i);  // C_i^T = [r_i]x
       for (const int coarse_block : scratch.touched) {
         RowSums& sums = scratch.row_sums[static_cast<size_t>(coarse_block - first_block_of_a)];
         sums.used = false;
@@ -189,10 +180,10 @@ TISSUE_HOT_KERNEL void TwoLevelPreconditioner::assemble_coarse_rows(const Shifte
         }
         AggregateSums& total = scratch.aggregate_sums[static_cast<size_t>(coarse_block - first_block_of_a)];
         total.force += sums.force;
-        add_cross_times(r_i, sums.force, total.turned_force);
+        total.turned_force.noalias() += c_i_transpose * sums.force;
         if (m_with_rotations) {
           total.moment += sums.moment;
-          add_cross_times(r_i, sums.moment, total.turned_moment);
+          total.turned_moment.noalias() += c_i_transpose * sums.moment;
         }
       }
     }
