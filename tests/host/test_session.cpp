@@ -262,6 +262,24 @@ TEST_P(CrossingCutsScenario, DrawsTheRenderSurfaceClosedInEveryFrame) {
 }
 INSTANTIATE_TEST_SUITE_P(HostScenarios, CrossingCutsScenario, ::testing::Values("x_cut_frog", "flap_frog"));
 
+// The careless hand's 10 + 10 hatched strokes through the frog sagging on its tray (docs/hatched_frog.toml,
+// the picture in docs/BENCHMARKS.md): the render surface closed in every frame (issue 41, item 4;
+// once 7 of its 96 frames had border or repeated edges where strokes passed closer than a tet).
+TEST(HatchedFrogScenario, DrawsTheRenderSurfaceClosedInEveryFrame) {
+  const Scenario scenario = load_scenario(SCENARIOS.parent_path().parent_path() / "docs" / "hatched_frog.toml");
+  const std::filesystem::path dir = fresh_dir("render_hatched_frog");
+  const SessionSummary s = run_offline(scenario, dir);
+  ASSERT_GT(s.cut_tets, 1000u);
+  std::vector<std::filesystem::path> frames;
+  for (const auto& entry : std::filesystem::directory_iterator(dir / "frames")) frames.push_back(entry.path());
+  ASSERT_GT(frames.size(), 90u);
+  for (const std::filesystem::path& frame : frames) {
+    const SurfaceShape shape = shape_of(vtu_triangles(frame));
+    EXPECT_EQ(shape.border, 0u) << frame.filename();
+    EXPECT_EQ(shape.repeated, 0u) << frame.filename();
+  }
+}
+
 // The hand's figures reach the summary (device kind "hand"): a hand pressing the frog was in contact,
 // and the device's force did work on it.
 // A scalpel drawn by a hand through the frog (E = 1 MPa): the stroke cuts through although the
