@@ -335,6 +335,9 @@ void DeformableBody::evaluate_pass(const Eigen::VectorXd& displacement_m, Eigen:
 }
 
 bool DeformableBody::evaluate_ahead(const Eigen::VectorXd& displacement_m, Eigen::VectorXd& internal_force_n) {
+  const bool cutting = m_element_revision != m_element_revision_at_ahead;
+  m_element_revision_at_ahead = m_element_revision;
+  if (cutting) return false;  // a stroke under way: the next step's cut would change the body again
   for (const ForceTerm* term : m_force_terms) {
     if (!term->idle()) return false;  // the tool moves between steps: it would not be taken
   }

@@ -118,7 +118,10 @@ class DeformableBody final : public DynamicsModel {
     evaluate_pass(displacement_m, internal_force_n, update_tangent, /*with_potential=*/true, ExtractInto::own);
   }
   /// The rotations go beside the elements' own (ExtractInto::ahead) and are swapped in when taken.
-  /// Declined while an attached force term is not idle.
+  /// Declined while an attached force term is not idle, and when the body was cut since the last
+  /// call: a stroke under way cuts the next step too, which could not take it (the caller's energy
+  /// pass, without the forces and the tangent, is cheaper; the first step after the stroke
+  /// evaluates its start itself).
   bool evaluate_ahead(const Eigen::VectorXd& displacement_m, Eigen::VectorXd& internal_force_n) override;
   bool take_evaluation_ahead(const Eigen::VectorXd& displacement_m) override;
   /// The uncut tets' forces and blocks are then assembled by the team (bitwise the same result).
@@ -409,6 +412,7 @@ class DeformableBody final : public DynamicsModel {
     m_evaluated_potential_j = std::numeric_limits<double>::quiet_NaN();
   }
   long m_element_revision = 0;  // counts enrichments
+  long m_element_revision_at_ahead = 0;  // m_element_revision at the last evaluate_ahead call
   long m_parts_revision = -1;   // m_element_revision when m_parts was found
 
   std::vector<ForceTerm*> m_force_terms;                // attached, not owned

@@ -48,7 +48,9 @@ class Forwarding final : public DynamicsModel {
     return m_body.potential_energy_at_last_evaluate_j();
   }
   bool evaluate_ahead(const Eigen::VectorXd& u, Eigen::VectorXd& f) override {
-    return m_ahead && m_body.evaluate_ahead(u, f);
+    const bool made = m_ahead && m_body.evaluate_ahead(u, f);
+    m_made += made ? 1 : 0;
+    return made;
   }
   bool take_evaluation_ahead(const Eigen::VectorXd& u) override {
     const bool taken = m_body.take_evaluation_ahead(u);
@@ -56,11 +58,13 @@ class Forwarding final : public DynamicsModel {
     return taken;
   }
   [[nodiscard]] int taken() const { return m_taken; }
+  [[nodiscard]] int made() const { return m_made; }
 
  private:
   DeformableBody& m_body;
   bool m_ahead;
   int m_taken = 0;
+  int m_made = 0;
 };
 
 const TetMesh& beam() {
@@ -232,6 +236,48 @@ TEST(EvaluationAhead, IsTakenOnlyAtTheSameDisplacementWithNothingChangedSince) {
   EXPECT_TRUE(swing.body.evaluate_ahead(u, force_ahead));
   swing.spring.set(std::nullopt, swing.body.term_layout());  // idle to idle: no change
   EXPECT_TRUE(swing.body.take_evaluation_ahead(u));
+}
+
+TEST(EvaluationAhead, IsNotMadeWhileAStrokeCutsStepAfterStep) {
+  // A stroke cuts the swinging beam across at x = 5.5 cm over three steps (a third of the crossed
+  // tets each): a step that cut would not take an evaluation made at the end of the step before, so
+  // none is made while the body is being cut (the guard takes its energy pass); the step after the
+  // stroke makes one again and the next takes it. The steps are bitwise those of a model that
+  // declines every evaluation ahead. (Made at every step's end, the two evaluations ahead of the
+  // stroke's steps were wasted: each cost a whole assembly.)
+  Swing ahead(true), declines(false);
+  const std::vector<TetCut> cuts =
+      xfem_test::plane_cuts(beam(), xfem_test::Plane{Eigen::Vector3d(1, 0.1, 0.05).normalized(), 0.0553});
+  ASSERT_GE(cuts.size(), 6U);
+  const size_t third = cuts.size() / 3;
+  for (int n = 0; n < 14; ++n) {
+    const int stroke_step = n - 6;  // steps 6, 7 and 8 cut
+    if (stroke_step >= 0 && stroke_step < 3) {
+      const auto first = cuts.begin() + static_cast<long>(third) * stroke_step;
+      const auto end = stroke_step == 2 ? cuts.end() : first + static_cast<long>(third);
+      const std::vector<TetCut> part(first, end);
+      for (Swing* swing : {&ahead, &declines}) {
+        swing->body.enrich(part, swing->state);
+        swing->integrator.restart(Restart::system_grown);
+      }
+    }
+    const int made_before = ahead.model.made(), taken_before = ahead.model.taken();
+    const StepReport report = ahead.step();
+    declines.step();
+    ASSERT_GT(report.guard_s, 0.0) << "step " << n << ": the swing turns the beam past the guard's angle";
+    if (stroke_step >= 0 && stroke_step < 3) {
+      EXPECT_EQ(ahead.model.made(), made_before) << "step " << n << ": made while the stroke cuts";
+    }
+    if (stroke_step == 3) {
+      EXPECT_GT(ahead.model.made(), made_before) << "the step after the stroke";
+    }
+    if (stroke_step == 4) {
+      EXPECT_GT(ahead.model.taken(), taken_before) << "the second step after the stroke";
+    }
+    ASSERT_TRUE(bitwise_equal(ahead.state.displacement_m, declines.state.displacement_m)) << "step " << n;
+    ASSERT_TRUE(bitwise_equal(ahead.state.velocity_m_per_s, declines.state.velocity_m_per_s)) << "step " << n;
+  }
+  EXPECT_GT(ahead.model.taken(), 5);
 }
 
 }  // namespace
