@@ -180,6 +180,20 @@ SurfaceShape shape_of(const std::vector<std::uint32_t>& triangles) {
   return shape;
 }
 
+// A session's frames (dir/frames, in time order), each checked drawn closed: no border edge and no
+// directed edge used twice.
+std::vector<std::filesystem::path> frames_drawn_closed(const std::filesystem::path& dir) {
+  std::vector<std::filesystem::path> frames;
+  for (const auto& entry : std::filesystem::directory_iterator(dir / "frames")) frames.push_back(entry.path());
+  std::sort(frames.begin(), frames.end());
+  for (const std::filesystem::path& frame : frames) {
+    const SurfaceShape shape = shape_of(vtu_triangles(frame));
+    EXPECT_EQ(shape.border, 0u) << frame.filename();
+    EXPECT_EQ(shape.repeated, 0u) << frame.filename();
+  }
+  return frames;
+}
+
 // The complete cut with the frog's render surface switched on (the scenario's surface.renderSurface):
 // every frame, while the blade is in the body and after, is the fine surface closed and consistently
 // oriented (every directed edge has its twin, none is used twice); the last (more than its 23240
@@ -217,15 +231,8 @@ TEST(RenderSurface, TheCompleteCutDrawsTheFrogClosedInEveryFrame) {
   const std::filesystem::path dir = fresh_dir("render_complete");
   const SessionSummary s = run_offline(scenario, dir);
   ASSERT_GT(s.cut_tets, 50u);
-  std::vector<std::filesystem::path> frames;
-  for (const auto& entry : std::filesystem::directory_iterator(dir / "frames")) frames.push_back(entry.path());
+  const std::vector<std::filesystem::path> frames = frames_drawn_closed(dir);
   ASSERT_GT(frames.size(), 40u);
-  std::sort(frames.begin(), frames.end());
-  for (const std::filesystem::path& frame : frames) {
-    const SurfaceShape shape = shape_of(vtu_triangles(frame));
-    EXPECT_EQ(shape.border, 0u) << frame.filename();
-    EXPECT_EQ(shape.repeated, 0u) << frame.filename();
-  }
   const std::vector<std::uint32_t> triangles = vtu_triangles(frames.back());
   EXPECT_GT(triangles.size(), 3u * 23240u);  // the uncut frog's triangles and the cut faces'
 
@@ -250,14 +257,8 @@ TEST_P(CrossingCutsScenario, DrawsTheRenderSurfaceClosedInEveryFrame) {
   const std::filesystem::path dir = fresh_dir(std::string("render_") + GetParam());
   const SessionSummary s = run_offline(scenario, dir);
   ASSERT_GT(s.cut_tets, 50u);
-  std::vector<std::filesystem::path> frames;
-  for (const auto& entry : std::filesystem::directory_iterator(dir / "frames")) frames.push_back(entry.path());
+  const std::vector<std::filesystem::path> frames = frames_drawn_closed(dir);
   ASSERT_GT(frames.size(), 40u);
-  for (const std::filesystem::path& frame : frames) {
-    const SurfaceShape shape = shape_of(vtu_triangles(frame));
-    EXPECT_EQ(shape.border, 0u) << frame.filename();
-    EXPECT_EQ(shape.repeated, 0u) << frame.filename();
-  }
   EXPECT_GT(vtu_triangles(frames.back()).size(), 3u * 23240u);  // the render surface, not the skin
 }
 INSTANTIATE_TEST_SUITE_P(HostScenarios, CrossingCutsScenario, ::testing::Values("x_cut_frog", "flap_frog"));
@@ -270,14 +271,8 @@ TEST(HatchedFrogScenario, DrawsTheRenderSurfaceClosedInEveryFrame) {
   const std::filesystem::path dir = fresh_dir("render_hatched_frog");
   const SessionSummary s = run_offline(scenario, dir);
   ASSERT_GT(s.cut_tets, 1000u);
-  std::vector<std::filesystem::path> frames;
-  for (const auto& entry : std::filesystem::directory_iterator(dir / "frames")) frames.push_back(entry.path());
+  const std::vector<std::filesystem::path> frames = frames_drawn_closed(dir);
   ASSERT_GT(frames.size(), 90u);
-  for (const std::filesystem::path& frame : frames) {
-    const SurfaceShape shape = shape_of(vtu_triangles(frame));
-    EXPECT_EQ(shape.border, 0u) << frame.filename();
-    EXPECT_EQ(shape.repeated, 0u) << frame.filename();
-  }
 }
 
 // The hand's figures reach the summary (device kind "hand"): a hand pressing the frog was in contact,
