@@ -10,6 +10,7 @@
 #include "importer/fmu_error.hpp"
 #include "scenario/scenario.hpp"
 #include "links/fmu_links.hpp"
+#include "schedule/timer_check.hpp"
 #include "session/session.hpp"
 #include "view/live_view.hpp"
 
@@ -29,6 +30,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
+#include <fstream>
 #include <iomanip>
 #include <iostream>
 #include <random>
@@ -234,6 +236,35 @@ CLI::App* add_bench_command(CLI::App& app, int& steps, double& step_s, std::stri
   return bench;
 }
 
+// `timer`'s arguments.
+struct TimerArguments {
+  double period_s = 1e-3;
+  double duration_s = 10.0;
+  std::string json_file;
+  bool no_priority = false;
+};
+
+CLI::App* add_timer_command(CLI::App& app, TimerArguments& a) {
+  CLI::App* timer = app.add_subcommand(
+      "timer", "Check this machine's timer alone: the haptic thread's ticks with no work, its deadline misses");
+  timer->add_option("--period", a.period_s, "Tick period [s]")->check(CLI::Range(1e-5, 1.0))->capture_default_str();
+  timer->add_option("--duration", a.duration_s, "How long [s]")->check(CLI::Range(1e-3, 3600.0))->capture_default_str();
+  timer->add_option("--json", a.json_file, "Also write the figures to this JSON file");
+  timer->add_flag("--no-rt-priority", a.no_priority, "Do not ask for SCHED_FIFO");
+  return timer;
+}
+
+int timer_command(const TimerArguments& a) {
+  const TimerCheck check = check_timer(a.period_s, a.duration_s, !a.no_priority);
+  print_timer_check(std::cout, check, a.period_s);
+  if (!a.json_file.empty()) {
+    std::ofstream json(a.json_file);
+    json << check.to_json();
+    if (!json) throw std::runtime_error("cannot write " + a.json_file);
+  }
+  return 0;
+}
+
 CLI::App* add_compare_command(CLI::App& app, CompareArguments& a, std::string& fmu_dir, bool& quiet) {
   CLI::App* compare =
       app.add_subcommand("compare",
@@ -315,6 +346,8 @@ int main(int argc, char** argv) {
   CLI::App* bench = add_bench_command(app, bench_steps, bench_step_s, fmu_dir);
   CompareArguments compare_arguments;
   CLI::App* compare = add_compare_command(app, compare_arguments, fmu_dir, quiet);
+  TimerArguments timer_arguments;
+  CLI::App* timer = add_timer_command(app, timer_arguments);
 
   CLI11_PARSE(app, argc, argv);
   try {
@@ -325,6 +358,7 @@ int main(int argc, char** argv) {
     }
     if (info->parsed()) return info_command(fmu_file);
     if (bench->parsed()) return bench_command(fmus, bench_steps, bench_step_s);
+    if (timer->parsed()) return timer_command(timer_arguments);
     if (compare->parsed()) {
       CompareOptions& options = compare_arguments.options;
       options.scenario_file = compare_arguments.scenario;

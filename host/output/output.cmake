@@ -16,4 +16,4 @@ add_library(tissue::host_output ALIAS tissue_host_output)
 # Headers are included as "output/<file>.hpp".
 target_include_directories(tissue_host_output PUBLIC ${PROJECT_SOURCE_DIR}/host)
 target_compile_features(tissue_host_output PUBLIC cxx_std_20)
-target_link_libraries(tissue_host_output PUBLIC tissue::host_device PRIVATE PNG::PNG nlohmann_json::nlohmann_json tissue::warnings)
+target_link_libraries(tissue_host_output PUBLIC tissue::host_device nlohmann_json::nlohmann_json PRIVATE PNG::PNG tissue::warnings)

@@ -8,13 +8,10 @@
 #include <ostream>
 
 namespace tissue::host {
-namespace {
 
 nlohmann::ordered_json percentiles_json(const Percentiles& p) {
   return {{"p50", p.p50}, {"p99", p.p99}, {"max", p.max}};
 }
-
-}  // namespace
 
 Percentiles percentiles(std::vector<double> values, double scale) {
   Percentiles p;

@@ -7,6 +7,8 @@
 #include "device/hand_device.hpp"
 #include "device/igtl_counters.hpp"
 
+#include <nlohmann/json_fwd.hpp>
+
 #include <cstdint>
 #include <filesystem>
 #include <iosfwd>
@@ -58,6 +60,8 @@ struct SessionSummary {
 
 /// p50, p99 and max of `values` times `scale` (zeros for none).
 Percentiles percentiles(std::vector<double> values, double scale);
+/// {"p50": .., "p99": .., "max": ..}.
+nlohmann::ordered_json percentiles_json(const Percentiles& p);
 
 /// The summary in a few lines, and where the outputs are.
 void print_summary(std::ostream& out, const SessionSummary& summary, const std::filesystem::path& output_dir);

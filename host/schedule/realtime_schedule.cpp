@@ -3,6 +3,7 @@
 
 #include "schedule/frame_budget.hpp"
 #include "schedule/memory_reserve.hpp"
+#include "schedule/tick_deadlines.hpp"
 #include "sync/frame_pipe.hpp"
 #include "sync/realtime_clock.hpp"
 
@@ -61,10 +62,10 @@ class RealtimeScheduler {
 
 // The haptic thread: ticks on absolute deadlines of the haptic period, measuring the periods.
 void RealtimeScheduler::haptic_thread(RealtimeRun& run) {
-  if (m_options.realtime_priority) run.haptic_priority = try_fifo_priority(80);
+  if (m_options.realtime_priority) run.haptic_priority = try_fifo_priority(HAPTIC_FIFO_PRIORITY);
   run.ready.fetch_add(1);
   run.go.wait(false, std::memory_order_acquire);  // blocked, not spinning: see run()
-  const Nanoseconds period = to_ns(m_schedule.haptic_period_s);
+  const TickDeadlines clock{run.start, to_ns(m_schedule.haptic_period_s)};
   Nanoseconds previous_wake = 0;
   if (m_options.haptic_thread_started) m_options.haptic_thread_started();
   for (std::uint64_t n = 0; n < m_schedule.ticks; ++n) {
@@ -72,7 +73,7 @@ void RealtimeScheduler::haptic_thread(RealtimeRun& run) {
       run.stopped_at = n;  // asked to end early (Ctrl-C): the summary covers the ticks run
       break;
     }
-    const Nanoseconds deadline = run.start + static_cast<Nanoseconds>(n) * period;
+    const Nanoseconds deadline = clock.deadline(n);
     sleep_until_ns(deadline);
     const Nanoseconds woke = now_ns();
     if (n == 0) m_summary.haptic_first_tick_late_us = static_cast<double>(woke - deadline) * 1e-3;
@@ -86,7 +87,7 @@ void RealtimeScheduler::haptic_thread(RealtimeRun& run) {
     }
     previous_wake = woke;
     m_steps.haptic_tick(n);
-    if (now_ns() > deadline + period) ++m_summary.deadline_misses;  // the next tick starts late
+    if (clock.missed(n, now_ns())) ++m_summary.deadline_misses;
     m_steps.haptic_tick_timed(n, m_periods_s.empty() ? 0.0 : m_periods_s.back(), m_summary.deadline_misses);
     run.ticks_done.store(n + 1, std::memory_order_relaxed);
   }
@@ -130,7 +131,7 @@ void RealtimeScheduler::record_frame(FramePipe& pipe, FrameBudget& frames, Nanos
 // The dynamics thread: a tissue step per slot, the overrun policy when one takes longer.
 void RealtimeScheduler::dynamics_thread(RealtimeRun& run, FramePipe& pipe) {
   if (m_options.realtime_priority) {
-    run.dynamics_priority = try_fifo_priority(70);
+    run.dynamics_priority = try_fifo_priority(DYNAMICS_FIFO_PRIORITY);
     touch_heap(DYNAMICS_HEAP_RESERVE_BYTES);  // locked with the rest by run()
   }
   run.ready.fetch_add(1);

@@ -6,7 +6,8 @@ add_library(tissue_host_schedule STATIC
   ${CMAKE_CURRENT_LIST_DIR}/schedule.cpp
   ${CMAKE_CURRENT_LIST_DIR}/offline_schedule.cpp
   ${CMAKE_CURRENT_LIST_DIR}/realtime_schedule.cpp
-  ${CMAKE_CURRENT_LIST_DIR}/memory_reserve.cpp)
+  ${CMAKE_CURRENT_LIST_DIR}/memory_reserve.cpp
+  ${CMAKE_CURRENT_LIST_DIR}/timer_check.cpp)
 add_library(tissue::host_schedule ALIAS tissue_host_schedule)
 target_include_directories(tissue_host_schedule PUBLIC ${PROJECT_SOURCE_DIR}/host)
 target_compile_features(tissue_host_schedule PUBLIC cxx_std_20)

@@ -6,7 +6,7 @@ Markdown table with the machine. Real time needs the cores to itself: run nothin
 
 Usage: tests/bench/realtime_table.py [--host build/release/host/tissue-host] [--runs 5] [--only NAME,NAME]
                                     [--set PARAMETER=VALUE ...] [--alternate PARAMETER=VALUE ...]
-                                    [--alternate-host OTHER/tissue-host]
+                                    [--alternate-host OTHER/tissue-host] [--timer-seconds 10]
 --set overrides Tissue parameters in every scenario (e.g. the default before issue 40:
 --set integrator.linearSolver=pcg --set integrator.newtonMaxIterations=5); --alternate runs each
 scenario's runs twice over, interleaved, without and with these overrides, and prints both tables
@@ -19,6 +19,8 @@ The progress lines (stderr) say what each overrun's slot held (slots.csv: the st
 Each run writes its frames to a temporary folder (Python's tempfile: TMPDIR): a render surface's VTU
 frames are 1.7 MB each, and on the 2-core VM their writeback to disk delays the haptic thread's
 wake-ups (docs/BENCHMARKS.md, Host); TMPDIR=/dev/shm measures the session without the disk.
+Before each run `tissue-host timer` ticks alone for --timer-seconds (10 s): the deadline misses the
+machine makes with no session at all, printed beside the session's (a run cannot miss fewer).
 Uses only the Python standard library.
 """
 import argparse
@@ -45,6 +47,8 @@ def main():
                         help="also run every scenario with these, interleaved run by run, and print both tables")
     parser.add_argument("--alternate-host", default=None, metavar="TISSUE_HOST",
                         help="also run every scenario with this tissue-host, interleaved run by run, and print both tables")
+    parser.add_argument("--timer-seconds", type=float, default=10.0,
+                        help="before each run, `tissue-host timer` alone this long (the machine's own deadline misses)")
     args = parser.parse_args()
     wanted = args.only.split(",")
     scenarios = sorted(p for p in (ROOT / "host" / "scenarios").glob("*.toml")
@@ -58,9 +62,14 @@ def main():
     for scenario in scenarios:
         runs = {label: [] for label, _, _ in variants}
         for k in range(args.runs):
+            timer = timer_alone(args.host, args.timer_seconds)
+            print("  the timer alone before run %d: misses %d of %d (%.2f %%), woke late max %.0f us"
+                  % (k + 1, timer["deadline_misses"], timer["ticks"], timer_misses_percent(timer),
+                     timer["wake_late_us"]["max"]), file=sys.stderr)
             for label, host, overrides in variants:
                 runs[label].append(run_once(host, scenario, overrides))
                 r = runs[label][-1]
+                r["timer_alone"] = timer
                 print("  %s%s run %d/%d: overruns %d (steps %d, slots skipped %d), misses %d of %d, step p99 %.2f ms, "
                       "SCHED_FIFO %s"
                       % (scenario.stem, " (" + label + ")" if label else "", k + 1, args.runs, r["tissue_overruns"],
@@ -79,6 +88,19 @@ def main():
         if label:
             print("\n%s (runs interleaved with the table above):\n" % label)
         print_table(rows[label])
+
+
+def timer_alone(host, seconds):
+    """`tissue-host timer`: the haptic thread's ticks with no session, as this machine keeps them now."""
+    with tempfile.TemporaryDirectory(prefix="tissue-timer-") as out:
+        path = pathlib.Path(out) / "timer.json"
+        subprocess.run([host, "timer", "--duration", str(seconds), "--json", str(path)], check=True,
+                       capture_output=True, text=True)
+        return json.loads(path.read_text())
+
+
+def timer_misses_percent(timer):
+    return 100.0 * timer["deadline_misses"] / max(timer["ticks"], 1)
 
 
 def toml_value(text):
@@ -137,8 +159,8 @@ def overrun_slots(path):
 
 def print_table(rows):
     print("| scenario | tissue overruns | haptic misses (of ticks) | misses % | tissue step p50 / p99 / max (ms), "
-          "median run | cut steps / before the cut: p50; p99 |")
-    print("|---|---|---|---:|---|---|")
+          "median run | cut steps / before the cut: p50; p99 | the timer alone before each run: misses % |")
+    print("|---|---|---|---:|---|---|---|")
     for name, runs in rows:
         overruns = [r["tissue_overruns"] for r in runs]
         misses = [r["deadline_misses"] for r in runs]
@@ -153,10 +175,11 @@ def print_table(rows):
             if during > 0 and before > 0:
                 ratios.append("%.2f / %.2f = %.2fx" % (during, before, during / before))
         cut = "; ".join(ratios) if ratios else "-"
-        print("| %s | %s | %s (of %d) | %.3f | %.2f / %.2f / %.2f (p99 of the runs %.2f-%.2f) | %s |"
+        alone = " ".join("%.2f" % timer_misses_percent(r["timer_alone"]) for r in runs)
+        print("| %s | %s | %s (of %d) | %.3f | %.2f / %.2f / %.2f (p99 of the runs %.2f-%.2f) | %s | %s |"
               % (name, " ".join(map(str, overruns)), " ".join(map(str, misses)), ticks,
                  100.0 * statistics.mean(misses) / max(ticks, 1), s["p50"], s["p99"], s["max"], min(p99s), max(p99s),
-                 cut))
+                 cut, alone))
 
 
 if __name__ == "__main__":
