@@ -23,6 +23,8 @@ using cut_render_detail::border_loops;
 using cut_render_detail::directed_key;
 using cut_render_detail::ear_clip;
 using cut_render_detail::edge_key;
+using cut_render_detail::flat_holes;
+using cut_render_detail::FlatHoles;
 using cut_render_detail::junction_smoothed;
 using cut_render_detail::merge_unfacing_switches;
 
@@ -581,8 +583,16 @@ void CutRenderSurface::cap_loops(const DeformableBody& body) {
   bridge_switches(loops, chains, m_rest_m, line, plane_of, alone, ends);
   bridge_tips(m_rest_m, line, ends);
   std::vector<std::vector<int>> faces;
-  m_open_loops += walk_faces(loops, chains, ends.link, chain_starting_at, faces);
+  const int unclosed = walk_faces(loops, chains, ends.link, chain_starting_at, faces);
   for (const std::vector<int>& face : faces) cap_polygon(face, m_rest_m, m_triangles, edges);
+  // Every walk closed: every loop is capped. Else the holes left: the flat ones filled (flat_holes).
+  if (unclosed > 0) {
+    CapEdges now{{}, {}, m_surface_edges, edges.vertices};
+    find_split_edges(m_triangles, m_points.size(), now);
+    const FlatHoles holes = flat_holes(now.directed, m_rest_m, part_of_point);
+    for (const std::vector<int>& hole : holes.flat) cap_polygon(hole, m_rest_m, m_triangles, now);
+    m_open_loops = holes.others;
+  }
   m_cap_triangles = static_cast<int>(m_triangles.size() - surface_triangles);
   m_simple_caps = std::move(simple_caps);
 }

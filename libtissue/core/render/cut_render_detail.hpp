@@ -35,4 +35,22 @@ void merge_unfacing_switches(std::map<std::array<int, 5>, std::vector<size_t>>& 
 // A loop's points' cuts with the short runs next to a junction given a neighbour's cut.
 std::vector<int> junction_smoothed(std::vector<int> label);
 
+// Whether the points of `loop` lie within `tolerance_m` of their least-squares plane.
+bool flat_within(const std::vector<int>& loop, const std::vector<Eigen::Vector3d>& x, double tolerance_m);
+
+// The holes the caps' chain walks left (a switch or a tip with no partner to close on: strokes closer
+// than a tet, several in one tet) are the border loops of the surface capped so far. One within
+// FLAT_HOLE_M of its plane, closed, all its points in one material part (part_of), is a cap's face
+// the walk missed, to be ear-clipped in that plane. Others stay open: filled flat, a hole around a
+// junction of two cuts drew a sheet through the piece (30 + 30 strokes, every hole filled: the
+// closed surface enclosed 0.39 of the simulated volume), and one between two parts a sheet between
+// pieces that fall apart.
+inline constexpr double FLAT_HOLE_M = 1e-4;
+struct FlatHoles {
+  std::vector<std::vector<int>> flat;  // in cap order (border_loops)
+  int others = 0;                      // the holes left open
+};
+FlatHoles flat_holes(const std::unordered_map<long long, int>& directed, const std::vector<Eigen::Vector3d>& x,
+                     const std::function<int(int)>& part_of);
+
 }  // namespace tissue::cut_render_detail

@@ -2,10 +2,12 @@
 // chains that face neither side, and the ear clipping that triangulates the faces (cut_render_caps.cpp).
 #include "core/render/cut_render_detail.hpp"
 
+#include <Eigen/Eigenvalues>
 #include <Eigen/Geometry>
 
 #include <algorithm>
 #include <climits>
+#include <cmath>
 #include <cstddef>
 #include <functional>
 #include <map>
@@ -155,6 +157,38 @@ std::vector<int> junction_smoothed(std::vector<int> label) {
     }
   }
   return label;
+}
+
+bool flat_within(const std::vector<int>& loop, const std::vector<Eigen::Vector3d>& x, double tolerance_m) {
+  if (loop.empty()) return true;
+  Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
+  for (const int q : loop) centroid += x[static_cast<size_t>(q)];
+  centroid /= static_cast<double>(loop.size());
+  Eigen::Matrix3d scatter = Eigen::Matrix3d::Zero();
+  for (const int q : loop) {
+    const Eigen::Vector3d d = x[static_cast<size_t>(q)] - centroid;
+    scatter += d * d.transpose();
+  }
+  const Eigen::Vector3d normal = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(scatter).eigenvectors().col(0);
+  return std::all_of(loop.begin(), loop.end(), [&](int q) {
+    return std::abs((x[static_cast<size_t>(q)] - centroid).dot(normal)) <= tolerance_m;
+  });
+}
+
+FlatHoles flat_holes(const std::unordered_map<long long, int>& directed, const std::vector<Eigen::Vector3d>& x,
+                     const std::function<int(int)>& part_of) {
+  FlatHoles holes;
+  for (std::vector<int>& loop : border_loops(directed)) {
+    const bool closed = loop.size() >= 3 && directed.contains(directed_key(loop.front(), loop.back()));
+    const int part = closed ? part_of(loop.front()) : -1;
+    const bool one_part = closed && std::all_of(loop.begin(), loop.end(), [&](int q) { return part_of(q) == part; });
+    if (one_part && flat_within(loop, x, FLAT_HOLE_M)) {
+      holes.flat.push_back(std::move(loop));
+    } else {
+      ++holes.others;
+    }
+  }
+  return holes;
 }
 
 // A chain whose points all ride on uncut tets faces neither side of its cut (0): a switch of it alone

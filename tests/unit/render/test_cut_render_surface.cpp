@@ -14,6 +14,7 @@
 #include "core/mesh/box_mesh.hpp"
 #include "core/mesh/mesh_io.hpp"
 #include "core/mesh/topology.hpp"
+#include "core/render/cut_render_detail.hpp"
 #include "core/render/cut_render_surface.hpp"
 #include "core/tissue.hpp"
 #include "unit/material_parts.hpp"
@@ -22,6 +23,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <functional>
 #include <memory>
@@ -616,6 +618,66 @@ TEST(CutRenderSurface, AChainFacingNeitherSideStillJoinsItsPartnerAtTheJunction)
     render_m3 += part.volume_m3;
   for (const double v : material_part_volumes_m3(frog.mesh, frog.body)) simulated_m3 += v;
   EXPECT_NEAR(render_m3 / simulated_m3, 1.042, 0.08);
+}
+
+}  // namespace
+}  // namespace tissue
+namespace tissue {
+namespace {
+
+// The border loops of `triangles` (directed edges without a twin, walked), counted by the test itself.
+std::vector<std::vector<int>> border_loops_of(const std::vector<std::array<int, 3>>& triangles) {
+  std::map<std::pair<int, int>, int> directed;
+  for (const auto& t : triangles) {
+    for (size_t k = 0; k < 3; ++k) ++directed[{t[k], t[(k + 1) % 3]}];
+  }
+  std::multimap<int, int> next;
+  for (const auto& [edge, uses] : directed) {
+    if (!directed.contains({edge.second, edge.first})) next.emplace(edge.first, edge.second);
+  }
+  std::vector<std::vector<int>> loops;
+  while (!next.empty()) {
+    std::vector<int> loop{next.begin()->first};
+    for (auto at = next.begin(); at != next.end(); at = next.find(loop.back())) {
+      const int to = at->second;
+      next.erase(at);
+      if (to == loop.front()) break;
+      loop.push_back(to);
+    }
+    loops.push_back(std::move(loop));
+  }
+  return loops;
+}
+
+// 30 + 30 hatched strokes, 2 mm apart: the chain walk cannot close every face there (issue 41, item
+// 4). What it leaves is reported as the surface's holes, which the test counts itself, and none of
+// them is flat: a flat hole is a face the walk missed, now filled (before: 378 holes, 185 of them
+// within 0.1 mm of their plane; now 193, none).
+TEST(CutRenderSurface, DenseHatchingLeavesNoFlatHole) {
+  CutFrog frog(hatching(30));
+  CutRenderSurface render = frog.cut_render_surface();
+  const std::vector<std::vector<int>> holes = border_loops_of(render.triangles());
+  EXPECT_EQ(render.open_loop_count(), static_cast<int>(holes.size()));
+  EXPECT_GT(render.open_loop_count(), 0);  // the issue's target is not reached: say so when it is
+  int flat = 0;
+  for (const std::vector<int>& hole : holes) flat += cut_render_detail::flat_within(hole, render.rest_positions_m(), 1e-4);
+  EXPECT_EQ(flat, 0);
+}
+
+TEST(FlatWithin, MeasuresTheLoopAgainstItsLeastSquaresPlaneWhateverItsTilt) {
+  const Eigen::Vector3d normal = Eigen::Vector3d(1.0, 2.0, 2.0) / 3.0;
+  const Eigen::Vector3d u = normal.unitOrthogonal(), v = normal.cross(u);
+  std::vector<Eigen::Vector3d> x;
+  std::vector<int> loop;
+  for (int k = 0; k < 12; ++k) {
+    const double angle = 2.0 * M_PI * k / 12.0;
+    // A 4 mm ring on a tilted plane, every other point 0.06 mm off it (+-0.03 mm about the fit).
+    x.push_back(Eigen::Vector3d(0.01, 0.02, 0.03) + 0.002 * (std::cos(angle) * u + std::sin(angle) * v) +
+                (k % 2 == 0 ? 6e-5 : 0.0) * normal);
+    loop.push_back(k);
+  }
+  EXPECT_TRUE(cut_render_detail::flat_within(loop, x, 3.1e-5));
+  EXPECT_FALSE(cut_render_detail::flat_within(loop, x, 2.9e-5));
 }
 
 }  // namespace
