@@ -38,16 +38,25 @@ std::vector<int> junction_smoothed(std::vector<int> label);
 // Whether the points of `loop` lie within `tolerance_m` of their least-squares plane.
 bool flat_within(const std::vector<int>& loop, const std::vector<Eigen::Vector3d>& x, double tolerance_m);
 
+// Splits `loop` by a chord between two of its points into two runs each within FLAT_HOLE_M of its
+// own plane (the first such chord that is not an edge already, edge_exists(u, v); loops of at most
+// MAX_SPLIT_HOLE_POINTS points), appended to `flat` in the loop's order, each closed by the chord.
+// Whether found.
+bool split_in_two_flat(const std::vector<int>& loop, const std::vector<Eigen::Vector3d>& x,
+                       std::vector<std::vector<int>>& flat, const std::function<bool(int, int)>& edge_exists = {});
+
 // The holes the caps' chain walks left (a switch or a tip with no partner to close on: strokes closer
-// than a tet, several in one tet) are the border loops of the surface capped so far. One within
-// FLAT_HOLE_M of its plane, closed, all its points in one material part (part_of), is a cap's face
-// the walk missed, to be ear-clipped in that plane. Others stay open: filled flat, a hole around a
-// junction of two cuts drew a sheet through the piece (30 + 30 strokes, every hole filled: the
-// closed surface enclosed 0.39 of the simulated volume), and one between two parts a sheet between
-// pieces that fall apart.
+// than a tet, several in one tet) are the border loops of the surface capped so far. One closed,
+// all its points in one material part (part_of), and within FLAT_HOLE_M of its plane is a cap's
+// face the walk missed, to be ear-clipped in that plane; one that a chord splits into two such
+// halves, two faces meeting at a junction of two cuts (split_in_two_flat). Others stay open: filled
+// flat, a hole around a junction drew a sheet through the piece (30 + 30 strokes, every hole filled:
+// the closed surface enclosed 0.39 of the simulated volume), and one between two parts a sheet
+// between pieces that fall apart.
 inline constexpr double FLAT_HOLE_M = 1e-4;
+inline constexpr size_t MAX_SPLIT_HOLE_POINTS = 96;
 struct FlatHoles {
-  std::vector<std::vector<int>> flat;  // in cap order (border_loops)
+  std::vector<std::vector<int>> flat;  // faces to fill, in cap order (border_loops)
   int others = 0;                      // the holes left open
 };
 FlatHoles flat_holes(const std::unordered_map<long long, int>& directed, const std::vector<Eigen::Vector3d>& x,

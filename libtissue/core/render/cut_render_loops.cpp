@@ -175,6 +175,71 @@ bool flat_within(const std::vector<int>& loop, const std::vector<Eigen::Vector3d
   });
 }
 
+namespace {
+
+// Running sums of a loop's points and their outer products, for the least-squares plane of any run.
+struct LoopMoments {
+  std::vector<Eigen::Vector3d> sum;  // of points [0, k)
+  std::vector<Eigen::Matrix3d> outer;
+
+  LoopMoments(const std::vector<int>& loop, const std::vector<Eigen::Vector3d>& x)
+      : sum(loop.size() + 1, Eigen::Vector3d::Zero()), outer(loop.size() + 1, Eigen::Matrix3d::Zero()) {
+    for (size_t k = 0; k < loop.size(); ++k) {
+      const Eigen::Vector3d& p = x[static_cast<size_t>(loop[k])];
+      sum[k + 1] = sum[k] + p;
+      outer[k + 1] = outer[k] + p * p.transpose();
+    }
+  }
+  // The sum of the squared distances of the points [first, end) (or all but them: `complement`) from
+  // their least-squares plane: at most count * (the largest distance)^2, and never smaller for more
+  // points.
+  [[nodiscard]] double squares_off_plane(size_t first, size_t end, bool complement) const {
+    Eigen::Vector3d s = sum[end] - sum[first];
+    Eigen::Matrix3d o = outer[end] - outer[first];
+    double count = static_cast<double>(end - first);
+    if (complement) {
+      s = sum.back() - s;
+      o = outer.back() - o;
+      count = static_cast<double>(sum.size() - 1) - count;
+    }
+    const Eigen::Matrix3d scatter = o - s * s.transpose() / count;
+    Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver;
+    solver.computeDirect(scatter, Eigen::EigenvaluesOnly);  // closed form, for the many runs tried
+    return std::max(solver.eigenvalues()(0), 0.0);
+  }
+};
+
+}  // namespace
+
+bool split_in_two_flat(const std::vector<int>& loop, const std::vector<Eigen::Vector3d>& x,
+                       std::vector<std::vector<int>>& flat, const std::function<bool(int, int)>& edge_exists) {
+  const size_t n = loop.size();
+  if (n > MAX_SPLIT_HOLE_POINTS) return false;
+  const LoopMoments moments(loop, x);
+  for (size_t i = 0; i < n; ++i) {
+    for (size_t j = i + 2; j + 2 <= n + i && j < n; ++j) {
+      // The halves: points i..j and j..i (wrapping), each with the chord (i, j) as an edge. Once the
+      // first half's squares exceed what n points within FLAT_HOLE_M can make, no longer one is flat.
+      constexpr double FLAT_SQUARE_M2 = FLAT_HOLE_M * FLAT_HOLE_M;
+      const double first_squares = moments.squares_off_plane(i, j + 1, false);
+      if (first_squares > static_cast<double>(n) * FLAT_SQUARE_M2) break;
+      if (first_squares > static_cast<double>(j + 1 - i) * FLAT_SQUARE_M2 ||
+          moments.squares_off_plane(i + 1, j, true) > static_cast<double>(n - (j - i - 1)) * FLAT_SQUARE_M2 ||
+          (edge_exists && edge_exists(loop[i], loop[j]))) {  // its four triangles would share the chord
+        continue;
+      }
+      std::vector<int> first(loop.begin() + static_cast<long>(i), loop.begin() + static_cast<long>(j) + 1);
+      std::vector<int> second(loop.begin() + static_cast<long>(j), loop.end());
+      second.insert(second.end(), loop.begin(), loop.begin() + static_cast<long>(i) + 1);
+      if (!flat_within(first, x, FLAT_HOLE_M) || !flat_within(second, x, FLAT_HOLE_M)) continue;
+      flat.push_back(std::move(first));
+      flat.push_back(std::move(second));
+      return true;
+    }
+  }
+  return false;
+}
+
 FlatHoles flat_holes(const std::unordered_map<long long, int>& directed, const std::vector<Eigen::Vector3d>& x,
                      const std::function<int(int)>& part_of) {
   FlatHoles holes;
@@ -184,7 +249,9 @@ FlatHoles flat_holes(const std::unordered_map<long long, int>& directed, const s
     const bool one_part = closed && std::all_of(loop.begin(), loop.end(), [&](int q) { return part_of(q) == part; });
     if (one_part && flat_within(loop, x, FLAT_HOLE_M)) {
       holes.flat.push_back(std::move(loop));
-    } else {
+    } else if (!one_part || !split_in_two_flat(loop, x, holes.flat, [&directed](int u, int v) {
+                 return directed.contains(directed_key(u, v)) || directed.contains(directed_key(v, u));
+               })) {
       ++holes.others;
     }
   }

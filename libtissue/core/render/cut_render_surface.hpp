@@ -30,12 +30,13 @@
 //   split points, the other triangles their pieces; the caps are made again. From scratch the first
 //   time, when the unchanged points' material parts regroup (a piece came free), and when the split
 //   points dropped by re-splits exceed a quarter of the surface's vertices.
-// * Holes the walk leaves (a switch with no partner): the surface's border loops then; one that is
-//   flat (within 0.1 mm of a plane) and in one material part is a missed face, ear-clipped.
+// * Holes the walk leaves (a switch with no partner): the surface's border loops then; one in one
+//   material part that is flat (within 0.1 mm of a plane), or two flat faces either side of a
+//   chord (a junction), is what the walk missed, ear-clipped.
 // Limits: the crack front is the straight line between the tips (right for a stroke through the
 // full depth), and its points follow one side; where two partial cuts cross, a switch may have no
 // partner and no tip to close on (the junction line ends inside the body) and the hole stays open
-// unless it is flat.
+// unless it is flat or two flat faces.
 #pragma once
 
 #include "core/fem/deformable_body.hpp"
@@ -79,8 +80,8 @@ class CutRenderSurface {
   /// re-meshes, split points no triangle uses any more), then the caps' line points.
   [[nodiscard]] int point_count() const { return static_cast<int>(m_points.size()); }
   [[nodiscard]] int cut_edge_count() const { return m_cut_edges; }
-  /// Holes the last rebuild left: the finished surface's border loops (a face the chain walk could
-  /// not close, not flat or between two material parts).
+  /// Holes the last rebuild left: the finished surface's border loops (faces the chain walk could
+  /// not close, neither flat nor two flat faces, or between two material parts).
   [[nodiscard]] int open_loop_count() const { return m_open_loops; }
   /// Whether the last rebuild started from the surface as given (else it redid only what changed).
   [[nodiscard]] bool rebuilt_from_scratch() const { return m_from_scratch; }
