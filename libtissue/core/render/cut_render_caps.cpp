@@ -585,7 +585,7 @@ void CutRenderSurface::cap_loops(const DeformableBody& body) {
   std::vector<std::vector<int>> faces;
   const int unclosed = walk_faces(loops, chains, ends.link, chain_starting_at, faces);
   for (const std::vector<int>& face : faces) cap_polygon(face, m_rest_m, m_triangles, edges);
-  // Every walk closed: every loop is capped. Else the holes left: the flat ones filled (flat_holes).
+  // Every walk closed: every loop is capped. Else the holes left, flat or two flat faces filled.
   if (unclosed > 0) {
     CapEdges now{{}, {}, m_surface_edges, edges.vertices};
     find_split_edges(m_triangles, m_points.size(), now);
