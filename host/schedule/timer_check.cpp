@@ -21,16 +21,17 @@ constexpr double MAX_TICKS = 1e7;
 // The haptic thread's loop (realtime_schedule.cpp) with nothing to do in a tick.
 TimerCheck run_ticks(Nanoseconds period, std::uint64_t ticks, bool realtime_priority) {
   TimerCheck check;
-  if (realtime_priority) check.priority = try_fifo_priority(HAPTIC_FIFO_PRIORITY);
+  check.priority = realtime_priority ? try_fifo_priority(HAPTIC_FIFO_PRIORITY) : Priority{false, "not asked"};
   std::vector<double> periods_s, late_s;
   periods_s.reserve(ticks);
   late_s.reserve(ticks);
   const TickDeadlines clock{now_ns() + period, period};
   Nanoseconds previous_wake = 0;
   for (std::uint64_t n = 0; n < ticks; ++n) {
-    sleep_until_ns(clock.deadline(n));
+    const Nanoseconds deadline = clock.deadline(n);
+    sleep_until_ns(deadline);
     const Nanoseconds woke = now_ns();
-    late_s.push_back(static_cast<double>(woke - clock.deadline(n)) * 1e-9);
+    late_s.push_back(static_cast<double>(woke - deadline) * 1e-9);
     if (n > 0) periods_s.push_back(static_cast<double>(woke - previous_wake) * 1e-9);
     previous_wake = woke;
     if (clock.missed(n, now_ns())) ++check.deadline_misses;
@@ -55,7 +56,6 @@ TimerCheck check_timer(double period_s, double duration_s, bool realtime_priorit
   // A thread of its own: the priority is the thread's, not the caller's.
   std::thread thread([&] { check = run_ticks(period, static_cast<std::uint64_t>(ticks), realtime_priority); });
   thread.join();
-  if (!realtime_priority) check.priority.note = "not asked";
   return check;
 }
 

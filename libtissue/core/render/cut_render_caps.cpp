@@ -186,12 +186,13 @@ struct CapEdges {
   }
 };
 
-// The directed edges of the split surface at its split points. (An edge between two of the surface's
-// own vertices keeps both its triangles: it is never a border.)
-void find_split_edges(const std::vector<std::array<int, 3>>& triangles, size_t point_count, CapEdges& edges) {
+// Adds the directed edges at split points of triangles[first, end) (the split surface's, later the
+// caps'). (An edge between two of the surface's own vertices keeps both its triangles: never a border.)
+void find_split_edges(const std::vector<std::array<int, 3>>& triangles, size_t first, size_t points, CapEdges& edges) {
   const int vertices = edges.vertices;
-  edges.directed.reserve(8 * (point_count - static_cast<size_t>(vertices)) + 64);
-  for (const auto& [a, b, c] : triangles) {
+  edges.directed.reserve(8 * (points - static_cast<size_t>(vertices)) + 64);
+  for (size_t t = first; t < triangles.size(); ++t) {
+    const auto& [a, b, c] = triangles[t];
     if (a < vertices && b < vertices && c < vertices) continue;
     for (const auto& [u, v] : {std::pair{a, b}, std::pair{b, c}, std::pair{c, a}}) {
       if (u >= vertices || v >= vertices) ++edges.directed[directed_key(u, v)];
@@ -521,7 +522,7 @@ std::vector<int> CutRenderSurface::line_points(int from, int to) {
 
 void CutRenderSurface::cap_loops(const DeformableBody& body) {
   CapEdges edges{{}, {}, m_surface_edges, static_cast<int>(m_surface.vertices_m.size())};
-  find_split_edges(m_triangles, m_points.size(), edges);
+  find_split_edges(m_triangles, 0, m_points.size(), edges);
   const std::vector<std::vector<int>> loops = border_loops(edges.directed);
   SimpleCaps simple_caps;  // this re-mesh's, for the next
   const size_t surface_triangles = m_triangles.size();
@@ -585,12 +586,11 @@ void CutRenderSurface::cap_loops(const DeformableBody& body) {
   std::vector<std::vector<int>> faces;
   const int unclosed = walk_faces(loops, chains, ends.link, chain_starting_at, faces);
   for (const std::vector<int>& face : faces) cap_polygon(face, m_rest_m, m_triangles, edges);
-  // Every walk closed: every loop is capped. Else the holes left, flat or two flat faces filled.
+  // Every walk closed: every loop is capped. Else the holes (the caps' edges added), flat ones filled.
   if (unclosed > 0) {
-    CapEdges now{{}, {}, m_surface_edges, edges.vertices};
-    find_split_edges(m_triangles, m_points.size(), now);
-    const FlatHoles holes = flat_holes(now.directed, m_rest_m, part_of_point);
-    for (const std::vector<int>& hole : holes.flat) cap_polygon(hole, m_rest_m, m_triangles, now);
+    find_split_edges(m_triangles, surface_triangles, m_points.size(), edges);
+    const FlatHoles holes = flat_holes(edges.directed, m_rest_m, part_of_point);
+    for (const std::vector<int>& hole : holes.flat) cap_polygon(hole, m_rest_m, m_triangles, edges);
     m_open_loops = holes.others;
   }
   m_cap_triangles = static_cast<int>(m_triangles.size() - surface_triangles);
