@@ -244,4 +244,50 @@ void CutSurface::update_points(const DeformableBody& body, const Eigen::VectorXd
   }
 }
 
+bool CutSurface::update_welds(const DeformableBody& body, const SurfaceMesh& surface,
+                              const Eigen::VectorXd& positions_m) {
+  // Whether point b is farther from position `at` than the fraction of the largest rest edge of the
+  // cut tet that made it (or made point a; points of real vertices only: never).
+  const auto far = [&](const Eigen::Vector3d& at, int a, int b) {
+    int owner = a >= m_vertex_count ? m_point_owner[static_cast<size_t>(a - m_vertex_count)] : -1;
+    if (owner < 0 && b >= m_vertex_count) owner = m_point_owner[static_cast<size_t>(b - m_vertex_count)];
+    if (owner < 0) return false;
+    const double largest_m = largest_edge_m(body.cut_tets()[static_cast<size_t>(owner)].rest_m);
+    return (positions_m.segment<3>(3 * b) - at).norm() > WELD_APART_FRACTION * largest_m;
+  };
+  const auto apart = [&](int a, int b) {
+    return a >= 0 && b >= 0 && a != b && far(positions_m.segment<3>(3 * a), a, b);
+  };
+  bool changed = false;
+  const auto set = [&changed](std::vector<std::uint8_t>& flags, size_t i, bool value) {
+    if (flags.size() <= i) flags.resize(i + 1, 0);
+    if ((flags[i] != 0) == value) return;
+    flags[i] = value ? 1 : 0;
+    changed = true;
+  };
+  for (size_t key = 0; key < m_root_drawn.size(); ++key) {
+    const int root_drawn = m_root_drawn[static_cast<size_t>(key_root(static_cast<int>(key)))];
+    if (root_drawn != m_key_drawn[key] || (key < m_key_apart.size() && m_key_apart[key] != 0))
+      set(m_key_apart, key, apart(m_key_drawn[key], root_drawn));
+  }
+  for (size_t i = 0; i < m_crack_edges.size(); ++i) {
+    const CrackEdge& edge = m_crack_edges[i];
+    set(m_strip_apart, i,
+        apart(drawn_point(edge.above[0]), drawn_point(edge.below[0])) ||
+            apart(drawn_point(edge.above[1]), drawn_point(edge.below[1])));
+  }
+  // A front joins its sides through the tet the cut left whole: both lie at that tet's edge point.
+  for (const int e : m_front_edges) {
+    const CrossedEdge& crossed = m_crossed[static_cast<size_t>(e)];
+    if (crossed.lower_side < 0 || crossed.upper_side < 0) continue;
+    const auto& ends = body.adjacency().edges[static_cast<size_t>(crossed.edge)];
+    const Eigen::Vector3d at = (1.0 - crossed.ratio) * positions_m.segment<3>(3 * ends[0]) +
+                               crossed.ratio * positions_m.segment<3>(3 * ends[1]);
+    const int lower = drawn_point(crossed.lower_side), upper = drawn_point(crossed.upper_side);  // as drawn
+    set(m_front_apart, static_cast<size_t>(e), far(at, lower, lower) || far(at, upper, upper));
+  }
+  if (changed) rebuild_drawn(body, surface);
+  return changed;
+}
+
 }  // namespace tissue

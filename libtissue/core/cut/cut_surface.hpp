@@ -70,6 +70,16 @@ class CutSurface {
   /// the vertex itself, or the first live corner made with the same weld key or one joined to it.
   [[nodiscard]] int drawn_point(int id) const;
 
+  /// Points the weld draws as one that come from different pieces (keys joined across cut sets,
+  /// the two sides at a crack front: their rows differ) are one while the material holds them
+  /// together; where a join or a front was wrong (near crossing strokes, a piece the later stroke
+  /// would have cut to a sliver) they part as the pieces move apart and drew sheets metres long
+  /// (15 + 15 hatched strokes on the frog). So each such join holds only while its points are within
+  /// WELD_APART_FRACTION of their tet's largest rest edge; apart, they are drawn apart (the surface
+  /// shows the gap). Call after update_points(); re-draws when a join held or let go, and says whether.
+  bool update_welds(const DeformableBody& body, const SurfaceMesh& surface, const Eigen::VectorXd& positions_m);
+  static constexpr double WELD_APART_FRACTION = 0.5;
+
  private:
   struct Point {
     int cut_tet = -1;  ///< -1: a point of real mesh vertices, sum_j weights_j x(vertices_j)
@@ -158,6 +168,9 @@ class CutSurface {
   std::vector<int> m_key_drawn;
   std::vector<int> m_key_parent;  // per key: the key it is joined to (join_compatible_keys), itself at a root
   std::vector<int> m_root_drawn;  // per root key: the point drawn for its keys
+  // update_welds(): per key, its point apart from its root's (drawn alone); per crack edge, its two
+  // sides apart (no strip); per crossed edge, its two sides apart (not drawn split at the front).
+  std::vector<std::uint8_t> m_key_apart, m_strip_apart, m_front_apart;
   std::unordered_map<std::int64_t, int> m_crossed_ids;  // (cut id, edge) -> index into m_crossed
   std::vector<CrossedEdge> m_crossed;
   std::vector<int> m_touched_edges;  // crossed edges given corners since the last update_fronts

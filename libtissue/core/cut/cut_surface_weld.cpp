@@ -50,13 +50,6 @@ int local_edge(int a, int b) {
   return 0;  // unreachable for two distinct local vertices
 }
 
-double largest_edge_m(const std::array<Eigen::Vector3d, 4>& x) {
-  double longest = 0.0;
-  for (const auto& edge : TET_EDGES)
-    longest = std::max(longest, (x[static_cast<size_t>(edge[0])] - x[static_cast<size_t>(edge[1])]).norm());
-  return longest;
-}
-
 // Sorts the first n entries by `less` (a few: insertion; std::sort on a std::array of 4 trips GCC 12's
 // array-bounds warning).
 template <class T, std::size_t N, class Less>
@@ -338,9 +331,9 @@ int CutSurface::drawn_point(int id) const {
   if (id < m_vertex_count) return id;
   const int key = m_point_key[static_cast<size_t>(id - m_vertex_count)];
   if (key < 0) return id;
-  const int representative = static_cast<size_t>(key) < m_root_drawn.size()
-                                 ? m_root_drawn[static_cast<size_t>(key_root(key))]
-                                 : m_key_drawn[static_cast<size_t>(key)];
+  const auto k = static_cast<size_t>(key);
+  const bool joined = k < m_root_drawn.size() && !(k < m_key_apart.size() && m_key_apart[k] != 0);
+  const int representative = joined ? m_root_drawn[static_cast<size_t>(key_root(key))] : m_key_drawn[k];
   return representative >= 0 ? representative : id;
 }
 
@@ -409,8 +402,10 @@ void CutSurface::match_cap_edges(int k) {
 // A_s -> A_t along it and the below side B_t -> B_s: the strip A_t A_s B_s B_t closes the two.
 void CutSurface::add_front_strips(const DeformableBody& body) {
   const TetAdjacency& adjacency = body.adjacency();
-  for (const CrackEdge& edge : m_crack_edges) {
-    if (m_retired[static_cast<size_t>(edge.cut_tet)] != 0) continue;
+  for (size_t i = 0; i < m_crack_edges.size(); ++i) {
+    const CrackEdge& edge = m_crack_edges[i];
+    const bool apart = i < m_strip_apart.size() && m_strip_apart[i] != 0;
+    if (m_retired[static_cast<size_t>(edge.cut_tet)] != 0 || apart) continue;
     const int tet = body.cut_tets()[static_cast<size_t>(edge.cut_tet)].cut.tet;
     const int neighbour = adjacency.face_neighbor[static_cast<size_t>(tet)][static_cast<size_t>(edge.face)];
     if (neighbour < 0 || cut_by(body, neighbour, edge.cut_id)) continue;
@@ -457,7 +452,8 @@ void CutSurface::collect_front_triangles(const DeformableBody& body, const Surfa
   m_on_cut_front.clear();
   for (const int e : m_front_edges) {
     const CrossedEdge& crossed = m_crossed[static_cast<size_t>(e)];
-    if (crossed.lower_side < 0 || crossed.upper_side < 0) continue;
+    const bool apart = static_cast<size_t>(e) < m_front_apart.size() && m_front_apart[static_cast<size_t>(e)] != 0;
+    if (crossed.lower_side < 0 || crossed.upper_side < 0 || apart) continue;
     // The surface triangles on the edge (two on a closed surface): one of an uncut tet is split where
     // the other's tet is cut by the session (the crack opens to the surface there). Two uncut ones
     // stay whole: the front only touches the surface at the crossing.

@@ -13,13 +13,6 @@
 namespace tissue {
 namespace {
 
-double largest_edge_m(const std::array<Eigen::Vector3d, 4>& x) {
-  double longest = 0.0;
-  for (const auto& edge : TET_EDGES)
-    longest = std::max(longest, (x[static_cast<std::size_t>(edge[1])] - x[static_cast<std::size_t>(edge[0])]).norm());
-  return longest;
-}
-
 // Corners closer than this fraction of the tet's longest edge are one (clipping round-off).
 constexpr double TOLERANCE_FRACTION = 1e-12;
 

@@ -4,7 +4,11 @@
 
 #include "core/mesh/tet_mesh.hpp"
 
+#include <Eigen/Core>
+
+#include <algorithm>
 #include <array>
+#include <cstddef>
 #include <vector>
 
 namespace tissue {
@@ -14,6 +18,16 @@ namespace tissue {
 inline constexpr std::array<std::array<int, 3>, 4> TET_FACES = {{{1, 2, 3}, {0, 3, 2}, {0, 1, 3}, {0, 2, 1}}};
 /// Local edges of a tet (pairs of local vertex indices).
 inline constexpr std::array<std::array<int, 2>, 6> TET_EDGES = {{{0, 1}, {0, 2}, {0, 3}, {1, 2}, {1, 3}, {2, 3}}};
+
+/// The longest edge of the tet with these corners. [m]
+inline double largest_edge_m(const std::array<Eigen::Vector3d, 4>& corners) {
+  double longest = 0.0;
+  for (const auto& edge : TET_EDGES) {
+    const auto [a, b] = edge;
+    longest = std::max(longest, (corners[static_cast<std::size_t>(a)] - corners[static_cast<std::size_t>(b)]).norm());
+  }
+  return longest;
+}
 
 struct SurfaceMesh {
   std::vector<std::array<int, 3>> triangles;  ///< mesh vertex ids, outward normal (right-hand rule)

@@ -5,6 +5,9 @@
 // the blade stops inside leaves one, joined beyond the crack's front.
 #include "core/fixed_region.hpp"
 #include "core/mesh/box_mesh.hpp"
+#include "core/mesh/mesh_io.hpp"
+#include "core/mesh/topology.hpp"
+#include "core/tissue_settings_schema.hpp"
 #include "core/tissue.hpp"
 #include "support/closed_surface.hpp"
 #include "support/scalpel_stroke.hpp"
@@ -15,6 +18,7 @@
 #include <algorithm>
 #include <cmath>
 #include <array>
+#include <filesystem>
 #include <vector>
 
 namespace tissue {
@@ -179,6 +183,84 @@ TEST(CutSurfaceWeld, AnXCutThatFallsApartDrawsFourPiecesAndStretchesNothing) {
   }
   EXPECT_LT(longest_m, 0.01 * std::sqrt(3.0) * 1.05);  // a cube's diagonal, 5% strain
   EXPECT_EQ(check_drawn_surface(tissue).pieces, 4);
+}
+
+// The longest edge of `triangles` over current_positions_m. [m]
+template <class Triangles>
+double longest_edge_m(const Tissue& tissue, const Triangles& triangles) {
+  const Eigen::VectorXd& x = tissue.current_positions_m();
+  double longest = 0.0;
+  for (const auto& t : triangles) {
+    for (size_t c = 0; c < 3; ++c) {
+      longest = std::max(longest, (x.segment<3>(3 * t[c]) - x.segment<3>(3 * t[(c + 1) % 3])).norm());
+    }
+  }
+  return longest;
+}
+
+// Strokes closer than the tets, the frog sagging (docs/hatched_frog.toml's scene with 15 strokes
+// across at its spacing; the first six): the drawn tet skin joins only points the material holds
+// together. Its points drawn as one (welded corners of pieces with different rows, the two sides at
+// a crack's front) are within WELD_APART_FRACTION of a tet's largest edge, so no drawn edge is longer
+// than the pieces' own faces (the cut faces with their own corners) and the mesh's skin by more than
+// a tet's largest edge. Before: after the sixth stroke a join and a front the later strokes made wrong
+// drew a 58 mm edge, and sheets metres long as the pieces fell (15 + 15 strokes: 37 m).
+TEST(CutSurfaceWeld, HatchedStrokesDrawNoSheetBetweenPiecesThatParted) {
+  const TetMesh mesh = read_mesh(std::filesystem::path(TISSUE_MESH_DIR) / "frog.veg");
+  TissueParameters parameters = default_parameters();
+  set_value(*find_setting("fixedRegion.axis"), parameters, std::int64_t{2});
+  set_value(*find_setting("fixedRegion.fraction"), parameters, 0.25);
+  set_value(*find_setting("material.youngModulus"), parameters, 3e5);
+  set_value(*find_setting("tool.bladeLength"), parameters, 0.2);
+  set_value(*find_setting("stepSize"), parameters, 0.01);
+  Tissue tissue(mesh, resolve_settings(parameters, &mesh));
+  Eigen::Vector3d low = mesh.rest_positions_m.front(), high = low;
+  double largest_tet_edge_m = 0.0;
+  for (const Eigen::Vector3d& p : mesh.rest_positions_m) {
+    low = low.cwiseMin(p);
+    high = high.cwiseMax(p);
+  }
+  for (int t = 0; t < mesh.tet_count(); ++t) {
+    largest_tet_edge_m = std::max(largest_tet_edge_m, largest_edge_m(mesh.rest_corners(t)));
+  }
+  const auto at = [&](double x, double y) {  // fractions of the rest box; the tip 2 heights below
+    return Eigen::Vector3d(low.x() + x * (high.x() - low.x()), low.y() + y * (high.y() - low.y()),
+                           low.z() - 2.0 * (high.z() - low.z()));
+  };
+  // Each stroke as the scenario's waypoints: put down below y = -0.15 at t0 + 0.05, drawn to y = 1.15
+  // by t0 + 0.35, lifted at t0 + 0.40; 0.45 s apart. One step per 10 ms, the tool where the
+  // waypoints put it (linear between them, the mode of the last one passed).
+  constexpr int STROKES = 6;
+  constexpr double PERIOD_S = 0.45;
+  double worst_excess_m = -1.0;
+  for (int n = 0; n <= static_cast<int>(STROKES * PERIOD_S / 0.01) + 30; ++n) {
+    const double t = n * 0.01;
+    const int k = std::min(STROKES - 1, static_cast<int>(t / PERIOD_S));
+    const double x = 0.15 + 0.05 * k;
+    const double local = t - k * PERIOD_S;
+    const bool drawing = local >= 0.05 && local < 0.40;
+    const double y = local < 0.05 ? -0.15 : local < 0.35 ? -0.15 + 1.3 * (local - 0.05) / 0.3 : 1.15;
+    Eigen::Vector3d tool = at(x, y);
+    if (local >= 0.40 && k + 1 < STROKES) {  // lifted, to the next stroke's start
+      const double moved = (local - 0.40) / 0.05;
+      tool = at(x + 0.05 * moved, 1.15 - 1.3 * moved);
+    }
+    tissue.set_tool(ToolPose{tool, Eigen::Quaterniond::Identity(), drawing ? ToolMode::scalpel : ToolMode::none});
+    tissue.step();
+    std::vector<std::array<int, 3>> drawn;
+    tissue.for_each_drawn_triangle([&](const std::array<int, 3>& triangle) { drawn.push_back(triangle); });
+    // The pieces' own faces: the cut faces with their own corners, and the mesh's skin triangles of
+    // uncut tets.
+    std::vector<std::array<int, 3>> own(tissue.cut_surface().triangles());
+    const std::vector<int>& replaced = tissue.cut_surface().replaced_triangles();
+    for (size_t s = 0; s < tissue.surface().triangles.size(); ++s) {
+      if (std::binary_search(replaced.begin(), replaced.end(), static_cast<int>(s))) continue;
+      own.push_back(tissue.surface().triangles[s]);
+    }
+    worst_excess_m = std::max(worst_excess_m, longest_edge_m(tissue, drawn) - longest_edge_m(tissue, own));
+  }
+  EXPECT_GT(tissue.body().cut_tets().size(), 500u);
+  EXPECT_LE(worst_excess_m, largest_tet_edge_m);
 }
 
 // Not yet closed (docs/DESIGN.md, "The tet skin welded"): near the line where the two strokes cross,
