@@ -265,10 +265,9 @@ bool CutSurface::update_welds(const DeformableBody& body, const SurfaceMesh& sur
     flags[i] = value ? 1 : 0;
     changed = true;
   };
-  for (size_t key = 0; key < m_root_drawn.size(); ++key) {
-    const int root_drawn = m_root_drawn[static_cast<size_t>(key_root(static_cast<int>(key)))];
-    if (root_drawn != m_key_drawn[key] || (key < m_key_apart.size() && m_key_apart[key] != 0))
-      set(m_key_apart, key, apart(m_key_drawn[key], root_drawn));
+  for (const int key : m_joined_keys) {
+    set(m_key_apart, static_cast<size_t>(key),
+        apart(m_key_drawn[static_cast<size_t>(key)], m_root_drawn[static_cast<size_t>(key_root(key))]));
   }
   for (size_t i = 0; i < m_crack_edges.size(); ++i) {
     const CrackEdge& edge = m_crack_edges[i];

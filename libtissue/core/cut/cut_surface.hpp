@@ -171,6 +171,7 @@ class CutSurface {
   // update_welds(): per key, its point apart from its root's (drawn alone); per crack edge, its two
   // sides apart (no strip); per crossed edge, its two sides apart (not drawn split at the front).
   std::vector<std::uint8_t> m_key_apart, m_strip_apart, m_front_apart;
+  std::vector<int> m_joined_keys;  // the keys drawn at another key's point (join_compatible_keys)
   std::unordered_map<std::int64_t, int> m_crossed_ids;  // (cut id, edge) -> index into m_crossed
   std::vector<CrossedEdge> m_crossed;
   std::vector<int> m_touched_edges;  // crossed edges given corners since the last update_fronts

@@ -325,6 +325,11 @@ void CutSurface::join_compatible_keys(const DeformableBody& body) {
     int& drawn = m_root_drawn[static_cast<size_t>(key_root(static_cast<int>(key)))];
     if (drawn < 0) drawn = m_key_drawn[key];
   }
+  m_joined_keys.clear();  // the keys drawn at another key's point (update_welds watches them)
+  for (size_t key = 0; key < m_keys.size(); ++key) {
+    if (m_root_drawn[static_cast<size_t>(key_root(static_cast<int>(key)))] != m_key_drawn[key])
+      m_joined_keys.push_back(static_cast<int>(key));
+  }
 }
 
 int CutSurface::drawn_point(int id) const {
