@@ -247,7 +247,7 @@ void CutSurface::update_points(const DeformableBody& body, const Eigen::VectorXd
 bool CutSurface::update_welds(const DeformableBody& body, const SurfaceMesh& surface,
                               const Eigen::VectorXd& positions_m) {
   // Whether point b is farther from position `at` than the fraction of the largest rest edge of the
-  // cut tet that made it (or made point a; points of real vertices only: never).
+  // cut tet that made point a (or, for a point of real vertices, b; two such points: never).
   const auto far = [&](const Eigen::Vector3d& at, int a, int b) {
     int owner = a >= m_vertex_count ? m_point_owner[static_cast<size_t>(a - m_vertex_count)] : -1;
     if (owner < 0 && b >= m_vertex_count) owner = m_point_owner[static_cast<size_t>(b - m_vertex_count)];

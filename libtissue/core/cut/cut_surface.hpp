@@ -169,7 +169,7 @@ class CutSurface {
   std::vector<int> m_key_parent;  // per key: the key it is joined to (join_compatible_keys), itself at a root
   std::vector<int> m_root_drawn;  // per root key: the point drawn for its keys
   // update_welds(): per key, its point apart from its root's (drawn alone); per crack edge, its two
-  // sides apart (no strip); per crossed edge, its two sides apart (not drawn split at the front).
+  // sides apart (no strip); per crossed edge, a side away from the edge's point (not drawn split).
   std::vector<std::uint8_t> m_key_apart, m_strip_apart, m_front_apart;
   std::vector<int> m_joined_keys;  // the keys drawn at another key's point (join_compatible_keys)
   std::unordered_map<std::int64_t, int> m_crossed_ids;  // (cut id, edge) -> index into m_crossed
