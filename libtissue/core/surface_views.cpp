@@ -39,7 +39,7 @@ void SurfaceViews::update_positions(const DeformableBody& body, const Eigen::Vec
   body.positions(displacement_m, m_vertex_positions_m);
   m_positions_m.head(m_vertex_positions_m.size()) = m_vertex_positions_m;
   m_cut_surface.update_points(body, displacement_m, m_positions_m);
-  m_cut_surface.update_welds(body, m_surface, m_positions_m);
+  m_cut_surface.update_welds(body, m_surface, displacement_m, m_positions_m);
 }
 
 void SurfaceViews::add_cut_tets(const DeformableBody& body, const Eigen::VectorXd& displacement_m, int first_cut_tet) {

@@ -244,8 +244,52 @@ void CutSurface::update_points(const DeformableBody& body, const Eigen::VectorXd
   }
 }
 
+bool cut_by(const DeformableBody& body, int tet, int cut_id) {
+  const int k = body.cut_tet_index(tet);
+  if (k < 0) return false;
+  const auto& cuts = body.cut_geometry(k).cuts;
+  return std::any_of(cuts.begin(), cuts.end(), [cut_id](const TetCut& cut) { return cut.cut_id == cut_id; });
+}
+
+namespace {
+
+// Where the material of `tet` is now at the point `ratio` along its edge v0-v1: between the real
+// vertices when the tet is uncut, else in the piece that holds the point at rest (on its side of each
+// cut bounding it). False when no piece holds it (the point on a plane).
+bool material_at(const DeformableBody& body, const Eigen::VectorXd& displacement_m, const Eigen::VectorXd& positions_m,
+                 int tet, std::array<int, 2> ends, double ratio, Eigen::Vector3d& at) {
+  const int k = body.cut_tet_index(tet);
+  if (k < 0) {
+    at = (1.0 - ratio) * positions_m.segment<3>(3 * ends[0]) + ratio * positions_m.segment<3>(3 * ends[1]);
+    return true;
+  }
+  const auto& rest = body.mesh().rest_positions_m;
+  const Eigen::Vector3d point =
+      (1.0 - ratio) * rest[static_cast<size_t>(ends[0])] + ratio * rest[static_cast<size_t>(ends[1])];
+  const CutTetGeometry& geometry = body.cut_geometry(k);
+  const Tet& vertices = body.cut_tets()[static_cast<size_t>(k)].vertices;
+  const auto local = [&](int v) {
+    return static_cast<size_t>(std::find(vertices.begin(), vertices.end(), v) - vertices.begin());
+  };
+  for (size_t q = 0; q < geometry.pieces.size(); ++q) {
+    const PieceSides& sides = geometry.pieces[q].sides;
+    bool holds = true;
+    for (size_t c = 0; c < geometry.planes.size() && holds; ++c) {
+      if ((sides.bounded & (1u << c)) == 0) continue;
+      holds = (geometry.planes[c].signed_distance(point) > 0.0) == ((sides.above & (1u << c)) != 0);
+    }
+    if (!holds) continue;
+    const TetPositions x = body.piece_positions(displacement_m, k, static_cast<int>(q));
+    at = (1.0 - ratio) * x[local(ends[0])] + ratio * x[local(ends[1])];
+    return true;
+  }
+  return false;
+}
+
+}  // namespace
+
 bool CutSurface::update_welds(const DeformableBody& body, const SurfaceMesh& surface,
-                              const Eigen::VectorXd& positions_m) {
+                              const Eigen::VectorXd& displacement_m, const Eigen::VectorXd& positions_m) {
   // Whether point b is farther from position `at` than the fraction of the largest rest edge of the
   // cut tet that made point a (or, for a point of real vertices, b; two such points: never).
   const auto far = [&](const Eigen::Vector3d& at, int a, int b) {
@@ -275,15 +319,32 @@ bool CutSurface::update_welds(const DeformableBody& body, const SurfaceMesh& sur
         apart(drawn_point(edge.above[0]), drawn_point(edge.below[0])) ||
             apart(drawn_point(edge.above[1]), drawn_point(edge.below[1])));
   }
-  // A front joins its sides through the tet the cut left whole: both lie at that tet's edge point.
+  // A front joins its sides through a tet around the edge the cut left whole: both lie at the
+  // edge's point between its real vertices and at the material's point in such a tet (one cut by
+  // other cuts: its piece's). Either alone let a split stretch: after 30 + 30 strokes the first, after
+  // 20 + 20 the second.
+  const TetAdjacency& adjacency = body.adjacency();
   for (const int e : m_front_edges) {
     const CrossedEdge& crossed = m_crossed[static_cast<size_t>(e)];
     if (crossed.lower_side < 0 || crossed.upper_side < 0) continue;
-    const auto& ends = body.adjacency().edges[static_cast<size_t>(crossed.edge)];
-    const Eigen::Vector3d at = (1.0 - crossed.ratio) * positions_m.segment<3>(3 * ends[0]) +
-                               crossed.ratio * positions_m.segment<3>(3 * ends[1]);
+    const auto edge = static_cast<size_t>(crossed.edge);
+    const auto& ends = adjacency.edges[edge];
+    const Eigen::Vector3d on_edge = (1.0 - crossed.ratio) * positions_m.segment<3>(3 * ends[0]) +
+                                    crossed.ratio * positions_m.segment<3>(3 * ends[1]);
     const int lower = drawn_point(crossed.lower_side), upper = drawn_point(crossed.upper_side);  // as drawn
-    set(m_front_apart, static_cast<size_t>(e), far(at, lower, lower) || far(at, upper, upper));
+    bool held = false;
+    if (far(on_edge, lower, lower) || far(on_edge, upper, upper)) {
+      set(m_front_apart, static_cast<size_t>(e), true);
+      continue;
+    }
+    for (int i = adjacency.edge_tets_begin[edge]; i < adjacency.edge_tets_begin[edge + 1] && !held; ++i) {
+      const int tet = adjacency.edge_tets[static_cast<size_t>(i)];
+      Eigen::Vector3d at;
+      held = !cut_by(body, tet, crossed.cut_id) &&
+             material_at(body, displacement_m, positions_m, tet, adjacency.edges[edge], crossed.ratio, at) &&
+             !far(at, lower, lower) && !far(at, upper, upper);
+    }
+    set(m_front_apart, static_cast<size_t>(e), !held);
   }
   if (changed) rebuild_drawn(body, surface);
   return changed;

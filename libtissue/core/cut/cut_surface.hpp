@@ -39,6 +39,9 @@
 
 namespace tissue {
 
+/// Whether session `cut_id` cut tet `tet` (its current cut, DeformableBody::cut_tet_index).
+[[nodiscard]] bool cut_by(const DeformableBody& body, int tet, int cut_id);
+
 class CutSurface {
  public:
   explicit CutSurface(int vertex_count) : m_vertex_count(vertex_count) {}
@@ -75,9 +78,12 @@ class CutSurface {
   /// together; where a join or a front was wrong (near crossing strokes, a piece the later stroke
   /// would have cut to a sliver) they part as the pieces move apart and drew sheets metres long
   /// (15 + 15 hatched strokes on the frog). So each such join holds only while its points are within
-  /// WELD_APART_FRACTION of their tet's largest rest edge; apart, they are drawn apart (the surface
-  /// shows the gap). Call after update_points(); re-draws when a join held or let go, and says whether.
-  bool update_welds(const DeformableBody& body, const SurfaceMesh& surface, const Eigen::VectorXd& positions_m);
+  /// WELD_APART_FRACTION of their tet's largest rest edge (a front's sides: of the material at the
+  /// crossing in a tet around the edge that the cut left whole); apart, they are drawn apart (the
+  /// surface shows the gap). Call after update_points() (its positions); re-draws when a join held
+  /// or let go, and says whether.
+  bool update_welds(const DeformableBody& body, const SurfaceMesh& surface, const Eigen::VectorXd& displacement_m,
+                    const Eigen::VectorXd& positions_m);
   static constexpr double WELD_APART_FRACTION = 0.5;
 
  private:

@@ -61,14 +61,6 @@ void sort_first(std::array<T, N>& values, int n, Less less) {
   }
 }
 
-// Whether session `cut_id` cut tet `tet`.
-bool cut_by(const DeformableBody& body, int tet, int cut_id) {
-  const int k = body.cut_tet_index(tet);
-  if (k < 0) return false;
-  const auto& cuts = body.cut_geometry(k).cuts;
-  return std::any_of(cuts.begin(), cuts.end(), [cut_id](const TetCut& cut) { return cut.cut_id == cut_id; });
-}
-
 // Whether some tet around mesh edge `edge` is not cut by session `cut_id`: the material is joined
 // around the edge there (the crack's front).
 bool at_front(const DeformableBody& body, int cut_id, int edge) {
