@@ -1,6 +1,7 @@
 // CutSurface (see cut_surface.hpp).
 #include "core/cut/cut_surface.hpp"
 
+#include "core/fem/piece_outside.hpp"
 #include "core/fem/tet_pieces.hpp"
 #include "core/mesh/topology.hpp"
 
@@ -253,16 +254,10 @@ bool cut_by(const DeformableBody& body, int tet, int cut_id) {
 
 namespace {
 
-// Where the material of `tet` is now at the point `ratio` along its edge v0-v1: between the real
-// vertices when the tet is uncut, else in the piece that holds the point at rest (on its side of each
-// cut bounding it). False when no piece holds it (the point on a plane).
-bool material_at(const DeformableBody& body, const Eigen::VectorXd& displacement_m, const Eigen::VectorXd& positions_m,
-                 int tet, std::array<int, 2> ends, double ratio, Eigen::Vector3d& at) {
-  const int k = body.cut_tet_index(tet);
-  if (k < 0) {
-    at = (1.0 - ratio) * positions_m.segment<3>(3 * ends[0]) + ratio * positions_m.segment<3>(3 * ends[1]);
-    return true;
-  }
+// Where the material of cut tet `k` is now at the point `ratio` along its edge `ends`: in the piece
+// that holds the point at rest (within the planes that bound it). False when none does.
+bool material_at(const DeformableBody& body, const Eigen::VectorXd& displacement_m, int k, std::array<int, 2> ends,
+                 double ratio, Eigen::Vector3d& at) {
   const auto& rest = body.mesh().rest_positions_m;
   const Eigen::Vector3d point =
       (1.0 - ratio) * rest[static_cast<size_t>(ends[0])] + ratio * rest[static_cast<size_t>(ends[1])];
@@ -272,13 +267,7 @@ bool material_at(const DeformableBody& body, const Eigen::VectorXd& displacement
     return static_cast<size_t>(std::find(vertices.begin(), vertices.end(), v) - vertices.begin());
   };
   for (size_t q = 0; q < geometry.pieces.size(); ++q) {
-    const PieceSides& sides = geometry.pieces[q].sides;
-    bool holds = true;
-    for (size_t c = 0; c < geometry.planes.size() && holds; ++c) {
-      if ((sides.bounded & (1u << c)) == 0) continue;
-      holds = (geometry.planes[c].signed_distance(point) > 0.0) == ((sides.above & (1u << c)) != 0);
-    }
-    if (!holds) continue;
+    if (outside_piece_m(geometry, q, point) > 0.0) continue;
     const TetPositions x = body.piece_positions(displacement_m, k, static_cast<int>(q));
     at = (1.0 - ratio) * x[local(ends[0])] + ratio * x[local(ends[1])];
     return true;
@@ -339,10 +328,11 @@ bool CutSurface::update_welds(const DeformableBody& body, const SurfaceMesh& sur
     }
     for (int i = adjacency.edge_tets_begin[edge]; i < adjacency.edge_tets_begin[edge + 1] && !held; ++i) {
       const int tet = adjacency.edge_tets[static_cast<size_t>(i)];
+      if (cut_by(body, tet, crossed.cut_id)) continue;
+      const int k = body.cut_tet_index(tet);  // an uncut tet's material is at on_edge: held
       Eigen::Vector3d at;
-      held = !cut_by(body, tet, crossed.cut_id) &&
-             material_at(body, displacement_m, positions_m, tet, adjacency.edges[edge], crossed.ratio, at) &&
-             !far(at, lower, lower) && !far(at, upper, upper);
+      held = k < 0 || (material_at(body, displacement_m, k, ends, crossed.ratio, at) && !far(at, lower, lower) &&
+                       !far(at, upper, upper));
     }
     set(m_front_apart, static_cast<size_t>(e), !held);
   }

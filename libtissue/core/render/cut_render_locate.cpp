@@ -2,6 +2,8 @@
 // material parts the cells make, and which points a re-mesh must locate again.
 #include "core/render/cut_render_surface.hpp"
 
+#include "core/fem/piece_outside.hpp"
+
 #include <Eigen/Dense>
 
 #include <algorithm>
@@ -9,23 +11,6 @@
 #include <numeric>
 
 namespace tissue {
-
-namespace {
-
-// How far `p` lies outside piece `piece` of a cut tet (the largest distance beyond the planes that
-// bound it; <= 0 inside). [m]
-double outside_piece_m(const CutTetGeometry& geometry, size_t piece, const Eigen::Vector3d& p) {
-  const PieceSides& sides = geometry.pieces[piece].sides;
-  double outside = -std::numeric_limits<double>::infinity();
-  for (size_t c = 0; c < geometry.cuts.size(); ++c) {
-    if ((sides.bounded & (1u << c)) == 0) continue;
-    const double toward_inside = (sides.above & (1u << c)) != 0 ? 1.0 : -1.0;
-    outside = std::max(outside, -toward_inside * geometry.planes[c].signed_distance(p));
-  }
-  return outside;
-}
-
-}  // namespace
 
 CutRenderSurface::Point CutRenderSurface::locate(const DeformableBody& body, int tet,
                                                  const Eigen::Vector3d& rest_m) const {
