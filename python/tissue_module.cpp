@@ -311,7 +311,7 @@ class PyTissue {
   }
   // The faces the cuts opened (k x 3, indices into surface()'s points), both sides.
   [[nodiscard]] py::array_t<std::int32_t> cut_faces() const {
-    const std::vector<std::array<int, 3>>& faces = m_tissue->cut_surface().drawn_triangles();
+    const std::vector<std::array<int, 3>>& faces = m_tissue->drawn_cut_triangles();
     py::array_t<std::int32_t> out({static_cast<py::ssize_t>(faces.size()), py::ssize_t{3}});
     for (std::size_t f = 0; f < faces.size(); ++f) std::copy(faces[f].begin(), faces[f].end(), out.mutable_data(f, 0));
     return out;

@@ -150,7 +150,7 @@ void TissueModel::build() {
   m_dirty = false;
   m_surface_revision = 0;
   m_integrator_iterations = 0;
-  m_surface_triangles = m_tissue->drawn_triangle_count();
+  m_surface_triangles = revision_triangles();
   m_surface_cut_tets = 0;
   m_drawn_current = false;
   m_capacity_warned = false;
@@ -180,12 +180,13 @@ const ports::SurfaceMesh& TissueModel::drawn_mesh() {
     flat_triangles(*render, m_drawn.triangles);
     m_drawn.cut_triangle_count = static_cast<std::uint64_t>(render->cap_triangle_count());
   } else {
-    const Eigen::VectorXd& x = tissue.current_positions_m();
-    m_drawn.positions_m.assign(x.data(), x.data() + x.size());
+    // The triangles first: making them may add points (current_positions_m() has them after).
     tissue.for_each_drawn_triangle([&](const std::array<int, 3>& triangle) {
       for (const int v : triangle) m_drawn.triangles.push_back(static_cast<std::uint32_t>(v));
     });
-    m_drawn.cut_triangle_count = tissue.cut_surface().drawn_triangles().size();
+    m_drawn.cut_triangle_count = tissue.drawn_cut_triangles().size();
+    const Eigen::VectorXd& x = tissue.current_positions_m();
+    m_drawn.positions_m.assign(x.data(), x.data() + x.size());
   }
   m_drawn_current = true;
   return m_drawn;
@@ -278,9 +279,13 @@ void TissueModel::ensure_built() {
   if (m_dirty || !m_tissue) build();
 }
 
+std::size_t TissueModel::revision_triangles() const {
+  return m_tissue->has_render_surface() ? 0 : m_tissue->drawn_triangle_count();
+}
+
 void TissueModel::update_surface_counters() {
   m_drawn_current = false;
-  const std::size_t triangles = m_tissue->drawn_triangle_count();
+  const std::size_t triangles = revision_triangles();
   const std::size_t cut_tets = m_tissue->body().cut_tets().size();
   if (triangles != m_surface_triangles || cut_tets != m_surface_cut_tets) {
     ++m_surface_revision;
@@ -538,7 +543,7 @@ void TissueModel::restore(const fmi3::ModelState& model_state) {
   }
   m_surface_revision = state->surface_revision;
   m_integrator_iterations = state->integrator_iterations;
-  m_surface_triangles = m_tissue->drawn_triangle_count();
+  m_surface_triangles = revision_triangles();
   m_surface_cut_tets = m_tissue->body().cut_tets().size();
   m_drawn_current = false;
 }

@@ -67,6 +67,10 @@ class TissueModel final : public fmi3::Model {
   void ensure_built();
   /// surface.revision after a step or a restore (the drawn surface is brought up to date only when read).
   void update_surface_counters();
+  /// What surface.revision follows besides the cut tets: the tet skin's triangle count (a join that
+  /// let go changes it); none for a render surface, which changes only with the cuts (so that a step
+  /// does not make the tet skin's lists for a surface it does not draw).
+  [[nodiscard]] std::size_t revision_triangles() const;
   /// Logs once that the surface outgrew the arrays' capacities (on reading the arrays or their counts).
   void warn_if_arrays_truncate();
   /// The drawn surface (the render surface when surface.renderSurface names one, else the tet skin),

@@ -39,7 +39,16 @@ void SurfaceViews::update_positions(const DeformableBody& body, const Eigen::Vec
   body.positions(displacement_m, m_vertex_positions_m);
   m_positions_m.head(m_vertex_positions_m.size()) = m_vertex_positions_m;
   m_cut_surface.update_points(body, displacement_m, m_positions_m);
-  m_cut_surface.update_welds(body, m_surface, displacement_m, m_positions_m);
+  m_drawn_current = false;
+}
+
+void SurfaceViews::bring_drawn_up_to_date(const DeformableBody& body, const Eigen::VectorXd& displacement_m) const {
+  if (m_drawn_current) return;
+  const int points = m_cut_surface.point_count();
+  m_cut_surface.update_drawn(body, m_surface, displacement_m, m_positions_m);
+  // Points the drawn lists added (split triangles' centres) get their positions.
+  if (m_cut_surface.point_count() != points) m_cut_surface.update_points(body, displacement_m, m_positions_m);
+  m_drawn_current = true;
 }
 
 void SurfaceViews::add_cut_tets(const DeformableBody& body, const Eigen::VectorXd& displacement_m, int first_cut_tet) {

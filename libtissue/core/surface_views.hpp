@@ -50,20 +50,38 @@ class SurfaceViews {
   [[nodiscard]] const CutRenderSurface* render_surface(const DeformableBody& body,
                                                        const Eigen::VectorXd& displacement_m) const;
 
-  /// The surface to draw, with corners indexing positions_m(): the mesh's surface without the
-  /// triangles of cut tets, their pieces either side of the cut (the skin), then the cut faces.
+  [[nodiscard]] bool has_render_surface() const { return m_render != nullptr; }
+
+  /// The surface to draw at `displacement_m` (the state of the last update_positions()), with
+  /// corners indexing positions_m(): the mesh's surface without the triangles of cut tets, their
+  /// pieces either side of the cut (the skin), then the cut faces. Its lists are made when read, for
+  /// the cuts and positions since they were last read: a step pays nothing for a tet skin that is
+  /// not drawn (a scene that draws its render surface).
   template <class Visit>
-  void for_each_drawn_triangle(Visit&& visit) const;
-  [[nodiscard]] std::size_t drawn_triangle_count() const {
+  void for_each_drawn_triangle(const DeformableBody& body, const Eigen::VectorXd& displacement_m, Visit&& visit) const;
+  [[nodiscard]] std::size_t drawn_triangle_count(const DeformableBody& body,
+                                                 const Eigen::VectorXd& displacement_m) const {
+    bring_drawn_up_to_date(body, displacement_m);
     return m_surface.triangles.size() - m_cut_surface.replaced_triangles().size() +
            m_cut_surface.skin_triangles().size() + m_cut_surface.drawn_triangles().size();
   }
+  /// The cut faces of the surface to draw (the last part of for_each_drawn_triangle()'s).
+  [[nodiscard]] const std::vector<std::array<int, 3>>& drawn_cut_triangles(
+      const DeformableBody& body, const Eigen::VectorXd& displacement_m) const {
+    bring_drawn_up_to_date(body, displacement_m);
+    return m_cut_surface.drawn_triangles();
+  }
 
  private:
+  void bring_drawn_up_to_date(const DeformableBody& body, const Eigen::VectorXd& displacement_m) const;
+
   SurfaceMesh m_surface;
   Eigen::VectorXd m_vertex_positions_m;
-  Eigen::VectorXd m_positions_m;
-  CutSurface m_cut_surface;
+  // The positions and the cut faces; their drawn lists (and the points those add) are brought up to
+  // date by the readers of the drawn surface (bring_drawn_up_to_date).
+  mutable Eigen::VectorXd m_positions_m;
+  mutable CutSurface m_cut_surface;
+  mutable bool m_drawn_current = true;
   LazySurfaceBvh m_bvh;
   // The render surface, brought up to date by render_surface() (re-meshed when the cut tets changed,
   // mapped when the state changed).
@@ -73,7 +91,9 @@ class SurfaceViews {
 };
 
 template <class Visit>
-void SurfaceViews::for_each_drawn_triangle(Visit&& visit) const {
+void SurfaceViews::for_each_drawn_triangle(const DeformableBody& body, const Eigen::VectorXd& displacement_m,
+                                           Visit&& visit) const {
+  bring_drawn_up_to_date(body, displacement_m);
   const std::vector<int>& replaced = m_cut_surface.replaced_triangles();  // ascending
   auto next_replaced = replaced.begin();
   for (std::size_t t = 0; t < m_surface.triangles.size(); ++t) {

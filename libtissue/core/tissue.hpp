@@ -167,16 +167,26 @@ class Tissue {
   /// The positions after the last step, as the BVH is refitted to: the mesh vertices (3 each), then
   /// the corners of the cut faces (cut_surface()).
   [[nodiscard]] const Eigen::VectorXd& current_positions_m() const { return m_surfaces.positions_m(); }
-  /// The faces the cuts opened; they are in the surface BVH after the mesh's surface triangles.
+  /// The faces the cuts opened; they are in the surface BVH after the mesh's surface triangles. Its
+  /// drawn lists are those of the last read of the drawn surface (for_each_drawn_triangle and its kin).
   [[nodiscard]] const CutSurface& cut_surface() const { return m_surfaces.cut_surface(); }
   /// The surface to draw, with corners indexing current_positions_m(): the mesh's surface without
   /// the triangles of cut tets, their pieces either side of the cut (the skin), then the cut faces.
+  /// Made when read (SurfaceViews::for_each_drawn_triangle).
   template <class Visit>
   void for_each_drawn_triangle(Visit&& visit) const {
-    m_surfaces.for_each_drawn_triangle(std::forward<Visit>(visit));
+    m_surfaces.for_each_drawn_triangle(m_body, m_state.displacement_m, std::forward<Visit>(visit));
   }
   /// How many triangles for_each_drawn_triangle() visits.
-  [[nodiscard]] std::size_t drawn_triangle_count() const { return m_surfaces.drawn_triangle_count(); }
+  [[nodiscard]] std::size_t drawn_triangle_count() const {
+    return m_surfaces.drawn_triangle_count(m_body, m_state.displacement_m);
+  }
+  /// The cut faces for_each_drawn_triangle() visits last.
+  [[nodiscard]] const std::vector<std::array<int, 3>>& drawn_cut_triangles() const {
+    return m_surfaces.drawn_cut_triangles(m_body, m_state.displacement_m);
+  }
+  /// Whether the scene draws a render surface (TissueSettings::render_surface) instead of the tet skin.
+  [[nodiscard]] bool has_render_surface() const { return m_surfaces.has_render_surface(); }
 
   [[nodiscard]] const SurfaceMesh& surface() const { return m_surfaces.surface(); }
   /// The render surface (TissueSettings::render_surface) at the current state, re-meshed for the

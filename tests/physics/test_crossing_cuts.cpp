@@ -330,7 +330,8 @@ TEST(CrossingCuts, AnXCutDrawsAClosedSurfacePerPiece) {
   SurfaceViews views(beam.body, false, nullptr);
   views.add_cut_tets(beam.body, beam.state.displacement_m, 0);
   std::vector<std::array<int, 3>> triangles;
-  views.for_each_drawn_triangle([&](const std::array<int, 3>& t) { triangles.push_back(t); });
+  views.for_each_drawn_triangle(beam.body, beam.state.displacement_m,
+                                [&](const std::array<int, 3>& t) { triangles.push_back(t); });
   EXPECT_EQ(test_support::check_surface(triangles, static_cast<int>(views.positions_m().size() / 3)).open_edges, 0);
 }
 

@@ -93,6 +93,7 @@ TEST(ScalpelCut, NoSurfaceTriangleStretchesAcrossTheOpening) {
   sweep(tissue, 0.0553, -0.005, 0.025);
   const double tip_before = mean_z_displacement(tissue, 0.09, 0.1);
   while (mean_z_displacement(tissue, 0.09, 0.1) - tip_before > -0.02) tissue.step();
+  ASSERT_GT(tissue.drawn_triangle_count(), 0u);  // the drawn lists below are made when the surface is read
   const CutSurface& cuts = tissue.cut_surface();
   const auto& mesh_triangles = tissue.surface().triangles;
   // The cut layer's outside: 4 sides of 2 squares of 1 cm, 2 triangles each.

@@ -53,7 +53,7 @@ int CutSurface::add_cut_tets(const DeformableBody& body, int first_cut_tet, cons
   }
   if (retired_any) fix_retired_representatives();
   update_fronts(body);
-  rebuild_drawn(body, surface);
+  m_drawn_stale = true;
   m_cut_tets = cut_tets;
   return static_cast<int>(m_triangles.size()) - triangles_before;
 }
@@ -277,8 +277,13 @@ bool material_at(const DeformableBody& body, const Eigen::VectorXd& displacement
 
 }  // namespace
 
-bool CutSurface::update_welds(const DeformableBody& body, const SurfaceMesh& surface,
+bool CutSurface::update_drawn(const DeformableBody& body, const SurfaceMesh& surface,
                               const Eigen::VectorXd& displacement_m, const Eigen::VectorXd& positions_m) {
+  const bool remade = m_drawn_stale;
+  if (m_drawn_stale) {
+    rebuild_drawn(body, surface);
+    m_drawn_stale = false;
+  }
   // Whether point b is farther from position `at` than the fraction of the largest rest edge of the
   // cut tet that made point a (or, for a point of real vertices, b; two such points: never).
   const auto far = [&](const Eigen::Vector3d& at, int a, int b) {
@@ -337,7 +342,7 @@ bool CutSurface::update_welds(const DeformableBody& body, const SurfaceMesh& sur
     set(m_front_apart, static_cast<size_t>(e), !held);
   }
   if (changed) rebuild_drawn(body, surface);
-  return changed;
+  return remade || changed;
 }
 
 }  // namespace tissue

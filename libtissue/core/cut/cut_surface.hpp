@@ -49,6 +49,7 @@ class CutSurface {
   /// Adds the faces of the cut tets [first_cut_tet, body.cut_tets().size()), and the skin pieces of
   /// their triangles in `surface` (the body's mesh surface), and retires the faces of the cut tets
   /// they replaced. Returns how many triangles were added (they are the last ones of triangles()).
+  /// The drawn lists are made again at the next update_drawn(), not here.
   int add_cut_tets(const DeformableBody& body, int first_cut_tet, const SurfaceMesh& surface);
 
   /// Resizes `positions_m` to 3 (vertex_count + point_count()) and writes the cut-face corners after
@@ -61,6 +62,7 @@ class CutSurface {
   /// Every cut face made, in the BVH's order: corner ids >= the mesh's vertex count (id -
   /// vertex_count indexes the points). The faces of retired cut tets are collapsed to a point.
   [[nodiscard]] const std::vector<std::array<int, 3>>& triangles() const { return m_triangles; }
+  // The drawn lists below are those of the last update_drawn().
   /// The cut faces to draw: triangles() without the retired ones, corners welded (drawn_point).
   [[nodiscard]] const std::vector<std::array<int, 3>>& drawn_triangles() const { return m_drawn; }
   /// The pieces that replace the surface triangles of cut tets in the output (not in the BVH: the
@@ -69,6 +71,8 @@ class CutSurface {
   [[nodiscard]] const std::vector<std::array<int, 3>>& skin_triangles() const { return m_skin; }
   /// Indices into SurfaceMesh::triangles of the triangles the skin pieces replace, ascending.
   [[nodiscard]] const std::vector<int>& replaced_triangles() const { return m_replaced; }
+  /// How many times the drawn lists were made (a reader that never draws the tet skin pays none).
+  [[nodiscard]] long drawn_rebuilds() const { return m_drawn_rebuilds; }
   /// The point drawn for corner id `id` (a mesh vertex, or a cut-face corner as triangles() names it):
   /// the vertex itself, or the first live corner made with the same weld key or one joined to it.
   [[nodiscard]] int drawn_point(int id) const;
@@ -80,9 +84,12 @@ class CutSurface {
   /// (15 + 15 hatched strokes on the frog). So each such join holds only while its points are within
   /// WELD_APART_FRACTION of their tet's largest rest edge (a front's sides: of the material at the
   /// crossing in a tet around the edge that the cut left whole); apart, they are drawn apart (the
-  /// surface shows the gap). Call after update_points() (its positions); re-draws when a join held
-  /// or let go, and says whether.
-  bool update_welds(const DeformableBody& body, const SurfaceMesh& surface, const Eigen::VectorXd& displacement_m,
+  /// surface shows the gap).
+  /// Brings the drawn lists to the body's cuts (made again after add_cut_tets) and to `positions_m`
+  /// (update_points() of `displacement_m`: where a join held or let go); says whether they changed.
+  /// Making them may add points (the centres of surface triangles split at a front): then call
+  /// update_points() again. Only a reader of the drawn surface needs it, when it reads.
+  bool update_drawn(const DeformableBody& body, const SurfaceMesh& surface, const Eigen::VectorXd& displacement_m,
                     const Eigen::VectorXd& positions_m);
   static constexpr double WELD_APART_FRACTION = 0.5;
 
@@ -158,6 +165,8 @@ class CutSurface {
   std::vector<std::array<int, 3>> m_triangles;
   std::vector<int> m_triangle_cut_tet;  // per triangle, the cut tet it belongs to
   std::vector<std::array<int, 3>> m_drawn;
+  bool m_drawn_stale = false;  // cut tets added since the drawn lists were made
+  long m_drawn_rebuilds = 0;
   std::vector<std::array<int, 3>> m_skin_made;  // the skin pieces as made (own corners)
   std::vector<int> m_skin_cut_tet;              // per made skin triangle, the cut tet it belongs to
   std::vector<int> m_skin_surface;              // and the surface triangle it is a piece of
@@ -174,7 +183,7 @@ class CutSurface {
   std::vector<int> m_key_drawn;
   std::vector<int> m_key_parent;  // per key: the key it is joined to (join_compatible_keys), itself at a root
   std::vector<int> m_root_drawn;  // per root key: the point drawn for its keys
-  // update_welds(): per key, its point apart from its root's (drawn alone); per crack edge, its two
+  // update_drawn(): per key, its point apart from its root's (drawn alone); per crack edge, its two
   // sides apart (no strip); per crossed edge, a side away from the edge's point (not drawn split).
   std::vector<std::uint8_t> m_key_apart, m_strip_apart, m_front_apart;
   std::vector<int> m_joined_keys;  // the keys drawn at another key's point (join_compatible_keys)

@@ -317,7 +317,7 @@ void CutSurface::join_compatible_keys(const DeformableBody& body) {
     int& drawn = m_root_drawn[static_cast<size_t>(key_root(static_cast<int>(key)))];
     if (drawn < 0) drawn = m_key_drawn[key];
   }
-  m_joined_keys.clear();  // the keys drawn at another key's point (update_welds watches them)
+  m_joined_keys.clear();  // the keys drawn at another key's point (update_drawn watches them)
   for (size_t key = 0; key < m_keys.size(); ++key) {
     if (m_root_drawn[static_cast<size_t>(key_root(static_cast<int>(key)))] != m_key_drawn[key])
       m_joined_keys.push_back(static_cast<int>(key));
@@ -419,6 +419,7 @@ void CutSurface::rebuild_drawn(const DeformableBody& body, const SurfaceMesh& su
     const std::array<int, 3> t = drawn(made);
     if (t[0] != t[1] && t[1] != t[2] && t[2] != t[0]) out.push_back(t);  // a face the weld folded away: none
   };
+  ++m_drawn_rebuilds;
   join_compatible_keys(body);
   m_drawn.clear();
   for (size_t t = 0; t < m_triangles.size(); ++t) add_live(m_drawn, m_triangles[t], m_triangle_cut_tet[t]);
