@@ -24,13 +24,21 @@ void HalfMatrix::derive_pattern(const BlockSparseMatrix& k) {
       m_column.push_back(c);
       m_full_slot.push_back(slot);
     }
-    // The diagonal first, the others by column (rows of K may hold appended blocks out of order).
-    std::vector<std::pair<int, int>> row;
-    for (size_t b = first; b < m_column.size(); ++b) row.emplace_back(m_column[b] == r ? -1 : m_column[b], m_full_slot[b]);
-    std::sort(row.begin(), row.end());
-    for (size_t b = first; b < m_column.size(); ++b) {
-      m_column[b] = row[b - first].first < 0 ? r : row[b - first].first;
-      m_full_slot[b] = row[b - first].second;
+    // The diagonal first, the others by column (rows of K may hold appended blocks out of order:
+    // after a cut; most rows are in order, and are left as they are).
+    bool ordered = first < m_column.size() && m_column[first] == r;
+    for (size_t b = first + 1; b < m_column.size() && ordered; ++b) ordered = m_column[b] > m_column[b - 1];
+    if (!ordered) {
+      std::vector<std::pair<int, int>>& row = m_sort_scratch;
+      row.clear();
+      for (size_t b = first; b < m_column.size(); ++b) {
+        row.emplace_back(m_column[b] == r ? -1 : m_column[b], m_full_slot[b]);
+      }
+      std::sort(row.begin(), row.end());
+      for (size_t b = first; b < m_column.size(); ++b) {
+        m_column[b] = row[b - first].first < 0 ? r : row[b - first].first;
+        m_full_slot[b] = row[b - first].second;
+      }
     }
     m_row_begin.push_back(static_cast<int>(m_column.size()));
   }

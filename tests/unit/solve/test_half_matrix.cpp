@@ -89,6 +89,12 @@ TEST(HalfMatrix, FollowsAGrownMatrix) {
   k.block(k.insert_block(appended, 1)) += coupling;
   k.block(k.insert_block(1, appended)) += coupling.transpose();
   k.block(k.find_slot(appended, appended)) = 5.0 * Eigen::Matrix3d::Identity();
+  // And a block placed after row 0's blocks of larger columns (the row out of order).
+  int between = 2;
+  while (k.find_slot(0, between) >= 0) ++between;
+  ASSERT_LT(between, last);
+  k.block(k.insert_block(0, between)) += coupling;
+  k.block(k.insert_block(between, 0)) += coupling.transpose();
   Eigen::VectorXd diagonal = Eigen::VectorXd::Constant(k.rows(), 2.0);
   diagonal.head(system.diagonal.size()) = system.diagonal;
   const ShiftedSystem grown{&k, 1.0, &diagonal};
