@@ -149,6 +149,7 @@ void TissueModel::build() {
   m_tissue->set_tool(tool_pose(m_values));
   m_dirty = false;
   m_surface_revision = 0;
+  m_surface_revision_stale = false;
   m_integrator_iterations = 0;
   m_surface_triangles = revision_triangles();
   m_surface_cut_tets = 0;
@@ -194,7 +195,7 @@ const ports::SurfaceMesh& TissueModel::drawn_mesh() {
 
 void TissueModel::drawn_embedding(ports::SurfaceEmbedding& embedding) {
   ensure_built();
-  embedding.revision = m_surface_revision;
+  embedding.revision = surface_revision();
   if (const CutRenderSurface* render = m_tissue->render_surface()) {
     // From the render surface itself, not through the drawn mesh (whose points it would copy).
     flat_triangles(*render, embedding.triangles);
@@ -230,7 +231,7 @@ void TissueModel::drawn_embedding(ports::SurfaceEmbedding& embedding) {
 
 void TissueModel::drawn_nodes(ports::SurfaceNodes& nodes) {
   ensure_built();
-  nodes.revision = m_surface_revision;
+  nodes.revision = surface_revision();
   if (const CutRenderSurface* render = m_tissue->render_surface()) {
     // The nodes alone: not the drawn mesh's points and triangles (a copy of the organ's 82k
     // triangles every frame, which the host maps itself).
@@ -242,7 +243,7 @@ void TissueModel::drawn_nodes(ports::SurfaceNodes& nodes) {
 }
 
 bool TissueModel::embedding_encoded(bool mesh_output) const {
-  return m_encoded_embedding && m_encoded_embedding->revision == m_surface_revision &&
+  return m_encoded_embedding && m_encoded_embedding->revision == surface_revision() &&
          m_encoded_embedding->mesh_output == mesh_output;
 }
 
@@ -253,16 +254,17 @@ const std::vector<std::uint8_t>& TissueModel::embedding_bytes(bool mesh_output) 
     drawn_embedding(m_embedding);
   } else {
     m_embedding = ports::SurfaceEmbedding{};
-    m_embedding.revision = m_surface_revision;
+    m_embedding.revision = surface_revision();
   }
   ports::encode(m_embedding, m_embedding_bytes);
-  m_encoded_embedding = EncodedEmbedding{m_surface_revision, mesh_output};
+  m_encoded_embedding = EncodedEmbedding{surface_revision(), mesh_output};
   return m_embedding_bytes;
 }
 
 void TissueModel::prepare_surface() {
   const bool mesh_output = m_values.boolean(vr(Vr::mesh_output_enabled));
   if (!m_values.boolean(vr(Vr::surface_prepare)) || !mesh_output || embedding_encoded(true)) return;
+  (void)surface_revision();  // here, not in the job (surface_revision's rule)
   // The job reads the tissue (const) and writes the render surface's and the embedding's members,
   // which every other call leaves alone until settle(); noexcept: a failure leaves the bytes stale,
   // so the read that follows computes them again and reports it.
@@ -283,8 +285,9 @@ std::size_t TissueModel::revision_triangles() const {
   return m_tissue->has_render_surface() ? 0 : m_tissue->drawn_triangle_count();
 }
 
-void TissueModel::update_surface_counters() {
-  m_drawn_current = false;
+std::uint64_t TissueModel::surface_revision() const {
+  if (!m_surface_revision_stale) return m_surface_revision;
+  m_surface_revision_stale = false;
   const std::size_t triangles = revision_triangles();
   const std::size_t cut_tets = m_tissue->body().cut_tets().size();
   if (triangles != m_surface_triangles || cut_tets != m_surface_cut_tets) {
@@ -292,6 +295,7 @@ void TissueModel::update_surface_counters() {
     m_surface_triangles = triangles;
     m_surface_cut_tets = cut_tets;
   }
+  return m_surface_revision;
 }
 
 void TissueModel::warn_if_arrays_truncate() {
@@ -344,13 +348,15 @@ fmi3::StepOutcome TissueModel::do_step(double current_time_s, double step_s) {
       m_integrator_iterations += static_cast<std::uint64_t>(report.dynamics.newton_iterations) +
                                  static_cast<std::uint64_t>(report.dynamics.linear_iterations);
     } catch (const std::exception& error) {
-      update_surface_counters();
+      m_drawn_current = false;
+      m_surface_revision_stale = true;
       log_events();
       m_context.log(fmi3::LogLevel::warning, std::string("doStep: an internal step failed: ") + error.what());
       return {false, m_start_time_s + tissue.time_s()};
     }
   }
-  update_surface_counters();
+  m_drawn_current = false;
+  m_surface_revision_stale = true;
   log_events();
   prepare_surface();
   return {true, m_start_time_s + tissue.time_s()};
@@ -363,6 +369,7 @@ void TissueModel::reset() {
   m_tissue.reset();
   m_dirty = true;
   m_surface_revision = 0;
+  m_surface_revision_stale = false;
 }
 
 // --- outputs ---
@@ -458,7 +465,8 @@ void TissueModel::get_uint64(const VariableInfo& info, std::span<std::uint64_t> 
       out[0] = mesh_out ? std::min<std::uint64_t>(drawn_mesh().triangles.size() / 3, m_values.uint64(vr(Vr::triangle_capacity))) : 0;
       return;
     case Vr::surface_revision:
-      out[0] = m_surface_revision;
+      if (m_surface_revision_stale) settle();  // (none runs then: surface_revision's rule)
+      out[0] = surface_revision();
       return;
     case Vr::cut_triangle_count:
       out[0] = mesh_out ? std::min<std::uint64_t>(drawn_mesh().cut_triangle_count, drawn_mesh().triangles.size() / 3) : 0;
@@ -509,7 +517,7 @@ std::span<const std::uint8_t> TissueModel::get_binary(const VariableInfo& info) 
         drawn_nodes(m_nodes);
       } else {
         m_nodes = ports::SurfaceNodes{};
-        m_nodes.revision = m_surface_revision;
+        m_nodes.revision = surface_revision();
       }
       ports::encode(m_nodes, m_nodes_bytes);
       return m_nodes_bytes;
@@ -525,7 +533,7 @@ std::unique_ptr<fmi3::ModelState> TissueModel::save() const {
   if (!m_tissue || m_dirty) throw VariableError("get FMU state: there is no model state before the model is built");
   auto state = std::make_unique<TissueState>();
   m_tissue->save(state->tissue);
-  state->surface_revision = m_surface_revision;
+  state->surface_revision = surface_revision();
   state->integrator_iterations = m_integrator_iterations;
   return state;
 }
@@ -542,6 +550,7 @@ void TissueModel::restore(const fmi3::ModelState& model_state) {
     throw VariableError(std::string("set FMU state: ") + error.what());
   }
   m_surface_revision = state->surface_revision;
+  m_surface_revision_stale = false;
   m_integrator_iterations = state->integrator_iterations;
   m_surface_triangles = revision_triangles();
   m_surface_cut_tets = m_tissue->body().cut_tets().size();

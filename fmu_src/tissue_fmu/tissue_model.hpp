@@ -65,8 +65,12 @@ class TissueModel final : public fmi3::Model {
  private:
   void build();
   void ensure_built();
-  /// surface.revision after a step or a restore (the drawn surface is brought up to date only when read).
-  void update_surface_counters();
+  /// surface.revision for the current state. A step only marks it stale: the first read after it
+  /// (an output, the surface's bytes, a saved state, a prepared frame) compares the drawn surface's
+  /// counts with the last ones, so a step between frames makes no tet-skin lists (DESIGN, "Drawn when
+  /// read"). No surface work may be running when it is stale (prepare_surface brings it up to date
+  /// before it starts one).
+  std::uint64_t surface_revision() const;
   /// What surface.revision follows besides the cut tets: the tet skin's triangle count (a join that
   /// let go changes it); none for a render surface, which changes only with the cuts (so that a step
   /// does not make the tet skin's lists for a surface it does not draw).
@@ -94,10 +98,12 @@ class TissueModel final : public fmi3::Model {
   double m_start_time_s = 0.0;
   bool m_dirty = true;  // a parameter changed since the Tissue was built
   std::unique_ptr<Tissue> m_tissue;
-  std::uint64_t m_surface_revision = 0;
+  // surface.revision and what it was last compared with; brought up to date by surface_revision().
+  mutable std::uint64_t m_surface_revision = 0;
+  mutable bool m_surface_revision_stale = false;
   std::uint64_t m_integrator_iterations = 0;  ///< integrator.iterations
-  std::uint64_t m_surface_triangles = 0;  // at the last revision check
-  std::size_t m_surface_cut_tets = 0;     // at the last revision check
+  mutable std::uint64_t m_surface_triangles = 0;  // at the last revision check
+  mutable std::size_t m_surface_cut_tets = 0;     // at the last revision check
   ports::SurfaceMesh m_drawn;
   bool m_drawn_current = false;
   ports::SurfaceEmbedding m_embedding;     // scratch of get_binary
