@@ -285,6 +285,11 @@ std::size_t TissueModel::revision_triangles() const {
   return m_tissue->has_render_surface() ? 0 : m_tissue->drawn_triangle_count();
 }
 
+void TissueModel::surface_moved() {
+  m_drawn_current = false;
+  m_surface_revision_stale = true;
+}
+
 std::uint64_t TissueModel::surface_revision() const {
   if (!m_surface_revision_stale) return m_surface_revision;
   m_surface_revision_stale = false;
@@ -348,15 +353,13 @@ fmi3::StepOutcome TissueModel::do_step(double current_time_s, double step_s) {
       m_integrator_iterations += static_cast<std::uint64_t>(report.dynamics.newton_iterations) +
                                  static_cast<std::uint64_t>(report.dynamics.linear_iterations);
     } catch (const std::exception& error) {
-      m_drawn_current = false;
-      m_surface_revision_stale = true;
+      surface_moved();
       log_events();
       m_context.log(fmi3::LogLevel::warning, std::string("doStep: an internal step failed: ") + error.what());
       return {false, m_start_time_s + tissue.time_s()};
     }
   }
-  m_drawn_current = false;
-  m_surface_revision_stale = true;
+  surface_moved();
   log_events();
   prepare_surface();
   return {true, m_start_time_s + tissue.time_s()};

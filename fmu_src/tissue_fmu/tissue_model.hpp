@@ -71,6 +71,9 @@ class TissueModel final : public fmi3::Model {
   /// read"). No surface work may be running when it is stale (prepare_surface brings it up to date
   /// before it starts one).
   std::uint64_t surface_revision() const;
+  /// Steps moved (and may have cut) the tissue: the drawn mesh and surface.revision are made again
+  /// when next read.
+  void surface_moved();
   /// What surface.revision follows besides the cut tets: the tet skin's triangle count (a join that
   /// let go changes it); none for a render surface, which changes only with the cuts (so that a step
   /// does not make the tet skin's lists for a surface it does not draw).

@@ -277,9 +277,8 @@ bool material_at(const DeformableBody& body, const Eigen::VectorXd& displacement
 
 }  // namespace
 
-bool CutSurface::update_drawn(const DeformableBody& body, const SurfaceMesh& surface,
+void CutSurface::update_drawn(const DeformableBody& body, const SurfaceMesh& surface,
                               const Eigen::VectorXd& displacement_m, const Eigen::VectorXd& positions_m) {
-  const bool remade = m_drawn_stale;
   if (m_drawn_stale) {
     rebuild_drawn(body, surface);
     m_drawn_stale = false;
@@ -342,7 +341,6 @@ bool CutSurface::update_drawn(const DeformableBody& body, const SurfaceMesh& sur
     set(m_front_apart, static_cast<size_t>(e), !held);
   }
   if (changed) rebuild_drawn(body, surface);
-  return remade || changed;
 }
 
 }  // namespace tissue

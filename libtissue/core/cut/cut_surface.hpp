@@ -86,10 +86,10 @@ class CutSurface {
   /// crossing in a tet around the edge that the cut left whole); apart, they are drawn apart (the
   /// surface shows the gap).
   /// Brings the drawn lists to the body's cuts (made again after add_cut_tets) and to `positions_m`
-  /// (update_points() of `displacement_m`: where a join held or let go); says whether they changed.
-  /// Making them may add points (the centres of surface triangles split at a front): then call
-  /// update_points() again. Only a reader of the drawn surface needs it, when it reads.
-  bool update_drawn(const DeformableBody& body, const SurfaceMesh& surface, const Eigen::VectorXd& displacement_m,
+  /// (update_points() of `displacement_m`: where a join held or let go). Making them may add points
+  /// (the centres of surface triangles split at a front): then call update_points() again. Only a
+  /// reader of the drawn surface needs it, when it reads.
+  void update_drawn(const DeformableBody& body, const SurfaceMesh& surface, const Eigen::VectorXd& displacement_m,
                     const Eigen::VectorXd& positions_m);
   static constexpr double WELD_APART_FRACTION = 0.5;
 
