@@ -1,6 +1,8 @@
 // compare.csv (see compare_table.hpp).
 #include "compare/compare_table.hpp"
 
+#include "output/session_log.hpp"
+
 #include <charconv>
 #include <fstream>
 #include <stdexcept>
@@ -10,12 +12,6 @@ namespace tissue::host {
 namespace {
 
 constexpr std::size_t COLUMNS = 16;
-
-void append_number(std::string& line, double value) {
-  char buffer[32];
-  const auto [end, error] = std::to_chars(buffer, buffer + sizeof(buffer), value);
-  line.append(buffer, error == std::errc() ? end : buffer);
-}
 
 template <class T>
 void append_optional(std::string& line, const std::optional<T>& value) {

@@ -1,6 +1,8 @@
 // vtu_writer.cpp - VTK XML UnstructuredGrid writer (VTK file formats, "XML File Formats").
 #include "output/vtu_writer.hpp"
 
+#include "output/session_log.hpp"
+
 #include <array>
 #include <bit>
 #include <charconv>
@@ -15,14 +17,7 @@ namespace {
 
 constexpr std::uint8_t VTK_TRIANGLE = 5;
 
-/// Appends the shortest decimal that reads back as @p value ("C" locale regardless of the global one).
-void append_number(std::string& out, double value) {
-  std::array<char, 32> buffer{};
-  const auto result = std::to_chars(buffer.data(), buffer.data() + buffer.size(), value);
-  out.append(buffer.data(), static_cast<std::size_t>(result.ptr - buffer.data()));
-}
-
-void append_number(std::string& out, std::uint64_t value) {
+void append_integer(std::string& out, std::uint64_t value) {
   std::array<char, 24> buffer{};
   const auto result = std::to_chars(buffer.data(), buffer.data() + buffer.size(), value);
   out.append(buffer.data(), static_cast<std::size_t>(result.ptr - buffer.data()));
@@ -76,7 +71,7 @@ void open_array(std::string& out, std::string_view indent, std::string_view type
   out += '"';
   if (components != 1) {
     out += " NumberOfComponents=\"";
-    append_number(out, std::uint64_t{components});
+    append_integer(out, std::uint64_t{components});
     out += '"';
   }
   out += extra;
@@ -140,7 +135,7 @@ std::string vtu_document(const SurfaceFrame& frame) {
     field_array(out, "tool_tip_m", frame.tool_tip_m.data(), 3);
     field_array(out, "tool_handle_m", frame.tool_handle_m.data(), 3);
     out += "      <DataArray type=\"Int32\" Name=\"tool_mode\" NumberOfTuples=\"1\" format=\"ascii\">\n        ";
-    append_number(out, static_cast<std::uint64_t>(frame.tool_mode));  // validated to be 0..2
+    append_integer(out, static_cast<std::uint64_t>(frame.tool_mode));  // validated to be 0..2
     out += "\n      </DataArray>\n";
   }
   if (frame.contact_active) {
@@ -150,9 +145,9 @@ std::string vtu_document(const SurfaceFrame& frame) {
   out += "    </FieldData>\n";
 
   out += "    <Piece NumberOfPoints=\"";
-  append_number(out, std::uint64_t{vertex_count});
+  append_integer(out, std::uint64_t{vertex_count});
   out += "\" NumberOfCells=\"";
-  append_number(out, std::uint64_t{triangle_count});
+  append_integer(out, std::uint64_t{triangle_count});
   out += "\">\n";
 
   out += "      <CellData Scalars=\"cut_face\">\n";

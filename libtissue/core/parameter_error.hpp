@@ -3,6 +3,7 @@
 #pragma once
 
 #include <stdexcept>
+#include <string>
 
 namespace tissue {
 
@@ -11,5 +12,12 @@ class ParameterError : public std::invalid_argument {
  public:
   using std::invalid_argument::invalid_argument;
 };
+
+/// Throws ParameterError "<settings>.<setting> = <value>: must be <range>" unless `ok`.
+inline void require_setting(const char* settings, bool ok, const char* setting, double value, const char* range) {
+  if (!ok) {
+    throw ParameterError(std::string(settings) + "." + setting + " = " + std::to_string(value) + ": must be " + range);
+  }
+}
 
 }  // namespace tissue

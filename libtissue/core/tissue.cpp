@@ -3,6 +3,7 @@
 
 #include "core/mesh/mesh_io.hpp"
 #include "core/tissue_settings_schema.hpp"
+#include "core/wall_clock.hpp"
 
 #include <algorithm>
 #include <chrono>
@@ -16,10 +17,6 @@ namespace {
 TissueSettings checked(TissueSettings settings) {
   validate(settings);
   return settings;
-}
-
-double seconds_since(std::chrono::steady_clock::time_point start) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 
 }  // namespace

@@ -7,24 +7,16 @@
 
 namespace tissue::haptic {
 
-namespace {
-
-void require(bool ok, const char* setting, double value, const char* range) {
-  if (!ok) {
-    throw ParameterError(std::string("CuttingSettings.") + setting + " = " + std::to_string(value) + ": must be " +
-                         range);
-  }
-}
-
-}  // namespace
-
 void validate(const CuttingSettings& settings) {
-  require(std::isfinite(settings.fracture_toughness_j_per_m2) && settings.fracture_toughness_j_per_m2 >= 0.0,
-          "fracture_toughness_j_per_m2", settings.fracture_toughness_j_per_m2, "finite and >= 0");
-  require(std::isfinite(settings.blade_friction_n_per_m) && settings.blade_friction_n_per_m >= 0.0,
-          "blade_friction_n_per_m", settings.blade_friction_n_per_m, "finite and >= 0");
-  require(std::isfinite(settings.smoothing_speed_m_per_s) && settings.smoothing_speed_m_per_s > 0.0,
-          "smoothing_speed_m_per_s", settings.smoothing_speed_m_per_s, "finite and > 0");
+  require_setting("CuttingSettings",
+                  std::isfinite(settings.fracture_toughness_j_per_m2) && settings.fracture_toughness_j_per_m2 >= 0.0,
+                  "fracture_toughness_j_per_m2", settings.fracture_toughness_j_per_m2, "finite and >= 0");
+  require_setting("CuttingSettings",
+                  std::isfinite(settings.blade_friction_n_per_m) && settings.blade_friction_n_per_m >= 0.0,
+                  "blade_friction_n_per_m", settings.blade_friction_n_per_m, "finite and >= 0");
+  require_setting("CuttingSettings",
+                  std::isfinite(settings.smoothing_speed_m_per_s) && settings.smoothing_speed_m_per_s > 0.0,
+                  "smoothing_speed_m_per_s", settings.smoothing_speed_m_per_s, "finite and > 0");
 }
 
 Eigen::Vector3d cutting_force(const CuttingSettings& settings, double blade_depth_m,

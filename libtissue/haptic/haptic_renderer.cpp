@@ -14,13 +14,6 @@ namespace tissue::haptic {
 
 namespace {
 
-void require(bool ok, const char* setting, double value, const char* range) {
-  if (!ok) {
-    throw ParameterError(std::string("RendererSettings.") + setting + " = " + std::to_string(value) + ": must be " +
-                         range);
-  }
-}
-
 std::array<double, 3> to_array(const Eigen::Vector3d& v) { return {v.x(), v.y(), v.z()}; }
 
 Eigen::Vector3d to_vector(const std::array<double, 3>& a) { return {a[0], a[1], a[2]}; }
@@ -65,18 +58,23 @@ void require_prepared(const TissueSample& sample, const std::string& what) {
 }  // namespace
 
 void validate(const RendererSettings& settings) {
-  require(std::isfinite(settings.max_force_n) && settings.max_force_n > 0.0, "max_force_n", settings.max_force_n,
-          "finite and > 0");
-  require(settings.max_force_rate_n_per_s > 0.0, "max_force_rate_n_per_s", settings.max_force_rate_n_per_s,
-          "> 0 (+infinity: no limit)");
-  require(std::isfinite(settings.passivity_min_hand_mass_kg) && settings.passivity_min_hand_mass_kg > 0.0,
-          "passivity_min_hand_mass_kg", settings.passivity_min_hand_mass_kg, "finite and > 0");
-  require(std::isfinite(settings.max_estimated_stiffness_n_per_m) && settings.max_estimated_stiffness_n_per_m >= 0.0,
-          "max_estimated_stiffness_n_per_m", settings.max_estimated_stiffness_n_per_m, "finite and >= 0");
-  require(std::isfinite(settings.contact_damping_n_s_per_m) && settings.contact_damping_n_s_per_m >= 0.0,
-          "contact_damping_n_s_per_m", settings.contact_damping_n_s_per_m, "finite and >= 0");
-  require(std::isfinite(settings.velocity_filter_cutoff_hz) && settings.velocity_filter_cutoff_hz > 0.0,
-          "velocity_filter_cutoff_hz", settings.velocity_filter_cutoff_hz, "finite and > 0");
+  require_setting("RendererSettings", std::isfinite(settings.max_force_n) && settings.max_force_n > 0.0, "max_force_n",
+                  settings.max_force_n, "finite and > 0");
+  require_setting("RendererSettings", settings.max_force_rate_n_per_s > 0.0, "max_force_rate_n_per_s",
+                  settings.max_force_rate_n_per_s, "> 0 (+infinity: no limit)");
+  require_setting("RendererSettings",
+                  std::isfinite(settings.passivity_min_hand_mass_kg) && settings.passivity_min_hand_mass_kg > 0.0,
+                  "passivity_min_hand_mass_kg", settings.passivity_min_hand_mass_kg, "finite and > 0");
+  require_setting(
+      "RendererSettings",
+      std::isfinite(settings.max_estimated_stiffness_n_per_m) && settings.max_estimated_stiffness_n_per_m >= 0.0,
+      "max_estimated_stiffness_n_per_m", settings.max_estimated_stiffness_n_per_m, "finite and >= 0");
+  require_setting("RendererSettings",
+                  std::isfinite(settings.contact_damping_n_s_per_m) && settings.contact_damping_n_s_per_m >= 0.0,
+                  "contact_damping_n_s_per_m", settings.contact_damping_n_s_per_m, "finite and >= 0");
+  require_setting("RendererSettings",
+                  std::isfinite(settings.velocity_filter_cutoff_hz) && settings.velocity_filter_cutoff_hz > 0.0,
+                  "velocity_filter_cutoff_hz", settings.velocity_filter_cutoff_hz, "finite and > 0");
   validate(settings.cutting);
 }
 

@@ -8,6 +8,11 @@
 
 namespace tissue {
 
+/// Vertex `vertex`'s point in a flat array of positions (x, y, z per vertex) [m].
+inline Eigen::Vector3d vertex_position(const Eigen::VectorXd& positions_m, int vertex) {
+  return positions_m.segment<3>(3 * static_cast<Eigen::Index>(vertex));
+}
+
 /// Where a segment a->b meets a triangle (t0, t1, t2).
 struct SegmentTriangleHit {
   double segment_parameter = 0.0;  ///< hit point = a + s (b - a), s in [0, 1]

@@ -3,6 +3,8 @@
 // that neither allocates nor changes the tree. The exact tests are those of geometry.hpp.
 #include "core/collide/surface_bvh.hpp"
 
+#include "core/collide/geometry.hpp"
+
 #ifndef BT_USE_DOUBLE_PRECISION
 #error "surface_bvh.cpp must see Bullet's double-precision build (link tissue::bullet)"
 #endif
@@ -28,10 +30,6 @@ namespace {
 /// Boxes grow by this fraction of the largest absolute coordinate, so that rounding in the box
 /// tests (about 1e-16 of the coordinates) never prunes a triangle the exact test would accept.
 constexpr double RELATIVE_BOX_MARGIN = 1e-9;
-
-Eigen::Vector3d vertex_position(const Eigen::VectorXd& positions_m, int vertex) {
-  return positions_m.segment<3>(3 * static_cast<Eigen::Index>(vertex));
-}
 
 /// The triangle's axis-aligned box, grown by margin_m on every side.
 btDbvtVolume triangle_box(const std::array<int, 3>& triangle, const Eigen::VectorXd& positions_m, double margin_m) {

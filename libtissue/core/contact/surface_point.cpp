@@ -14,10 +14,6 @@
 namespace tissue {
 namespace {
 
-Eigen::Vector3d vertex_position(const Eigen::VectorXd& positions_m, int vertex) {
-  return positions_m.segment<3>(3 * static_cast<Eigen::Index>(vertex));
-}
-
 // The closest point of one triangle to the query.
 struct TriangleCandidate {
   int triangle = -1;

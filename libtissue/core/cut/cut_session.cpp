@@ -2,6 +2,7 @@
 #include "core/cut/cut_session.hpp"
 
 #include "core/state_error.hpp"
+#include "core/wall_clock.hpp"
 
 #include <algorithm>
 #include <chrono>
@@ -12,10 +13,6 @@
 namespace tissue {
 
 namespace {
-
-double seconds_since(std::chrono::steady_clock::time_point start) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-}
 
 // The largest turn of the blade one cutter sweep covers (its two triangles span the ruled surface
 // of a turning segment to within ~ L (1 - cos(angle / 2)), 0.1 mm for a 3 cm blade at 5 degrees).

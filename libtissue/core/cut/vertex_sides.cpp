@@ -3,7 +3,9 @@
 // vertices' sides. Member functions of VolumeCutter, apart from the search.
 #include "core/cut/volume_cutter.hpp"
 
+#include "core/collide/geometry.hpp"
 #include "core/cut/cut_geometry.hpp"
+#include "core/index_cast.hpp"
 
 #include <Eigen/Geometry>
 #include <Eigen/LU>
@@ -13,16 +15,6 @@
 #include <limits>
 
 namespace tissue {
-namespace {
-
-std::size_t at(int index) { return static_cast<std::size_t>(index); }
-
-Eigen::Vector3d vertex_position(const Eigen::VectorXd& positions_m, int vertex) {
-  return positions_m.segment<3>(3 * static_cast<Eigen::Index>(vertex));
-}
-
-}  // namespace
-
 bool VolumeCutter::continues_plane(const Blade& previous, const Blade& current) const {
   if (m_cut_id < 0 || !m_plane.valid) return false;
   const Eigen::Vector3d motion = 0.5 * ((current.tip_m - previous.tip_m) + (current.handle_m - previous.handle_m));
@@ -74,11 +66,11 @@ void VolumeCutter::decide_if_passed(int vertex, const Eigen::VectorXd& positions
   const PlaneOffset o = plane_offset(vertex, positions_m);
   if (!o.within_span()) return;
   if (o.ahead_m > 0.0) {
-    if (m_watched_flag[at(vertex)] == 0) {
-      m_watched_flag[at(vertex)] = 1;
+    if (m_watched_flag[to_size(vertex)] == 0) {
+      m_watched_flag[to_size(vertex)] = 1;
       m_watched.push_back(vertex);
     }
-  } else if (o.ahead_m >= m_strip_back_m - m_vertex_reach_m[at(vertex)]) {
+  } else if (o.ahead_m >= m_strip_back_m - m_vertex_reach_m[to_size(vertex)]) {
     // In this step's strip, or behind it by less than an edge (a tet the sweep enters that reaches
     // back off the plane). Not one far behind: a piece swinging on its last bridge carries
     // vertices the blade passed long ago, off its plane, back into its path.
@@ -93,9 +85,9 @@ void VolumeCutter::decide_around_vertices_on_blade(const Eigen::VectorXd& positi
   while (!m_on_blade.empty()) {
     const int vertex = m_on_blade.back();
     m_on_blade.pop_back();
-    const int end = m_adjacency.vertex_tets_begin[at(vertex) + 1];
-    for (int k = m_adjacency.vertex_tets_begin[at(vertex)]; k < end; ++k) {
-      for (const int v : m_mesh.tets[at(m_adjacency.vertex_tets[at(k)])]) decide_if_passed(v, positions_m);
+    const int end = m_adjacency.vertex_tets_begin[to_size(vertex) + 1];
+    for (int k = m_adjacency.vertex_tets_begin[to_size(vertex)]; k < end; ++k) {
+      for (const int v : m_mesh.tets[to_size(m_adjacency.vertex_tets[to_size(k)])]) decide_if_passed(v, positions_m);
     }
   }
 }
@@ -104,13 +96,13 @@ void VolumeCutter::pass_watched(const Eigen::VectorXd& positions_m) {
   std::size_t kept = 0;
   for (const int vertex : m_watched) {
     if (decided_now(vertex)) {
-      m_watched_flag[at(vertex)] = 0;
+      m_watched_flag[to_size(vertex)] = 0;
       continue;
     }
     const PlaneOffset o = plane_offset(vertex, positions_m);
     if (o.within_span() && o.ahead_m <= 0.0) {
       record_side(vertex, o.distance_m);
-      m_watched_flag[at(vertex)] = 0;
+      m_watched_flag[to_size(vertex)] = 0;
       continue;
     }
     m_watched[kept++] = vertex;
@@ -119,33 +111,34 @@ void VolumeCutter::pass_watched(const Eigen::VectorXd& positions_m) {
 }
 
 void VolumeCutter::record_side(int vertex, double distance_m) {
-  const double snap_m = m_vertex_snap_m[at(vertex)];
+  const double snap_m = m_vertex_snap_m[to_size(vertex)];
   if (!side_decided(vertex)) m_session_vertices.push_back(vertex);  // once (a later passage decides again)
-  m_vertex_session[at(vertex)] = m_cut_id;
-  m_vertex_distance_m[at(vertex)] = distance_m;
-  m_vertex_turn_rad[at(vertex)] = m_turn_rad;
-  m_vertex_side[at(vertex)] = distance_m > snap_m ? std::int8_t{1} : (distance_m < -snap_m ? std::int8_t{-1} : std::int8_t{0});
+  m_vertex_session[to_size(vertex)] = m_cut_id;
+  m_vertex_distance_m[to_size(vertex)] = distance_m;
+  m_vertex_turn_rad[to_size(vertex)] = m_turn_rad;
+  m_vertex_side[to_size(vertex)] =
+      distance_m > snap_m ? std::int8_t{1} : (distance_m < -snap_m ? std::int8_t{-1} : std::int8_t{0});
   m_new_vertices.push_back(vertex);
-  if (m_vertex_side[at(vertex)] == 0) m_on_blade.push_back(vertex);
+  if (m_vertex_side[to_size(vertex)] == 0) m_on_blade.push_back(vertex);
 }
 
 bool VolumeCutter::has_both_sides_passed(int tet) const {
   bool below = false;
   bool above = false;
-  for (const int v : m_mesh.tets[at(tet)]) {
-    if (!decided_now(v) || m_fitted_close[at(v)] == m_close_count) continue;
-    below |= m_vertex_side[at(v)] < 0;
-    above |= m_vertex_side[at(v)] >= 0;
+  for (const int v : m_mesh.tets[to_size(tet)]) {
+    if (!decided_now(v) || m_fitted_close[to_size(v)] == m_close_count) continue;
+    below |= m_vertex_side[to_size(v)] < 0;
+    above |= m_vertex_side[to_size(v)] >= 0;
   }
   return below && above && one_passage(tet);
 }
 
 bool VolumeCutter::stopped_in(int tet) const {
   bool passed = false;
-  for (const int v : m_mesh.tets[at(tet)]) {
+  for (const int v : m_mesh.tets[to_size(tet)]) {
     if (!decided_now(v)) {
-      if (m_watched_flag[at(v)] == 0) return false;
-    } else if (m_fitted_close[at(v)] != m_close_count) {
+      if (m_watched_flag[to_size(v)] == 0) return false;
+    } else if (m_fitted_close[to_size(v)] != m_close_count) {
       passed = true;
     }
   }
@@ -155,10 +148,10 @@ bool VolumeCutter::stopped_in(int tet) const {
 bool VolumeCutter::one_passage(int tet) const {
   double first_rad = std::numeric_limits<double>::infinity();
   double last_rad = -first_rad;
-  for (const int v : m_mesh.tets[at(tet)]) {
+  for (const int v : m_mesh.tets[to_size(tet)]) {
     if (!decided_now(v)) continue;
-    first_rad = std::min(first_rad, m_vertex_turn_rad[at(v)]);
-    last_rad = std::max(last_rad, m_vertex_turn_rad[at(v)]);
+    first_rad = std::min(first_rad, m_vertex_turn_rad[to_size(v)]);
+    last_rad = std::max(last_rad, m_vertex_turn_rad[to_size(v)]);
   }
   return last_rad - first_rad <= 0.5 * PASSAGE_TURN_RAD;
 }
@@ -183,15 +176,15 @@ void VolumeCutter::close_session(CutStepReport& report, const Eigen::VectorXd& p
     ++m_stamp;
     m_closing.clear();
     for (const int vertex : m_session_vertices) {
-      const int end = m_adjacency.vertex_tets_begin[at(vertex) + 1];
-      for (int k = m_adjacency.vertex_tets_begin[at(vertex)]; k < end; ++k) {
-        const int tet = m_adjacency.vertex_tets[at(k)];
-        if (m_tet_stamp[at(tet)] == m_stamp || cut_now(tet)) continue;
-        m_tet_stamp[at(tet)] = m_stamp;
+      const int end = m_adjacency.vertex_tets_begin[to_size(vertex) + 1];
+      for (int k = m_adjacency.vertex_tets_begin[to_size(vertex)]; k < end; ++k) {
+        const int tet = m_adjacency.vertex_tets[to_size(k)];
+        if (m_tet_stamp[to_size(tet)] == m_stamp || cut_now(tet)) continue;
+        m_tet_stamp[to_size(tet)] = m_stamp;
         const bool stopped = stopped_in(tet);
         const bool both_sides = has_both_sides_passed(tet);
         if (!stopped && !both_sides) continue;
-        for (const int v : m_mesh.tets[at(tet)]) {
+        for (const int v : m_mesh.tets[to_size(tet)]) {
           if (decided_now(v)) continue;
           if (stopped) {
             m_closing.push_back(v);
@@ -200,7 +193,7 @@ void VolumeCutter::close_session(CutStepReport& report, const Eigen::VectorXd& p
           // Only where the blade went: between tip and handle, not more than an edge ahead of where
           // it stopped (a tet it crossed whole whose vertex lies ahead, off its plane).
           const PlaneOffset o = plane_offset(v, positions_m);
-          if (both_sides && o.within_span() && o.ahead_m <= m_vertex_reach_m[at(v)]) m_closing.push_back(v);
+          if (both_sides && o.within_span() && o.ahead_m <= m_vertex_reach_m[to_size(v)]) m_closing.push_back(v);
         }
       }
     }
@@ -215,24 +208,24 @@ void VolumeCutter::close_session(CutStepReport& report, const Eigen::VectorXd& p
 }
 
 void VolumeCutter::decide_from_neighbours(int vertex, const Eigen::VectorXd& positions_m) {
-  const Eigen::Vector3d& x = m_mesh.rest_positions_m[at(vertex)];
-  const int begin = m_adjacency.vertex_tets_begin[at(vertex)];
-  const int end = m_adjacency.vertex_tets_begin[at(vertex) + 1];
+  const Eigen::Vector3d& x = m_mesh.rest_positions_m[to_size(vertex)];
+  const int begin = m_adjacency.vertex_tets_begin[to_size(vertex)];
+  const int end = m_adjacency.vertex_tets_begin[to_size(vertex) + 1];
   double reach_m = 0.0;  // the rest positions are scaled by the star's size: a fit of order one
   for (int k = begin; k < end; ++k) {
-    for (const int w : m_mesh.tets[at(m_adjacency.vertex_tets[at(k)])]) {
-      reach_m = std::max(reach_m, (m_mesh.rest_positions_m[at(w)] - x).norm());
+    for (const int w : m_mesh.tets[to_size(m_adjacency.vertex_tets[to_size(k)])]) {
+      reach_m = std::max(reach_m, (m_mesh.rest_positions_m[to_size(w)] - x).norm());
     }
   }
   Eigen::Matrix4d normal_matrix = Eigen::Matrix4d::Zero();
   Eigen::Vector4d right = Eigen::Vector4d::Zero();
   for (int k = begin; k < end; ++k) {
-    for (const int w : m_mesh.tets[at(m_adjacency.vertex_tets[at(k)])]) {
+    for (const int w : m_mesh.tets[to_size(m_adjacency.vertex_tets[to_size(k)])]) {
       if (w == vertex || !decided_now(w)) continue;
       Eigen::Vector4d row;
-      row << (m_mesh.rest_positions_m[at(w)] - x) / reach_m, 1.0;
+      row << (m_mesh.rest_positions_m[to_size(w)] - x) / reach_m, 1.0;
       normal_matrix += row * row.transpose();
-      right += row * m_vertex_distance_m[at(w)];
+      right += row * m_vertex_distance_m[to_size(w)];
     }
   }
   // The fit's value at the vertex itself, in the material: where the body now carries the vertex
@@ -241,17 +234,17 @@ void VolumeCutter::decide_from_neighbours(int vertex, const Eigen::VectorXd& pos
   Eigen::FullPivLU<Eigen::Matrix4d> fit(normal_matrix);
   fit.setThreshold(FIT_PIVOT_FLOOR);
   record_side(vertex, reach_m > 0.0 && fit.rank() == 4 ? fit.solve(right)[3] : plane_offset(vertex, positions_m).distance_m);
-  m_fitted_close[at(vertex)] = m_close_count;
+  m_fitted_close[to_size(vertex)] = m_close_count;
 }
 
 std::optional<TetCut> VolumeCutter::cut_of(int tet, double end_margin) const {
-  const Tet& vertices = m_mesh.tets[at(tet)];
+  const Tet& vertices = m_mesh.tets[to_size(tet)];
   // The vertices' states: +1, -1, or 0 on the blade (within the snap distance when decided).
   std::array<std::int8_t, 4> state{};
   int below = 0;
   for (std::size_t j = 0; j < 4; ++j) {
     if (!decided_now(vertices[j])) return std::nullopt;
-    state[j] = m_vertex_side[at(vertices[j])];
+    state[j] = m_vertex_side[to_size(vertices[j])];
     below += state[j] < 0 ? 1 : 0;
   }
   if (!one_passage(tet)) return std::nullopt;  // its vertices decided by different turns
@@ -266,17 +259,17 @@ std::optional<TetCut> VolumeCutter::cut_of(int tet, double end_margin) const {
   // when they were decided (an edge whose end the body carried across the blade and back).
   std::array<double, 6> ratio{};
   for (std::size_t k = 0; k < 6; ++k) {
-    const std::size_t i = at(TET_EDGES[k][0]);
-    const std::size_t j = at(TET_EDGES[k][1]);
+    const std::size_t i = to_size(TET_EDGES[k][0]);
+    const std::size_t j = to_size(TET_EDGES[k][1]);
     if (side[i] == side[j]) continue;
-    const int edge = m_adjacency.tet_edges[at(tet)][k];
-    const auto& ends = m_adjacency.edges[at(edge)];
+    const int edge = m_adjacency.tet_edges[to_size(tet)][k];
+    const auto& ends = m_adjacency.edges[to_size(edge)];
     double r = 0.0;  // along {v0, v1}
     if (crossed_now(edge)) {
-      r = m_edge_ratio[at(edge)];
+      r = m_edge_ratio[to_size(edge)];
     } else {
-      const double d0 = m_vertex_distance_m[at(ends[0])];
-      const double d1 = m_vertex_distance_m[at(ends[1])];
+      const double d0 = m_vertex_distance_m[to_size(ends[0])];
+      const double d1 = m_vertex_distance_m[to_size(ends[1])];
       r = d0 / (d0 - d1);
     }
     // Stored along {v0, v1} with v0 < v1; the tet's local edge may run the other way.

@@ -3,6 +3,7 @@
 
 #include "core/collide/geometry.hpp"
 #include "core/cut/cut_geometry.hpp"
+#include "core/index_cast.hpp"
 #include "core/material/material.hpp"
 
 #include <Eigen/Geometry>
@@ -19,8 +20,6 @@
 namespace tissue {
 namespace {
 
-std::size_t at(int index) { return static_cast<std::size_t>(index); }
-
 /// The local vertices a cut puts above, as bits.
 std::uint8_t above_mask(const TetCut& cut) {
   unsigned mask = 0u;
@@ -28,10 +27,6 @@ std::uint8_t above_mask(const TetCut& cut) {
     if (cut.side[v] > 0) mask |= 1u << v;
   }
   return static_cast<std::uint8_t>(mask);
-}
-
-Eigen::Vector3d vertex_position(const Eigen::VectorXd& positions_m, int vertex) {
-  return positions_m.segment<3>(3 * static_cast<Eigen::Index>(vertex));
 }
 
 bool is_finite(const Blade& blade) { return blade.tip_m.allFinite() && blade.handle_m.allFinite(); }
@@ -43,7 +38,7 @@ bool segment_touches_tet(const Eigen::Vector3d& a, const Eigen::Vector3d& b, con
     if (barycentric && barycentric->minCoeff() >= 0.0) return true;
   }
   for (const auto& face : TET_FACES) {
-    if (intersect_segment_triangle(a, b, x[at(face[0])], x[at(face[1])], x[at(face[2])])) return true;
+    if (intersect_segment_triangle(a, b, x[to_size(face[0])], x[to_size(face[1])], x[to_size(face[2])])) return true;
   }
   return false;
 }
@@ -162,10 +157,10 @@ VolumeCutter::VolumeCutter(const TetMesh& mesh, const TetAdjacency& adjacency, c
   m_vertex_snap_m.assign(vertices, std::numeric_limits<double>::infinity());
   m_vertex_reach_m.assign(vertices, 0.0);
   for (const auto& ends : adjacency.edges) {
-    const double length_m = (mesh.rest_positions_m[at(ends[1])] - mesh.rest_positions_m[at(ends[0])]).norm();
+    const double length_m = (mesh.rest_positions_m[to_size(ends[1])] - mesh.rest_positions_m[to_size(ends[0])]).norm();
     for (const int v : ends) {
-      m_vertex_snap_m[at(v)] = std::min(m_vertex_snap_m[at(v)], settings.vertex_snap_fraction * length_m);
-      m_vertex_reach_m[at(v)] = std::max(m_vertex_reach_m[at(v)], length_m);
+      m_vertex_snap_m[to_size(v)] = std::min(m_vertex_snap_m[to_size(v)], settings.vertex_snap_fraction * length_m);
+      m_vertex_reach_m[to_size(v)] = std::max(m_vertex_reach_m[to_size(v)], length_m);
     }
   }
   for (double& snap_m : m_vertex_snap_m) {
@@ -192,7 +187,7 @@ VolumeCutter::VolumeCutter(const TetMesh& mesh, const TetAdjacency& adjacency, c
 
 std::optional<double> VolumeCutter::edge_crossing(int edge) const {
   if (m_cut_id < 0 || !crossed_now(edge)) return std::nullopt;
-  return m_edge_ratio[at(edge)];
+  return m_edge_ratio[to_size(edge)];
 }
 
 CutStepReport VolumeCutter::end_cut(const Eigen::VectorXd& positions_m) {
@@ -321,7 +316,7 @@ void VolumeCutter::restore(const SessionState& state) {
   m_record_epoch = state.record_epoch;
   std::fill(m_watched_flag.begin(), m_watched_flag.end(), std::uint8_t{0});
   m_watched.assign(state.watched.begin(), state.watched.end());
-  for (const int vertex : m_watched) m_watched_flag[at(vertex)] = 1;
+  for (const int vertex : m_watched) m_watched_flag[to_size(vertex)] = 1;
   m_session_vertices.assign(state.session_vertices.begin(), state.session_vertices.end());
   m_plane = BladePlane{state.plane[0], state.plane[1], state.plane[2], state.plane[3], state.plane[4], state.plane_valid};
   m_last_stroke_normal = state.plane[5];
@@ -386,7 +381,7 @@ CutStepReport VolumeCutter::step(const Blade& previous, const Blade& current, co
   if (new_session) {
     ++m_cut_id;
     m_session_vertices.clear();
-    for (const int vertex : m_watched) m_watched_flag[at(vertex)] = 0;
+    for (const int vertex : m_watched) m_watched_flag[to_size(vertex)] = 0;
     m_watched.clear();
   }
   if (was_cutting) ++m_stamp;
@@ -433,23 +428,24 @@ void VolumeCutter::find_initial_tets(const Blade& blade, const Eigen::VectorXd& 
   const int surface_triangles = static_cast<int>(m_surface.triangles.size());
   for (const auto& hit : m_hits) {
     if (hit.triangle < 0 || hit.triangle >= surface_triangles) continue;  // a cut face
-    const int entry = m_surface.triangle_tet[at(hit.triangle)];
-    if (m_tet_stamp[at(entry)] == m_stamp) continue;
-    m_tet_stamp[at(entry)] = m_stamp;
+    const int entry = m_surface.triangle_tet[to_size(hit.triangle)];
+    if (m_tet_stamp[to_size(entry)] == m_stamp) continue;
+    m_tet_stamp[to_size(entry)] = m_stamp;
     m_stack.push_back(entry);
     while (!m_stack.empty()) {
       const int tet = m_stack.back();
       m_stack.pop_back();
       m_active.push_back(tet);
-      const Tet& vertices = m_mesh.tets[at(tet)];
+      const Tet& vertices = m_mesh.tets[to_size(tet)];
       for (std::size_t k = 0; k < 4; ++k) {
-        const int next = m_adjacency.face_neighbor[at(tet)][k];
-        if (next < 0 || m_tet_stamp[at(next)] == m_stamp) continue;
+        const int next = m_adjacency.face_neighbor[to_size(tet)][k];
+        if (next < 0 || m_tet_stamp[to_size(next)] == m_stamp) continue;
         const auto& face = TET_FACES[k];
-        if (intersect_segment_triangle(blade.tip_m, blade.handle_m, vertex_position(positions_m, vertices[at(face[0])]),
-                                       vertex_position(positions_m, vertices[at(face[1])]),
-                                       vertex_position(positions_m, vertices[at(face[2])]))) {
-          m_tet_stamp[at(next)] = m_stamp;
+        if (intersect_segment_triangle(blade.tip_m, blade.handle_m,
+                                       vertex_position(positions_m, vertices[to_size(face[0])]),
+                                       vertex_position(positions_m, vertices[to_size(face[1])]),
+                                       vertex_position(positions_m, vertices[to_size(face[2])]))) {
+          m_tet_stamp[to_size(next)] = m_stamp;
           m_stack.push_back(next);
         }
       }
@@ -465,9 +461,9 @@ void VolumeCutter::collect_surface_seeds(const Sweep& sweep, const Eigen::Vector
   const int surface_triangles = static_cast<int>(m_surface.triangles.size());
   for (const int triangle : m_box_triangles) {
     if (triangle < 0 || triangle >= surface_triangles) continue;  // a cut face
-    const int tet = m_surface.triangle_tet[at(triangle)];
-    if (m_tet_stamp[at(tet)] == m_stamp) continue;
-    const auto& vertices = m_surface.triangles[at(triangle)];
+    const int tet = m_surface.triangle_tet[to_size(triangle)];
+    if (m_tet_stamp[to_size(tet)] == m_stamp) continue;
+    const auto& vertices = m_surface.triangles[to_size(triangle)];
     if (sweep.crosses_triangle(vertex_position(positions_m, vertices[0]), vertex_position(positions_m, vertices[1]),
                                vertex_position(positions_m, vertices[2]))) {
       m_seeds.push_back(tet);
@@ -476,8 +472,8 @@ void VolumeCutter::collect_surface_seeds(const Sweep& sweep, const Eigen::Vector
 }
 
 void VolumeCutter::push_unvisited(int tet) {
-  if (m_tet_stamp[at(tet)] == m_stamp) return;
-  m_tet_stamp[at(tet)] = m_stamp;  // algorithm 2's isVisited
+  if (m_tet_stamp[to_size(tet)] == m_stamp) return;
+  m_tet_stamp[to_size(tet)] = m_stamp;  // algorithm 2's isVisited
   m_visited.push_back(tet);
   m_stack.push_back(tet);
 }
@@ -493,8 +489,8 @@ void VolumeCutter::search_from(int seed, const Sweep& sweep, const Eigen::Vector
 }
 
 void VolumeCutter::visit(int tet, const Sweep& sweep, const Eigen::VectorXd& positions_m) {
-  for (const int edge : m_adjacency.tet_edges[at(tet)]) process_edge(edge, sweep, positions_m);
-  const Tet& vertices = m_mesh.tets[at(tet)];
+  for (const int edge : m_adjacency.tet_edges[to_size(tet)]) process_edge(edge, sweep, positions_m);
+  const Tet& vertices = m_mesh.tets[to_size(tet)];
   // A vertex of a tet the sweep touches that the blade passed in this step (behind the blade, not
   // behind the sweep's start) gets its side now, for the session and every tet around it; one still
   // ahead of the blade is watched until it is passed (pass_watched).
@@ -503,12 +499,12 @@ void VolumeCutter::visit(int tet, const Sweep& sweep, const Eigen::VectorXd& pos
   }
   // Added: step across faces the sweep's boundary crosses (no edge need be crossed there).
   for (std::size_t k = 0; k < 4; ++k) {
-    const int next = m_adjacency.face_neighbor[at(tet)][k];
-    if (next < 0 || m_tet_stamp[at(next)] == m_stamp) continue;
+    const int next = m_adjacency.face_neighbor[to_size(tet)][k];
+    if (next < 0 || m_tet_stamp[to_size(next)] == m_stamp) continue;
     const auto& face = TET_FACES[k];
-    if (sweep.boundary_crosses(vertex_position(positions_m, vertices[at(face[0])]),
-                               vertex_position(positions_m, vertices[at(face[1])]),
-                               vertex_position(positions_m, vertices[at(face[2])]))) {
+    if (sweep.boundary_crosses(vertex_position(positions_m, vertices[to_size(face[0])]),
+                               vertex_position(positions_m, vertices[to_size(face[1])]),
+                               vertex_position(positions_m, vertices[to_size(face[2])]))) {
       push_unvisited(next);
     }
   }
@@ -517,19 +513,20 @@ void VolumeCutter::visit(int tet, const Sweep& sweep, const Eigen::VectorXd& pos
 // Each edge is tested once per step; the first crossing in a session is recorded (algorithm 3) and
 // the tets around it are searched next.
 void VolumeCutter::process_edge(int edge, const Sweep& sweep, const Eigen::VectorXd& positions_m) {
-  if (m_edge_stamp[at(edge)] == m_stamp) return;
-  m_edge_stamp[at(edge)] = m_stamp;
-  const auto& ends = m_adjacency.edges[at(edge)];
+  if (m_edge_stamp[to_size(edge)] == m_stamp) return;
+  m_edge_stamp[to_size(edge)] = m_stamp;
+  const auto& ends = m_adjacency.edges[to_size(edge)];
   const auto crossing = sweep.cross_edge(vertex_position(positions_m, ends[0]), vertex_position(positions_m, ends[1]));
   if (!crossing) return;
   if (!crossed_now(edge)) {
-    m_edge_session[at(edge)] = m_record_epoch;
-    m_edge_turn_rad[at(edge)] = m_turn_rad;
-    m_edge_ratio[at(edge)] = *crossing;
+    m_edge_session[to_size(edge)] = m_record_epoch;
+    m_edge_turn_rad[to_size(edge)] = m_turn_rad;
+    m_edge_ratio[to_size(edge)] = *crossing;
     ++m_new_crossings;
   }
-  const int end = m_adjacency.edge_tets_begin[at(edge) + 1];
-  for (int k = m_adjacency.edge_tets_begin[at(edge)]; k < end; ++k) push_unvisited(m_adjacency.edge_tets[at(k)]);
+  const int end = m_adjacency.edge_tets_begin[to_size(edge) + 1];
+  for (int k = m_adjacency.edge_tets_begin[to_size(edge)]; k < end; ++k)
+    push_unvisited(m_adjacency.edge_tets[to_size(k)]);
 }
 
 // Algorithm 4: the searched tets that the blade still touches (an end inside counts, so the
@@ -537,7 +534,7 @@ void VolumeCutter::process_edge(int edge, const Sweep& sweep, const Eigen::Vecto
 void VolumeCutter::find_next_active(const Blade& blade, const Eigen::VectorXd& positions_m) {
   m_active.clear();
   for (const int tet : m_visited) {
-    const Tet& vertices = m_mesh.tets[at(tet)];
+    const Tet& vertices = m_mesh.tets[to_size(tet)];
     const std::array<Eigen::Vector3d, 4> x = {
         vertex_position(positions_m, vertices[0]), vertex_position(positions_m, vertices[1]),
         vertex_position(positions_m, vertices[2]), vertex_position(positions_m, vertices[3])};
@@ -558,11 +555,11 @@ void VolumeCutter::complete_touched_tets(CutStepReport& report, const Eigen::Vec
 
 void VolumeCutter::cut_around_new_vertices(CutStepReport& report) {
   for (const int vertex : m_new_vertices) {
-    const int end = m_adjacency.vertex_tets_begin[at(vertex) + 1];
-    for (int k = m_adjacency.vertex_tets_begin[at(vertex)]; k < end; ++k) {
-      const int tet = m_adjacency.vertex_tets[at(k)];
-      if (m_candidate_stamp[at(tet)] == m_stamp) continue;
-      m_candidate_stamp[at(tet)] = m_stamp;
+    const int end = m_adjacency.vertex_tets_begin[to_size(vertex) + 1];
+    for (int k = m_adjacency.vertex_tets_begin[to_size(vertex)]; k < end; ++k) {
+      const int tet = m_adjacency.vertex_tets[to_size(k)];
+      if (m_candidate_stamp[to_size(tet)] == m_stamp) continue;
+      m_candidate_stamp[to_size(tet)] = m_stamp;
       m_candidates.push_back(tet);
     }
   }
@@ -572,9 +569,9 @@ void VolumeCutter::cut_around_new_vertices(CutStepReport& report) {
     if (cut_now(tet)) continue;
     const auto cut = cut_of(tet, end_margin);
     if (!cut) continue;
-    if (m_tet_cut_count[at(tet)] >= MAX_PIECE_CUTS) {  // the pieces' capacity (convex_piece.hpp)
-      if (m_tet_ignored_session[at(tet)] != m_cut_id) {
-        m_tet_ignored_session[at(tet)] = m_cut_id;
+    if (m_tet_cut_count[to_size(tet)] >= MAX_PIECE_CUTS) {  // the pieces' capacity (convex_piece.hpp)
+      if (m_tet_ignored_session[to_size(tet)] != m_cut_id) {
+        m_tet_ignored_session[to_size(tet)] = m_cut_id;
         ++report.ignored_cuts;
       }
       continue;
@@ -583,15 +580,15 @@ void VolumeCutter::cut_around_new_vertices(CutStepReport& report) {
     // through a vertex or an edge touched no tet for a step: the same plane) and gives the tet's
     // vertices the sides the last one gave them makes no new cut: the pieces are those it has.
     const std::uint8_t above = above_mask(*cut);
-    const std::uint8_t last = m_tet_cut_above[at(tet)];
-    if (m_tet_cut_count[at(tet)] > 0 && m_tet_cut_session[at(tet)] == m_cut_id - 1 && continues_last_stroke() &&
-        (last == above || last == (~above & 0xFu))) {
+    const std::uint8_t last = m_tet_cut_above[to_size(tet)];
+    if (m_tet_cut_count[to_size(tet)] > 0 && m_tet_cut_session[to_size(tet)] == m_cut_id - 1 &&
+        continues_last_stroke() && (last == above || last == (~above & 0xFu))) {
       continue;
     }
-    m_tet_cut_session[at(tet)] = m_cut_id;
-    m_tet_cut_turn_rad[at(tet)] = m_turn_rad;
-    m_tet_cut_above[at(tet)] = above;
-    ++m_tet_cut_count[at(tet)];
+    m_tet_cut_session[to_size(tet)] = m_cut_id;
+    m_tet_cut_turn_rad[to_size(tet)] = m_turn_rad;
+    m_tet_cut_above[to_size(tet)] = above;
+    ++m_tet_cut_count[to_size(tet)];
     m_new_cuts.push_back(*cut);
   }
   m_candidates.clear();

@@ -4,6 +4,7 @@
 #include "core/fem/xfem_elasticity.hpp"
 
 #include "core/fem/corotational_kernel.hpp"
+#include "core/index_cast.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -15,7 +16,6 @@ namespace {
 
 constexpr std::array<CutPart, 2> PARTS{CutPart::above, CutPart::below};
 
-size_t to_size(int i) { return static_cast<size_t>(i); }
 Eigen::Index to_int(size_t i) { return static_cast<Eigen::Index>(i); }
 
 }  // namespace

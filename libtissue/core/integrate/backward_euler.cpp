@@ -1,6 +1,8 @@
 // Semi-implicit backward Euler step (see backward_euler.hpp).
 #include "core/integrate/backward_euler.hpp"
 
+#include "core/wall_clock.hpp"
+
 #include <algorithm>
 #include <array>
 #include <chrono>
@@ -11,10 +13,6 @@
 
 namespace tissue {
 namespace {
-
-double seconds_since(std::chrono::steady_clock::time_point start) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-}
 
 // Lends a step's team to the model and the solver and takes it back when the step ends, however
 // it ends.

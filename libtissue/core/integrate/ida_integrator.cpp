@@ -1,6 +1,8 @@
 // IdaIntegrator (see ida_integrator.hpp).
 #include "core/integrate/ida_integrator.hpp"
 
+#include "core/wall_clock.hpp"
+
 #include <ida/ida.h>
 #include <ida/ida_ls.h>
 #include <nvector/nvector_serial.h>
@@ -18,10 +20,6 @@
 
 namespace tissue {
 namespace {
-
-double seconds_since(std::chrono::steady_clock::time_point start) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-}
 
 // GMRES: Krylov subspace size before a restart, and restarts allowed.
 constexpr int KRYLOV_DIMENSION = 30;

@@ -25,7 +25,7 @@
 namespace tissue {
 namespace {
 
-constexpr const char* WHO = "CholeskyPcgSolver";
+constexpr const char* CHOLESKY_PCG = "CholeskyPcgSolver";
 
 }  // namespace
 
@@ -103,8 +103,8 @@ struct CholeskyPcgSolver::Impl {
       refresh_wanted = false;  // the next solve says whether this factor does (after a failure: still wanted)
     } else {
       ++counters.refresh_failures;
-      last_failure = spare->factored() ? std::string(WHO) + ": the refreshed factor has more rows than A"
-                                       : spare->failure_message(WHO);
+      last_failure = spare->factored() ? std::string(CHOLESKY_PCG) + ": the refreshed factor has more rows than A"
+                                       : spare->failure_message(CHOLESKY_PCG);
     }
   }
 
@@ -141,8 +141,9 @@ std::string CholeskyPcgSolver::Refresh::problem() const {
 }
 
 CholeskyPcgSolver::CholeskyPcgSolver(PcgSolver::Settings pcg, Refresh refresh) {
-  validate_pcg_settings(pcg, WHO);
-  if (const std::string problem = refresh.problem(); !problem.empty()) throw SolverError(std::string(WHO) + ": " + problem);
+  validate_pcg_settings(pcg, CHOLESKY_PCG);
+  if (const std::string problem = refresh.problem(); !problem.empty())
+    throw SolverError(std::string(CHOLESKY_PCG) + ": " + problem);
   m_impl = std::make_unique<Impl>(pcg, refresh);
 }
 
@@ -177,12 +178,12 @@ void CholeskyPcgSolver::forget_earlier_setups() {
 void CholeskyPcgSolver::setup(const ShiftedSystem& system) {
   Impl& impl = *m_impl;
   impl.system = ShiftedSystem{nullptr, 1.0, nullptr};
-  system.check(WHO);
+  system.check(CHOLESKY_PCG);
   const long n = system.rows();
   ++impl.counters.setups;
   if (impl.in_flight && ++impl.setups_since_start >= impl.refresh.pickup_setups) impl.pick_up(n);
 
-  jacobi_inverse_diagonal(system, impl.inverse_diagonal, WHO);  // also refuses a diagonal <= 0
+  jacobi_inverse_diagonal(system, impl.inverse_diagonal, CHOLESKY_PCG);  // also refuses a diagonal <= 0
   if (!impl.usable(*system.stiffness) || (impl.refresh.refactor_on_growth && impl.stale(*system.stiffness))) {
     impl.discard_refresh();  // older than what we factorize now
     impl.forgotten = false;
@@ -191,7 +192,7 @@ void CholeskyPcgSolver::setup(const ShiftedSystem& system) {
     ++impl.counters.factorizations;
     if (impl.active->factorize() != CholmodFactor::Status::ok) {
       impl.counters.factor_rows = 0;
-      throw SolverError(impl.active->failure_message(WHO));
+      throw SolverError(impl.active->failure_message(CHOLESKY_PCG));
     }
   } else if (!impl.in_flight && (impl.refresh_wanted || impl.stale(*system.stiffness))) {
     impl.start_refresh(system);

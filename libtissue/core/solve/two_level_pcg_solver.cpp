@@ -6,12 +6,12 @@
 
 namespace tissue {
 namespace {
-constexpr const char* WHO = "TwoLevelPcgSolver";
+constexpr const char* TWO_LEVEL_PCG = "TwoLevelPcgSolver";
 }  // namespace
 
 TwoLevelPcgSolver::TwoLevelPcgSolver(PcgSolver::Settings settings)
     : m_settings(settings), m_preconditioner(std::make_unique<TwoLevelPreconditioner>()) {
-  validate_pcg_settings(settings, WHO);
+  validate_pcg_settings(settings, TWO_LEVEL_PCG);
   m_work.matrix = HalfMatrix(resolved_precision(settings.matrix_precision, settings.tolerance));
 }
 
@@ -23,13 +23,13 @@ void TwoLevelPcgSolver::setup_nearby(const ShiftedSystem& system) { set_up(syste
 
 void TwoLevelPcgSolver::set_up(const ShiftedSystem& system, bool nearby) {
   m_system = ShiftedSystem{nullptr, 1.0, nullptr};
-  system.check(WHO);
+  system.check(TWO_LEVEL_PCG);
   if (system.block_positions != nullptr &&
       system.block_positions->size() < static_cast<size_t>(system.stiffness->block_rows())) {
-    throw SolverError(std::string(WHO) + ": fewer block positions than block rows");
+    throw SolverError(std::string(TWO_LEVEL_PCG) + ": fewer block positions than block rows");
   }
   m_work.resize(system.rows());
-  jacobi_inverse_diagonal(system, m_inverse_diagonal, WHO);  // also refuses a diagonal <= 0
+  jacobi_inverse_diagonal(system, m_inverse_diagonal, TWO_LEVEL_PCG);  // also refuses a diagonal <= 0
   if (nearby) {
     m_preconditioner->setup_nearby(system, m_inverse_diagonal, m_team);
   } else {
@@ -40,7 +40,7 @@ void TwoLevelPcgSolver::set_up(const ShiftedSystem& system, bool nearby) {
 }
 
 SolveReport TwoLevelPcgSolver::solve(const Eigen::VectorXd& b, Eigen::VectorXd& x) {
-  if (!is_set_up()) throw SolverError(std::string(WHO) + ": solve() without a setup()");
+  if (!is_set_up()) throw SolverError(std::string(TWO_LEVEL_PCG) + ": solve() without a setup()");
   m_system.check_sizes(b, x);
   return preconditioned_cg</*ROW_WISE=*/false>(
       m_system, b, x, m_settings.tolerance, m_settings.max_iterations, m_work, m_team,

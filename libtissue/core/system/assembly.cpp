@@ -2,6 +2,7 @@
 // the per-tet slot table that lets a step assemble R K_e R^T without any index search.
 #include "core/system/assembly.hpp"
 
+#include "core/index_cast.hpp"
 #include "core/mesh/topology.hpp"
 
 #include <algorithm>
@@ -11,8 +12,6 @@
 namespace tissue {
 
 namespace {
-
-size_t to_size(int i) { return static_cast<size_t>(i); }
 
 // Refuses a tet whose vertices are not vertices of the numbered mesh.
 void check_tet(const Tet& tet, int t, int vertex_count) {

@@ -8,6 +8,7 @@
 // slots hold column -1 and zero values, so a newly used slot is a zero block.
 #include "core/system/block_sparse_matrix.hpp"
 
+#include "core/index_cast.hpp"
 #include "core/system/hot_kernel.hpp"
 #include "core/system/work_team.hpp"
 
@@ -28,8 +29,6 @@ constexpr int DEFAULT_SPARE_ROW_CAPACITY = 16;
 int spare_row_count(double fraction, int rows) {
   return static_cast<int>(std::ceil(fraction * static_cast<double>(rows)));
 }
-
-size_t to_size(int i) { return static_cast<size_t>(i); }
 
 }  // namespace
 
