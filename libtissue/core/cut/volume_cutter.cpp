@@ -5,6 +5,7 @@
 #include "core/cut/cut_geometry.hpp"
 #include "core/index_cast.hpp"
 #include "core/material/material.hpp"
+#include "core/wall_clock.hpp"
 
 #include <Eigen/Geometry>
 
@@ -205,7 +206,7 @@ CutStepReport VolumeCutter::end_cut(const Eigen::VectorXd& positions_m) {
   m_active.clear();
   m_idle_steps = 2;  // ended on purpose: the next session is a new stroke
   report.newly_cut_tets = static_cast<int>(m_new_cuts.size());
-  report.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  report.seconds = seconds_since(start);
   return report;
 }
 
@@ -367,7 +368,7 @@ CutStepReport VolumeCutter::step(const Blade& previous, const Blade& current, co
     collect_surface_seeds(Sweep(previous, current), positions_m, bvh);
     if (m_active.empty() && m_seeds.empty()) {
       m_idle_steps = std::min(m_idle_steps + 1, 2);
-      report.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+      report.seconds = seconds_since(start);
       return report;
     }
     m_seeds.clear();
@@ -415,7 +416,7 @@ CutStepReport VolumeCutter::step(const Blade& previous, const Blade& current, co
   report.active_tets = static_cast<int>(m_active.size());
   report.new_edge_crossings = m_new_crossings;
   report.newly_cut_tets = static_cast<int>(m_new_cuts.size());
-  report.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  report.seconds = seconds_since(start);
   return report;
 }
 
