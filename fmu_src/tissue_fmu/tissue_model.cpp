@@ -148,12 +148,8 @@ void TissueModel::build() {
   m_tissue = make_tissue(parameters, m_context.resource_path);
   m_tissue->set_tool(tool_pose(m_values));
   m_dirty = false;
-  m_surface_revision = 0;
-  m_surface_revision_stale = false;
   m_integrator_iterations = 0;
-  m_surface_triangles = revision_triangles();
-  m_surface_cut_tets = 0;
-  m_drawn_current = false;
+  start_surface_revision(0);
   m_capacity_warned = false;
 }
 
@@ -283,6 +279,14 @@ void TissueModel::ensure_built() {
 
 std::size_t TissueModel::revision_triangles() const {
   return m_tissue->has_render_surface() ? 0 : m_tissue->drawn_triangle_count();
+}
+
+void TissueModel::start_surface_revision(std::uint64_t revision) {
+  m_surface_revision = revision;
+  m_surface_revision_stale = false;
+  m_surface_triangles = revision_triangles();
+  m_surface_cut_tets = m_tissue->body().cut_tets().size();
+  m_drawn_current = false;
 }
 
 void TissueModel::surface_moved() {
@@ -552,12 +556,8 @@ void TissueModel::restore(const fmi3::ModelState& model_state) {
   } catch (const StateError& error) {
     throw VariableError(std::string("set FMU state: ") + error.what());
   }
-  m_surface_revision = state->surface_revision;
-  m_surface_revision_stale = false;
   m_integrator_iterations = state->integrator_iterations;
-  m_surface_triangles = revision_triangles();
-  m_surface_cut_tets = m_tissue->body().cut_tets().size();
-  m_drawn_current = false;
+  start_surface_revision(state->surface_revision);
 }
 
 void TissueModel::serialize(const fmi3::ModelState& model_state, serial::ByteWriter& writer) const {

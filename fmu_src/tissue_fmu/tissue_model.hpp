@@ -71,6 +71,9 @@ class TissueModel final : public fmi3::Model {
   /// read"). No surface work may be running when it is stale (prepare_surface brings it up to date
   /// before it starts one).
   std::uint64_t surface_revision() const;
+  /// surface.revision is `revision` for the tissue as it is now (built or restored): what later reads
+  /// compare with are its drawn surface's counts now, and the drawn mesh is made again when read.
+  void start_surface_revision(std::uint64_t revision);
   /// Steps moved (and may have cut) the tissue: the drawn mesh and surface.revision are made again
   /// when next read.
   void surface_moved();
