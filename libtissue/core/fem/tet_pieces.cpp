@@ -6,6 +6,7 @@
 #include <Eigen/Eigenvalues>
 #include <Eigen/Geometry>
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 #include <string>
@@ -113,14 +114,20 @@ std::vector<TetPiece> split_pieces(const std::array<Eigen::Vector3d, 4>& rest_m,
     const ConvexPiece geometry = piece_geometry(rest_m, earlier, old.sides);
     const double above_m3 = std::abs(geometry.clipped(plane, true, tolerance_m).volume_m3());
     const double below_m3 = std::abs(geometry.clipped(plane, false, tolerance_m).volume_m3());
-    const double smallest_m3 = cut.min_volume_fraction * tet_volume_m3;
-    if (above_m3 < smallest_m3 || below_m3 < smallest_m3) {
+    // Split wherever the plane passes through the piece (both sides hold volume): a sliver left whole
+    // here would be cut in the tet beside it, and the two tets' pieces would disagree on their shared
+    // face (the weld, issue 43). Each side's fraction is at least the smallest, as the first cut's
+    // are clamped; a piece too small for two such sides stays whole.
+    const double smallest = cut.min_volume_fraction;
+    const double touching_m3 = SMALLEST_MIN_VOLUME_FRACTION * tet_volume_m3;
+    if (above_m3 <= touching_m3 || below_m3 <= touching_m3 || old.volume_fraction < 2.0 * smallest) {
       const std::uint32_t side = above_m3 >= below_m3 ? bit : 0u;
       pieces.push_back(
           TetPiece{PieceSides{old.sides.bounded, old.sides.above | side}, old.volume_fraction, static_cast<int>(p)});
       continue;
     }
-    const double above_fraction = old.volume_fraction * above_m3 / (above_m3 + below_m3);
+    const double above_fraction =
+        std::clamp(old.volume_fraction * above_m3 / (above_m3 + below_m3), smallest, old.volume_fraction - smallest);
     pieces.push_back(
         TetPiece{PieceSides{old.sides.bounded | bit, old.sides.above | bit}, above_fraction, static_cast<int>(p)});
     pieces.push_back(TetPiece{PieceSides{old.sides.bounded | bit, old.sides.above},

@@ -2,9 +2,10 @@
 // Fedkiw 2004; Sifakis, Der and Fedkiw 2007). Each cut of a tet is the plane through its crossings
 // in the rest configuration (exact for a 1-3 split and for a planar stroke; the least-squares plane
 // of a bent 2-2 quad). The first cut makes two pieces with its own exact fraction (part_volume);
-// each later cut splits every piece it passes through with at least the smallest fraction on both
-// sides, and leaves the others as they were. A piece is then a convex cell: the tet clipped by the
-// planes that bound it, each on one side.
+// each later cut splits every piece it passes through (volume on both sides, however thin: the tets
+// around a face must agree on its pieces), each side's fraction clamped to at least the smallest as
+// the first cut's is (a piece under twice the smallest stays whole), and leaves the others as they
+// were. A piece is then a convex cell: the tet clipped by the planes that bound it, each on one side.
 #pragma once
 
 #include "core/fem/convex_piece.hpp"

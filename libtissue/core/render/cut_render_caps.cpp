@@ -593,7 +593,7 @@ void CutRenderSurface::cap_loops(const DeformableBody& body) {
     for (const std::vector<int>& hole : holes.flat) cap_polygon(hole, m_rest_m, m_triangles, edges);
     m_open_loops = holes.others;
   }
-  m_cap_triangles = static_cast<int>(m_triangles.size() - surface_triangles);
+  m_cap_triangles = static_cast<int>(cut_render_detail::drop_bubbles(m_triangles, surface_triangles, m_rest_m));
   m_simple_caps = std::move(simple_caps);
 }
 

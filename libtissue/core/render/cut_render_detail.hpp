@@ -62,4 +62,15 @@ struct FlatHoles {
 FlatHoles flat_holes(const std::unordered_map<long long, int>& directed, const std::vector<Eigen::Vector3d>& x,
                      const std::function<int(int)>& part_of);
 
+// A closed shell of the finished surface that encloses less than BUBBLE_M3 (a cube of FLAT_HOLE_M) is
+// below what the render surface resolves: a render point on a sliver piece near where two cuts meet
+// (a later cut splits every piece it passes through, issue 43), all its neighbours across the planes,
+// capped on its own. Such shells are not drawn.
+inline constexpr double BUBBLE_M3 = FLAT_HOLE_M * FLAT_HOLE_M * FLAT_HOLE_M;
+// Removes from `triangles` the closed shells (every edge used once each way) holding a triangle from
+// `first_cap` on (a cap) and enclosing less than BUBBLE_M3 at `x`, keeping the order of the rest;
+// returns how many of the triangles from `first_cap` on are left.
+size_t drop_bubbles(std::vector<std::array<int, 3>>& triangles, size_t first_cap,
+                    const std::vector<Eigen::Vector3d>& x);
+
 }  // namespace tissue::cut_render_detail

@@ -11,6 +11,8 @@
 #include <cstddef>
 #include <functional>
 #include <map>
+#include <numeric>
+#include <unordered_map>
 #include <utility>
 
 namespace tissue::cut_render_detail {
@@ -287,6 +289,63 @@ void merge_unfacing_switches(std::map<std::array<int, 5>, std::vector<size_t>>& 
     into->push_back(it->second[0]);
     it = switches.erase(it);
   }
+}
+
+}  // namespace tissue::cut_render_detail
+
+namespace tissue::cut_render_detail {
+
+size_t drop_bubbles(std::vector<std::array<int, 3>>& triangles, size_t first_cap,
+                    const std::vector<Eigen::Vector3d>& x) {
+  std::vector<int> parent(x.size());
+  std::iota(parent.begin(), parent.end(), 0);
+  const auto root = [&parent](int v) {
+    while (parent[static_cast<size_t>(v)] != v)
+      v = parent[static_cast<size_t>(v)] = parent[static_cast<size_t>(parent[static_cast<size_t>(v)])];
+    return v;
+  };
+  for (const auto& t : triangles) {
+    parent[static_cast<size_t>(root(t[0]))] = root(t[1]);
+    parent[static_cast<size_t>(root(t[1]))] = root(t[2]);
+  }
+  // The shells holding a cap, each with its volume about one of its points (closed: any point will do).
+  std::unordered_map<int, double> volume_m3;
+  for (size_t t = first_cap; t < triangles.size(); ++t) volume_m3.emplace(root(triangles[t][0]), 0.0);
+  for (const auto& t : triangles) {
+    const auto shell = volume_m3.find(root(t[0]));
+    if (shell == volume_m3.end()) continue;
+    const Eigen::Vector3d& o = x[static_cast<size_t>(shell->first)];
+    const Eigen::Vector3d a = x[static_cast<size_t>(t[0])] - o, b = x[static_cast<size_t>(t[1])] - o,
+                          c = x[static_cast<size_t>(t[2])] - o;
+    shell->second += a.dot(b.cross(c)) / 6.0;
+  }
+  // The small ones, if closed.
+  std::unordered_map<long long, int> directed;
+  for (const auto& t : triangles) {
+    const auto shell = volume_m3.find(root(t[0]));
+    if (shell == volume_m3.end() || std::abs(shell->second) >= BUBBLE_M3) continue;
+    for (size_t k = 0; k < 3; ++k) ++directed[directed_key(t[k], t[(k + 1) % 3])];
+  }
+  if (directed.empty()) return triangles.size() - first_cap;
+  std::unordered_map<int, bool> open;
+  for (const auto& [key, uses] : directed) {
+    const auto from = static_cast<int>(key >> 32), to = static_cast<int>(key & 0xffffffffLL);
+    const auto twin = directed.find(directed_key(to, from));
+    if (uses != 1 || twin == directed.end() || twin->second != 1) open[root(from)] = true;
+  }
+  const auto bubble = [&](const std::array<int, 3>& t) {
+    const int shell = root(t[0]);
+    const auto found = volume_m3.find(shell);
+    return found != volume_m3.end() && std::abs(found->second) < BUBBLE_M3 && !open.contains(shell);
+  };
+  size_t kept_caps = 0, out = 0;
+  for (size_t t = 0; t < triangles.size(); ++t) {
+    if (bubble(triangles[t])) continue;
+    if (t >= first_cap) ++kept_caps;
+    triangles[out++] = triangles[t];
+  }
+  triangles.resize(out);
+  return kept_caps;
 }
 
 }  // namespace tissue::cut_render_detail

@@ -261,6 +261,31 @@ TEST(TetPieces, ACrossingCutSplitsBothPiecesAndAFarCutOnlyTheOneItReaches) {
   }
 }
 
+// A later cut that takes a sliver off a piece (here 2e-5 of the tet, under the smallest fraction
+// 1e-3) still splits it: the tet beside it, where the same plane cuts more, splits its piece too, and
+// the two must agree on their shared face (issue 43: left whole, the drawn surfaces disagreed). The
+// sliver's fraction is clamped up to the smallest, from its sibling, as a first cut's is; the fractions
+// still add up to 1.
+TEST(TetPieces, ALaterCutSplitsASliverWithTheSmallestFraction) {
+  const double s = 0.01;
+  const std::array<Eigen::Vector3d, 4> x{Eigen::Vector3d(0, 0, 0), Eigen::Vector3d(s, 0, 0), Eigen::Vector3d(0, s, 0),
+                                         Eigen::Vector3d(0, 0, s)};
+  // x = 0.3 s, then z = (1 - c) s: the corner above it, x < 0.3 s, holds c^3 of the tet (c = 0.027).
+  const double corner = std::cbrt(2e-5);
+  std::vector<TetCut> cuts{cut_by(x, CutPlane{Eigen::Vector3d::UnitX(), 0.3 * s}, 0),
+                           cut_by(x, CutPlane{Eigen::Vector3d::UnitZ(), (1.0 - corner) * s}, 1)};
+  const std::vector<TetPiece> one = split_pieces(x, std::span(cuts).first(1), {});
+  const std::vector<TetPiece> two = split_pieces(x, cuts, one);
+  ASSERT_EQ(two.size(), 3u) << "the piece x < 0.3 s split; x > 0.3 s lies below z = 0.7 s";
+  double total = 0.0, sliver = 0.0;
+  for (const TetPiece& piece : two) {
+    total += piece.volume_fraction;
+    if ((piece.sides.bounded & 2u) != 0 && (piece.sides.above & 2u) != 0) sliver = piece.volume_fraction;
+  }
+  EXPECT_DOUBLE_EQ(sliver, 1e-3);
+  EXPECT_NEAR(total, 1.0, 1e-15);
+}
+
 }  // namespace
 }  // namespace tissue
 

@@ -316,12 +316,12 @@ TEST(CutSurfaceWeld, HatchedStrokesDrawNoSheetBetweenPiecesThatParted) {
   EXPECT_LE(worst_excess_m, largest_tet_edge_m);
 }
 
-// Not yet closed (docs/DESIGN.md, "The tet skin welded"): near the line where the two strokes cross,
-// the tets cut twice disagree where the second cut crosses a shared edge (each fits its own plane
-// through its crossings), so the pieces meeting at the edge differ from tet to tet; and a later cut
-// leaves a piece whole where it would cut off less than the smallest fraction, which no cap closes
-// (16-24 open edges).
-TEST(CutSurfaceWeld, DISABLED_CrossingStrokesStayClosedAtEveryStep) {
+// Two strokes crossing (an X) near a column of mesh vertices: the tets cut twice there each hold a
+// sliver of a quadrant (the junction runs 0.35 mm from their face). A later cut now splits every
+// piece it passes through, however thin (its fraction clamped to the smallest, as a first cut's is),
+// so the tets either side of a face agree on its pieces; before, a piece it would have cut to less
+// than the smallest fraction stayed whole in one tet and was cut in the next (24 open edges).
+TEST(CutSurfaceWeld, CrossingStrokesStayClosedAtEveryStep) {
   const TetMesh mesh = make_box_mesh(4, 4, 2, 0.01);
   Tissue tissue(mesh, block_settings(mesh));
   EXPECT_EQ(stroke_worst_open(tissue, {0.0033, -0.005}, {0.0347, 0.045}), 0);

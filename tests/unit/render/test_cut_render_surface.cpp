@@ -718,3 +718,37 @@ TEST(FlatWithin, MeasuresTheLoopAgainstItsLeastSquaresPlaneWhateverItsTilt) {
 
 }  // namespace
 }  // namespace tissue
+
+namespace tissue {
+namespace {
+
+// Closed shells under a cube of 0.1 mm that hold a cap are not drawn (drop_bubbles): of three tets'
+// boundaries, one 1 mm across (kept), one 10 um across (dropped) and one 10 um across with a face
+// missing (open: kept, its hole is counted, not hidden), the caps being each tet's last face.
+TEST(DropBubbles, RemovesOnlyTinyClosedShellsThatHoldACap) {
+  std::vector<Eigen::Vector3d> x;
+  std::vector<std::array<int, 3>> skin, caps;
+  const auto add_tet = [&](double size_m, double offset_m, bool closed) {
+    const int o = static_cast<int>(x.size());
+    x.emplace_back(offset_m, 0, 0);
+    x.emplace_back(offset_m + size_m, 0, 0);
+    x.emplace_back(offset_m, size_m, 0);
+    x.emplace_back(offset_m, 0, size_m);
+    skin.push_back({o, o + 2, o + 1});
+    skin.push_back({o, o + 1, o + 3});
+    if (closed) skin.push_back({o, o + 3, o + 2});
+    caps.push_back({o + 1, o + 2, o + 3});
+  };
+  add_tet(1e-3, 0.0, true);
+  add_tet(1e-5, 0.01, true);
+  add_tet(1e-5, 0.02, false);
+  std::vector<std::array<int, 3>> triangles = skin;
+  triangles.insert(triangles.end(), caps.begin(), caps.end());
+  const size_t caps_left = cut_render_detail::drop_bubbles(triangles, skin.size(), x);
+  EXPECT_EQ(caps_left, 2u);
+  ASSERT_EQ(triangles.size(), 7u);  // the big tet's four, the open one's three
+  for (const auto& t : triangles) EXPECT_TRUE(t[0] < 4 || t[0] >= 8) << "a triangle of the dropped tet";
+}
+
+}  // namespace
+}  // namespace tissue
