@@ -291,10 +291,6 @@ void merge_unfacing_switches(std::map<std::array<int, 5>, std::vector<size_t>>& 
   }
 }
 
-}  // namespace tissue::cut_render_detail
-
-namespace tissue::cut_render_detail {
-
 size_t drop_bubbles(std::vector<std::array<int, 3>>& triangles, size_t first_cap,
                     const std::vector<Eigen::Vector3d>& x) {
   std::vector<int> parent(x.size());

@@ -33,6 +33,8 @@
 // * Holes the walk leaves (a switch with no partner): the surface's border loops then; one in one
 //   material part that is flat (within 0.1 mm of a plane), or two flat faces either side of a
 //   chord (a junction), is what the walk missed, ear-clipped.
+// * A closed shell holding a cap and enclosing less than a cube of 0.1 mm (a render point alone on a
+//   sliver piece where cuts cross) is not drawn (cut_render_detail::drop_bubbles).
 // Limits: the crack front is the straight line between the tips (right for a stroke through the
 // full depth), and its points follow one side; where two partial cuts cross, a switch may have no
 // partner and no tip to close on (the junction line ends inside the body) and the hole stays open
