@@ -304,39 +304,43 @@ size_t drop_bubbles(std::vector<std::array<int, 3>>& triangles, size_t first_cap
     parent[static_cast<size_t>(root(t[0]))] = root(t[1]);
     parent[static_cast<size_t>(root(t[1]))] = root(t[2]);
   }
-  // The shells holding a cap, each with its volume about one of its points (closed: any point will do).
-  std::unordered_map<int, double> volume_m3;
-  for (size_t t = first_cap; t < triangles.size(); ++t) volume_m3.emplace(root(triangles[t][0]), 0.0);
-  for (const auto& t : triangles) {
-    const auto shell = volume_m3.find(root(t[0]));
-    if (shell == volume_m3.end()) continue;
-    const Eigen::Vector3d& o = x[static_cast<size_t>(shell->first)];
-    const Eigen::Vector3d a = x[static_cast<size_t>(t[0])] - o, b = x[static_cast<size_t>(t[1])] - o,
-                          c = x[static_cast<size_t>(t[2])] - o;
-    shell->second += a.dot(b.cross(c)) / 6.0;
+  // Per shell holding a cap (by its root point): its volume about that point (closed: any point will
+  // do); others are not candidates.
+  constexpr signed char NOT_A_CANDIDATE = 0, SMALL = 1, OPEN = 2;
+  std::vector<signed char> state(x.size(), NOT_A_CANDIDATE);
+  std::vector<double> volume_m3(x.size(), 0.0);
+  for (size_t t = first_cap; t < triangles.size(); ++t) state[static_cast<size_t>(root(triangles[t][0]))] = SMALL;
+  std::vector<size_t> shell_of(triangles.size());
+  for (size_t t = 0; t < triangles.size(); ++t) {
+    const auto shell = static_cast<size_t>(root(triangles[t][0]));
+    shell_of[t] = shell;
+    if (state[shell] == NOT_A_CANDIDATE) continue;
+    const Eigen::Vector3d& o = x[shell];
+    const auto& [i, j, k] = triangles[t];
+    const Eigen::Vector3d a = x[static_cast<size_t>(i)] - o, b = x[static_cast<size_t>(j)] - o,
+                          c = x[static_cast<size_t>(k)] - o;
+    volume_m3[shell] += a.dot(b.cross(c)) / 6.0;
   }
-  // The small ones, if closed.
+  // The small ones, if closed (every edge once each way).
   std::unordered_map<long long, int> directed;
-  for (const auto& t : triangles) {
-    const auto shell = volume_m3.find(root(t[0]));
-    if (shell == volume_m3.end() || std::abs(shell->second) >= BUBBLE_M3) continue;
-    for (size_t k = 0; k < 3; ++k) ++directed[directed_key(t[k], t[(k + 1) % 3])];
+  for (size_t t = 0; t < triangles.size(); ++t) {
+    const size_t shell = shell_of[t];
+    if (state[shell] == NOT_A_CANDIDATE) continue;
+    if (std::abs(volume_m3[shell]) >= BUBBLE_M3) {
+      state[shell] = NOT_A_CANDIDATE;
+      continue;
+    }
+    for (size_t c = 0; c < 3; ++c) ++directed[directed_key(triangles[t][c], triangles[t][(c + 1) % 3])];
   }
   if (directed.empty()) return triangles.size() - first_cap;
-  std::unordered_map<int, bool> open;
   for (const auto& [key, uses] : directed) {
     const auto from = static_cast<int>(key >> 32), to = static_cast<int>(key & 0xffffffffLL);
     const auto twin = directed.find(directed_key(to, from));
-    if (uses != 1 || twin == directed.end() || twin->second != 1) open[root(from)] = true;
+    if (uses != 1 || twin == directed.end() || twin->second != 1) state[static_cast<size_t>(root(from))] = OPEN;
   }
-  const auto bubble = [&](const std::array<int, 3>& t) {
-    const int shell = root(t[0]);
-    const auto found = volume_m3.find(shell);
-    return found != volume_m3.end() && std::abs(found->second) < BUBBLE_M3 && !open.contains(shell);
-  };
   size_t kept_caps = 0, out = 0;
   for (size_t t = 0; t < triangles.size(); ++t) {
-    if (bubble(triangles[t])) continue;
+    if (state[shell_of[t]] == SMALL) continue;  // a closed small shell: a bubble
     if (t >= first_cap) ++kept_caps;
     triangles[out++] = triangles[t];
   }
