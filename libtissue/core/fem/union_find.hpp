@@ -1,5 +1,5 @@
-// The root of an element of a union-find held as a parent array (internal to core/fem: the ghosts'
-// grouping around a vertex, a body's parts).
+// The root of an element of a union-find held as a parent array (internal to libtissue/core: the
+// ghosts' grouping around a vertex, a body's parts, the render surface's material parts and shells).
 #pragma once
 
 #include <cstddef>

@@ -3,6 +3,7 @@
 #include "core/render/cut_render_surface.hpp"
 
 #include "core/fem/piece_outside.hpp"
+#include "core/fem/union_find.hpp"
 
 #include <Eigen/Dense>
 
@@ -34,12 +35,7 @@ void CutRenderSurface::find_material_parts(const DeformableBody& body) {
   const int vertex_count = m_mesh.vertex_count();
   m_copy_root.resize(static_cast<size_t>(vertex_count) + static_cast<size_t>(body.dof_count() / 3));
   std::iota(m_copy_root.begin(), m_copy_root.end(), 0);
-  const auto find = [&](int i) {
-    while (m_copy_root[static_cast<size_t>(i)] != i) {
-      i = m_copy_root[static_cast<size_t>(i)] = m_copy_root[static_cast<size_t>(m_copy_root[static_cast<size_t>(i)])];
-    }
-    return i;
-  };
+  const auto find = [&](int i) { return find_root(m_copy_root, i); };
   for (int t = 0; t < m_mesh.tet_count(); ++t) {
     const int k = body.cut_tet_index(t);
     const int pieces = k < 0 ? 1 : static_cast<int>(body.xfem().piece_count(k));

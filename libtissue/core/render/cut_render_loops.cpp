@@ -2,6 +2,8 @@
 // chains that face neither side, and the ear clipping that triangulates the faces (cut_render_caps.cpp).
 #include "core/render/cut_render_detail.hpp"
 
+#include "core/fem/union_find.hpp"
+
 #include <Eigen/Eigenvalues>
 #include <Eigen/Geometry>
 
@@ -295,11 +297,7 @@ size_t drop_bubbles(std::vector<std::array<int, 3>>& triangles, size_t first_cap
                     const std::vector<Eigen::Vector3d>& x) {
   std::vector<int> parent(x.size());
   std::iota(parent.begin(), parent.end(), 0);
-  const auto root = [&parent](int v) {
-    while (parent[static_cast<size_t>(v)] != v)
-      v = parent[static_cast<size_t>(v)] = parent[static_cast<size_t>(parent[static_cast<size_t>(v)])];
-    return v;
-  };
+  const auto root = [&parent](int v) { return find_root(parent, v); };
   for (const auto& t : triangles) {
     parent[static_cast<size_t>(root(t[0]))] = root(t[1]);
     parent[static_cast<size_t>(root(t[1]))] = root(t[2]);
