@@ -2,6 +2,7 @@
 // haptic core (libtissue/haptic, which includes this leaf and links nothing of the core).
 #pragma once
 
+#include <cmath>
 #include <stdexcept>
 #include <string>
 
@@ -18,6 +19,13 @@ inline void require_setting(const char* settings, bool ok, const char* setting, 
   if (!ok) {
     throw ParameterError(std::string(settings) + "." + setting + " = " + std::to_string(value) + ": must be " + range);
   }
+}
+/// require_setting for the two common ranges, each condition written once with its words.
+inline void require_finite_non_negative(const char* settings, const char* setting, double value) {
+  require_setting(settings, std::isfinite(value) && value >= 0.0, setting, value, "finite and >= 0");
+}
+inline void require_finite_positive(const char* settings, const char* setting, double value) {
+  require_setting(settings, std::isfinite(value) && value > 0.0, setting, value, "finite and > 0");
 }
 
 }  // namespace tissue

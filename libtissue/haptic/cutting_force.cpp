@@ -8,15 +8,10 @@
 namespace tissue::haptic {
 
 void validate(const CuttingSettings& settings) {
-  require_setting("CuttingSettings",
-                  std::isfinite(settings.fracture_toughness_j_per_m2) && settings.fracture_toughness_j_per_m2 >= 0.0,
-                  "fracture_toughness_j_per_m2", settings.fracture_toughness_j_per_m2, "finite and >= 0");
-  require_setting("CuttingSettings",
-                  std::isfinite(settings.blade_friction_n_per_m) && settings.blade_friction_n_per_m >= 0.0,
-                  "blade_friction_n_per_m", settings.blade_friction_n_per_m, "finite and >= 0");
-  require_setting("CuttingSettings",
-                  std::isfinite(settings.smoothing_speed_m_per_s) && settings.smoothing_speed_m_per_s > 0.0,
-                  "smoothing_speed_m_per_s", settings.smoothing_speed_m_per_s, "finite and > 0");
+  constexpr const char* WHO = "CuttingSettings";
+  require_finite_non_negative(WHO, "fracture_toughness_j_per_m2", settings.fracture_toughness_j_per_m2);
+  require_finite_non_negative(WHO, "blade_friction_n_per_m", settings.blade_friction_n_per_m);
+  require_finite_positive(WHO, "smoothing_speed_m_per_s", settings.smoothing_speed_m_per_s);
 }
 
 Eigen::Vector3d cutting_force(const CuttingSettings& settings, double blade_depth_m,

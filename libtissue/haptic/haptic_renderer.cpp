@@ -58,23 +58,14 @@ void require_prepared(const TissueSample& sample, const std::string& what) {
 }  // namespace
 
 void validate(const RendererSettings& settings) {
-  require_setting("RendererSettings", std::isfinite(settings.max_force_n) && settings.max_force_n > 0.0, "max_force_n",
-                  settings.max_force_n, "finite and > 0");
-  require_setting("RendererSettings", settings.max_force_rate_n_per_s > 0.0, "max_force_rate_n_per_s",
-                  settings.max_force_rate_n_per_s, "> 0 (+infinity: no limit)");
-  require_setting("RendererSettings",
-                  std::isfinite(settings.passivity_min_hand_mass_kg) && settings.passivity_min_hand_mass_kg > 0.0,
-                  "passivity_min_hand_mass_kg", settings.passivity_min_hand_mass_kg, "finite and > 0");
-  require_setting(
-      "RendererSettings",
-      std::isfinite(settings.max_estimated_stiffness_n_per_m) && settings.max_estimated_stiffness_n_per_m >= 0.0,
-      "max_estimated_stiffness_n_per_m", settings.max_estimated_stiffness_n_per_m, "finite and >= 0");
-  require_setting("RendererSettings",
-                  std::isfinite(settings.contact_damping_n_s_per_m) && settings.contact_damping_n_s_per_m >= 0.0,
-                  "contact_damping_n_s_per_m", settings.contact_damping_n_s_per_m, "finite and >= 0");
-  require_setting("RendererSettings",
-                  std::isfinite(settings.velocity_filter_cutoff_hz) && settings.velocity_filter_cutoff_hz > 0.0,
-                  "velocity_filter_cutoff_hz", settings.velocity_filter_cutoff_hz, "finite and > 0");
+  constexpr const char* WHO = "RendererSettings";
+  require_finite_positive(WHO, "max_force_n", settings.max_force_n);
+  require_setting(WHO, settings.max_force_rate_n_per_s > 0.0, "max_force_rate_n_per_s", settings.max_force_rate_n_per_s,
+                  "> 0 (+infinity: no limit)");
+  require_finite_positive(WHO, "passivity_min_hand_mass_kg", settings.passivity_min_hand_mass_kg);
+  require_finite_non_negative(WHO, "max_estimated_stiffness_n_per_m", settings.max_estimated_stiffness_n_per_m);
+  require_finite_non_negative(WHO, "contact_damping_n_s_per_m", settings.contact_damping_n_s_per_m);
+  require_finite_positive(WHO, "velocity_filter_cutoff_hz", settings.velocity_filter_cutoff_hz);
   validate(settings.cutting);
 }
 
