@@ -150,7 +150,7 @@ constexpr auto integrator_settings() {
       Setting("integrator.warmStart", 13, boolean)
           .python("warm_start")
           .start("false")
-          .describe("PCG starts from the combination of the last 4 steps' velocity changes nearest the solution in the "
+          .describe("PCG starts from the combination of the last 8 steps' velocity changes nearest the solution in the "
                     "energy norm (their Galerkin projection: one product with the matrix each) instead of zero")
           .member(TISSUE_MEMBER(settings.solver.warm_start)),
       Setting("integrator.refactorInBackground", 85, boolean)

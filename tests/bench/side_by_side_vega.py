@@ -16,7 +16,7 @@ Usage: tests/bench/side_by_side_vega.py [--vega PATH] [--bench PATH] [--rounds 5
 --converged (issue 40): converged steps instead, one thread, no protections, no damping: Vega's strict
 PCG (eps 1e-6) against ours converged to a relative residual of 1e-6 five ways: Jacobi PCG, PCG
 preconditioned by the lagged Cholesky factor (warm-started), the two-level preconditioner (the
-real-time default's solver) from zero and warm-started (the Galerkin projection onto the last four
+real-time default's solver) from zero and warm-started (the Galerkin projection onto the last eight
 steps' velocity changes), CHOLMOD.
 Ours is also run with two threads (defaults), unpinned. --scaling adds the organ at two sizes between the
 bridge and it (meshes/make_liver.py and Gmsh) and prints ms per step against tet count with the fitted

@@ -130,9 +130,10 @@ StepReport BackwardEuler::step(DynamicsModel& model, DynamicState& state, double
   report.assembly_s = seconds_since(assembly_start);
 
   const auto solve_start = std::chrono::steady_clock::now();
-  start_velocity_change(system);
   try {
-    report.solve = m_solver->solve(system, m_rhs, m_velocity_change);
+    m_solver->setup(system);
+    start_velocity_change(system);  // after the setup: its products are the solver's
+    report.solve = m_solver->solve(m_rhs, m_velocity_change);
   } catch (const SolverError& error) {
     m_velocity_change.setZero();
     m_past_velocity_changes.resize(0);
@@ -186,7 +187,7 @@ void BackwardEuler::start_velocity_change(const ShiftedSystem& system) {
   const Eigen::Index past = std::min<Eigen::Index>(past_velocity_changes(n), WARM_START_STEPS);
   if (!m_settings.warm_start || past == 0) return;
   galerkin_start(system, m_rhs, Eigen::Map<const Eigen::MatrixXd>(m_past_velocity_changes.data(), n, past),
-                 m_velocity_change, m_warm_start);
+                 m_velocity_change, m_warm_start, m_solver.get());
 }
 
 void BackwardEuler::remember_velocity_change() {

@@ -44,7 +44,7 @@ class BackwardEuler final : public Integrator {
   /// Halvings of a correction before the line search gives up on it.
   static constexpr int LINE_SEARCH_HALVINGS = 6;
   /// The steps' velocity changes a warm start combines (each costs one product with the matrix).
-  static constexpr int WARM_START_STEPS = 4;
+  static constexpr int WARM_START_STEPS = 8;
   struct Settings {
     /// Start each solve from the combination of the last WARM_START_STEPS steps' dv nearest the
     /// solution in the energy norm of the step's matrix, instead of from zero (matters for
@@ -88,7 +88,8 @@ class BackwardEuler final : public Integrator {
   // How many whole velocity changes of `n` unknowns the history holds (0 when its length does not
   // divide by n: the system grew since).
   [[nodiscard]] Eigen::Index past_velocity_changes(Eigen::Index n) const;
-  // m_velocity_change = the warm start of the solve of `system` x = m_rhs (zero without one).
+  // m_velocity_change = the warm start of the solve of `system` x = m_rhs (zero without one), by the
+  // solver's products: after its setup.
   void start_velocity_change(const ShiftedSystem& system);
   // Puts m_velocity_change first among the past velocity changes.
   void remember_velocity_change();

@@ -8,7 +8,8 @@
 namespace tissue {
 
 void galerkin_start(const ShiftedSystem& system, const Eigen::VectorXd& b,
-                    const Eigen::Ref<const Eigen::MatrixXd>& columns, Eigen::VectorXd& x0, GalerkinStartWork& work) {
+                    const Eigen::Ref<const Eigen::MatrixXd>& columns, Eigen::VectorXd& x0, GalerkinStartWork& work,
+                    const LinearSolver* solver) {
   x0.setZero(b.size());
   const Eigen::Index count = columns.cols();
   if (count == 0 || count > GALERKIN_MAX_COLUMNS || columns.rows() != b.size() || !columns.allFinite()) return;
@@ -17,7 +18,9 @@ void galerkin_start(const ShiftedSystem& system, const Eigen::VectorXd& b,
   work.products.resize(b.size(), count);
   for (Eigen::Index k = 0; k < count; ++k) {
     work.column = columns.col(k);
-    system.multiply(work.column, work.product);
+    if (solver == nullptr || !solver->multiply_set_up(system, work.column, work.product)) {
+      system.multiply(work.column, work.product);
+    }
     work.products.col(k) = work.product;
   }
   const Small gram = columns.transpose() * work.products;

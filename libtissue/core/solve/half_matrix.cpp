@@ -184,10 +184,10 @@ void HalfMatrix::finish_part(Eigen::VectorXd& y, int part) const {
   for (long i = first; i < end; ++i) y[i] += m_spill[i];
 }
 
-void HalfMatrix::multiply(const Eigen::VectorXd& x, Eigen::VectorXd& y) const {
+void HalfMatrix::multiply(const Eigen::VectorXd& x, Eigen::VectorXd& y, WorkTeam* team) const {
   y.resize(3L * block_rows());
-  for (int part = 0; part < PARTS; ++part) multiply_part(x, y, part);
-  for (int part = 0; part < PARTS; ++part) finish_part(y, part);
+  run_parts(team, PARTS, [&](int part) { multiply_part(x, y, part); });
+  run_parts(team, PARTS, [&](int part) { finish_part(y, part); });
 }
 
 }  // namespace tissue

@@ -60,8 +60,9 @@ class HalfMatrix {
   void multiply_part(const Eigen::VectorXd& x, Eigen::VectorXd& y, int part) const;
   /// Adds to the rows of `part` the terms earlier parts sent them.
   void finish_part(Eigen::VectorXd& y, int part) const;
-  /// y = A x, all parts on this thread (y resized if needed).
-  void multiply(const Eigen::VectorXd& x, Eigen::VectorXd& y) const;
+  /// y = A x (y resized if needed): the parts side by side on `team`'s members when given, else all
+  /// on this thread; bitwise the same either way.
+  void multiply(const Eigen::VectorXd& x, Eigen::VectorXd& y, WorkTeam* team = nullptr) const;
 
   [[nodiscard]] MatrixPrecision precision() const { return m_precision; }
   /// Bytes of matrix values and column indices one product streams.

@@ -26,6 +26,17 @@ void validate_pcg_settings(const PcgSolver::Settings& settings, const char* who)
 /// 1 / diag(A), length rows() (resized if needed); throws SolverError for an entry <= 0 or not finite.
 void jacobi_inverse_diagonal(const ShiftedSystem& system, Eigen::VectorXd& inverse_diagonal, const char* who);
 
+/// A CG solver's LinearSolver::multiply_set_up: y = A x through `work.matrix` (the copy the setup of
+/// `set_up` assigned) on `team`'s members, if `system` is that one.
+inline bool multiply_set_up_copy(const PcgWorkspace& work, const ShiftedSystem& set_up, WorkTeam* team,
+                                 const ShiftedSystem& system, const Eigen::VectorXd& x, Eigen::VectorXd& y) {
+  const bool same = set_up.stiffness != nullptr && set_up.stiffness == system.stiffness &&
+                    set_up.stiffness_scale == system.stiffness_scale && set_up.diagonal == system.diagonal;
+  if (!same || x.rows() != system.rows()) return false;
+  work.matrix.multiply(x, y, team);
+  return true;
+}
+
 /// The rows of a system's vectors in PARTS consecutive parts (boundaries on block rows, balanced by
 /// the matrix blocks of each part), and the team (or none) that works on them side by side.
 class VectorParts {

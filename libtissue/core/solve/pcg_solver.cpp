@@ -48,6 +48,11 @@ void PcgSolver::setup(const ShiftedSystem& system) {
   m_system = system;
 }
 
+bool PcgSolver::multiply_set_up(const ShiftedSystem& system, const Eigen::VectorXd& x,
+                               Eigen::VectorXd& y) const {
+  return multiply_set_up_copy(m_work, m_system, m_team, system, x, y);
+}
+
 SolveReport PcgSolver::solve(const Eigen::VectorXd& b, Eigen::VectorXd& x) {
   if (!is_set_up()) throw SolverError("PcgSolver: solve() without a setup()");
   m_system.check_sizes(b, x);

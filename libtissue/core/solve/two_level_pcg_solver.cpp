@@ -39,6 +39,11 @@ void TwoLevelPcgSolver::set_up(const ShiftedSystem& system, bool nearby) {
   m_system = system;
 }
 
+bool TwoLevelPcgSolver::multiply_set_up(const ShiftedSystem& system, const Eigen::VectorXd& x,
+                                       Eigen::VectorXd& y) const {
+  return multiply_set_up_copy(m_work, m_system, m_team, system, x, y);
+}
+
 SolveReport TwoLevelPcgSolver::solve(const Eigen::VectorXd& b, Eigen::VectorXd& x) {
   if (!is_set_up()) throw SolverError(std::string(TWO_LEVEL_PCG) + ": solve() without a setup()");
   m_system.check_sizes(b, x);

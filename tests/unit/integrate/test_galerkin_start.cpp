@@ -77,5 +77,33 @@ TEST(GalerkinStart, NothingUsableGivesZero) {
   EXPECT_EQ(x0, Eigen::VectorXd::Zero(b.size()));
 }
 
+TEST(GalerkinStart, TakesTheSolversProductsWhenSetUpForTheSystem) {
+  // With the solver that was set up for the system, its compact copy's products: the same start to
+  // rounding with double entries, to the entries' rounding with single ones (a different product,
+  // so it was used); a solver set up for another system is not asked.
+  const test::TestSystem system = test::make_grid_system(4, 4, 3, 34);
+  const ShiftedSystem shifted = system.shifted(0.6);
+  std::mt19937 rng(10);
+  const Eigen::VectorXd b = test::random_vector(shifted.rows(), rng);
+  Eigen::MatrixXd columns(b.size(), 3);
+  for (Eigen::Index k = 0; k < columns.cols(); ++k) columns.col(k) = test::random_vector(b.size(), rng);
+  GalerkinStartWork work;
+  Eigen::VectorXd expected, x0;
+  galerkin_start(shifted, b, columns, expected, work);
+  PcgSolver strict({1e-8, 100});  // double entries
+  strict.setup(shifted);
+  galerkin_start(shifted, b, columns, x0, work, &strict);
+  EXPECT_LE((x0 - expected).norm(), 1e-12 * expected.norm());
+  PcgSolver real_time({1e-3, 10});  // single entries
+  real_time.setup(shifted);
+  galerkin_start(shifted, b, columns, x0, work, &real_time);
+  const double difference = (x0 - expected).norm() / expected.norm();
+  EXPECT_GT(difference, 0.0);
+  EXPECT_LE(difference, 1e-5);
+  real_time.setup(system.shifted(0.7));
+  galerkin_start(shifted, b, columns, x0, work, &real_time);
+  EXPECT_EQ(x0, expected);
+}
+
 }  // namespace
 }  // namespace tissue

@@ -1,6 +1,7 @@
 // Tests of the Jacobi-PCG solver: it reaches the dense solution, honours warm start, the
 // tolerance and the iteration cap, and refuses systems it cannot solve.
 #include "core/solve/linear_solver.hpp"
+#include "core/system/work_team.hpp"
 
 #include "solve/test_systems.hpp"
 
@@ -192,6 +193,37 @@ TEST(ShiftedSystem, MultiplyIsScaledStiffnessPlusDiagonal) {
   system.shifted(0.37).multiply(x, y);
   const Eigen::VectorXd expected = system.dense(0.37) * x;
   EXPECT_LE((y - expected).norm(), 1e-12 * expected.norm());
+}
+
+TEST(Pcg, ProductOfTheLastSetupIsTheSystemsThroughTheSolversCopy) {
+  // multiply_set_up streams the compact copy the CG products use: A x to rounding with double
+  // entries (a strict tolerance), to the entries' rounding (6e-8) with single ones (the real-time
+  // 1e-3), bitwise the same on a team of two; refused before a setup and for another system.
+  const test::TestSystem system = test::make_grid_system(6, 5, 4, 9);
+  const ShiftedSystem shifted = system.shifted(0.4);
+  std::mt19937 rng(13);
+  const Eigen::VectorXd x = test::random_vector(shifted.rows(), rng);
+  Eigen::VectorXd expected;
+  shifted.multiply(x, expected);
+  for (const double tolerance : {1e-6, 1e-3}) {
+    PcgSolver jacobi({tolerance, 100});
+    TwoLevelPcgSolver two_level({tolerance, 100});
+    for (LinearSolver* solver : std::vector<LinearSolver*>{&jacobi, &two_level}) {
+      Eigen::VectorXd y;
+      EXPECT_FALSE(solver->multiply_set_up(shifted, x, y)) << solver->name() << " before its setup";
+      solver->setup(shifted);
+      EXPECT_FALSE(solver->multiply_set_up(system.shifted(0.5), x, y)) << solver->name() << ", another scale";
+      ASSERT_TRUE(solver->multiply_set_up(shifted, x, y)) << solver->name();
+      const double error = (y - expected).norm() / expected.norm();
+      EXPECT_LE(error, tolerance < 1e-5 ? 1e-14 : 1e-6) << solver->name() << ", tolerance " << tolerance;
+      WorkTeam team(2);
+      solver->lend_work_team(&team);
+      Eigen::VectorXd together;
+      ASSERT_TRUE(solver->multiply_set_up(shifted, x, together));
+      solver->lend_work_team(nullptr);
+      EXPECT_EQ(together, y) << solver->name() << ", tolerance " << tolerance;
+    }
+  }
 }
 
 }  // namespace
