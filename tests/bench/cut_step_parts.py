@@ -2,8 +2,10 @@
 """Where a cut step's time goes (issue 41, item 5): the frog of cut_frog_complete (held at its hind
 30%, E 300 kPa, 10 ms steps) through `import tissue`, a vertical scalpel drawn across at 60% of its
 length in 175 steps. Prints, per kind of step, the medians of the step's parts (TissueStepReport's
-wall times, ms), how often the tangent was re-laid out and the mean Newton corrections (a step that
-turns an element far is corrected: a cost that follows the trajectory, not the code):
+wall times, ms), how often the tangent was re-laid out, the mean Newton corrections (a step that
+turns an element far is corrected: a cost that follows the trajectory, not the code) and the page
+faults a step took (getrusage's minor faults: memory first touched within the step, which a real-time
+host that locked its memory at the start does not pay):
 
 * before: 40 steps with the scalpel beside the body, before any cut;
 * enriching: the stroke's steps that cut tets (the volume cutter's new cuts, enriched at once)
@@ -25,11 +27,20 @@ Usage: /usr/bin/python3 tests/bench/cut_step_parts.py [--runs 3] [--solver pcgTw
 """
 import argparse
 import os
+import resource
 import statistics
 import sys
 
 ROOT = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..")
 PARTS = ("total_s", "assembly_s", "solve_s", "guard_s", "cut_s", "enrich_s", "positions_s")
+
+
+def step_counting_faults(body):
+    """body.step()'s report, with the page faults the step took (memory first touched in it)."""
+    before = resource.getrusage(resource.RUSAGE_SELF).ru_minflt
+    report = body.step()
+    report["page_faults"] = resource.getrusage(resource.RUSAGE_SELF).ru_minflt - before
+    return report
 
 
 def stroke(tissue, solver, organ):
@@ -50,7 +61,7 @@ def stroke(tissue, solver, organ):
     kinds = {"before": [], "enriching": [], "re-layout": [], "plain": []}
     for _ in range(20 if organ else 40):
         body.set_tool((x, lower[1] - 0.05, tip_z), mode="scalpel")
-        kinds["before"].append(body.step())
+        kinds["before"].append(step_counting_faults(body))
     steps = 150 if organ else 175
     for n in range(steps + 1):
         if organ:  # from the front to the back, as cut_organ's
@@ -58,7 +69,7 @@ def stroke(tissue, solver, organ):
         else:
             y = lower[1] - 0.01 + n / steps * (size[1] + 0.02)
         body.set_tool((x, y, tip_z), mode="scalpel")
-        report = body.step()
+        report = step_counting_faults(body)
         if report["newly_cut_tets"] == 0:
             kinds["plain"].append(report)
         else:
@@ -67,7 +78,7 @@ def stroke(tissue, solver, organ):
         kinds["after"] = []
         body.set_tool((x, lower[1] - 0.1, upper[2] + 0.1), mode="none")
         for _ in range(40):
-            kinds["after"].append(body.step())
+            kinds["after"].append(step_counting_faults(body))
     return kinds
 
 
@@ -80,7 +91,7 @@ def scenario_steps(tissue, path):
     while n * scenario.tissue_step_s < scenario.duration_s:
         position, orientation, mode = scenario.tool_at(n * scenario.tissue_step_s)
         body.set_tool(position, orientation, mode=mode)
-        report = body.step()
+        report = step_counting_faults(body)
         if report["newly_cut_tets"] > 0:
             cut = True
             kinds["re-layout" if report["matrix_relayout"] else "enriching"].append(report)
@@ -102,8 +113,8 @@ def main():
     import tissue  # noqa: E402
 
     print("| run | steps | n | total | assembly | solve | energy guard | cut | enrich | positions | re-layouts "
-          "| Newton corrections (mean) | total / before |")
-    print("|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|")
+          "| Newton corrections (mean) | page faults (median / max) | total / before |")
+    print("|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|")
     for run in range(args.runs):
         kinds = scenario_steps(tissue, args.scenario) if args.scenario else stroke(tissue, args.solver, args.organ)
         before_ms = 1e3 * statistics.median(r["total_s"] for r in kinds["before"])
@@ -114,10 +125,10 @@ def main():
             medians = [1e3 * statistics.median(r[p] for r in reports) if p in reports[0] else None for p in PARTS]
             relayouts = sum(bool(r["matrix_relayout"]) for r in reports) if "matrix_relayout" in reports[0] else "-"
             newton = statistics.mean(r["newton_iterations"] for r in reports)
-            print("| %d | %s | %d | %s | %s | %.2f | %.2fx |" % (run + 1, name, len(reports),
-                                                              " | ".join("-" if m is None else "%.2f" % m
-                                                                         for m in medians),
-                                                              relayouts, newton, medians[0] / before_ms))
+            faults = [r["page_faults"] for r in reports]
+            print("| %d | %s | %d | %s | %s | %.2f | %d / %d | %.2fx |" % (
+                run + 1, name, len(reports), " | ".join("-" if m is None else "%.2f" % m for m in medians), relayouts,
+                newton, statistics.median(faults), max(faults), medians[0] / before_ms))
 
 
 if __name__ == "__main__":

@@ -216,6 +216,12 @@ void BlockSparseMatrix::reserve_slots(size_t slots) {
   if (m_column.capacity() >= slots) return;
   m_column.reserve(2 * slots);
   m_values.reserve(9 * m_column.capacity());
+  // Sized up and back, a vector keeps its capacity, and the pages written stay resident.
+  const size_t columns = m_column.size(), values = m_values.size();
+  m_column.resize(m_column.capacity(), -1);
+  m_values.resize(m_values.capacity(), 0.0);
+  m_column.resize(columns);
+  m_values.resize(values);
 }
 
 // In place, from the last row to the first: a row's room never shrinks, so each row moves to a slot
