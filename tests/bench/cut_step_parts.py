@@ -4,8 +4,8 @@
 length in 175 steps. Prints, per kind of step, the medians of the step's parts (TissueStepReport's
 wall times, ms), how often the tangent was re-laid out, the mean Newton corrections (a step that
 turns an element far is corrected: a cost that follows the trajectory, not the code) and the page
-faults a step took (getrusage's minor faults: memory first touched within the step, which a real-time
-host that locked its memory at the start does not pay):
+faults a step took (getrusage's minor faults: memory first touched within the step; tissue-host,
+which locks what it holds at its start, pays them only for memory allocated since):
 
 * before: 40 steps with the scalpel beside the body, before any cut;
 * enriching: the stroke's steps that cut tets (the volume cutter's new cuts, enriched at once)
