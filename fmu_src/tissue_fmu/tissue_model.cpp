@@ -1,6 +1,7 @@
 // TissueModel (see tissue_model.hpp).
 #include "tissue_fmu/tissue_model.hpp"
 
+#include "core/system/resident_reserve.hpp"
 #include "core/tissue_settings_schema.hpp"
 #include "core/tissue_snapshot_io.hpp"
 #include "resources/default_mesh.hpp"
@@ -147,10 +148,27 @@ void TissueModel::build() {
   const TissueParameters parameters = tissue_parameters(m_values);
   m_tissue = make_tissue(parameters, m_context.resource_path);
   m_tissue->set_tool(tool_pose(m_values));
+  reserve_render_outputs();
   m_dirty = false;
   m_integrator_iterations = 0;
   start_surface_revision(0);
   m_capacity_warned = false;
+}
+
+void TissueModel::reserve_render_outputs() {
+  const CutRenderSurface* render = m_tissue->render_surface();
+  if (render == nullptr) return;
+  const size_t points = render->point_room(), triangles = render->triangle_room();
+  reserve_resident(m_embedding.triangles, 3 * triangles);
+  reserve_resident(m_embedding.point_nodes, 4 * points);
+  reserve_resident(m_embedding.point_weights, 4 * points);
+  reserve_resident(m_drawn.triangles, 3 * triangles);
+  reserve_resident(m_drawn.positions_m, 3 * points);
+  // The encoded embedding: its arrays and a header well under a kilobyte.
+  const size_t embedding_bytes =
+      1024 + 4 * sizeof(std::uint32_t) * points + 4 * sizeof(double) * points + 3 * sizeof(std::uint32_t) * triangles;
+  reserve_resident(m_embedding_bytes, embedding_bytes);
+  reserve_resident(m_mesh_bytes, 1024 + 3 * sizeof(double) * points + 3 * sizeof(std::uint32_t) * triangles);
 }
 
 namespace {

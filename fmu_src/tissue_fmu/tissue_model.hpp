@@ -64,6 +64,9 @@ class TissueModel final : public fmi3::Model {
 
  private:
   void build();
+  /// With a render surface: room for its outputs' arrays and bytes as large as the room it holds
+  /// for a session's cuts, written now (CutRenderSurface::point_room), not at the first cut.
+  void reserve_render_outputs();
   void ensure_built();
   /// surface.revision for the current state. A step only marks it stale: the first read after it
   /// (an output, the surface's bytes, a saved state, a prepared frame) compares the drawn surface's

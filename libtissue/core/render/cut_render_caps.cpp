@@ -525,7 +525,7 @@ void CutRenderSurface::cap_loops(const DeformableBody& body) {
   find_split_edges(m_triangles, 0, m_points.size(), edges);
   const std::vector<std::vector<int>> loops = border_loops(edges.directed);
   SimpleCaps simple_caps;  // this re-mesh's, for the next
-  const size_t surface_triangles = m_triangles.size();
+  const size_t first_cap = m_triangles.size();  // the split skin's triangles come before
   m_open_loops = 0;
   const auto part_of_point = [&](int point) { return part_of(body, m_points[static_cast<size_t>(point)]); };
   // Which side of cut `cut` the material of a point's piece lies on (+1 above, -1 below, 0 unknown:
@@ -588,12 +588,12 @@ void CutRenderSurface::cap_loops(const DeformableBody& body) {
   for (const std::vector<int>& face : faces) cap_polygon(face, m_rest_m, m_triangles, edges);
   // Every walk closed: every loop is capped. Else the holes (the caps' edges added), flat ones filled.
   if (unclosed > 0) {
-    find_split_edges(m_triangles, surface_triangles, m_points.size(), edges);
+    find_split_edges(m_triangles, first_cap, m_points.size(), edges);
     const FlatHoles holes = flat_holes(edges.directed, m_rest_m, part_of_point);
     for (const std::vector<int>& hole : holes.flat) cap_polygon(hole, m_rest_m, m_triangles, edges);
     m_open_loops = holes.others;
   }
-  m_cap_triangles = static_cast<int>(cut_render_detail::drop_bubbles(m_triangles, surface_triangles, m_rest_m));
+  m_cap_triangles = static_cast<int>(cut_render_detail::drop_bubbles(m_triangles, first_cap, m_rest_m, m_bubbles));
   m_simple_caps = std::move(simple_caps);
 }
 

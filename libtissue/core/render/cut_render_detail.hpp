@@ -67,10 +67,19 @@ FlatHoles flat_holes(const std::unordered_map<long long, int>& directed, const s
 // (a later cut splits every piece it passes through, issue 43), all its neighbours across the planes,
 // capped on its own. Such shells are not drawn.
 inline constexpr double BUBBLE_M3 = FLAT_HOLE_M * FLAT_HOLE_M * FLAT_HOLE_M;
+// drop_bubbles' working arrays, kept by its caller from re-mesh to re-mesh: grown once, they are
+// not allocated (and their pages not faulted in) again inside a step's slot.
+struct BubbleScratch {
+  std::vector<int> parent, size;      // per point
+  std::vector<signed char> state;     // per point
+  std::vector<double> volume_m3;      // per point
+  std::vector<std::size_t> shell_of;  // per triangle
+  std::unordered_map<long long, int> directed;
+};
 // Removes from `triangles` the closed shells (every edge used once each way) holding a triangle from
 // `first_cap` on (a cap) and enclosing less than BUBBLE_M3 at `x`, keeping the order of the rest;
 // returns how many of the triangles from `first_cap` on are left.
-size_t drop_bubbles(std::vector<std::array<int, 3>>& triangles, size_t first_cap,
-                    const std::vector<Eigen::Vector3d>& x);
+size_t drop_bubbles(std::vector<std::array<int, 3>>& triangles, size_t first_cap, const std::vector<Eigen::Vector3d>& x,
+                    BubbleScratch& scratch);
 
 }  // namespace tissue::cut_render_detail

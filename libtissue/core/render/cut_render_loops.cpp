@@ -293,22 +293,39 @@ void merge_unfacing_switches(std::map<std::array<int, 5>, std::vector<size_t>>& 
   }
 }
 
-size_t drop_bubbles(std::vector<std::array<int, 3>>& triangles, size_t first_cap,
-                    const std::vector<Eigen::Vector3d>& x) {
-  std::vector<int> parent(x.size());
+size_t drop_bubbles(std::vector<std::array<int, 3>>& triangles, size_t first_cap, const std::vector<Eigen::Vector3d>& x,
+                    BubbleScratch& scratch) {
+  // Shells: union by size over the triangles' corners, then each point's root at once (the passes
+  // below read it for every triangle: 82k on the organ's surface at every re-mesh).
+  std::vector<int>& parent = scratch.parent;
+  std::vector<int>& size = scratch.size;
+  parent.resize(x.size());
   std::iota(parent.begin(), parent.end(), 0);
-  const auto root = [&parent](int v) { return find_root(parent, v); };
+  size.assign(x.size(), 1);
+  const auto unite = [&](int a, int b) {
+    a = find_root(parent, a);
+    b = find_root(parent, b);
+    if (a == b) return;
+    if (size[static_cast<size_t>(a)] < size[static_cast<size_t>(b)]) std::swap(a, b);
+    parent[static_cast<size_t>(b)] = a;
+    size[static_cast<size_t>(a)] += size[static_cast<size_t>(b)];
+  };
   for (const auto& t : triangles) {
-    parent[static_cast<size_t>(root(t[0]))] = root(t[1]);
-    parent[static_cast<size_t>(root(t[1]))] = root(t[2]);
+    unite(t[0], t[1]);
+    unite(t[1], t[2]);
   }
+  for (size_t i = 0; i < parent.size(); ++i) parent[i] = find_root(parent, static_cast<int>(i));
+  const auto root = [&parent](int v) { return parent[static_cast<size_t>(v)]; };
   // Per shell holding a cap (by its root point): its volume about that point (closed: any point will
   // do); others are not candidates.
   constexpr signed char NOT_A_CANDIDATE = 0, SMALL = 1, OPEN = 2;
-  std::vector<signed char> state(x.size(), NOT_A_CANDIDATE);
-  std::vector<double> volume_m3(x.size(), 0.0);
+  std::vector<signed char>& state = scratch.state;
+  std::vector<double>& volume_m3 = scratch.volume_m3;
+  state.assign(x.size(), NOT_A_CANDIDATE);
+  volume_m3.assign(x.size(), 0.0);
   for (size_t t = first_cap; t < triangles.size(); ++t) state[static_cast<size_t>(root(triangles[t][0]))] = SMALL;
-  std::vector<size_t> shell_of(triangles.size());
+  std::vector<size_t>& shell_of = scratch.shell_of;
+  shell_of.resize(triangles.size());
   for (size_t t = 0; t < triangles.size(); ++t) {
     const auto shell = static_cast<size_t>(root(triangles[t][0]));
     shell_of[t] = shell;
@@ -320,7 +337,8 @@ size_t drop_bubbles(std::vector<std::array<int, 3>>& triangles, size_t first_cap
     volume_m3[shell] += a.dot(b.cross(c)) / 6.0;
   }
   // The small ones, if closed (every edge once each way).
-  std::unordered_map<long long, int> directed;
+  std::unordered_map<long long, int>& directed = scratch.directed;
+  directed.clear();
   for (size_t t = 0; t < triangles.size(); ++t) {
     const size_t shell = shell_of[t];
     if (state[shell] == NOT_A_CANDIDATE) continue;

@@ -198,13 +198,16 @@ void CutRenderSurface::split_skin(const DeformableBody& body, const std::vector<
   const size_t vertices = m_surface.vertices_m.size();
   // The material part of each surface vertex riding on an uncut tet (-1 for the others): an edge
   // between two of them is cut only if their parts differ.
-  std::vector<int> uncut_part(vertices, -1);
+  std::vector<int>& uncut_part = m_uncut_part;
+  uncut_part.assign(vertices, -1);
   for (size_t v = 0; v < vertices; ++v) {
     if (m_points[v].cut_tet < 0) uncut_part[v] = part[v];
   }
-  std::vector<std::array<int, 3>> skin;
+  std::vector<std::array<int, 3>>& skin = m_next_skin;
+  skin.clear();
   skin.reserve(m_surface.triangles.size() + m_skin.size() / 8);
-  std::vector<int> skin_first(m_surface.triangles.size() + 1, 0);
+  std::vector<int>& skin_first = m_next_skin_first;
+  skin_first.assign(m_surface.triangles.size() + 1, 0);
   const auto is_clean = [&](size_t t) {
     const auto& triangle = m_surface.triangles[t];
     return dirty[static_cast<size_t>(triangle[0])] == 0 && dirty[static_cast<size_t>(triangle[1])] == 0 &&
@@ -231,8 +234,8 @@ void CutRenderSurface::split_skin(const DeformableBody& body, const std::vector<
     split_triangle(triangle, cut, cuts, skin);
   }
   skin_first.back() = static_cast<int>(skin.size());
-  m_skin = std::move(skin);
-  m_skin_first = std::move(skin_first);
+  m_skin.swap(skin);
+  m_skin_first.swap(skin_first);
 }
 
 }  // namespace tissue

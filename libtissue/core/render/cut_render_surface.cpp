@@ -4,6 +4,7 @@
 #include "core/render/cut_render_surface.hpp"
 
 #include "core/render/cut_render_detail.hpp"
+#include "core/system/resident_reserve.hpp"
 
 #include <Eigen/Dense>
 
@@ -20,7 +21,32 @@ CutRenderSurface::CutRenderSurface(const TetMesh& mesh, TriangleSurface surface,
     : m_mesh(mesh),
       m_surface(std::move(surface)),
       m_embedding(embed_surface(m_mesh, m_surface, max_outside_m, source_name)) {
-  m_points.reserve(m_embedding.size());
+  // Room for the split and cap points (and the triangles they make) of a session's cuts, written
+  // now: the first cut's split points re-allocated the per-point arrays of the organ's 41k-point
+  // surface inside its slot (docs/BENCHMARKS.md). Past the room they grow as before.
+  const size_t points = m_surface.vertices_m.size() + m_surface.vertices_m.size() / SPLIT_POINT_ROOM_DIVISOR;
+  const size_t triangles = m_surface.triangles.size() + m_surface.triangles.size() / SPLIT_POINT_ROOM_DIVISOR;
+  reserve_resident(m_points, points);
+  reserve_resident(m_rest_m, points);
+  reserve_resident(m_point_cut, points);
+  reserve_resident(m_point_nodes, points);
+  reserve_resident(m_positions_m, points);
+  reserve_resident(m_normals, points);
+  reserve_resident(m_triangles, triangles);
+  const size_t vertices = m_surface.vertices_m.size();
+  reserve_resident(m_dirty, vertices);
+  reserve_resident(m_part, vertices);
+  reserve_resident(m_uncut_part, vertices);
+  reserve_resident(m_vertex_part, vertices);
+  reserve_resident(m_skin, triangles);
+  reserve_resident(m_next_skin, triangles);
+  reserve_resident(m_skin_first, m_surface.triangles.size() + 1);
+  reserve_resident(m_next_skin_first, m_surface.triangles.size() + 1);
+  reserve_resident(m_bubbles.parent, points);
+  reserve_resident(m_bubbles.size, points);
+  reserve_resident(m_bubbles.state, points);
+  reserve_resident(m_bubbles.volume_m3, points);
+  reserve_resident(m_bubbles.shell_of, triangles);
   for (const SurfaceEmbedding& e : m_embedding) m_points.push_back(Point{e.tet, e.weights, -1, -1});
   m_rest_m = m_surface.vertices_m;
   m_triangles = m_surface.triangles;
@@ -45,8 +71,10 @@ void CutRenderSurface::rebuild(const DeformableBody& body) {
   find_material_parts(body);
   const size_t vertices = m_surface.vertices_m.size();
   const auto tet_count = static_cast<size_t>(m_mesh.tet_count());
-  std::vector<char> dirty(vertices, 1);
-  std::vector<int> part(vertices, -1);
+  std::vector<char>& dirty = m_dirty;
+  std::vector<int>& part = m_part;
+  dirty.assign(vertices, 1);
+  part.assign(vertices, -1);
   const bool scratch = mark_dirty_points(body, dirty, part);
   m_from_scratch = scratch;
   const size_t old_split_points = m_split_points;
@@ -90,7 +118,7 @@ void CutRenderSurface::map_points_to_nodes(size_t first_new, const std::vector<c
   }
   const bool all = m_from_scratch || static_cast<size_t>(pieces) > m_slot_stride;
   if (all) {
-    m_slot_stride = static_cast<size_t>(pieces);
+    m_slot_stride = std::max(static_cast<size_t>(pieces), MIN_SLOT_STRIDE);
     m_slot_of.clear();
     m_slots.clear();
   }

@@ -42,6 +42,7 @@
 #pragma once
 
 #include "core/fem/deformable_body.hpp"
+#include "core/render/cut_render_detail.hpp"
 #include "core/render/embedded_surface.hpp"
 
 #include <Eigen/Core>
@@ -85,6 +86,11 @@ class CutRenderSurface {
   /// Holes the last rebuild left: the finished surface's border loops (faces the chain walk could
   /// not close, neither flat nor two flat faces, or between two material parts).
   [[nodiscard]] int open_loop_count() const { return m_open_loops; }
+  /// The points and triangles the surface holds room for (written at construction): a reader that
+  /// copies them (an FMU's outputs) reserves as much, so that a cut's first split points grow
+  /// neither its arrays nor this surface's inside a step's slot.
+  [[nodiscard]] size_t point_room() const { return m_points.capacity(); }
+  [[nodiscard]] size_t triangle_room() const { return m_triangles.capacity(); }
   /// Whether the last rebuild started from the surface as given (else it redid only what changed).
   [[nodiscard]] bool rebuilt_from_scratch() const { return m_from_scratch; }
 
@@ -102,6 +108,12 @@ class CutRenderSurface {
                       std::vector<Eigen::Vector3d>& nodes_m) const;
 
  private:
+  /// Per-point arrays hold room for this fraction (1 / it) more points than the surface has
+  /// vertices, written at construction (a first cut then grows none of them).
+  static constexpr size_t SPLIT_POINT_ROOM_DIVISOR = 2;
+  /// Pieces per cut tet the node slots are laid out for at least: a tet cut once or twice maps only
+  /// its own points (a stride too small re-maps every point: 2 ms on the organ's surface).
+  static constexpr size_t MIN_SLOT_STRIDE = 4;
   struct Point {
     int tet = -1;
     Eigen::Vector4d weights = Eigen::Vector4d::Zero();
@@ -117,6 +129,7 @@ class CutRenderSurface {
                                        std::vector<int>& part) const;
   void relocate_points(const DeformableBody& body, const std::vector<char>& dirty, std::vector<int>& part);
   void drop_moved_splits(const std::vector<char>& dirty);
+  /// Splits the skin into m_next_skin (m_next_skin_first), then swaps it with m_skin.
   void split_skin(const DeformableBody& body, const std::vector<char>& dirty, const std::vector<int>& part);
   const std::array<int, 2>* split_edge(const DeformableBody& body, const std::vector<int>& uncut_part, int u, int v);
   void cap_loops(const DeformableBody& body);
@@ -175,6 +188,14 @@ class CutRenderSurface {
   mutable std::vector<Eigen::Vector3d> m_normals;  // of m_positions_m once m_normals_current
   mutable bool m_normals_current = false;
   mutable Eigen::VectorXd m_real_positions_m;
+  // A re-mesh's working arrays, kept from one to the next and their room written at construction
+  // (reserve_resident): per surface vertex whether it is located again and its material part (and,
+  // riding on an uncut tet, in uncut_part), the skin being split, and drop_bubbles' arrays.
+  std::vector<char> m_dirty;
+  std::vector<int> m_part, m_uncut_part;
+  std::vector<std::array<int, 3>> m_next_skin;
+  std::vector<int> m_next_skin_first;
+  cut_render_detail::BubbleScratch m_bubbles;
 };
 
 }  // namespace tissue

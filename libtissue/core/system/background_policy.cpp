@@ -15,4 +15,12 @@ void leave_realtime_policy() noexcept {
   (void)pthread_setschedparam(pthread_self(), SCHED_OTHER, &parameters);
 }
 
+void lend_realtime_policy(pthread_t thread) noexcept {
+  int policy = SCHED_OTHER;
+  sched_param parameters{};
+  if (pthread_getschedparam(pthread_self(), &policy, &parameters) != 0) return;
+  if (policy != SCHED_FIFO && policy != SCHED_RR) return;
+  (void)pthread_setschedparam(thread, policy, &parameters);
+}
+
 }  // namespace tissue

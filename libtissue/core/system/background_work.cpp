@@ -41,6 +41,12 @@ void BackgroundWork::start(std::function<void()> job) {
 void BackgroundWork::wait() {
   if (!m_pending) return;
   std::unique_lock lock(m_mutex);
+  // A job still running gets the waiter's real-time priority until it finishes (the thread takes
+  // the normal policy again as it finishes).
+  if (m_running && !m_lent) {
+    lend_realtime_policy(m_thread.native_handle());
+    m_lent = true;
+  }
   m_changed.wait(lock, [this] { return !m_running; });
   m_pending = false;
 }
@@ -52,8 +58,9 @@ bool BackgroundWork::busy() {
 }
 
 void BackgroundWork::serve() noexcept {
-  leave_realtime_policy();  // the job runs in the time the real-time threads leave idle
   std::unique_lock lock(m_mutex);
+  // The job runs in the time the real-time threads leave idle (unless its owner already waits).
+  if (!m_lent) leave_realtime_policy();
   for (;;) {
     m_changed.wait(lock, [this] { return m_stop || static_cast<bool>(m_job); });
     if (m_stop) return;
@@ -62,6 +69,8 @@ void BackgroundWork::serve() noexcept {
     lock.unlock();
     job();
     lock.lock();
+    if (m_lent) leave_realtime_policy();  // the owner's policy was lent for this job only
+    m_lent = false;
     m_running = false;
     m_changed.notify_all();
   }

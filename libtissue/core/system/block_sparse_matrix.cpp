@@ -10,6 +10,7 @@
 
 #include "core/index_cast.hpp"
 #include "core/system/hot_kernel.hpp"
+#include "core/system/resident_reserve.hpp"
 #include "core/system/work_team.hpp"
 
 #include <algorithm>
@@ -214,14 +215,8 @@ void BlockSparseMatrix::diagonal(Eigen::VectorXd& diagonal) const {
 
 void BlockSparseMatrix::reserve_slots(size_t slots) {
   if (m_column.capacity() >= slots) return;
-  m_column.reserve(2 * slots);
-  m_values.reserve(9 * m_column.capacity());
-  // Sized up and back, a vector keeps its capacity, and the pages written stay resident.
-  const size_t columns = m_column.size(), values = m_values.size();
-  m_column.resize(m_column.capacity(), -1);
-  m_values.resize(m_values.capacity(), 0.0);
-  m_column.resize(columns);
-  m_values.resize(values);
+  reserve_resident(m_column, 2 * slots);
+  reserve_resident(m_values, 9 * m_column.capacity());
 }
 
 // In place, from the last row to the first: a row's room never shrinks, so each row moves to a slot

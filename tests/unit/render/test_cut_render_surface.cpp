@@ -744,7 +744,8 @@ TEST(DropBubbles, RemovesOnlyTinyClosedShellsThatHoldACap) {
   add_tet(1e-5, 0.02, false);
   std::vector<std::array<int, 3>> triangles = skin;
   triangles.insert(triangles.end(), caps.begin(), caps.end());
-  const size_t caps_left = cut_render_detail::drop_bubbles(triangles, skin.size(), x);
+  cut_render_detail::BubbleScratch scratch;
+  const size_t caps_left = cut_render_detail::drop_bubbles(triangles, skin.size(), x, scratch);
   EXPECT_EQ(caps_left, 2u);
   ASSERT_EQ(triangles.size(), 7u);  // the big tet's four, the open one's three
   for (const auto& t : triangles) EXPECT_TRUE(t[0] < 4 || t[0] >= 8) << "a triangle of the dropped tet";

@@ -1,7 +1,8 @@
 // BackgroundWork (core/system/background_work.hpp): one job at a time on a thread of its own. A job
 // runs once, wait() returns after it, and a job handed over from a real-time (SCHED_FIFO) thread
 // runs at the normal policy, so that it only takes what the real-time threads leave idle
-// (inherited, it would take a core from the dynamics team).
+// (inherited, it would take a core from the dynamics team), but at the owner's while the owner
+// waits for it.
 #include "core/system/background_work.hpp"
 
 #include "fifo_thread.hpp"
@@ -40,15 +41,47 @@ TEST(BackgroundWork, EachJobRunsOnceOnItsThreadAndWaitReturnsAfterIt) {
   EXPECT_NE(ran_on, std::this_thread::get_id());
 }
 
+// Finished without a wait() (busy() polled): the owner lends it nothing.
 TEST(BackgroundWork, AJobHandedOverFromARealTimeThreadRunsAtTheNormalPolicy) {
   int policy_in_job = -1;
   const bool fifo = test::run_on_a_fifo_thread([&] {
     BackgroundWork work;  // its thread is made by this (real-time) thread at the first job
     work.start([&] { policy_in_job = sched_getscheduler(0); });
+    while (work.busy()) std::this_thread::yield();
     work.wait();
   });
   if (!fifo) GTEST_SKIP() << "SCHED_FIFO not permitted here (not root, no CAP_SYS_NICE)";
   EXPECT_EQ(policy_in_job, SCHED_OTHER);
+}
+
+// Priority inheritance: while a real-time owner waits for a job, the job runs at the owner's
+// policy and priority (else normal threads hold back what the owner waits for: the organ's first
+// cut); the next job starts at the normal policy again. The job watches its own policy for up to
+// 10 s: without the lending it never sees SCHED_FIFO.
+TEST(BackgroundWork, AJobARealTimeOwnerWaitsForRunsAtTheOwnersPriority) {
+  int policy_waited_for = -1, priority_waited_for = -1, policy_next = -1;
+  const bool fifo = test::run_on_a_fifo_thread([&] {
+    BackgroundWork work;
+    work.start([] {});  // the thread made (it inherits SCHED_FIFO and leaves it), not waited for
+    while (work.busy()) std::this_thread::yield();
+    work.start([&] {
+      const auto give_up = std::chrono::steady_clock::now() + std::chrono::seconds(10);
+      sched_param parameters{};
+      do {
+        (void)pthread_getschedparam(pthread_self(), &policy_waited_for, &parameters);
+        std::this_thread::sleep_for(std::chrono::microseconds(100));
+      } while (policy_waited_for != SCHED_FIFO && std::chrono::steady_clock::now() < give_up);
+      priority_waited_for = parameters.sched_priority;
+    });
+    work.wait();
+    work.start([&] { policy_next = sched_getscheduler(0); });
+    while (work.busy()) std::this_thread::yield();
+    work.wait();
+  });
+  if (!fifo) GTEST_SKIP() << "SCHED_FIFO not permitted here (not root, no CAP_SYS_NICE)";
+  EXPECT_EQ(policy_waited_for, SCHED_FIFO);
+  EXPECT_EQ(priority_waited_for, 10);
+  EXPECT_EQ(policy_next, SCHED_OTHER);
 }
 
 TEST(BackgroundWork, DestructionWaitsForARunningJob) {
