@@ -47,7 +47,7 @@ TEST(BackgroundWork, AJobHandedOverFromARealTimeThreadRunsAtTheNormalPolicy) {
   const bool fifo = test::run_on_a_fifo_thread([&] {
     BackgroundWork work;  // its thread is made by this (real-time) thread at the first job
     work.start([&] { policy_in_job = sched_getscheduler(0); });
-    while (work.busy()) std::this_thread::yield();
+    while (work.busy()) std::this_thread::sleep_for(std::chrono::microseconds(100));  // a FIFO spin starves it
     work.wait();
   });
   if (!fifo) GTEST_SKIP() << "SCHED_FIFO not permitted here (not root, no CAP_SYS_NICE)";
@@ -63,7 +63,7 @@ TEST(BackgroundWork, AJobARealTimeOwnerWaitsForRunsAtTheOwnersPriority) {
   const bool fifo = test::run_on_a_fifo_thread([&] {
     BackgroundWork work;
     work.start([] {});  // the thread made (it inherits SCHED_FIFO and leaves it), not waited for
-    while (work.busy()) std::this_thread::yield();
+    while (work.busy()) std::this_thread::sleep_for(std::chrono::microseconds(100));
     work.start([&] {
       const auto give_up = std::chrono::steady_clock::now() + std::chrono::seconds(10);
       sched_param parameters{};
@@ -75,7 +75,7 @@ TEST(BackgroundWork, AJobARealTimeOwnerWaitsForRunsAtTheOwnersPriority) {
     });
     work.wait();
     work.start([&] { policy_next = sched_getscheduler(0); });
-    while (work.busy()) std::this_thread::yield();
+    while (work.busy()) std::this_thread::sleep_for(std::chrono::microseconds(100));
     work.wait();
   });
   if (!fifo) GTEST_SKIP() << "SCHED_FIFO not permitted here (not root, no CAP_SYS_NICE)";
