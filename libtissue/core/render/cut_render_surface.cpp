@@ -24,8 +24,9 @@ CutRenderSurface::CutRenderSurface(const TetMesh& mesh, TriangleSurface surface,
   // Room for the split and cap points (and the triangles they make) of a session's cuts, written
   // now: the first cut's split points re-allocated the per-point arrays of the organ's 41k-point
   // surface inside its slot (docs/BENCHMARKS.md). Past the room they grow as before.
-  const size_t points = m_surface.vertices_m.size() + m_surface.vertices_m.size() / SPLIT_POINT_ROOM_DIVISOR;
-  const size_t triangles = m_surface.triangles.size() + m_surface.triangles.size() / SPLIT_POINT_ROOM_DIVISOR;
+  const size_t vertices = m_surface.vertices_m.size(), surface_triangles = m_surface.triangles.size();
+  const size_t points = vertices + vertices / SPLIT_POINT_ROOM_DIVISOR;
+  const size_t triangles = surface_triangles + surface_triangles / SPLIT_POINT_ROOM_DIVISOR;
   reserve_resident(m_points, points);
   reserve_resident(m_rest_m, points);
   reserve_resident(m_point_cut, points);
@@ -33,15 +34,14 @@ CutRenderSurface::CutRenderSurface(const TetMesh& mesh, TriangleSurface surface,
   reserve_resident(m_positions_m, points);
   reserve_resident(m_normals, points);
   reserve_resident(m_triangles, triangles);
-  const size_t vertices = m_surface.vertices_m.size();
   reserve_resident(m_dirty, vertices);
   reserve_resident(m_part, vertices);
   reserve_resident(m_uncut_part, vertices);
   reserve_resident(m_vertex_part, vertices);
   reserve_resident(m_skin, triangles);
   reserve_resident(m_next_skin, triangles);
-  reserve_resident(m_skin_first, m_surface.triangles.size() + 1);
-  reserve_resident(m_next_skin_first, m_surface.triangles.size() + 1);
+  reserve_resident(m_skin_first, surface_triangles + 1);
+  reserve_resident(m_next_skin_first, surface_triangles + 1);
   reserve_resident(m_bubbles.parent, points);
   reserve_resident(m_bubbles.size, points);
   reserve_resident(m_bubbles.state, points);

@@ -6,8 +6,8 @@
 // owner lends it its policy: background_policy.hpp). The one mechanism for work beside the steps:
 // the Tissue FMU's surface prepared after a cut (docs/DESIGN.md, "The surface is prepared after a
 // cut"), the contact stiffness K_c (BackgroundContactStiffness) and the lagged Cholesky factor's
-// refactorization (CholeskyPcgSolver). The thread is made at the first job and lives until destruction. Not
-// thread-safe: one owner calls start() and wait().
+// refactorization (CholeskyPcgSolver). The thread is made at the first job and lives until
+// destruction. Not thread-safe: one owner calls start() and wait().
 #pragma once
 
 #include <condition_variable>
