@@ -60,38 +60,48 @@ int CutRenderSurface::part_of(const DeformableBody& body, const Point& point) co
 
 // Incremental: only what rides on a tet whose cut changed since the last re-mesh, or on one of its
 // face neighbours (whose cut planes an edge's split may use), is located and split again; every
-// other edge keeps its split points and every other triangle its pieces. From scratch the first
-// time, when the material parts of the unchanged points regrouped (a piece came free: an uncut
-// edge may now be cut anywhere), and when dropped split points pile up.
+// other edge keeps its split points and every other triangle its pieces. Where the material parts
+// regrouped (a piece came free, or two joined), an edge between two unchanged points whose ends went
+// from one part to two (or back) is split again too: such an edge is split by its ends' parts where
+// no piece tells them apart. From scratch the first time and when dropped split points pile up.
 bool CutRenderSurface::mark_dirty_points(const DeformableBody& body, std::vector<char>& dirty,
                                          std::vector<int>& part) const {
   const size_t vertices = m_surface.vertices_m.size();
   const auto tet_count = static_cast<size_t>(m_mesh.tet_count());
-  bool scratch = m_tet_cut.size() != tet_count || m_orphan_points > static_cast<int>(vertices) / 4;
-  std::vector<char> dirty_tet(tet_count, scratch ? 1 : 0);
-  for (size_t t = 0; t < tet_count && !scratch; ++t) {
+  const bool scratch = m_tet_cut.size() != tet_count || m_orphan_points > static_cast<int>(vertices) / 4;
+  if (scratch) return true;
+  std::vector<char> dirty_tet(tet_count, 0);
+  for (size_t t = 0; t < tet_count; ++t) {
     if (body.cut_tet_index(static_cast<int>(t)) == m_tet_cut[t]) continue;
     dirty_tet[t] = 1;
     for (const int n : body.adjacency().face_neighbor[t]) {
       if (n >= 0) dirty_tet[static_cast<size_t>(n)] = 1;
     }
   }
-  if (!scratch) {
-    // The unchanged points' parts must group them as before: old and new part ids in one-to-one
-    // correspondence over them.
-    std::vector<int> old_to_new(m_part_ids, -1), new_to_old(m_copy_root.size(), -1);
-    for (size_t v = 0; v < vertices && !scratch; ++v) {
-      dirty[v] = dirty_tet[static_cast<size_t>(m_embedding[v].tet)];
-      if (dirty[v] != 0) continue;
-      part[v] = part_of(body, m_points[v]);
-      int& to_new = old_to_new[static_cast<size_t>(m_vertex_part[v])];
-      int& to_old = new_to_old[static_cast<size_t>(part[v])];
-      if (to_new < 0) to_new = part[v];
-      if (to_old < 0) to_old = m_vertex_part[v];
-      scratch = to_new != part[v] || to_old != m_vertex_part[v];
+  // Whether the unchanged points' parts group them as before (old and new part ids in one-to-one
+  // correspondence over them); if not, the edges between them that went from one part to two (or
+  // back) are split again.
+  std::vector<int> old_to_new(m_part_ids, -1), new_to_old(m_copy_root.size(), -1);
+  bool regrouped = false;
+  for (size_t v = 0; v < vertices; ++v) {
+    dirty[v] = dirty_tet[static_cast<size_t>(m_embedding[v].tet)];
+    if (dirty[v] != 0) continue;
+    part[v] = part_of(body, m_points[v]);
+    int& to_new = old_to_new[static_cast<size_t>(m_vertex_part[v])];
+    int& to_old = new_to_old[static_cast<size_t>(part[v])];
+    if (to_new < 0) to_new = part[v];
+    if (to_old < 0) to_old = m_vertex_part[v];
+    regrouped = regrouped || to_new != part[v] || to_old != m_vertex_part[v];
+  }
+  for (size_t t = 0; regrouped && t < m_surface.triangles.size(); ++t) {
+    const auto& triangle = m_surface.triangles[t];
+    for (size_t k = 0; k < 3; ++k) {
+      const auto u = static_cast<size_t>(triangle[k]), w = static_cast<size_t>(triangle[(k + 1) % 3]);
+      if (dirty[u] != 0 || dirty[w] != 0) continue;  // split again anyway
+      if ((m_vertex_part[u] == m_vertex_part[w]) != (part[u] == part[w])) dirty[u] = dirty[w] = 1;
     }
   }
-  return scratch;
+  return false;
 }
 
 // Locates the dirty surface vertices again (their cells) and gives them their material parts.

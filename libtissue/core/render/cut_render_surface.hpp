@@ -27,9 +27,10 @@
 //   a cut tet between theirs) is split where it crosses a cut plane of the cut tets around its ends.
 // * Re-meshing is incremental: only the points on tets whose cut changed (and on their face
 //   neighbours) are located and their edges and triangles split again; the other edges keep their
-//   split points, the other triangles their pieces; the caps are made again. From scratch the first
-//   time, when the unchanged points' material parts regroup (a piece came free), and when the split
-//   points dropped by re-splits exceed a quarter of the surface's vertices.
+//   split points, the other triangles their pieces; the caps are made again. Where the material parts
+//   regroup (a piece came free), the edges whose ends went from one part to two (or back) are split
+//   again too. From scratch the first time and when the split points dropped by re-splits exceed a
+//   quarter of the surface's vertices.
 // * Holes the walk leaves (a switch with no partner): the surface's border loops then; one in one
 //   material part that is flat (within 0.1 mm of a plane), or two flat faces either side of a
 //   chord (a junction), is what the walk missed, ear-clipped.
@@ -63,7 +64,7 @@ class CutRenderSurface {
                    const std::string& source_name = "render surface");
 
   /// Re-meshes the surface for the body's cuts: again only where the cut tets changed since the
-  /// last call (from the surface as given the first time, and when a piece came free).
+  /// last call (from the surface as given the first time).
   void rebuild(const DeformableBody& body);
   /// Positions for the body's state (after rebuild for the body's current cuts); the normals are
   /// found when next read.
