@@ -425,11 +425,11 @@ double enclosed_at_rest_m3(const CutRenderSurface& render) {
 
 // Re-meshing after every blade step that cut redoes only the tets whose cut changed (and their
 // neighbours) and keeps the rest, also at the steps where a piece comes free (the material parts
-// regroup); at every 7th step, at the steps where the parts regroup and at the end it is the surface
-// re-meshed from scratch for the same cuts: the same skin triangles (corner for corner at rest, and mapped onto a
-// state that moves every unknown to the same positions bitwise: the same pieces), as many open loops,
-// and the same enclosed volume (the caps lie in their cut planes, so how they are triangulated does
-// not change it: to round-off). The caps' triangles: as many for the X and the flap; within 1% for
+// regroup); at every 7th step, at the steps where the parts regroup and at the end it is the
+// surface re-meshed from scratch for the same cuts: the same skin triangles (corner for corner at
+// rest, and mapped onto a state that moves every unknown to the same positions bitwise: the same
+// pieces), as many open loops, and the same enclosed volume (the caps lie in their cut planes, so
+// how they are triangulated does not change it: to round-off). The caps' triangles: as many for the X and the flap; within 1% for
 // 3 + 3 hatched strokes (re-cut tets, many crack tips: where several tips of one cut lie on a loop,
 // which pairs with which follows the loop's order, and so the points' numbering).
 TEST(CutRenderSurface, ReMeshingStepByStepIsReMeshingFromScratch) {
@@ -460,7 +460,7 @@ TEST(CutRenderSurface, ReMeshingStepByStepIsReMeshingFromScratch) {
       const bool regrouped = now_parts != parts;
       regroups += regrouped ? 1 : 0;
       parts = now_parts;
-      if (steps % 7 != 0 && !regrouped) return;  // compared every 7th step, where the parts regroup, and at the end
+      if (steps % 7 != 0 && !regrouped) return;  // compared then (and at the end)
       CutRenderSurface scratch = pristine;
       scratch.rebuild(body);
       ASSERT_TRUE(scratch.rebuilt_from_scratch());
