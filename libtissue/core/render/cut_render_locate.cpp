@@ -68,8 +68,7 @@ bool CutRenderSurface::mark_dirty_points(const DeformableBody& body, std::vector
                                          std::vector<int>& part) const {
   const size_t vertices = m_surface.vertices_m.size();
   const auto tet_count = static_cast<size_t>(m_mesh.tet_count());
-  const bool scratch = m_tet_cut.size() != tet_count || m_orphan_points > static_cast<int>(vertices) / 4;
-  if (scratch) return true;
+  if (m_tet_cut.size() != tet_count || m_orphan_points > static_cast<int>(vertices) / 4) return true;
   std::vector<char> dirty_tet(tet_count, 0);
   for (size_t t = 0; t < tet_count; ++t) {
     if (body.cut_tet_index(static_cast<int>(t)) == m_tet_cut[t]) continue;

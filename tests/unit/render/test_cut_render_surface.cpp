@@ -429,9 +429,10 @@ double enclosed_at_rest_m3(const CutRenderSurface& render) {
 // surface re-meshed from scratch for the same cuts: the same skin triangles (corner for corner at
 // rest, and mapped onto a state that moves every unknown to the same positions bitwise: the same
 // pieces), as many open loops, and the same enclosed volume (the caps lie in their cut planes, so
-// how they are triangulated does not change it: to round-off). The caps' triangles: as many for the X and the flap; within 1% for
-// 3 + 3 hatched strokes (re-cut tets, many crack tips: where several tips of one cut lie on a loop,
-// which pairs with which follows the loop's order, and so the points' numbering).
+// how they are triangulated does not change it: to round-off). The caps' triangles: as many for the
+// X and the flap; within 1% for 3 + 3 hatched strokes (re-cut tets, many crack tips: where several
+// tips of one cut lie on a loop, which pairs with which follows the loop's order, and so the points'
+// numbering).
 TEST(CutRenderSurface, ReMeshingStepByStepIsReMeshingFromScratch) {
   const std::array<Eigen::Vector2d, 3> corner{Eigen::Vector2d(-0.0213, -0.0117), Eigen::Vector2d(0.0161, -0.0129),
                                               Eigen::Vector2d(-0.0019, 0.0147)};
