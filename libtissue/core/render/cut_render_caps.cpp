@@ -495,31 +495,6 @@ void bridge_tips(const std::vector<Eigen::Vector3d>& rest_m, const LinePoints& l
 
 }  // namespace
 
-int CutRenderSurface::add_point_like(int model, const Eigen::Vector3d& rest_m) {
-  const Point& like = m_points[static_cast<size_t>(model)];
-  m_points.push_back(
-      Point{like.tet, barycentric_weights(m_mesh.rest_corners(like.tet), rest_m), like.cut_tet, like.piece});
-  m_rest_m.push_back(rest_m);
-  m_point_cut.push_back(-1);
-  return static_cast<int>(m_points.size()) - 1;
-}
-
-std::vector<int> CutRenderSurface::line_points(int from, int to) {
-  // Interior points about JOIN_SPACING_M apart on the straight rest segment; each half rides on the
-  // cell of its nearer end (exact under that piece's rigid motion).
-  constexpr double JOIN_SPACING_M = 0.0015;
-  const Eigen::Vector3d a = m_rest_m[static_cast<size_t>(from)];
-  const Eigen::Vector3d b = m_rest_m[static_cast<size_t>(to)];
-  // At least one point: the line must not coincide with an edge the skin may already have.
-  const int segments = std::max(2, static_cast<int>(std::ceil((b - a).norm() / JOIN_SPACING_M)));
-  std::vector<int> points;
-  for (int k = 1; k < segments; ++k) {
-    const double s = static_cast<double>(k) / segments;
-    points.push_back(add_point_like(s < 0.5 ? from : to, a + s * (b - a)));
-  }
-  return points;
-}
-
 void CutRenderSurface::cap_loops(const DeformableBody& body) {
   CapEdges edges{{}, {}, m_surface_edges, static_cast<int>(m_surface.vertices_m.size())};
   find_split_edges(m_triangles, 0, m_points.size(), edges);
@@ -589,9 +564,17 @@ void CutRenderSurface::cap_loops(const DeformableBody& body) {
   // Every walk closed: every loop is capped. Else the holes (the caps' edges added), flat ones filled.
   if (unclosed > 0) {
     find_split_edges(m_triangles, first_cap, m_points.size(), edges);
-    const FlatHoles holes = flat_holes(edges.directed, m_rest_m, part_of_point);
-    for (const std::vector<int>& hole : holes.flat) cap_polygon(hole, m_rest_m, m_triangles, edges);
-    m_open_loops = holes.others;
+    const FlatHoles holes = flat_holes(
+        edges.directed, m_rest_m, part_of_point, [&](int point) { return m_point_cut[static_cast<size_t>(point)]; },
+        line);
+    std::vector<size_t> face_first{m_triangles.size()};  // each face's first triangle, then the end
+    for (const std::vector<int>& hole : holes.flat) {
+      cap_polygon(hole, m_rest_m, m_triangles, edges);
+      face_first.push_back(m_triangles.size());
+    }
+    std::vector<FilledHole> filled;
+    for (const auto& p : holes.peeled) filled.push_back({p.part, face_first[p.first_face], face_first[p.end_face]});
+    m_open_loops = holes.others + drop_unsound_fills(body, filled, holes.open_parts);
   }
   m_cap_triangles = static_cast<int>(cut_render_detail::drop_bubbles(m_triangles, first_cap, m_rest_m, m_bubbles));
   m_simple_caps = std::move(simple_caps);

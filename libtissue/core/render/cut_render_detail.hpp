@@ -58,9 +58,27 @@ inline constexpr size_t MAX_SPLIT_HOLE_POINTS = 96;
 struct FlatHoles {
   std::vector<std::vector<int>> flat;  // faces to fill, in cap order (border_loops)
   int others = 0;                      // the holes left open
+  std::vector<int> open_parts;         // their material parts (-1: a hole in two)
+  // The holes peel_by_cuts filled: their part and their faces flat[first_face, end_face).
+  struct Peeled {
+    int part;
+    size_t first_face, end_face;
+  };
+  std::vector<Peeled> peeled;
 };
 FlatHoles flat_holes(const std::unordered_map<long long, int>& directed, const std::vector<Eigen::Vector3d>& x,
-                     const std::function<int(int)>& part_of);
+                     const std::function<int(int)>& part_of, const std::function<int(int)>& cut_of = {},
+                     const std::function<std::vector<int>(int, int)>& line_points = {});
+
+// A hole of one material part that no chord splits into two flat faces: the faces of the cuts its
+// points lie on (cut_of; -1 for none) that the walk did not close. Peeled one cut's run at a time,
+// the run whose ends lie nearest first, each closed by the straight line between its ends
+// (line_points(from, to): the new points between two), which the rest of the hole then runs the
+// other way; the last run is the last face. Runs on no cut, or of a point or two, between two runs of
+// one cut belong to that cut's run. Appends the faces to `faces`; false for fewer than 3 points.
+bool peel_by_cuts(const std::vector<int>& loop, const std::vector<Eigen::Vector3d>& x,
+                  const std::function<int(int)>& cut_of, const std::function<std::vector<int>(int, int)>& line_points,
+                  std::vector<std::vector<int>>& faces);
 
 // A closed shell of the finished surface that encloses less than BUBBLE_M3 (a cube of FLAT_HOLE_M) is
 // below what the render surface resolves: a render point on a sliver piece near where two cuts meet

@@ -1,5 +1,6 @@
 // CutRenderSurface: which cell (tet, and piece of a cut tet) each surface point rides on, the
-// material parts the cells make, and which points a re-mesh must locate again.
+// material parts the cells make, which points a re-mesh must locate again, and the points the caps
+// add (on lines between two points, riding on the cell of the nearer).
 #include "core/render/cut_render_surface.hpp"
 
 #include "core/fem/piece_outside.hpp"
@@ -8,6 +9,7 @@
 #include <Eigen/Dense>
 
 #include <algorithm>
+#include <cmath>
 #include <limits>
 #include <numeric>
 
@@ -118,6 +120,31 @@ void CutRenderSurface::relocate_points(const DeformableBody& body, const std::ve
       part[v] = part_of(body, m_points[v]);
     }
   }
+}
+
+int CutRenderSurface::add_point_like(int model, const Eigen::Vector3d& rest_m) {
+  const Point& like = m_points[static_cast<size_t>(model)];
+  m_points.push_back(
+      Point{like.tet, barycentric_weights(m_mesh.rest_corners(like.tet), rest_m), like.cut_tet, like.piece});
+  m_rest_m.push_back(rest_m);
+  m_point_cut.push_back(-1);
+  return static_cast<int>(m_points.size()) - 1;
+}
+
+std::vector<int> CutRenderSurface::line_points(int from, int to) {
+  // Interior points about JOIN_SPACING_M apart on the straight rest segment; each half rides on the
+  // cell of its nearer end (exact under that piece's rigid motion).
+  constexpr double JOIN_SPACING_M = 0.0015;
+  const Eigen::Vector3d a = m_rest_m[static_cast<size_t>(from)];
+  const Eigen::Vector3d b = m_rest_m[static_cast<size_t>(to)];
+  // At least one point: the line must not coincide with an edge the skin may already have.
+  const int segments = std::max(2, static_cast<int>(std::ceil((b - a).norm() / JOIN_SPACING_M)));
+  std::vector<int> points;
+  for (int k = 1; k < segments; ++k) {
+    const double s = static_cast<double>(k) / segments;
+    points.push_back(add_point_like(s < 0.5 ? from : to, a + s * (b - a)));
+  }
+  return points;
 }
 
 }  // namespace tissue

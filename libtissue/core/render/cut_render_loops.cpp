@@ -12,6 +12,7 @@
 #include <cmath>
 #include <cstddef>
 #include <functional>
+#include <limits>
 #include <map>
 #include <numeric>
 #include <unordered_map>
@@ -244,19 +245,126 @@ bool split_in_two_flat(const std::vector<int>& loop, const std::vector<Eigen::Ve
   return false;
 }
 
+namespace {
+
+// A maximal run of a hole's points on one cut (-1: on none, the line points of caps made before).
+struct CutRun {
+  int cut;
+  std::vector<int> points;  // in the hole's order
+};
+
+// Joins run `i` and the one after it (cyclic) into one on `cut`.
+void join_with_next(std::vector<CutRun>& runs, size_t i, int cut) {
+  const size_t next = (i + 1) % runs.size();
+  runs[i].cut = cut;
+  if (next == 0) {  // the last run before the first: the first's points come after
+    runs[0].points.insert(runs[0].points.begin(), runs[i].points.begin(), runs[i].points.end());
+    runs[0].cut = cut;
+    runs.pop_back();
+    return;
+  }
+  runs[i].points.insert(runs[i].points.end(), runs[next].points.begin(), runs[next].points.end());
+  runs.erase(runs.begin() + static_cast<std::ptrdiff_t>(next));
+}
+
+// The runs made whole: neighbours on one cut joined; a run on no cut, or of at most SHORT_RUN points,
+// between two runs of one cut joins them (a junction line already capped on its other side, a switch
+// a few points long); a run on no cut between two cuts joins the run before it.
+void normalize_runs(std::vector<CutRun>& runs) {
+  constexpr size_t SHORT_RUN = 2;
+  for (bool changed = true; changed && runs.size() > 1;) {
+    changed = false;
+    for (size_t i = 0; i < runs.size() && runs.size() > 1 && !changed; ++i) {
+      const size_t next = (i + 1) % runs.size();
+      if (runs[i].cut == runs[next].cut) {
+        join_with_next(runs, i, runs[i].cut);
+        changed = true;
+      }
+    }
+    for (size_t i = 0; i < runs.size() && runs.size() > 2 && !changed; ++i) {
+      const size_t before = (i + runs.size() - 1) % runs.size(), after = (i + 1) % runs.size();
+      const CutRun& run = runs[i];
+      if ((run.cut < 0 || run.points.size() <= SHORT_RUN) && runs[before].cut >= 0 &&
+          runs[before].cut == runs[after].cut) {
+        join_with_next(runs, before, runs[before].cut);  // the run after joins it next (same cut)
+        changed = true;
+      }
+    }
+    for (size_t i = 0; i < runs.size() && runs.size() > 1 && !changed; ++i) {
+      if (runs[i].cut >= 0) continue;
+      const size_t before = (i + runs.size() - 1) % runs.size();
+      join_with_next(runs, before, runs[before].cut);
+      changed = true;
+    }
+  }
+}
+
+}  // namespace
+
+bool peel_by_cuts(const std::vector<int>& loop, const std::vector<Eigen::Vector3d>& x,
+                  const std::function<int(int)>& cut_of, const std::function<std::vector<int>(int, int)>& line_points,
+                  std::vector<std::vector<int>>& faces) {
+  const size_t n = loop.size();
+  if (n < 3) return false;
+  size_t start = 0;  // a change of cut, if there is one
+  while (start < n && cut_of(loop[start]) == cut_of(loop[(start + n - 1) % n])) ++start;
+  std::vector<CutRun> runs;
+  for (size_t k = 0; k < n; ++k) {
+    const int point = loop[(start + k) % n];
+    if (runs.empty() || runs.back().cut != cut_of(point)) runs.push_back(CutRun{cut_of(point), {}});
+    runs.back().points.push_back(point);
+  }
+  normalize_runs(runs);
+  while (runs.size() > 1) {
+    // The run whose ends lie nearest each other: its face closed by the line between them.
+    size_t best = runs.size();
+    double nearest = std::numeric_limits<double>::infinity();
+    for (size_t i = 0; i < runs.size(); ++i) {
+      const std::vector<int>& points = runs[i].points;
+      if (points.size() < 2) continue;
+      const double gap = (x[static_cast<size_t>(points.front())] - x[static_cast<size_t>(points.back())]).norm();
+      if (gap < nearest) {
+        nearest = gap;
+        best = i;
+      }
+    }
+    if (best == runs.size()) return false;
+    const int first = runs[best].points.front(), last = runs[best].points.back();
+    std::vector<int> line = line_points(last, first);
+    std::vector<int> face = std::move(runs[best].points);
+    face.insert(face.end(), line.begin(), line.end());
+    faces.push_back(std::move(face));
+    // What is left runs the line the other way, its ends kept.
+    std::vector<int> rest{first};
+    rest.insert(rest.end(), line.rbegin(), line.rend());
+    rest.push_back(last);
+    runs[best] = CutRun{-1, std::move(rest)};
+    normalize_runs(runs);
+  }
+  faces.push_back(std::move(runs.front().points));
+  return true;
+}
+
 FlatHoles flat_holes(const std::unordered_map<long long, int>& directed, const std::vector<Eigen::Vector3d>& x,
-                     const std::function<int(int)>& part_of) {
+                     const std::function<int(int)>& part_of, const std::function<int(int)>& cut_of,
+                     const std::function<std::vector<int>(int, int)>& line_points) {
   FlatHoles holes;
   for (std::vector<int>& loop : border_loops(directed)) {
     const bool closed = loop.size() >= 3 && directed.contains(directed_key(loop.front(), loop.back()));
     const int part = closed ? part_of(loop.front()) : -1;
     const bool one_part = closed && std::all_of(loop.begin(), loop.end(), [&](int q) { return part_of(q) == part; });
+    const auto edge_exists = [&directed](int u, int v) {
+      return directed.contains(directed_key(u, v)) || directed.contains(directed_key(v, u));
+    };
+    const size_t first_face = holes.flat.size();
     if (one_part && flat_within(loop, x, FLAT_HOLE_M)) {
       holes.flat.push_back(std::move(loop));
-    } else if (!one_part || !split_in_two_flat(loop, x, holes.flat, [&directed](int u, int v) {
-                 return directed.contains(directed_key(u, v)) || directed.contains(directed_key(v, u));
-               })) {
+    } else if (one_part && split_in_two_flat(loop, x, holes.flat, edge_exists)) {
+    } else if (one_part && line_points && peel_by_cuts(loop, x, cut_of, line_points, holes.flat)) {
+      holes.peeled.push_back({part, first_face, holes.flat.size()});
+    } else {
       ++holes.others;
+      holes.open_parts.push_back(one_part ? part : -1);
     }
   }
   return holes;

@@ -134,6 +134,18 @@ class CutRenderSurface {
   void split_skin(const DeformableBody& body, const std::vector<char>& dirty, const std::vector<int>& part);
   const std::array<int, 2>* split_edge(const DeformableBody& body, const std::vector<int>& uncut_part, int u, int v);
   void cap_loops(const DeformableBody& body);
+  /// A hole filled by peel_by_cuts: its material part and its triangles in m_triangles.
+  struct FilledHole {
+    int part = -1;
+    size_t first_triangle = 0, end_triangle = 0;
+  };
+  /// A part whose filled holes leave its volume off its simulated one (times the uncut surface's
+  /// ratio to the tets') by more than this, or that keeps an open hole, keeps none of them.
+  static constexpr double FILLED_PART_VOLUME_TOLERANCE = 0.15;
+  /// Drops the triangles of the filled holes of such parts (cut_render_fill.cpp; `open_parts`: the
+  /// parts of the holes left open, -1 for a hole in two). Returns how many holes it opened again.
+  int drop_unsound_fills(const DeformableBody& body, const std::vector<FilledHole>& filled,
+                         const std::vector<int>& open_parts);
   void find_material_parts(const DeformableBody& body);
   /// The nodes of the points (after the points are final): all of them after a re-mesh from scratch,
   /// else those of `dirty_vertices` and from `first_new` on.
