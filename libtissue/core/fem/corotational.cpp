@@ -5,13 +5,13 @@
 #include "core/fem/corotational.hpp"
 
 #include "core/fem/corotational_kernel.hpp"
+#include "core/fem/element_blocks.hpp"
 #include "core/mesh/topology.hpp"
 #include "core/system/hot_kernel.hpp"
 
 #include <algorithm>
 #include <array>
 #include <cassert>
-#include <cstring>
 #include <limits>
 #include <numeric>
 #include <stdexcept>
@@ -288,99 +288,6 @@ TISSUE_HOT_KERNEL void CorotationalElasticity::add_tets(const std::vector<int>& 
   if (energy_j != nullptr) *energy_j += energy;
 }
 
-namespace {
-
-// Adds a tet's tangent blocks through its slots: block(i, j) for i <= j (and its transpose at
-// (j, i)), skipping blocks that touch a fixed vertex (slot -1), so a block is computed only where
-// it is stored.
-template <class Block>
-void add_tet_blocks(const TetSlots& tet_slots, BlockSparseMatrix& tangent, Block block) {
-  for (int i = 0; i < 4; ++i) {
-    for (int j = i; j < 4; ++j) {
-      const int slot_ij = tet_slots[static_cast<size_t>(4 * i + j)];
-      if (slot_ij < 0) continue;
-      const Eigen::Matrix3d b = block(i, j);
-      tangent.add_block(slot_ij, b);
-      if (i != j) tangent.add_block_transposed(tet_slots[static_cast<size_t>(4 * j + i)], b);
-    }
-  }
-}
-
-}  // namespace
-
-// The lanes helpers are always inlined into the kernel's clones: -Wpsabi's note (a 32-byte vector
-// passed or returned without AVX) concerns calls that never happen. GCC issues it while it
-// generates the clones, at the end of the file, so it stays off to the end (clang warns alike).
-#pragma GCC diagnostic ignored "-Wpsabi"  // (clang too)
-
-namespace {
-
-// Four doubles in one AVX2 register (two SSE registers in the baseline clone); lane 3 of a column
-// is zero.
-using Lanes = double __attribute__((vector_size(32)));
-
-// A block's nine values (column-major) += low (values 0-3), high (4-7) and last (8): the same
-// loads and stores for every add of this kernel to a block, so that the next tet's loads take the
-// last one's stores whole (docs/DESIGN.md, "Blocks are added entry by entry").
-[[gnu::always_inline]] inline void add_block_lanes(double* to, Lanes low, Lanes high, double last) {
-  Lanes value_low, value_high;
-  std::memcpy(&value_low, to, sizeof(Lanes));
-  std::memcpy(&value_high, to + 4, sizeof(Lanes));
-  value_low += low;
-  value_high += high;
-  std::memcpy(to, &value_low, sizeof(Lanes));
-  std::memcpy(to + 4, &value_high, sizeof(Lanes));
-  to[8] += last;
-}
-
-// rotated_stiffness_block's blocks of one tet, R K_ij R^T = V [lambda c_i c_j^T + mu c_j c_i^T +
-// mu (g_i . g_j) I], added through its slots as add_tet_blocks does, each column in lanes:
-// column k of block (i, j) is (lambda V c_i) c_j[k] + (mu V c_j) c_i[k] + mu V (g_i . g_j) e_k, and
-// block (j, i) its exact transpose (the lanes shuffled).
-[[gnu::always_inline]] inline void add_rotated_stiffness_blocks(const TetSlots& tet_slots, BlockSparseMatrix& tangent,
-                                                                const TetRest& rest, const LameParameters& lame,
-                                                                const Eigen::Matrix3d& rotation) {
-  const double lambda_v = lame.lambda_pa * rest.volume_m3;
-  const double mu_v = lame.mu_pa * rest.volume_m3;
-  const Eigen::Matrix<double, 3, 4>& g = rest.shape_gradients_per_m;
-  // c = R g, each column made in lanes from R's columns (read from memory as scalars: lanes put
-  // together on the stack would be loaded whole from pieces stored apart, the stall above).
-  const Lanes r0{rotation(0, 0), rotation(1, 0), rotation(2, 0), 0.0};
-  const Lanes r1{rotation(0, 1), rotation(1, 1), rotation(2, 1), 0.0};
-  const Lanes r2{rotation(0, 2), rotation(1, 2), rotation(2, 2), 0.0};
-  std::array<Lanes, 4> column{}, lambda_column{}, mu_column{};
-  for (int i = 0; i < 4; ++i) {
-    column[static_cast<size_t>(i)] = r0 * g(0, i) + r1 * g(1, i) + r2 * g(2, i);
-    lambda_column[static_cast<size_t>(i)] = lambda_v * column[static_cast<size_t>(i)];
-    mu_column[static_cast<size_t>(i)] = mu_v * column[static_cast<size_t>(i)];
-  }
-  for (int i = 0; i < 4; ++i) {
-    const Lanes& c_i = column[static_cast<size_t>(i)];
-    const Lanes& lambda_c_i = lambda_column[static_cast<size_t>(i)];
-    for (int j = i; j < 4; ++j) {
-      const int slot_ij = tet_slots[static_cast<size_t>(4 * i + j)];
-      if (slot_ij < 0) continue;
-      const Lanes& c_j = column[static_cast<size_t>(j)];
-      const Lanes& mu_c_j = mu_column[static_cast<size_t>(j)];
-      const double diagonal = mu_v * g.col(i).dot(g.col(j));
-      const Lanes column0 = lambda_c_i * c_j[0] + mu_c_j * c_i[0] + Lanes{diagonal, 0.0, 0.0, 0.0};
-      const Lanes column1 = lambda_c_i * c_j[1] + mu_c_j * c_i[1] + Lanes{0.0, diagonal, 0.0, 0.0};
-      const Lanes column2 = lambda_c_i * c_j[2] + mu_c_j * c_i[2] + Lanes{0.0, 0.0, diagonal, 0.0};
-      add_block_lanes(tangent.block(slot_ij).data(), __builtin_shufflevector(column0, column1, 0, 1, 2, 4),
-                      __builtin_shufflevector(column1, column2, 1, 2, 4, 5), column2[2]);
-      if (i == j) continue;
-      // The transpose's values in storage order: (c0[0] c1[0] c2[0] c0[1]) (c1[1] c2[1] c0[2] c1[2]) c2[2].
-      const Lanes first_rows = __builtin_shufflevector(column0, column1, 0, 4, 1, 5);  // c0[0] c1[0] c0[1] c1[1]
-      const Lanes last_rows = __builtin_shufflevector(column1, column2, 1, 5, 2, 6);   // c1[1] c2[1] c1[2] c2[2]
-      add_block_lanes(tangent.block(tet_slots[static_cast<size_t>(4 * j + i)]).data(),
-                      __builtin_shufflevector(first_rows, column2, 0, 1, 4, 2),
-                      __builtin_shufflevector(last_rows, column0, 0, 1, 6, 2), column2[2]);
-    }
-  }
-}
-
-}  // namespace
-
 TISSUE_HOT_KERNEL void CorotationalElasticity::add_tet(size_t k, const Eigen::Matrix3d& f, const Eigen::Matrix3d& r,
                                                        Eigen::VectorXd& internal_forces_n, BlockSparseMatrix* tangent,
                                                        const std::vector<TetSlots>* slots) const {
@@ -395,13 +302,13 @@ TISSUE_HOT_KERNEL void CorotationalElasticity::add_tet(size_t k, const Eigen::Ma
   const TetSlots& tet_slots = (*slots)[static_cast<size_t>(m_tet_id[k])];
   if (m_elements.model == MaterialModel::corotational_linear) {
     // Each stored block straight from the rotated shape gradients (the hot path: no 12 x 12).
-    const LameParameters& lame = lame_of(rest);
-    add_rotated_stiffness_blocks(tet_slots, *tangent, rest, lame, r);
+    element_blocks::add_rotated_stiffness_blocks(tet_slots, *tangent, rest.shape_gradients_per_m, lame_of(rest),
+                                                 rest.volume_m3, r);
     return;
   }
   std::array<Eigen::Matrix3d, 16> blocks;
   m_elements.blocks(rest, r, f, blocks);
-  add_tet_blocks(tet_slots, *tangent, [&](int i, int j) { return blocks[static_cast<size_t>(4 * i + j)]; });
+  element_blocks::add_blocks(tet_slots, *tangent, [&](int i, int j) { return blocks[static_cast<size_t>(4 * i + j)]; });
 }
 
 TISSUE_HOT_KERNEL double CorotationalElasticity::energy_of(const std::vector<int>& tets,

@@ -4,7 +4,10 @@
 #include "core/fem/xfem_elasticity.hpp"
 
 #include "core/fem/corotational_kernel.hpp"
+#include "core/fem/element_blocks.hpp"
+#include "core/fem/rotation.hpp"
 #include "core/index_cast.hpp"
+#include "core/system/hot_kernel.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -46,6 +49,7 @@ void XfemElasticity::reserve(int cut_tets) {
   m_ghost_dofs.reserve(2 * n);
   m_rotations.reserve(2 * n);
   m_warm_starts.reserve(2 * n);
+  m_gradients.reserve(2 * n);
   m_ghost_begin.reserve(n + 1);
   m_ghost_rows.reserve(4 * n);
   m_slot_begin.reserve(n + 1);
@@ -109,17 +113,22 @@ bool XfemElasticity::all_parked(int k) const {
                      m_parked.begin() + static_cast<long>(begin + piece_count(k)), [](std::uint8_t p) { return p != 0; });
 }
 
+std::array<int, 4> XfemElasticity::piece_dofs(std::size_t p) const {
+  std::array<int, 4> dof{};
+  for (int i = 0; i < 4; ++i) {
+    const int ghost = m_ghost_dofs[p][to_size(i)];
+    dof[to_size(i)] = ghost < 0 ? i : ghost;
+  }
+  return dof;
+}
+
 void XfemElasticity::mark_written_slots(int k, std::vector<std::uint8_t>& keep) const {
   const int dofs = dof_count(k);
   const int* const slots = m_slots.data() + m_slot_begin[static_cast<std::size_t>(k)];
   const std::size_t begin = piece_begin(k);
   for (std::size_t p = begin; p < begin + piece_count(k); ++p) {
     if (m_parked[p] != 0) continue;
-    std::array<int, 4> dof{};
-    for (int i = 0; i < 4; ++i) {
-      const int ghost = m_ghost_dofs[p][to_size(i)];
-      dof[to_size(i)] = ghost < 0 ? i : ghost;
-    }
+    const std::array<int, 4> dof = piece_dofs(p);
     for (const int a : dof) {
       for (const int b : dof) {
         const int slot = slots[dofs * a + b];
@@ -174,9 +183,45 @@ TetPositions piece_positions(const CutPiece& piece, const TetPositions& real_pos
   return p;
 }
 
-void XfemElasticity::evaluate(const Eigen::VectorXd& positions_m, const Eigen::VectorXd& displacement_m,
-                              Eigen::VectorXd& vertex_forces_n, Eigen::VectorXd& internal_force_n,
-                              BlockSparseMatrix* tangent, double* elastic_energy_j, ExtractInto into) {
+// Every counted piece's F and, in SIMD lanes four pieces at a time, its rotation (extract_rotations,
+// as the uncut tets'): F into m_gradients.
+void XfemElasticity::extract_piece_rotations(const Eigen::VectorXd& positions_m, const Eigen::VectorXd& displacement_m,
+                                             std::vector<Eigen::Matrix3d>& rotations,
+                                             std::vector<Eigen::Quaterniond>& warm_starts) {
+  m_gradients.resize(m_pieces.size());
+  std::array<Eigen::Matrix3d, ROTATION_BATCH> lane_gradients;
+  std::array<Eigen::Quaterniond*, ROTATION_BATCH> lane_warm_starts{};
+  std::array<Eigen::Matrix3d*, ROTATION_BATCH> lane_rotations{};
+  int lanes = 0;
+  TetPositions real_m;
+  for (size_t k = 0; k < m_cut_tets.size(); ++k) {
+    if (m_retired[k] != 0 || all_parked(static_cast<int>(k))) continue;
+    gather(k, positions_m, real_m);
+    const std::size_t first = piece_begin(static_cast<int>(k));
+    for (size_t p = first; p < first + piece_count(static_cast<int>(k)); ++p) {
+      if (m_parked[p] != 0) continue;
+      m_gradients[p] =
+          deformation_gradient(m_rest[k], piece_positions(m_pieces[p], real_m, m_cut_tets[k].rest_m, displacement_m));
+      const auto lane = static_cast<size_t>(lanes++);
+      lane_gradients[lane] = m_gradients[p];
+      lane_warm_starts[lane] = &warm_starts[p];
+      lane_rotations[lane] = &rotations[p];
+      if (lanes < ROTATION_BATCH) continue;
+      extract_rotations(lanes, lane_gradients.data(), lane_warm_starts.data(), lane_rotations.data(),
+                        m_rotation_settings);
+      lanes = 0;
+    }
+  }
+  if (lanes > 0) {
+    extract_rotations(lanes, lane_gradients.data(), lane_warm_starts.data(), lane_rotations.data(),
+                      m_rotation_settings);
+  }
+}
+
+TISSUE_HOT_KERNEL void XfemElasticity::evaluate(const Eigen::VectorXd& positions_m,
+                                                const Eigen::VectorXd& displacement_m, Eigen::VectorXd& vertex_forces_n,
+                                                Eigen::VectorXd& internal_force_n, BlockSparseMatrix* tangent,
+                                                double* elastic_energy_j, ExtractInto into) {
   // Ahead: every piece's as it is first (retired and parked ones keep theirs), then extracted there.
   if (into == ExtractInto::ahead) {
     m_rotations_ahead = m_rotations;
@@ -184,7 +229,7 @@ void XfemElasticity::evaluate(const Eigen::VectorXd& positions_m, const Eigen::V
   }
   std::vector<Eigen::Matrix3d>& rotations = into == ExtractInto::ahead ? m_rotations_ahead : m_rotations;
   std::vector<Eigen::Quaterniond>& warm_starts = into == ExtractInto::ahead ? m_warm_starts_ahead : m_warm_starts;
-  TetPositions real_m;
+  extract_piece_rotations(positions_m, displacement_m, rotations, warm_starts);
   double energy = 0.0;
   for (size_t k = 0; k < m_cut_tets.size(); ++k) {
     if (m_retired[k] != 0 || all_parked(static_cast<int>(k))) continue;
@@ -192,16 +237,16 @@ void XfemElasticity::evaluate(const Eigen::VectorXd& positions_m, const Eigen::V
     const TetRest& rest = m_rest[k];
     const std::size_t first = piece_begin(static_cast<int>(k));
     const std::size_t count = piece_count(static_cast<int>(k));
-    gather(k, positions_m, real_m);
-
-    // Per piece: F_p, R_p (warm-started per piece), its nodal forces Fp_i, and what it adds.
+    const int dofs = dof_count(static_cast<int>(k));
+    const int* const slots = m_slots.data() + m_slot_begin[k];
+    // Per piece: its nodal forces Fp_i and, through the slots of its local DOFs, its blocks (each
+    // piece's block of two real vertices added on its own, as a tet's).
     Eigen::Matrix<double, 3, 4> vertex_sum = Eigen::Matrix<double, 3, 4>::Zero();
     for (size_t p = first; p < first + count; ++p) {
       if (m_parked[p] != 0) continue;
       const CutPiece& piece = m_pieces[p];
-      const Eigen::Matrix3d f =
-          deformation_gradient(rest, piece_positions(piece, real_m, cut_tet.rest_m, displacement_m));
-      const Eigen::Matrix3d& r = rotations[p] = extract_rotation(f, warm_starts[p], m_rotation_settings);
+      const Eigen::Matrix3d& f = m_gradients[p];
+      const Eigen::Matrix3d& r = rotations[p];
       const Eigen::Matrix<double, 3, 4> forces = m_elements.forces(rest, r, f);
       if (elastic_energy_j != nullptr) energy += piece.weight * m_elements.energy_j(rest, r, f);
       for (size_t i = 0; i < 4; ++i) {
@@ -211,58 +256,23 @@ void XfemElasticity::evaluate(const Eigen::VectorXd& positions_m, const Eigen::V
           internal_force_n.segment<3>(3 * piece.ghost_row[i]) += piece.weight * forces.col(to_int(i));
         }
       }
+      if (tangent == nullptr) continue;
+      const std::array<int, 4> dof = piece_dofs(p);
+      TetSlots piece_slots{};
+      for (size_t i = 0; i < 4; ++i) {
+        for (size_t j = 0; j < 4; ++j) piece_slots[4 * i + j] = slots[dofs * dof[i] + dof[j]];
+      }
+      if (m_elements.model == MaterialModel::corotational_linear) {
+        element_blocks::add_rotated_stiffness_blocks(piece_slots, *tangent, rest.shape_gradients_per_m,
+                                                     m_elements.lame_of(rest), piece.weight * rest.volume_m3, r);
+        continue;
+      }
+      std::array<Eigen::Matrix3d, 16> blocks;
+      m_elements.blocks(rest, r, f, blocks);
+      element_blocks::add_blocks(piece_slots, *tangent,
+                                 [&](int i, int j) { return piece.weight * blocks[to_size(4 * i + j)]; });
     }
     for (int i = 0; i < 4; ++i) vertex_forces_n.segment<3>(3 * cut_tet.vertices[to_size(i)]) += vertex_sum.col(i);
-
-    if (tangent == nullptr) continue;
-    const int dofs = dof_count(static_cast<int>(k));
-    const int* const slots = m_slots.data() + m_slot_begin[k];
-    // The u-u blocks are summed over the pieces first (written once), the blocks with a ghost
-    // directly.
-    std::array<Eigen::Matrix3d, 16> uu;
-    for (int i = 0; i < 4; ++i) {
-      for (int j = i; j < 4; ++j) uu[to_size(4 * i + j)].setZero();
-    }
-    for (size_t p = first; p < first + count; ++p) {
-      if (m_parked[p] != 0) continue;
-      const CutPiece& piece = m_pieces[p];
-      // The piece's DOF at each local vertex: u of the vertex (i) or its ghost (>= 4).
-      std::array<int, 4> dof{};
-      for (int i = 0; i < 4; ++i) {
-        const int ghost = m_ghost_dofs[p][to_size(i)];
-        dof[to_size(i)] = ghost < 0 ? i : ghost;
-      }
-      // The co-rotational blocks need the piece's rotation only; other models its F.
-      const Eigen::Matrix3d f =
-          m_elements.model == MaterialModel::corotational_linear
-              ? Eigen::Matrix3d::Identity()
-              : deformation_gradient(rest, piece_positions(piece, real_m, cut_tet.rest_m, displacement_m));
-      std::array<Eigen::Matrix3d, 16> blocks;
-      m_elements.blocks(rest, rotations[p], f, blocks);
-      for (int i = 0; i < 4; ++i) {
-        for (int j = i; j < 4; ++j) {
-          const int a = dof[to_size(i)];
-          const int b = dof[to_size(j)];
-          if (a < 4 && b < 4) {
-            uu[to_size(4 * i + j)] += piece.weight * blocks[to_size(4 * i + j)];
-            continue;
-          }
-          const int slot = slots[dofs * a + b];
-          if (slot < 0) continue;  // with a fixed vertex's u
-          const Eigen::Matrix3d block = piece.weight * blocks[to_size(4 * i + j)];
-          tangent->add_block(slot, block);
-          if (a != b) tangent->add_block_transposed(slots[dofs * b + a], block);
-        }
-      }
-    }
-    for (int i = 0; i < 4; ++i) {
-      for (int j = i; j < 4; ++j) {
-        const int slot = slots[dofs * i + j];
-        if (slot < 0) continue;  // a fixed vertex's u
-        tangent->add_block(slot, uu[to_size(4 * i + j)]);
-        if (i != j) tangent->add_block_transposed(slots[dofs * j + i], uu[to_size(4 * i + j)]);
-      }
-    }
   }
   if (elastic_energy_j != nullptr) *elastic_energy_j = energy;
 }

@@ -203,6 +203,11 @@ class XfemElasticity {
  private:
   // Real positions of the local vertices of cut tet k.
   void gather(size_t k, const Eigen::VectorXd& positions_m, TetPositions& real_m) const;
+  // Piece p's local DOF at each of its tet's vertices: u of the vertex (0-3) or its ghost (>= 4).
+  [[nodiscard]] std::array<int, 4> piece_dofs(std::size_t p) const;
+  // evaluate's first pass: every counted piece's F (into m_gradients) and its rotation.
+  void extract_piece_rotations(const Eigen::VectorXd& positions_m, const Eigen::VectorXd& displacement_m,
+                               std::vector<Eigen::Matrix3d>& rotations, std::vector<Eigen::Quaterniond>& warm_starts);
 
   [[nodiscard]] std::size_t piece_begin(int k) const {
     return static_cast<std::size_t>(m_piece_begin[static_cast<std::size_t>(k)]);
@@ -223,6 +228,7 @@ class XfemElasticity {
   std::vector<Eigen::Quaterniond> m_warm_starts;  // per piece
   std::vector<Eigen::Matrix3d> m_rotations_ahead;  // an evaluation ahead's: all pieces', the ones it skips copied
   std::vector<Eigen::Quaterniond> m_warm_starts_ahead;
+  std::vector<Eigen::Matrix3d> m_gradients;  // per piece: its F at the last evaluate (evaluate's working array)
   std::vector<int> m_ghost_begin{0};
   std::vector<int> m_ghost_rows;
   std::vector<std::size_t> m_slot_begin{0};
