@@ -49,10 +49,12 @@ bool split_in_two_flat(const std::vector<int>& loop, const std::vector<Eigen::Ve
 // than a tet, several in one tet) are the border loops of the surface capped so far. One closed,
 // all its points in one material part (part_of), and within FLAT_HOLE_M of its plane is a cap's
 // face the walk missed, to be ear-clipped in that plane; one that a chord splits into two such
-// halves, two faces meeting at a junction of two cuts (split_in_two_flat). Others stay open: filled
+// halves, two faces meeting at a junction of two cuts (split_in_two_flat); another of one part is
+// peeled by its cuts (peel_by_cuts, `cut_of` and `line_points` given), which the caller keeps only
+// where the part then encloses its simulated volume (CutRenderSurface::drop_unsound_fills). Filled
 // flat, a hole around a junction drew a sheet through the piece (30 + 30 strokes, every hole filled:
-// the closed surface enclosed 0.39 of the simulated volume), and one between two parts a sheet
-// between pieces that fall apart.
+// the closed surface enclosed 0.39 of the simulated volume), and one between two parts would draw a
+// sheet between pieces that fall apart: those stay open.
 inline constexpr double FLAT_HOLE_M = 1e-4;
 inline constexpr size_t MAX_SPLIT_HOLE_POINTS = 96;
 struct FlatHoles {
@@ -75,7 +77,8 @@ FlatHoles flat_holes(const std::unordered_map<long long, int>& directed, const s
 // the run whose ends lie nearest first, each closed by the straight line between its ends
 // (line_points(from, to): the new points between two), which the rest of the hole then runs the
 // other way; the last run is the last face. Runs on no cut, or of a point or two, between two runs of
-// one cut belong to that cut's run. Appends the faces to `faces`; false for fewer than 3 points.
+// one cut belong to that cut's run. Appends the faces to `faces` (none unless the whole hole is
+// peeled); false for fewer than 3 points or a run left of a single point.
 bool peel_by_cuts(const std::vector<int>& loop, const std::vector<Eigen::Vector3d>& x,
                   const std::function<int(int)>& cut_of, const std::function<std::vector<int>(int, int)>& line_points,
                   std::vector<std::vector<int>>& faces);

@@ -315,6 +315,7 @@ bool peel_by_cuts(const std::vector<int>& loop, const std::vector<Eigen::Vector3
     runs.back().points.push_back(point);
   }
   normalize_runs(runs);
+  std::vector<std::vector<int>> peeled;  // appended to `faces` only if the whole hole is peeled
   while (runs.size() > 1) {
     // The run whose ends lie nearest each other: its face closed by the line between them.
     size_t best = runs.size();
@@ -333,7 +334,7 @@ bool peel_by_cuts(const std::vector<int>& loop, const std::vector<Eigen::Vector3
     std::vector<int> line = line_points(last, first);
     std::vector<int> face = std::move(runs[best].points);
     face.insert(face.end(), line.begin(), line.end());
-    faces.push_back(std::move(face));
+    peeled.push_back(std::move(face));
     // What is left runs the line the other way, its ends kept.
     std::vector<int> rest{first};
     rest.insert(rest.end(), line.rbegin(), line.rend());
@@ -341,7 +342,8 @@ bool peel_by_cuts(const std::vector<int>& loop, const std::vector<Eigen::Vector3
     runs[best] = CutRun{-1, std::move(rest)};
     normalize_runs(runs);
   }
-  faces.push_back(std::move(runs.front().points));
+  peeled.push_back(std::move(runs.front().points));
+  for (std::vector<int>& face : peeled) faces.push_back(std::move(face));
   return true;
 }
 
@@ -359,13 +361,15 @@ FlatHoles flat_holes(const std::unordered_map<long long, int>& directed, const s
     const size_t first_face = holes.flat.size();
     if (one_part && flat_within(loop, x, FLAT_HOLE_M)) {
       holes.flat.push_back(std::move(loop));
-    } else if (one_part && split_in_two_flat(loop, x, holes.flat, edge_exists)) {
-    } else if (one_part && line_points && peel_by_cuts(loop, x, cut_of, line_points, holes.flat)) {
-      holes.peeled.push_back({part, first_face, holes.flat.size()});
-    } else {
-      ++holes.others;
-      holes.open_parts.push_back(one_part ? part : -1);
+      continue;
     }
+    if (one_part && split_in_two_flat(loop, x, holes.flat, edge_exists)) continue;
+    if (one_part && line_points && peel_by_cuts(loop, x, cut_of, line_points, holes.flat)) {
+      holes.peeled.push_back({part, first_face, holes.flat.size()});
+      continue;
+    }
+    ++holes.others;
+    holes.open_parts.push_back(one_part ? part : -1);
   }
   return holes;
 }

@@ -809,6 +809,13 @@ TEST(PeelByCuts, PeelsAHoleIntoItsCutsFacesClosedByLines) {
   ASSERT_EQ(faces.size(), 2U);  // cut 6's run (the nearest ends), then the rest: one face of cut 5
   EXPECT_EQ(faces[0], (std::vector<int>{10, 11, 12}));
   EXPECT_EQ(faces[1].size(), ring.size() + 1);  // and the line's point
+
+  // Four points on four cuts: no run to close by a line; nothing is added.
+  faces.clear();
+  const std::vector<int> four{0, 1, 2, 3};
+  EXPECT_FALSE(cut_render_detail::peel_by_cuts(
+      four, y, [](int q) { return q; }, midpoint, faces));
+  EXPECT_TRUE(faces.empty());
 }
 
 TEST(FlatWithin, MeasuresTheLoopAgainstItsLeastSquaresPlaneWhateverItsTilt) {
