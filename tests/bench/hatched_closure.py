@@ -1,7 +1,8 @@
 #!/usr/bin/env python3
 """Whether the render surface stays closed under hatched strokes on trajectories next to the one the
-suite checks (issue 41, item 4). `test_host_session --gtest_filter='HatchedFrogScenario.*'` checks one
-trajectory: docs/hatched_frog.toml (10 + 10 strokes through the sagging frog) through tissue-host.
+suite checks (issue 41, item 4). `test_host_session --gtest_filter='*HatchedFrog*'` checks three
+trajectories: docs/hatched_frog.toml (10 + 10 strokes through the sagging frog) through tissue-host,
+as it is and with Young's modulus x 1.03 and x 1.05.
 Cut decisions are sensitive to rounding (a step's results moved by 1e-13 m flip a tet's cut a few
 dozen steps later), so a change to the arithmetic anywhere in a step moves the strokes onto a
 neighbouring trajectory. This runs the scenario's tissue and tool path through `import tissue`
