@@ -302,7 +302,8 @@ TEST(HatchedFrogScenario, DrawsTheRenderSurfaceClosedInEveryFrame) {
 // pieces free at other steps; tests/bench/hatched_closure.py): where a later stroke crosses an
 // earlier one within tets at rest, the chain walk leaves holes (through `import tissue` 518 and 554
 // border edges at the end, and open from step 563 and 297 on). They are now filled by their cuts'
-// faces where the part then encloses its simulated volume. Closed in every frame, and the last frame
+// faces where the part then encloses its simulated volume (or the faces bound the solid they close
+// as drawn: python/tests/test_scenario.py, x 1.08). Closed in every frame, and the last frame
 // encloses the first's volume to 10%: the blade takes no material (the sagging body's strain and the
 // surface's bulge over the tets move it by ~4%), while a sheet through a piece took 20-90% of its
 // part where the 30 + 30 hatching's holes were filled unchecked.

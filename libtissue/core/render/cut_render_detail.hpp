@@ -10,6 +10,7 @@
 #include <functional>
 #include <map>
 #include <unordered_map>
+#include <utility>
 #include <vector>
 
 namespace tissue::cut_render_detail {
@@ -51,7 +52,8 @@ bool split_in_two_flat(const std::vector<int>& loop, const std::vector<Eigen::Ve
 // face the walk missed, to be ear-clipped in that plane; one that a chord splits into two such
 // halves, two faces meeting at a junction of two cuts (split_in_two_flat); another of one part is
 // peeled by its cuts (peel_by_cuts, `cut_of` and `line_points` given), which the caller keeps only
-// where the part then encloses its simulated volume (CutRenderSurface::drop_unsound_fills). Filled
+// where the part then encloses its simulated volume or the faces bound the solid they close
+// (CutRenderSurface::drop_unsound_fills, fills_bounding_solids). Filled
 // flat, a hole around a junction drew a sheet through the piece (30 + 30 strokes, every hole filled:
 // the closed surface enclosed 0.39 of the simulated volume), and one between two parts would draw a
 // sheet between pieces that fall apart: those stay open.
@@ -82,6 +84,24 @@ FlatHoles flat_holes(const std::unordered_map<long long, int>& directed, const s
 bool peel_by_cuts(const std::vector<int>& loop, const std::vector<Eigen::Vector3d>& x,
                   const std::function<int(int)>& cut_of, const std::function<std::vector<int>(int, int)>& line_points,
                   std::vector<std::vector<int>>& faces);
+
+// Whether the faces peel_by_cuts filled into a hole bound the solid they close, as drawn: behind
+// each of its FILL_PROBES largest triangles, FILL_PROBE_OFFSET_M from the centroid, the shell it
+// joins (the triangles joined by shared points) winds once around the point and in front of it not
+// at all (the solid's face, outward), or it winds at least once on both sides (the fill lies within
+// the solid, where no one sees it). Peeled faces laid back to back in the open (a sheet across a
+// 2 mm column of 30 + 30 hatched strokes: a hole that runs up one wall of a cut and down the other)
+// wind 0 on both sides; a face turned into its shell -1 on one.
+inline constexpr double FILL_PROBE_OFFSET_M = 5e-5;
+inline constexpr size_t FILL_PROBES = 3;
+// The winding number of the triangles `shell` (indices into `triangles`) around `point`: the sum of
+// their solid angles (Van Oosterom and Strackee 1983) over 4 pi; 1 inside a closed outward shell.
+double winding_number(const std::vector<std::array<int, 3>>& triangles, const std::vector<size_t>& shell,
+                      const std::vector<Eigen::Vector3d>& x, const Eigen::Vector3d& point);
+// Per fill (the triangles [first, second) of `triangles`), whether it bounds a solid as above.
+std::vector<char> fills_bounding_solids(const std::vector<std::array<int, 3>>& triangles,
+                                        const std::vector<Eigen::Vector3d>& x,
+                                        const std::vector<std::pair<size_t, size_t>>& fills);
 
 // A closed shell of the finished surface that encloses less than BUBBLE_M3 (a cube of FLAT_HOLE_M) is
 // below what the render surface resolves: a render point on a sliver piece near where two cuts meet

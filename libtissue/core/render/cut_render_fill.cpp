@@ -1,12 +1,96 @@
 // CutRenderSurface: the holes filled by their cuts' faces (cut_render_detail::peel_by_cuts) are kept
-// only where their material part then encloses its simulated volume (cut_render_surface.hpp).
+// where their material part then encloses its simulated volume, or where they bound the solid they
+// close as drawn (cut_render_detail::fills_bounding_solids; cut_render_surface.hpp).
 #include "core/render/cut_render_surface.hpp"
+
+#include "core/fem/union_find.hpp"
 
 #include <algorithm>
 #include <cmath>
+#include <numbers>
+#include <numeric>
 #include <vector>
 
 namespace tissue {
+
+namespace cut_render_detail {
+
+double winding_number(const std::vector<std::array<int, 3>>& triangles, const std::vector<size_t>& shell,
+                      const std::vector<Eigen::Vector3d>& x, const Eigen::Vector3d& point) {
+  double solid_angles = 0.0;
+  for (const size_t t : shell) {
+    const std::array<int, 3>& corners = triangles[t];
+    const Eigen::Vector3d a = x[static_cast<size_t>(corners[0])] - point;
+    const Eigen::Vector3d b = x[static_cast<size_t>(corners[1])] - point;
+    const Eigen::Vector3d c = x[static_cast<size_t>(corners[2])] - point;
+    const double la = a.norm(), lb = b.norm(), lc = c.norm();
+    const double denominator = la * lb * lc + a.dot(b) * lc + b.dot(c) * la + c.dot(a) * lb;
+    solid_angles += 2.0 * std::atan2(a.dot(b.cross(c)), denominator);
+  }
+  return solid_angles / (4.0 * std::numbers::pi);
+}
+
+std::vector<char> fills_bounding_solids(const std::vector<std::array<int, 3>>& triangles,
+                                        const std::vector<Eigen::Vector3d>& x,
+                                        const std::vector<std::pair<size_t, size_t>>& fills) {
+  // Shells: the triangles joined by shared points (union-find over the points).
+  std::vector<int> root(x.size());
+  std::iota(root.begin(), root.end(), 0);
+  for (const std::array<int, 3>& t : triangles) {
+    const int first = find_root(root, t[0]);
+    for (size_t j = 1; j < 3; ++j) root[static_cast<size_t>(find_root(root, t[j]))] = first;
+  }
+  // The probes: each fill's largest triangles; the shells they lie on, listed.
+  struct Probe {
+    size_t fill;
+    Eigen::Vector3d centroid, normal;
+    int shell;
+  };
+  std::vector<Probe> probes;
+  std::vector<int> shell_index(x.size(), -1);  // by root
+  int shells = 0;
+  for (size_t f = 0; f < fills.size(); ++f) {
+    std::vector<size_t> order(fills[f].second - fills[f].first);
+    std::iota(order.begin(), order.end(), fills[f].first);
+    const auto doubled_area = [&](size_t t) {
+      const std::array<int, 3>& c = triangles[t];
+      const Eigen::Vector3d& a = x[static_cast<size_t>(c[0])];
+      return (x[static_cast<size_t>(c[1])] - a).cross(x[static_cast<size_t>(c[2])] - a);
+    };
+    const size_t count = std::min(FILL_PROBES, order.size());
+    std::partial_sort(order.begin(), order.begin() + static_cast<long>(count), order.end(),
+                      [&](size_t s, size_t t) { return doubled_area(s).norm() > doubled_area(t).norm(); });
+    for (size_t k = 0; k < count; ++k) {
+      const size_t t = order[k];
+      const Eigen::Vector3d normal = doubled_area(t);
+      if (!(normal.norm() > 0.0)) continue;  // a flat triangle bounds nothing and hides nothing
+      const std::array<int, 3>& c = triangles[t];
+      const Eigen::Vector3d centroid =
+          (x[static_cast<size_t>(c[0])] + x[static_cast<size_t>(c[1])] + x[static_cast<size_t>(c[2])]) / 3.0;
+      int& shell = shell_index[static_cast<size_t>(find_root(root, c[0]))];
+      if (shell < 0) shell = shells++;
+      probes.push_back({f, centroid, normal.normalized(), shell});
+    }
+  }
+  std::vector<std::vector<size_t>> shell_triangles(static_cast<size_t>(shells));
+  for (size_t t = 0; t < triangles.size(); ++t) {
+    const int shell = shell_index[static_cast<size_t>(find_root(root, triangles[t][0]))];
+    if (shell >= 0) shell_triangles[static_cast<size_t>(shell)].push_back(t);
+  }
+  std::vector<char> sound(fills.size(), 1);
+  for (const Probe& probe : probes) {
+    const std::vector<size_t>& shell = shell_triangles[static_cast<size_t>(probe.shell)];
+    const double in_front = winding_number(triangles, shell, x, probe.centroid + FILL_PROBE_OFFSET_M * probe.normal);
+    const double behind = winding_number(triangles, shell, x, probe.centroid - FILL_PROBE_OFFSET_M * probe.normal);
+    const long front = std::lround(in_front), back = std::lround(behind);
+    const bool boundary = front == 0 && back == 1;  // the solid's face, outward
+    const bool hidden = front >= 1 && back >= 1;    // within the solid: no one sees it
+    if (!boundary && !hidden) sound[probe.fill] = 0;
+  }
+  return sound;
+}
+
+}  // namespace cut_render_detail
 
 namespace {
 
@@ -40,13 +124,17 @@ int CutRenderSurface::drop_unsound_fills(const DeformableBody& body, const std::
   for (const auto& t : m_triangles) {
     render_m3[static_cast<size_t>(part_of(body, m_points[static_cast<size_t>(t[0])]))] += enclosed_m3(m_rest_m, t);
   }
+  std::vector<std::pair<size_t, size_t>> ranges;
+  for (const FilledHole& hole : filled) ranges.emplace_back(hole.first_triangle, hole.end_triangle);
+  const std::vector<char> bounding = cut_render_detail::fills_bounding_solids(m_triangles, m_rest_m, ranges);
   std::vector<char> drop(m_triangles.size(), 0);
   int reopened = 0;
-  for (const FilledHole& hole : filled) {
+  for (size_t h = 0; h < filled.size(); ++h) {
+    const FilledHole& hole = filled[h];
     const auto part = static_cast<size_t>(hole.part);
     const double ratio = render_m3[part] / (r0 * simulated_m3[part]);
     const bool open = std::find(open_parts.begin(), open_parts.end(), hole.part) != open_parts.end();
-    if (!open && std::abs(ratio - 1.0) <= FILLED_PART_VOLUME_TOLERANCE) continue;
+    if ((!open && std::abs(ratio - 1.0) <= FILLED_PART_VOLUME_TOLERANCE) || bounding[h] != 0) continue;
     for (size_t t = hole.first_triangle; t < hole.end_triangle; ++t) drop[t] = 1;
     ++reopened;
   }

@@ -140,10 +140,12 @@ class CutRenderSurface {
     size_t first_triangle = 0, end_triangle = 0;
   };
   /// A part whose filled holes leave its volume off its simulated one (times the uncut surface's
-  /// ratio to the tets') by more than this, or that keeps an open hole, keeps none of them.
+  /// ratio to the tets') by more than this, or that keeps an open hole, keeps only those of them that
+  /// bound the solid they close as drawn (cut_render_detail::fills_bounding_solids).
   static constexpr double FILLED_PART_VOLUME_TOLERANCE = 0.15;
-  /// Drops the triangles of the filled holes of such parts (cut_render_fill.cpp; `open_parts`: the
-  /// parts of the holes left open, -1 for a hole in two). Returns how many holes it opened again.
+  /// Drops the triangles of the filled holes that neither rule keeps (cut_render_fill.cpp;
+  /// `open_parts`: the parts of the holes left open, -1 for a hole in two). Returns how many holes it
+  /// opened again.
   int drop_unsound_fills(const DeformableBody& body, const std::vector<FilledHole>& filled,
                          const std::vector<int>& open_parts);
   void find_material_parts(const DeformableBody& body);

@@ -692,13 +692,15 @@ std::vector<std::vector<int>> border_loops_of(const std::vector<std::array<int, 
 // 4). What it leaves is reported as the surface's holes, which the test counts itself, and none of
 // them is flat or two flat faces: those are faces the walk missed, now filled (before: 378 holes,
 // 185 of them within 0.1 mm of their plane; then 116-120; 109 since holes are also filled by their
-// cuts' faces where the part then encloses its simulated volume: most such fills here would not).
+// cuts' faces where the part then encloses its simulated volume, most such fills here would not; 27
+// since those that bound the solid they close as drawn are kept too: 40 leaves room for rounding).
 TEST(CutRenderSurface, DenseHatchingLeavesNoFlatHole) {
   CutFrog frog(hatching(30));
   CutRenderSurface render = frog.cut_render_surface();
   const std::vector<std::vector<int>> holes = border_loops_of(render.triangles());
   EXPECT_EQ(render.open_loop_count(), static_cast<int>(holes.size()));
-  EXPECT_GT(render.open_loop_count(), 0);  // the target is not reached: say so when it is
+  EXPECT_GT(render.open_loop_count(), 0);  // the target (17) is not reached: say so when it is
+  EXPECT_LE(render.open_loop_count(), 40);
   int flat = 0, two_flat = 0;
   for (const std::vector<int>& hole : holes) {
     flat += cut_render_detail::flat_within(hole, render.rest_positions_m(), 1e-4);
