@@ -124,18 +124,25 @@ int CutRenderSurface::drop_unsound_fills(const DeformableBody& body, const std::
   for (const auto& t : m_triangles) {
     render_m3[static_cast<size_t>(part_of(body, m_points[static_cast<size_t>(t[0])]))] += enclosed_m3(m_rest_m, t);
   }
-  std::vector<std::pair<size_t, size_t>> ranges;
-  for (const FilledHole& hole : filled) ranges.emplace_back(hole.first_triangle, hole.end_triangle);
-  const std::vector<char> bounding = cut_render_detail::fills_bounding_solids(m_triangles, m_rest_m, ranges);
-  std::vector<char> drop(m_triangles.size(), 0);
-  int reopened = 0;
-  for (size_t h = 0; h < filled.size(); ++h) {
-    const FilledHole& hole = filled[h];
+  // The fills the volume refuses, then those of them that do not bound their solid as drawn either
+  // (the winding numbers only where needed: a shell of the organ's surface is 80k triangles).
+  std::vector<std::pair<size_t, size_t>> refused;
+  for (const FilledHole& hole : filled) {
     const auto part = static_cast<size_t>(hole.part);
     const double ratio = render_m3[part] / (r0 * simulated_m3[part]);
     const bool open = std::find(open_parts.begin(), open_parts.end(), hole.part) != open_parts.end();
-    if ((!open && std::abs(ratio - 1.0) <= FILLED_PART_VOLUME_TOLERANCE) || bounding[h] != 0) continue;
-    for (size_t t = hole.first_triangle; t < hole.end_triangle; ++t) drop[t] = 1;
+    if (open || std::abs(ratio - 1.0) > FILLED_PART_VOLUME_TOLERANCE) {
+      refused.emplace_back(hole.first_triangle, hole.end_triangle);
+    }
+  }
+  if (refused.empty()) return 0;
+  const std::vector<char> bounding = cut_render_detail::fills_bounding_solids(m_triangles, m_rest_m, refused);
+  std::vector<char> drop(m_triangles.size(), 0);
+  int reopened = 0;
+  for (size_t h = 0; h < refused.size(); ++h) {
+    if (bounding[h] != 0) continue;
+    std::fill(drop.begin() + static_cast<long>(refused[h].first), drop.begin() + static_cast<long>(refused[h].second),
+              1);
     ++reopened;
   }
   size_t kept = 0;
