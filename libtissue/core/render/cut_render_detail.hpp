@@ -108,6 +108,11 @@ std::vector<char> fills_bounding_solids(const std::vector<std::array<int, 3>>& t
 // (a later cut splits every piece it passes through, issue 43), all its neighbours across the planes,
 // capped on its own. Such shells are not drawn.
 inline constexpr double BUBBLE_M3 = FLAT_HOLE_M * FLAT_HOLE_M * FLAT_HOLE_M;
+// The shells of `triangles` (the triangles joined by shared points): for each of `point_count`
+// points, in `root`, the point that names its shell (union by size over the triangles' corners,
+// `size` its working array; both resized here, their room kept).
+void point_shells(const std::vector<std::array<int, 3>>& triangles, size_t point_count, std::vector<int>& root,
+                  std::vector<int>& size);
 // drop_bubbles' working arrays, kept by its caller from re-mesh to re-mesh: grown once, they are
 // not allocated (and their pages not faulted in) again inside a step's slot.
 struct BubbleScratch {

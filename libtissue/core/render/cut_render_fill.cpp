@@ -3,12 +3,10 @@
 // close as drawn (cut_render_detail::fills_bounding_solids; cut_render_surface.hpp).
 #include "core/render/cut_render_surface.hpp"
 
-#include "core/fem/union_find.hpp"
-
 #include <algorithm>
 #include <cmath>
 #include <numbers>
-#include <numeric>
+#include <tuple>
 #include <vector>
 
 namespace tissue {
@@ -33,13 +31,12 @@ double winding_number(const std::vector<std::array<int, 3>>& triangles, const st
 std::vector<char> fills_bounding_solids(const std::vector<std::array<int, 3>>& triangles,
                                         const std::vector<Eigen::Vector3d>& x,
                                         const std::vector<std::pair<size_t, size_t>>& fills) {
-  // Shells: the triangles joined by shared points (union-find over the points).
-  std::vector<int> root(x.size());
-  std::iota(root.begin(), root.end(), 0);
-  for (const std::array<int, 3>& t : triangles) {
-    const int first = find_root(root, t[0]);
-    for (size_t j = 1; j < 3; ++j) root[static_cast<size_t>(find_root(root, t[j]))] = first;
-  }
+  std::vector<int> root, size;
+  point_shells(triangles, x.size(), root, size);
+  std::vector<int> shell_index(x.size(), -1);  // by root point: the shells that hold a probe, numbered
+  const auto shell_of = [&](int point) -> int& {
+    return shell_index[static_cast<size_t>(root[static_cast<size_t>(point)])];
+  };
   // The probes: each fill's largest triangles; the shells they lie on, listed.
   struct Probe {
     size_t fill;
@@ -47,34 +44,33 @@ std::vector<char> fills_bounding_solids(const std::vector<std::array<int, 3>>& t
     int shell;
   };
   std::vector<Probe> probes;
-  std::vector<int> shell_index(x.size(), -1);  // by root
   int shells = 0;
   for (size_t f = 0; f < fills.size(); ++f) {
-    std::vector<size_t> order(fills[f].second - fills[f].first);
-    std::iota(order.begin(), order.end(), fills[f].first);
-    const auto doubled_area = [&](size_t t) {
+    // (the norm of its doubled area, its normal times that, the triangle), the largest first
+    std::vector<std::tuple<double, Eigen::Vector3d, size_t>> by_area;
+    for (size_t t = fills[f].first; t < fills[f].second; ++t) {
       const std::array<int, 3>& c = triangles[t];
       const Eigen::Vector3d& a = x[static_cast<size_t>(c[0])];
-      return (x[static_cast<size_t>(c[1])] - a).cross(x[static_cast<size_t>(c[2])] - a);
-    };
-    const size_t count = std::min(FILL_PROBES, order.size());
-    std::partial_sort(order.begin(), order.begin() + static_cast<long>(count), order.end(),
-                      [&](size_t s, size_t t) { return doubled_area(s).norm() > doubled_area(t).norm(); });
+      const Eigen::Vector3d normal = (x[static_cast<size_t>(c[1])] - a).cross(x[static_cast<size_t>(c[2])] - a);
+      by_area.emplace_back(normal.norm(), normal, t);
+    }
+    const size_t count = std::min(FILL_PROBES, by_area.size());
+    std::partial_sort(by_area.begin(), by_area.begin() + static_cast<long>(count), by_area.end(),
+                      [](const auto& s, const auto& t) { return std::get<0>(s) > std::get<0>(t); });
     for (size_t k = 0; k < count; ++k) {
-      const size_t t = order[k];
-      const Eigen::Vector3d normal = doubled_area(t);
-      if (!(normal.norm() > 0.0)) continue;  // a flat triangle bounds nothing and hides nothing
+      const auto& [area, normal, t] = by_area[k];
+      if (!(area > 0.0)) continue;  // a flat triangle bounds nothing and hides nothing
       const std::array<int, 3>& c = triangles[t];
       const Eigen::Vector3d centroid =
           (x[static_cast<size_t>(c[0])] + x[static_cast<size_t>(c[1])] + x[static_cast<size_t>(c[2])]) / 3.0;
-      int& shell = shell_index[static_cast<size_t>(find_root(root, c[0]))];
+      int& shell = shell_of(c[0]);
       if (shell < 0) shell = shells++;
       probes.push_back({f, centroid, normal.normalized(), shell});
     }
   }
   std::vector<std::vector<size_t>> shell_triangles(static_cast<size_t>(shells));
   for (size_t t = 0; t < triangles.size(); ++t) {
-    const int shell = shell_index[static_cast<size_t>(find_root(root, triangles[t][0]))];
+    const int shell = shell_of(triangles[t][0]);
     if (shell >= 0) shell_triangles[static_cast<size_t>(shell)].push_back(t);
   }
   std::vector<char> sound(fills.size(), 1);

@@ -405,28 +405,31 @@ void merge_unfacing_switches(std::map<std::array<int, 5>, std::vector<size_t>>& 
   }
 }
 
-size_t drop_bubbles(std::vector<std::array<int, 3>>& triangles, size_t first_cap, const std::vector<Eigen::Vector3d>& x,
-                    BubbleScratch& scratch) {
-  // Shells: union by size over the triangles' corners, then each point's root at once (the passes
-  // below read it for every triangle: 82k on the organ's surface at every re-mesh).
-  std::vector<int>& parent = scratch.parent;
-  std::vector<int>& size = scratch.size;
-  parent.resize(x.size());
-  std::iota(parent.begin(), parent.end(), 0);
-  size.assign(x.size(), 1);
+void point_shells(const std::vector<std::array<int, 3>>& triangles, size_t point_count, std::vector<int>& root,
+                  std::vector<int>& size) {
+  root.resize(point_count);
+  std::iota(root.begin(), root.end(), 0);
+  size.assign(point_count, 1);
   const auto unite = [&](int a, int b) {
-    a = find_root(parent, a);
-    b = find_root(parent, b);
+    a = find_root(root, a);
+    b = find_root(root, b);
     if (a == b) return;
     if (size[static_cast<size_t>(a)] < size[static_cast<size_t>(b)]) std::swap(a, b);
-    parent[static_cast<size_t>(b)] = a;
+    root[static_cast<size_t>(b)] = a;
     size[static_cast<size_t>(a)] += size[static_cast<size_t>(b)];
   };
   for (const auto& t : triangles) {
     unite(t[0], t[1]);
     unite(t[1], t[2]);
   }
-  for (size_t i = 0; i < parent.size(); ++i) parent[i] = find_root(parent, static_cast<int>(i));
+  // Each point's root at once: the callers read it for every triangle (82k on the organ's surface).
+  for (size_t i = 0; i < root.size(); ++i) root[i] = find_root(root, static_cast<int>(i));
+}
+
+size_t drop_bubbles(std::vector<std::array<int, 3>>& triangles, size_t first_cap, const std::vector<Eigen::Vector3d>& x,
+                    BubbleScratch& scratch) {
+  point_shells(triangles, x.size(), scratch.parent, scratch.size);
+  const std::vector<int>& parent = scratch.parent;
   const auto root = [&parent](int v) { return parent[static_cast<size_t>(v)]; };
   // Per shell holding a cap (by its root point): its volume about that point (closed: any point will
   // do); others are not candidates.
