@@ -321,7 +321,11 @@ TEST_P(HatchedFrogNeighbours, DrawTheRenderSurfaceClosedInEveryFrame) {
   ASSERT_GT(frames.size(), 90u);
   EXPECT_NEAR(vtu_enclosed_m3(frames.back()) / vtu_enclosed_m3(frames.front()), 1.0, 0.1);
 }
-INSTANTIATE_TEST_SUITE_P(YoungModulusScaled, HatchedFrogNeighbours, ::testing::Values(1.03, 1.05));
+// x 0.93 and x 1.02 drew one edge with four triangles (a cut's loop passing a surface vertex twice,
+// clipped whole); x 1.06 ended at 1.32 times the first frame's volume (a parked piece swelling as it
+// fell: its rows solved only to the real-time cap), and with that fixed 13 of 21 trajectories drew
+// the four-triangle edge. All 21 (x 0.93 ... 1.13) pass; these five run in the suite.
+INSTANTIATE_TEST_SUITE_P(YoungModulusScaled, HatchedFrogNeighbours, ::testing::Values(0.93, 1.02, 1.03, 1.05, 1.06));
 
 // The hand's figures reach the summary (device kind "hand"): a hand pressing the frog was in contact,
 // and the device's force did work on it.

@@ -237,6 +237,8 @@ class DeformableBody final : public DynamicsModel {
     return static_cast<size_t>(row) < m_row_parked.size() && m_row_parked[static_cast<size_t>(row)] != 0;
   }
   [[nodiscard]] int parked_row_count() const { return m_parked_rows; }
+  /// The parked rows (DynamicsModel::rows_left).
+  [[nodiscard]] const std::vector<std::uint8_t>* rows_left() const override { return &m_row_parked; }
 
   /// Whether cut tet k was replaced by a later cut of its tet (then it adds nothing).
   [[nodiscard]] bool retired(int k) const { return m_xfem.retired(k); }

@@ -4,6 +4,8 @@
 #include "core/solve/linear_solver.hpp"
 #include "core/system/hot_kernel.hpp"
 
+#include <Eigen/Cholesky>
+
 #include <algorithm>
 #include <cstring>
 
@@ -59,11 +61,23 @@ void HalfMatrix::derive_pattern(const BlockSparseMatrix& k) {
 
 template <class Real>
 void HalfMatrix::copy_part(const BlockSparseMatrix& k, double scale, std::vector<Real>& to, int part) {
-  const auto end = static_cast<size_t>(m_row_begin[static_cast<size_t>(end_block_row(part))]);
-  for (auto b = static_cast<size_t>(m_row_begin[static_cast<size_t>(first_block_row(part))]); b < end; ++b) {
-    const double* from = k.block(m_full_slot[b]).data();
-    Real* block = &to[9 * b];
-    for (int e = 0; e < 9; ++e) block[e] = static_cast<Real>(scale * from[e]);
+  std::vector<std::uint8_t>& coupled = m_coupled[static_cast<size_t>(part)];
+  coupled.assign(static_cast<size_t>(block_rows()), 0);
+  for (int r = first_block_row(part); r < end_block_row(part); ++r) {
+    const auto begin = static_cast<size_t>(m_row_begin[static_cast<size_t>(r)]);
+    const auto end = static_cast<size_t>(m_row_begin[static_cast<size_t>(r) + 1]);
+    for (size_t b = begin; b < end; ++b) {
+      const double* from = k.block(m_full_slot[b]).data();
+      Real* block = &to[9 * b];
+      bool nonzero = false;
+      for (int e = 0; e < 9; ++e) {
+        block[e] = static_cast<Real>(scale * from[e]);
+        nonzero |= block[e] != Real(0);
+      }
+      if (b == begin || !nonzero) continue;  // the diagonal block joins nothing
+      coupled[static_cast<size_t>(r)] = 1;
+      coupled[static_cast<size_t>(m_column[b])] = 1;
+    }
   }
 }
 
@@ -90,6 +104,28 @@ void HalfMatrix::assign(const ShiftedSystem& system, WorkTeam* team) {
     }
   });
   m_diagonal = *system.diagonal;
+  m_isolated_rows.clear();
+  for (int r = 0; r < block_rows(); ++r) {
+    const auto row = static_cast<size_t>(r);
+    if (m_coupled[0][row] == 0 && m_coupled[1][row] == 0) m_isolated_rows.push_back(r);
+  }
+}
+
+template <class Real>
+Eigen::Matrix3d HalfMatrix::diagonal_block(const std::vector<Real>& values, int row) const {
+  const Real* block = &values[9 * static_cast<size_t>(m_row_begin[static_cast<size_t>(row)])];
+  Eigen::Matrix3d a;
+  for (int e = 0; e < 9; ++e) a(e % 3, e / 3) = static_cast<double>(block[e]);  // column-major
+  a.diagonal() += m_diagonal.segment<3>(3L * row);
+  return a;
+}
+
+void HalfMatrix::solve_isolated_rows(const Eigen::VectorXd& b, Eigen::VectorXd& x) const {
+  for (const int row : m_isolated_rows) {
+    const Eigen::Matrix3d a =
+        m_precision == MatrixPrecision::single ? diagonal_block(m_single, row) : diagonal_block(m_double, row);
+    x.segment<3>(3L * row) = a.ldlt().solve(b.segment<3>(3L * row));
+  }
 }
 
 long HalfMatrix::streamed_bytes() const {

@@ -64,13 +64,24 @@ class HalfMatrix {
   /// on this thread; bitwise the same either way.
   void multiply(const Eigen::VectorXd& x, Eigen::VectorXd& y, WorkTeam* team = nullptr) const;
 
+  /// The block rows no nonzero block joins to another (found by assign, ascending): a part parked
+  /// out of the field, whose elements add nothing, leaves rows with only their mass. Each is its
+  /// own 3 x 3 system.
+  [[nodiscard]] const std::vector<int>& isolated_rows() const { return m_isolated_rows; }
+  /// x_i = A_ii^-1 b_i for each of isolated_rows(), with A_ii as the products use it.
+  void solve_isolated_rows(const Eigen::VectorXd& b, Eigen::VectorXd& x) const;
+
   [[nodiscard]] MatrixPrecision precision() const { return m_precision; }
   /// Bytes of matrix values and column indices one product streams.
   [[nodiscard]] long streamed_bytes() const;
 
  private:
+  /// Copies the part's rows' blocks and marks in m_coupled[part] the rows its nonzero off-diagonal
+  /// blocks join (its own and their columns').
   template <class Real>
   void copy_part(const BlockSparseMatrix& k, double scale, std::vector<Real>& to, int part);
+  template <class Real>
+  [[nodiscard]] Eigen::Matrix3d diagonal_block(const std::vector<Real>& values, int row) const;
   template <class Real>
   void multiply_rows(const Real* values, const double* x, double* y, int part) const;
   void derive_pattern(const BlockSparseMatrix& k);
@@ -84,6 +95,8 @@ class HalfMatrix {
   std::vector<float> m_single;    // 9 per stored block, column-major, s K
   std::vector<double> m_double;
   Eigen::VectorXd m_diagonal;     // d
+  std::array<std::vector<std::uint8_t>, PARTS> m_coupled;  // per part's blocks: per block row, whether joined
+  std::vector<int> m_isolated_rows;
   std::array<int, PARTS + 1> m_first_block_row{};
   int m_spill_end = 0;                   // 1 + the last block row part 0 sends terms to
   mutable Eigen::VectorXd m_spill;       // the terms for rows [end_block_row(0), m_spill_end)

@@ -75,12 +75,49 @@ struct PartSums {
   }
 };
 
-/// Solves A x = b (A as work.matrix holds it: the caller's setup assigned it from `system`) from the initial guess x (a non-finite guess is replaced by zero) until
-/// ||r|| <= tolerance * ||b|| or max_iterations. `precondition(r, z, first, count)` sets
-/// z = P^-1 r for an SPD P: with ROW_WISE it is called for each part's rows (z_i depends on r_i
-/// only) and must write only those; otherwise once for all rows (first 0, count rows()). z has r's
-/// length and is not r. Sizes checked by the caller; `work` sized by it. `team`: nullptr, or two
-/// members that share the work (the results are bitwise the same).
+/// CG's start: r = b - A x from the caller's x (a non-finite guess is replaced by zero; a zero guess,
+/// the default step's, gives r = b without a product: one of a real-time step's eleven), the parts
+/// of |r|^2 in `r_squared`; returns |r|. The rows no block joins to another (HalfMatrix::isolated_rows:
+/// a part parked out of the field) are solved exactly first and r is zero there, where CG then
+/// leaves them: within an iteration cap it would leave each off by p_k(1) times its start's error,
+/// and nothing pulls such rows back together (a parked piece swelled as it fell).
+inline double start_residual(const VectorParts& parts, const Eigen::VectorXd& b, const PartSums& b_squared,
+                             Eigen::VectorXd& x, PcgWorkspace& work, PartSums& r_squared) {
+  const auto segment = [&parts](auto& v, int part) { return v.segment(parts.first(part), parts.count(part)); };
+  const std::vector<int>& isolated = work.matrix.isolated_rows();
+  const bool zero_guess = (x.array() == 0.0).all();
+  if (!isolated.empty() && x.allFinite()) work.matrix.solve_isolated_rows(b, x);
+  if (zero_guess) {
+    work.residual = b;
+    r_squared = b_squared;
+  } else {
+    parts.run([&](int part) { work.matrix.multiply_part(x, work.product, part); });
+    parts.run([&](int part) {
+      work.matrix.finish_part(work.product, part);
+      segment(work.residual, part) = segment(b, part) - segment(work.product, part);
+      r_squared.values[static_cast<size_t>(part)] = segment(work.residual, part).squaredNorm();
+    });
+  }
+  const bool finite = std::isfinite(std::sqrt(r_squared.total()));
+  if (!finite) {
+    x.setZero();
+    work.residual = b;
+    if (!isolated.empty()) work.matrix.solve_isolated_rows(b, x);
+  }
+  if (!isolated.empty() || !finite) {
+    for (const int row : isolated) work.residual.segment<3>(3L * row).setZero();
+    parts.run(
+        [&](int part) { r_squared.values[static_cast<size_t>(part)] = segment(work.residual, part).squaredNorm(); });
+  }
+  return std::sqrt(r_squared.total());
+}
+
+/// Solves A x = b (A as work.matrix holds it: the caller's setup assigned it from `system`) from the
+/// initial guess x (start_residual) until ||r|| <= tolerance * ||b|| or max_iterations. `precondition(r, z, first,
+/// count)` sets z = P^-1 r for an SPD P: with ROW_WISE it is called for each part's rows (z_i depends on r_i only) and
+/// must write only those; otherwise once for all rows (first 0, count rows()). z has r's length and is not r. Sizes
+/// checked by the caller; `work` sized by it. `team`: nullptr, or two members that share the work (the results are
+/// bitwise the same).
 template <bool ROW_WISE, class Preconditioner>
 SolveReport preconditioned_cg(const ShiftedSystem& system, const Eigen::VectorXd& b, Eigen::VectorXd& x,
                               double tolerance, int max_iterations, PcgWorkspace& work, WorkTeam* team,
@@ -99,25 +136,7 @@ SolveReport preconditioned_cg(const ShiftedSystem& system, const Eigen::VectorXd
     return report;
   }
 
-  // r = b - A x, warm-started from the caller's x; a non-finite guess is replaced by zero. A zero
-  // guess (the default step's) gives r = b without a product: one of a real-time step's eleven.
-  if ((x.array() == 0.0).all()) {
-    work.residual = b;
-    r_squared = b_squared;
-  } else {
-    parts.run([&](int part) { work.matrix.multiply_part(x, work.product, part); });
-    parts.run([&](int part) {
-      work.matrix.finish_part(work.product, part);
-      segment(work.residual, part) = segment(b, part) - segment(work.product, part);
-      r_squared.values[static_cast<size_t>(part)] = segment(work.residual, part).squaredNorm();
-    });
-  }
-  double r_norm = std::sqrt(r_squared.total());
-  if (!std::isfinite(r_norm)) {
-    x.setZero();
-    work.residual = b;
-    r_norm = b_norm;
-  }
+  double r_norm = start_residual(parts, b, b_squared, x, work, r_squared);
   const double threshold = tolerance * b_norm;
   report.relative_residual = r_norm / b_norm;
   if (work.residual_history != nullptr) work.residual_history->push_back(report.relative_residual);
@@ -132,7 +151,11 @@ SolveReport preconditioned_cg(const ShiftedSystem& system, const Eigen::VectorXd
     rz_parts.values[static_cast<size_t>(part)] = segment(work.residual, part).dot(segment(work.preconditioned, part));
   };
   auto precondition_all = [&] {
-    if constexpr (!ROW_WISE) precondition(work.residual, work.preconditioned, 0L, work.residual.size());
+    if constexpr (!ROW_WISE) {
+      precondition(work.residual, work.preconditioned, 0L, work.residual.size());
+      // CG leaves the isolated rows alone (a row-wise preconditioner gives zero from r's zero there).
+      for (const int row : work.matrix.isolated_rows()) work.preconditioned.segment<3>(3L * row).setZero();
+    }
     parts.run(precondition_part);
     return rz_parts.total();
   };

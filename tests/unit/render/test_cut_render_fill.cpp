@@ -1,10 +1,14 @@
 // The holes peel_by_cuts fills are kept where they bound the solid they close (cut_render_fill.cpp):
 // the winding number of a shell, and the probes behind and in front of a fill's largest triangles.
+// And ear_clip (cut_render_loops.cpp), which caps the loops, on a loop that passes a point twice.
 #include "core/render/cut_render_detail.hpp"
 
 #include <gtest/gtest.h>
 
+#include <Eigen/Geometry>
+
 #include <array>
+#include <map>
 #include <numeric>
 #include <utility>
 #include <vector>
@@ -90,6 +94,33 @@ TEST(FillsBoundingSolids, KeepsFacesOfTheSolidAndWithinItDropsSheetsInTheOpenAnd
 
   const std::vector<char> sound = cut_render_detail::fills_bounding_solids(triangles, x, fills);
   EXPECT_EQ(sound, (std::vector<char>{1, 0, 0, 1}));
+}
+
+// Two openings of one cut touching at a surface vertex make one loop that passes it twice (the
+// hatched frog through tissue-host: a 131-point loop). Clipped whole, a diagonal ran from a third
+// point to both passes: one edge with four triangles. Now each lobe is clipped on its own: every
+// directed edge once, each triangle wound as the loop, the lobes' area whole.
+TEST(EarClip, ALoopThatPassesAPointTwiceIsClippedAsTwoLoops) {
+  // Two lobes in z = 0 meeting at point 0, each wound counter-clockwise: 0 1 2 3 4 and 0 5 6 7 8.
+  const std::vector<Eigen::Vector3d> x{{0, 0, 0},  {1, -1, 0}, {3, -1, 0},  {3, 1, 0},  {1, 1, 0},
+                                       {-1, 1, 0}, {-3, 1, 0}, {-3, -1, 0}, {-1, -1, 0}};
+  const std::vector<int> loop{0, 1, 2, 3, 4, 0, 5, 6, 7, 8};
+  Triangles triangles;
+  cut_render_detail::ear_clip(loop, x, triangles, [](int, int) { return false; });
+  std::map<std::pair<int, int>, int> uses;
+  double area = 0.0;
+  for (const auto& [a, b, c] : triangles) {
+    ++uses[{a, b}];
+    ++uses[{b, c}];
+    ++uses[{c, a}];
+    const double z = (x[static_cast<size_t>(b)] - x[static_cast<size_t>(a)])
+                         .cross(x[static_cast<size_t>(c)] - x[static_cast<size_t>(a)])
+                         .z();
+    EXPECT_GT(z, 0.0) << a << " " << b << " " << c;
+    area += 0.5 * z;
+  }
+  for (const auto& [edge, count] : uses) EXPECT_EQ(count, 1) << edge.first << " -> " << edge.second;
+  EXPECT_NEAR(area, 2 * 5.0, 1e-12);  // each lobe: a 2 x 2 square and a triangle of 1
 }
 
 }  // namespace
