@@ -85,9 +85,12 @@ BackwardEuler::BackwardEuler(std::unique_ptr<LinearSolver> solver, Settings sett
 ShiftedSystem BackwardEuler::step_system(const DynamicsModel& model, double h, const Eigen::VectorXd& displacement_m) {
   m_system_diagonal.resize(model.dof_count());
   m_system_diagonal.noalias() = model.mass_kg() + h * model.mass_damping_kg_per_s();
-  return ShiftedSystem{&model.tangent(), h * model.stiffness_damping_s() + h * h, &m_system_diagonal,
+  return ShiftedSystem{&model.tangent(),
+                       h * model.stiffness_damping_s() + h * h,
+                       &m_system_diagonal,
                        m_solver->follows_block_frames() ? model.block_frames() : nullptr,
-                       m_solver->uses_block_positions() ? model.block_positions(displacement_m) : nullptr};
+                       m_solver->uses_block_positions() ? model.block_positions(displacement_m) : nullptr,
+                       model.rows_left()};
 }
 
 StepReport BackwardEuler::step(DynamicsModel& model, DynamicState& state, double step_size_s) {

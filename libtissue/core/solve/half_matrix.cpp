@@ -61,23 +61,11 @@ void HalfMatrix::derive_pattern(const BlockSparseMatrix& k) {
 
 template <class Real>
 void HalfMatrix::copy_part(const BlockSparseMatrix& k, double scale, std::vector<Real>& to, int part) {
-  std::vector<std::uint8_t>& coupled = m_coupled[static_cast<size_t>(part)];
-  coupled.assign(static_cast<size_t>(block_rows()), 0);
-  for (int r = first_block_row(part); r < end_block_row(part); ++r) {
-    const auto begin = static_cast<size_t>(m_row_begin[static_cast<size_t>(r)]);
-    const auto end = static_cast<size_t>(m_row_begin[static_cast<size_t>(r) + 1]);
-    for (size_t b = begin; b < end; ++b) {
-      const double* from = k.block(m_full_slot[b]).data();
-      Real* block = &to[9 * b];
-      bool nonzero = false;
-      for (int e = 0; e < 9; ++e) {
-        block[e] = static_cast<Real>(scale * from[e]);
-        nonzero |= block[e] != Real(0);
-      }
-      if (b == begin || !nonzero) continue;  // the diagonal block joins nothing
-      coupled[static_cast<size_t>(r)] = 1;
-      coupled[static_cast<size_t>(m_column[b])] = 1;
-    }
+  const auto end = static_cast<size_t>(m_row_begin[static_cast<size_t>(end_block_row(part))]);
+  for (auto b = static_cast<size_t>(m_row_begin[static_cast<size_t>(first_block_row(part))]); b < end; ++b) {
+    const double* from = k.block(m_full_slot[b]).data();
+    Real* block = &to[9 * b];
+    for (int e = 0; e < 9; ++e) block[e] = static_cast<Real>(scale * from[e]);
   }
 }
 
@@ -104,10 +92,19 @@ void HalfMatrix::assign(const ShiftedSystem& system, WorkTeam* team) {
     }
   });
   m_diagonal = *system.diagonal;
+  // Of the rows that left the dynamics, those whose row of K (which holds both halves) has no nonzero
+  // block but its diagonal: a pass over their rows only (a later cut of a parked tet may join some).
   m_isolated_rows.clear();
-  for (int r = 0; r < block_rows(); ++r) {
-    const auto row = static_cast<size_t>(r);
-    if (m_coupled[0][row] == 0 && m_coupled[1][row] == 0) m_isolated_rows.push_back(r);
+  const std::vector<std::uint8_t>* left = system.rows_left;
+  const int left_rows = left == nullptr ? 0 : std::min(block_rows(), static_cast<int>(left->size()));
+  for (int r = 0; r < left_rows; ++r) {
+    if ((*left)[static_cast<size_t>(r)] == 0) continue;
+    bool joined = false;
+    for (int slot = k.row_begin(r); slot < k.row_begin(r) + k.row_size(r) && !joined; ++slot) {
+      const int c = k.slot_column(slot);
+      joined = c >= 0 && c != r && !k.block(slot).isZero(0.0);
+    }
+    if (!joined) m_isolated_rows.push_back(r);
   }
 }
 

@@ -64,9 +64,9 @@ class HalfMatrix {
   /// on this thread; bitwise the same either way.
   void multiply(const Eigen::VectorXd& x, Eigen::VectorXd& y, WorkTeam* team = nullptr) const;
 
-  /// The block rows no nonzero block joins to another (found by assign, ascending): a part parked
-  /// out of the field, whose elements add nothing, leaves rows with only their mass. Each is its
-  /// own 3 x 3 system.
+  /// The rows the system says left the dynamics (ShiftedSystem::rows_left) that no nonzero block of
+  /// K joins to another (found by assign, ascending): a part parked out of the field, whose elements
+  /// add nothing, leaves rows with only their mass. Each is its own 3 x 3 system.
   [[nodiscard]] const std::vector<int>& isolated_rows() const { return m_isolated_rows; }
   /// x_i = A_ii^-1 b_i for each of isolated_rows(), with A_ii as the products use it.
   void solve_isolated_rows(const Eigen::VectorXd& b, Eigen::VectorXd& x) const;
@@ -76,8 +76,6 @@ class HalfMatrix {
   [[nodiscard]] long streamed_bytes() const;
 
  private:
-  /// Copies the part's rows' blocks and marks in m_coupled[part] the rows its nonzero off-diagonal
-  /// blocks join (its own and their columns').
   template <class Real>
   void copy_part(const BlockSparseMatrix& k, double scale, std::vector<Real>& to, int part);
   template <class Real>
@@ -94,8 +92,7 @@ class HalfMatrix {
   std::vector<std::pair<int, int>> m_sort_scratch;  // derive_pattern's: a row out of order, sorted
   std::vector<float> m_single;    // 9 per stored block, column-major, s K
   std::vector<double> m_double;
-  Eigen::VectorXd m_diagonal;     // d
-  std::array<std::vector<std::uint8_t>, PARTS> m_coupled;  // per part's blocks: per block row, whether joined
+  Eigen::VectorXd m_diagonal;  // d
   std::vector<int> m_isolated_rows;
   std::array<int, PARTS + 1> m_first_block_row{};
   int m_spill_end = 0;                   // 1 + the last block row part 0 sends terms to

@@ -11,6 +11,7 @@
 
 #include <Eigen/Core>
 
+#include <cstdint>
 #include <memory>
 #include <stdexcept>
 #include <string>
@@ -29,6 +30,11 @@ struct ShiftedSystem {
   /// Optional (nullptr: none): per block row, the point its unknowns move [m] (DynamicsModel::
   /// block_positions); given to solvers that use_block_positions().
   const std::vector<Eigen::Vector3d>* block_positions = nullptr;
+  /// Optional (nullptr: none): per block row, nonzero where the row left the dynamics
+  /// (DynamicsModel::rows_left: a part parked out of the field; may be shorter than the rows). Those
+  /// of them no nonzero block of K joins to another are each solved exactly by the CG solvers
+  /// (HalfMatrix::isolated_rows).
+  const std::vector<std::uint8_t>* rows_left = nullptr;
 
   [[nodiscard]] int rows() const { return stiffness->rows(); }
   /// y = A x. No allocation. x and y must be different vectors.
