@@ -205,13 +205,13 @@ struct Run::Watchdog {
   bool done = false;
   std::thread thread;
 
-  explicit Watchdog(std::string name) {
-    thread = std::thread([this, name = std::move(name)] {
+  Watchdog(std::string name, double limit_s) {
+    thread = std::thread([this, name = std::move(name), limit_s] {
       std::unique_lock lock(mutex);
-      const auto limit = std::chrono::duration<double>(hang_limit_s());
+      const auto limit = std::chrono::duration<double>(limit_s);
       if (!done_signal.wait_for(lock, limit, [this] { return done; })) {
         std::fprintf(stderr, "extremes: case %s still running after %.0f s: counted as a hang, aborting\n",
-                     name.c_str(), hang_limit_s());
+                     name.c_str(), limit_s);
         std::fflush(stderr);
         std::abort();
       }
@@ -229,9 +229,12 @@ struct Run::Watchdog {
   Watchdog& operator=(const Watchdog&) = delete;
 };
 
-Run::Run(std::string name, Method method, Scene scene)
-    : m_name(std::move(name)), m_method(method), m_start(std::chrono::steady_clock::now()) {
-  m_watchdog = std::make_unique<Watchdog>(m_name);
+Run::Run(std::string name, Method method, Scene scene, double time_scale)
+    : m_name(std::move(name)),
+      m_method(method),
+      m_budget_s(case_budget_s() * time_scale),
+      m_start(std::chrono::steady_clock::now()) {
+  m_watchdog = std::make_unique<Watchdog>(m_name, hang_limit_s() * time_scale);
   use_method(scene.settings, method);
   try {
     m_tissue = std::make_unique<Tissue>(std::move(scene.mesh), std::move(scene.settings));
@@ -375,9 +378,8 @@ bool Run::step() {
         1e3 * report.dynamics.guard_s, 1e3 * report.cut_s, 1e3 * report.enrich_s, 1e3 * report.contact_s,
         1e3 * report.positions_s);
   }
-  if (m_running &&
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - m_start).count() > case_budget_s()) {
-    fail("took longer than the budget of " + std::to_string(case_budget_s()) + " s");
+  if (m_running && std::chrono::duration<double>(std::chrono::steady_clock::now() - m_start).count() > m_budget_s) {
+    fail("took longer than the budget of " + std::to_string(m_budget_s) + " s");
   }
   return m_running;
 }
@@ -522,7 +524,7 @@ void run_case(const Case& c, Method method) {
   }
   Outcome outcome;
   {
-    Run run(c.id + "/" + std::string(method_id(method)), method, c.scene());
+    Run run(c.id + "/" + std::string(method_id(method)), method, c.scene(), c.time_scale);
     if (run.running()) c.script(run);
     outcome = run.finish();
   }
@@ -549,7 +551,7 @@ void run_case(const Case& c, Method method) {
     EXPECT_TRUE(allowed) << "refused where a bounded state was expected: " << outcome.reason;
     if (allowed) std::printf("[extremes]   a refusal this case allows: %s\n", c.refusal_note.c_str());
   }
-  EXPECT_LT(outcome.wall_s, case_budget_s());
+  EXPECT_LT(outcome.wall_s, case_budget_s() * c.time_scale);
 }
 
 std::string case_test_name(const std::vector<Case>& cases, int index, Method method) {

@@ -114,7 +114,8 @@ struct Outcome {
 /// watchdog: a case still running after hang_limit_s() aborts the executable with its name.
 class Run {
  public:
-  Run(std::string name, Method method, Scene scene);
+  /// `time_scale`: the case may take this many times the suite's budget and hang limit (Case::time_scale).
+  Run(std::string name, Method method, Scene scene, double time_scale = 1.0);
   ~Run();
   Run(const Run&) = delete;
   Run& operator=(const Run&) = delete;
@@ -146,6 +147,7 @@ class Run {
   std::string m_name;
   Method m_method;
   std::unique_ptr<Tissue> m_tissue;
+  double m_budget_s;
   Outcome m_outcome;
   bool m_running = true;
   double m_tool_work_j = 0.0;
@@ -201,6 +203,9 @@ struct Case {
   /// that a fix takes the finding off this list).
   std::vector<Method> known_failures = {};
   std::string known_failure_note = {};
+  /// The case may take this many times the suite's budget and hang limit (case_budget_s(),
+  /// hang_limit_s()): a case long by design, its time measured in docs/BENCHMARKS.md.
+  double time_scale = 1.0;
 };
 
 /// Runs `c` with `method`, checks the outcome with gtest assertions and records the table cell.

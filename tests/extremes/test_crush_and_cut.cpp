@@ -190,11 +190,11 @@ Case hinged_cube() {
 
 // A careless hand on the frog (issue 21): the frog on its tray, STROKES strokes of a vertical
 // scalpel across the body (along y) and then STROKES along it (along x), each at 5 m/s, offset and
-// tilted at random (seeded): the tets where they cross are cut several times. 10 + 10 strokes (4 + 4
-// under sanitizers) to stay within the suite's time; 30 + 30 were run once (docs/BENCHMARKS.md,
-// stability at the extremes). Then 50 steps.
+// tilted at random (seeded): the tets where they cross are cut several times. 30 + 30 strokes (issue
+// 41; 4 + 4 under sanitizers), 2150 steps: 34 s on one core of the 2-core VM, so five times the
+// suite's budget (docs/BENCHMARKS.md, "30 + 30 careless strokes"). Then 50 steps.
 Case careless_cross_hatching() {
-  constexpr int STROKES = UNDER_SANITIZER ? 4 : 10;
+  constexpr int STROKES = UNDER_SANITIZER ? 4 : 30;
   Case c;
   c.id = "FrogCrossHatched";
   c.label = "frog on a tray: " + std::to_string(STROKES) + " strokes across and " + std::to_string(STROKES) +
@@ -203,6 +203,7 @@ Case careless_cross_hatching() {
   c.not_run_reason =
       "too slow: BE + CHOLMOD took 57 ms a step on the cross-hatched frog (524 of 750 steps in the 30 s budget, "
       "bounded so far: 0.13 / 0.16 J); IDA starts afresh at every cut (several hundred here)";
+  c.time_scale = UNDER_SANITIZER ? 1.0 : 5.0;
   c.scene = [] {
     Scene scene = frog_on_tray();
     scene.settings.interaction.blade_length_m = 0.1;
