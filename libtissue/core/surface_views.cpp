@@ -3,6 +3,7 @@
 
 #include "core/parameter_error.hpp"
 
+#include <algorithm>
 #include <span>
 
 namespace tissue {
@@ -56,6 +57,31 @@ void SurfaceViews::add_cut_tets(const DeformableBody& body, const Eigen::VectorX
   update_positions(body, displacement_m);
   const auto& faces = m_cut_surface.triangles();
   m_bvh.add_triangles(std::span(faces).last(static_cast<size_t>(new_faces)));
+  // The faces of the cut tets these replaced are out of the tree: no query needs a zero-area face,
+  // and their corners are no longer updated.
+  // (The cut faces are the tree's last triangles; without a BVH of the surface, all of them.)
+  const int first_cut_face = m_bvh.unfitted().triangle_count() - static_cast<int>(faces.size());
+  std::vector<int> retired = m_cut_surface.take_retired_faces();
+  for (int& face : retired) face += first_cut_face;
+  m_bvh.remove_triangles(retired);
+}
+
+void SurfaceViews::take_out_parked(const DeformableBody& body) {
+  const int cut_faces = static_cast<int>(m_cut_surface.triangles().size());
+  const int first_cut_face = m_bvh.unfitted().triangle_count() - cut_faces;
+  std::vector<int> ids;
+  for (int t = 0; t < first_cut_face; ++t) {  // the mesh's surface triangles (when the BVH has them)
+    const std::array<int, 3>& triangle = m_surface.triangles[static_cast<size_t>(t)];
+    const bool parked = std::all_of(triangle.begin(), triangle.end(), [&](int v) {
+      const int row = body.dofs().vertex_row[static_cast<size_t>(v)];
+      return row >= 0 && body.parked(row);
+    });
+    if (parked) ids.push_back(t);
+  }
+  const auto first_face = ids.size();
+  m_cut_surface.parked_faces(body, ids);
+  for (auto k = first_face; k < ids.size(); ++k) ids[k] += first_cut_face;
+  m_bvh.remove_triangles(ids);
 }
 
 const CutRenderSurface* SurfaceViews::render_surface(const DeformableBody& body,

@@ -37,6 +37,11 @@ class SurfaceViews {
   /// The cut tets from `first_cut_tet` on were just made: their opened faces join the surface and
   /// the BVH, at `displacement_m` (both parts still coincide).
   void add_cut_tets(const DeformableBody& body, const Eigen::VectorXd& displacement_m, int first_cut_tet);
+  /// Parts of `body` were parked (out of the field, out of the dynamics): their faces leave the BVH
+  /// (the mesh's surface triangles whose three vertices are parked, the cut faces of parked pieces),
+  /// so that the blade's and the probe's queries and the refits before them no longer pay for them.
+  /// They are still drawn.
+  void take_out_parked(const DeformableBody& body);
 
   [[nodiscard]] const SurfaceMesh& surface() const { return m_surface; }
   [[nodiscard]] const CutSurface& cut_surface() const { return m_cut_surface; }

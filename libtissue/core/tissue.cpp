@@ -123,6 +123,7 @@ int Tissue::park_fallen_parts() {
   std::vector<int> rows = m_body.park_parts_outside(operating_field(), m_state);
   if (rows.empty()) return 0;
   m_integrator->restart(Restart::system_grown);  // velocities set, blocks dropped
+  m_surfaces.take_out_parked(m_body);
   const int count = static_cast<int>(rows.size());
   m_parked.push_back({static_cast<int>(m_cuts.batch_ends().size()), std::move(rows)});
   return count;
@@ -200,6 +201,7 @@ void Tissue::replay(const TissueSnapshot& snapshot) {
     const int batches = static_cast<int>(m_cuts.batch_ends().size()) + 1;  // this one is recorded after
     for (; next < parked.size() && parked[next].after_batch == batches; ++next) {
       m_body.park_rows(parked[next].rows);  // std::invalid_argument: the replay's StateError
+      m_surfaces.take_out_parked(m_body);
       m_parked.push_back(parked[next]);
     }
     return made;

@@ -15,6 +15,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <vector>
@@ -115,6 +116,21 @@ TEST(PartsOutOfTheField, AFallenPieceLeavesTheDynamicsAndFallsOnAsOneBody) {
     }
   }
   EXPECT_LT(tangent.nonzero_blocks(), blocks_before);
+
+  // The piece's faces left the surface BVH's tree: out of it are exactly the triangles whose
+  // corners all lie outside the operating field (the mesh's surface of the piece, its cut faces).
+  const SurfaceBvh& bvh = parking.surface_bvh();
+  const Eigen::AlignedBox3d field = parking.operating_field();
+  const Eigen::VectorXd& x = parking.current_positions_m();
+  int out = 0;
+  for (int id = 0; id < bvh.triangle_count(); ++id) {
+    const std::array<int, 3>& t = bvh.triangle(id);
+    const bool outside = std::none_of(t.begin(), t.end(), [&](int v) { return field.contains(x.segment<3>(3 * v)); });
+    EXPECT_EQ(bvh.in_tree(id), !outside) << "triangle " << id;
+    out += bvh.in_tree(id) ? 0 : 1;
+  }
+  EXPECT_GT(out, 0);
+  EXPECT_EQ(keeping.surface_bvh().triangle_count(), bvh.triangle_count());
 
   // The body left behind moves as if the piece were still there.
   const Eigen::VectorXd left = held_part(parking, 0.07);

@@ -34,6 +34,8 @@ class LazySurfaceBvh {
   [[nodiscard]] const Eigen::VectorXd& positions_m() const { return m_positions_m; }
   /// Appends triangles, fitted to the current positions.
   void add_triangles(std::span<const std::array<int, 3>> triangles) { m_bvh.add_triangles(triangles, m_positions_m); }
+  /// Takes triangles out of the tree (SurfaceBvh::remove_triangles); the boxes left stay as fitted.
+  void remove_triangles(std::span<const int> ids) { m_bvh.remove_triangles(ids); }
 
  private:
   const Eigen::VectorXd& m_positions_m;

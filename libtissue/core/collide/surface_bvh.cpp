@@ -168,9 +168,32 @@ void SurfaceBvh::refit(const Eigen::VectorXd& positions_m) {
   check_positions(positions_m, m_tree->required_position_count);
   const double margin_m = box_margin(positions_m);
   for (size_t i = 0; i < m_triangles.size(); ++i) {
-    m_tree->leaves[i]->volume = triangle_box(m_triangles[i], positions_m, margin_m);
+    btDbvtNode* leaf = m_tree->leaves[i];
+    if (leaf != nullptr) leaf->volume = triangle_box(m_triangles[i], positions_m, margin_m);
   }
   for (btDbvtNode* node : m_tree->refit_order) Merge(node->childs[0]->volume, node->childs[1]->volume, node->volume);
+}
+
+void SurfaceBvh::remove_triangles(std::span<const int> ids) {
+  for (const int id : ids) {
+    if (id < 0 || id >= triangle_count()) {
+      throw std::invalid_argument("SurfaceBvh: no triangle " + std::to_string(id) + " to remove (" +
+                                  std::to_string(triangle_count()) + " triangles)");
+    }
+  }
+  bool removed = false;
+  for (const int id : ids) {
+    btDbvtNode*& leaf = m_tree->leaves[static_cast<size_t>(id)];
+    if (leaf == nullptr) continue;
+    m_tree->dbvt.remove(leaf);
+    leaf = nullptr;
+    removed = true;
+  }
+  if (removed) compute_refit_order(m_tree->dbvt, m_tree->refit_order);
+}
+
+bool SurfaceBvh::in_tree(int id) const {
+  return id >= 0 && id < triangle_count() && m_tree->leaves[static_cast<size_t>(id)] != nullptr;
 }
 
 int SurfaceBvh::add_triangle(const std::array<int, 3>& triangle, const Eigen::VectorXd& positions_m) {

@@ -41,6 +41,14 @@ class SurfaceBvh {
   /// refit. Returns the id of the first. Throws std::invalid_argument (nothing added) for a bad id.
   int add_triangles(std::span<const std::array<int, 3>> triangles, const Eigen::VectorXd& positions_m);
 
+  /// Takes triangles out of the tree (the faces of cut tets a later cut replaced, of parts out of the
+  /// field): no query returns them and refit() no longer fits them; their ids and corners stay
+  /// (triangle(id)), so ids never change. An id already out is skipped. Throws std::invalid_argument
+  /// (nothing removed) for an id that is not a triangle's.
+  void remove_triangles(std::span<const int> ids);
+  /// Whether triangle `id` is in the tree (not removed).
+  [[nodiscard]] bool in_tree(int id) const;
+
   struct SegmentHit {
     int triangle = -1;
     double segment_parameter = 0.0;  ///< point = a + s (b - a)

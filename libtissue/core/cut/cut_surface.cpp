@@ -44,28 +44,62 @@ int CutSurface::add_cut_tets(const DeformableBody& body, int first_cut_tet, cons
       add_piece_faces(body, k, surface);
     }
   }
+  std::vector<std::uint8_t> retiring(static_cast<size_t>(cut_tets), 0);
   bool retired_any = false;
   for (int k = 0; k < cut_tets; ++k) {
     if (body.retired(k) && m_retired[static_cast<size_t>(k)] == 0) {
-      retire(body, k);
+      retiring[static_cast<size_t>(k)] = 1;
       retired_any = true;
     }
   }
-  if (retired_any) fix_retired_representatives();
+  if (retired_any) {
+    retire(body, retiring);
+    fix_retired_representatives();
+  }
   update_fronts(body);
   m_drawn_stale = true;
   m_cut_tets = cut_tets;
   return static_cast<int>(m_triangles.size()) - triangles_before;
 }
 
-void CutSurface::retire(const DeformableBody& body, int k) {
-  m_retired[static_cast<size_t>(k)] = 1;
-  // Its corners all follow vertex 0 of the first piece of the tet's current cut tet: zero area.
-  const int current = body.cut_tet_index(body.cut_tets()[static_cast<size_t>(k)].cut.tet);
-  // (Its corners are no longer drawn: the weld's keys turn to live corners.)
-  for (size_t p = 0; p < m_points.size(); ++p) {
-    if (m_point_owner[p] == k) m_points[p] = Point{current, 0, {1.0, 0.0, 0.0, 0.0}};
+void CutSurface::retire(const DeformableBody& body, const std::vector<std::uint8_t>& retiring) {
+  const auto is_retiring = [&](int k) { return k >= 0 && retiring[static_cast<size_t>(k)] != 0; };
+  for (size_t k = 0; k < retiring.size(); ++k) {
+    if (retiring[k] != 0) m_retired[k] = 1;
   }
+  // Their corners all follow vertex 0 of the first piece of the tet's current cut tet (zero area),
+  // and are no longer updated (nothing draws them: the weld's keys turn to live corners).
+  for (size_t p = 0; p < m_points.size(); ++p) {
+    const int k = m_point_owner[p];
+    if (!is_retiring(k)) continue;
+    const int current = body.cut_tet_index(body.cut_tets()[static_cast<size_t>(k)].cut.tet);
+    m_points[p] = Point{current, 0, {1.0, 0.0, 0.0, 0.0}};
+    m_points[p].retired = Point::Retired::to_place;
+  }
+  for (size_t t = 0; t < m_triangles.size(); ++t) {
+    if (is_retiring(m_triangle_cut_tet[t])) m_retired_faces.push_back(static_cast<int>(t));
+  }
+}
+
+void CutSurface::parked_faces(const DeformableBody& body, std::vector<int>& faces) const {
+  for (size_t t = 0; t < m_triangles.size(); ++t) {
+    const int owner = m_triangle_cut_tet[t];
+    if (owner < 0 || m_retired[static_cast<size_t>(owner)] != 0) continue;
+    // A face's corners follow one piece: the first corner that is a cut-face point says which.
+    for (const int id : m_triangles[t]) {
+      if (id < m_vertex_count) continue;
+      const Point& point = m_points[static_cast<size_t>(id - m_vertex_count)];
+      if (point.cut_tet < 0) continue;
+      if (body.xfem().parked(point.cut_tet, point.piece)) faces.push_back(static_cast<int>(t));
+      break;
+    }
+  }
+}
+
+std::vector<int> CutSurface::take_retired_faces() {
+  std::vector<int> faces;
+  faces.swap(m_retired_faces);
+  return faces;
 }
 
 void CutSurface::replace_surface_triangles(int tet, const SurfaceMesh& surface) {
@@ -224,6 +258,17 @@ void CutSurface::update_points(const DeformableBody& body, const Eigen::VectorXd
                                Eigen::Vector3d::Zero()};
   for (size_t p = 0; p < m_points.size(); ++p) {
     const Point& point = m_points[p];
+    if (point.retired != Point::Retired::no) {
+      // A retired face's corner: nothing reads it. Placed once, where its collapse point (vertex 0
+      // of its tet) is at rest, so that a state replayed into a fresh instance has the same positions.
+      if (point.retired == Point::Retired::to_place) {
+        const int vertex = body.cut_tets()[static_cast<size_t>(point.cut_tet)].vertices[0];
+        positions_m.segment<3>(3 * (m_vertex_count + static_cast<Eigen::Index>(p))) =
+            body.mesh().rest_positions_m[static_cast<size_t>(vertex)];
+        point.retired = Point::Retired::placed;
+      }
+      continue;
+    }
     if (point.cut_tet < 0) {  // of real vertices, whose positions the caller wrote
       Eigen::Vector3d x = Eigen::Vector3d::Zero();
       for (size_t j = 0; j < 4; ++j) {

@@ -52,8 +52,17 @@ class CutSurface {
   /// The drawn lists are made again at the next update_drawn(), not here.
   int add_cut_tets(const DeformableBody& body, int first_cut_tet, const SurfaceMesh& surface);
 
+  /// The faces (indices into triangles(), retired ones left out) of pieces that are parked
+  /// (XfemElasticity::parked: their part left the operating field), appended to `faces`.
+  void parked_faces(const DeformableBody& body, std::vector<int>& faces) const;
+  /// The faces retired since the last call (indices into triangles(): the faces of the cut tets a
+  /// later cut replaced, collapsed to a point), for the BVH to take out; then forgets them.
+  [[nodiscard]] std::vector<int> take_retired_faces();
+
   /// Resizes `positions_m` to 3 (vertex_count + point_count()) and writes the cut-face corners after
   /// the mesh vertices, whose positions (the first 3 vertex_count entries) the caller has written.
+  /// The corners of retired faces (nothing reads them) are placed once, at their collapse point's
+  /// rest position.
   void update_points(const DeformableBody& body, const Eigen::VectorXd& displacement_m,
                      Eigen::VectorXd& positions_m) const;
 
@@ -99,6 +108,10 @@ class CutSurface {
     int piece = 0;
     std::array<double, 4> weights{};  ///< the corner is sum_j weights_j p_j of the piece's vertices
     std::array<int, 4> vertices{-1, -1, -1, -1};
+    /// A corner of a retired face: update_points() places it once (at its collapse point's rest
+    /// position), then leaves it there.
+    enum class Retired : std::uint8_t { no, to_place, placed };
+    mutable Retired retired = Retired::no;
   };
   /// What a corner is in the material (cut_surface_weld.cpp): its mesh vertices (ascending, -1
   /// after), the ghost row each is seen through (-1: the real vertex), the cut ids it lies on.
@@ -157,7 +170,7 @@ class CutSurface {
   void add_once_cut_faces(const DeformableBody& body, int k, const SurfaceMesh& surface);
   void add_piece_faces(const DeformableBody& body, int k, const SurfaceMesh& surface);
   void replace_surface_triangles(int tet, const SurfaceMesh& surface);
-  void retire(const DeformableBody& body, int k);
+  void retire(const DeformableBody& body, const std::vector<std::uint8_t>& retiring);
 
   int m_vertex_count = 0;
   int m_cut_tets = 0;
@@ -172,6 +185,7 @@ class CutSurface {
   std::vector<int> m_skin_surface;              // and the surface triangle it is a piece of
   std::vector<std::array<int, 3>> m_skin;       // drawn: welded, live, then the front splits
   std::vector<std::uint8_t> m_retired;          // per cut tet: its faces retired
+  std::vector<int> m_retired_faces;             // faces retired since take_retired_faces()
   std::vector<int> m_cut_replaced;              // surface triangles of cut tets, ascending
   std::vector<int> m_replaced;                  // those and the uncut ones split at a front, ascending
   // The weld (cut_surface_weld.cpp): per point its key and maker (-1: a point of real vertices);

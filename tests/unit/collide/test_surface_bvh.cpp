@@ -458,6 +458,58 @@ TEST(SurfaceBvh, AddedTrianglesAreFoundAndRefitted) {
   compare_boxes(bvh, triangles, deformed, f.size_m, 35);
 }
 
+// Faces taken out (the faces of retired cut tets, issue 41) are never returned, are not refitted,
+// keep their ids, and the rest answer as brute force over the kept triangles does.
+TEST(SurfaceBvh, RemovedTrianglesAreNeverFoundAndTheRestAnswerAsBefore) {
+  const Frog& f = frog();
+  SurfaceBvh bvh(f.triangles, f.rest_m);
+  const int n = bvh.triangle_count();
+  std::vector<int> removed;
+  for (int id = 0; id < n; id += 3) removed.push_back(id);
+  bvh.remove_triangles(removed);
+  bvh.remove_triangles(std::vector<int>{0, 3});  // out already: skipped
+  Triangles kept;
+  std::vector<int> kept_id;
+  for (int id = 0; id < n; ++id) {
+    EXPECT_EQ(bvh.in_tree(id), id % 3 != 0) << id;
+    EXPECT_EQ(bvh.triangle(id), f.triangles[static_cast<size_t>(id)]);  // ids and corners stay
+    if (id % 3 == 0) continue;
+    kept.push_back(f.triangles[static_cast<size_t>(id)]);
+    kept_id.push_back(id);
+  }
+  // The leaves of the kept triangles only, each once.
+  int leaves = 0;
+  for (const SurfaceBvh::NodeShape& node : bvh.shape()) {
+    if (node.triangle < 0) continue;
+    ++leaves;
+    EXPECT_NE(node.triangle % 3, 0);
+  }
+  EXPECT_EQ(leaves, static_cast<int>(kept.size()));
+
+  const Eigen::VectorXd deformed = deform(f, f.rest_m);
+  bvh.refit(deformed);
+  std::mt19937 random(41);
+  std::vector<SurfaceBvh::SegmentHit> segment_hits;
+  std::vector<SurfaceBvh::SphereHit> sphere_hits;
+  int hits_seen = 0;
+  for (int query = 0; query < 400; ++query) {
+    const Eigen::Vector3d point = random_surface_point(random, f.triangles, deformed);
+    const Eigen::Vector3d d = 0.3 * f.size_m * random_unit(random);
+    bvh.intersect_segment(point - d, point + d, deformed, segment_hits);
+    std::vector<SurfaceBvh::SegmentHit> brute = brute_segment(kept, point - d, point + d, deformed);
+    for (SurfaceBvh::SegmentHit& hit : brute) hit.triangle = kept_id[static_cast<size_t>(hit.triangle)];
+    expect_same(segment_hits, brute, query);
+    bvh.intersect_sphere(point, 0.05 * f.size_m, deformed, sphere_hits);
+    std::vector<SurfaceBvh::SphereHit> brute_hits = brute_sphere(kept, point, 0.05 * f.size_m, deformed);
+    for (SurfaceBvh::SphereHit& hit : brute_hits) hit.triangle = kept_id[static_cast<size_t>(hit.triangle)];
+    expect_same(sphere_hits, brute_hits, query);
+    hits_seen += static_cast<int>(segment_hits.size() + sphere_hits.size());
+  }
+  EXPECT_GT(hits_seen, 1000);
+  EXPECT_THROW(bvh.remove_triangles(std::vector<int>{n}), std::invalid_argument);
+  EXPECT_THROW(bvh.remove_triangles(std::vector<int>{-1}), std::invalid_argument);
+}
+
 TEST(SurfaceBvh, EmptyTreeGrowsByAddition) {
   const Eigen::VectorXd x = square_positions();
   SurfaceBvh bvh({}, x);
