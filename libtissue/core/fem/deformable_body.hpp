@@ -23,6 +23,7 @@
 #include "core/system/dynamics_model.hpp"
 #include "core/system/force_term.hpp"
 #include "core/system/rayleigh_damping.hpp"
+#include "core/system/rows_left.hpp"
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
@@ -233,9 +234,7 @@ class DeformableBody final : public DynamicsModel {
   /// state follows). Throws std::invalid_argument, nothing changed, for a row out of range.
   void park_rows(std::span<const int> rows);
   /// Whether block row `row` belongs to a part taken out of the dynamics.
-  [[nodiscard]] bool parked(int row) const {
-    return static_cast<size_t>(row) < m_row_parked.size() && m_row_parked[static_cast<size_t>(row)] != 0;
-  }
+  [[nodiscard]] bool parked(int row) const { return row_left(&m_row_parked, row); }
   [[nodiscard]] int parked_row_count() const { return m_parked_rows; }
   /// The parked rows (DynamicsModel::rows_left).
   [[nodiscard]] const std::vector<std::uint8_t>* rows_left() const override { return &m_row_parked; }

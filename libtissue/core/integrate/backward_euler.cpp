@@ -1,5 +1,6 @@
 // Semi-implicit backward Euler step (see backward_euler.hpp).
 #include "core/integrate/backward_euler.hpp"
+#include "core/system/rows_left.hpp"
 
 #include "core/wall_clock.hpp"
 
@@ -218,9 +219,7 @@ bool BackwardEuler::guard_energy(DynamicsModel& model, const DynamicState& state
   // taking the step's excess from them drained the parts falling away (they hold most of the motion
   // relative to the mean): the hatched frog's pieces stopped in mid-air while later strokes cut.
   const std::vector<std::uint8_t>* left = model.rows_left();
-  const auto in = [left](Eigen::Index r) {
-    return left == nullptr || static_cast<size_t>(r) >= left->size() || (*left)[static_cast<size_t>(r)] == 0;
-  };
+  const auto in = [left](Eigen::Index r) { return !row_left(left, r); };
   const Eigen::VectorXd& load = model.external_force_n();
   Eigen::Vector3d momentum = Eigen::Vector3d::Zero();
   Eigen::Vector3d mass_sum = Eigen::Vector3d::Zero();

@@ -1,5 +1,6 @@
 // HalfMatrix (half_matrix.hpp): the compact copy and its product kernel.
 #include "core/solve/half_matrix.hpp"
+#include "core/system/rows_left.hpp"
 
 #include "core/solve/linear_solver.hpp"
 #include "core/system/hot_kernel.hpp"
@@ -97,8 +98,8 @@ void HalfMatrix::assign(const ShiftedSystem& system, WorkTeam* team) {
   m_isolated_rows.clear();
   const std::vector<std::uint8_t>* left = system.rows_left;
   const int left_rows = left == nullptr ? 0 : std::min(block_rows(), static_cast<int>(left->size()));
-  for (int r = 0; r < left_rows; ++r) {
-    if ((*left)[static_cast<size_t>(r)] == 0) continue;
+  for (int r = 0; r < left_rows; ++r) {  // (rows past the list are in)
+    if (!row_left(left, r)) continue;
     bool joined = false;
     for (int slot = k.row_begin(r); slot < k.row_begin(r) + k.row_size(r) && !joined; ++slot) {
       const int c = k.slot_column(slot);

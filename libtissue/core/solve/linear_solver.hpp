@@ -31,7 +31,7 @@ struct ShiftedSystem {
   /// block_positions); given to solvers that use_block_positions().
   const std::vector<Eigen::Vector3d>* block_positions = nullptr;
   /// Optional (nullptr: none): per block row, nonzero where the row left the dynamics
-  /// (DynamicsModel::rows_left: a part parked out of the field; may be shorter than the rows). Those
+  /// (DynamicsModel::rows_left: a part parked out of the field; read with row_left()). Those
   /// of them no nonzero block of K joins to another are each solved exactly by the CG solvers
   /// (HalfMatrix::isolated_rows).
   const std::vector<std::uint8_t>* rows_left = nullptr;

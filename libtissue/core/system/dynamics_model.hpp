@@ -66,7 +66,8 @@ class DynamicsModel {
   /// Per block row, nonzero where the row has left the dynamics (a part parked out of the operating
   /// field): no element joins it to another, it keeps its mass and weight and falls on as a free
   /// particle, whose backward-Euler step is exact and loses energy. The energy guard leaves those rows
-  /// out. May be shorter than the rows (the rest are in); nullptr (the default): every row is in.
+  /// out. May be shorter than the rows (the rest are in); nullptr (the default): every row is in. Read
+  /// it with row_left() (core/system/rows_left.hpp).
   [[nodiscard]] virtual const std::vector<std::uint8_t>* rows_left() const { return nullptr; }
   /// The potential of the model's forces at u: elastic energy plus that of any spring to a fixed
   /// target, minus f_ext . u [J]; NaN for a model that cannot say (its steps are not energy-guarded).
