@@ -59,16 +59,18 @@ void SurfaceViews::add_cut_tets(const DeformableBody& body, const Eigen::VectorX
   m_bvh.add_triangles(std::span(faces).last(static_cast<size_t>(new_faces)));
   // The faces of the cut tets these replaced are out of the tree: no query needs a zero-area face,
   // and their corners are no longer updated.
-  // (The cut faces are the tree's last triangles; without a BVH of the surface, all of them.)
-  const int first_cut_face = m_bvh.unfitted().triangle_count() - static_cast<int>(faces.size());
   std::vector<int> retired = m_cut_surface.take_retired_faces();
-  for (int& face : retired) face += first_cut_face;
+  for (int& face : retired) face += first_cut_face_id();
   m_bvh.remove_triangles(retired);
 }
 
+int SurfaceViews::first_cut_face_id() const {
+  // The cut faces are the tree's last triangles; without a BVH of the surface, all of them.
+  return m_bvh.unfitted().triangle_count() - static_cast<int>(m_cut_surface.triangles().size());
+}
+
 void SurfaceViews::take_out_parked(const DeformableBody& body) {
-  const int cut_faces = static_cast<int>(m_cut_surface.triangles().size());
-  const int first_cut_face = m_bvh.unfitted().triangle_count() - cut_faces;
+  const int first_cut_face = first_cut_face_id();
   std::vector<int> ids;
   for (int t = 0; t < first_cut_face; ++t) {  // the mesh's surface triangles (when the BVH has them)
     const std::array<int, 3>& triangle = m_surface.triangles[static_cast<size_t>(t)];

@@ -78,6 +78,8 @@ class SurfaceViews {
   }
 
  private:
+  // The BVH id of the first cut face (cut face t is this + t).
+  [[nodiscard]] int first_cut_face_id() const;
   void bring_drawn_up_to_date(const DeformableBody& body, const Eigen::VectorXd& displacement_m) const;
 
   SurfaceMesh m_surface;
