@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numeric>
 
 namespace tissue {
 
@@ -19,8 +20,14 @@ void TwoLevelPreconditioner::setup(const ShiftedSystem& system, const Eigen::Vec
     return;
   }
   if (aggregated) {
-    m_with_rotations = system.block_positions != nullptr;
-    aggregate(system);  // with this setup's basis
+    // A refresh due after a cut: the local level's aggregates (made now if the cut is newer) join
+    // the coarse level; else (none fits, or too many rows changed) every row is aggregated anew.
+    if (patch_fits(system) || (patchable(system) && aggregate_changed_rows(system))) {
+      merge_local_level(system);
+    } else {
+      m_with_rotations = system.block_positions != nullptr;
+      aggregate(system);  // with this setup's basis
+    }
     m_setups_since_coarse = COARSE_REFRESH_SETUPS;  // a coarse level now
   }
   if (++m_setups_since_coarse < COARSE_REFRESH_SETUPS) return;
@@ -45,17 +52,54 @@ bool TwoLevelPreconditioner::aggregates_fit(const ShiftedSystem& system) const {
          k.block_rows() == m_rows && (system.block_positions != nullptr) == m_with_rotations;
 }
 
+namespace {
+
+std::vector<int> every_row(int rows) {
+  std::vector<int> all(static_cast<size_t>(rows));
+  std::iota(all.begin(), all.end(), 0);
+  return all;
+}
+
+}  // namespace
+
 void TwoLevelPreconditioner::aggregate(const ShiftedSystem& system) {
+  const std::vector<int> all = every_row(system.stiffness->block_rows());
+  const StrongGraph graph(system, all, all, STRENGTH);
+  adopt_aggregates(system, aggregate_rows(AGGREGATE_REACH, graph, m_aggregate_of_row));
+}
+
+void TwoLevelPreconditioner::merge_local_level(const ShiftedSystem& system) {
+  const int rows = system.stiffness->block_rows();
+  // The earlier aggregates none of whose rows is the local level's keep their rows, renumbered in
+  // order; the local level's follow. (A touched aggregate's rows are all the local level's.)
+  std::vector<int> kept_as(static_cast<size_t>(aggregate_count()), 0);
+  for (const int i : m_local.rows) {
+    const int a = i < m_rows ? m_aggregate_of_row[static_cast<size_t>(i)] : -1;
+    if (a >= 0) kept_as[static_cast<size_t>(a)] = -1;
+  }
+  int count = 0;
+  for (int& a : kept_as) a = a < 0 ? -1 : count++;
+  m_aggregate_of_row.resize(static_cast<size_t>(rows), -1);
+  for (int i = 0; i < rows; ++i) {
+    int& a = m_aggregate_of_row[static_cast<size_t>(i)];
+    const int l = m_local.local_of[static_cast<size_t>(i)];
+    if (l >= 0) {
+      const int b = m_local.aggregate_of[static_cast<size_t>(l)];
+      a = b < 0 ? -1 : count + b;
+    } else if (a >= 0) {
+      a = kept_as[static_cast<size_t>(a)];
+    }
+  }
+  adopt_aggregates(system, count + m_local.aggregates.count());
+}
+
+void TwoLevelPreconditioner::adopt_aggregates(const ShiftedSystem& system, int count) {
   const BlockSparseMatrix& k = *system.stiffness;
   const int rows = k.block_rows();
-  std::vector<int> every_row(static_cast<size_t>(rows));
-  for (int i = 0; i < rows; ++i) every_row[static_cast<size_t>(i)] = i;
-  const StrongGraph graph(system, every_row, every_row, STRENGTH);
-  const int count = aggregate_rows(AGGREGATE_REACH, graph, m_aggregate_of_row);
   m_aggregated_row_size.resize(static_cast<size_t>(rows));
   for (int i = 0; i < rows; ++i) m_aggregated_row_size[static_cast<size_t>(i)] = k.row_size(i);
   m_local.ok = false;
-  m_coarse.group(every_row, m_aggregate_of_row, count, m_entry_of_row);
+  m_coarse.group(every_row(rows), m_aggregate_of_row, count, m_entry_of_row);
   m_coarse.make_basis(system.block_positions, /*count_rotations=*/true);
   for (int part = 0; part <= MAX_STEP_THREADS; ++part) {
     m_aggregate_split[static_cast<size_t>(part)] = m_coarse.split(part, MAX_STEP_THREADS);

@@ -9,11 +9,13 @@
 // unassigned becomes a root and takes them; a row left over joins the aggregate of its strongest
 // assigned neighbour (or becomes one of its own). A row with no strong neighbour (an orphaned ghost,
 // a part taken out of the dynamics: nothing but its mass) joins none: its coarse columns would only
-// repeat Jacobi's solve of it, and the thousands a hatched body leaves grew the coarse level. A coupling is strong when ||A_ij||_F > STRENGTH sqrt(||A_ii||_F ||A_jj||_F):
-// the blocks a cut left in the pattern at zero never join the two sides of a cut. Made at the
-// first setup and again at the first coarse refresh after K's pattern or layout changed (a cut),
-// from that setup's values; a cut between refreshes gets a local level meanwhile (the rows it
-// changed aggregated anew beside the coarse level made before: two_level_local_level.cpp).
+// repeat Jacobi's solve of it, and the thousands a hatched body leaves grew the coarse level. A coupling is strong when
+// ||A_ij||_F > STRENGTH sqrt(||A_ii||_F ||A_jj||_F): the blocks a cut left in the pattern at zero never join the two
+// sides of a cut. Made at the first setup and whenever K's pattern or layout changed in a way no local level serves,
+// from that setup's values; a cut between refreshes gets a local level meanwhile (the rows it changed aggregated anew
+// beside the coarse level made before: two_level_local_level.cpp), and at the next coarse refresh the local level's
+// aggregates take the place of those it replaced in the coarse level (the rest kept: only the cut's rows are aggregated
+// anew, not the whole matrix).
 //
 // Coarse space: per aggregate, the translations and the rotations about its centroid of the rows'
 // points (ShiftedSystem::block_positions at each setup; translations only without them),
@@ -87,7 +89,13 @@ class TwoLevelPreconditioner {
   /// Whether the aggregates are of `system`'s K: the same object, pattern, layout and size, and
   /// points given as when they were made.
   [[nodiscard]] bool aggregates_fit(const ShiftedSystem& system) const;
+  /// Aggregates every row of `system` anew.
   void aggregate(const ShiftedSystem& system);
+  /// Aggregates made of the local level's (of `system`'s K as it is) and the earlier ones it did not
+  /// replace: the rows of the aggregates a cut touched get the local level's aggregates.
+  void merge_local_level(const ShiftedSystem& system);
+  /// The coarse space and pattern of m_aggregate_of_row (`count` aggregates) over `system`'s K.
+  void adopt_aggregates(const ShiftedSystem& system, int count);
   /// Between coarse refreshes, a cut's rows get a local level (patch()) when patchable().
   [[nodiscard]] bool patchable(const ShiftedSystem& system) const;
   /// Whether the local level is of `system`'s K as it is (no cut since the patch).
@@ -95,10 +103,11 @@ class TwoLevelPreconditioner {
   /// Makes the local level for the rows added or changed (in block count) since the aggregation;
   /// false (nothing made) when they are too many for it.
   bool patch(const ShiftedSystem& system);
-  /// The local level's matrix over `local_rows` (local_of, aggregate_of, entry_of: patch()'s
-  /// maps), assembled and factorized into m_local.
-  void factorize_local(const ShiftedSystem& system, const std::vector<int>& local_rows, const std::vector<int>& local_of,
-                       const std::vector<int>& aggregate_of, const std::vector<int>& entry_of);
+  /// patch()'s first half: the local level's rows and aggregates (not its matrix); false when the
+  /// rows are none or too many for it.
+  bool aggregate_changed_rows(const ShiftedSystem& system);
+  /// The local level's matrix over its rows, assembled and factorized into m_local.
+  void factorize_local(const ShiftedSystem& system);
   void make_coarse_pattern(const BlockSparseMatrix& k);
   /// An aggregated row's point minus its aggregate's centroid.
   [[nodiscard]] const Eigen::Vector3d& offset_of_row(int row) const {
@@ -154,6 +163,10 @@ class TwoLevelPreconditioner {
   // motions of small aggregates of them, with their own (dense) coarse matrix from the setup that
   // made them, added to the coarse level made before (additive, so P stays positive definite).
   struct LocalLevel {
+    std::vector<int> rows;          // its block rows, ascending
+    std::vector<int> local_of;      // per block row of K: its index in rows, or -1
+    std::vector<int> aggregate_of;  // per index in rows: its aggregate, or -1 (no strong neighbour)
+    std::vector<int> entry_of;      // per index in rows: its entry in aggregates.rows, or -1
     RigidAggregates aggregates;
     Eigen::LDLT<Eigen::MatrixXd> factor;
     Eigen::VectorXd rhs, solution;
