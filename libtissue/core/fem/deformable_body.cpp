@@ -455,10 +455,12 @@ void DeformableBody::refresh_cut_tet_slots(int cut_tet_index) {
     std::fill(slots.begin(), slots.end(), -1);
     return;
   }
+  std::vector<std::uint8_t> coupled;
+  m_xfem.coupled_dofs(cut_tet_index, coupled);
   for (int r = 0; r < dofs; ++r) {
     for (int col = 0; col < dofs; ++col) {
       int slot = -1;
-      if (m_xfem.couples(cut_tet_index, r, col) && row_of(r) >= 0 && row_of(col) >= 0) {
+      if (coupled[static_cast<size_t>(dofs * r + col)] != 0 && row_of(r) >= 0 && row_of(col) >= 0) {
         slot = m_tangent.find_slot(row_of(r), row_of(col));
         if (slot < 0)
           throw std::logic_error("enrich: a block of cut tet " + std::to_string(cut_tet.cut.tet) + " is missing");

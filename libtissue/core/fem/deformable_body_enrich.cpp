@@ -468,10 +468,12 @@ void DeformableBody::orphan_unused_vertex_rows(const EnrichBatch& batch) {
 // 4. The blocks the pieces of cut tet k couple beyond u-u (which exist already).
 void DeformableBody::list_coupled_blocks(int k, std::vector<std::pair<int, int>>& new_blocks) const {
   const int dofs = m_xfem.dof_count(k);
+  std::vector<std::uint8_t> coupled;
+  m_xfem.coupled_dofs(k, coupled);
   for (int r = 0; r < dofs; ++r) {
     for (int col = 0; col < dofs; ++col) {
       if (r < 4 && col < 4) continue;
-      if (!m_xfem.couples(k, r, col)) continue;  // identically zero
+      if (coupled[static_cast<size_t>(dofs * r + col)] == 0) continue;  // identically zero
       const int row = cut_tet_dof_row(k, r);
       const int column = cut_tet_dof_row(k, col);
       if (row < 0 || column < 0) continue;  // a fixed vertex's u

@@ -138,18 +138,20 @@ void XfemElasticity::mark_written_slots(int k, std::vector<std::uint8_t>& keep) 
   }
 }
 
-bool XfemElasticity::couples(int k, int dof_i, int dof_j) const {
-  if (dof_i < 4 && dof_j < 4) return true;  // the uncut tet's blocks (kept)
+void XfemElasticity::coupled_dofs(int k, std::vector<std::uint8_t>& coupled) const {
+  const int dofs = dof_count(k);
+  coupled.assign(to_size(dofs * dofs), 0);
+  for (int a = 0; a < 4; ++a) {
+    for (int b = 0; b < 4; ++b) coupled[to_size(dofs * a + b)] = 1;  // the uncut tet's blocks (kept)
+  }
   const std::size_t begin = piece_begin(k);
   for (std::size_t p = begin; p < begin + piece_count(k); ++p) {
     if (m_parked[p] != 0) continue;
-    const std::array<int, 4>& dofs = m_ghost_dofs[p];
-    const auto uses = [&](int dof) {
-      return dof < 4 ? dofs[to_size(dof)] < 0 : std::find(dofs.begin(), dofs.end(), dof) != dofs.end();
-    };
-    if (uses(dof_i) && uses(dof_j)) return true;
+    const std::array<int, 4> dof = piece_dofs(p);
+    for (const int a : dof) {
+      for (const int b : dof) coupled[to_size(dofs * a + b)] = 1;
+    }
   }
-  return false;
 }
 
 void XfemElasticity::restore_rotations(const std::vector<Eigen::Matrix3d>& rotations,

@@ -392,11 +392,11 @@ double BackwardEuler::line_search(DynamicsModel& model, const DynamicState& stat
   const double beta_s = model.stiffness_damping_s();
   std::array<double, 3> quadratic{0.0, 0.0, 0.0};  // v^T K v, c^T K v, c^T K c
   if (beta_s != 0.0) {
-    const BlockSparseMatrix& stiffness = model.tangent();
+    // K v1 is the right side's (the same K, the same v1): one product, not two (a full K's product
+    // per correction, a tenth of a hatched run's late steps).
+    quadratic = {m_end_velocity.dot(m_stiffness_times_velocity), m_correction.dot(m_stiffness_times_velocity), 0.0};
     m_trial_product.resize(m_correction.size());
-    stiffness.multiply(m_end_velocity, m_trial_product, team);
-    quadratic = {m_end_velocity.dot(m_trial_product), m_correction.dot(m_trial_product), 0.0};
-    stiffness.multiply(m_correction, m_trial_product, team);
+    model.tangent().multiply(m_correction, m_trial_product, team);
     quadratic[2] = m_correction.dot(m_trial_product);
   }
   const auto stiffness_damping_j = [&](double share) {

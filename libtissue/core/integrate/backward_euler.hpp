@@ -109,7 +109,8 @@ class BackwardEuler final : public Integrator {
   // The share t of m_correction to take (0: none lowers the incremental potential); the trial taken
   // is left in m_trial_velocity, its potential energy in m_trial_potential_j. The iterate's
   // potential energy is m_end_potential_j when known. `evaluate_whole`: the whole correction's trial
-  // is evaluated with the tangent (m_trial_evaluated tells whether the search took it).
+  // is evaluated with the tangent (m_trial_evaluated tells whether the search took it). With
+  // stiffness damping, m_stiffness_times_velocity must hold K m_end_velocity (correct()'s right side).
   double line_search(DynamicsModel& model, const DynamicState& state, double h, WorkTeam* team, bool evaluate_whole);
 
   std::unique_ptr<LinearSolver> m_solver;
