@@ -107,6 +107,7 @@ struct Outcome {
   /// it: the god-object holds the tool at the side it entered); 0 if none.
   int contact_started_outside_at = 0;
   double wall_s = 0.0;
+  double budget_s = 0.0;  ///< the wall time it was given (case_budget_s() times Case::time_scale)
 };
 
 /// Runs one case: builds the Tissue (a ParameterError is a refusal), steps it through the script,
