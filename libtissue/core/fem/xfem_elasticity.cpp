@@ -123,18 +123,11 @@ std::array<int, 4> XfemElasticity::piece_dofs(std::size_t p) const {
 }
 
 void XfemElasticity::mark_written_slots(int k, std::vector<std::uint8_t>& keep) const {
-  const int dofs = dof_count(k);
   const int* const slots = m_slots.data() + m_slot_begin[static_cast<std::size_t>(k)];
-  const std::size_t begin = piece_begin(k);
-  for (std::size_t p = begin; p < begin + piece_count(k); ++p) {
-    if (m_parked[p] != 0) continue;
-    const std::array<int, 4> dof = piece_dofs(p);
-    for (const int a : dof) {
-      for (const int b : dof) {
-        const int slot = slots[dofs * a + b];
-        if (slot >= 0) keep[static_cast<std::size_t>(slot)] = 1;
-      }
-    }
+  std::vector<std::uint8_t> coupled;
+  coupled_dofs(k, coupled);
+  for (std::size_t pair = 0; pair < coupled.size(); ++pair) {
+    if (coupled[pair] != 0 && slots[pair] >= 0) keep[static_cast<std::size_t>(slots[pair])] = 1;
   }
 }
 

@@ -156,7 +156,8 @@ class XfemElasticity {
   /// piece of it that is not parked uses both i and j (its four DOFs, piece_dofs); the four u DOFs
   /// always couple. One pass over the pieces (asking pair by pair cost 5% of a hatched run).
   void coupled_dofs(int k, std::vector<std::uint8_t>& coupled) const;
-  /// Marks keep[slot] for every slot the unparked pieces of cut tet k write (evaluate's blocks).
+  /// Marks keep[slot] for every slot of cut tet k's table whose DOFs couple (coupled_dofs): the
+  /// blocks its unparked pieces write (evaluate's), and its u-u blocks.
   void mark_written_slots(int k, std::vector<std::uint8_t>& keep) const;
   [[nodiscard]] CutTetSlots slots(int k) {
     const auto begin = m_slot_begin[static_cast<std::size_t>(k)];

@@ -33,21 +33,6 @@ bool TwoLevelPreconditioner::patch_fits(const ShiftedSystem& system) const {
          (system.block_positions != nullptr) == m_with_rotations;
 }
 
-bool TwoLevelPreconditioner::patch(const ShiftedSystem& system) {
-  if (!aggregate_changed_rows(system)) return false;
-  const BlockSparseMatrix& k = *system.stiffness;
-  LocalLevel& level = m_local;
-  factorize_local(system);
-  const int columns = level.aggregates.columns();
-  level.ok = columns > 0 && level.factor.info() == Eigen::Success && (level.factor.vectorD().array() > 0.0).all();
-  level.rhs.resize(columns);
-  level.solution.resize(columns);
-  level.pattern_revision = k.pattern_revision();
-  level.layout_revision = k.layout_revision();
-  level.rows_of_k = k.block_rows();
-  return level.ok;
-}
-
 bool TwoLevelPreconditioner::aggregate_changed_rows(const ShiftedSystem& system) {
   const BlockSparseMatrix& k = *system.stiffness;
   const int rows = k.block_rows();
@@ -88,9 +73,9 @@ bool TwoLevelPreconditioner::aggregate_changed_rows(const ShiftedSystem& system)
 
 // Al = Pl^T A Pl, dense (RigidAggregates::basis); factorized (LDL^T). Row i of aggregate a, per
 // aggregate b its blocks reach: S_b = sum_j A_ij P_j over the rows j of b, then Al_ab += P_i^T S_b.
-void TwoLevelPreconditioner::factorize_local(const ShiftedSystem& system) {
+bool TwoLevelPreconditioner::factorize_local(const ShiftedSystem& system) {
   const BlockSparseMatrix& k = *system.stiffness;
-  const LocalLevel& local = m_local;
+  LocalLevel& local = m_local;
   const RigidAggregates& level = local.aggregates;
   const int count = static_cast<int>(local.rows.size());
   const int columns = level.columns();
@@ -125,7 +110,14 @@ void TwoLevelPreconditioner::factorize_local(const ShiftedSystem& system) {
           block.topLeftCorner(width(a), width(b));
     }
   }
-  m_local.factor.compute(matrix);
+  local.factor.compute(matrix);
+  local.ok = columns > 0 && local.factor.info() == Eigen::Success && (local.factor.vectorD().array() > 0.0).all();
+  local.rhs.resize(columns);
+  local.solution.resize(columns);
+  local.pattern_revision = k.pattern_revision();
+  local.layout_revision = k.layout_revision();
+  local.rows_of_k = k.block_rows();
+  return local.ok;
 }
 
 }  // namespace tissue

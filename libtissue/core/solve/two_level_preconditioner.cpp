@@ -15,14 +15,16 @@ void TwoLevelPreconditioner::setup(const ShiftedSystem& system, const Eigen::Vec
   m_inverse_diagonal = &inverse_diagonal;
   const bool aggregated = !aggregates_fit(system);
   const bool refresh_due = m_setups_since_coarse + 1 >= COARSE_REFRESH_SETUPS;
-  if (aggregated && !refresh_due && (patch_fits(system) || (patchable(system) && patch(system)))) {
-    ++m_setups_since_coarse;  // the coarse level made before serves, with the local level beside it
-    return;
-  }
   if (aggregated) {
-    // A refresh due after a cut: the local level's aggregates (made now if the cut is newer) join
-    // the coarse level; else (none fits, or too many rows changed) every row is aggregated anew.
-    if (patch_fits(system) || (patchable(system) && aggregate_changed_rows(system))) {
+    // The rows the cuts since the aggregation changed, aggregated apart (the local level), if they can be.
+    const bool local = patch_fits(system) || (patchable(system) && aggregate_changed_rows(system));
+    if (local && !refresh_due && (m_local.ok || factorize_local(system))) {
+      ++m_setups_since_coarse;  // the coarse level made before serves, with the local level beside it
+      return;
+    }
+    // A refresh due (or the local level's matrix not positive definite): the local level's
+    // aggregates join the coarse level; else (too many rows changed) every row is aggregated anew.
+    if (local) {
       merge_local_level(system);
     } else {
       m_with_rotations = system.block_positions != nullptr;

@@ -96,18 +96,17 @@ class TwoLevelPreconditioner {
   void merge_local_level(const ShiftedSystem& system);
   /// The coarse space and pattern of m_aggregate_of_row (`count` aggregates) over `system`'s K.
   void adopt_aggregates(const ShiftedSystem& system, int count);
-  /// Between coarse refreshes, a cut's rows get a local level (patch()) when patchable().
+  /// Between coarse refreshes, a cut's rows get a local level when patchable().
   [[nodiscard]] bool patchable(const ShiftedSystem& system) const;
-  /// Whether the local level is of `system`'s K as it is (no cut since the patch).
+  /// Whether the local level is of `system`'s K as it is (no cut since it was made).
   [[nodiscard]] bool patch_fits(const ShiftedSystem& system) const;
-  /// Makes the local level for the rows added or changed (in block count) since the aggregation;
-  /// false (nothing made) when they are too many for it.
-  bool patch(const ShiftedSystem& system);
-  /// patch()'s first half: the local level's rows and aggregates (not its matrix); false when the
-  /// rows are none or too many for it.
+  /// The local level's rows (those added or changed in block count since the aggregation, and the
+  /// rest of their aggregates) and their aggregates, not its matrix; false when the rows are none or
+  /// too many for it.
   bool aggregate_changed_rows(const ShiftedSystem& system);
-  /// The local level's matrix over its rows, assembled and factorized into m_local.
-  void factorize_local(const ShiftedSystem& system);
+  /// The local level's matrix over its rows, assembled and factorized into m_local, which then fits
+  /// `system`; whether it serves (positive definite).
+  bool factorize_local(const ShiftedSystem& system);
   void make_coarse_pattern(const BlockSparseMatrix& k);
   /// An aggregated row's point minus its aggregate's centroid.
   [[nodiscard]] const Eigen::Vector3d& offset_of_row(int row) const {
