@@ -48,6 +48,8 @@ import fmpy
 from fmpy.fmi1 import FMICallException
 from fmpy.fmi3 import FMU3Slave, fmi3ValueReference
 
+from hatch_plan import hatched_strokes
+
 ROOT = pathlib.Path(__file__).resolve().parents[2]
 
 MESH_MAGIC = 0x314D5354       # "TSM1"
@@ -382,18 +384,7 @@ class Run:
         tip_z = lo[2] - a.tip_below * ext[2]
         if tip_z + a.blade_length < hi[2] + ext[2]:
             print(f"  note: the blade reaches z = {tip_z + a.blade_length:.3f} m, the frog's top is {hi[2]:.3f} m")
-        margin = a.margin
-        plan = []
-        # Parallel: along x (the body's length), y spread over the middle two thirds of the width.
-        for k in range(a.strokes):
-            y = lo[1] + ext[1] * (1 / 6 + (2 / 3) * k / max(a.strokes - 1, 1)) + 1.3e-5
-            plan.append(("along x", f"y = {y:+.4f}", [lo[0] - margin * ext[0], y, tip_z],
-                         [hi[0] + margin * ext[0], y, tip_z]))
-        # Crossing: along y (across the body), x over the middle two thirds of the length, head first.
-        for k in range(a.strokes):
-            x = hi[0] - ext[0] * (1 / 6 + (2 / 3) * k / max(a.strokes - 1, 1)) + 1.3e-5
-            plan.append(("across", f"x = {x:+.4f}", [x, lo[1] - margin * ext[1], tip_z],
-                         [x, hi[1] + margin * ext[1], tip_z]))
+        plan = hatched_strokes(lo, hi, a.strokes, a.tip_below, a.margin)
         total = len(plan)
         for k, (kind, where, start, end) in enumerate(plan, 1):
             steps_before, wall_before = self.steps, sum(self.step_wall)
