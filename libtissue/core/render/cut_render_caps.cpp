@@ -20,6 +20,8 @@
 namespace tissue {
 
 using cut_render_detail::border_loops;
+using cut_render_detail::cap_polygon;
+using cut_render_detail::CapEdges;
 using cut_render_detail::directed_key;
 using cut_render_detail::ear_clip;
 using cut_render_detail::edge_key;
@@ -164,28 +166,6 @@ int walk_faces(const std::vector<std::vector<int>>& loops, const std::vector<Cha
 using SimpleCaps =
     std::map<std::vector<int>, std::vector<std::array<int, 3>>>;  // loop (from its smallest point) -> cap
 
-// The edges a cap must not run along (ear_clip's edge_exists): the split surface's directed edges at
-// its split points (a border edge has no twin), the caps' edges so far and the surface's own.
-struct CapEdges {
-  std::unordered_map<long long, int> directed;   // (u, v) -> count
-  std::unordered_set<long long> caps;            // (lower, higher) of the caps' edges so far
-  const std::unordered_set<long long>& surface;  // the surface's own edges
-  int vertices;                                  // the surface's vertices: the points below
-
-  bool operator()(int u, int v) const {
-    const long long undirected = edge_key(u, v);
-    if (caps.contains(undirected)) return true;
-    if (u < vertices && v < vertices) return surface.contains(undirected);
-    return directed.contains(directed_key(u, v)) || directed.contains(directed_key(v, u));
-  }
-  void add(const std::array<int, 3>& triangle) {
-    for (size_t k = 0; k < 3; ++k) {
-      const int u = triangle[k], v = triangle[(k + 1) % 3];
-      caps.insert(edge_key(u, v));
-    }
-  }
-};
-
 // Adds the directed edges at split points of triangles[first, end) (the split surface's, later the
 // caps'). (An edge between two of the surface's own vertices keeps both its triangles: never a border.)
 void find_split_edges(const std::vector<std::array<int, 3>>& triangles, size_t first, size_t points, CapEdges& edges) {
@@ -199,14 +179,6 @@ void find_split_edges(const std::vector<std::array<int, 3>>& triangles, size_t f
     }
   }
   edges.caps.reserve(edges.directed.size() + 64);
-}
-
-// Caps a polygon (ear_clip), its edges added to `edges`.
-void cap_polygon(const std::vector<int>& polygon, const std::vector<Eigen::Vector3d>& rest_m,
-                 std::vector<std::array<int, 3>>& triangles, CapEdges& edges) {
-  const size_t before = triangles.size();
-  ear_clip(polygon, rest_m, triangles, [&edges](int u, int v) { return edges(u, v); });
-  for (size_t t = before; t < triangles.size(); ++t) edges.add(triangles[t]);
 }
 
 // The cap of a loop on one cut, the opening of a piece cut free by one plane. The same loop as at the
@@ -574,10 +546,22 @@ void CutRenderSurface::cap_loops(const DeformableBody& body) {
     }
     std::vector<FilledHole> filled;
     for (const auto& p : holes.peeled) filled.push_back({p.part, face_first[p.first_face], face_first[p.end_face]});
-    m_open_loops = holes.others + drop_unsound_fills(body, filled, holes.open_parts);
+    std::vector<std::vector<int>> refused;  // the holes whose peeled faces were dropped, peeled again
+    for (const size_t h : drop_unsound_fills(body, filled, holes.open_parts)) refused.push_back(holes.peeled[h].loop);
+    const int closed = cut_render_detail::peel_again(
+        refused, m_triangles, first_cap, m_rest_m, edges,
+        [&](int point) { return m_point_cut[static_cast<size_t>(point)]; }, line);
+    m_open_loops = holes.others + static_cast<int>(refused.size()) - closed;
   }
   m_cap_triangles = static_cast<int>(cut_render_detail::drop_bubbles(m_triangles, first_cap, m_rest_m, m_bubbles));
   m_simple_caps = std::move(simple_caps);
+}
+
+void cut_render_detail::cap_polygon(const std::vector<int>& polygon, const std::vector<Eigen::Vector3d>& rest_m,
+                                    std::vector<std::array<int, 3>>& triangles, CapEdges& edges) {
+  const size_t before = triangles.size();
+  ear_clip(polygon, rest_m, triangles, [&edges](int u, int v) { return edges(u, v); });
+  for (size_t t = before; t < triangles.size(); ++t) edges.add(triangles[t]);
 }
 
 }  // namespace tissue

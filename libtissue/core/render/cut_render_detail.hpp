@@ -10,6 +10,7 @@
 #include <functional>
 #include <map>
 #include <unordered_map>
+#include <unordered_set>
 #include <utility>
 #include <vector>
 
@@ -23,10 +24,36 @@ inline long long edge_key(int u, int v) { return directed_key(std::min(u, v), st
 // no twin), each in the order its cap runs them (against the skin).
 std::vector<std::vector<int>> border_loops(const std::unordered_map<long long, int>& directed);
 
+// The edges a cap must not run along (ear_clip's edge_exists): the split surface's directed edges at
+// its split points (a border edge has no twin), the caps' edges so far and the surface's own.
+struct CapEdges {
+  std::unordered_map<long long, int> directed;   // (u, v) -> count
+  std::unordered_set<long long> caps;            // (lower, higher) of the caps' edges so far
+  const std::unordered_set<long long>& surface;  // the surface's own edges
+  int vertices;                                  // the surface's vertices: the points below
+
+  bool operator()(int u, int v) const {
+    const long long undirected = edge_key(u, v);
+    if (caps.contains(undirected)) return true;
+    if (u < vertices && v < vertices) return surface.contains(undirected);
+    return directed.contains(directed_key(u, v)) || directed.contains(directed_key(v, u));
+  }
+  void add(const std::array<int, 3>& triangle) {
+    for (size_t k = 0; k < 3; ++k) {
+      const int u = triangle[k], v = triangle[(k + 1) % 3];
+      caps.insert(edge_key(u, v));
+    }
+  }
+};
+
 // Triangulates the closed polygon `loop` (point indices, positions `x`) by ear clipping in its
 // best-fit plane, wound as the polygon, never along an edge for which edge_exists(u, v) holds.
 void ear_clip(const std::vector<int>& loop, const std::vector<Eigen::Vector3d>& x,
               std::vector<std::array<int, 3>>& triangles, const std::function<bool(int, int)>& edge_exists);
+
+// Caps a polygon (ear_clip), its edges added to `edges`.
+void cap_polygon(const std::vector<int>& polygon, const std::vector<Eigen::Vector3d>& rest_m,
+                 std::vector<std::array<int, 3>>& triangles, CapEdges& edges);
 
 // A chain whose points all ride on uncut tets faces neither side of its cut (0): a switch of it alone
 // under its key (part, cut lo, cut hi, facing on lo, facing on hi) joins the one lone switch whose
@@ -67,6 +94,7 @@ struct FlatHoles {
   struct Peeled {
     int part;
     size_t first_face, end_face;
+    std::vector<int> loop;  // the hole (peel_again's, when its faces are dropped)
   };
   std::vector<Peeled> peeled;
 };
@@ -74,16 +102,22 @@ FlatHoles flat_holes(const std::unordered_map<long long, int>& directed, const s
                      const std::function<int(int)>& part_of, const std::function<int(int)>& cut_of = {},
                      const std::function<std::vector<int>(int, int)>& line_points = {});
 
+// Which run peel_by_cuts takes next: the one whose ends lie nearest each other (the first try), the
+// one whose ends lie farthest apart, the longest, the shortest (peel_again's tries, in this order).
+enum class PeelOrder { nearest_ends, farthest_ends, longest_run, shortest_run };
+inline constexpr std::array<PeelOrder, 3> PEEL_AGAIN_ORDERS{PeelOrder::farthest_ends, PeelOrder::longest_run,
+                                                            PeelOrder::shortest_run};
+
 // A hole of one material part that no chord splits into two flat faces: the faces of the cuts its
 // points lie on (cut_of; -1 for none) that the walk did not close. Peeled one cut's run at a time,
-// the run whose ends lie nearest first, each closed by the straight line between its ends
-// (line_points(from, to): the new points between two), which the rest of the hole then runs the
-// other way; the last run is the last face. Runs on no cut, or of a point or two, between two runs of
-// one cut belong to that cut's run. Appends the faces to `faces` (none unless the whole hole is
-// peeled); false for fewer than 3 points or a run left of a single point.
+// the run `order` names first (by default the one whose ends lie nearest), each closed by the straight line between its
+// ends (line_points(from, to): the new points between two), which the rest of the hole then runs the other way; the
+// last run is the last face. Runs on no cut, or of a point or two, between two runs of one cut belong to that cut's
+// run. Appends the faces to `faces` (none unless the whole hole is peeled); false for fewer than 3 points or a run left
+// of a single point.
 bool peel_by_cuts(const std::vector<int>& loop, const std::vector<Eigen::Vector3d>& x,
                   const std::function<int(int)>& cut_of, const std::function<std::vector<int>(int, int)>& line_points,
-                  std::vector<std::vector<int>>& faces);
+                  std::vector<std::vector<int>>& faces, PeelOrder order = PeelOrder::nearest_ends);
 
 // Whether the faces peel_by_cuts filled into a hole bound the solid they close, as drawn: behind
 // each of its FILL_PROBES largest triangles, FILL_PROBE_OFFSET_M from the centroid, the shell it
@@ -102,6 +136,21 @@ double winding_number(const std::vector<std::array<int, 3>>& triangles, const st
 std::vector<char> fills_bounding_solids(const std::vector<std::array<int, 3>>& triangles,
                                         const std::vector<Eigen::Vector3d>& x,
                                         const std::vector<std::pair<size_t, size_t>>& fills);
+
+// Removes from `triangles` the fills (ranges [first, second)) whose `keep` is 0, the order of the
+// rest kept.
+void drop_fills(std::vector<std::array<int, 3>>& triangles, const std::vector<std::pair<size_t, size_t>>& fills,
+                const std::vector<char>& keep);
+
+// The holes `loops` whose peeled faces neither rule kept (CutRenderSurface::drop_unsound_fills),
+// peeled again in PEEL_AGAIN_ORDERS' orders in turn: each try's faces capped at the end of
+// `triangles` (`edges` made again from the caps from `first_cap` on first: the dropped faces' edges
+// gone), kept where they bound the solid they close (fills_bounding_solids), else dropped for the next
+// order. On the hatched frog at rest the faces a peeling leaves as a sheet across a 2 mm column
+// depend on which run it takes first. Returns how many holes were closed.
+int peel_again(std::vector<std::vector<int>> loops, std::vector<std::array<int, 3>>& triangles, size_t first_cap,
+               const std::vector<Eigen::Vector3d>& x, CapEdges& edges, const std::function<int(int)>& cut_of,
+               const std::function<std::vector<int>(int, int)>& line_points);
 
 // A closed shell of the finished surface that encloses less than BUBBLE_M3 (a cube of FLAT_HOLE_M) is
 // below what the render surface resolves: a render point on a sliver piece near where two cuts meet

@@ -1,6 +1,7 @@
 // CutRenderSurface: the holes filled by their cuts' faces (cut_render_detail::peel_by_cuts) are kept
 // where their material part then encloses its simulated volume, or where they bound the solid they
-// close as drawn (cut_render_detail::fills_bounding_solids; cut_render_surface.hpp).
+// close as drawn (cut_render_detail::fills_bounding_solids; cut_render_surface.hpp); the others are
+// peeled again in other orders (cut_render_detail::peel_again).
 #include "core/render/cut_render_surface.hpp"
 
 #include <algorithm>
@@ -86,6 +87,55 @@ std::vector<char> fills_bounding_solids(const std::vector<std::array<int, 3>>& t
   return sound;
 }
 
+void drop_fills(std::vector<std::array<int, 3>>& triangles, const std::vector<std::pair<size_t, size_t>>& fills,
+                const std::vector<char>& keep) {
+  std::vector<char> drop(triangles.size(), 0);
+  for (size_t f = 0; f < fills.size(); ++f) {
+    if (keep[f] != 0) continue;
+    std::fill(drop.begin() + static_cast<long>(fills[f].first), drop.begin() + static_cast<long>(fills[f].second), 1);
+  }
+  size_t kept = 0;
+  for (size_t t = 0; t < triangles.size(); ++t) {
+    if (drop[t] == 0) triangles[kept++] = triangles[t];
+  }
+  triangles.resize(kept);
+}
+
+int peel_again(std::vector<std::vector<int>> loops, std::vector<std::array<int, 3>>& triangles, size_t first_cap,
+               const std::vector<Eigen::Vector3d>& x, CapEdges& edges, const std::function<int(int)>& cut_of,
+               const std::function<std::vector<int>(int, int)>& line_points) {
+  int closed = 0;
+  for (const PeelOrder order : PEEL_AGAIN_ORDERS) {
+    if (loops.empty()) break;
+    edges.caps.clear();  // the caps kept so far: the dropped faces' edges are free again
+    for (size_t t = first_cap; t < triangles.size(); ++t) edges.add(triangles[t]);
+    std::vector<std::pair<size_t, size_t>> fills;
+    std::vector<size_t> fill_loop;
+    for (size_t l = 0; l < loops.size(); ++l) {
+      std::vector<std::vector<int>> faces;
+      if (!peel_by_cuts(loops[l], x, cut_of, line_points, faces, order)) continue;
+      const size_t first = triangles.size();
+      for (const std::vector<int>& face : faces) cap_polygon(face, x, triangles, edges);
+      fills.emplace_back(first, triangles.size());
+      fill_loop.push_back(l);
+    }
+    if (fills.empty()) continue;
+    const std::vector<char> sound = fills_bounding_solids(triangles, x, fills);
+    std::vector<char> open(loops.size(), 1);
+    for (size_t f = 0; f < fills.size(); ++f) {
+      if (sound[f] != 0) open[fill_loop[f]] = 0;
+    }
+    drop_fills(triangles, fills, sound);
+    size_t kept = 0;
+    for (size_t l = 0; l < loops.size(); ++l) {
+      if (open[l] != 0) loops[kept++] = std::move(loops[l]);
+    }
+    closed += static_cast<int>(loops.size() - kept);
+    loops.resize(kept);
+  }
+  return closed;
+}
+
 }  // namespace cut_render_detail
 
 namespace {
@@ -96,9 +146,10 @@ double enclosed_m3(const std::vector<Eigen::Vector3d>& x, const std::array<int, 
 
 }  // namespace
 
-int CutRenderSurface::drop_unsound_fills(const DeformableBody& body, const std::vector<FilledHole>& filled,
-                                         const std::vector<int>& open_parts) {
-  if (filled.empty()) return 0;
+std::vector<size_t> CutRenderSurface::drop_unsound_fills(const DeformableBody& body,
+                                                         const std::vector<FilledHole>& filled,
+                                                         const std::vector<int>& open_parts) {
+  if (filled.empty()) return {};
   // The uncut render surface encloses r0 times the tets' volume (it bulges out of their flat faces).
   double surface_m3 = 0.0, tets_m3 = 0.0;
   for (const auto& t : m_surface.triangles) surface_m3 += enclosed_m3(m_surface.vertices_m, t);
@@ -123,30 +174,25 @@ int CutRenderSurface::drop_unsound_fills(const DeformableBody& body, const std::
   // The fills the volume refuses, then those of them that do not bound their solid as drawn either
   // (the winding numbers only where needed: a shell of the organ's surface is 80k triangles).
   std::vector<std::pair<size_t, size_t>> refused;
-  for (const FilledHole& hole : filled) {
+  std::vector<size_t> refused_hole;  // its index in `filled`
+  for (size_t h = 0; h < filled.size(); ++h) {
+    const FilledHole& hole = filled[h];
     const auto part = static_cast<size_t>(hole.part);
     const double ratio = render_m3[part] / (r0 * simulated_m3[part]);
     const bool open = std::find(open_parts.begin(), open_parts.end(), hole.part) != open_parts.end();
     if (open || std::abs(ratio - 1.0) > FILLED_PART_VOLUME_TOLERANCE) {
       refused.emplace_back(hole.first_triangle, hole.end_triangle);
+      refused_hole.push_back(h);
     }
   }
-  if (refused.empty()) return 0;
+  if (refused.empty()) return {};
   const std::vector<char> bounding = cut_render_detail::fills_bounding_solids(m_triangles, m_rest_m, refused);
-  std::vector<char> drop(m_triangles.size(), 0);
-  int reopened = 0;
+  std::vector<size_t> dropped;
   for (size_t h = 0; h < refused.size(); ++h) {
-    if (bounding[h] != 0) continue;
-    std::fill(drop.begin() + static_cast<long>(refused[h].first), drop.begin() + static_cast<long>(refused[h].second),
-              1);
-    ++reopened;
+    if (bounding[h] == 0) dropped.push_back(refused_hole[h]);
   }
-  size_t kept = 0;
-  for (size_t t = 0; t < m_triangles.size(); ++t) {
-    if (drop[t] == 0) m_triangles[kept++] = m_triangles[t];
-  }
-  m_triangles.resize(kept);
-  return reopened;
+  cut_render_detail::drop_fills(m_triangles, refused, bounding);
+  return dropped;
 }
 
 }  // namespace tissue

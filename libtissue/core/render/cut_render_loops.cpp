@@ -321,7 +321,7 @@ void normalize_runs(std::vector<CutRun>& runs) {
 
 bool peel_by_cuts(const std::vector<int>& loop, const std::vector<Eigen::Vector3d>& x,
                   const std::function<int(int)>& cut_of, const std::function<std::vector<int>(int, int)>& line_points,
-                  std::vector<std::vector<int>>& faces) {
+                  std::vector<std::vector<int>>& faces, PeelOrder order) {
   const size_t n = loop.size();
   if (n < 3) return false;
   size_t start = 0;  // a change of cut, if there is one
@@ -335,15 +335,21 @@ bool peel_by_cuts(const std::vector<int>& loop, const std::vector<Eigen::Vector3
   normalize_runs(runs);
   std::vector<std::vector<int>> peeled;  // appended to `faces` only if the whole hole is peeled
   while (runs.size() > 1) {
-    // The run whose ends lie nearest each other: its face closed by the line between them.
+    // The run `order` names (by default the one whose ends lie nearest each other): its face closed by
+    // the line between its ends.
     size_t best = runs.size();
-    double nearest = std::numeric_limits<double>::infinity();
+    double least = std::numeric_limits<double>::infinity();
     for (size_t i = 0; i < runs.size(); ++i) {
       const std::vector<int>& points = runs[i].points;
       if (points.size() < 2) continue;
       const double gap = (x[static_cast<size_t>(points.front())] - x[static_cast<size_t>(points.back())]).norm();
-      if (gap < nearest) {
-        nearest = gap;
+      const auto length = static_cast<double>(points.size());
+      const double rank = order == PeelOrder::nearest_ends    ? gap
+                          : order == PeelOrder::farthest_ends ? -gap
+                          : order == PeelOrder::longest_run   ? -length
+                                                              : length;
+      if (rank < least) {
+        least = rank;
         best = i;
       }
     }
@@ -383,7 +389,7 @@ FlatHoles flat_holes(const std::unordered_map<long long, int>& directed, const s
     }
     if (one_part && split_in_two_flat(loop, x, holes.flat, edge_exists)) continue;
     if (one_part && line_points && peel_by_cuts(loop, x, cut_of, line_points, holes.flat)) {
-      holes.peeled.push_back({part, first_face, holes.flat.size()});
+      holes.peeled.push_back({part, first_face, holes.flat.size(), std::move(loop)});
       continue;
     }
     ++holes.others;

@@ -144,10 +144,10 @@ class CutRenderSurface {
   /// bound the solid they close as drawn (cut_render_detail::fills_bounding_solids).
   static constexpr double FILLED_PART_VOLUME_TOLERANCE = 0.15;
   /// Drops the triangles of the filled holes that neither rule keeps (cut_render_fill.cpp;
-  /// `open_parts`: the parts of the holes left open, -1 for a hole in two). Returns how many holes it
-  /// opened again.
-  int drop_unsound_fills(const DeformableBody& body, const std::vector<FilledHole>& filled,
-                         const std::vector<int>& open_parts);
+  /// `open_parts`: the parts of the holes left open, -1 for a hole in two). Returns the holes it
+  /// opened again (indices into `filled`).
+  std::vector<size_t> drop_unsound_fills(const DeformableBody& body, const std::vector<FilledHole>& filled,
+                                         const std::vector<int>& open_parts);
   void find_material_parts(const DeformableBody& body);
   /// The nodes of the points (after the points are final): all of them after a re-mesh from scratch,
   /// else those of `dirty_vertices` and from `first_new` on.
