@@ -757,6 +757,7 @@ TEST(SplitInTwoFlat, SplitsAHoleOnTwoPlanesAlongTheirJunction) {
 // by the line between its ends, the nearest ends first. The peeled faces lie on their cut's plane;
 // the faces together run each of the hole's edges once as the hole does and each line once each way.
 // Line points (on no cut) and a short run between two runs of one cut belong to that cut's face.
+// Peeled in the other orders (peel_again's), other faces come out, as closed.
 TEST(PeelByCuts, PeelsAHoleIntoItsCutsFacesClosedByLines) {
   std::vector<Eigen::Vector3d> x{{4e-3, 1e-3, 0}, {4e-3, 4e-3, 0}, {1e-3, 4e-3, 0},    // z = 0: cut 2
                                  {0, 4e-3, 1e-3}, {0, 4e-3, 4e-3}, {0, 1.5e-3, 4e-3},  // x = 0: cut 0
@@ -800,6 +801,34 @@ TEST(PeelByCuts, PeelsAHoleIntoItsCutsFacesClosedByLines) {
     EXPECT_EQ(uses, 1);
     if (edge.first >= 9 || edge.second >= 9) {
       EXPECT_EQ(directed.count({edge.second, edge.first}), 1U);  // a line: run both ways
+    }
+  }
+
+  // Peeled in peel_again's orders: three faces again that run the hole's edges once each and their
+  // lines once each way; the first is the run the order names (the farthest ends: cut 2 or 1, 4.2 mm
+  // apart, not cut 0), and the faces after it need not lie on one plane (the lines join other runs).
+  for (const cut_render_detail::PeelOrder order : cut_render_detail::PEEL_AGAIN_ORDERS) {
+    std::vector<std::vector<int>> again;
+    ASSERT_TRUE(cut_render_detail::peel_by_cuts(hole, x, cut_of, line_points, again, order));
+    ASSERT_EQ(again.size(), 3U);
+    std::map<std::pair<int, int>, int> runs;
+    for (const std::vector<int>& face : again) {
+      for (size_t i = 0; i < face.size(); ++i) ++runs[{face[i], face[(i + 1) % face.size()]}];
+    }
+    for (size_t i = 0; i < hole.size(); ++i) EXPECT_EQ((runs[{hole[i], hole[(i + 1) % hole.size()]}]), 1);
+    for (const auto& [edge, uses] : runs) {
+      EXPECT_EQ(uses, 1);
+      if (edge.first >= 9 && edge.second >= 9) {
+        EXPECT_EQ(runs.count({edge.second, edge.first}), 1U);
+      }
+    }
+    for (const int q : again[0]) {
+      if (cut_of(q) >= 0) {
+        EXPECT_EQ(cut_of(q), cut_of(again[0].front()));
+      }
+    }
+    if (order == cut_render_detail::PeelOrder::farthest_ends) {
+      EXPECT_NE(cut_of(again[0].front()), 0);
     }
   }
 
