@@ -548,10 +548,9 @@ void CutRenderSurface::cap_loops(const DeformableBody& body) {
     for (const auto& p : holes.peeled) filled.push_back({p.part, face_first[p.first_face], face_first[p.end_face]});
     std::vector<std::vector<int>> refused;  // the holes whose peeled faces were dropped, peeled again
     for (const size_t h : drop_unsound_fills(body, filled, holes.open_parts)) refused.push_back(holes.peeled[h].loop);
-    const int closed = cut_render_detail::peel_again(
-        refused, m_triangles, first_cap, m_rest_m, edges,
-        [&](int point) { return m_point_cut[static_cast<size_t>(point)]; }, line);
-    m_open_loops = holes.others + static_cast<int>(refused.size()) - closed;
+    m_open_loops = holes.others + cut_render_detail::peel_again(
+                                      std::move(refused), m_triangles, first_cap, m_rest_m, edges,
+                                      [&](int point) { return m_point_cut[static_cast<size_t>(point)]; }, line);
   }
   m_cap_triangles = static_cast<int>(cut_render_detail::drop_bubbles(m_triangles, first_cap, m_rest_m, m_bubbles));
   m_simple_caps = std::move(simple_caps);

@@ -147,7 +147,7 @@ void drop_fills(std::vector<std::array<int, 3>>& triangles, const std::vector<st
 // `triangles` (`edges` made again from the caps from `first_cap` on first: the dropped faces' edges
 // gone), kept where they bound the solid they close (fills_bounding_solids), else dropped for the next
 // order. On the hatched frog at rest the faces a peeling leaves as a sheet across a 2 mm column
-// depend on which run it takes first. Returns how many holes were closed.
+// depend on which run it takes first. Returns how many holes are left open.
 int peel_again(std::vector<std::vector<int>> loops, std::vector<std::array<int, 3>>& triangles, size_t first_cap,
                const std::vector<Eigen::Vector3d>& x, CapEdges& edges, const std::function<int(int)>& cut_of,
                const std::function<std::vector<int>(int, int)>& line_points);

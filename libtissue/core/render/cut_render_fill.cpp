@@ -104,7 +104,6 @@ void drop_fills(std::vector<std::array<int, 3>>& triangles, const std::vector<st
 int peel_again(std::vector<std::vector<int>> loops, std::vector<std::array<int, 3>>& triangles, size_t first_cap,
                const std::vector<Eigen::Vector3d>& x, CapEdges& edges, const std::function<int(int)>& cut_of,
                const std::function<std::vector<int>(int, int)>& line_points) {
-  int closed = 0;
   for (const PeelOrder order : PEEL_AGAIN_ORDERS) {
     if (loops.empty()) break;
     edges.caps.clear();  // the caps kept so far: the dropped faces' edges are free again
@@ -130,10 +129,9 @@ int peel_again(std::vector<std::vector<int>> loops, std::vector<std::array<int, 
     for (size_t l = 0; l < loops.size(); ++l) {
       if (open[l] != 0) loops[kept++] = std::move(loops[l]);
     }
-    closed += static_cast<int>(loops.size() - kept);
     loops.resize(kept);
   }
-  return closed;
+  return static_cast<int>(loops.size());
 }
 
 }  // namespace cut_render_detail
