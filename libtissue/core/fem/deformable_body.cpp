@@ -260,22 +260,51 @@ TISSUE_HOT_KERNEL double DeformableBody::largest_element_turn_rad(const Eigen::V
     largest_of_part[static_cast<size_t>(member)] = largest;
   });
   double largest_rad = *std::max_element(largest_of_part.begin(), largest_of_part.end());
+  for_each_piece_turn(increment_m, [&](const std::array<int, 4>& /*rows*/, double turn_rad) {
+    largest_rad = std::max(largest_rad, turn_rad);
+  });
+  return largest_rad;
+}
+
+template <class Visit>
+void DeformableBody::for_each_piece_turn(const Eigen::VectorXd& increment_m, Visit&& visit) const {
   TetPositions increment;
   for (int k = 0; k < m_xfem.cut_tet_count(); ++k) {
     if (m_xfem.retired(k)) continue;
-    const CutTet& cut_tet = m_xfem.cut_tets()[static_cast<size_t>(k)];
     for (int p = 0; p < static_cast<int>(m_xfem.piece_count(k)); ++p) {
       if (m_xfem.parked(k, p)) continue;
-      const CutPiece& piece = m_xfem.piece(k, p);
+      const std::array<int, 4> rows = piece_rows(k, p);
       for (size_t j = 0; j < 4; ++j) {
-        increment[j] = piece.ghost_row[j] < 0 ? vertex_increment(cut_tet.vertices[j])
-                                              : Eigen::Vector3d(increment_m.segment<3>(3 * piece.ghost_row[j]));
+        increment[j] = rows[j] < 0 ? Eigen::Vector3d::Zero() : Eigen::Vector3d(increment_m.segment<3>(3 * rows[j]));
       }
-      largest_rad = std::max(largest_rad, std::sqrt(piece.weight) *
-                                              turn_angle_rad(m_xfem.rest(k), m_xfem.rotation(k, p), increment));
+      visit(rows,
+            std::sqrt(m_xfem.piece(k, p).weight) * turn_angle_rad(m_xfem.rest(k), m_xfem.rotation(k, p), increment));
     }
   }
-  return largest_rad;
+}
+
+void DeformableBody::mark_turning_rows(const Eigen::VectorXd& increment_m, double angle_rad,
+                                       std::vector<std::uint8_t>& turning) const {
+  check_unknowns(increment_m);
+  turning.assign(static_cast<size_t>(dof_count() / 3), 0);
+  const auto mark = [&](const std::array<int, 4>& rows, double turn_rad) {
+    if (!(turn_rad > angle_rad)) return;
+    for (const int row : rows) {
+      if (row >= 0) turning[static_cast<size_t>(row)] = 1;
+    }
+  };
+  m_elasticity.for_each_included(0, static_cast<size_t>(m_elasticity.tet_count()),
+                                 [&](const Tet& tet, const TetRest& rest, const Eigen::Matrix3d& rotation) {
+                                   std::array<int, 4> rows{};
+                                   TetPositions increment;
+                                   for (size_t j = 0; j < 4; ++j) {
+                                     rows[j] = vertex_block_row(tet[j]);
+                                     increment[j] = rows[j] < 0 ? Eigen::Vector3d::Zero()
+                                                                : Eigen::Vector3d(increment_m.segment<3>(3 * rows[j]));
+                                   }
+                                   mark(rows, turn_angle_rad(rest, rotation, increment));
+                                 });
+  for_each_piece_turn(increment_m, mark);
 }
 
 double DeformableBody::total_mass_kg() const {

@@ -140,6 +140,9 @@ class DeformableBody final : public DynamicsModel {
   /// ~ V theta^2, so a part turning theta strays as a whole tet turning sqrt(w) theta (a sliver at a
   /// cut's front spinning fast no longer sets off a Newton correction of the whole body).
   [[nodiscard]] double largest_turn_rad(const Eigen::VectorXd& increment_m, double resolution_rad) const override;
+  /// Each uncut tet and live cut piece measured as largest_turn_rad() measures it past its bound.
+  void mark_turning_rows(const Eigen::VectorXd& increment_m, double angle_rad,
+                         std::vector<std::uint8_t>& turning) const override;
   /// elastic_energy_j + the attached terms' energies - f_ext . u. [J]
   [[nodiscard]] double potential_energy_j(const Eigen::VectorXd& displacement_m) override;
   /// The same sum at the last evaluate_with_potential()'s displacement, made in that pass (NaN after
@@ -366,6 +369,10 @@ class DeformableBody final : public DynamicsModel {
   void check_unknowns(const Eigen::VectorXd& displacement_m) const;
   // largest_turn_rad past its bound: every uncut tet and cut part.
   [[nodiscard]] double largest_element_turn_rad(const Eigen::VectorXd& increment_m) const;
+  // visit(rows, turn_rad) for each live cut piece not parked: its four block rows (-1: a fixed
+  // vertex) and its turn by the increment, times the square root of its volume share.
+  template <class Visit>
+  void for_each_piece_turn(const Eigen::VectorXd& increment_m, Visit&& visit) const;
   [[nodiscard]] int vertex_block_row(int vertex) const { return m_dofs.vertex_row[static_cast<size_t>(vertex)]; }
 
   XfemElasticity m_xfem;

@@ -211,7 +211,11 @@ void BackwardEuler::remember_velocity_change() {
 // Energy projection (Dinev et al. 2018): E = 1/2 v^T M v + potential. If the step's end holds more
 // than its start, v1 = mean + s (v1 - mean), mean the mass-weighted mean velocity (so the momentum
 // is kept), with s in [0, 1) chosen to bring E back; if the mean motion alone is too much, it is
-// scaled too. `state` has u1 and still v0.
+// scaled too. If the end's potential alone is above the start's energy, no velocity brings it back
+// (the gain is in the positions): the rows of the elements the step turned past the guard's angle
+// lose their motion relative to their mean, and the others keep theirs (zeroing every velocity
+// stopped every part, a falling one too, and kept the hatched frog's pre-stressed chips from
+// settling: docs/DESIGN.md). `state` has u1 and still v0.
 bool BackwardEuler::guard_energy(DynamicsModel& model, const DynamicState& state, double h) {
   const Eigen::VectorXd& mass = model.mass_kg();
   const Eigen::Index blocks = mass.size() / 3;
@@ -261,7 +265,8 @@ bool BackwardEuler::guard_energy(DynamicsModel& model, const DynamicState& state
   const double mean_kinetic_j = 0.5 * mass_sum.dot(mean_velocity.cwiseProduct(mean_velocity));
   const double relative_kinetic_j = std::max(0.0, kinetic_after_j - mean_kinetic_j);
   if (kinetic_after_j + potential_after_j <= before_j) return false;
-  const double room_j = std::max(0.0, before_j - potential_after_j);
+  if (potential_after_j >= before_j) return brake_turning_rows(model, h);
+  const double room_j = before_j - potential_after_j;
   const bool relative_only = room_j >= mean_kinetic_j && relative_kinetic_j > 0.0;
   const double s = relative_only ? std::sqrt((room_j - mean_kinetic_j) / relative_kinetic_j)
                                  : (kinetic_after_j > 0.0 ? std::sqrt(room_j / kinetic_after_j) : 0.0);
@@ -269,6 +274,27 @@ bool BackwardEuler::guard_energy(DynamicsModel& model, const DynamicState& state
     if (!in(r)) continue;
     auto v1 = m_end_velocity.segment<3>(3 * r);
     v1 = relative_only ? Eigen::Vector3d(mean_velocity + s * (v1 - mean_velocity)) : Eigen::Vector3d(s * v1);
+  }
+  return true;
+}
+
+bool BackwardEuler::brake_turning_rows(const DynamicsModel& model, double h) {
+  m_end_displacement.noalias() = h * m_end_velocity;  // the step's increment
+  model.mark_turning_rows(m_end_displacement, m_settings.newton.energy_guard_angle_rad, m_turning_rows);
+  const Eigen::VectorXd& mass = model.mass_kg();
+  const std::vector<std::uint8_t>* left = model.rows_left();
+  const auto braked = [&](Eigen::Index r) { return m_turning_rows[static_cast<size_t>(r)] != 0 && !row_left(left, r); };
+  Eigen::Vector3d momentum = Eigen::Vector3d::Zero();
+  Eigen::Vector3d mass_sum = Eigen::Vector3d::Zero();
+  for (Eigen::Index r = 0; r < mass.size() / 3; ++r) {
+    if (!braked(r)) continue;
+    momentum += mass.segment<3>(3 * r).cwiseProduct(m_end_velocity.segment<3>(3 * r));
+    mass_sum += mass.segment<3>(3 * r);
+  }
+  if (!(mass_sum.minCoeff() > 0.0)) return false;
+  const Eigen::Vector3d mean_velocity = momentum.cwiseQuotient(mass_sum);
+  for (Eigen::Index r = 0; r < mass.size() / 3; ++r) {
+    if (braked(r)) m_end_velocity.segment<3>(3 * r) = mean_velocity;
   }
   return true;
 }

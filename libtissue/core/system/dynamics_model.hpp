@@ -63,6 +63,13 @@ class DynamicsModel {
                                                 double /*resolution_rad*/) const {
     return 0.0;
   }
+  /// Sets turning[r] = 1 for every block row r of an element that `increment_m` turns further than
+  /// `angle_rad` (as largest_turn_rad() measures it), and 0 for the others; `turning` gets one entry
+  /// per block row. The default (a model with no elements to ask) marks every row.
+  virtual void mark_turning_rows(const Eigen::VectorXd& increment_m, double /*angle_rad*/,
+                                 std::vector<std::uint8_t>& turning) const {
+    turning.assign(static_cast<std::size_t>(increment_m.size() / 3), 1);
+  }
   /// Per block row, nonzero where the row has left the dynamics (a part parked out of the operating
   /// field): no element joins it to another, it keeps its mass and weight and falls on as a free
   /// particle, whose backward-Euler step is exact and loses energy. The energy guard leaves those rows
