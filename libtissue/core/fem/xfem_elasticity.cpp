@@ -9,12 +9,60 @@
 #include "core/index_cast.hpp"
 #include "core/system/hot_kernel.hpp"
 
+#include <Eigen/Eigenvalues>
+
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
 #include <string>
 
 namespace tissue {
+namespace {
+
+// The co-rotational tangent's missing term where it stiffens (TWIST_STIFFNESS_STRAIN): the twists
+// Q_ab = U (e_a e_b^T - e_b e_a^T) V^T / sqrt 2 of F = U diag(s) V^T (S = sym(R^T F) = V diag(s) V^T,
+// U = R V) have the energy's second derivative e_ab = 2 mu + 2 (lambda (tr S - 3) - 2 mu) / (s_a + s_b),
+// which R K R^T leaves at 0 (R^T Q_ab is skew: no strain); where it is positive (a stretched element
+// resists turning) V e_ab (Q_ab g_i)(Q_ab g_j)^T is added to block (i, j). Exact where all three are
+// positive, and positive semi-definite always.
+void add_twist_stiffness(const TetSlots& slots, BlockSparseMatrix& tangent, const Eigen::Matrix<double, 3, 4>& g,
+                         const LameParameters& lame, double volume_m3, const Eigen::Matrix3d& rotation,
+                         const Eigen::Matrix3d& gradient) {
+  const Eigen::Matrix3d stretch = 0.5 * (rotation.transpose() * gradient + gradient.transpose() * rotation);
+  if (!((stretch - Eigen::Matrix3d::Identity()).squaredNorm() > TWIST_STIFFNESS_STRAIN * TWIST_STIFFNESS_STRAIN))
+    return;
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eigen;
+  eigen.computeDirect(stretch);
+  const Eigen::Vector3d& s = eigen.eigenvalues();
+  const Eigen::Matrix3d& v = eigen.eigenvectors();
+  const Eigen::Matrix3d u = rotation * v;
+  const double trace_excess = s.sum() - 3.0;
+  constexpr std::array<std::array<int, 2>, 3> PAIRS{{{0, 1}, {0, 2}, {1, 2}}};
+  std::array<std::array<Eigen::Vector3d, 4>, 3> t;  // per positive twist k: Q_k g_i, scaled by sqrt(V e_k)
+  int twists = 0;
+  for (const auto& [a, b] : PAIRS) {
+    const double sum = s[a] + s[b];
+    if (!(sum > 0.0)) continue;
+    const double stiffness = 2.0 * lame.mu_pa + 2.0 * (lame.lambda_pa * trace_excess - 2.0 * lame.mu_pa) / sum;
+    if (!(stiffness > 0.0)) continue;
+    const Eigen::Matrix3d twist =
+        std::sqrt(0.5 * volume_m3 * stiffness) * (u.col(a) * v.col(b).transpose() - u.col(b) * v.col(a).transpose());
+    for (int i = 0; i < 4; ++i) t[static_cast<size_t>(twists)][static_cast<size_t>(i)] = twist * g.col(i);
+    ++twists;
+  }
+  if (twists == 0) return;
+  element_blocks::add_blocks(slots, tangent, [&](int i, int j) -> Eigen::Matrix3d {
+    Eigen::Matrix3d block = Eigen::Matrix3d::Zero();
+    for (int k = 0; k < twists; ++k) {
+      block.noalias() += t[static_cast<size_t>(k)][static_cast<size_t>(i)] *
+                         t[static_cast<size_t>(k)][static_cast<size_t>(j)].transpose();
+    }
+    return block;
+  });
+}
+
+}  // namespace
+
 namespace {
 
 constexpr std::array<CutPart, 2> PARTS{CutPart::above, CutPart::below};
@@ -260,6 +308,8 @@ TISSUE_HOT_KERNEL void XfemElasticity::evaluate(const Eigen::VectorXd& positions
       if (m_elements.model == MaterialModel::corotational_linear) {
         element_blocks::add_rotated_stiffness_blocks(piece_slots, *tangent, rest.shape_gradients_per_m,
                                                      m_elements.lame_of(rest), piece.weight * rest.volume_m3, r);
+        add_twist_stiffness(piece_slots, *tangent, rest.shape_gradients_per_m, m_elements.lame_of(rest),
+                            piece.weight * rest.volume_m3, r, f);
         continue;
       }
       std::array<Eigen::Matrix3d, 16> blocks;

@@ -103,6 +103,14 @@ using CutTetSlots = std::span<int>;
 TetPositions piece_positions(const CutPiece& piece, const TetPositions& real_positions_m,
                              const TetPositions& rest_positions_m, const Eigen::VectorXd& displacement_m);
 
+/// A co-rotational piece strained further than this (|sym(R^T F) - I|, Frobenius norm) gets in its
+/// tangent the twist stiffness R K R^T lacks, where positive (a stretched piece resists turning).
+/// Pieces pulled that far by their ghosts (the chips of 30 + 30 hatched strokes, sheared 1.78x and
+/// 0.55x) otherwise turned past the Newton corrections' trigger in every step; no piece of the shipped
+/// cutting scenarios is strained that far (their steps unchanged); for every piece the term cost the
+/// frog's plain steps 12-22% for no correction saved in cut_frog_complete (docs/BENCHMARKS.md).
+inline constexpr double TWIST_STIFFNESS_STRAIN = 0.25;
+
 class XfemElasticity {
  public:
   /// `rotation`: when the parts' rotation extraction stops (validated by the caller's body settings).

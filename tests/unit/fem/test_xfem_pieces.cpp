@@ -15,6 +15,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cstdio>
 #include <random>
 #include <vector>
 
@@ -210,6 +211,37 @@ TEST(XfemPieces, TangentMatchesFiniteDifferencesWhenEveryPieceMovesRigidly) {
   EXPECT_TRUE(couples(0, dof_of(ghost_row(1, 0))));
   EXPECT_FALSE(couples(1, dof_of(ghost_row(2, 0))));
   EXPECT_EQ(tet.xfem.dof_count(0), BLOCK_ROWS);
+}
+
+// Each piece stretched (principal stretches 1.2-1.4 along axes of its own, far past
+// TWIST_STIFFNESS_STRAIN) and turned its own way: R K R^T misses the stiffness of the pieces'
+// twists, e_ab = 2 mu + 2 (lambda (tr S - 3) - 2 mu) / (s_a + s_b), all positive here, so with the
+// twist terms the tangent is the exact derivative of the force (1e-6 relative, as for rigid pieces);
+// without them it is off by the size of the stiffness itself (the 30 + 30 hatched frog's chips,
+// strained so, turned past the Newton corrections' trigger in every step).
+TEST(XfemPieces, TangentMatchesFiniteDifferencesWherePiecesAreStretchedAndTurned) {
+  FourPieces tet;
+  Vector q = Vector::Zero();
+  const auto placed = [&](int p, int j) {
+    const Eigen::Matrix3d axes =
+        Eigen::AngleAxisd(0.3 + 0.5 * p, Eigen::Vector3d(p, 1.0, 1.0).normalized()).toRotationMatrix();
+    const Eigen::Matrix3d stretch = axes * Eigen::Vector3d(1.4, 1.3 - 0.02 * p, 1.2).asDiagonal() * axes.transpose();
+    const Eigen::Matrix3d turn =
+        Eigen::AngleAxisd(0.4 * (p + 1), Eigen::Vector3d(1.0, p, 2.0 - p).normalized()).toRotationMatrix();
+    return (turn * stretch * REST[static_cast<size_t>(j)] + Eigen::Vector3d(0.003 * p, -0.002, 0.001 * p)).eval();
+  };
+  for (int j = 0; j < 4; ++j) q.segment<3>(3 * j) = placed(j, j) - REST[static_cast<size_t>(j)];
+  for (int j = 0; j < 4; ++j) {
+    for (int p = 0; p < PIECES; ++p) {
+      if (p != j) q.segment<3>(3 * ghost_row(j, p)) = placed(p, j) - REST[static_cast<size_t>(j)];
+    }
+  }
+  tet.force(q, true);
+  const Matrix analytic = tet.dense_tangent();
+  const Eigen::MatrixXd numeric = central_differences(q, [&](const Vector& at) { return tet.force(at); });
+  std::printf("  |numeric - analytic| / |analytic| = %.2g\n", (numeric - analytic).norm() / analytic.norm());
+  EXPECT_LT((numeric - analytic).norm(), 1e-6 * analytic.norm());
+  EXPECT_LT((analytic - analytic.transpose()).norm(), 1e-12 * analytic.norm());
 }
 
 TEST(XfemPieces, BadPiecesAreRefused) {
