@@ -61,10 +61,6 @@ void add_twist_stiffness(const TetSlots& slots, BlockSparseMatrix& tangent, cons
   });
 }
 
-}  // namespace
-
-namespace {
-
 constexpr std::array<CutPart, 2> PARTS{CutPart::above, CutPart::below};
 
 Eigen::Index to_int(size_t i) { return static_cast<Eigen::Index>(i); }
