@@ -169,6 +169,15 @@ double turn_angle_rad(const TetRest& rest, const Eigen::Matrix3d& rotation, cons
   return 0.5 * Eigen::Vector3d(w(2, 1) - w(1, 2), w(0, 2) - w(2, 0), w(1, 0) - w(0, 1)).norm();
 }
 
+// The increments of an element's four block rows (-1: a fixed vertex, which does not move).
+TetPositions row_increments(const std::array<int, 4>& rows, const Eigen::VectorXd& increment_m) {
+  TetPositions increment;
+  for (size_t j = 0; j < 4; ++j) {
+    increment[j] = rows[j] < 0 ? Eigen::Vector3d::Zero() : Eigen::Vector3d(increment_m.segment<3>(3 * rows[j]));
+  }
+  return increment;
+}
+
 }  // namespace
 
 const std::vector<Eigen::Matrix3d>* DeformableBody::block_frames() const {
@@ -239,24 +248,16 @@ double DeformableBody::largest_turn_rad(const Eigen::VectorXd& increment_m, doub
 
 // (A hot kernel: GCC cannot clone the virtual largest_turn_rad itself.)
 TISSUE_HOT_KERNEL double DeformableBody::largest_element_turn_rad(const Eigen::VectorXd& increment_m) const {
-  const auto vertex_increment = [&](int vertex) -> Eigen::Vector3d {
-    const int row = vertex_block_row(vertex);
-    return row < 0 ? Eigen::Vector3d::Zero() : Eigen::Vector3d(increment_m.segment<3>(3 * row));
-  };
   // The uncut tets (those the co-rotational model has not handed to XFEM) in halves of its storage
   // order, which streams its per-tet data, side by side with a team (a maximum: the same in any order).
   std::array<double, MAX_STEP_THREADS> largest_of_part{};
   const int parts = team_parts(m_team);
   run_parts(m_team, parts, [&](int member) {
-    TetPositions increment;
     double largest = 0.0;
     const auto tets = static_cast<size_t>(m_elasticity.tet_count());
-    m_elasticity.for_each_included(tets * static_cast<size_t>(member) / static_cast<size_t>(parts),
-                                   tets * static_cast<size_t>(member + 1) / static_cast<size_t>(parts),
-                                   [&](const Tet& tet, const TetRest& rest, const Eigen::Matrix3d& rotation) {
-                                     for (size_t j = 0; j < 4; ++j) increment[j] = vertex_increment(tet[j]);
-                                     largest = std::max(largest, turn_angle_rad(rest, rotation, increment));
-                                   });
+    for_each_tet_turn(tets * static_cast<size_t>(member) / static_cast<size_t>(parts),
+                      tets * static_cast<size_t>(member + 1) / static_cast<size_t>(parts), increment_m,
+                      [&](const std::array<int, 4>& /*rows*/, double turn_rad) { largest = std::max(largest, turn_rad); });
     largest_of_part[static_cast<size_t>(member)] = largest;
   });
   double largest_rad = *std::max_element(largest_of_part.begin(), largest_of_part.end());
@@ -267,18 +268,24 @@ TISSUE_HOT_KERNEL double DeformableBody::largest_element_turn_rad(const Eigen::V
 }
 
 template <class Visit>
+void DeformableBody::for_each_tet_turn(size_t first, size_t end, const Eigen::VectorXd& increment_m,
+                                       Visit&& visit) const {
+  m_elasticity.for_each_included(first, end, [&](const Tet& tet, const TetRest& rest, const Eigen::Matrix3d& rotation) {
+    const std::array<int, 4> rows{vertex_block_row(tet[0]), vertex_block_row(tet[1]), vertex_block_row(tet[2]),
+                                  vertex_block_row(tet[3])};
+    visit(rows, turn_angle_rad(rest, rotation, row_increments(rows, increment_m)));
+  });
+}
+
+template <class Visit>
 void DeformableBody::for_each_piece_turn(const Eigen::VectorXd& increment_m, Visit&& visit) const {
-  TetPositions increment;
   for (int k = 0; k < m_xfem.cut_tet_count(); ++k) {
     if (m_xfem.retired(k)) continue;
     for (int p = 0; p < static_cast<int>(m_xfem.piece_count(k)); ++p) {
       if (m_xfem.parked(k, p)) continue;
       const std::array<int, 4> rows = piece_rows(k, p);
-      for (size_t j = 0; j < 4; ++j) {
-        increment[j] = rows[j] < 0 ? Eigen::Vector3d::Zero() : Eigen::Vector3d(increment_m.segment<3>(3 * rows[j]));
-      }
-      visit(rows,
-            std::sqrt(m_xfem.piece(k, p).weight) * turn_angle_rad(m_xfem.rest(k), m_xfem.rotation(k, p), increment));
+      visit(rows, std::sqrt(m_xfem.piece(k, p).weight) *
+                      turn_angle_rad(m_xfem.rest(k), m_xfem.rotation(k, p), row_increments(rows, increment_m)));
     }
   }
 }
@@ -293,17 +300,7 @@ void DeformableBody::mark_turning_rows(const Eigen::VectorXd& increment_m, doubl
       if (row >= 0) turning[static_cast<size_t>(row)] = 1;
     }
   };
-  m_elasticity.for_each_included(0, static_cast<size_t>(m_elasticity.tet_count()),
-                                 [&](const Tet& tet, const TetRest& rest, const Eigen::Matrix3d& rotation) {
-                                   std::array<int, 4> rows{};
-                                   TetPositions increment;
-                                   for (size_t j = 0; j < 4; ++j) {
-                                     rows[j] = vertex_block_row(tet[j]);
-                                     increment[j] = rows[j] < 0 ? Eigen::Vector3d::Zero()
-                                                                : Eigen::Vector3d(increment_m.segment<3>(3 * rows[j]));
-                                   }
-                                   mark(rows, turn_angle_rad(rest, rotation, increment));
-                                 });
+  for_each_tet_turn(0, static_cast<size_t>(m_elasticity.tet_count()), increment_m, mark);
   for_each_piece_turn(increment_m, mark);
 }
 

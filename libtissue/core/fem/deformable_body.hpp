@@ -369,8 +369,11 @@ class DeformableBody final : public DynamicsModel {
   void check_unknowns(const Eigen::VectorXd& displacement_m) const;
   // largest_turn_rad past its bound: every uncut tet and cut part.
   [[nodiscard]] double largest_element_turn_rad(const Eigen::VectorXd& increment_m) const;
-  // visit(rows, turn_rad) for each live cut piece not parked: its four block rows (-1: a fixed
-  // vertex) and its turn by the increment, times the square root of its volume share.
+  // visit(rows, turn_rad) for the uncut tets at the co-rotational model's storage indices [first, end):
+  // their four block rows (-1: a fixed vertex) and their turn by the increment.
+  template <class Visit>
+  void for_each_tet_turn(size_t first, size_t end, const Eigen::VectorXd& increment_m, Visit&& visit) const;
+  // The same for each live cut piece not parked, its turn times the square root of its volume share.
   template <class Visit>
   void for_each_piece_turn(const Eigen::VectorXd& increment_m, Visit&& visit) const;
   [[nodiscard]] int vertex_block_row(int vertex) const { return m_dofs.vertex_row[static_cast<size_t>(vertex)]; }
