@@ -241,6 +241,10 @@ class DeformableBody final : public DynamicsModel {
   [[nodiscard]] int parked_row_count() const { return m_parked_rows; }
   /// The parked rows (DynamicsModel::rows_left).
   [[nodiscard]] const std::vector<std::uint8_t>* rows_left() const override { return &m_row_parked; }
+  /// The parts the elements join the rows into (find_body_parts), found again only after a cut
+  /// changed the elements (parking does not change how they join).
+  [[nodiscard]] const BodyParts& body_parts() const;
+  [[nodiscard]] const std::vector<int>* row_parts() const override { return &body_parts().part_of_row; }
 
   /// Whether cut tet k was replaced by a later cut of its tet (then it adds nothing).
   [[nodiscard]] bool retired(int k) const { return m_xfem.retired(k); }
@@ -402,10 +406,9 @@ class DeformableBody final : public DynamicsModel {
   std::vector<int> m_cut_index;                 // per tet: index into cut_tets(), or -1
   std::vector<std::uint8_t> m_row_parked;       // per block row (shorter: the rest are not parked)
   int m_parked_rows = 0;
-  // park_parts_outside's parts, found again only after a cut changed the elements (parking does not
-  // change how they join): the union-find over the organ's 52k tets is milliseconds, and the look
-  // every 10 steps should not be.
-  BodyParts m_parts;
+  // body_parts(), found again only after a cut changed the elements: the union-find over the
+  // organ's 52k tets is milliseconds, and the look every 10 steps should not be.
+  mutable BodyParts m_parts;
   double m_evaluated_potential_j = std::numeric_limits<double>::quiet_NaN();  // at the last evaluate()
   // Moves on at every evaluate, enrich, park, re-layout, rotations' restore or reset and term
   // attached or detached; with the terms' own ForceTerm::revision, evaluation_revision().
@@ -424,7 +427,7 @@ class DeformableBody final : public DynamicsModel {
   }
   long m_element_revision = 0;  // counts enrichments
   long m_element_revision_at_ahead = 0;  // m_element_revision at the last evaluate_ahead call
-  long m_parts_revision = -1;   // m_element_revision when m_parts was found
+  mutable long m_parts_revision = -1;    // m_element_revision when m_parts was found
 
   std::vector<ForceTerm*> m_force_terms;                // attached, not owned
   WorkTeam* m_team = nullptr;                           // lent for a step (lend_work_team)

@@ -20,17 +20,21 @@ struct PartSummary {
 
 }  // namespace
 
+const BodyParts& DeformableBody::body_parts() const {
+  if (m_parts_revision != m_element_revision) {
+    m_parts = find_body_parts(*this);
+    m_parts_revision = m_element_revision;
+  }
+  return m_parts;
+}
+
 std::vector<int> DeformableBody::park_parts_outside(const Eigen::AlignedBox3d& field, DynamicState& state) {
   check_unknowns(state.displacement_m);
   if (state.velocity_m_per_s.size() != dof_count()) {
     throw std::invalid_argument("park_parts_outside: the state has " + std::to_string(state.velocity_m_per_s.size()) +
                                 " velocities, the body " + std::to_string(dof_count()) + " unknowns");
   }
-  if (m_parts_revision != m_element_revision) {
-    m_parts = find_body_parts(*this);
-    m_parts_revision = m_element_revision;
-  }
-  const BodyParts& parts = m_parts;
+  const BodyParts& parts = body_parts();
   const std::vector<Eigen::Vector3d>& points = *block_positions(state.displacement_m);
   std::vector<PartSummary> summary(static_cast<size_t>(parts.count()));
   const int rows = dof_count() / 3;

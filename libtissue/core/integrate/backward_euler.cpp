@@ -208,12 +208,44 @@ void BackwardEuler::remember_velocity_change() {
   m_past_velocity_changes.head(n) = m_velocity_change;
 }
 
+namespace {
+
+// The model's part of each block row (DynamicsModel::row_parts): 0 for every row of a model of one
+// part (or whose list does not match its rows), -1 for a row no element uses.
+class RowParts {
+ public:
+  RowParts(const DynamicsModel& model, Eigen::Index rows) : m_parts(model.row_parts()) {
+    if (m_parts != nullptr && static_cast<Eigen::Index>(m_parts->size()) != rows) m_parts = nullptr;
+  }
+  int operator()(Eigen::Index row) const { return m_parts == nullptr ? 0 : (*m_parts)[static_cast<size_t>(row)]; }
+
+ private:
+  const std::vector<int>* m_parts;
+};
+
+// Adds a row of mass `m` and velocity `v` to its part's momentum and mass (the lists grown to hold it).
+void add_to_part(std::vector<Eigen::Vector3d>& momentum, std::vector<Eigen::Vector3d>& mass, int part,
+                 const Eigen::Vector3d& m, const Eigen::Vector3d& v) {
+  const auto at = static_cast<size_t>(part);
+  if (at >= mass.size()) {
+    momentum.resize(at + 1, Eigen::Vector3d::Zero());
+    mass.resize(at + 1, Eigen::Vector3d::Zero());
+  }
+  momentum[at] += m.cwiseProduct(v);
+  mass[at] += m;
+}
+
+}  // namespace
+
 // Energy projection (Dinev et al. 2018): E = 1/2 v^T M v + potential. If the step's end holds more
-// than its start, v1 = mean + s (v1 - mean), mean the mass-weighted mean velocity (so the momentum
-// is kept), with s in [0, 1) chosen to bring E back; if the mean motion alone is too much, it is
-// scaled too. If the end's potential alone is above the start's energy, no velocity brings it back
-// (the gain is in the positions): the rows of the elements the step turned past the guard's angle
-// lose their motion relative to their mean, and the others keep theirs (zeroing every velocity
+// than its start, v1 = mean + s (v1 - mean) on every row, mean the mass-weighted mean velocity of the
+// row's part (DynamicsModel::row_parts: no force acts between parts, so each keeps its momentum; a
+// row no element uses keeps its velocity), with s in [0, 1) chosen to bring E back; if the mean
+// motions alone are too much, they are scaled too (with one mean for the whole body, a piece cut
+// free and falling beside a part that turned lost speed at every guarded step). If the end's
+// potential alone is above the start's energy, no velocity brings it back (the gain is in the
+// positions): the rows of the elements the step turned past the guard's angle lose their motion
+// relative to their part's turning rows' mean, and the others keep theirs (zeroing every velocity
 // stopped every part, a falling one too, and kept the hatched frog's pre-stressed chips from
 // settling: docs/DESIGN.md). `state` has u1 and still v0.
 bool BackwardEuler::guard_energy(DynamicsModel& model, const DynamicState& state, double h) {
@@ -225,9 +257,11 @@ bool BackwardEuler::guard_energy(DynamicsModel& model, const DynamicState& state
   const std::vector<std::uint8_t>* left = model.rows_left();
   const auto in = [left](Eigen::Index r) { return !row_left(left, r); };
   const Eigen::VectorXd& load = model.external_force_n();
-  Eigen::Vector3d momentum = Eigen::Vector3d::Zero();
-  Eigen::Vector3d mass_sum = Eigen::Vector3d::Zero();
+  const RowParts part_of(model, blocks);
+  m_part_momentum.clear();
+  m_part_mass.clear();
   double kinetic_before_j = 0.0, kinetic_after_j = 0.0;
+  double own_kinetic_j = 0.0;  // of the rows no element uses (each its own mean)
   double left_potential_before_j = 0.0, left_potential_after_j = 0.0;  // -f . u of the rows left
   for (Eigen::Index r = 0; r < blocks; ++r) {
     const auto m = mass.segment<3>(3 * r);
@@ -239,12 +273,21 @@ bool BackwardEuler::guard_energy(DynamicsModel& model, const DynamicState& state
     }
     const auto v0 = state.velocity_m_per_s.segment<3>(3 * r);
     const auto v1 = m_end_velocity.segment<3>(3 * r);
-    momentum += m.cwiseProduct(v1);
-    mass_sum += m;
     kinetic_before_j += 0.5 * v0.dot(m.cwiseProduct(v0));
     kinetic_after_j += 0.5 * v1.dot(m.cwiseProduct(v1));
+    const int part = part_of(r);
+    if (part < 0) {
+      own_kinetic_j += 0.5 * v1.dot(m.cwiseProduct(v1));
+      continue;
+    }
+    add_to_part(m_part_momentum, m_part_mass, part, m, v1);
   }
-  const Eigen::Vector3d mean_velocity = momentum.cwiseQuotient(mass_sum.cwiseMax(1e-300));
+  double mean_kinetic_j = own_kinetic_j;
+  for (size_t part = 0; part < m_part_mass.size(); ++part) {
+    Eigen::Vector3d& mean_velocity = m_part_momentum[part];  // the momentum becomes the mean velocity
+    mean_velocity = mean_velocity.cwiseQuotient(m_part_mass[part].cwiseMax(1e-300));
+    mean_kinetic_j += 0.5 * m_part_mass[part].dot(mean_velocity.cwiseProduct(mean_velocity));
+  }
   double potential_before_j = m_start_potential_j;  // a pass over the elements saved
   if (!std::isfinite(potential_before_j)) {
     m_end_displacement.noalias() = state.displacement_m - h * m_end_velocity;  // u0
@@ -262,7 +305,6 @@ bool BackwardEuler::guard_energy(DynamicsModel& model, const DynamicState& state
   if (!std::isfinite(potential_after_j)) potential_after_j = model.potential_energy_j(state.displacement_m);
   if (!std::isfinite(before_j) || !std::isfinite(potential_after_j)) return false;  // the model cannot say
   potential_after_j -= left_potential_after_j;
-  const double mean_kinetic_j = 0.5 * mass_sum.dot(mean_velocity.cwiseProduct(mean_velocity));
   const double relative_kinetic_j = std::max(0.0, kinetic_after_j - mean_kinetic_j);
   if (kinetic_after_j + potential_after_j <= before_j) return false;
   if (potential_after_j >= before_j) return brake_turning_rows(model, h);
@@ -273,7 +315,13 @@ bool BackwardEuler::guard_energy(DynamicsModel& model, const DynamicState& state
   for (Eigen::Index r = 0; r < blocks; ++r) {
     if (!in(r)) continue;
     auto v1 = m_end_velocity.segment<3>(3 * r);
-    v1 = relative_only ? Eigen::Vector3d(mean_velocity + s * (v1 - mean_velocity)) : Eigen::Vector3d(s * v1);
+    const int part = part_of(r);
+    if (!relative_only) {
+      v1 *= s;
+    } else if (part >= 0) {
+      const Eigen::Vector3d& mean_velocity = m_part_momentum[static_cast<size_t>(part)];
+      v1 = mean_velocity + s * (v1 - mean_velocity);
+    }
   }
   return true;
 }
@@ -283,20 +331,27 @@ bool BackwardEuler::brake_turning_rows(const DynamicsModel& model, double h) {
   model.mark_turning_rows(m_end_displacement, m_settings.newton.energy_guard_angle_rad, m_turning_rows);
   const Eigen::VectorXd& mass = model.mass_kg();
   const std::vector<std::uint8_t>* left = model.rows_left();
-  const auto braked = [&](Eigen::Index r) { return m_turning_rows[static_cast<size_t>(r)] != 0 && !row_left(left, r); };
-  Eigen::Vector3d momentum = Eigen::Vector3d::Zero();
-  Eigen::Vector3d mass_sum = Eigen::Vector3d::Zero();
-  for (Eigen::Index r = 0; r < mass.size() / 3; ++r) {
+  const Eigen::Index blocks = mass.size() / 3;
+  const RowParts part_of(model, blocks);
+  // (A row no element uses turns with none: each braked row has a part.)
+  const auto braked = [&](Eigen::Index r) {
+    return m_turning_rows[static_cast<size_t>(r)] != 0 && !row_left(left, r) && part_of(r) >= 0;
+  };
+  m_part_momentum.clear();
+  m_part_mass.clear();
+  for (Eigen::Index r = 0; r < blocks; ++r) {
     if (!braked(r)) continue;
-    momentum += mass.segment<3>(3 * r).cwiseProduct(m_end_velocity.segment<3>(3 * r));
-    mass_sum += mass.segment<3>(3 * r);
+    add_to_part(m_part_momentum, m_part_mass, part_of(r), mass.segment<3>(3 * r), m_end_velocity.segment<3>(3 * r));
   }
-  if (!(mass_sum.minCoeff() > 0.0)) return false;
-  const Eigen::Vector3d mean_velocity = momentum.cwiseQuotient(mass_sum);
-  for (Eigen::Index r = 0; r < mass.size() / 3; ++r) {
-    if (braked(r)) m_end_velocity.segment<3>(3 * r) = mean_velocity;
+  bool any = false;
+  for (Eigen::Index r = 0; r < blocks; ++r) {
+    if (!braked(r)) continue;
+    const auto part = static_cast<size_t>(part_of(r));
+    if (!(m_part_mass[part].minCoeff() > 0.0)) continue;
+    m_end_velocity.segment<3>(3 * r) = m_part_momentum[part].cwiseQuotient(m_part_mass[part]);
+    any = true;
   }
-  return true;
+  return any;
 }
 
 // Newton on the backward-Euler equations in v1 (u1 = u0 + h v1):

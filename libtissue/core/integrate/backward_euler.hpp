@@ -97,7 +97,8 @@ class BackwardEuler final : public Integrator {
   // potential energy at the start is m_start_potential_j when the step's evaluate found it.
   bool guard_energy(DynamicsModel& model, const DynamicState& state, double h);
   // The guard where no velocity takes the gain back: the rows of the elements v1 turns past the
-  // guard's angle (not left) get their mass-weighted mean velocity; true if there were any.
+  // guard's angle (not left) get the mass-weighted mean velocity of their part's such rows; true if
+  // there were any.
   bool brake_turning_rows(const DynamicsModel& model, double h);
   // The step's incremental potential at v1 (backward_euler.cpp), given beta v1^T K v1 and the
   // model's potential energy at u0 + h v1.
@@ -127,6 +128,7 @@ class BackwardEuler final : public Integrator {
   GalerkinStartWork m_warm_start;
   Eigen::VectorXd m_end_displacement;  // the Newton iterate u0 + h v1
   std::vector<std::uint8_t> m_turning_rows;  // brake_turning_rows()
+  std::vector<Eigen::Vector3d> m_part_momentum, m_part_mass;  // guard_energy(): per part of the model
   Eigen::VectorXd m_end_velocity;      // v1
   Eigen::VectorXd m_correction;        // a Newton correction of v1
   Eigen::VectorXd m_trial_velocity;    // v1 + t correction, in the line search

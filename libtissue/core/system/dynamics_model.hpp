@@ -76,6 +76,11 @@ class DynamicsModel {
   /// out. May be shorter than the rows (the rest are in); nullptr (the default): every row is in. Read
   /// it with row_left() (core/system/rows_left.hpp).
   [[nodiscard]] virtual const std::vector<std::uint8_t>* rows_left() const { return nullptr; }
+  /// Per block row, the part of the model it belongs to: rows that elements join, directly or through
+  /// others, share a part (numbered from 0); -1 for a row no element uses. No force acts between two
+  /// parts, so each keeps its own momentum (the energy guard keeps it). nullptr (the default): the
+  /// model is one part. Valid until the model next changes.
+  [[nodiscard]] virtual const std::vector<int>* row_parts() const { return nullptr; }
   /// The potential of the model's forces at u: elastic energy plus that of any spring to a fixed
   /// target, minus f_ext . u [J]; NaN for a model that cannot say (its steps are not energy-guarded).
   [[nodiscard]] virtual double potential_energy_j(const Eigen::VectorXd& /*displacement_m*/) {

@@ -13,6 +13,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
 #include <cstdio>
 #include <limits>
 #include <string>
@@ -39,6 +40,24 @@ DynamicState at_rest(const DeformableBody& body) {
   return DynamicState{Eigen::VectorXd::Zero(body.dof_count()), Eigen::VectorXd::Zero(body.dof_count()), 0.0};
 }
 
+// Linearized steps (no Newton corrections), the energy guard on.
+BackwardEuler::Settings linearized_steps() {
+  BackwardEuler::NewtonCorrections newton;
+  newton.trigger_angle_rad = OFF;
+  return BackwardEuler::Settings{false, newton};
+}
+
+// At rest but each vertex v moving at velocity_of(v, its rest position).
+template <class VelocityOf>
+DynamicState moving(const DeformableBody& body, const TetMesh& mesh, VelocityOf velocity_of) {
+  DynamicState state = at_rest(body);
+  for (int v = 0; v < mesh.vertex_count(); ++v) {
+    state.velocity_m_per_s.segment<3>(3 * body.dofs().vertex_row[static_cast<size_t>(v)]) =
+        velocity_of(v, mesh.rest_positions_m[static_cast<size_t>(v)]);
+  }
+  return state;
+}
+
 // |r(v1)| / |h f_ext| for r = h (f_ext - f_int(u1) - alpha M v1 - beta K(u1) v1) - M (v1 - v0).
 double relative_residual(DeformableBody& body, const DynamicState& start, const DynamicState& end, double h) {
   Eigen::VectorXd force;
@@ -62,6 +81,24 @@ TetMesh side_by_side(const TetMesh& first, const TetMesh& second, const Eigen::V
   }
   return mesh;
 }
+
+// The hinged 2 mm cube of EnergyGuardKeepsAHingedCubeFromGainingEnergy beside a free 2 mm cube,
+// 1 cm away, falling at 0.1 m/s: one body of two parts that no element joins, at rest but the fall.
+struct HingedBesideFalling {
+  TetMesh cube = make_box_mesh(1, 1, 1, 0.002);
+  TetMesh mesh = side_by_side(cube, cube, Eigen::Vector3d(0.01, 0, 0));
+  BodySettings settings =
+      settings_for(vertices_in_box(mesh, Eigen::Vector3d(-1.0, -1.0, -1.0), Eigen::Vector3d(1e-9, 1.0, 1e-9)));
+  DeformableBody body{mesh, settings};
+  std::vector<int> falling;  // the free cube's block rows
+  DynamicState state = at_rest(body);
+  HingedBesideFalling() {
+    for (int v = cube.vertex_count(); v < mesh.vertex_count(); ++v) {
+      falling.push_back(body.dofs().vertex_row[static_cast<size_t>(v)]);
+      state.velocity_m_per_s(3 * falling.back() + 2) = -0.1;
+    }
+  }
+};
 
 TEST(BackwardEulerLargeTurns, NewtonCorrectionsSolveAStepThatBendsTheBeamFar) {
   // A 10 cm cantilever (E = 100 kPa) released under gravity with one 0.1 s step: the linearized
@@ -128,52 +165,75 @@ TEST(BackwardEulerLargeTurns, EnergyGuardKeepsAHingedCubeFromGainingEnergy) {
   EXPECT_GT(gain_off, 0.05 * work_scale);
 }
 
+// 60 steps of 1 ms with exact solves and the default protections: the steps guarded, the falling
+// rows' largest error against backward Euler's free fall with mass damping, (1 + h alpha) v1 = v0 +
+// h g, and the largest gain of energy over the start with gravity's largest work, of the hinged cube
+// alone when `hinged_only` (else of the body).
+struct FallReport {
+  int guarded = 0;
+  double largest_error_m_per_s = 0.0, largest_gain_j = -1.0, work_scale_j = 0.0;
+};
+FallReport fall_beside_hinged(HingedBesideFalling& scene, bool hinged_only) {
+  DeformableBody& body = scene.body;
+  DynamicState& state = scene.state;
+  const auto counted = [&](const Eigen::VectorXd& v) {
+    Eigen::VectorXd in = v;
+    if (hinged_only) {
+      for (const int row : scene.falling) in.segment<3>(3 * row).setZero();
+    }
+    return in;
+  };
+  const auto energy = [&] {
+    return body.kinetic_energy_j(counted(state.velocity_m_per_s)) +
+           body.potential_energy_j(counted(state.displacement_m));
+  };
+  BackwardEuler integrator(std::make_unique<CholmodSolver>(), BackwardEuler::Settings{});
+  const double h = 1e-3;
+  const double energy_before_j = energy();
+  FallReport report;
+  for (int n = 0; n < 60; ++n) {
+    const double v0 = state.velocity_m_per_s(3 * scene.falling.front() + 2);
+    report.guarded += integrator.step(body, state, h).energy_guarded ? 1 : 0;
+    report.largest_gain_j = std::max(report.largest_gain_j, energy() - energy_before_j);
+    report.work_scale_j = std::max(report.work_scale_j, body.external_force_n().dot(counted(state.displacement_m)));
+    const Eigen::Vector3d expected(0.0, 0.0, (v0 - h * 9.81) / (1.0 + h * scene.settings.damping.mass_damping_per_s));
+    for (const int row : scene.falling) {
+      report.largest_error_m_per_s =
+          std::max(report.largest_error_m_per_s, (state.velocity_m_per_s.segment<3>(3 * row) - expected).norm());
+    }
+  }
+  std::printf("  %d steps guarded; the falling cube's largest velocity error %.3g m/s; largest gain %.3g J\n",
+              report.guarded, report.largest_error_m_per_s, report.largest_gain_j);
+  return report;
+}
+
 TEST(BackwardEulerLargeTurns, EnergyGuardLeavesAPartThatLeftTheDynamicsAlone) {
   // The hinged cube above beside a second 2 mm cube, 1 cm away, whose rows are parked
   // (DeformableBody::park_rows: a part cut free that fell out of the field) and fall at 0.1 m/s. The
   // guard acts on the hinged cube's steps and keeps its energy from rising; the parked rows keep
-  // backward Euler's free fall with mass damping exactly, (1 + h alpha) v1 = v0 + h g (no element:
-  // nothing else acts on them). Before, the guard took the hinged cube's excess from the motion
-  // relative to the mean, mostly the parked cube's: it slowed down (the hatched frog's pieces stopped
-  // in mid-air while strokes cut).
-  const TetMesh cube = make_box_mesh(1, 1, 1, 0.002);
-  const TetMesh mesh = side_by_side(cube, cube, Eigen::Vector3d(0.01, 0, 0));
-  const std::vector<int> hinge =
-      vertices_in_box(mesh, Eigen::Vector3d(-1.0, -1.0, -1.0), Eigen::Vector3d(1e-9, 1.0, 1e-9));
-  const BodySettings settings = settings_for(hinge);
-  DeformableBody body(mesh, settings);
-  std::vector<int> parked;
-  for (int v = cube.vertex_count(); v < mesh.vertex_count(); ++v)
-    parked.push_back(body.dofs().vertex_row[static_cast<size_t>(v)]);
-  body.park_rows(parked);
-  BackwardEuler integrator(std::make_unique<CholmodSolver>(), BackwardEuler::Settings{});
-  DynamicState state = at_rest(body);
-  for (const int row : parked) state.velocity_m_per_s(3 * row + 2) = -0.1;
-  const double h = 1e-3;
-  const double alpha_per_s = settings.damping.mass_damping_per_s;
-  // The hinged cube's energy (its start's is zero) and the work of gravity on it. [J]
-  const auto hinged = [&](const Eigen::VectorXd& v) {
-    Eigen::VectorXd in = v;
-    for (const int row : parked) in.segment<3>(3 * row).setZero();
-    return in;
-  };
-  int guarded = 0;
-  double largest_gain_j = -1.0, work_scale_j = 0.0;
-  for (int n = 0; n < 60; ++n) {
-    const double v0 = state.velocity_m_per_s(3 * parked.front() + 2);
-    guarded += integrator.step(body, state, h).energy_guarded ? 1 : 0;
-    const Eigen::VectorXd u = hinged(state.displacement_m);
-    largest_gain_j = std::max(largest_gain_j, body.kinetic_energy_j(hinged(state.velocity_m_per_s)) +
-                                                  body.potential_energy_j(u));  // its elements, its weight
-    work_scale_j = std::max(work_scale_j, body.external_force_n().dot(u));
-    const Eigen::Vector3d expected(0.0, 0.0, (v0 - h * 9.81) / (1.0 + h * alpha_per_s));
-    for (const int row : parked) {
-      EXPECT_LT((state.velocity_m_per_s.segment<3>(3 * row) - expected).norm(), 1e-12)
-          << "row " << row << " step " << n;
-    }
-  }
-  EXPECT_GT(guarded, 0);
-  EXPECT_LE(largest_gain_j, 1e-12 * work_scale_j);
+  // backward Euler's free fall with mass damping exactly (no element: nothing else acts on them).
+  // Before, the guard took the hinged cube's excess from the motion relative to the mean, mostly
+  // the parked cube's: it slowed down (the hatched frog's pieces stopped in mid-air while strokes cut).
+  HingedBesideFalling scene;
+  scene.body.park_rows(scene.falling);
+  const FallReport report = fall_beside_hinged(scene, /*hinged_only=*/true);
+  EXPECT_GT(report.guarded, 0);
+  EXPECT_LT(report.largest_error_m_per_s, 1e-12);
+  EXPECT_LE(report.largest_gain_j, 1e-12 * report.work_scale_j);
+}
+
+TEST(BackwardEulerLargeTurns, EnergyGuardKeepsTheMomentumOfEachPart) {
+  // The same two cubes, both in the dynamics (not parked): one body of two parts that no element
+  // joins. The guard acts on the hinged cube's steps; the falling cube has no stress and one
+  // velocity, so backward Euler's step is its free fall exactly, and the guard keeps it: each part's
+  // velocities are scaled about that part's own mean, and the body's energy never rises. Before,
+  // about the mean of the whole body, which the hinged cube held near rest: the falling cube lost
+  // speed at every guarded step (a piece cut free and falling beside a part that turned).
+  HingedBesideFalling scene;
+  const FallReport report = fall_beside_hinged(scene, /*hinged_only=*/false);
+  EXPECT_GT(report.guarded, 0);
+  EXPECT_LT(report.largest_error_m_per_s, 1e-12);
+  EXPECT_LE(report.largest_gain_j, 1e-12 * report.work_scale_j);
 }
 
 TEST(BackwardEulerLargeTurns, EnergyGuardDoesNotStopAFallingPartForAGainNoVelocityTakesBack) {
@@ -191,19 +251,12 @@ TEST(BackwardEulerLargeTurns, EnergyGuardDoesNotStopAFallingPartForAGainNoVeloci
   const TetMesh mesh = side_by_side(falling, spinning, Eigen::Vector3d(0.03, 0, 0));
   const BodySettings settings = settings_for({});
   DeformableBody body(mesh, settings);
-  BackwardEuler::NewtonCorrections newton;
-  newton.trigger_angle_rad = OFF;
-  BackwardEuler integrator(std::make_unique<CholmodSolver>(), BackwardEuler::Settings{false, newton});
-  DynamicState state = at_rest(body);
+  BackwardEuler integrator(std::make_unique<CholmodSolver>(), linearized_steps());
   const Eigen::Vector3d centre(0.031, 0.001, 0.001);
   const Eigen::Vector3d spin_rad_per_s(0.0, 0.0, 200.0);
-  for (int v = 0; v < mesh.vertex_count(); ++v) {
-    const int row = body.dofs().vertex_row[static_cast<size_t>(v)];
-    state.velocity_m_per_s.segment<3>(3 * row) =
-        v < falling.vertex_count()
-            ? Eigen::Vector3d(0.0, 0.0, -0.1)
-            : Eigen::Vector3d(spin_rad_per_s.cross(mesh.rest_positions_m[static_cast<size_t>(v)] - centre));
-  }
+  DynamicState state = moving(body, mesh, [&](int v, const Eigen::Vector3d& x) -> Eigen::Vector3d {
+    return v < falling.vertex_count() ? Eigen::Vector3d(0.0, 0.0, -0.1) : spin_rad_per_s.cross(x - centre);
+  });
   const double h = 0.01;
   const double energy_before_j = energy_j(body, state);
   const double v0 = state.velocity_m_per_s(2);
@@ -224,6 +277,48 @@ TEST(BackwardEulerLargeTurns, EnergyGuardDoesNotStopAFallingPartForAGainNoVeloci
         (state.velocity_m_per_s.segment<3>(3 * row) - state.velocity_m_per_s.segment<3>(3 * first_spinning)).norm(),
         1e-12)
         << "vertex " << v;
+  }
+}
+
+TEST(BackwardEulerLargeTurns, EnergyGuardBrakesEachPartAboutItsOwnMean) {
+  // Two free 2 mm cubes in one body, each spinning at 200 rad/s, the second also flying at 1 m/s
+  // along x; one 10 ms linearized step with exact solves, as above: no velocity takes the gain back,
+  // so the guard brakes the turning rows. Each cube's rows take the mean of that cube's: each keeps
+  // backward Euler's momentum law, (1 + h alpha) p1 = p0 + h m g (no force acts between them).
+  // Before, every braked row took one mean: the flying cube gave half its momentum to the other.
+  const TetMesh cube = make_box_mesh(1, 1, 1, 0.002);
+  const TetMesh mesh = side_by_side(cube, cube, Eigen::Vector3d(0.03, 0, 0));
+  const double alpha_per_s = settings_for({}).damping.mass_damping_per_s;
+  DeformableBody body(mesh, settings_for({}));
+  const Eigen::Vector3d spin_rad_per_s(0.0, 0.0, 200.0);
+  BackwardEuler integrator(std::make_unique<CholmodSolver>(), linearized_steps());
+  DynamicState state = moving(body, mesh, [&](int v, const Eigen::Vector3d& x) -> Eigen::Vector3d {
+    const bool second = v >= cube.vertex_count();
+    const Eigen::Vector3d centre = second ? Eigen::Vector3d(0.031, 0.001, 0.001) : Eigen::Vector3d(0.001, 0.001, 0.001);
+    return spin_rad_per_s.cross(x - centre) + (second ? Eigen::Vector3d(1.0, 0.0, 0.0) : Eigen::Vector3d::Zero());
+  });
+  const auto momentum = [&](bool second) {
+    Eigen::Vector3d p = Eigen::Vector3d::Zero();
+    for (int v = second ? cube.vertex_count() : 0; v < (second ? mesh.vertex_count() : cube.vertex_count()); ++v) {
+      const int row = body.dofs().vertex_row[static_cast<size_t>(v)];
+      p += body.mass_kg().segment<3>(3 * row).cwiseProduct(state.velocity_m_per_s.segment<3>(3 * row));
+    }
+    return p;
+  };
+  const double h = 0.01;
+  const double cube_mass_kg = 1000.0 * 0.002 * 0.002 * 0.002;
+  const std::array<Eigen::Vector3d, 2> before{momentum(false), momentum(true)};
+  const double energy_before_j = energy_j(body, state);
+  EXPECT_TRUE(integrator.step(body, state, h).energy_guarded);
+  ASSERT_GT(body.potential_energy_j(state.displacement_m), energy_before_j);  // the case: the brake
+  for (const bool second : {false, true}) {
+    const Eigen::Vector3d expected =
+        (before[second ? 1 : 0] + h * cube_mass_kg * Eigen::Vector3d(0.0, 0.0, -9.81)) / (1.0 + h * alpha_per_s);
+    std::printf("  cube %d: momentum %.6g %.6g %.6g kg m/s, expected %.6g %.6g %.6g\n", second ? 2 : 1,
+                momentum(second).x(), momentum(second).y(), momentum(second).z(), expected.x(), expected.y(),
+                expected.z());
+    EXPECT_LT((momentum(second) - expected).norm(), 1e-9 * cube_mass_kg * 1.0)
+        << "cube " << (second ? 2 : 1);  // 1e-9 of 1 m/s
   }
 }
 
