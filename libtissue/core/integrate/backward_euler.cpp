@@ -257,11 +257,7 @@ bool BackwardEuler::guard_energy(DynamicsModel& model, const DynamicState& state
   const std::vector<std::uint8_t>* left = model.rows_left();
   const auto in = [left](Eigen::Index r) { return !row_left(left, r); };
   const Eigen::VectorXd& load = model.external_force_n();
-  const RowParts part_of(model, blocks);
-  m_part_momentum.clear();
-  m_part_mass.clear();
   double kinetic_before_j = 0.0, kinetic_after_j = 0.0;
-  double own_kinetic_j = 0.0;  // of the rows no element uses (each its own mean)
   double left_potential_before_j = 0.0, left_potential_after_j = 0.0;  // -f . u of the rows left
   for (Eigen::Index r = 0; r < blocks; ++r) {
     const auto m = mass.segment<3>(3 * r);
@@ -275,18 +271,6 @@ bool BackwardEuler::guard_energy(DynamicsModel& model, const DynamicState& state
     const auto v1 = m_end_velocity.segment<3>(3 * r);
     kinetic_before_j += 0.5 * v0.dot(m.cwiseProduct(v0));
     kinetic_after_j += 0.5 * v1.dot(m.cwiseProduct(v1));
-    const int part = part_of(r);
-    if (part < 0) {
-      own_kinetic_j += 0.5 * v1.dot(m.cwiseProduct(v1));
-      continue;
-    }
-    add_to_part(m_part_momentum, m_part_mass, part, m, v1);
-  }
-  double mean_kinetic_j = own_kinetic_j;
-  for (size_t part = 0; part < m_part_mass.size(); ++part) {
-    Eigen::Vector3d& mean_velocity = m_part_momentum[part];  // the momentum becomes the mean velocity
-    mean_velocity = mean_velocity.cwiseQuotient(m_part_mass[part].cwiseMax(1e-300));
-    mean_kinetic_j += 0.5 * m_part_mass[part].dot(mean_velocity.cwiseProduct(mean_velocity));
   }
   double potential_before_j = m_start_potential_j;  // a pass over the elements saved
   if (!std::isfinite(potential_before_j)) {
@@ -305,9 +289,12 @@ bool BackwardEuler::guard_energy(DynamicsModel& model, const DynamicState& state
   if (!std::isfinite(potential_after_j)) potential_after_j = model.potential_energy_j(state.displacement_m);
   if (!std::isfinite(before_j) || !std::isfinite(potential_after_j)) return false;  // the model cannot say
   potential_after_j -= left_potential_after_j;
-  const double relative_kinetic_j = std::max(0.0, kinetic_after_j - mean_kinetic_j);
   if (kinetic_after_j + potential_after_j <= before_j) return false;
   if (potential_after_j >= before_j) return brake_turning_rows(model, h);
+  // The parts only now (found again after a cut: a union-find over the elements).
+  const RowParts part_of(model, blocks);
+  const double mean_kinetic_j = part_means(model);
+  const double relative_kinetic_j = std::max(0.0, kinetic_after_j - mean_kinetic_j);
   const double room_j = before_j - potential_after_j;
   const bool relative_only = room_j >= mean_kinetic_j && relative_kinetic_j > 0.0;
   const double s = relative_only ? std::sqrt((room_j - mean_kinetic_j) / relative_kinetic_j)
@@ -324,6 +311,32 @@ bool BackwardEuler::guard_energy(DynamicsModel& model, const DynamicState& state
     }
   }
   return true;
+}
+
+double BackwardEuler::part_means(const DynamicsModel& model) {
+  const Eigen::VectorXd& mass = model.mass_kg();
+  const RowParts part_of(model, mass.size() / 3);
+  const std::vector<std::uint8_t>* left = model.rows_left();
+  m_part_momentum.clear();
+  m_part_mass.clear();
+  double mean_kinetic_j = 0.0;  // first the rows no element uses (each its own mean)
+  for (Eigen::Index r = 0; r < mass.size() / 3; ++r) {
+    if (row_left(left, r)) continue;
+    const auto m = mass.segment<3>(3 * r);
+    const auto v1 = m_end_velocity.segment<3>(3 * r);
+    const int part = part_of(r);
+    if (part < 0) {
+      mean_kinetic_j += 0.5 * v1.dot(m.cwiseProduct(v1));
+    } else {
+      add_to_part(m_part_momentum, m_part_mass, part, m, v1);
+    }
+  }
+  for (size_t part = 0; part < m_part_mass.size(); ++part) {
+    Eigen::Vector3d& mean_velocity = m_part_momentum[part];  // the momentum becomes the mean velocity
+    mean_velocity = mean_velocity.cwiseQuotient(m_part_mass[part].cwiseMax(1e-300));
+    mean_kinetic_j += 0.5 * m_part_mass[part].dot(mean_velocity.cwiseProduct(mean_velocity));
+  }
+  return mean_kinetic_j;
 }
 
 bool BackwardEuler::brake_turning_rows(const DynamicsModel& model, double h) {

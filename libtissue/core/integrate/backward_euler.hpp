@@ -96,6 +96,10 @@ class BackwardEuler final : public Integrator {
   // Scales v1 (m_end_velocity) so that the step's energy does not rise; true if it did. The
   // potential energy at the start is m_start_potential_j when the step's evaluate found it.
   bool guard_energy(DynamicsModel& model, const DynamicState& state, double h);
+  // Each part's (DynamicsModel::row_parts) mass-weighted mean velocity of v1 over the rows not left
+  // into m_part_momentum (its mass into m_part_mass); returns the kinetic energy of those means, a
+  // row no element uses counting as its own mean.
+  double part_means(const DynamicsModel& model);
   // The guard where no velocity takes the gain back: the rows of the elements v1 turns past the
   // guard's angle (not left) get the mass-weighted mean velocity of their part's such rows; true if
   // there were any.
@@ -128,7 +132,7 @@ class BackwardEuler final : public Integrator {
   GalerkinStartWork m_warm_start;
   Eigen::VectorXd m_end_displacement;  // the Newton iterate u0 + h v1
   std::vector<std::uint8_t> m_turning_rows;  // brake_turning_rows()
-  std::vector<Eigen::Vector3d> m_part_momentum, m_part_mass;  // guard_energy(): per part of the model
+  std::vector<Eigen::Vector3d> m_part_momentum, m_part_mass;  // per part of the model: part_means(), the brake
   Eigen::VectorXd m_end_velocity;      // v1
   Eigen::VectorXd m_correction;        // a Newton correction of v1
   Eigen::VectorXd m_trial_velocity;    // v1 + t correction, in the line search
