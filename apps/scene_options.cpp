@@ -85,6 +85,13 @@ void add_scene_options(CLI::App& app, SceneOptions& options) {
                  "Newton corrections at most in a step (0: the core's 5; the FMU, tissue-host and Python default to 1)")
       ->check(CLI::Range(0, 100))
       ->capture_default_str();
+  app.add_option("--newton-trigger-angle", options.newton_trigger_angle_rad,
+                 "Newton corrections in a step whose linearized solve turns some element further than this [rad] "
+                 "(0: the core's 0.05; a tiny angle converges every step's Newton iterations)")
+      ->check(CLI::Range(0.0, 10.0));
+  app.add_flag("--predicted-end", options.linearize_at_predicted_end,
+               "Backward Euler linearizes each step at its predicted end u0 + h v0 (the FMU, tissue-host and "
+               "Python default) instead of at its start");
   app.add_option("--threads", options.threads, "Threads per step, 1 or 2 (a team made and joined by each step)")
       ->capture_default_str();
 }
@@ -113,6 +120,10 @@ Scene make_scene(const SceneOptions& options) {
   if (!options.large_turn_protection) {
     settings.integrator.newton.trigger_angle_rad = std::numeric_limits<double>::infinity();
     settings.integrator.newton.energy_guard_angle_rad = std::numeric_limits<double>::infinity();
+  }
+  settings.integrator.newton.linearize_at_predicted_end = options.linearize_at_predicted_end;
+  if (options.newton_trigger_angle_rad > 0.0) {
+    settings.integrator.newton.trigger_angle_rad = options.newton_trigger_angle_rad;
   }
   settings.integrator.threads = options.threads;
   settings.body.gravity_m_per_s2 = parse_vector(options.gravity, "--gravity");

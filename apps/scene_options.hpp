@@ -44,6 +44,11 @@ struct SceneOptions {
   /// the core's own cap. The products (the FMU, tissue-host, Python) default to 1
   /// (`integrator.newtonMaxIterations`).
   int newton_max_iterations = 0;
+  /// Each step linearized at its predicted end (NewtonCorrections::linearize_at_predicted_end; the
+  /// products' default, `integrator.linearizeAtPredictedEnd`); the core's step otherwise.
+  bool linearize_at_predicted_end = false;
+  /// Newton corrections' trigger angle [rad] (NewtonCorrections::trigger_angle_rad); 0: the core's.
+  double newton_trigger_angle_rad = 0.0;
   int threads = 1;  ///< IntegratorSettings::threads
 };
 

@@ -230,12 +230,18 @@ CompareSettingsList default_settings() {
   };
   list.settings = {
       // The real-time default (issue 40: the two-level preconditioner, capped at 10 iterations, one
-      // Newton correction), the default before it (Jacobi PCG capped at 10, up to 5 corrections),
+      // Newton correction, each step linearized at its predicted end), the same linearized at the start
+      // (the dissertation's step, the default before issue 41), the default before issue 40 (Jacobi PCG
+      // capped at 10, up to 5 corrections),
       // Jacobi PCG converged, CG on the lagged Cholesky factor (warm-started, converged), the
       // two-level preconditioner converged from the warm start (the fastest converged step: docs/BENCHMARKS.md).
       setting("be-pcgTwoLevel-tol1e-3-cap10",
               be({text("integrator.linearSolver", "pcgTwoLevel"), number("integrator.pcgTolerance", 1e-3),
                   integer("integrator.pcgMaxIterations", 10), integer("integrator.newtonMaxIterations", 1)})),
+      setting("be-pcgTwoLevel-tol1e-3-cap10-atStart",
+              be({text("integrator.linearSolver", "pcgTwoLevel"), number("integrator.pcgTolerance", 1e-3),
+                  integer("integrator.pcgMaxIterations", 10), integer("integrator.newtonMaxIterations", 1),
+                  ParameterSetting{"integrator.linearizeAtPredictedEnd", false}})),
       setting("be-pcg-tol1e-3-cap10",
               be({text("integrator.linearSolver", "pcg"), number("integrator.pcgTolerance", 1e-3),
                   integer("integrator.pcgMaxIterations", 10), integer("integrator.newtonMaxIterations", 5)})),

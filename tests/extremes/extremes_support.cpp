@@ -93,6 +93,7 @@ TissueSettings default_settings() {
   settings.body.damping = RayleighDamping{1.0, 1e-3};
   settings.body.gravity_m_per_s2 = {0.0, 0.0, -9.81};
   settings.step_size_s = 1e-3;
+  settings.integrator.newton.linearize_at_predicted_end = true;  // the products' step
   return settings;
 }
 

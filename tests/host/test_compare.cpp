@@ -239,6 +239,7 @@ ModelDescription tissue_like(bool with_ida) {
     <Int32 name="integrator.pcgMaxIterations" valueReference="12" causality="parameter" variability="fixed" start="10"/>
     <Boolean name="integrator.warmStart" valueReference="13" causality="parameter" variability="fixed" start="false"/>
     <Int32 name="integrator.newtonMaxIterations" valueReference="86" causality="parameter" variability="fixed" start="1"/>
+    <Boolean name="integrator.linearizeAtPredictedEnd" valueReference="92" causality="parameter" variability="fixed" start="true"/>
     <Float64 name="stepSize" valueReference="14" causality="parameter" variability="fixed" start="0.001"/>
     <Float64 name="contact.force" valueReference="43" causality="output" variability="continuous"/>)";
   if (with_ida) {
@@ -263,11 +264,10 @@ TEST(CompareSettings, TheDefaultListAndSteps) {
   const CompareSettingsList list = default_settings();
   std::vector<std::string> names;
   for (const CompareSetting& s : list.settings) names.push_back(s.name);
-  EXPECT_EQ(names,
-            (std::vector<std::string>{"be-pcgTwoLevel-tol1e-3-cap10", "be-pcg-tol1e-3-cap10", "be-pcg-tol1e-6-cap1000",
-                                      "be-pcgCholesky-tol1e-5-cap25", "be-pcgTwoLevel-tol1e-6-warm", "be-cholmod",
-                                      "ida-klu-rtol1e-3",
-                                      "ida-klu-rtol1e-5", "ida-krylov-rtol1e-3"}));
+  EXPECT_EQ(names, (std::vector<std::string>{
+                       "be-pcgTwoLevel-tol1e-3-cap10", "be-pcgTwoLevel-tol1e-3-cap10-atStart", "be-pcg-tol1e-3-cap10",
+                       "be-pcg-tol1e-6-cap1000", "be-pcgCholesky-tol1e-5-cap25", "be-pcgTwoLevel-tol1e-6-warm",
+                       "be-cholmod", "ida-klu-rtol1e-3", "ida-klu-rtol1e-5", "ida-krylov-rtol1e-3"}));
   EXPECT_EQ(default_steps(0.01), (std::vector<double>{0.001, 0.01}));
   EXPECT_EQ(default_steps(0.005), (std::vector<double>{0.001, 0.005}));
   EXPECT_EQ(default_steps(0.001), (std::vector<double>{0.001}));
@@ -277,7 +277,7 @@ TEST(CompareSettings, TheDefaultListAndSteps) {
 TEST(CompareSettings, WithIdaEveryRunIsPlannedAndTheReferenceIsIda) {
   std::string note;
   const std::vector<RunSpec> runs = plan_runs(default_settings(), scenario_with_step(0.01), tissue_like(true), note);
-  ASSERT_EQ(runs.size(), 1u + 9u * 2u);
+  ASSERT_EQ(runs.size(), 1u + 10u * 2u);
   EXPECT_TRUE(note.empty()) << note;
   EXPECT_TRUE(runs[0].is_reference);
   EXPECT_EQ(runs[0].step_s, 0.001);
@@ -289,17 +289,17 @@ TEST(CompareSettings, WithIdaEveryRunIsPlannedAndTheReferenceIsIda) {
   EXPECT_EQ(runs[1].setting, "be-pcgTwoLevel-tol1e-3-cap10");
   EXPECT_EQ(runs[1].step_s, 0.001);
   EXPECT_EQ(runs[2].step_s, 0.01);
-  const SettingDescription lagged = describe_setting(runs[7].parameters, tissue_like(true));
-  EXPECT_EQ(runs[7].setting, "be-pcgCholesky-tol1e-5-cap25");
+  const SettingDescription lagged = describe_setting(runs[9].parameters, tissue_like(true));
+  EXPECT_EQ(runs[9].setting, "be-pcgCholesky-tol1e-5-cap25");
   EXPECT_EQ(lagged.family(), "backwardEuler/pcgCholesky");
   EXPECT_EQ(lagged.tolerance, 1e-5);
   EXPECT_EQ(lagged.iteration_cap, 25);
-  const SettingDescription warm = describe_setting(runs[9].parameters, tissue_like(true));
-  EXPECT_EQ(runs[9].setting, "be-pcgTwoLevel-tol1e-6-warm");
+  const SettingDescription warm = describe_setting(runs[11].parameters, tissue_like(true));
+  EXPECT_EQ(runs[11].setting, "be-pcgTwoLevel-tol1e-6-warm");
   EXPECT_EQ(warm.family(), "backwardEuler/pcgTwoLevel");
   EXPECT_EQ(warm.tolerance, 1e-6);
-  const SettingDescription cholmod = describe_setting(runs[11].parameters, tissue_like(true));
-  EXPECT_EQ(runs[11].setting, "be-cholmod");
+  const SettingDescription cholmod = describe_setting(runs[13].parameters, tissue_like(true));
+  EXPECT_EQ(runs[13].setting, "be-cholmod");
   EXPECT_EQ(cholmod.family(), "backwardEuler/cholmod");
   EXPECT_FALSE(cholmod.tolerance);
   EXPECT_FALSE(cholmod.iteration_cap);
@@ -309,7 +309,7 @@ TEST(CompareSettings, WithoutIdaTheIdaRowsAreSkippedAndTheReferenceFallsBack) {
   const ModelDescription old_tissue = tissue_like(false);
   std::string note;
   const std::vector<RunSpec> runs = plan_runs(default_settings(), scenario_with_step(0.01), old_tissue, note);
-  ASSERT_EQ(runs.size(), 19u);
+  ASSERT_EQ(runs.size(), 21u);
   EXPECT_NE(note.find("integrator.method"), std::string::npos) << note;
   EXPECT_EQ(describe_setting(runs[0].parameters, old_tissue).family(), "backwardEuler/cholmod");
   for (const RunSpec& run : runs) {

@@ -153,18 +153,23 @@ TEST(CompareRuns, TheDefaultListOnTheBeam) {
   std::vector<std::string> header;
   const std::vector<CsvRow> rows = read_csv(dir.path() / "compare.csv", &header);
   EXPECT_EQ(header, COLUMNS);
-  ASSERT_EQ(rows.size(), 1u + 9u * 2u);
+  ASSERT_EQ(rows.size(), 1u + 10u * 2u);
   EXPECT_EQ(report.rows.size(), rows.size());
   EXPECT_EQ(rows[0].at("setting"), "reference");
   for (const char* column : {"rms_error_m", "max_error_m", "force_error_n", "energy_drift_j"}) {
     EXPECT_EQ(number(rows[0], column), 0.0) << column;
   }
   EXPECT_EQ(rows[0].at("pareto"), "0");
-  const std::vector<std::string> settings{"be-pcgTwoLevel-tol1e-3-cap10", "be-pcg-tol1e-3-cap10",
-                                          "be-pcg-tol1e-6-cap1000",       "be-pcgCholesky-tol1e-5-cap25",
-                                          "be-pcgTwoLevel-tol1e-6-warm",  "be-cholmod",
+  const std::vector<std::string> settings{"be-pcgTwoLevel-tol1e-3-cap10",
+                                          "be-pcgTwoLevel-tol1e-3-cap10-atStart",
+                                          "be-pcg-tol1e-3-cap10",
+                                          "be-pcg-tol1e-6-cap1000",
+                                          "be-pcgCholesky-tol1e-5-cap25",
+                                          "be-pcgTwoLevel-tol1e-6-warm",
+                                          "be-cholmod",
                                           "ida-klu-rtol1e-3",
-                                          "ida-klu-rtol1e-5",             "ida-krylov-rtol1e-3"};
+                                          "ida-klu-rtol1e-5",
+                                          "ida-krylov-rtol1e-3"};
   int on_front = 0;
   for (std::size_t k = 0; k < settings.size(); ++k) {
     for (std::size_t s = 0; s < 2; ++s) {
@@ -190,9 +195,9 @@ TEST(CompareRuns, TheDefaultListOnTheBeam) {
   EXPECT_EQ(rows[1].at("linear_solver"), "pcgTwoLevel");
   EXPECT_EQ(rows[1].at("iteration_cap"), "10");
   EXPECT_EQ(std::stod(rows[1].at("tolerance")), 1e-3);
-  EXPECT_EQ(rows[7].at("linear_solver"), "pcgCholesky");
-  EXPECT_EQ(rows[13].at("integrator"), "ida");
-  EXPECT_EQ(rows[13].at("linear_solver"), "klu");
+  EXPECT_EQ(rows[9].at("linear_solver"), "pcgCholesky");
+  EXPECT_EQ(rows[15].at("integrator"), "ida");
+  EXPECT_EQ(rows[15].at("linear_solver"), "klu");
 
   const auto rms = [&](const std::string& setting, const std::string& step) {
     return number(row_of(rows, setting, step), "rms_error_m");

@@ -61,6 +61,26 @@ void add_spring_tangent(const PointSpring& spring, const std::array<int, 9>& slo
   }
 }
 
+// The blocks add_spring_tangent enters, c k w_i w_j D, times `vector`, added to `product` by rows.
+void add_spring_tangent_product(const PointSpring& spring, const std::array<int, 3>& rows,
+                                const Eigen::VectorXd& vector, Eigen::VectorXd& product) {
+  Eigen::Vector3d point = Eigen::Vector3d::Zero();  // sum_j w_j v_j over the free vertices
+  for (size_t j = 0; j < 3; ++j) {
+    if (rows[j] >= 0) point += spring.weights[static_cast<Eigen::Index>(j)] * vector.segment<3>(3L * rows[j]);
+  }
+  const Eigen::Vector3d force =
+      (spring.tangent_fraction * spring.stiffness_n_per_m) * (spring_projector(spring) * point);
+  for (size_t i = 0; i < 3; ++i) {
+    if (rows[i] >= 0) product.segment<3>(3L * rows[i]) += spring.weights[static_cast<Eigen::Index>(i)] * force;
+  }
+}
+
+std::array<int, 3> spring_rows(const PointSpring& spring, const TermLayout& layout) {
+  std::array<int, 3> rows{};
+  for (size_t i = 0; i < 3; ++i) rows[i] = layout.vertex_row[static_cast<size_t>(spring.vertices[i])];
+  return rows;
+}
+
 double spring_energy_j(const PointSpring& spring, const Eigen::VectorXd& positions_m) {
   // D is a projector (D^T D = D): k/2 |D (x_p - target)|^2; F's potential is -F . x_p.
   const Eigen::Vector3d point_m = spring_material_point_m(spring, positions_m);
@@ -130,6 +150,12 @@ void PointSpringTerm::add_tangent(BlockSparseMatrix& tangent) const {
   for (size_t p = 0; p < m_pad.size(); ++p) add_spring_tangent(m_pad[p], m_pad_slots[p], tangent);
 }
 
+void PointSpringTerm::add_tangent_product(const Eigen::VectorXd& vector, Eigen::VectorXd& product) const {
+  if (!m_spring) return;
+  add_spring_tangent_product(*m_spring, m_rows[0], vector, product);
+  for (size_t p = 0; p < m_pad.size(); ++p) add_spring_tangent_product(m_pad[p], m_rows[p + 1], vector, product);
+}
+
 double PointSpringTerm::energy_j(const Eigen::VectorXd& positions_m) const {
   if (!m_spring) return 0.0;
   double energy_j = spring_energy_j(*m_spring, positions_m);
@@ -140,9 +166,14 @@ double PointSpringTerm::energy_j(const Eigen::VectorXd& positions_m) const {
 void PointSpringTerm::locate(const TermLayout& layout) {
   m_slots.fill(-1);
   m_pad_slots.clear();
+  m_rows.clear();
   if (!m_spring) return;
   m_slots = spring_slots(*m_spring, layout);
-  for (const PointSpring& spring : m_pad) m_pad_slots.push_back(spring_slots(spring, layout));
+  m_rows.push_back(spring_rows(*m_spring, layout));
+  for (const PointSpring& spring : m_pad) {
+    m_pad_slots.push_back(spring_slots(spring, layout));
+    m_rows.push_back(spring_rows(spring, layout));
+  }
 }
 
 void PointSpringTerm::set(std::optional<PointSpring> spring, const TermLayout& layout, std::vector<PointSpring> pad) {

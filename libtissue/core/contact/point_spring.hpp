@@ -65,6 +65,7 @@ class PointSpringTerm final : public ForceTerm {
 
   void add_force(const Eigen::VectorXd& positions_m, Eigen::VectorXd& vertex_forces_n) override;
   void add_tangent(BlockSparseMatrix& tangent) const override;
+  void add_tangent_product(const Eigen::VectorXd& vector, Eigen::VectorXd& product) const override;
   [[nodiscard]] double energy_j(const Eigen::VectorXd& positions_m) const override;
   void locate(const TermLayout& layout) override;
   /// No spring set (then no pad either).
@@ -77,6 +78,7 @@ class PointSpringTerm final : public ForceTerm {
   Slots m_slots{};
   std::vector<PointSpring> m_pad;
   std::vector<Slots> m_pad_slots;
+  std::vector<std::array<int, 3>> m_rows;  // per spring (the point's, then the pad's): its vertices' rows, -1 fixed
   Eigen::Vector3d m_force_on_body_n = Eigen::Vector3d::Zero();
 };
 

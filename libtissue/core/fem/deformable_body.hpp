@@ -276,6 +276,11 @@ class DeformableBody final : public DynamicsModel {
   /// Stops adding `term` (nothing if it is not attached).
   void detach(ForceTerm& term);
   [[nodiscard]] const std::vector<ForceTerm*>& force_terms() const { return m_force_terms; }
+  void add_force_terms_tangent_product(const Eigen::VectorXd& vector, Eigen::VectorXd& product) const override {
+    for (const ForceTerm* term : m_force_terms) {
+      if (!term->idle()) term->add_tangent_product(vector, product);
+    }
+  }
   /// Where the mesh vertices sit in the tangent, for a term's checks and slots.
   [[nodiscard]] TermLayout term_layout() const { return {m_mesh.vertex_count(), m_dofs.vertex_row, &m_tangent}; }
 

@@ -105,34 +105,15 @@ StepReport BackwardEuler::step(DynamicsModel& model, DynamicState& state, double
                            std::to_string(n));
   }
   StepReport report;
+  reserve_guard_lists(n / 3);
   // The opt-in team lives for this step only: joined (and taken back from the model) on every exit.
   std::optional<WorkTeam> team;
   if (m_settings.threads > 1) team.emplace(m_settings.threads);
   const TeamLoan loan(model, *m_solver, team ? &*team : nullptr);
   const auto assembly_start = std::chrono::steady_clock::now();
-  // The start as the last step's energy guard evaluated it ahead, when the model takes that (nothing
-  // changed it since); else the energy guard's start found in the same pass when the guard may act.
-  const bool taken = m_end_evaluated && model.take_evaluation_ahead(state.displacement_m);
-  m_end_evaluated = false;
-  if (taken) {
-    m_start_potential_j = model.potential_energy_at_last_evaluate_j();  // m_internal_force_n its force
-  } else if (std::isfinite(m_settings.newton.energy_guard_angle_rad)) {
-    model.evaluate_with_potential(state.displacement_m, m_internal_force_n, /*update_tangent=*/true);
-    m_start_potential_j = model.potential_energy_at_last_evaluate_j();
-  } else {
-    model.evaluate(state.displacement_m, m_internal_force_n, /*update_tangent=*/true);
-    m_start_potential_j = std::numeric_limits<double>::quiet_NaN();
-  }
-  const BlockSparseMatrix& stiffness = model.tangent();
-
-  // rhs = h (f_ext - f_int - alpha M v - (beta + h) K v)
-  m_stiffness_times_velocity.resize(n);
-  stiffness.multiply(state.velocity_m_per_s, m_stiffness_times_velocity, team ? &*team : nullptr);
-  m_rhs.resize(n);
-  m_rhs.noalias() = h * (model.external_force_n() - m_internal_force_n -
-                         model.mass_damping_kg_per_s().cwiseProduct(state.velocity_m_per_s) -
-                         (model.stiffness_damping_s() + h) * m_stiffness_times_velocity);
-  const ShiftedSystem system = step_system(model, h, state.displacement_m);
+  const bool predicted = m_settings.newton.linearize_at_predicted_end;
+  linearize(model, state, h, team ? &*team : nullptr);
+  const ShiftedSystem system = step_system(model, h, predicted ? m_end_displacement : state.displacement_m);
   report.assembly_s = seconds_since(assembly_start);
 
   const auto solve_start = std::chrono::steady_clock::now();
@@ -153,15 +134,25 @@ StepReport BackwardEuler::step(DynamicsModel& model, DynamicState& state, double
     throw IntegrationError("backward Euler: the velocity update is not finite; state kept");
   }
   m_end_velocity.noalias() = state.velocity_m_per_s + m_velocity_change;
-  m_end_displacement.noalias() = h * m_end_velocity;  // the step's increment
-  // One pass answers both thresholds; a corrected step is measured again for the guard.
+  // The corrections follow the turn from where the step was linearized, the guard the step's own
+  // turn, h v1 (a steady swing linearized at its predicted end still gains energy: the co-rotational
+  // tangent lacks the rotation's derivative). Linearized at the start, one pass answers both
+  // thresholds; a corrected step is measured again for the guard.
   const NewtonCorrections& newton = m_settings.newton;
-  double turn_rad =
-      model.largest_turn_rad(m_end_displacement, std::min(newton.trigger_angle_rad, newton.energy_guard_angle_rad));
-  m_end_potential_j = std::numeric_limits<double>::quiet_NaN();
-  if (turn_rad > newton.trigger_angle_rad) {
+  if (predicted) {
+    m_end_displacement.noalias() = h * m_velocity_change;
+  } else {
+    m_end_displacement.noalias() = h * m_end_velocity;
+  }
+  double turn_rad = model.largest_turn_rad(
+      m_end_displacement,
+      predicted ? newton.trigger_angle_rad : std::min(newton.trigger_angle_rad, newton.energy_guard_angle_rad));
+  const bool corrected = turn_rad > newton.trigger_angle_rad;
+  if (corrected) {
     correct(model, state, h, report, team ? &*team : nullptr);
     m_velocity_change.noalias() = m_end_velocity - state.velocity_m_per_s;
+  }
+  if (corrected || predicted) {
     m_end_displacement.noalias() = h * m_end_velocity;
     turn_rad = model.largest_turn_rad(m_end_displacement, newton.energy_guard_angle_rad);
   }
@@ -176,6 +167,66 @@ StepReport BackwardEuler::step(DynamicsModel& model, DynamicState& state, double
   state.velocity_m_per_s = m_end_velocity;
   state.time_s += h;
   return report;
+}
+
+// Evaluates the model where the step is linearized (u0, or the predicted end u0 + h v0, left in
+// m_end_displacement) and sets m_rhs, the right side of the step's solve.
+void BackwardEuler::linearize(DynamicsModel& model, const DynamicState& state, double h, WorkTeam* team) {
+  const bool predicted = m_settings.newton.linearize_at_predicted_end;
+  const Eigen::Index n = state.displacement_m.size();
+  m_end_potential_j = std::numeric_limits<double>::quiet_NaN();
+  // The start as the last step's energy guard evaluated it ahead, when the model takes that (nothing
+  // changed it since); else the energy guard's start found in the same pass when the guard may act.
+  // Linearized at the predicted end, the start's potential is found by the guard when it acts.
+  const bool taken = m_end_evaluated && model.take_evaluation_ahead(state.displacement_m);
+  m_end_evaluated = false;
+  m_start_potential_j = std::numeric_limits<double>::quiet_NaN();
+  if (predicted) {
+    m_end_velocity = state.velocity_m_per_s;
+    m_end_displacement.noalias() = state.displacement_m + h * m_end_velocity;
+    model.evaluate(m_end_displacement, m_internal_force_n, /*update_tangent=*/true);
+  } else if (taken) {
+    m_start_potential_j = model.potential_energy_at_last_evaluate_j();  // m_internal_force_n its force
+  } else if (std::isfinite(m_settings.newton.energy_guard_angle_rad)) {
+    model.evaluate_with_potential(state.displacement_m, m_internal_force_n, /*update_tangent=*/true);
+    m_start_potential_j = model.potential_energy_at_last_evaluate_j();
+  } else {
+    model.evaluate(state.displacement_m, m_internal_force_n, /*update_tangent=*/true);
+  }
+  const BlockSparseMatrix& stiffness = model.tangent();
+
+  // rhs = h (f_ext - f_int(u) - alpha M v0 - (beta + h) K v0) at u = u0; at the predicted end
+  // u = u0 + h v0 (Newton's residual at v1 = v0), h (f_ext - f_int(u) - alpha M v0 - beta K v0).
+  // (At the predicted end the product is the damping's alone: the tool's spring enters it undamped.)
+  const double stiffness_times_velocity_s = model.stiffness_damping_s() + (predicted ? 0.0 : h);
+  m_stiffness_times_velocity.setZero(n);
+  if (predicted && stiffness_times_velocity_s != 0.0) {
+    damped_stiffness_product(model, state.velocity_m_per_s, m_stiffness_times_velocity, team);
+  } else if (stiffness_times_velocity_s != 0.0) {
+    stiffness.multiply(state.velocity_m_per_s, m_stiffness_times_velocity, team);
+  }
+  m_rhs.resize(n);
+  m_rhs.noalias() = h * (model.external_force_n() - m_internal_force_n -
+                         model.mass_damping_kg_per_s().cwiseProduct(state.velocity_m_per_s) -
+                         stiffness_times_velocity_s * m_stiffness_times_velocity);
+}
+
+// At most one part per row: reserved as the system grows (a cut, which allocates anyway), so that the
+// first step the guard scales after it does not allocate.
+void BackwardEuler::reserve_guard_lists(Eigen::Index blocks) {
+  const auto rows = static_cast<size_t>(blocks);
+  if (m_part_mass.capacity() >= rows) return;
+  m_part_momentum.reserve(rows);
+  m_part_mass.reserve(rows);
+  m_turning_rows.reserve(rows);
+}
+
+void BackwardEuler::damped_stiffness_product(const DynamicsModel& model, const Eigen::VectorXd& v,
+                                             Eigen::VectorXd& product, WorkTeam* team) {
+  model.tangent().multiply(v, product, team);
+  m_terms_product.setZero(v.size());
+  model.add_force_terms_tangent_product(v, m_terms_product);
+  product -= m_terms_product;
 }
 
 // The initial guess: zero (as Vega and the dissertation), or galerkin_start over the last steps'
@@ -282,7 +333,8 @@ bool BackwardEuler::guard_energy(DynamicsModel& model, const DynamicState& state
   // Else by the next step's start evaluated now, ahead (a whole assembly that the next step takes
   // instead of its own: 3.3 ms of the organ's 19 saved), where the model will; else by a pass of its own.
   double potential_after_j = m_end_potential_j;
-  if (!std::isfinite(potential_after_j) && model.evaluate_ahead(state.displacement_m, m_internal_force_n)) {
+  if (!std::isfinite(potential_after_j) && evaluates_ahead() &&
+      model.evaluate_ahead(state.displacement_m, m_internal_force_n)) {
     m_end_evaluated = true;
     potential_after_j = model.potential_energy_at_last_evaluate_j();
   }
@@ -389,12 +441,11 @@ void BackwardEuler::correct(DynamicsModel& model, const DynamicState& state, dou
     } else if (!evaluated) {
       model.evaluate(m_end_displacement, m_internal_force_n, /*update_tangent=*/true);
     }
-    const BlockSparseMatrix& stiffness = model.tangent();
     m_rhs.noalias() = h * (model.external_force_n() - m_internal_force_n -
                            model.mass_damping_kg_per_s().cwiseProduct(m_end_velocity)) -
                       mass.cwiseProduct(m_end_velocity - state.velocity_m_per_s);
     if (beta_s != 0.0) {
-      stiffness.multiply(m_end_velocity, m_stiffness_times_velocity, team);
+      damped_stiffness_product(model, m_end_velocity, m_stiffness_times_velocity, team);
       m_rhs.noalias() -= (h * beta_s) * m_stiffness_times_velocity;
     }
     const ShiftedSystem system = step_system(model, h, m_end_displacement);
@@ -490,7 +541,7 @@ double BackwardEuler::line_search(DynamicsModel& model, const DynamicState& stat
     // per correction, a tenth of a hatched run's late steps).
     quadratic = {m_end_velocity.dot(m_stiffness_times_velocity), m_correction.dot(m_stiffness_times_velocity), 0.0};
     m_trial_product.resize(m_correction.size());
-    model.tangent().multiply(m_correction, m_trial_product, team);
+    damped_stiffness_product(model, m_correction, m_trial_product, team);
     quadratic[2] = m_correction.dot(m_trial_product);
   }
   const auto stiffness_damping_j = [&](double share) {
@@ -514,7 +565,8 @@ double BackwardEuler::line_search(DynamicsModel& model, const DynamicState& stat
     // The first trial of the last correction is likely the step's end: evaluated ahead of the next
     // step, which takes it as its start if the search does (else the next one is not at that u).
     const bool whole = halving == 0 && evaluate_whole;
-    const TrialPass pass = whole ? TrialPass::with_tangent : halving == 0 ? TrialPass::ahead : TrialPass::potential;
+    const bool ahead = halving == 0 && evaluates_ahead();
+    const TrialPass pass = whole ? TrialPass::with_tangent : ahead ? TrialPass::ahead : TrialPass::potential;
     m_trial_potential_j = trial_potential_j(model, state, h, pass);
     if (incremental_potential_j(model, state, h, m_trial_velocity, stiffness_damping_j(share), m_trial_potential_j) <=
         start_j) {

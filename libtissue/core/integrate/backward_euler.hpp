@@ -40,6 +40,13 @@ class BackwardEuler final : public Integrator {
     /// tangent lacks the rotation's derivative, so a full correction can overshoot a fast-turning
     /// piece and the iterates swing (docs/DESIGN.md, "Newton corrections"). false: full corrections.
     bool line_search = true;
+    /// Newton's first iterate: true, the last step's velocity (the step linearized at the predicted
+    /// end u0 + h v0, so that a steady turn is not linearized h omega away from where it ends: a chunk
+    /// swinging on a thread needs no corrections); false, v1 = 0 (linearized at the start u0: the
+    /// dissertation's step). The same cost a step but a second turn pass: the turn that triggers the
+    /// corrections is then h (v1 - v0), from the predicted end; the guard's stays the step's own, h v1
+    /// (docs/DESIGN.md, "The step linearized at its predicted end").
+    bool linearize_at_predicted_end = false;
   };
   /// Halvings of a correction before the line search gives up on it.
   static constexpr int LINE_SEARCH_HALVINGS = 6;
@@ -84,6 +91,18 @@ class BackwardEuler final : public Integrator {
 
  private:
   void correct(DynamicsModel& model, const DynamicState& state, double h, StepReport& report, WorkTeam* team);
+  // The model evaluated where the step is linearized (at u0, or at the predicted end u0 + h v0, left in
+  // m_end_displacement) and m_rhs, the step's right side.
+  void linearize(DynamicsModel& model, const DynamicState& state, double h, WorkTeam* team);
+  // Reserves the guard's lists per part and per row for `blocks` rows.
+  void reserve_guard_lists(Eigen::Index blocks);
+  // product = K v without the force terms' share (DynamicsModel::add_force_terms_tangent_product):
+  // the stiffness damping's product, beta K v, damps the tissue and not the tool's spring, whose share
+  // of the tangent takes the step's (h beta + h^2) to h^2 (undamped_tangent_fraction).
+  void damped_stiffness_product(const DynamicsModel& model, const Eigen::VectorXd& v, Eigen::VectorXd& product,
+                                WorkTeam* team);
+  // Whether a step may evaluate the next step's start ahead (its start is u1, not u1 + h v1).
+  [[nodiscard]] bool evaluates_ahead() const { return !m_settings.newton.linearize_at_predicted_end; }
   ShiftedSystem step_system(const DynamicsModel& model, double h, const Eigen::VectorXd& displacement_m);
   // How many whole velocity changes of `n` unknowns the history holds (0 when its length does not
   // divide by n: the system grew since).
@@ -138,6 +157,7 @@ class BackwardEuler final : public Integrator {
   Eigen::VectorXd m_trial_velocity;    // v1 + t correction, in the line search
   Eigen::VectorXd m_trial_displacement;
   Eigen::VectorXd m_trial_product;     // K v of a trial
+  Eigen::VectorXd m_terms_product;     // the force terms' share of K v (damped_stiffness_product)
   double m_trial_potential_j = 0.0;    // the model's potential energy at the last trial's u1
   double m_start_potential_j = 0.0;    // at u0, from the step's evaluate (NaN: the model keeps none)
   double m_end_potential_j = 0.0;      // at u0 + h v1 when the corrections' line search found it, else NaN

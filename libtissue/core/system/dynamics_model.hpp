@@ -98,6 +98,10 @@ class DynamicsModel {
   [[nodiscard]] virtual double potential_energy_at_last_evaluate_j() const {
     return std::numeric_limits<double>::quiet_NaN();
   }
+  /// Adds the force terms' share of tangent() (ForceTerm: the blocks a term such as the tool's spring
+  /// enters with Integrator::undamped_tangent_share, which the step must not damp) times `vector` to
+  /// `product`. None by default.
+  virtual void add_force_terms_tangent_product(const Eigen::VectorXd& /*vector*/, Eigen::VectorXd& /*product*/) const {}
   /// evaluate_with_potential(u, f, true) ahead of the next step, whose start u is: the model keeps
   /// its state from before (what a save records) until the next step takes the evaluation
   /// (take_evaluation_ahead), so that a step from a restored state, evaluating u itself, continues

@@ -29,6 +29,9 @@ class ForceTerm {
   virtual void add_force(const Eigen::VectorXd& positions_m, Eigen::VectorXd& vertex_forces_n) = 0;
   /// Adds the term's stiffness d f / d x to the body's tangent, at the blocks locate() found.
   virtual void add_tangent(BlockSparseMatrix& tangent) const = 0;
+  /// Adds the term's blocks of the tangent (as add_tangent enters them) times `vector` (3 per block
+  /// row of the layout's tangent) to `product`: the share of the tangent's product that is the term's.
+  virtual void add_tangent_product(const Eigen::VectorXd& vector, Eigen::VectorXd& product) const = 0;
   /// The term's potential at the vertex positions [J].
   [[nodiscard]] virtual double energy_j(const Eigen::VectorXd& positions_m) const = 0;
   /// Finds its blocks in `layout`: when attached to a body and after the body's tangent was re-laid out.

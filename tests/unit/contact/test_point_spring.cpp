@@ -176,6 +176,50 @@ TEST(PointSpring, ForceAndTangentMatchTheDefinitionAndFiniteDifferences) {
   }
 }
 
+// The terms' product (ForceTerm::add_tangent_product) is the spring's blocks of the tangent times a
+// vector, with the tangent fraction and a direction, for a spring with a fixed vertex and a pad: the
+// step's stiffness damping takes it out of beta K v, so it must be the very blocks add_tangent entered.
+TEST(PointSpring, TheTermsProductIsItsBlocksOfTheTangentTimesTheVector) {
+  Bar bar(3, 1e5);
+  Eigen::VectorXd u(bar.body.dof_count()), v(bar.body.dof_count());
+  for (Eigen::Index k = 0; k < u.size(); ++k) {
+    u(k) = 3e-4 * std::sin(1.3 * static_cast<double>(k));
+    v(k) = std::cos(0.7 * static_cast<double>(k));
+  }
+  Eigen::VectorXd force;
+  bar.set_point_spring(std::nullopt);
+  bar.body.evaluate(u, force, true);
+  const Eigen::MatrixXd k_without = dense(bar.body.tangent());
+  Eigen::VectorXd none = Eigen::VectorXd::Zero(v.size());
+  bar.body.add_force_terms_tangent_product(v, none);
+  EXPECT_EQ(none.norm(), 0.0);  // an idle term adds nothing
+
+  std::array<int, 3> held{-1, -1, -1};  // one clamped vertex and two free ones of a tet
+  for (const Tet& tet : bar.mesh.tets) {
+    std::vector<int> fixed, free;
+    for (int vertex : tet)
+      (bar.body.dofs().vertex_row[static_cast<size_t>(vertex)] < 0 ? fixed : free).push_back(vertex);
+    if (!fixed.empty() && free.size() >= 2) {
+      held = {free[0], fixed[0], free[1]};
+      break;
+    }
+  }
+  ASSERT_GE(held[1], 0);
+  PointSpring spring{held, Eigen::Vector3d(0.2, 0.3, 0.5), Eigen::Vector3d(0.02, 0.013, 0.007), 250.0};
+  spring.tangent_fraction = 0.4;
+  PointSpring pad = spring;
+  pad.vertices = bar.face_at(0.03);
+  pad.stiffness_n_per_m = 40.0;
+  pad.direction = Eigen::Vector3d(1.0, -2.0, 0.5).normalized();
+  bar.spring_term.set(spring, bar.body.term_layout(), {pad});
+  bar.body.evaluate(u, force, true);
+  const Eigen::VectorXd expected = (dense(bar.body.tangent()) - k_without) * v;
+  Eigen::VectorXd product = Eigen::VectorXd::Constant(v.size(), 1.0);  // it adds
+  bar.body.add_force_terms_tangent_product(v, product);
+  ASSERT_GT(expected.norm(), 1.0);
+  EXPECT_LT((product - Eigen::VectorXd::Constant(v.size(), 1.0) - expected).norm(), 1e-12 * expected.norm());
+}
+
 // A pad's springs (point_contact.hpp, "A pad") beside the point's: each acts as if it were alone, so
 // force, tangent, energy and the force on the body are the sums of the springs' own.
 TEST(PointSpring, APadsSpringsActAsIfEachWereAlone) {
