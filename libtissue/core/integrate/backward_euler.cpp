@@ -134,30 +134,34 @@ StepReport BackwardEuler::step(DynamicsModel& model, DynamicState& state, double
     throw IntegrationError("backward Euler: the velocity update is not finite; state kept");
   }
   m_end_velocity.noalias() = state.velocity_m_per_s + m_velocity_change;
-  // The corrections follow the turn from where the step was linearized, the guard the step's own
-  // turn, h v1 (a steady swing linearized at its predicted end still gains energy: the co-rotational
-  // tangent lacks the rotation's derivative). Linearized at the start, one pass answers both
-  // thresholds; a corrected step is measured again for the guard.
+  // The corrections follow the turn from where the step was linearized. Linearized at the start, so
+  // does the guard, and one pass answers both thresholds (a corrected step is measured again).
+  // Linearized at the predicted end, the guard acts on a step whose change of turn, h (v1 - v0), passes
+  // its angle, or whose own turn, h v1, passes the corrections' trigger: a steady swing linearized at its
+  // predicted end still gains energy when it turns far (the co-rotational tangent lacks the rotation's
+  // derivative: the hinged cube at ~0.1 rad a step), and a sagging organ turning 0.005-0.05 rad a step
+  // does not need the guard's two energy passes (nothing is evaluated ahead in this mode).
   const NewtonCorrections& newton = m_settings.newton;
-  if (predicted) {
-    m_end_displacement.noalias() = h * m_velocity_change;
-  } else {
-    m_end_displacement.noalias() = h * m_end_velocity;
-  }
-  double turn_rad = model.largest_turn_rad(
-      m_end_displacement,
-      predicted ? newton.trigger_angle_rad : std::min(newton.trigger_angle_rad, newton.energy_guard_angle_rad));
-  const bool corrected = turn_rad > newton.trigger_angle_rad;
-  if (corrected) {
+  const auto linearization_turn = [&](double angle_rad) {  // of h (v1 - where the step was linearized)
+    if (predicted) {
+      m_end_displacement.noalias() = h * m_velocity_change;
+    } else {
+      m_end_displacement.noalias() = h * m_end_velocity;
+    }
+    return model.largest_turn_rad(m_end_displacement, angle_rad);
+  };
+  double turn_rad = linearization_turn(std::min(newton.trigger_angle_rad, newton.energy_guard_angle_rad));
+  if (turn_rad > newton.trigger_angle_rad) {
     correct(model, state, h, report, team ? &*team : nullptr);
     m_velocity_change.noalias() = m_end_velocity - state.velocity_m_per_s;
+    turn_rad = linearization_turn(newton.energy_guard_angle_rad);
   }
-  if (corrected || predicted) {
+  bool guard = turn_rad > newton.energy_guard_angle_rad;
+  if (predicted && !guard && std::isfinite(newton.energy_guard_angle_rad)) {
     m_end_displacement.noalias() = h * m_end_velocity;
-    turn_rad = model.largest_turn_rad(m_end_displacement, newton.energy_guard_angle_rad);
+    guard = model.largest_turn_rad(m_end_displacement, newton.trigger_angle_rad) > newton.trigger_angle_rad;
   }
   remember_velocity_change();
-  const bool guard = turn_rad > newton.energy_guard_angle_rad;
   state.displacement_m += h * m_end_velocity;
   if (guard) {
     const auto guard_start = std::chrono::steady_clock::now();
