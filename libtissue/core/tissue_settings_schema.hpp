@@ -195,7 +195,8 @@ constexpr auto integrator_settings() {
           .core_default("the core takes the dissertation's step, linearized at the start, unless a caller asks")
           .describe("Backward Euler: each step is linearized at the predicted end u0 + h v0 (Newton's first "
                     "iteration from the last velocity) instead of at its start u0 (false: the dissertation's step). "
-                    "The same cost a step; a beam swinging on a hinge is then followed to within 0.2% of the "
+                    "One assembly and one solve a step, as before; a beam swinging on a hinge is then followed to "
+                    "within 0.2% of the "
                     "converged equations at 1 ms steps without Newton corrections (linearized at the start: 23%, "
                     "and corrections in most of its steps at 4 ms: docs/DESIGN.md)")
           .member(TISSUE_MEMBER(settings.integrator.newton.linearize_at_predicted_end)),

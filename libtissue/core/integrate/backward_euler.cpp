@@ -197,17 +197,18 @@ void BackwardEuler::linearize(DynamicsModel& model, const DynamicState& state, d
   } else {
     model.evaluate(state.displacement_m, m_internal_force_n, /*update_tangent=*/true);
   }
-  const BlockSparseMatrix& stiffness = model.tangent();
 
   // rhs = h (f_ext - f_int(u) - alpha M v0 - (beta + h) K v0) at u = u0; at the predicted end
   // u = u0 + h v0 (Newton's residual at v1 = v0), h (f_ext - f_int(u) - alpha M v0 - beta K v0).
   // (At the predicted end the product is the damping's alone: the tool's spring enters it undamped.)
   const double stiffness_times_velocity_s = model.stiffness_damping_s() + (predicted ? 0.0 : h);
-  m_stiffness_times_velocity.setZero(n);
-  if (predicted && stiffness_times_velocity_s != 0.0) {
+  m_stiffness_times_velocity.resize(n);
+  if (stiffness_times_velocity_s == 0.0) {
+    m_stiffness_times_velocity.setZero();
+  } else if (predicted) {
     damped_stiffness_product(model, state.velocity_m_per_s, m_stiffness_times_velocity, team);
-  } else if (stiffness_times_velocity_s != 0.0) {
-    stiffness.multiply(state.velocity_m_per_s, m_stiffness_times_velocity, team);
+  } else {
+    model.tangent().multiply(state.velocity_m_per_s, m_stiffness_times_velocity, team);
   }
   m_rhs.resize(n);
   m_rhs.noalias() = h * (model.external_force_n() - m_internal_force_n -

@@ -43,9 +43,10 @@ class BackwardEuler final : public Integrator {
     /// Newton's first iterate: true, the last step's velocity (the step linearized at the predicted
     /// end u0 + h v0, so that a steady turn is not linearized h omega away from where it ends: a chunk
     /// swinging on a thread needs no corrections); false, v1 = 0 (linearized at the start u0: the
-    /// dissertation's step). The same cost a step but a second turn pass: the turn that triggers the
-    /// corrections is then h (v1 - v0), from the predicted end; the guard's stays the step's own, h v1
-    /// (docs/DESIGN.md, "The step linearized at its predicted end").
+    /// dissertation's step). One assembly and one solve a step, as before. The turn that triggers the
+    /// corrections is then h (v1 - v0), from the predicted end; the guard acts when that passes its
+    /// angle or the step's own turn, h v1, passes the trigger (a second turn pass), and nothing is
+    /// evaluated ahead (docs/DESIGN.md, "The step linearized at its predicted end").
     bool linearize_at_predicted_end = false;
   };
   /// Halvings of a correction before the line search gives up on it.
