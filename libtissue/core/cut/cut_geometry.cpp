@@ -19,15 +19,6 @@ constexpr unsigned ALL_VERTICES = 0b1111u;
 
 bool in_group(unsigned group, int vertex) { return ((group >> static_cast<unsigned>(vertex)) & 1u) != 0u; }
 
-/// Local edge index (TET_EDGES) of the vertex pair {a, b}, in either order.
-int local_edge(int a, int b) {
-  for (int k = 0; k < 6; ++k) {
-    const auto& edge = TET_EDGES[static_cast<std::size_t>(k)];
-    if ((edge[0] == a && edge[1] == b) || (edge[0] == b && edge[1] == a)) return k;
-  }
-  return -1;
-}
-
 /// Signed volume of the cone from `origin` over the triangle (a, b, c): one term of the divergence theorem.
 double cone_volume(const Eigen::Vector3d& origin, const Eigen::Vector3d& a, const Eigen::Vector3d& b,
                    const Eigen::Vector3d& c) {

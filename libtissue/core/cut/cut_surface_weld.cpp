@@ -41,15 +41,6 @@ std::array<double, 4> barycentric(const std::array<Eigen::Vector3d, 4>& corners,
   return {1.0 - tail.sum(), tail(0), tail(1), tail(2)};
 }
 
-// The index into TET_EDGES of local edge a-b.
-int local_edge(int a, int b) {
-  for (int e = 0; e < 6; ++e) {
-    const auto& edge = TET_EDGES[static_cast<size_t>(e)];
-    if ((edge[0] == a && edge[1] == b) || (edge[0] == b && edge[1] == a)) return e;
-  }
-  return 0;  // unreachable for two distinct local vertices
-}
-
 // Sorts the first n entries by `less` (a few: insertion; std::sort on a std::array of 4 trips GCC 12's
 // array-bounds warning).
 template <class T, std::size_t N, class Less>

@@ -5,7 +5,6 @@
 
 #include "core/fem/rotation.hpp"
 #include "core/mesh/topology.hpp"
-#include "core/system/hot_kernel.hpp"
 
 #include <algorithm>
 #include <array>
@@ -160,26 +159,6 @@ DeformableBody::DeformableBody(TetMesh mesh, BodySettings settings)
   }
 }
 
-namespace {
-
-// |axial vector of skew(R^T G)|, G = sum_i du_i grad(phi_i)^T: the angle a displacement increment
-// du turns a tet of rotation R (to first order).
-double turn_angle_rad(const TetRest& rest, const Eigen::Matrix3d& rotation, const TetPositions& increment_m) {
-  const Eigen::Matrix3d w = rotation.transpose() * deformation_gradient(rest, increment_m);
-  return 0.5 * Eigen::Vector3d(w(2, 1) - w(1, 2), w(0, 2) - w(2, 0), w(1, 0) - w(0, 1)).norm();
-}
-
-// The increments of an element's four block rows (-1: a fixed vertex, which does not move).
-TetPositions row_increments(const std::array<int, 4>& rows, const Eigen::VectorXd& increment_m) {
-  TetPositions increment;
-  for (size_t j = 0; j < 4; ++j) {
-    increment[j] = rows[j] < 0 ? Eigen::Vector3d::Zero() : Eigen::Vector3d(increment_m.segment<3>(3 * rows[j]));
-  }
-  return increment;
-}
-
-}  // namespace
-
 const std::vector<Eigen::Matrix3d>* DeformableBody::block_frames() const {
   // A vertex's frame: the mean turn of its uncut tets, their unit quaternions summed (each signed
   // to agree with the sum so far: q and -q are one turn) and normalized, so it depends on the
@@ -227,81 +206,6 @@ const std::vector<Eigen::Vector3d>* DeformableBody::block_positions(const Eigen:
   for (int row = 0; row < m_dofs.free_vertex_count(); ++row) moved(row, m_dofs.row_vertex[static_cast<size_t>(row)]);
   for (const EnrichedDof& dof : m_enriched_dofs) moved(dof.row, dof.vertex);
   return &m_block_positions;
-}
-
-double DeformableBody::largest_turn_rad(const Eigen::VectorXd& increment_m, double resolution_rad) const {
-  if (increment_m.size() != dof_count()) {
-    throw std::invalid_argument("largest_turn_rad: the increment has " + std::to_string(increment_m.size()) +
-                                " entries, the body " + std::to_string(dof_count()) + " unknowns");
-  }
-  double largest_block_m = 0.0;
-  for (Eigen::Index row = 0; row < increment_m.size() / 3; ++row) {
-    largest_block_m = std::max(largest_block_m, increment_m.segment<3>(3 * row).norm());
-  }
-  // G = sum_{i>0} (dp_i - dp_0) grad(phi_i)^T with |dp_i - dp_0| <= 2 max|block| (a piece's vertex
-  // moves by one block, du or dc), so the angle is at most |G| <= 6 max|block| max|grad(phi)|; the
-  // bound below keeps the factor 12 of the shifted enrichment (du + Psi da), which is safe.
-  const double bound_rad = 12.0 * largest_block_m * m_largest_shape_gradient_per_m;
-  if (bound_rad <= resolution_rad) return bound_rad;
-  return largest_element_turn_rad(increment_m);
-}
-
-// (A hot kernel: GCC cannot clone the virtual largest_turn_rad itself.)
-TISSUE_HOT_KERNEL double DeformableBody::largest_element_turn_rad(const Eigen::VectorXd& increment_m) const {
-  // The uncut tets (those the co-rotational model has not handed to XFEM) in halves of its storage
-  // order, which streams its per-tet data, side by side with a team (a maximum: the same in any order).
-  std::array<double, MAX_STEP_THREADS> largest_of_part{};
-  const int parts = team_parts(m_team);
-  run_parts(m_team, parts, [&](int member) {
-    double largest = 0.0;
-    const auto tets = static_cast<size_t>(m_elasticity.tet_count());
-    for_each_tet_turn(tets * static_cast<size_t>(member) / static_cast<size_t>(parts),
-                      tets * static_cast<size_t>(member + 1) / static_cast<size_t>(parts), increment_m,
-                      [&](const std::array<int, 4>& /*rows*/, double turn_rad) { largest = std::max(largest, turn_rad); });
-    largest_of_part[static_cast<size_t>(member)] = largest;
-  });
-  double largest_rad = *std::max_element(largest_of_part.begin(), largest_of_part.end());
-  for_each_piece_turn(increment_m, [&](const std::array<int, 4>& /*rows*/, double turn_rad) {
-    largest_rad = std::max(largest_rad, turn_rad);
-  });
-  return largest_rad;
-}
-
-template <class Visit>
-void DeformableBody::for_each_tet_turn(size_t first, size_t end, const Eigen::VectorXd& increment_m,
-                                       Visit&& visit) const {
-  m_elasticity.for_each_included(first, end, [&](const Tet& tet, const TetRest& rest, const Eigen::Matrix3d& rotation) {
-    const std::array<int, 4> rows{vertex_block_row(tet[0]), vertex_block_row(tet[1]), vertex_block_row(tet[2]),
-                                  vertex_block_row(tet[3])};
-    visit(rows, turn_angle_rad(rest, rotation, row_increments(rows, increment_m)));
-  });
-}
-
-template <class Visit>
-void DeformableBody::for_each_piece_turn(const Eigen::VectorXd& increment_m, Visit&& visit) const {
-  for (int k = 0; k < m_xfem.cut_tet_count(); ++k) {
-    if (m_xfem.retired(k)) continue;
-    for (int p = 0; p < static_cast<int>(m_xfem.piece_count(k)); ++p) {
-      if (m_xfem.parked(k, p)) continue;
-      const std::array<int, 4> rows = piece_rows(k, p);
-      visit(rows, std::sqrt(m_xfem.piece(k, p).weight) *
-                      turn_angle_rad(m_xfem.rest(k), m_xfem.rotation(k, p), row_increments(rows, increment_m)));
-    }
-  }
-}
-
-void DeformableBody::mark_turning_rows(const Eigen::VectorXd& increment_m, double angle_rad,
-                                       std::vector<std::uint8_t>& turning) const {
-  check_unknowns(increment_m);
-  turning.assign(static_cast<size_t>(dof_count() / 3), 0);
-  const auto mark = [&](const std::array<int, 4>& rows, double turn_rad) {
-    if (!(turn_rad > angle_rad)) return;
-    for (const int row : rows) {
-      if (row >= 0) turning[static_cast<size_t>(row)] = 1;
-    }
-  };
-  for_each_tet_turn(0, static_cast<size_t>(m_elasticity.tet_count()), increment_m, mark);
-  for_each_piece_turn(increment_m, mark);
 }
 
 double DeformableBody::total_mass_kg() const {
@@ -393,7 +297,18 @@ double DeformableBody::elastic_energy_j(const Eigen::VectorXd& displacement_m) {
 }
 
 double DeformableBody::potential_energy_j(const Eigen::VectorXd& displacement_m) {
-  return potential_with_elastic_j(elastic_energy_j(displacement_m), displacement_m);  // positions set
+  const double energy_j = potential_with_elastic_j(elastic_energy_j(displacement_m), displacement_m);  // positions set
+  m_kept_potential.energy_j = energy_j;
+  m_kept_potential.revision = evaluation_revision();
+  m_kept_potential.displacement_m = displacement_m;
+  return energy_j;
+}
+
+double DeformableBody::kept_potential_energy_j(const Eigen::VectorXd& displacement_m) const {
+  const KeptPotential& kept = m_kept_potential;
+  const bool same = kept.revision == evaluation_revision() && kept.displacement_m.size() == displacement_m.size() &&
+                    (kept.displacement_m.array() == displacement_m.array()).all();
+  return same ? kept.energy_j : std::numeric_limits<double>::quiet_NaN();
 }
 
 double DeformableBody::potential_with_elastic_j(double elastic_energy_j, const Eigen::VectorXd& displacement_m) const {

@@ -30,6 +30,7 @@
 
 #include <array>
 #include <cstdint>
+#include <limits>
 #include <optional>
 #include <span>
 #include <utility>
@@ -140,11 +141,16 @@ class DeformableBody final : public DynamicsModel {
   /// ~ V theta^2, so a part turning theta strays as a whole tet turning sqrt(w) theta (a sliver at a
   /// cut's front spinning fast no longer sets off a Newton correction of the whole body).
   [[nodiscard]] double largest_turn_rad(const Eigen::VectorXd& increment_m, double resolution_rad) const override;
+  /// Both turns as largest_turn_rad() answers each, in one pass over the elements where both pass
+  /// their bounds.
+  [[nodiscard]] std::array<double, 2> largest_turns_rad(const Eigen::VectorXd& first_m, const Eigen::VectorXd& second_m,
+                                                        std::array<double, 2> resolution_rad) const override;
   /// Each uncut tet and live cut piece measured as largest_turn_rad() measures it past its bound.
   void mark_turning_rows(const Eigen::VectorXd& increment_m, double angle_rad,
                          std::vector<std::uint8_t>& turning) const override;
   /// elastic_energy_j + the attached terms' energies - f_ext . u. [J]
   [[nodiscard]] double potential_energy_j(const Eigen::VectorXd& displacement_m) override;
+  [[nodiscard]] double kept_potential_energy_j(const Eigen::VectorXd& displacement_m) const override;
   /// The same sum at the last evaluate_with_potential()'s displacement, made in that pass (NaN after
   /// a plain evaluate(), a cut, a part parked, a term attached or detached; a term's own parameters
   /// changed since are not in it: read it right after the evaluate).
@@ -376,15 +382,20 @@ class DeformableBody final : public DynamicsModel {
   // Adds a mass (negative: removes it) to a row with its mass damping alpha m and its weight m g.
   void add_row_load(int row, double mass_kg, double alpha_per_s);
   void check_unknowns(const Eigen::VectorXd& displacement_m) const;
-  // largest_turn_rad past its bound: every uncut tet and cut part.
-  [[nodiscard]] double largest_element_turn_rad(const Eigen::VectorXd& increment_m) const;
+  // largest_turn_rad's bound: 12 max|block of the increment| max|grad(phi)|. Checks the increment's size.
+  [[nodiscard]] double turn_bound_rad(const Eigen::VectorXd& increment_m) const;
+  // largest_turn_rad past its bound, every uncut tet and cut part, for one increment or two (a null
+  // second: its entry 0) in one pass.
+  [[nodiscard]] std::array<double, 2> largest_element_turns_rad(
+      std::array<const Eigen::VectorXd*, 2> increments_m) const;
   // visit(rows, turn_rad) for the uncut tets at the co-rotational model's storage indices [first, end):
-  // their four block rows (-1: a fixed vertex) and their turn by the increment.
+  // their four block rows (-1: a fixed vertex) and their turns by the increments (0 for a null one).
   template <class Visit>
-  void for_each_tet_turn(size_t first, size_t end, const Eigen::VectorXd& increment_m, Visit&& visit) const;
-  // The same for each live cut piece not parked, its turn times the square root of its volume share.
+  void for_each_tet_turn(size_t first, size_t end, std::array<const Eigen::VectorXd*, 2> increments_m,
+                         Visit&& visit) const;
+  // The same for each live cut piece not parked, its turns times the square root of its volume share.
   template <class Visit>
-  void for_each_piece_turn(const Eigen::VectorXd& increment_m, Visit&& visit) const;
+  void for_each_piece_turn(std::array<const Eigen::VectorXd*, 2> increments_m, Visit&& visit) const;
   [[nodiscard]] int vertex_block_row(int vertex) const { return m_dofs.vertex_row[static_cast<size_t>(vertex)]; }
 
   XfemElasticity m_xfem;
@@ -425,6 +436,12 @@ class DeformableBody final : public DynamicsModel {
     Eigen::VectorXd displacement_m;
   };
   EvaluationAhead m_ahead;
+  struct KeptPotential {  // the last potential_energy_j call
+    double energy_j = std::numeric_limits<double>::quiet_NaN();
+    std::uint64_t revision = 0;  // evaluation_revision() right after it
+    Eigen::VectorXd displacement_m;
+  };
+  KeptPotential m_kept_potential;
   // What any change of the model does: the potential of the last evaluate is no longer the model's.
   void changed() {
     ++m_changes;

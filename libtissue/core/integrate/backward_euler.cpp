@@ -113,6 +113,7 @@ StepReport BackwardEuler::step(DynamicsModel& model, DynamicState& state, double
   const auto assembly_start = std::chrono::steady_clock::now();
   const bool predicted = m_settings.newton.linearize_at_predicted_end;
   linearize(model, state, h, team ? &*team : nullptr);
+  m_end_potential_by_pass = false;
   const ShiftedSystem system = step_system(model, h, predicted ? m_end_displacement : state.displacement_m);
   report.assembly_s = seconds_since(assembly_start);
 
@@ -141,26 +142,30 @@ StepReport BackwardEuler::step(DynamicsModel& model, DynamicState& state, double
   // predicted end still gains energy when it turns far (the co-rotational tangent lacks the rotation's
   // derivative: the hinged cube at ~0.1 rad a step), and a sagging organ turning 0.005-0.05 rad a step
   // does not need the guard's two energy passes (nothing is evaluated ahead in this mode).
+  // At the predicted end both turns are measured in one pass over the elements.
   const NewtonCorrections& newton = m_settings.newton;
-  const auto linearization_turn = [&](double angle_rad) {  // of h (v1 - where the step was linearized)
-    if (predicted) {
-      m_end_displacement.noalias() = h * m_velocity_change;
-    } else {
-      m_end_displacement.noalias() = h * m_end_velocity;
+  const bool step_turn_guards = predicted && std::isfinite(newton.energy_guard_angle_rad);
+  double turn_rad = 0.0;       // of h (v1 - where the step was linearized)
+  double step_turn_rad = 0.0;  // of h v1, where step_turn_guards
+  const auto measure_turns = [&](double angle_rad) {
+    m_end_displacement.noalias() = h * (predicted ? m_velocity_change : m_end_velocity);
+    if (!step_turn_guards) {
+      turn_rad = model.largest_turn_rad(m_end_displacement, angle_rad);
+      return;
     }
-    return model.largest_turn_rad(m_end_displacement, angle_rad);
+    m_step_increment_m.noalias() = h * m_end_velocity;
+    const std::array<double, 2> turns =
+        model.largest_turns_rad(m_end_displacement, m_step_increment_m, {angle_rad, newton.trigger_angle_rad});
+    turn_rad = turns[0];
+    step_turn_rad = turns[1];
   };
-  double turn_rad = linearization_turn(std::min(newton.trigger_angle_rad, newton.energy_guard_angle_rad));
+  measure_turns(std::min(newton.trigger_angle_rad, newton.energy_guard_angle_rad));
   if (turn_rad > newton.trigger_angle_rad) {
     correct(model, state, h, report, team ? &*team : nullptr);
     m_velocity_change.noalias() = m_end_velocity - state.velocity_m_per_s;
-    turn_rad = linearization_turn(newton.energy_guard_angle_rad);
+    measure_turns(newton.energy_guard_angle_rad);
   }
-  bool guard = turn_rad > newton.energy_guard_angle_rad;
-  if (predicted && !guard && std::isfinite(newton.energy_guard_angle_rad)) {
-    m_end_displacement.noalias() = h * m_end_velocity;
-    guard = model.largest_turn_rad(m_end_displacement, newton.trigger_angle_rad) > newton.trigger_angle_rad;
-  }
+  const bool guard = turn_rad > newton.energy_guard_angle_rad || step_turn_rad > newton.trigger_angle_rad;
   remember_velocity_change();
   state.displacement_m += h * m_end_velocity;
   if (guard) {
@@ -186,6 +191,15 @@ void BackwardEuler::linearize(DynamicsModel& model, const DynamicState& state, d
   m_end_evaluated = false;
   m_start_potential_j = std::numeric_limits<double>::quiet_NaN();
   if (predicted) {
+    // The guard's start: the last guard's pass at this u kept by the model, else (when the last step
+    // made that pass) the same pass now, before this step's evaluation moves the rotations' warm
+    // starts, so that a step restored here finds the same energy, bitwise.
+    if (std::isfinite(m_settings.newton.energy_guard_angle_rad)) {
+      m_start_potential_j = model.kept_potential_energy_j(state.displacement_m);
+      if (!std::isfinite(m_start_potential_j) && m_end_potential_by_pass) {
+        m_start_potential_j = model.potential_energy_j(state.displacement_m);
+      }
+    }
     m_end_velocity = state.velocity_m_per_s;
     m_end_displacement.noalias() = state.displacement_m + h * m_end_velocity;
     model.evaluate(m_end_displacement, m_internal_force_n, /*update_tangent=*/true);
@@ -252,6 +266,19 @@ void BackwardEuler::start_velocity_change(const ShiftedSystem& system) {
                  m_velocity_change, m_warm_start, m_solver.get());
 }
 
+Eigen::VectorXd BackwardEuler::internal_state() const {
+  if (!m_end_potential_by_pass) return m_past_velocity_changes;
+  Eigen::VectorXd state(m_past_velocity_changes.size() + 1);
+  state << m_past_velocity_changes, 1.0;
+  return state;
+}
+
+void BackwardEuler::restore_internal_state(const Eigen::VectorXd& internal_state) {
+  m_end_potential_by_pass = internal_state.size() % 3 == 1 && internal_state[internal_state.size() - 1] == 1.0;
+  m_past_velocity_changes =
+      m_end_potential_by_pass ? Eigen::VectorXd(internal_state.head(internal_state.size() - 1)) : internal_state;
+}
+
 void BackwardEuler::remember_velocity_change() {
   const Eigen::Index n = m_velocity_change.size();
   const Eigen::Index kept =
@@ -262,166 +289,6 @@ void BackwardEuler::remember_velocity_change() {
     m_past_velocity_changes.segment(n * k, n) = m_past_velocity_changes.segment(n * (k - 1), n);
   }
   m_past_velocity_changes.head(n) = m_velocity_change;
-}
-
-namespace {
-
-// The model's part of each block row (DynamicsModel::row_parts): 0 for every row of a model of one
-// part (or whose list does not match its rows), -1 for a row no element uses.
-class RowParts {
- public:
-  RowParts(const DynamicsModel& model, Eigen::Index rows) : m_parts(model.row_parts()) {
-    if (m_parts != nullptr && static_cast<Eigen::Index>(m_parts->size()) != rows) m_parts = nullptr;
-  }
-  int operator()(Eigen::Index row) const { return m_parts == nullptr ? 0 : (*m_parts)[static_cast<size_t>(row)]; }
-
- private:
-  const std::vector<int>* m_parts;
-};
-
-// Adds a row of mass `m` and velocity `v` to its part's momentum and mass (the lists grown to hold it).
-void add_to_part(std::vector<Eigen::Vector3d>& momentum, std::vector<Eigen::Vector3d>& mass, int part,
-                 const Eigen::Vector3d& m, const Eigen::Vector3d& v) {
-  const auto at = static_cast<size_t>(part);
-  if (at >= mass.size()) {
-    momentum.resize(at + 1, Eigen::Vector3d::Zero());
-    mass.resize(at + 1, Eigen::Vector3d::Zero());
-  }
-  momentum[at] += m.cwiseProduct(v);
-  mass[at] += m;
-}
-
-}  // namespace
-
-// Energy projection (Dinev et al. 2018): E = 1/2 v^T M v + potential. If the step's end holds more
-// than its start, v1 = mean + s (v1 - mean) on every row, mean the mass-weighted mean velocity of the
-// row's part (DynamicsModel::row_parts: no force acts between parts, so each keeps its momentum; a
-// row no element uses keeps its velocity), with s in [0, 1) chosen to bring E back; if the mean
-// motions alone are too much, they are scaled too (with one mean for the whole body, a piece cut
-// free and falling beside a part that turned lost speed at every guarded step). If the end's
-// potential alone is above the start's energy, no velocity brings it back (the gain is in the
-// positions): the rows of the elements the step turned past the guard's angle lose their motion
-// relative to their part's turning rows' mean, and the others keep theirs (zeroing every velocity
-// stopped every part, a falling one too, and kept the hatched frog's pre-stressed chips from
-// settling: docs/DESIGN.md). `state` has u1 and still v0.
-bool BackwardEuler::guard_energy(DynamicsModel& model, const DynamicState& state, double h) {
-  const Eigen::VectorXd& mass = model.mass_kg();
-  const Eigen::Index blocks = mass.size() / 3;
-  // The rows that left the dynamics (parked parts) are left out: their free fall is exact, and
-  // taking the step's excess from them drained the parts falling away (they hold most of the motion
-  // relative to the mean): the hatched frog's pieces stopped in mid-air while later strokes cut.
-  const std::vector<std::uint8_t>* left = model.rows_left();
-  const auto in = [left](Eigen::Index r) { return !row_left(left, r); };
-  const Eigen::VectorXd& load = model.external_force_n();
-  double kinetic_before_j = 0.0, kinetic_after_j = 0.0;
-  double left_potential_before_j = 0.0, left_potential_after_j = 0.0;  // -f . u of the rows left
-  for (Eigen::Index r = 0; r < blocks; ++r) {
-    const auto m = mass.segment<3>(3 * r);
-    if (!in(r)) {
-      const auto u1 = state.displacement_m.segment<3>(3 * r);
-      left_potential_after_j -= load.segment<3>(3 * r).dot(u1);
-      left_potential_before_j -= load.segment<3>(3 * r).dot(u1 - h * m_end_velocity.segment<3>(3 * r));
-      continue;
-    }
-    const auto v0 = state.velocity_m_per_s.segment<3>(3 * r);
-    const auto v1 = m_end_velocity.segment<3>(3 * r);
-    kinetic_before_j += 0.5 * v0.dot(m.cwiseProduct(v0));
-    kinetic_after_j += 0.5 * v1.dot(m.cwiseProduct(v1));
-  }
-  double potential_before_j = m_start_potential_j;  // a pass over the elements saved
-  if (!std::isfinite(potential_before_j)) {
-    m_end_displacement.noalias() = state.displacement_m - h * m_end_velocity;  // u0
-    potential_before_j = model.potential_energy_j(m_end_displacement);
-  }
-  const double before_j = kinetic_before_j + potential_before_j - left_potential_before_j;
-  // The end's potential: the corrections' last line search found it at the same u1, when it did.
-  // Else by the next step's start evaluated now, ahead (a whole assembly that the next step takes
-  // instead of its own: 3.3 ms of the organ's 19 saved), where the model will; else by a pass of its own.
-  double potential_after_j = m_end_potential_j;
-  if (!std::isfinite(potential_after_j) && evaluates_ahead() &&
-      model.evaluate_ahead(state.displacement_m, m_internal_force_n)) {
-    m_end_evaluated = true;
-    potential_after_j = model.potential_energy_at_last_evaluate_j();
-  }
-  if (!std::isfinite(potential_after_j)) potential_after_j = model.potential_energy_j(state.displacement_m);
-  if (!std::isfinite(before_j) || !std::isfinite(potential_after_j)) return false;  // the model cannot say
-  potential_after_j -= left_potential_after_j;
-  if (kinetic_after_j + potential_after_j <= before_j) return false;
-  if (potential_after_j >= before_j) return brake_turning_rows(model, h);
-  // The parts only now (found again after a cut: a union-find over the elements).
-  const RowParts part_of(model, blocks);
-  const double mean_kinetic_j = part_means(model);
-  const double relative_kinetic_j = std::max(0.0, kinetic_after_j - mean_kinetic_j);
-  const double room_j = before_j - potential_after_j;
-  const bool relative_only = room_j >= mean_kinetic_j && relative_kinetic_j > 0.0;
-  const double s = relative_only ? std::sqrt((room_j - mean_kinetic_j) / relative_kinetic_j)
-                                 : (kinetic_after_j > 0.0 ? std::sqrt(room_j / kinetic_after_j) : 0.0);
-  for (Eigen::Index r = 0; r < blocks; ++r) {
-    if (!in(r)) continue;
-    auto v1 = m_end_velocity.segment<3>(3 * r);
-    const int part = part_of(r);
-    if (!relative_only) {
-      v1 *= s;
-    } else if (part >= 0) {
-      const Eigen::Vector3d& mean_velocity = m_part_momentum[static_cast<size_t>(part)];
-      v1 = mean_velocity + s * (v1 - mean_velocity);
-    }
-  }
-  return true;
-}
-
-double BackwardEuler::part_means(const DynamicsModel& model) {
-  const Eigen::VectorXd& mass = model.mass_kg();
-  const RowParts part_of(model, mass.size() / 3);
-  const std::vector<std::uint8_t>* left = model.rows_left();
-  m_part_momentum.clear();
-  m_part_mass.clear();
-  double mean_kinetic_j = 0.0;  // first the rows no element uses (each its own mean)
-  for (Eigen::Index r = 0; r < mass.size() / 3; ++r) {
-    if (row_left(left, r)) continue;
-    const auto m = mass.segment<3>(3 * r);
-    const auto v1 = m_end_velocity.segment<3>(3 * r);
-    const int part = part_of(r);
-    if (part < 0) {
-      mean_kinetic_j += 0.5 * v1.dot(m.cwiseProduct(v1));
-    } else {
-      add_to_part(m_part_momentum, m_part_mass, part, m, v1);
-    }
-  }
-  for (size_t part = 0; part < m_part_mass.size(); ++part) {
-    Eigen::Vector3d& mean_velocity = m_part_momentum[part];  // the momentum becomes the mean velocity
-    mean_velocity = mean_velocity.cwiseQuotient(m_part_mass[part].cwiseMax(1e-300));
-    mean_kinetic_j += 0.5 * m_part_mass[part].dot(mean_velocity.cwiseProduct(mean_velocity));
-  }
-  return mean_kinetic_j;
-}
-
-bool BackwardEuler::brake_turning_rows(const DynamicsModel& model, double h) {
-  m_end_displacement.noalias() = h * m_end_velocity;  // the step's increment
-  model.mark_turning_rows(m_end_displacement, m_settings.newton.energy_guard_angle_rad, m_turning_rows);
-  const Eigen::VectorXd& mass = model.mass_kg();
-  const std::vector<std::uint8_t>* left = model.rows_left();
-  const Eigen::Index blocks = mass.size() / 3;
-  const RowParts part_of(model, blocks);
-  // (A row no element uses turns with none: each braked row has a part.)
-  const auto braked = [&](Eigen::Index r) {
-    return m_turning_rows[static_cast<size_t>(r)] != 0 && !row_left(left, r) && part_of(r) >= 0;
-  };
-  m_part_momentum.clear();
-  m_part_mass.clear();
-  for (Eigen::Index r = 0; r < blocks; ++r) {
-    if (!braked(r)) continue;
-    add_to_part(m_part_momentum, m_part_mass, part_of(r), mass.segment<3>(3 * r), m_end_velocity.segment<3>(3 * r));
-  }
-  bool any = false;
-  for (Eigen::Index r = 0; r < blocks; ++r) {
-    if (!braked(r)) continue;
-    const auto part = static_cast<size_t>(part_of(r));
-    if (!(m_part_mass[part].minCoeff() > 0.0)) continue;
-    m_end_velocity.segment<3>(3 * r) = m_part_momentum[part].cwiseQuotient(m_part_mass[part]);
-    any = true;
-  }
-  return any;
 }
 
 // Newton on the backward-Euler equations in v1 (u1 = u0 + h v1):

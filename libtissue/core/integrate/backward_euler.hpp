@@ -69,12 +69,12 @@ class BackwardEuler final : public Integrator {
   [[nodiscard]] std::string_view name() const override { return "backwardEuler"; }
   [[nodiscard]] const LinearSolver& solver() const { return *m_solver; }
   /// The last steps' velocity changes, newest first, one after the other (the next solve's warm
-  /// start when enabled; the last one alone without it).
-  [[nodiscard]] Eigen::VectorXd internal_state() const override { return m_past_velocity_changes; }
-  /// Takes any vector: a step uses it only when its length is a multiple of the unknowns' count.
-  void restore_internal_state(const Eigen::VectorXd& internal_state) override {
-    m_past_velocity_changes = internal_state;
-  }
+  /// start when enabled; the last one alone without it), and where the guard found the end's potential.
+  /// One entry more (1) when the last step's guard found its end potential by a pass.
+  [[nodiscard]] Eigen::VectorXd internal_state() const override;
+  /// Takes any vector: a step uses the velocity changes only when their length is a multiple of the
+  /// unknowns' count (a multiple of 3; one entry more is the flag above).
+  void restore_internal_state(const Eigen::VectorXd& internal_state) override;
   /// One step depends on the state alone (a grown system drops the warm start); a save or a restore
   /// makes the solver forget its lagged factor (LinearSolver::forget_earlier_setups). A step's start
   /// evaluated ahead by the last step's energy guard is what the step would evaluate itself, bitwise
@@ -151,6 +151,7 @@ class BackwardEuler final : public Integrator {
   Eigen::VectorXd m_past_velocity_changes;  // kept: the last steps', newest first (internal_state)
   GalerkinStartWork m_warm_start;
   Eigen::VectorXd m_end_displacement;  // the Newton iterate u0 + h v1
+  Eigen::VectorXd m_step_increment_m;  // h v1, whose turn the guard reads at the predicted end
   std::vector<std::uint8_t> m_turning_rows;  // brake_turning_rows()
   std::vector<Eigen::Vector3d> m_part_momentum, m_part_mass;  // per part of the model: part_means(), the brake
   Eigen::VectorXd m_end_velocity;      // v1
@@ -166,6 +167,11 @@ class BackwardEuler final : public Integrator {
   // The energy guard evaluated the step's end ahead (DynamicsModel::evaluate_ahead): m_internal_force_n
   // is its force, for the next step's start if the model lets it take the evaluation.
   bool m_end_evaluated = false;
+  // The last step's guard found its end potential by a pass (DynamicsModel::potential_energy_j at u1):
+  // linearized at the predicted end, the next step takes its start potential from that pass, or makes
+  // the same pass before its own evaluation. Carried in internal_state(), so a restored step does
+  // what the step it continues did, bitwise.
+  bool m_end_potential_by_pass = false;
 };
 
 /// Throws ParameterError unless the trigger angle is > 0 (infinity: off) and 1 to 100 iterations.

@@ -18,6 +18,14 @@ namespace tissue {
 inline constexpr std::array<std::array<int, 3>, 4> TET_FACES = {{{1, 2, 3}, {0, 3, 2}, {0, 1, 3}, {0, 2, 1}}};
 /// Local edges of a tet (pairs of local vertex indices).
 inline constexpr std::array<std::array<int, 2>, 6> TET_EDGES = {{{0, 1}, {0, 2}, {0, 3}, {1, 2}, {1, 3}, {2, 3}}};
+/// The index into TET_EDGES of the local edge between vertices a and b, in either order; -1 if a == b.
+inline constexpr int local_edge(int a, int b) {
+  for (int k = 0; k < 6; ++k) {
+    const auto& edge = TET_EDGES[static_cast<std::size_t>(k)];
+    if ((edge[0] == a && edge[1] == b) || (edge[0] == b && edge[1] == a)) return k;
+  }
+  return -1;
+}
 
 /// The longest edge of the tet with these corners. [m]
 inline double largest_edge_m(const std::array<Eigen::Vector3d, 4>& corners) {

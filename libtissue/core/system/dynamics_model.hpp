@@ -8,6 +8,7 @@
 
 #include <Eigen/Core>
 
+#include <array>
 #include <cstdint>
 #include <limits>
 #include <vector>
@@ -63,6 +64,13 @@ class DynamicsModel {
                                                 double /*resolution_rad*/) const {
     return 0.0;
   }
+  /// {largest_turn_rad(first_m, resolution_rad[0]), largest_turn_rad(second_m, resolution_rad[1])}, as
+  /// those two calls answer; a model may find both in one pass over its elements.
+  [[nodiscard]] virtual std::array<double, 2> largest_turns_rad(const Eigen::VectorXd& first_m,
+                                                                const Eigen::VectorXd& second_m,
+                                                                std::array<double, 2> resolution_rad) const {
+    return {largest_turn_rad(first_m, resolution_rad[0]), largest_turn_rad(second_m, resolution_rad[1])};
+  }
   /// Sets turning[r] = 1 for every block row r of an element that `increment_m` turns further than
   /// `angle_rad` (as largest_turn_rad() measures it), and 0 for the others; `turning` gets one entry
   /// per block row. The default (a model with no elements to ask) marks every row.
@@ -84,6 +92,13 @@ class DynamicsModel {
   /// The potential of the model's forces at u: elastic energy plus that of any spring to a fixed
   /// target, minus f_ext . u [J]; NaN for a model that cannot say (its steps are not energy-guarded).
   [[nodiscard]] virtual double potential_energy_j(const Eigen::VectorXd& /*displacement_m*/) {
+    return std::numeric_limits<double>::quiet_NaN();
+  }
+  /// What the last potential_energy_j(u) call answered, when u is bitwise that call's displacement
+  /// and nothing changed the model since (no evaluate, cut, park, restore, term attached, detached or
+  /// moved): the value a new call would give, bitwise (a call reads the rotations' warm starts and
+  /// does not change them). NaN otherwise, and for a model that keeps none.
+  [[nodiscard]] virtual double kept_potential_energy_j(const Eigen::VectorXd& /*displacement_m*/) const {
     return std::numeric_limits<double>::quiet_NaN();
   }
   /// evaluate(), and potential_energy_j at u found in the same pass where the model can (then

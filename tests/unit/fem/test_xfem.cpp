@@ -12,6 +12,7 @@
 #include <Eigen/Geometry>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <map>
@@ -392,6 +393,39 @@ TEST(XfemEnrich, ASliverTurnsTheStepAsAWholeTetTurningSqrtOfItsShare) {
   }
   const double expected_rad = std::sqrt(sliver) * std::sin(angle_rad);  // |axial(skew(R - I))| = sin
   EXPECT_NEAR(body.largest_turn_rad(increment, 0.0), expected_rad, 1e-9 * expected_rad);
+}
+
+// The predicted step's guard asks two turns (h (v1 - v0) and h v1) in one pass over the elements:
+// each is what largest_turn_rad gives, bitwise, uncut tets and pieces alike, whichever of the two
+// passes its bound.
+TEST(XfemEnrich, TwoTurnsInOnePassAreEachTheTurnAlone) {
+  Box box;
+  DynamicState state{box.deformed(0.8), Eigen::VectorXd::Zero(box.body.dof_count())};
+  box.body.enrich(xfem_test::plane_cuts(box.mesh, Plane{Eigen::Vector3d(1, 0.2, 0.1).normalized(), 0.0213}), state);
+  ASSERT_GT(box.body.cut_tets().size(), 0U);
+  Eigen::VectorXd f;
+  box.body.evaluate(state.displacement_m, f, false);  // the rotations the turns are measured from
+  const Eigen::Index n = box.body.dof_count();
+  Eigen::VectorXd first(n), second(n);
+  for (Eigen::Index i = 0; i < n; ++i) {
+    first[i] = 1e-4 * std::sin(1.7 * static_cast<double>(i));
+    second[i] = 2e-4 * std::cos(0.9 * static_cast<double>(i) + 0.3);
+  }
+  const double first_rad = box.body.largest_turn_rad(first, 0.0);
+  const double second_rad = box.body.largest_turn_rad(second, 0.0);
+  ASSERT_GT(first_rad, 0.0);
+  ASSERT_NE(first_rad, second_rad);
+  const auto expect_alone = [&](const Eigen::VectorXd& a, const Eigen::VectorXd& b, double resolution_a_rad,
+                                double resolution_b_rad) {
+    const std::array<double, 2> turns = box.body.largest_turns_rad(a, b, {resolution_a_rad, resolution_b_rad});
+    EXPECT_EQ(turns[0], box.body.largest_turn_rad(a, resolution_a_rad));
+    EXPECT_EQ(turns[1], box.body.largest_turn_rad(b, resolution_b_rad));
+  };
+  expect_alone(first, second, 0.0, 0.0);  // both past their bounds: the fused pass
+  expect_alone(second, first, 0.0, 0.0);
+  expect_alone(first, second, 1e9, 0.0);  // one under its bound: that bound, the other's pass
+  expect_alone(first, second, 0.0, 1e9);
+  expect_alone(first, second, 1e9, 1e9);
 }
 
 TEST(XfemEnrich, AtADeformedStateKeepsForcesTangentAndEnergy) {

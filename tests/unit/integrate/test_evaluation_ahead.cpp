@@ -15,6 +15,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <optional>
 
 namespace tissue {
@@ -40,7 +41,13 @@ class Forwarding final : public DynamicsModel {
   [[nodiscard]] double largest_turn_rad(const Eigen::VectorXd& increment, double resolution_rad) const override {
     return m_body.largest_turn_rad(increment, resolution_rad);
   }
-  [[nodiscard]] double potential_energy_j(const Eigen::VectorXd& u) override { return m_body.potential_energy_j(u); }
+  [[nodiscard]] double potential_energy_j(const Eigen::VectorXd& u) override {
+    ++m_potential_passes;
+    return m_body.potential_energy_j(u);
+  }
+  [[nodiscard]] double kept_potential_energy_j(const Eigen::VectorXd& u) const override {
+    return m_ahead ? m_body.kept_potential_energy_j(u) : std::numeric_limits<double>::quiet_NaN();
+  }
   void evaluate_with_potential(const Eigen::VectorXd& u, Eigen::VectorXd& f, bool tangent) override {
     m_body.evaluate_with_potential(u, f, tangent);
   }
@@ -59,12 +66,14 @@ class Forwarding final : public DynamicsModel {
   }
   [[nodiscard]] int taken() const { return m_taken; }
   [[nodiscard]] int made() const { return m_made; }
+  [[nodiscard]] int potential_passes() const { return m_potential_passes; }
 
  private:
   DeformableBody& m_body;
   bool m_ahead;
   int m_taken = 0;
   int m_made = 0;
+  int m_potential_passes = 0;
 };
 
 const TetMesh& beam() {
@@ -90,6 +99,13 @@ struct Swing {
   DynamicState state{Eigen::VectorXd::Zero(body.dof_count()), Eigen::VectorXd::Zero(body.dof_count()), 0.0};
   double step_size_s = 0.01;
   explicit Swing(bool ahead) : model(body, ahead) { body.attach(spring); }
+  // Linearized at the predicted end (the products' step): nothing is evaluated ahead; the guard's
+  // end potential is kept for the next step's start.
+  Swing(bool keeps, bool predicted) : Swing(keeps) {
+    BackwardEuler::Settings settings;
+    settings.newton.linearize_at_predicted_end = predicted;
+    integrator = BackwardEuler(std::make_unique<PcgSolver>(PcgSolver::Settings{1e-8, 10000}), settings);
+  }
   StepReport step() { return integrator.step(model, state, step_size_s); }
 };
 
@@ -278,6 +294,90 @@ TEST(EvaluationAhead, IsNotMadeWhileAStrokeCutsStepAfterStep) {
     ASSERT_TRUE(bitwise_equal(ahead.state.velocity_m_per_s, declines.state.velocity_m_per_s)) << "step " << n;
   }
   EXPECT_GT(ahead.model.taken(), 5);
+}
+
+}  // namespace
+}  // namespace tissue
+
+namespace tissue {
+namespace {
+
+// Linearized at the predicted end the guard's start potential is the last guard's end potential,
+// kept by the body (one energy pass a guarded step instead of two): the steps are bitwise those of a
+// model that keeps none, across the tool's spring being set, and a state saved and restored between
+// two guarded steps continues bitwise in a fresh body (the restored step makes the same pass before
+// its evaluation moves the warm starts).
+TEST(KeptPotential, TheStepsAreBitwiseThoseOfAModelThatKeepsNone) {
+  Swing keeps(true, true), keeps_none(false, true);
+  int guarded = 0;
+  for (int n = 0; n < 45; ++n) {
+    if (n == 30) {
+      for (Swing* swing : {&keeps, &keeps_none}) swing->spring.set(pull_on_the_tip(), swing->body.term_layout());
+    }
+    const StepReport report = keeps.step();
+    keeps_none.step();
+    guarded += report.guard_s > 0.0 ? 1 : 0;
+    ASSERT_TRUE(bitwise_equal(keeps.state.displacement_m, keeps_none.state.displacement_m)) << "step " << n;
+    ASSERT_TRUE(bitwise_equal(keeps.state.velocity_m_per_s, keeps_none.state.velocity_m_per_s)) << "step " << n;
+  }
+  std::printf("  %d guarded steps: %d energy passes keeping the end's, %d without\n", guarded,
+              keeps.model.potential_passes(), keeps_none.model.potential_passes());
+  EXPECT_GE(guarded, 10);
+  // Without a kept one: the start's and the end's pass of each guarded step, and the start's pass of a
+  // step after a guarded one made before its evaluation (whether or not it is guarded itself).
+  EXPECT_GE(keeps_none.model.potential_passes(), 2 * guarded);
+  EXPECT_LT(keeps.model.potential_passes(), guarded + 10);
+  EXPECT_EQ(keeps.model.made(), 0);  // nothing evaluated ahead in this mode
+}
+
+TEST(KeptPotential, AStateRestoredBetweenGuardedStepsContinuesBitwiseInAFreshBody) {
+  Swing original(true, true);
+  int guarded_at_save = 0;
+  for (int n = 0; n < 12; ++n) guarded_at_save = original.step().guard_s > 0.0 ? 1 : 0;
+  ASSERT_EQ(guarded_at_save, 1);  // the save falls after a step whose guard made its end's pass
+  DeformableBody::Rotations rotations;
+  original.body.save_rotations(rotations);
+  original.integrator.restart(Restart::state_saved);
+  const Eigen::VectorXd internal_state = original.integrator.internal_state();
+  const DynamicState saved = original.state;
+  Swing fresh(true, true);
+  fresh.body.restore_rotations(rotations);
+  fresh.integrator.restore_internal_state(internal_state);
+  fresh.integrator.restart(Restart::state_restored);
+  fresh.state = saved;
+  // What the restored step's pass before its evaluation finds is what the original keeps, bitwise.
+  const double kept_j = original.body.kept_potential_energy_j(saved.displacement_m);
+  ASSERT_TRUE(std::isfinite(kept_j));
+  EXPECT_EQ(fresh.body.potential_energy_j(saved.displacement_m), kept_j);
+  int scaled = 0;
+  for (int n = 0; n < 20; ++n) {
+    scaled += original.step().energy_guarded ? 1 : 0;
+    fresh.step();
+    ASSERT_TRUE(bitwise_equal(original.state.displacement_m, fresh.state.displacement_m)) << "step " << n;
+    ASSERT_TRUE(bitwise_equal(original.state.velocity_m_per_s, fresh.state.velocity_m_per_s)) << "step " << n;
+  }
+  std::printf("  %d of the 20 steps after the restore scaled by the guard\n", scaled);
+  EXPECT_GT(fresh.model.potential_passes(), 0);
+}
+
+TEST(KeptPotential, IsKeptOnlyAtTheSameDisplacementWithNothingChangedSince) {
+  Swing swing(true, true);
+  for (int n = 0; n < 5; ++n) swing.step();
+  const Eigen::VectorXd u = swing.state.displacement_m;
+  const double energy_j = swing.body.potential_energy_j(u);
+  EXPECT_EQ(swing.body.kept_potential_energy_j(u), energy_j);
+  EXPECT_EQ(swing.body.potential_energy_j(u), energy_j);  // the pass changes nothing it reads
+  Eigen::VectorXd other = u;
+  other[other.size() - 1] = std::nextafter(other[other.size() - 1], 1.0);
+  EXPECT_TRUE(std::isnan(swing.body.kept_potential_energy_j(other)));
+  swing.spring.set(pull_on_the_tip(), swing.body.term_layout());
+  EXPECT_TRUE(std::isnan(swing.body.kept_potential_energy_j(u)));
+  const double pulled_j = swing.body.potential_energy_j(u);
+  EXPECT_EQ(swing.body.kept_potential_energy_j(u), pulled_j);
+  EXPECT_NE(pulled_j, energy_j);
+  Eigen::VectorXd force;
+  swing.body.evaluate(u, force, false);
+  EXPECT_TRUE(std::isnan(swing.body.kept_potential_energy_j(u)));
 }
 
 }  // namespace
