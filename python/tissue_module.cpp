@@ -78,8 +78,7 @@ struct PythonOnly {
 // A keyword's value as the schema's type, or TypeError.
 SettingValue python_value(const SettingInfo& setting, const py::handle& value) {
   const auto wrong = [&]() -> py::type_error {
-    return py::type_error(std::string(setting.python_keyword) + " must be " +
-                          (setting.type == SettingType::vector3 ? "three numbers" : "of another type") + ", got " +
+    return py::type_error(std::string(setting.python_keyword) + " must be " + expected_value_text(setting) + ", got " +
                           std::string(py::str(py::type::of(value).attr("__name__"))));
   };
   try {

@@ -122,6 +122,11 @@ std::string range_text(const SettingInfo& setting) {
   return text;
 }
 
+std::string expected_value_text(const SettingInfo& setting) {
+  if (setting.type == SettingType::enumeration) return list_names(setting.items);
+  return std::string(type_name(setting.type));
+}
+
 void check_value(const SettingInfo& setting, const SettingValue& value) {
   if (!holds_type(setting.type, value)) refuse(setting, std::string(type_name(setting.type)), value);
   if (const auto* vector = std::get_if<std::array<double, 3>>(&value)) {

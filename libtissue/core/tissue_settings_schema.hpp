@@ -452,6 +452,10 @@ const SettingInfo* find_setting(std::string_view name);
 /// The setting of a Python keyword, or nullptr.
 const SettingInfo* find_python_setting(std::string_view keyword);
 
+/// What a value of the setting's type is, for a message: "a number", "an integer", "a boolean",
+/// "three numbers", "a text", or for an enumeration its items' names, "a, b or c".
+std::string expected_value_text(const SettingInfo& setting);
+
 /// Every setting at its default (the schema's start values).
 TissueParameters default_parameters();
 

@@ -145,8 +145,15 @@ def test_bad_input_is_refused_with_the_cores_message():
         tissue.Tissue(box=(2, 2, 2), poisson_ratio=0.5)
     with pytest.raises(TypeError, match="young_modulus"):
         tissue.Tissue(box=(2, 2, 2), young_modulus=1e5)  # the keyword is young_modulus_pa
-    with pytest.raises(TypeError, match="pcg_max_iterations"):
+    with pytest.raises(TypeError, match="pcg_max_iterations must be an integer, got float"):
         tissue.Tissue(box=(2, 2, 2), pcg_max_iterations=2.5)
+    # A wrong type names the type the setting takes (an enumeration: its items).
+    with pytest.raises(TypeError, match="young_modulus_pa must be a number, got str"):
+        tissue.Tissue(box=(2, 2, 2), young_modulus_pa="1e5")
+    with pytest.raises(TypeError, match="linearize_at_predicted_end must be a boolean, got float"):
+        tissue.Tissue(box=(2, 2, 2), linearize_at_predicted_end=1.0)
+    with pytest.raises(TypeError, match=r"linear_solver must be .*pcgTwoLevel.*, got int"):
+        tissue.Tissue(box=(2, 2, 2), linear_solver=3)
     with pytest.raises(TypeError):
         tissue.Tissue("frog")  # keywords only
     with pytest.raises(ValueError):
