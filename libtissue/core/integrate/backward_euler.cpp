@@ -141,8 +141,8 @@ StepReport BackwardEuler::step(DynamicsModel& model, DynamicState& state, double
   // its angle, or whose own turn, h v1, passes the corrections' trigger: a steady swing linearized at its
   // predicted end still gains energy when it turns far (the co-rotational tangent lacks the rotation's
   // derivative: the hinged cube at ~0.1 rad a step), and a sagging organ turning 0.005-0.05 rad a step
-  // does not need the guard's two energy passes (nothing is evaluated ahead in this mode).
-  // At the predicted end both turns are measured in one pass over the elements.
+  // does not need the guard's energy passes (nothing is evaluated ahead in this mode: the next step
+  // takes the end's pass as its start, linearize()). Both turns are measured in one pass.
   const NewtonCorrections& newton = m_settings.newton;
   const bool step_turn_guards = predicted && std::isfinite(newton.energy_guard_angle_rad);
   double turn_rad = 0.0;       // of h (v1 - where the step was linearized)
