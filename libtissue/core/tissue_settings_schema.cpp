@@ -128,7 +128,7 @@ std::string expected_value_text(const SettingInfo& setting) {
 }
 
 void check_value(const SettingInfo& setting, const SettingValue& value) {
-  if (!holds_type(setting.type, value)) refuse(setting, std::string(type_name(setting.type)), value);
+  if (!holds_type(setting.type, value)) refuse(setting, expected_value_text(setting), value);
   if (const auto* vector = std::get_if<std::array<double, 3>>(&value)) {
     for (const double v : *vector) {
       if (!std::isfinite(v)) refuse(setting, "finite", value);

@@ -8,8 +8,6 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
-#include <stdexcept>
-#include <string>
 
 namespace tissue {
 namespace {
@@ -28,6 +26,12 @@ TetPositions row_increments(const std::array<int, 4>& rows, const Eigen::VectorX
     increment[j] = rows[j] < 0 ? Eigen::Vector3d::Zero() : Eigen::Vector3d(increment_m.segment<3>(3 * rows[j]));
   }
   return increment;
+}
+
+// Each of `largest`'s two turns raised to the element's where that is larger.
+void take_larger(std::array<double, 2>& largest, const std::array<double, 2>& turn_rad) {
+  largest[0] = std::max(largest[0], turn_rad[0]);
+  largest[1] = std::max(largest[1], turn_rad[1]);
 }
 
 }  // namespace
@@ -75,20 +79,14 @@ TISSUE_HOT_KERNEL std::array<double, 2> DeformableBody::largest_element_turns_ra
     for_each_tet_turn(tets * static_cast<size_t>(member) / static_cast<size_t>(parts),
                       tets * static_cast<size_t>(member + 1) / static_cast<size_t>(parts), increments_m,
                       [&](const std::array<int, 4>& /*rows*/, const std::array<double, 2>& turn_rad) {
-                        largest[0] = std::max(largest[0], turn_rad[0]);
-                        largest[1] = std::max(largest[1], turn_rad[1]);
+                        take_larger(largest, turn_rad);
                       });
     largest_of_part[static_cast<size_t>(member)] = largest;
   });
   std::array<double, 2> largest_rad{};
-  for (int member = 0; member < parts; ++member) {
-    for (size_t i = 0; i < 2; ++i) {
-      largest_rad[i] = std::max(largest_rad[i], largest_of_part[static_cast<size_t>(member)][i]);
-    }
-  }
+  for (int member = 0; member < parts; ++member) take_larger(largest_rad, largest_of_part[static_cast<size_t>(member)]);
   for_each_piece_turn(increments_m, [&](const std::array<int, 4>& /*rows*/, const std::array<double, 2>& turn_rad) {
-    largest_rad[0] = std::max(largest_rad[0], turn_rad[0]);
-    largest_rad[1] = std::max(largest_rad[1], turn_rad[1]);
+    take_larger(largest_rad, turn_rad);
   });
   return largest_rad;
 }

@@ -45,8 +45,9 @@ class BackwardEuler final : public Integrator {
     /// swinging on a thread needs no corrections); false, v1 = 0 (linearized at the start u0: the
     /// dissertation's step). One assembly and one solve a step, as before. The turn that triggers the
     /// corrections is then h (v1 - v0), from the predicted end; the guard acts when that passes its
-    /// angle or the step's own turn, h v1, passes the trigger (a second turn pass), and nothing is
-    /// evaluated ahead (docs/DESIGN.md, "The step linearized at its predicted end").
+    /// angle or the step's own turn, h v1, passes the trigger (both turns in one pass), and nothing is
+    /// evaluated ahead: the guard's end potential is the next step's start (docs/DESIGN.md, "The step
+    /// linearized at its predicted end").
     bool linearize_at_predicted_end = false;
   };
   /// Halvings of a correction before the line search gives up on it.
@@ -69,8 +70,8 @@ class BackwardEuler final : public Integrator {
   [[nodiscard]] std::string_view name() const override { return "backwardEuler"; }
   [[nodiscard]] const LinearSolver& solver() const { return *m_solver; }
   /// The last steps' velocity changes, newest first, one after the other (the next solve's warm
-  /// start when enabled; the last one alone without it), and where the guard found the end's potential.
-  /// One entry more (1) when the last step's guard found its end potential by a pass.
+  /// start when enabled; the last one alone without it), then one entry more (1) when the last step's
+  /// guard found its end potential by a pass (m_end_potential_by_pass).
   [[nodiscard]] Eigen::VectorXd internal_state() const override;
   /// Takes any vector: a step uses the velocity changes only when their length is a multiple of the
   /// unknowns' count (a multiple of 3; one entry more is the flag above).
