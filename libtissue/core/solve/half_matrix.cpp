@@ -66,7 +66,7 @@ void HalfMatrix::copy_part(const BlockSparseMatrix& k, double scale, std::vector
   for (auto b = static_cast<size_t>(m_row_begin[static_cast<size_t>(first_block_row(part))]); b < end; ++b) {
     const double* from = k.block(m_full_slot[b]).data();
     Real* block = &to[9 * b];
-    for (int e = 0; e < 9; ++e) block[e] = static_cast<Real>(scale * from[e]);
+    for (int e = 0; e < 9; ++e) block[e] = static_cast<Real>(scale * from[3 * (e % 3) + e / 3]);  // row-major
   }
 }
 
@@ -113,7 +113,7 @@ template <class Real>
 Eigen::Matrix3d HalfMatrix::diagonal_block(const std::vector<Real>& values, int row) const {
   const Real* block = &values[9 * static_cast<size_t>(m_row_begin[static_cast<size_t>(row)])];
   Eigen::Matrix3d a;
-  for (int e = 0; e < 9; ++e) a(e % 3, e / 3) = static_cast<double>(block[e]);  // column-major
+  for (int e = 0; e < 9; ++e) a(e / 3, e % 3) = static_cast<double>(block[e]);  // row-major
   a.diagonal() += m_diagonal.segment<3>(3L * row);
   return a;
 }
@@ -166,6 +166,8 @@ TISSUE_HOT_KERNEL void HalfMatrix::multiply_rows(const Real* __restrict values, 
                                                  double* __restrict y, int part) const {
   const int first = first_block_row(part);
   const int end = end_block_row(part);
+  const int last_row = block_rows() - 1;
+  constexpr long PREFETCH_VALUES = 1024 / sizeof(Real);
   const int* __restrict column = m_column.data();
   const int* __restrict row_begin = m_row_begin.data();
   const double* __restrict d = m_diagonal.data();
@@ -174,32 +176,34 @@ TISSUE_HOT_KERNEL void HalfMatrix::multiply_rows(const Real* __restrict values, 
   if (part == 0) std::fill(spill + 3L * end, spill + 3L * m_spill_end, 0.0);
   for (int r = first; r < end; ++r) {
     const double x0 = x[3 * r], x1 = x[3 * r + 1], x2 = x[3 * r + 2];
-    const Lanes x_r = {x0, x1, x2, 0.0};
     const int begin = row_begin[r];
     const int stop = row_begin[r + 1];
-    // The diagonal block (symmetric) and d.
-    const Real* b = values + 9L * begin;
-    Lanes y_r = load_lanes(b) * x0 + load_lanes(b + 3) * x1 + load_lanes(b + 6) * x2;
-    y_r += Lanes{d[3 * r], d[3 * r + 1], d[3 * r + 2], 0.0} * x_r;
+    // Row i of y_r gathered lane-wise over the row's blocks (acc_i += B_row_i * x_c), summed
+    // across lanes once at the row's end; lane 3 carries a neighbour's product and is never read.
+    Lanes acc0{}, acc1{}, acc2{};
     for (int k = begin + 1; k < stop; ++k) {
-      b = values + 9L * k;
+      const Real* b = values + 9L * k;
+      __builtin_prefetch(b + PREFETCH_VALUES);
       const int c = column[k];
       const double* xc = x + 3L * c;
-      const Lanes column0 = load_lanes(b), column1 = load_lanes(b + 3), column2 = load_lanes(b + 6);
-      y_r += column0 * xc[0] + column1 * xc[1] + column2 * xc[2];
-      // The transposed term, B^T x_r, for row c: the three columns' dots with x_r, summed across
-      // lanes pairwise (lane 3 of each product is zero).
-      const Lanes p0 = column0 * x_r, p1 = column1 * x_r, p2 = column2 * x_r;
-      const Lanes pairs01 = __builtin_shufflevector(p0, p1, 0, 4, 2, 6) + __builtin_shufflevector(p0, p1, 1, 5, 3, 7);
-      const Lanes sums = __builtin_shufflevector(pairs01, p2, 0, 1, 4, 5) + __builtin_shufflevector(pairs01, p2, 2, 3, 6, 7);
+      const Lanes x_c = c < last_row ? load_lanes(xc) : Lanes{xc[0], xc[1], xc[2], 0.0};
+      const Lanes row0 = load_lanes(b), row1 = load_lanes(b + 3), row2 = load_lanes(b + 6);
+      acc0 += row0 * x_c;
+      acc1 += row1 * x_c;
+      acc2 += row2 * x_c;
+      // The transposed term, B^T x_r = x_r0 row0 + x_r1 row1 + x_r2 row2, for row c (lanes 0-2).
+      const Lanes t = row0 * x0 + row1 * x1 + row2 * x2;
       double* to = (c < end ? y : spill) + 3L * c;
-      to[0] += sums[0];
-      to[1] += sums[1];
-      to[2] += sums[2] + sums[3];
+      to[0] += t[0];
+      to[1] += t[1];
+      to[2] += t[2];
     }
-    y[3 * r] += y_r[0];
-    y[3 * r + 1] += y_r[1];
-    y[3 * r + 2] += y_r[2];
+    // The diagonal block (symmetric) and d.
+    const Real* b = values + 9L * begin;
+    const Lanes diagonal = load_lanes(b) * x0 + load_lanes(b + 3) * x1 + load_lanes(b + 6) * x2;
+    y[3 * r] += diagonal[0] + d[3 * r] * x0 + (acc0[0] + acc0[1] + acc0[2]);
+    y[3 * r + 1] += diagonal[1] + d[3 * r + 1] * x1 + (acc1[0] + acc1[1] + acc1[2]);
+    y[3 * r + 2] += diagonal[2] + d[3 * r + 2] * x2 + (acc2[0] + acc2[1] + acc2[2]);
   }
 }
 

@@ -90,7 +90,7 @@ class HalfMatrix {
   std::vector<int> m_column;      // per stored block
   std::vector<int> m_full_slot;   // per stored block: the slot of K it copies
   std::vector<std::pair<int, int>> m_sort_scratch;  // derive_pattern's: a row out of order, sorted
-  std::vector<float> m_single;    // 9 per stored block, column-major, s K
+  std::vector<float> m_single;                      // 9 per stored block, row-major, s K
   std::vector<double> m_double;
   Eigen::VectorXd m_diagonal;  // d
   std::vector<int> m_isolated_rows;
