@@ -128,6 +128,25 @@ void BM_HalfMultiply(benchmark::State& state) {
 }
 BENCHMARK(BM_HalfMultiply)->ArgsProduct({{0, 2}, {0, 1}})->Unit(benchmark::kMicrosecond);
 
+// The warm start's eight products in one pass over the values (HalfMatrix::multiply_columns); the
+// time is for all eight (compare eight times BM_HalfMultiply's).
+void BM_HalfMultiplyEightColumns(benchmark::State& state) {
+  Fixture f(static_cast<int>(state.range(0)));
+  const Eigen::VectorXd diagonal = f.body.mass_kg();
+  const ShiftedSystem system{&f.body.tangent(), 1e-4, &diagonal};
+  HalfMatrix half(state.range(1) == 1 ? MatrixPrecision::single : MatrixPrecision::double_precision);
+  half.assign(system);
+  Eigen::MatrixXd x(f.body.dof_count(), HalfMatrix::COLUMN_LANES);
+  for (int c = 0; c < x.cols(); ++c) x.col(c) = (c + 1.0) * f.displacement;
+  RowMajorMatrix y;
+  for (auto _ : state) {
+    half.multiply_columns(x, y);
+    benchmark::DoNotOptimize(y.data());
+  }
+  f.count(state);
+}
+BENCHMARK(BM_HalfMultiplyEightColumns)->ArgsProduct({{0, 2}, {0, 1}})->Unit(benchmark::kMicrosecond);
+
 void solve_benchmark(benchmark::State& state, LinearSolver& solver) {
   Fixture f(static_cast<int>(state.range(0)));
   const double h = 0.01;

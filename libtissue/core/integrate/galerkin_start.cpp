@@ -15,13 +15,13 @@ void galerkin_start(const ShiftedSystem& system, const Eigen::VectorXd& b,
   if (count == 0 || count > GALERKIN_MAX_COLUMNS || columns.rows() != b.size() || !columns.allFinite()) return;
   using Small = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, GALERKIN_MAX_COLUMNS, GALERKIN_MAX_COLUMNS>;
   using SmallVector = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, GALERKIN_MAX_COLUMNS, 1>;
-  work.products.resize(b.size(), count);
-  for (Eigen::Index k = 0; k < count; ++k) {
-    work.column = columns.col(k);
-    if (solver == nullptr || !solver->multiply_set_up(system, work.column, work.product)) {
+  if (solver == nullptr || !solver->multiply_set_up(system, columns, work.products)) {
+    work.products.resize(b.size(), count);
+    for (Eigen::Index k = 0; k < count; ++k) {
+      work.column = columns.col(k);
       system.multiply(work.column, work.product);
+      work.products.col(k) = work.product;
     }
-    work.products.col(k) = work.product;
   }
   const Small gram = columns.transpose() * work.products;
   const SmallVector projected_b = columns.transpose() * b;

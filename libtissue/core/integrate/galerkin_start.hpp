@@ -13,7 +13,7 @@ inline constexpr int GALERKIN_MAX_COLUMNS = 8;
 
 /// galerkin_start's scratch, kept between steps so that a step allocates only while the history fills.
 struct GalerkinStartWork {
-  Eigen::MatrixXd products;  // A times each column
+  RowMajorMatrix products;  // A times each column
   Eigen::VectorXd column, product;
 };
 
@@ -22,9 +22,9 @@ struct GalerkinStartWork {
 /// as zero and as each column (all lie in the span). Linearly dependent columns (a free fall's equal
 /// velocity changes) make X^T A X singular: c is then its pseudo-inverse's (eigenvalues below 1e-12
 /// of the largest dropped), which gives the same x0. Non-finite columns, no column, or more than
-/// GALERKIN_MAX_COLUMNS give zero. One product with A per column: by `solver`'s products when given
-/// and set up for `system` (LinearSolver::multiply_set_up), else ShiftedSystem::multiply. x0 is
-/// resized to b's length.
+/// GALERKIN_MAX_COLUMNS give zero. One product with A per column: by `solver`'s products (all columns in one pass) when
+/// given and set up for `system` (LinearSolver::multiply_set_up), else ShiftedSystem::multiply. x0 is resized to b's
+/// length.
 void galerkin_start(const ShiftedSystem& system, const Eigen::VectorXd& b,
                     const Eigen::Ref<const Eigen::MatrixXd>& columns, Eigen::VectorXd& x0, GalerkinStartWork& work,
                     const LinearSolver* solver = nullptr);

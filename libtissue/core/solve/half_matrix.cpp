@@ -8,6 +8,7 @@
 #include <Eigen/Cholesky>
 
 #include <algorithm>
+#include <array>
 #include <cstring>
 
 namespace tissue {
@@ -159,7 +160,123 @@ using Lanes = double __attribute__((vector_size(32)));
                static_cast<double>(from[3])};
 }
 
+// COLUMN_LANES doubles: lane l of a block row's component i is column l's entry (multiply_columns),
+// as two four-lane halves (a wider generic vector times a scalar goes through the stack in GCC's
+// AVX2 clone, ~40x slower).
+struct ColumnLanes {
+  Lanes low, high;
+};
+static_assert(HalfMatrix::COLUMN_LANES == 8, "two halves of four lanes");
+
+[[gnu::always_inline]] inline ColumnLanes load_column_lanes(const double* from) {
+  return {load_lanes(from), load_lanes(from + 4)};
+}
+[[gnu::always_inline]] inline ColumnLanes operator*(double scale, const ColumnLanes& lanes) {
+  return {scale * lanes.low, scale * lanes.high};
+}
+[[gnu::always_inline]] inline ColumnLanes operator+(const ColumnLanes& a, const ColumnLanes& b) {
+  return {a.low + b.low, a.high + b.high};
+}
+[[gnu::always_inline]] inline ColumnLanes& operator+=(ColumnLanes& a, const ColumnLanes& b) {
+  a.low += b.low;
+  a.high += b.high;
+  return a;
+}
+[[gnu::always_inline]] inline void add_column_lanes(double* to, const ColumnLanes& lanes) {
+  const Lanes low = load_lanes(to) + lanes.low, high = load_lanes(to + 4) + lanes.high;
+  std::memcpy(to, &low, sizeof(low));
+  std::memcpy(to + 4, &high, sizeof(high));
+}
+
 }  // namespace
+
+template <class Real>
+TISSUE_HOT_KERNEL void HalfMatrix::multiply_lanes_rows(const Real* __restrict values, double* __restrict y,
+                                                       int part) const {
+  constexpr long ROW = 3L * COLUMN_LANES;
+  constexpr long PREFETCH_VALUES = 1024 / sizeof(Real);
+  const int first = first_block_row(part);
+  const int end = end_block_row(part);
+  const int* __restrict column = m_column.data();
+  const int* __restrict row_begin = m_row_begin.data();
+  const double* __restrict d = m_diagonal.data();
+  const double* __restrict x = m_lanes_in.data();
+  double* __restrict spill = m_lanes_spill.data();
+  std::fill(y + ROW * first, y + ROW * end, 0.0);
+  if (part == 0) std::fill(spill + ROW * end, spill + ROW * m_spill_end, 0.0);
+  for (int r = first; r < end; ++r) {
+    const double* x_r = x + ROW * r;
+    const ColumnLanes x0 = load_column_lanes(x_r), x1 = load_column_lanes(x_r + COLUMN_LANES),
+                      x2 = load_column_lanes(x_r + 2 * COLUMN_LANES);
+    const Real* b = values + 9L * row_begin[r];
+    // The diagonal block (symmetric) and d, then the upper blocks: each B x_c into the row's own
+    // sums, B^T x_r into row c's (B row-major: b[3 i + j] = B_ij).
+    ColumnLanes acc0 = (double(b[0]) + d[3 * r]) * x0 + double(b[1]) * x1 + double(b[2]) * x2;
+    ColumnLanes acc1 = double(b[3]) * x0 + (double(b[4]) + d[3 * r + 1]) * x1 + double(b[5]) * x2;
+    ColumnLanes acc2 = double(b[6]) * x0 + double(b[7]) * x1 + (double(b[8]) + d[3 * r + 2]) * x2;
+    for (int k = row_begin[r] + 1; k < row_begin[r + 1]; ++k) {
+      b = values + 9L * k;
+      __builtin_prefetch(b + PREFETCH_VALUES);
+      const int c = column[k];
+      const double* x_c = x + ROW * c;
+      const double b00 = b[0], b01 = b[1], b02 = b[2], b10 = b[3], b11 = b[4], b12 = b[5], b20 = b[6], b21 = b[7],
+                   b22 = b[8];
+      const ColumnLanes c0 = load_column_lanes(x_c), c1 = load_column_lanes(x_c + COLUMN_LANES),
+                        c2 = load_column_lanes(x_c + 2 * COLUMN_LANES);
+      acc0 += b00 * c0 + b01 * c1 + b02 * c2;
+      acc1 += b10 * c0 + b11 * c1 + b12 * c2;
+      acc2 += b20 * c0 + b21 * c1 + b22 * c2;
+      double* to = (c < end ? y : spill) + ROW * c;
+      add_column_lanes(to, b00 * x0 + b10 * x1 + b20 * x2);
+      add_column_lanes(to + COLUMN_LANES, b01 * x0 + b11 * x1 + b21 * x2);
+      add_column_lanes(to + 2 * COLUMN_LANES, b02 * x0 + b12 * x1 + b22 * x2);
+    }
+    double* y_r = y + ROW * r;
+    add_column_lanes(y_r, acc0);
+    add_column_lanes(y_r + COLUMN_LANES, acc1);
+    add_column_lanes(y_r + 2 * COLUMN_LANES, acc2);
+  }
+}
+
+void HalfMatrix::multiply_columns(const Eigen::Ref<const Eigen::MatrixXd>& x, RowMajorMatrix& y, WorkTeam* team) const {
+  constexpr long ROW = 3L * COLUMN_LANES;
+  const long rows = block_rows();
+  y.resize(3 * rows, x.cols());
+  m_lanes_in.resize(static_cast<size_t>(ROW * rows));
+  m_lanes_spill.resize(static_cast<size_t>(ROW * rows));
+  // A block row's 24 lanes (component i, lane l at 8 i + l) are its three rows of X in row-major
+  // order: entry e of column l at COLUMN_LANES e + l. Y of COLUMN_LANES columns is written in place.
+  const long entries = 3 * rows;
+  const bool in_place = x.cols() == COLUMN_LANES;
+  if (!in_place) m_lanes_out.resize(static_cast<size_t>(ROW * rows));
+  double* out = in_place ? y.data() : m_lanes_out.data();
+  for (Eigen::Index first = 0; first < x.cols(); first += COLUMN_LANES) {
+    const auto lanes = static_cast<int>(std::min<Eigen::Index>(COLUMN_LANES, x.cols() - first));
+    std::array<const double*, COLUMN_LANES> columns{};
+    for (int l = 0; l < lanes; ++l) columns[static_cast<size_t>(l)] = &x.coeffRef(0, first + l);
+    for (long e = 0; e < entries; ++e) {
+      double* to = m_lanes_in.data() + COLUMN_LANES * e;
+      for (int l = 0; l < COLUMN_LANES; ++l) to[l] = l < lanes ? columns[static_cast<size_t>(l)][e] : 0.0;
+    }
+    run_parts(team, PARTS, [&](int part) {
+      if (m_precision == MatrixPrecision::single) {
+        multiply_lanes_rows(m_single.data(), out, part);
+      } else {
+        multiply_lanes_rows(m_double.data(), out, part);
+      }
+    });
+    run_parts(team, PARTS, [&](int part) {  // the terms part 0 sent to part 1's rows
+      if (part == 0) return;
+      const long begin = ROW * first_block_row(part);
+      const long stop = ROW * std::min(end_block_row(part), m_spill_end);
+      for (long e = begin; e < stop; ++e) out[e] += m_lanes_spill[static_cast<size_t>(e)];
+    });
+    if (in_place) continue;
+    for (long e = 0; e < entries; ++e) {
+      for (int l = 0; l < lanes; ++l) y(e, first + l) = out[COLUMN_LANES * e + l];
+    }
+  }
+}
 
 template <class Real>
 TISSUE_HOT_KERNEL void HalfMatrix::multiply_rows(const Real* __restrict values, const double* __restrict x,

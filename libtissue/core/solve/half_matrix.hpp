@@ -38,6 +38,9 @@ inline constexpr double SINGLE_PRECISION_TOLERANCE = 1e-5;
   return tolerance >= SINGLE_PRECISION_TOLERANCE ? MatrixPrecision::single : MatrixPrecision::double_precision;
 }
 
+/// Products of several columns, as HalfMatrix::multiply_columns writes them.
+using RowMajorMatrix = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
+
 class HalfMatrix {
  public:
   static constexpr int PARTS = MAX_STEP_THREADS;
@@ -64,6 +67,14 @@ class HalfMatrix {
   /// on this thread; bitwise the same either way.
   void multiply(const Eigen::VectorXd& x, Eigen::VectorXd& y, WorkTeam* team = nullptr) const;
 
+  /// Y = A X (Y resized to X's shape; row-major, as the kernel writes it) for X's columns together, up
+  /// to COLUMN_LANES of them in each pass over the values (one lane each): a product per column costs
+  /// that column's bytes of A, these share them (the warm start's eight products, galerkin_start).
+  /// Parts as multiply's: bitwise the same on a team of two. Each column equals multiply's to rounding
+  /// (the same terms, in another order).
+  void multiply_columns(const Eigen::Ref<const Eigen::MatrixXd>& x, RowMajorMatrix& y, WorkTeam* team = nullptr) const;
+  static constexpr int COLUMN_LANES = 8;
+
   /// The rows the system says left the dynamics (ShiftedSystem::rows_left) that no nonzero block of
   /// K joins to another (found by assign, ascending): a part parked out of the field, whose elements
   /// add nothing, leaves rows with only their mass. Each is its own 3 x 3 system.
@@ -82,6 +93,8 @@ class HalfMatrix {
   [[nodiscard]] Eigen::Matrix3d diagonal_block(const std::vector<Real>& values, int row) const;
   template <class Real>
   void multiply_rows(const Real* values, const double* x, double* y, int part) const;
+  template <class Real>
+  void multiply_lanes_rows(const Real* values, double* y, int part) const;
   void derive_pattern(const BlockSparseMatrix& k);
 
   MatrixPrecision m_precision;
@@ -97,6 +110,8 @@ class HalfMatrix {
   std::array<int, PARTS + 1> m_first_block_row{};
   int m_spill_end = 0;                   // 1 + the last block row part 0 sends terms to
   mutable Eigen::VectorXd m_spill;       // the terms for rows [end_block_row(0), m_spill_end)
+  // multiply_columns': per block row, its three components' COLUMN_LANES lanes (24 values).
+  mutable std::vector<double> m_lanes_in, m_lanes_out, m_lanes_spill;  // (out: when Y has fewer columns)
   const BlockSparseMatrix* m_source = nullptr;
   std::uint64_t m_pattern_revision = 0, m_layout_revision = 0;
 };

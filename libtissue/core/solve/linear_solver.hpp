@@ -99,13 +99,13 @@ class LinearSolver {
   }
   /// Whether solve(b, x) has an A to use.
   [[nodiscard]] virtual bool is_set_up() const = 0;
-  /// y = A x for `system` when the last setup() was of it (the same K, scale and d), for products
+  /// Y = A X for `system` when the last setup() was of it (the same K, scale and d), for products
   /// beside the solve (the warm start's, galerkin_start): the CG solvers through the compact copy
-  /// their products stream (half of K's blocks, single precision at real-time tolerances), on the
-  /// lent team, and true; false (y untouched) for the others and another system: then
-  /// ShiftedSystem::multiply. x and y must be different vectors.
-  virtual bool multiply_set_up(const ShiftedSystem& /*system*/, const Eigen::VectorXd& /*x*/,
-                               Eigen::VectorXd& /*y*/) const {
+  /// their products stream (half of K's blocks, single precision at real-time tolerances), all of X's
+  /// columns in one pass over it (HalfMatrix::multiply_columns), on the lent team, and true; false (Y
+  /// untouched) for the others and another system: then ShiftedSystem::multiply. X and Y must differ.
+  virtual bool multiply_set_up(const ShiftedSystem& /*system*/, const Eigen::Ref<const Eigen::MatrixXd>& /*x*/,
+                               RowMajorMatrix& /*y*/) const {
     return false;
   }
   /// Lends the solver a team of threads for its solves until lent nullptr (an integrator lends its
@@ -161,7 +161,8 @@ class PcgSolver final : public LinearSolver {
   [[nodiscard]] bool is_set_up() const override { return m_system.stiffness != nullptr; }
   [[nodiscard]] std::string_view name() const override { return "pcg"; }
   void lend_work_team(WorkTeam* team) override { m_team = team; }
-  bool multiply_set_up(const ShiftedSystem& system, const Eigen::VectorXd& x, Eigen::VectorXd& y) const override;
+  bool multiply_set_up(const ShiftedSystem& system, const Eigen::Ref<const Eigen::MatrixXd>& x,
+                       RowMajorMatrix& y) const override;
   [[nodiscard]] const Settings& settings() const { return m_settings; }
   /// Appends the relative residual ||r_k|| / ||b|| of every iteration k >= 0 of the solves that
   /// follow to `history` (kept by the caller; nullptr stops). For convergence plots.
@@ -200,7 +201,8 @@ class TwoLevelPcgSolver final : public LinearSolver {
   [[nodiscard]] bool is_set_up() const override { return m_system.stiffness != nullptr; }
   [[nodiscard]] std::string_view name() const override { return "pcgTwoLevel"; }
   void lend_work_team(WorkTeam* team) override { m_team = team; }
-  bool multiply_set_up(const ShiftedSystem& system, const Eigen::VectorXd& x, Eigen::VectorXd& y) const override;
+  bool multiply_set_up(const ShiftedSystem& system, const Eigen::Ref<const Eigen::MatrixXd>& x,
+                       RowMajorMatrix& y) const override;
   /// The aggregates are made anew at the next setup, as in a fresh solver.
   void forget_earlier_setups() override;
   [[nodiscard]] bool uses_block_positions() const override { return true; }

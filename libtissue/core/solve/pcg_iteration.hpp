@@ -26,14 +26,15 @@ void validate_pcg_settings(const PcgSolver::Settings& settings, const char* who)
 /// 1 / diag(A), length rows() (resized if needed); throws SolverError for an entry <= 0 or not finite.
 void jacobi_inverse_diagonal(const ShiftedSystem& system, Eigen::VectorXd& inverse_diagonal, const char* who);
 
-/// A CG solver's LinearSolver::multiply_set_up: y = A x through `work.matrix` (the copy the setup of
+/// A CG solver's LinearSolver::multiply_set_up: Y = A X through `work.matrix` (the copy the setup of
 /// `set_up` assigned) on `team`'s members, if `system` is that one.
 inline bool multiply_set_up_copy(const PcgWorkspace& work, const ShiftedSystem& set_up, WorkTeam* team,
-                                 const ShiftedSystem& system, const Eigen::VectorXd& x, Eigen::VectorXd& y) {
+                                 const ShiftedSystem& system, const Eigen::Ref<const Eigen::MatrixXd>& x,
+                                 RowMajorMatrix& y) {
   const bool same = set_up.stiffness != nullptr && set_up.stiffness == system.stiffness &&
                     set_up.stiffness_scale == system.stiffness_scale && set_up.diagonal == system.diagonal;
   if (!same || x.rows() != system.rows()) return false;
-  work.matrix.multiply(x, y, team);
+  work.matrix.multiply_columns(x, y, team);
   return true;
 }
 

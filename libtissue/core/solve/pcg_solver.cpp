@@ -48,8 +48,8 @@ void PcgSolver::setup(const ShiftedSystem& system) {
   m_system = system;
 }
 
-bool PcgSolver::multiply_set_up(const ShiftedSystem& system, const Eigen::VectorXd& x,
-                               Eigen::VectorXd& y) const {
+bool PcgSolver::multiply_set_up(const ShiftedSystem& system, const Eigen::Ref<const Eigen::MatrixXd>& x,
+                                RowMajorMatrix& y) const {
   return multiply_set_up_copy(m_work, m_system, m_team, system, x, y);
 }
 

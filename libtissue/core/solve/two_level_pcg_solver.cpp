@@ -39,8 +39,8 @@ void TwoLevelPcgSolver::set_up(const ShiftedSystem& system, bool nearby) {
   m_system = system;
 }
 
-bool TwoLevelPcgSolver::multiply_set_up(const ShiftedSystem& system, const Eigen::VectorXd& x,
-                                       Eigen::VectorXd& y) const {
+bool TwoLevelPcgSolver::multiply_set_up(const ShiftedSystem& system, const Eigen::Ref<const Eigen::MatrixXd>& x,
+                                        RowMajorMatrix& y) const {
   return multiply_set_up_copy(m_work, m_system, m_team, system, x, y);
 }
 

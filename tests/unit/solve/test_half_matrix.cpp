@@ -75,6 +75,39 @@ TEST(HalfMatrix, TwoPartsSideBySideGiveBitwiseTheProductOfOneThread) {
   EXPECT_NE(unfinished, alone);
 }
 
+TEST(HalfMatrix, ColumnsTogetherAreEachColumnsProduct) {
+  // multiply_columns shares each pass over the values among up to eight columns: each column of
+  // the result is that column's product to rounding (double: the same terms in another order;
+  // single: the same rounded entries), for fewer columns than lanes and for more (two passes), and
+  // two parts side by side give bitwise one thread's.
+  const test::TestSystem system = test::make_grid_system(8, 6, 5, 3);
+  const ShiftedSystem shifted = system.shifted(0.8);
+  std::mt19937 rng(17);
+  for (const MatrixPrecision precision : {MatrixPrecision::double_precision, MatrixPrecision::single}) {
+    HalfMatrix matrix(precision);
+    matrix.assign(shifted);
+    ASSERT_GT(matrix.first_block_row(1), 0);
+    for (const int columns : {1, 3, 8, 11}) {
+      Eigen::MatrixXd x(shifted.rows(), columns);
+      for (int c = 0; c < columns; ++c) x.col(c) = test::random_vector(shifted.rows(), rng);
+      RowMajorMatrix together;
+      matrix.multiply_columns(x, together);
+      ASSERT_EQ(together.rows(), shifted.rows());
+      ASSERT_EQ(together.cols(), columns);
+      for (int c = 0; c < columns; ++c) {
+        Eigen::VectorXd alone;
+        matrix.multiply(x.col(c), alone);
+        EXPECT_LE((together.col(c) - alone).norm(), 1e-14 * alone.norm()) << columns << " columns, column " << c;
+        EXPECT_LE((together.col(c) - full_product(shifted, x.col(c))).norm(), 1e-6 * alone.norm());
+      }
+      WorkTeam team(2);
+      RowMajorMatrix on_team = RowMajorMatrix::Constant(shifted.rows(), columns, 1e300);
+      matrix.multiply_columns(x, on_team, &team);
+      EXPECT_EQ(on_team, together) << columns << " columns";
+    }
+  }
+}
+
 TEST(HalfMatrix, FollowsAGrownMatrix) {
   test::TestSystem system = test::make_grid_system(4, 4, 3, 9);
   HalfMatrix matrix(MatrixPrecision::double_precision);

@@ -199,26 +199,35 @@ TEST(Pcg, ProductOfTheLastSetupIsTheSystemsThroughTheSolversCopy) {
   // multiply_set_up streams the compact copy the CG products use: A x to rounding with double
   // entries (a strict tolerance), to the entries' rounding (6e-8) with single ones (the real-time
   // 1e-3), bitwise the same on a team of two; refused before a setup and for another system.
+  // Three columns at once, each as alone.
   const test::TestSystem system = test::make_grid_system(6, 5, 4, 9);
   const ShiftedSystem shifted = system.shifted(0.4);
   std::mt19937 rng(13);
-  const Eigen::VectorXd x = test::random_vector(shifted.rows(), rng);
-  Eigen::VectorXd expected;
-  shifted.multiply(x, expected);
+  Eigen::MatrixXd x(shifted.rows(), 3);
+  Eigen::MatrixXd expected(shifted.rows(), 3);
+  for (int column = 0; column < 3; ++column) {
+    const Eigen::VectorXd x_column = test::random_vector(shifted.rows(), rng);
+    Eigen::VectorXd product;
+    shifted.multiply(x_column, product);
+    x.col(column) = x_column;
+    expected.col(column) = product;
+  }
   for (const double tolerance : {1e-6, 1e-3}) {
     PcgSolver jacobi({tolerance, 100});
     TwoLevelPcgSolver two_level({tolerance, 100});
     for (LinearSolver* solver : std::vector<LinearSolver*>{&jacobi, &two_level}) {
-      Eigen::VectorXd y;
+      RowMajorMatrix y;
       EXPECT_FALSE(solver->multiply_set_up(shifted, x, y)) << solver->name() << " before its setup";
       solver->setup(shifted);
       EXPECT_FALSE(solver->multiply_set_up(system.shifted(0.5), x, y)) << solver->name() << ", another scale";
       ASSERT_TRUE(solver->multiply_set_up(shifted, x, y)) << solver->name();
-      const double error = (y - expected).norm() / expected.norm();
-      EXPECT_LE(error, tolerance < 1e-5 ? 1e-14 : 1e-6) << solver->name() << ", tolerance " << tolerance;
+      for (int column = 0; column < 3; ++column) {
+        const double error = (y.col(column) - expected.col(column)).norm() / expected.col(column).norm();
+        EXPECT_LE(error, tolerance < 1e-5 ? 1e-14 : 1e-6) << solver->name() << ", tolerance " << tolerance;
+      }
       WorkTeam team(2);
       solver->lend_work_team(&team);
-      Eigen::VectorXd together;
+      RowMajorMatrix together;
       ASSERT_TRUE(solver->multiply_set_up(shifted, x, together));
       solver->lend_work_team(nullptr);
       EXPECT_EQ(together, y) << solver->name() << ", tolerance " << tolerance;
