@@ -84,6 +84,7 @@ TEST(PartsOutOfTheField, AFallenPieceLeavesTheDynamicsAndFallsOnAsOneBody) {
     ++steps;
   }
   const DeformableBody& body = parking.body();
+  std::printf("parked after %d steps\n", steps);
   ASSERT_GT(body.parked_row_count(), 0) << "the piece never left the field";
   std::printf("parked %d rows after %d steps; tangent blocks %d -> %d (the piece's %d go)\n", body.parked_row_count(),
               steps, blocks_before, body.tangent().nonzero_blocks(), blocks_before - body.tangent().nonzero_blocks());
@@ -154,12 +155,15 @@ TEST_P(ParkedUnderTheRealTimeSolver, APieceFallsOnAsOneBody) {
   settings.solver.pcg = PcgSolver::Settings{1e-3, 10};
   Tissue tissue(mesh, settings);
   const std::vector<ToolPose> poses = stroke_poses(settings.step_size_s);
+  // Under Jacobi CG capped at 10 iterations the freed piece sinks slowly (issue 40): it leaves the
+  // field after ~200 steps, the count moving by a few percent with the products' rounding.
   int steps = 0;
-  for (; tissue.body().parked_row_count() == 0 && steps < 200; ++steps) {
+  for (; tissue.body().parked_row_count() == 0 && steps < 400; ++steps) {
     if (static_cast<size_t>(steps) < poses.size()) tissue.set_tool(poses[static_cast<size_t>(steps)]);
     tissue.step();
   }
   const DeformableBody& body = tissue.body();
+  std::printf("parked after %d steps\n", steps);
   ASSERT_GT(body.parked_row_count(), 0) << "the piece never left the field";
   std::vector<int> parked;
   for (int row = 0; row < body.dof_count() / 3; ++row) {

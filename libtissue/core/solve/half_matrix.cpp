@@ -14,37 +14,32 @@
 namespace tissue {
 
 void HalfMatrix::derive_pattern(const BlockSparseMatrix& k) {
+  // Row c of the copy holds A's blocks (c, r), r >= c, row-major: K's block (r, c) column-major is
+  // that block's transpose, so its nine values copied in storage order are (c, r) row-major (K is
+  // symmetric). K's rows taken in ascending r give each row c its blocks by ascending column, the
+  // diagonal (r = c) first, whatever the order of the slots within K's rows (appended after a cut).
   const int n = k.block_rows();
-  m_row_begin.assign(1, 0);
-  m_column.clear();
-  m_full_slot.clear();
+  m_row_begin.assign(static_cast<size_t>(n) + 1, 0);
   for (int r = 0; r < n; ++r) {
-    const int begin = k.row_begin(r);
-    const int end = begin + k.row_size(r);
-    const size_t first = m_column.size();
-    for (int slot = begin; slot < end; ++slot) {
+    for (int slot = k.row_begin(r); slot < k.row_begin(r) + k.row_size(r); ++slot) {
       const int c = k.slot_column(slot);
-      if (c < r) continue;
-      m_column.push_back(c);
-      m_full_slot.push_back(slot);
+      if (c >= 0 && c <= r) ++m_row_begin[static_cast<size_t>(c) + 1];
     }
-    // The diagonal first, the others by column (rows of K may hold appended blocks out of order:
-    // after a cut; most rows are in order, and are left as they are).
-    bool ordered = first < m_column.size() && m_column[first] == r;
-    for (size_t b = first + 1; b < m_column.size() && ordered; ++b) ordered = m_column[b] > m_column[b - 1];
-    if (!ordered) {
-      std::vector<std::pair<int, int>>& row = m_sort_scratch;
-      row.clear();
-      for (size_t b = first; b < m_column.size(); ++b) {
-        row.emplace_back(m_column[b] == r ? -1 : m_column[b], m_full_slot[b]);
-      }
-      std::sort(row.begin(), row.end());
-      for (size_t b = first; b < m_column.size(); ++b) {
-        m_column[b] = row[b - first].first < 0 ? r : row[b - first].first;
-        m_full_slot[b] = row[b - first].second;
-      }
+  }
+  for (int c = 0; c < n; ++c) m_row_begin[static_cast<size_t>(c) + 1] += m_row_begin[static_cast<size_t>(c)];
+  const auto blocks = static_cast<size_t>(m_row_begin.back());
+  m_column.resize(blocks);
+  m_full_slot.resize(blocks);
+  std::vector<int>& cursor = m_fill_cursor;
+  cursor.assign(m_row_begin.begin(), m_row_begin.end() - 1);
+  for (int r = 0; r < n; ++r) {
+    for (int slot = k.row_begin(r); slot < k.row_begin(r) + k.row_size(r); ++slot) {
+      const int c = k.slot_column(slot);
+      if (c < 0 || c > r) continue;
+      const auto at = static_cast<size_t>(cursor[static_cast<size_t>(c)]++);
+      m_column[at] = r;
+      m_full_slot[at] = slot;
     }
-    m_row_begin.push_back(static_cast<int>(m_column.size()));
   }
   for (int part = 0; part <= PARTS; ++part) {
     m_first_block_row[static_cast<size_t>(part)] = part == PARTS ? n : k.balanced_row_split(part, PARTS);
@@ -67,7 +62,7 @@ void HalfMatrix::copy_part(const BlockSparseMatrix& k, double scale, std::vector
   for (auto b = static_cast<size_t>(m_row_begin[static_cast<size_t>(first_block_row(part))]); b < end; ++b) {
     const double* from = k.block(m_full_slot[b]).data();
     Real* block = &to[9 * b];
-    for (int e = 0; e < 9; ++e) block[e] = static_cast<Real>(scale * from[3 * (e % 3) + e / 3]);  // row-major
+    for (int e = 0; e < 9; ++e) block[e] = static_cast<Real>(scale * from[e]);  // (c, r) row-major
   }
 }
 

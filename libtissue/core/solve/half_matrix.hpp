@@ -19,7 +19,6 @@
 
 #include <array>
 #include <cstdint>
-#include <utility>
 #include <vector>
 
 namespace tissue {
@@ -102,7 +101,7 @@ class HalfMatrix {
   std::vector<int> m_row_begin;   // block rows + 1
   std::vector<int> m_column;      // per stored block
   std::vector<int> m_full_slot;   // per stored block: the slot of K it copies
-  std::vector<std::pair<int, int>> m_sort_scratch;  // derive_pattern's: a row out of order, sorted
+  std::vector<int> m_fill_cursor;                   // derive_pattern's: per row, where its next block goes
   std::vector<float> m_single;                      // 9 per stored block, row-major, s K
   std::vector<double> m_double;
   Eigen::VectorXd m_diagonal;  // d
