@@ -10,6 +10,7 @@
 #include <algorithm>
 #include <array>
 #include <cstring>
+#include <type_traits>
 
 namespace tissue {
 
@@ -293,23 +294,38 @@ TISSUE_HOT_KERNEL void HalfMatrix::multiply_rows(const Real* __restrict values, 
     // Row i of y_r gathered lane-wise over the row's blocks (acc_i += B_row_i * x_c), summed
     // across lanes once at the row's end; lane 3 carries a neighbour's product and is never read.
     Lanes acc0{}, acc1{}, acc2{};
-    for (int k = begin + 1; k < stop; ++k) {
+    // One block: its terms for this row, and B^T x_r = x_r0 row0 + x_r1 row1 + x_r2 row2 (lanes
+    // 0-2) for row c in `target`. x_c is read four wide except for the last row (`Narrow`).
+    const auto add_block = [&](int k, double* __restrict target, auto narrow) {
       const Real* b = values + 9L * k;
       __builtin_prefetch(b + PREFETCH_VALUES);
       const int c = column[k];
       const double* xc = x + 3L * c;
-      const Lanes x_c = c < last_row ? load_lanes(xc) : Lanes{xc[0], xc[1], xc[2], 0.0};
+      Lanes x_c;
+      if constexpr (decltype(narrow)::value) {
+        x_c = Lanes{xc[0], xc[1], xc[2], 0.0};
+      } else {
+        x_c = load_lanes(xc);
+      }
       const Lanes row0 = load_lanes(b), row1 = load_lanes(b + 3), row2 = load_lanes(b + 6);
       acc0 += row0 * x_c;
       acc1 += row1 * x_c;
       acc2 += row2 * x_c;
-      // The transposed term, B^T x_r = x_r0 row0 + x_r1 row1 + x_r2 row2, for row c (lanes 0-2).
       const Lanes t = row0 * x0 + row1 * x1 + row2 * x2;
-      double* to = (c < end ? y : spill) + 3L * c;
+      double* to = target + 3L * c;
       to[0] += t[0];
       to[1] += t[1];
       to[2] += t[2];
-    }
+    };
+    // The row's columns ascend: those of later parts' rows (part 0's terms for them go to the
+    // spill) are its last blocks, and the last row's column, if any, is its very last.
+    const bool last_column = stop > begin + 1 && column[stop - 1] == last_row;
+    const int wide_stop = last_column ? stop - 1 : stop;
+    int spill_from = wide_stop;
+    while (spill_from > begin + 1 && column[spill_from - 1] >= end) --spill_from;
+    for (int k = begin + 1; k < spill_from; ++k) add_block(k, y, std::false_type{});
+    for (int k = spill_from; k < wide_stop; ++k) add_block(k, spill, std::false_type{});
+    if (last_column) add_block(stop - 1, last_row < end ? y : spill, std::true_type{});
     // The diagonal block (symmetric) and d.
     const Real* b = values + 9L * begin;
     const Lanes diagonal = load_lanes(b) * x0 + load_lanes(b + 3) * x1 + load_lanes(b + 6) * x2;
