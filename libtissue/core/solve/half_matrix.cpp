@@ -199,7 +199,7 @@ TISSUE_HOT_KERNEL void HalfMatrix::multiply_lanes_rows(const Real* __restrict va
   const double* __restrict x = m_lanes_in.data();
   double* __restrict spill = m_lanes_spill.data();
   std::fill(y + ROW * first, y + ROW * end, 0.0);
-  if (part == 0) std::fill(spill + ROW * end, spill + ROW * m_spill_end, 0.0);
+  clear_spill(spill, ROW, part);
   for (int r = first; r < end; ++r) {
     const double* x_r = x + ROW * r;
     const ColumnLanes x0 = load_column_lanes(x_r), x1 = load_column_lanes(x_r + COLUMN_LANES),
@@ -261,12 +261,7 @@ void HalfMatrix::multiply_columns(const Eigen::Ref<const Eigen::MatrixXd>& x, Ro
         multiply_lanes_rows(m_double.data(), out, part);
       }
     });
-    run_parts(team, PARTS, [&](int part) {  // the terms part 0 sent to part 1's rows
-      if (part == 0) return;
-      const long begin = ROW * first_block_row(part);
-      const long stop = ROW * std::min(end_block_row(part), m_spill_end);
-      for (long e = begin; e < stop; ++e) out[e] += m_lanes_spill[static_cast<size_t>(e)];
-    });
+    run_parts(team, PARTS, [&](int part) { add_spill(out, m_lanes_spill.data(), ROW, part); });
     if (in_place) continue;
     for (long e = 0; e < entries; ++e) {
       for (int l = 0; l < lanes; ++l) y(e, first + l) = out[COLUMN_LANES * e + l];
@@ -286,7 +281,7 @@ TISSUE_HOT_KERNEL void HalfMatrix::multiply_rows(const Real* __restrict values, 
   const double* __restrict d = m_diagonal.data();
   double* __restrict spill = m_spill.data();
   std::fill(y + 3L * first, y + 3L * end, 0.0);
-  if (part == 0) std::fill(spill + 3L * end, spill + 3L * m_spill_end, 0.0);
+  clear_spill(spill, 3, part);
   for (int r = first; r < end; ++r) {
     const double x0 = x[3 * r], x1 = x[3 * r + 1], x2 = x[3 * r + 2];
     const int begin = row_begin[r];
@@ -343,12 +338,17 @@ void HalfMatrix::multiply_part(const Eigen::VectorXd& x, Eigen::VectorXd& y, int
   }
 }
 
-void HalfMatrix::finish_part(Eigen::VectorXd& y, int part) const {
-  if (part == 0) return;
-  const long first = 3L * first_block_row(part);
-  const long end = std::min(3L * end_block_row(part), 3L * m_spill_end);
-  for (long i = first; i < end; ++i) y[i] += m_spill[i];
+void HalfMatrix::clear_spill(double* spill, long row_width, int part) const {
+  if (part == 0) std::fill(spill + row_width * end_block_row(0), spill + row_width * m_spill_end, 0.0);
 }
+
+void HalfMatrix::add_spill(double* y, const double* spill, long row_width, int part) const {
+  if (part == 0) return;
+  const long stop = row_width * std::min(end_block_row(part), m_spill_end);
+  for (long e = row_width * first_block_row(part); e < stop; ++e) y[e] += spill[e];
+}
+
+void HalfMatrix::finish_part(Eigen::VectorXd& y, int part) const { add_spill(y.data(), m_spill.data(), 3, part); }
 
 void HalfMatrix::multiply(const Eigen::VectorXd& x, Eigen::VectorXd& y, WorkTeam* team) const {
   y.resize(3L * block_rows());

@@ -95,6 +95,10 @@ class HalfMatrix {
   template <class Real>
   void multiply_lanes_rows(const Real* values, double* y, int part) const;
   void derive_pattern(const BlockSparseMatrix& k);
+  // The spill's rules, for vectors of `row_width` values a block row (3, or multiply_columns' lanes):
+  // part 0 clears the rows it sends terms to; part 1 adds them to its own after both are done.
+  void clear_spill(double* spill, long row_width, int part) const;
+  void add_spill(double* y, const double* spill, long row_width, int part) const;
 
   MatrixPrecision m_precision;
   // Pattern: per block row its diagonal block first, then its upper blocks by column.
