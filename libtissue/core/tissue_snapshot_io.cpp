@@ -19,7 +19,7 @@ constexpr std::uint64_t MAGIC = 0x31305353'49535354ULL;  // "TSSISS01" read as l
 // had turned when each tet was cut and each edge crossed (a spiral cuts a tet once per turn);
 // 12: the contact spring's direction and constant force, the contact's sticking and friction (issue 42);
 // 13: a pad probe's springs and its samples pressed (issue 42)
-constexpr std::uint32_t VERSION = 13;
+constexpr std::uint32_t VERSION = 14;
 
 // The core's Eigen types and cut records on top of the shared byte stream.
 class Writer : public serial::ByteWriter {
@@ -185,6 +185,8 @@ std::vector<std::uint8_t> serialize_snapshot(const TissueSnapshot& s) {
   w.put_all(s.rotations.tet_warm_starts);
   w.put_all(s.rotations.pieces);
   w.put_all(s.rotations.piece_warm_starts);
+  w.put_all(s.rotations.tet_turns_before);
+  w.put_all(s.rotations.piece_turns_before);
   w.put(s.integrator_state);
   const VolumeCutter::SessionState& c = s.cutter;
   w.put(static_cast<std::uint8_t>(c.cutting));
@@ -261,6 +263,8 @@ TissueSnapshot read_snapshot(std::span<const std::uint8_t> bytes) {
   r.get_all(s.rotations.tet_warm_starts, 32);
   r.get_all(s.rotations.pieces, 72);
   r.get_all(s.rotations.piece_warm_starts, 32);
+  r.get_all(s.rotations.tet_turns_before, 32);
+  r.get_all(s.rotations.piece_turns_before, 32);
   r.get(s.integrator_state);
   VolumeCutter::SessionState& c = s.cutter;
   c.cutting = r.get_bool();

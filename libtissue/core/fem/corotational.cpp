@@ -57,6 +57,7 @@ CorotationalElasticity::CorotationalElasticity(const TetMesh& mesh, const std::v
   m_warm_starts.assign(m_tets.size(), Eigen::Quaterniond::Identity());
   m_rotations_ahead = m_rotations;
   m_warm_starts_ahead = m_warm_starts;
+  m_turns_before = m_warm_starts;
   m_excluded.assign(m_tets.size(), 0);
 }
 
@@ -166,6 +167,7 @@ void CorotationalElasticity::exclude(int tet) {
   m_excluded[k] = 1;
   m_rotations_ahead[k] = m_rotations[k];  // frozen alike in both sets from now on
   m_warm_starts_ahead[k] = m_warm_starts[k];
+  m_turns_before[k] = m_warm_starts[k];
 }
 
 std::vector<Eigen::Matrix3d> CorotationalElasticity::rotations() const {
@@ -174,22 +176,41 @@ std::vector<Eigen::Matrix3d> CorotationalElasticity::rotations() const {
   return by_tet;
 }
 
-std::vector<Eigen::Quaterniond> CorotationalElasticity::warm_starts() const {
-  std::vector<Eigen::Quaterniond> by_tet(m_warm_starts.size());
-  for (size_t k = 0; k < m_warm_starts.size(); ++k) by_tet[static_cast<size_t>(m_tet_id[k])] = m_warm_starts[k];
+namespace {
+
+// Per-tet values held by storage index, in mesh order.
+std::vector<Eigen::Quaterniond> by_tet_id(const std::vector<Eigen::Quaterniond>& stored,
+                                          const std::vector<int>& tet_id) {
+  std::vector<Eigen::Quaterniond> by_tet(stored.size());
+  for (size_t k = 0; k < stored.size(); ++k) by_tet[static_cast<size_t>(tet_id[k])] = stored[k];
   return by_tet;
 }
 
+}  // namespace
+
+std::vector<Eigen::Quaterniond> CorotationalElasticity::warm_starts() const {
+  return by_tet_id(m_warm_starts, m_tet_id);
+}
+
+std::vector<Eigen::Quaterniond> CorotationalElasticity::turns_before() const {
+  return by_tet_id(m_turns_before, m_tet_id);
+}
+
 void CorotationalElasticity::restore_rotations(const std::vector<Eigen::Matrix3d>& rotations,
-                                               const std::vector<Eigen::Quaterniond>& warm_starts) {
-  if (rotations.size() != m_tets.size() || warm_starts.size() != m_tets.size()) {
-    throw std::invalid_argument("co-rotational elasticity: expected one rotation and warm start per tet (" +
-                                std::to_string(m_tets.size()) + "), got " + std::to_string(rotations.size()) +
-                                " and " + std::to_string(warm_starts.size()));
+                                               const std::vector<Eigen::Quaterniond>& warm_starts,
+                                               const std::vector<Eigen::Quaterniond>& turns_before) {
+  if (rotations.size() != m_tets.size() || warm_starts.size() != m_tets.size() ||
+      turns_before.size() != m_tets.size()) {
+    throw std::invalid_argument(
+        "co-rotational elasticity: expected one rotation, warm start and turn before per tet (" +
+        std::to_string(m_tets.size()) + "), got " + std::to_string(rotations.size()) + ", " +
+        std::to_string(warm_starts.size()) + " and " + std::to_string(turns_before.size()));
   }
   for (size_t t = 0; t < rotations.size(); ++t) {
-    m_rotations[stored(static_cast<int>(t))] = rotations[t];
-    m_warm_starts[stored(static_cast<int>(t))] = warm_starts[t];
+    const size_t k = stored(static_cast<int>(t));
+    m_rotations[k] = rotations[t];
+    m_warm_starts[k] = warm_starts[t];
+    m_turns_before[k] = turns_before[t];
   }
   m_rotations_ahead = m_rotations;
   m_warm_starts_ahead = m_warm_starts;
@@ -200,6 +221,7 @@ void CorotationalElasticity::reset_rotations() {
   std::fill(m_warm_starts.begin(), m_warm_starts.end(), Eigen::Quaterniond::Identity());
   m_rotations_ahead = m_rotations;
   m_warm_starts_ahead = m_warm_starts;
+  m_turns_before = m_warm_starts;
 }
 
 void CorotationalElasticity::evaluate(const Eigen::VectorXd& positions_m, Eigen::VectorXd& internal_forces_n,
@@ -224,13 +246,15 @@ void CorotationalElasticity::evaluate(const Eigen::VectorXd& positions_m, Eigen:
 template <class TetAt, class Visit>
 void CorotationalElasticity::in_rotation_batches(size_t count, TetAt tet_at, const Eigen::VectorXd& positions_m,
                                                  std::vector<Eigen::Quaterniond>* warm_starts,
-                                                 std::vector<Eigen::Matrix3d>* rotations, Visit visit) const {
+                                                 std::vector<Eigen::Matrix3d>* rotations,
+                                                 std::vector<Eigen::Quaterniond>* turns_before, Visit visit) const {
   std::array<size_t, ROTATION_BATCH> batch{};
   std::array<Eigen::Matrix3d, ROTATION_BATCH> gradients;
   std::array<Eigen::Quaterniond, ROTATION_BATCH> warm_start_copies;
   std::array<Eigen::Matrix3d, ROTATION_BATCH> rotation_copies;
   std::array<Eigen::Quaterniond*, ROTATION_BATCH> lane_warm_starts{};
   std::array<Eigen::Matrix3d*, ROTATION_BATCH> lane_rotations{};
+  std::array<Eigen::Quaterniond*, ROTATION_BATCH> lane_turns_before{};
   size_t next = 0;
   while (next < count) {
     int lanes = 0;
@@ -242,6 +266,7 @@ void CorotationalElasticity::in_rotation_batches(size_t count, TetAt tet_at, con
       gradients[lane] = deformation_gradient(m_rest[t], gather(positions_m, m_tets[t]));
       if (warm_starts != nullptr) {
         if (warm_starts != &m_warm_starts) (*warm_starts)[t] = m_warm_starts[t];  // the ahead set, from the own
+        lane_turns_before[lane] = &(*turns_before)[t];
         lane_warm_starts[lane] = &(*warm_starts)[t];
         lane_rotations[lane] = &(*rotations)[t];
       } else {
@@ -250,7 +275,9 @@ void CorotationalElasticity::in_rotation_batches(size_t count, TetAt tet_at, con
         lane_rotations[lane] = &rotation_copies[lane];
       }
     }
-    extract_rotations(lanes, gradients.data(), lane_warm_starts.data(), lane_rotations.data(), m_rotation_settings);
+    extract_rotations(
+        lanes, gradients.data(), lane_warm_starts.data(), lane_rotations.data(), m_rotation_settings,
+        warm_starts != nullptr ? TurnsBefore{lane_turns_before.data(), warm_starts == &m_warm_starts} : TurnsBefore{});
     for (size_t lane = 0; lane < static_cast<size_t>(lanes); ++lane) {
       visit(batch[lane], gradients[lane], *lane_rotations[lane]);
     }
@@ -279,7 +306,7 @@ TISSUE_HOT_KERNEL void CorotationalElasticity::add_tets(const std::vector<int>& 
   in_rotation_batches(
       tets.size(), [&tets](size_t k) { return tets[k]; }, positions_m,
       into == ExtractInto::ahead ? &m_warm_starts_ahead : &m_warm_starts,
-      into == ExtractInto::ahead ? &m_rotations_ahead : &m_rotations,
+      into == ExtractInto::ahead ? &m_rotations_ahead : &m_rotations, &m_turns_before,
       [&](size_t t, const Eigen::Matrix3d& f, const Eigen::Matrix3d& rotation) {
         prefetch_next();
         add_tet(t, f, rotation, internal_forces_n, tangent, slots);
@@ -317,7 +344,7 @@ TISSUE_HOT_KERNEL double CorotationalElasticity::energy_of(const std::vector<int
   // list's order, as add_tets adds them.
   double energy = 0.0;
   in_rotation_batches(
-      tets.size(), [&tets](size_t k) { return tets[k]; }, positions_m, nullptr, nullptr,
+      tets.size(), [&tets](size_t k) { return tets[k]; }, positions_m, nullptr, nullptr, nullptr,
       [&](size_t t, const Eigen::Matrix3d& f, const Eigen::Matrix3d& rotation) {
         energy += m_elements.energy_j(m_rest[t], rotation, f);
       });

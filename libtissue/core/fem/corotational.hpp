@@ -49,7 +49,7 @@ class CorotationalElasticity {
   [[nodiscard]] const ElementModel& elements() const { return m_elements; }
   [[nodiscard]] const TetRest& rest(int tet) const { return m_rest[stored(tet)]; }
   [[nodiscard]] const Eigen::Matrix3d& rotation(int tet) const { return m_rotations[stored(tet)]; }
-  /// The same turn as a unit quaternion (the warm start of the next extraction is that rotation's).
+  /// The same turn as a unit quaternion (the next extraction starts from it extrapolated).
   [[nodiscard]] const Eigen::Quaterniond& turn(int tet) const { return m_warm_starts[stored(tet)]; }
 
   /// Hands `tet` over to another model (a cut tet, modelled by XfemElasticity): evaluate() and
@@ -82,10 +82,11 @@ class CorotationalElasticity {
   void evaluate(const Eigen::VectorXd& positions_m, Eigen::VectorXd& internal_forces_n, BlockSparseMatrix* tangent,
                 const std::vector<TetSlots>* slots, WorkTeam* team = nullptr, double* elastic_energy_j = nullptr,
                 ExtractInto into = ExtractInto::own);
-  /// The rotations and warm starts of the last evaluate() ahead become the tets' own (an excluded
-  /// tet's are the same in both sets).
+  /// The rotations and warm starts of the last evaluate() ahead become the tets' own, the own ones
+  /// the turns before (an excluded tet's are the same in all sets).
   void take_ahead() {
     m_rotations.swap(m_rotations_ahead);
+    m_turns_before.swap(m_warm_starts);
     m_warm_starts.swap(m_warm_starts_ahead);
   }
 
@@ -109,15 +110,18 @@ class CorotationalElasticity {
   /// starts, with one thread or two.
   [[nodiscard]] double elastic_energy_j(const Eigen::VectorXd& positions_m, WorkTeam* team = nullptr) const;
 
-  /// Forgets the warm starts (rotations back to identity), e.g. after a state was restored.
+  /// Forgets the warm starts (rotations back to identity, no turn), e.g. after a state was restored.
   void reset_rotations();
-  /// The rotations and their warm starts, per tet in mesh order (what a saved state must carry to
-  /// continue bitwise).
+  /// The rotations, their warm starts and the turns before them (each extraction starts from
+  /// extrapolated_turn(warm start, turn before); an evaluation's own extraction makes the warm start
+  /// the turn before), per tet in mesh order: what a saved state must carry to continue bitwise.
   [[nodiscard]] std::vector<Eigen::Matrix3d> rotations() const;
   [[nodiscard]] std::vector<Eigen::Quaterniond> warm_starts() const;
-  /// Sets both; throws std::invalid_argument (nothing changed) unless there is one of each per tet.
+  [[nodiscard]] std::vector<Eigen::Quaterniond> turns_before() const;
+  /// Sets the three; throws std::invalid_argument (nothing changed) unless there is one of each per tet.
   void restore_rotations(const std::vector<Eigen::Matrix3d>& rotations,
-                         const std::vector<Eigen::Quaterniond>& warm_starts);
+                         const std::vector<Eigen::Quaterniond>& warm_starts,
+                         const std::vector<Eigen::Quaterniond>& turns_before);
 
  private:
   /// Adds the force of the tet at storage index k and (with `tangent`) its blocks, with F = f and
@@ -126,18 +130,19 @@ class CorotationalElasticity {
                BlockSparseMatrix* tangent, const std::vector<TetSlots>* slots) const;
 
   /// visit(t, F, R) for the tets tet_at(0) .. tet_at(count - 1) that are not excluded, in order, their
-  /// rotations extracted ROTATION_BATCH at a time side by side (SIMD lanes). From and into the tets'
-  /// own warm starts and rotations when given (a step; the ahead set: each lane's warm start copied
-  /// there from the own first); else from copies of the warm starts, the
-  /// rotations kept in the batch (reporting must not change the dynamics). Defined in the .cpp, for
-  /// the hot kernels there.
+  /// rotations extracted ROTATION_BATCH at a time side by side (SIMD lanes). A step's (`warm_starts`,
+  /// `rotations` and `turns_before` given: the own set, or the ahead one, its warm starts copied from
+  /// the own first) from extrapolated_turn(own warm start, turn before), an own one keeping its warm
+  /// starts as the turns before; else from copies of the warm starts as they are, the rotations kept
+  /// in the batch (reporting must not change the dynamics, and a report at the positions of the last
+  /// evaluation starts where it ended). Defined in the .cpp, for the hot kernels there.
   /// The energy of the tets `tets` (storage indices) at the positions, added in their order.
   [[nodiscard]] double energy_of(const std::vector<int>& tets, const Eigen::VectorXd& positions_m) const;
 
   template <class TetAt, class Visit>
   void in_rotation_batches(size_t count, TetAt tet_at, const Eigen::VectorXd& positions_m,
                            std::vector<Eigen::Quaterniond>* warm_starts, std::vector<Eigen::Matrix3d>* rotations,
-                           Visit visit) const;
+                           std::vector<Eigen::Quaterniond>* turns_before, Visit visit) const;
 
   /// Adds the forces and blocks of `tets` (skipping excluded ones), rotations in batches, and their
   /// energy into `energy_j` when given.
@@ -162,6 +167,7 @@ class CorotationalElasticity {
   std::vector<Eigen::Quaterniond> m_warm_starts;
   std::vector<Eigen::Matrix3d> m_rotations_ahead;  // an evaluation ahead's (ExtractInto)
   std::vector<Eigen::Quaterniond> m_warm_starts_ahead;
+  std::vector<Eigen::Quaterniond> m_turns_before;  // the own warm starts before their last extraction
   std::vector<char> m_excluded;  // 1 = modelled elsewhere (cut)
   ElementModel m_elements;  // the model, Lame parameters per material
   RotationSettings m_rotation_settings;

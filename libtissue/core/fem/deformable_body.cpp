@@ -324,15 +324,18 @@ double DeformableBody::kinetic_energy_j(const Eigen::VectorXd& velocity_m_per_s)
 void DeformableBody::save_rotations(Rotations& rotations) const {
   rotations.tets = m_elasticity.rotations();
   rotations.tet_warm_starts = m_elasticity.warm_starts();
+  rotations.tet_turns_before = m_elasticity.turns_before();
   rotations.pieces = m_xfem.piece_rotations();
   rotations.piece_warm_starts = m_xfem.piece_warm_starts();
+  rotations.piece_turns_before = m_xfem.piece_turns_before();
 }
 
 void DeformableBody::check_rotations(const Rotations& rotations) const {
   const size_t tets = static_cast<size_t>(m_mesh.tet_count());
+  const size_t pieces = m_xfem.piece_rotations().size();
   if (rotations.tets.size() != tets || rotations.tet_warm_starts.size() != tets ||
-      rotations.pieces.size() != m_xfem.piece_rotations().size() ||
-      rotations.piece_warm_starts.size() != m_xfem.piece_warm_starts().size()) {
+      rotations.tet_turns_before.size() != tets || rotations.pieces.size() != pieces ||
+      rotations.piece_warm_starts.size() != pieces || rotations.piece_turns_before.size() != pieces) {
     throw std::invalid_argument("body: the saved rotations are of " + std::to_string(rotations.tets.size()) +
                                 " tets and " + std::to_string(rotations.pieces.size()) + " cut-tet pieces, the body has " +
                                 std::to_string(tets) + " and " + std::to_string(m_xfem.piece_rotations().size()));
@@ -346,13 +349,15 @@ void DeformableBody::check_rotations(const Rotations& rotations) const {
   check_all(rotations.tet_warm_starts, is_unit_quaternion, "tet warm start (a unit quaternion)");
   check_all(rotations.pieces, is_rotation, "piece rotation");
   check_all(rotations.piece_warm_starts, is_unit_quaternion, "piece warm start (a unit quaternion)");
+  check_all(rotations.tet_turns_before, is_unit_quaternion, "tet turn before (a unit quaternion)");
+  check_all(rotations.piece_turns_before, is_unit_quaternion, "piece turn before (a unit quaternion)");
 }
 
 void DeformableBody::restore_rotations(const Rotations& rotations) {
   check_rotations(rotations);
   changed();
-  m_elasticity.restore_rotations(rotations.tets, rotations.tet_warm_starts);
-  m_xfem.restore_rotations(rotations.pieces, rotations.piece_warm_starts);
+  m_elasticity.restore_rotations(rotations.tets, rotations.tet_warm_starts, rotations.tet_turns_before);
+  m_xfem.restore_rotations(rotations.pieces, rotations.piece_warm_starts, rotations.piece_turns_before);
 }
 
 void DeformableBody::reset_rotations() {

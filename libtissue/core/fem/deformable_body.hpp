@@ -292,13 +292,16 @@ class DeformableBody final : public DynamicsModel {
 
   /// Forgets the rotation warm starts of all tets and parts (e.g. after a state was restored).
   void reset_rotations();
-  /// The rotations and warm starts of all tets and cut-tet pieces: with u, v they make the state a
-  /// step continues from bitwise.
+  /// The rotations, warm starts and turns before (the warm starts before the last extraction: the
+  /// next starts from extrapolated_turn) of all tets and cut-tet pieces: with u, v they make the state
+  /// a step continues from bitwise.
   struct Rotations {
     std::vector<Eigen::Matrix3d> tets;
     std::vector<Eigen::Quaterniond> tet_warm_starts;
+    std::vector<Eigen::Quaterniond> tet_turns_before;
     std::vector<Eigen::Matrix3d> pieces;  ///< cut tet after cut tet, piece after piece
     std::vector<Eigen::Quaterniond> piece_warm_starts;
+    std::vector<Eigen::Quaterniond> piece_turns_before;
   };
   void save_rotations(Rotations& rotations) const;
   /// Throws std::invalid_argument unless the sizes match the mesh and cuts and every rotation is one

@@ -155,6 +155,35 @@ Lanes lane_sqrt(Lanes v) {
   return out;
 }
 
+// q (b^-1 q), normalised, per lane (extrapolated_turn), from the lanes' warm starts q and the turns
+// before b; with `keep`, q goes into the turns before.
+void start_extrapolated(int count, const TurnsBefore& turns, LaneQuaternion& q) {
+  const int k1 = count > 1 ? 1 : 0, k2 = count > 2 ? 2 : 0, k3 = count > 3 ? 3 : 0;
+  const Eigen::Quaterniond &b0 = *turns.before[0], &b1 = *turns.before[k1], &b2 = *turns.before[k2],
+                           &b3 = *turns.before[k3];
+  // c = b^-1 q = conj(b) q (b a unit quaternion)
+  const Lanes bw{b0.w(), b1.w(), b2.w(), b3.w()}, bx{b0.x(), b1.x(), b2.x(), b3.x()};
+  const Lanes by{b0.y(), b1.y(), b2.y(), b3.y()}, bz{b0.z(), b1.z(), b2.z(), b3.z()};
+  const Lanes cw = bw * q.w + bx * q.x + by * q.y + bz * q.z;
+  const Lanes cx = bw * q.x - bx * q.w - by * q.z + bz * q.y;
+  const Lanes cy = bw * q.y + bx * q.z - by * q.w - bz * q.x;
+  const Lanes cz = bw * q.z - bx * q.y + by * q.x - bz * q.w;
+  if (turns.keep) {
+    for (int l = 0; l < count; ++l) *turns.before[l] = Eigen::Quaterniond(q.w[l], q.x[l], q.y[l], q.z[l]);
+  }
+  // p = q c
+  LaneQuaternion p;
+  p.w = q.w * cw - q.x * cx - q.y * cy - q.z * cz;
+  p.x = q.w * cx + q.x * cw + q.y * cz - q.z * cy;
+  p.y = q.w * cy - q.x * cz + q.y * cw + q.z * cx;
+  p.z = q.w * cz + q.x * cy - q.y * cx + q.z * cw;
+  const Lanes inverse_norm = 1.0 / lane_sqrt(p.w * p.w + p.x * p.x + p.y * p.y + p.z * p.z);
+  q.w = p.w * inverse_norm;
+  q.x = p.x * inverse_norm;
+  q.y = p.y * inverse_norm;
+  q.z = p.z * inverse_norm;
+}
+
 bool any(LaneMask mask) {
   for (int l = 0; l < ROTATION_BATCH; ++l) {
     if (mask[l] != 0) return true;
@@ -165,7 +194,8 @@ bool any(LaneMask mask) {
 }  // namespace
 
 TISSUE_HOT_KERNEL void extract_rotations(int count, const Eigen::Matrix3d* f_in, Eigen::Quaterniond* const* warm_starts,
-                       Eigen::Matrix3d* const* rotations, const RotationSettings& settings) {
+                                         Eigen::Matrix3d* const* rotations, const RotationSettings& settings,
+                                         TurnsBefore turns) {
   if (count <= 0) return;
   if (count > ROTATION_BATCH) {
     throw std::invalid_argument("extract_rotations: at most " + std::to_string(ROTATION_BATCH) + " at once");
@@ -184,6 +214,7 @@ TISSUE_HOT_KERNEL void extract_rotations(int count, const Eigen::Matrix3d* f_in,
   q.x = Lanes{w0.x(), w1.x(), w2.x(), w3.x()};
   q.y = Lanes{w0.y(), w1.y(), w2.y(), w3.y()};
   q.z = Lanes{w0.z(), w1.z(), w2.z(), w3.z()};
+  if (turns.before != nullptr) start_extrapolated(count, turns, q);
   const Lanes scale{f0.cwiseAbs().maxCoeff(), f1.cwiseAbs().maxCoeff(), f2.cwiseAbs().maxCoeff(),
                     f3.cwiseAbs().maxCoeff()};
   Lanes r[9];
@@ -239,7 +270,8 @@ TISSUE_HOT_KERNEL void extract_rotations(int count, const Eigen::Matrix3d* f_in,
   }
   for (int l = 0; l < count; ++l) {
     Eigen::Matrix3d& rotation = *rotations[l];
-    if (usable[l] == 0) {  // F = 0 or not finite: the warm start's rotation, warm start kept
+    if (usable[l] == 0) {  // F = 0 or not finite: the start's rotation, kept as the warm start
+      *warm_starts[l] = Eigen::Quaterniond(q.w[l], q.x[l], q.y[l], q.z[l]);
       rotation = warm_starts[l]->toRotationMatrix();
       continue;
     }

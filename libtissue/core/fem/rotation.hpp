@@ -42,8 +42,29 @@ void validate(const RotationSettings& settings);
 Eigen::Matrix3d extract_rotation(const Eigen::Matrix3d& deformation_gradient, Eigen::Quaterniond& warm_start,
                                  const RotationSettings& settings = {});
 
+/// The warm start of a rotation's next extraction: the turn it made since the extraction `before`
+/// made once more, now (before^-1 now), normalised. For an element turning steadily that is its next
+/// rotation (exactly, for a constant turn per step); the rotation itself is still found by the
+/// iteration, to the same tolerance, so only the iteration's steps change: a warm start off by a
+/// step's turn a needs a Newton step while 0.55 a^3 > max_error_rad, one off by the change of the turn
+/// (a^2-ish) none more often. Both unit quaternions; the result is one too.
+/// Inline: it runs once per element and evaluation, beside the extraction.
+[[nodiscard]] inline Eigen::Quaterniond extrapolated_turn(const Eigen::Quaterniond& now,
+                                                          const Eigen::Quaterniond& before) {
+  return (now * (before.conjugate() * now)).normalized();
+}
+
 /// How many deformation gradients extract_rotations() takes at once (its SIMD lanes).
 inline constexpr int ROTATION_BATCH = 4;
+
+/// Where extract_rotations() starts: from each warm start as it is, or from extrapolated_turn(warm
+/// start, turns_before[k]) (computed in the lanes), the warm start as it was then kept in
+/// turns_before[k] when `keep` is set (a step's own extraction: what it starts from becomes the turn
+/// before of the next).
+struct TurnsBefore {
+  Eigen::Quaterniond* const* before = nullptr;  ///< one per lane; nullptr: no extrapolation
+  bool keep = false;
+};
 
 /// extract_rotation() of up to ROTATION_BATCH deformation gradients at once, in SIMD lanes (the same
 /// iteration, stopping rule and fallback per lane, so each result equals extract_rotation()'s to
@@ -51,7 +72,8 @@ inline constexpr int ROTATION_BATCH = 4;
 /// `*rotations[k]`. Iterating lanes side by side hides the latency of each lane's dependent chain
 /// (divisions, square roots), which is what bounds the one-at-a-time version.
 void extract_rotations(int count, const Eigen::Matrix3d* f, Eigen::Quaterniond* const* warm_starts,
-                       Eigen::Matrix3d* const* rotations, const RotationSettings& settings = {});
+                       Eigen::Matrix3d* const* rotations, const RotationSettings& settings = {},
+                       TurnsBefore turns = {});
 
 /// How far from orthonormal (Frobenius norm of R^T R - I) or from unit length a rotation or a warm
 /// start may be and still count as one: far above the rounding of the ones the engine makes.

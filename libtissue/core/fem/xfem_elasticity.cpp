@@ -93,6 +93,7 @@ void XfemElasticity::reserve(int cut_tets) {
   m_ghost_dofs.reserve(2 * n);
   m_rotations.reserve(2 * n);
   m_warm_starts.reserve(2 * n);
+  m_turns_before.reserve(2 * n);
   m_gradients.reserve(2 * n);
   m_ghost_begin.reserve(n + 1);
   m_ghost_rows.reserve(4 * n);
@@ -141,6 +142,7 @@ void XfemElasticity::add(const CutTet& cut_tet, std::span<const CutPiece> pieces
     m_ghost_dofs.push_back(dofs);
     m_rotations.push_back(rotations[p]);
     m_warm_starts.emplace_back(rotations[p]);
+    m_turns_before.emplace_back(rotations[p]);
   }
   m_piece_begin.push_back(static_cast<int>(m_pieces.size()));
   const std::size_t dofs = 4 + ghost_rows().size();
@@ -192,19 +194,23 @@ void XfemElasticity::coupled_dofs(int k, std::vector<std::uint8_t>& coupled) con
 }
 
 void XfemElasticity::restore_rotations(const std::vector<Eigen::Matrix3d>& rotations,
-                                       const std::vector<Eigen::Quaterniond>& warm_starts) {
-  if (rotations.size() != m_rotations.size() || warm_starts.size() != m_warm_starts.size()) {
+                                       const std::vector<Eigen::Quaterniond>& warm_starts,
+                                       const std::vector<Eigen::Quaterniond>& turns_before) {
+  if (rotations.size() != m_rotations.size() || warm_starts.size() != m_warm_starts.size() ||
+      turns_before.size() != m_turns_before.size()) {
     throw std::invalid_argument("XFEM: expected the rotations of " + std::to_string(m_rotations.size()) +
-                                " cut-tet pieces, got " + std::to_string(rotations.size()) + " and " +
-                                std::to_string(warm_starts.size()));
+                                " cut-tet pieces, got " + std::to_string(rotations.size()) + ", " +
+                                std::to_string(warm_starts.size()) + " and " + std::to_string(turns_before.size()));
   }
   m_rotations = rotations;
   m_warm_starts = warm_starts;
+  m_turns_before = turns_before;
 }
 
 void XfemElasticity::reset_rotations() {
   std::fill(m_rotations.begin(), m_rotations.end(), Eigen::Matrix3d::Identity());
   std::fill(m_warm_starts.begin(), m_warm_starts.end(), Eigen::Quaterniond::Identity());
+  std::fill(m_turns_before.begin(), m_turns_before.end(), Eigen::Quaterniond::Identity());
 }
 
 void XfemElasticity::gather(size_t k, const Eigen::VectorXd& positions_m, TetPositions& real_m) const {
@@ -226,11 +232,13 @@ TetPositions piece_positions(const CutPiece& piece, const TetPositions& real_pos
 // as the uncut tets'): F into m_gradients.
 void XfemElasticity::extract_piece_rotations(const Eigen::VectorXd& positions_m, const Eigen::VectorXd& displacement_m,
                                              std::vector<Eigen::Matrix3d>& rotations,
-                                             std::vector<Eigen::Quaterniond>& warm_starts) {
+                                             std::vector<Eigen::Quaterniond>& warm_starts, bool keep) {
   m_gradients.resize(m_pieces.size());
   std::array<Eigen::Matrix3d, ROTATION_BATCH> lane_gradients;
   std::array<Eigen::Quaterniond*, ROTATION_BATCH> lane_warm_starts{};
   std::array<Eigen::Matrix3d*, ROTATION_BATCH> lane_rotations{};
+  std::array<Eigen::Quaterniond*, ROTATION_BATCH> lane_turns_before{};
+  const TurnsBefore turns{lane_turns_before.data(), keep};
   int lanes = 0;
   TetPositions real_m;
   for (size_t k = 0; k < m_cut_tets.size(); ++k) {
@@ -244,16 +252,17 @@ void XfemElasticity::extract_piece_rotations(const Eigen::VectorXd& positions_m,
       const auto lane = static_cast<size_t>(lanes++);
       lane_gradients[lane] = m_gradients[p];
       lane_warm_starts[lane] = &warm_starts[p];
+      lane_turns_before[lane] = &m_turns_before[p];
       lane_rotations[lane] = &rotations[p];
       if (lanes < ROTATION_BATCH) continue;
       extract_rotations(lanes, lane_gradients.data(), lane_warm_starts.data(), lane_rotations.data(),
-                        m_rotation_settings);
+                        m_rotation_settings, turns);
       lanes = 0;
     }
   }
   if (lanes > 0) {
-    extract_rotations(lanes, lane_gradients.data(), lane_warm_starts.data(), lane_rotations.data(),
-                      m_rotation_settings);
+    extract_rotations(lanes, lane_gradients.data(), lane_warm_starts.data(), lane_rotations.data(), m_rotation_settings,
+                      turns);
   }
 }
 
@@ -268,7 +277,7 @@ TISSUE_HOT_KERNEL void XfemElasticity::evaluate(const Eigen::VectorXd& positions
   }
   std::vector<Eigen::Matrix3d>& rotations = into == ExtractInto::ahead ? m_rotations_ahead : m_rotations;
   std::vector<Eigen::Quaterniond>& warm_starts = into == ExtractInto::ahead ? m_warm_starts_ahead : m_warm_starts;
-  extract_piece_rotations(positions_m, displacement_m, rotations, warm_starts);
+  extract_piece_rotations(positions_m, displacement_m, rotations, warm_starts, into == ExtractInto::own);
   double energy = 0.0;
   for (size_t k = 0; k < m_cut_tets.size(); ++k) {
     if (m_retired[k] != 0 || all_parked(static_cast<int>(k))) continue;

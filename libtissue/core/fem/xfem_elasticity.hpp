@@ -190,9 +190,11 @@ class XfemElasticity {
   void evaluate(const Eigen::VectorXd& positions_m, const Eigen::VectorXd& displacement_m,
                 Eigen::VectorXd& vertex_forces_n, Eigen::VectorXd& internal_force_n, BlockSparseMatrix* tangent,
                 double* elastic_energy_j = nullptr, ExtractInto into = ExtractInto::own);
-  /// The rotations and warm starts of the last evaluate() ahead become the pieces' own.
+  /// The rotations and warm starts of the last evaluate() ahead become the pieces' own, the own ones
+  /// the turns before.
   void take_ahead() {
     m_rotations.swap(m_rotations_ahead);
+    m_turns_before.swap(m_warm_starts);
     m_warm_starts.swap(m_warm_starts_ahead);
   }
 
@@ -203,21 +205,28 @@ class XfemElasticity {
 
   /// Forgets the warm starts (rotations back to identity).
   void reset_rotations();
-  /// The pieces' rotations and warm starts, cut tet after cut tet (retired ones included).
+  /// The pieces' rotations, warm starts and turns before (as CorotationalElasticity's: each
+  /// extraction starts from extrapolated_turn(warm start, turn before)), cut tet after cut tet
+  /// (retired ones included).
   [[nodiscard]] const std::vector<Eigen::Matrix3d>& piece_rotations() const { return m_rotations; }
   [[nodiscard]] const std::vector<Eigen::Quaterniond>& piece_warm_starts() const { return m_warm_starts; }
-  /// Sets both; throws std::invalid_argument (nothing changed) unless there is one of each per piece.
+  [[nodiscard]] const std::vector<Eigen::Quaterniond>& piece_turns_before() const { return m_turns_before; }
+  /// Sets the three; throws std::invalid_argument (nothing changed) unless there is one of each per piece.
   void restore_rotations(const std::vector<Eigen::Matrix3d>& rotations,
-                         const std::vector<Eigen::Quaterniond>& warm_starts);
+                         const std::vector<Eigen::Quaterniond>& warm_starts,
+                         const std::vector<Eigen::Quaterniond>& turns_before);
 
  private:
   // Real positions of the local vertices of cut tet k.
   void gather(size_t k, const Eigen::VectorXd& positions_m, TetPositions& real_m) const;
   // Piece p's local DOF at each of its tet's vertices: u of the vertex (0-3) or its ghost (>= 4).
   [[nodiscard]] std::array<int, 4> piece_dofs(std::size_t p) const;
-  // evaluate's first pass: every counted piece's F (into m_gradients) and its rotation.
+  // evaluate's first pass: every counted piece's F (into m_gradients) and its rotation, from
+  // extrapolated_turn(warm start, turn before); `keep`: the own set's, which keeps the warm starts it
+  // replaces as the turns before.
   void extract_piece_rotations(const Eigen::VectorXd& positions_m, const Eigen::VectorXd& displacement_m,
-                               std::vector<Eigen::Matrix3d>& rotations, std::vector<Eigen::Quaterniond>& warm_starts);
+                               std::vector<Eigen::Matrix3d>& rotations, std::vector<Eigen::Quaterniond>& warm_starts,
+                               bool keep);
 
   [[nodiscard]] std::size_t piece_begin(int k) const {
     return static_cast<std::size_t>(m_piece_begin[static_cast<std::size_t>(k)]);
@@ -238,6 +247,7 @@ class XfemElasticity {
   std::vector<Eigen::Quaterniond> m_warm_starts;  // per piece
   std::vector<Eigen::Matrix3d> m_rotations_ahead;  // an evaluation ahead's: all pieces', the ones it skips copied
   std::vector<Eigen::Quaterniond> m_warm_starts_ahead;
+  std::vector<Eigen::Quaterniond> m_turns_before;  // per piece: its warm start before the last own extraction
   std::vector<Eigen::Matrix3d> m_gradients;  // per piece: its F at the last evaluate (evaluate's working array)
   std::vector<int> m_ghost_begin{0};
   std::vector<int> m_ghost_rows;

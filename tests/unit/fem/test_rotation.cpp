@@ -98,6 +98,31 @@ TEST(Rotation, WarmStartConvergesToTheSameRotation) {
   }
 }
 
+// A turn about a fixed axis, seen between any two fixed frames (q_k = A exp(k theta) B), is
+// extrapolated exactly: q_k (q_{k-1}^-1 q_k) = A exp((k+1) theta) B. A quaternion and its negative
+// are the same rotation: either sign of the turn before gives the same next rotation.
+TEST(Rotation, ExtrapolatedTurnOfASteadyTurnIsItsNextTurn) {
+  std::mt19937 rng(23);
+  std::normal_distribution<double> normal;
+  for (int trial = 0; trial < 200; ++trial) {
+    const Eigen::Quaterniond a(random_rotation(rng)), b(random_rotation(rng));
+    const Eigen::Vector3d axis = Eigen::Vector3d(normal(rng), normal(rng), normal(rng)).normalized();
+    const double theta_rad = 0.4 * normal(rng);
+    const auto turn = [&](int k) { return a * Eigen::Quaterniond(Eigen::AngleAxisd(k * theta_rad, axis)) * b; };
+    const int k = trial % 7;
+    const Eigen::Matrix3d next = turn(k + 1).toRotationMatrix();
+    for (const double sign : {1.0, -1.0}) {
+      const Eigen::Quaterniond before(sign * turn(k - 1).coeffs());
+      const Eigen::Quaterniond guess = extrapolated_turn(turn(k), before);
+      EXPECT_NEAR(guess.norm(), 1.0, 1e-15);
+      EXPECT_LT((guess.toRotationMatrix() - next).norm(), 1e-13) << "trial " << trial << " sign " << sign;
+    }
+  }
+  // Not turning: the rotation itself.
+  const Eigen::Quaterniond still(random_rotation(rng));
+  EXPECT_LT((extrapolated_turn(still, still).coeffs() - still.coeffs()).norm(), 1e-15);
+}
+
 // F = R_true U with U symmetric positive definite, principal stretches in [0.2, 2].
 Eigen::Matrix3d random_deformation(std::mt19937& rng, Eigen::Matrix3d* rotation = nullptr) {
   std::uniform_real_distribution<double> stretch(0.2, 2.0);
@@ -138,31 +163,44 @@ TEST(Rotation, BatchedExtractionEqualsOneAtATime) {
   gradients.push_back(Eigen::Vector3d(1.2, 0.9, -0.3).asDiagonal());                 // inverted
   gradients.push_back(Eigen::AngleAxisd(M_PI, Eigen::Vector3d::UnitX()).toRotationMatrix());  // saddle
   gradients.push_back(Eigen::Vector3d(1.0, 0.0, 0.0).asDiagonal());                  // a line
-  for (const double max_error_rad : {RotationSettings{}.max_error_rad, 4e-18}) {
-    RotationSettings settings;
-    settings.max_error_rad = max_error_rad;
-    for (int count = 1; count <= ROTATION_BATCH; ++count) {
-      for (size_t first = 0; first + static_cast<size_t>(count) <= gradients.size(); first += static_cast<size_t>(count)) {
-        std::array<Eigen::Quaterniond, ROTATION_BATCH> warm_batch{};
-        std::array<Eigen::Matrix3d, ROTATION_BATCH> rotation_batch{};
-        std::array<Eigen::Quaterniond*, ROTATION_BATCH> warm_pointers{};
-        std::array<Eigen::Matrix3d*, ROTATION_BATCH> rotation_pointers{};
-        for (size_t l = 0; l < static_cast<size_t>(count); ++l) {
-          warm_batch[l] = Eigen::Quaterniond(Eigen::AngleAxisd(0.01 * normal(rng), Eigen::Vector3d::UnitZ()));
-          warm_pointers[l] = &warm_batch[l];
-          rotation_pointers[l] = &rotation_batch[l];
-        }
-        const std::array<Eigen::Quaterniond, ROTATION_BATCH> warm_single = warm_batch;
-        extract_rotations(count, &gradients[first], warm_pointers.data(), rotation_pointers.data(), settings);
-        for (size_t l = 0; l < static_cast<size_t>(count); ++l) {
-          Eigen::Quaterniond warm = warm_single[l];
-          const Eigen::Matrix3d single = extract_rotation(gradients[first + l], warm, settings);
-          EXPECT_LT((rotation_batch[l] - single).norm(), 1e-13) << "gradient " << first + l << " of a batch of " << count;
-          EXPECT_LT((warm_batch[l].coeffs() - warm.coeffs()).norm(), 1e-13) << "gradient " << first + l;
+  // With turns before, each lane starts from extrapolated_turn (and, kept, its warm start as it was
+  // becomes the turn before).
+  for (const bool extrapolated : {false, true})
+    for (const double max_error_rad : {RotationSettings{}.max_error_rad, 4e-18}) {
+      RotationSettings settings;
+      settings.max_error_rad = max_error_rad;
+      for (int count = 1; count <= ROTATION_BATCH; ++count) {
+        for (size_t first = 0; first + static_cast<size_t>(count) <= gradients.size();
+             first += static_cast<size_t>(count)) {
+          std::array<Eigen::Quaterniond, ROTATION_BATCH> warm_batch{};
+          std::array<Eigen::Matrix3d, ROTATION_BATCH> rotation_batch{};
+          std::array<Eigen::Quaterniond*, ROTATION_BATCH> warm_pointers{};
+          std::array<Eigen::Matrix3d*, ROTATION_BATCH> rotation_pointers{};
+          std::array<Eigen::Quaterniond, ROTATION_BATCH> before_batch{};
+          std::array<Eigen::Quaterniond*, ROTATION_BATCH> before_pointers{};
+          for (size_t l = 0; l < static_cast<size_t>(count); ++l) {
+            warm_batch[l] = Eigen::Quaterniond(Eigen::AngleAxisd(0.01 * normal(rng), Eigen::Vector3d::UnitZ()));
+            before_batch[l] = Eigen::Quaterniond(Eigen::AngleAxisd(0.02 * normal(rng), Eigen::Vector3d::UnitY()));
+            warm_pointers[l] = &warm_batch[l];
+            rotation_pointers[l] = &rotation_batch[l];
+            before_pointers[l] = &before_batch[l];
+          }
+          const std::array<Eigen::Quaterniond, ROTATION_BATCH> warm_single = warm_batch;
+          const std::array<Eigen::Quaterniond, ROTATION_BATCH> before_single = before_batch;
+          extract_rotations(count, &gradients[first], warm_pointers.data(), rotation_pointers.data(), settings,
+                            extrapolated ? TurnsBefore{before_pointers.data(), true} : TurnsBefore{});
+          for (size_t l = 0; l < static_cast<size_t>(count); ++l) {
+            Eigen::Quaterniond warm =
+                extrapolated ? extrapolated_turn(warm_single[l], before_single[l]) : warm_single[l];
+            EXPECT_EQ(before_batch[l].coeffs(), (extrapolated ? warm_single[l] : before_single[l]).coeffs());
+            const Eigen::Matrix3d single = extract_rotation(gradients[first + l], warm, settings);
+            EXPECT_LT((rotation_batch[l] - single).norm(), 1e-13)
+                << "gradient " << first + l << " of a batch of " << count;
+            EXPECT_LT((warm_batch[l].coeffs() - warm.coeffs()).norm(), 1e-13) << "gradient " << first + l;
+          }
         }
       }
     }
-  }
 }
 
 TEST(Rotation, SettingsOutsideTheirRangeAreRefused) {

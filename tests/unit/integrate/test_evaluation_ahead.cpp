@@ -231,6 +231,7 @@ TEST(EvaluationAhead, IsTakenOnlyAtTheSameDisplacementWithNothingChangedSince) {
   EXPECT_EQ(after.tet_warm_starts.size(), before.tet_warm_starts.size());
   for (size_t t = 0; t < before.tet_warm_starts.size(); ++t) {
     ASSERT_EQ(after.tet_warm_starts[t].coeffs(), before.tet_warm_starts[t].coeffs()) << "tet " << t;
+    ASSERT_EQ(after.tet_turns_before[t].coeffs(), before.tet_turns_before[t].coeffs()) << "tet " << t;
   }
   // ... after another evaluate, after the rotations were restored, after the spring was set.
   EXPECT_FALSE(ahead_then([&] {

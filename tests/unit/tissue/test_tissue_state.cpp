@@ -538,7 +538,7 @@ TEST(TissueState, RefusesDisplacementsAndVelocitiesBeyondTheLargestCoordinate) {
   }
 }
 
-// A state whose saved rotations are not rotations (a NaN or non-unit warm start, a rotation
+// A state whose saved rotations are not rotations (a NaN or non-unit warm start or turn before, a rotation
 // stretched, mirrored or NaN) is refused before anything changes: restored, a NaN warm start made
 // the next step's matrix NaN (found by fuzzing the FMU state: "A is not positive definite: diagonal
 // entry 9 is -nan"). A warm start turned to another unit quaternion is a warm start still.
@@ -546,12 +546,15 @@ TEST(TissueState, RefusesRotationsAndWarmStartsThatAreNone) {
   PressedFrog pressed;
   const double nan = std::numeric_limits<double>::quiet_NaN();
   const size_t tet = 3;
-  pressed.expect_refused({[&](TissueSnapshot& s) { s.rotations.tet_warm_starts[tet] = Eigen::Quaterniond(nan, 0.0, 0.0, 0.0); },
-                          [&](TissueSnapshot& s) { s.rotations.tet_warm_starts[tet] = Eigen::Quaterniond(0.0, 0.0, 0.0, 0.0); },
-                          [&](TissueSnapshot& s) { s.rotations.tet_warm_starts[tet].coeffs() *= 2.0; },
-                          [&](TissueSnapshot& s) { s.rotations.tets[tet](1, 2) = nan; },
-                          [&](TissueSnapshot& s) { s.rotations.tets[tet] *= 1.01; },
-                          [&](TissueSnapshot& s) { s.rotations.tets[tet] = -s.rotations.tets[tet]; }});
+  pressed.expect_refused(
+      {[&](TissueSnapshot& s) { s.rotations.tet_warm_starts[tet] = Eigen::Quaterniond(nan, 0.0, 0.0, 0.0); },
+       [&](TissueSnapshot& s) { s.rotations.tet_warm_starts[tet] = Eigen::Quaterniond(0.0, 0.0, 0.0, 0.0); },
+       [&](TissueSnapshot& s) { s.rotations.tet_warm_starts[tet].coeffs() *= 2.0; },
+       [&](TissueSnapshot& s) { s.rotations.tet_turns_before[tet] = Eigen::Quaterniond(nan, 0.0, 0.0, 0.0); },
+       [&](TissueSnapshot& s) { s.rotations.tet_turns_before[tet].coeffs() *= 0.5; },
+       [&](TissueSnapshot& s) { s.rotations.tets[tet](1, 2) = nan; },
+       [&](TissueSnapshot& s) { s.rotations.tets[tet] *= 1.01; },
+       [&](TissueSnapshot& s) { s.rotations.tets[tet] = -s.rotations.tets[tet]; }});
   Tissue& tissue = pressed.tissue;
   TissueSnapshot turned = pressed.saved;
   turned.rotations.tet_warm_starts[tet] = Eigen::Quaterniond(Eigen::AngleAxisd(0.3, Eigen::Vector3d::UnitZ()));
