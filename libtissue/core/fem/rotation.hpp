@@ -47,8 +47,8 @@ Eigen::Matrix3d extract_rotation(const Eigen::Matrix3d& deformation_gradient, Ei
 /// rotation (exactly, for a constant turn per step); the rotation itself is still found by the
 /// iteration, to the same tolerance, so only the iteration's steps change: a warm start off by a
 /// step's turn a needs a Newton step while 0.55 a^3 > max_error_rad, one off by the change of the turn
-/// (a^2-ish) none more often. Both unit quaternions; the result is one too.
-/// Inline: it runs once per element and evaluation, beside the extraction.
+/// (a^2-ish) none more often. Both unit quaternions; the result is one too. The scalar form of what
+/// extract_rotations() computes in its lanes (TurnsBefore); tests compare the two.
 [[nodiscard]] inline Eigen::Quaterniond extrapolated_turn(const Eigen::Quaterniond& now,
                                                           const Eigen::Quaterniond& before) {
   return (now * (before.conjugate() * now)).normalized();
