@@ -170,23 +170,19 @@ void CorotationalElasticity::exclude(int tet) {
   m_turns_before[k] = m_warm_starts[k];
 }
 
-std::vector<Eigen::Matrix3d> CorotationalElasticity::rotations() const {
-  std::vector<Eigen::Matrix3d> by_tet(m_rotations.size());
-  for (size_t k = 0; k < m_rotations.size(); ++k) by_tet[static_cast<size_t>(m_tet_id[k])] = m_rotations[k];
-  return by_tet;
-}
-
 namespace {
 
 // Per-tet values held by storage index, in mesh order.
-std::vector<Eigen::Quaterniond> by_tet_id(const std::vector<Eigen::Quaterniond>& stored,
-                                          const std::vector<int>& tet_id) {
-  std::vector<Eigen::Quaterniond> by_tet(stored.size());
+template <class Value>
+std::vector<Value> by_tet_id(const std::vector<Value>& stored, const std::vector<int>& tet_id) {
+  std::vector<Value> by_tet(stored.size());
   for (size_t k = 0; k < stored.size(); ++k) by_tet[static_cast<size_t>(tet_id[k])] = stored[k];
   return by_tet;
 }
 
 }  // namespace
+
+std::vector<Eigen::Matrix3d> CorotationalElasticity::rotations() const { return by_tet_id(m_rotations, m_tet_id); }
 
 std::vector<Eigen::Quaterniond> CorotationalElasticity::warm_starts() const {
   return by_tet_id(m_warm_starts, m_tet_id);

@@ -130,6 +130,16 @@ struct LaneQuaternion {
   Lanes w, x, y, z;
 };
 
+// The quaternions *from[0] .. *from[count - 1] in lanes; lanes beyond count repeat the first. Each
+// vector made whole from four values in memory (see extract_rotations: no stores lane by lane).
+LaneQuaternion load_lanes(Eigen::Quaterniond* const* from, int count) {
+  const Eigen::Quaterniond &q0 = *from[0], &q1 = *from[count > 1 ? 1 : 0], &q2 = *from[count > 2 ? 2 : 0],
+                           &q3 = *from[count > 3 ? 3 : 0];
+  return {Lanes{q0.w(), q1.w(), q2.w(), q3.w()}, Lanes{q0.x(), q1.x(), q2.x(), q3.x()},
+          Lanes{q0.y(), q1.y(), q2.y(), q3.y()}, Lanes{q0.z(), q1.z(), q2.z(), q3.z()}};
+}
+
+
 // R(q) for a unit quaternion, as Eigen's toRotationMatrix (r[i + 3 j] = R(i, j)).
 void lane_rotation_matrix(const LaneQuaternion& q, Lanes* r) {
   const Lanes tx = 2.0 * q.x, ty = 2.0 * q.y, tz = 2.0 * q.z;
@@ -155,19 +165,21 @@ Lanes lane_sqrt(Lanes v) {
   return out;
 }
 
+// p / |p| per lane.
+LaneQuaternion normalized(const LaneQuaternion& p) {
+  const Lanes inverse_norm = 1.0 / lane_sqrt(p.w * p.w + p.x * p.x + p.y * p.y + p.z * p.z);
+  return {p.w * inverse_norm, p.x * inverse_norm, p.y * inverse_norm, p.z * inverse_norm};
+}
+
 // q (b^-1 q), normalised, per lane (extrapolated_turn), from the lanes' warm starts q and the turns
 // before b; with `keep`, q goes into the turns before.
 void start_extrapolated(int count, const TurnsBefore& turns, LaneQuaternion& q) {
-  const int k1 = count > 1 ? 1 : 0, k2 = count > 2 ? 2 : 0, k3 = count > 3 ? 3 : 0;
-  const Eigen::Quaterniond &b0 = *turns.before[0], &b1 = *turns.before[k1], &b2 = *turns.before[k2],
-                           &b3 = *turns.before[k3];
   // c = b^-1 q = conj(b) q (b a unit quaternion)
-  const Lanes bw{b0.w(), b1.w(), b2.w(), b3.w()}, bx{b0.x(), b1.x(), b2.x(), b3.x()};
-  const Lanes by{b0.y(), b1.y(), b2.y(), b3.y()}, bz{b0.z(), b1.z(), b2.z(), b3.z()};
-  const Lanes cw = bw * q.w + bx * q.x + by * q.y + bz * q.z;
-  const Lanes cx = bw * q.x - bx * q.w - by * q.z + bz * q.y;
-  const Lanes cy = bw * q.y + bx * q.z - by * q.w - bz * q.x;
-  const Lanes cz = bw * q.z - bx * q.y + by * q.x - bz * q.w;
+  const LaneQuaternion b = load_lanes(turns.before, count);
+  const Lanes cw = b.w * q.w + b.x * q.x + b.y * q.y + b.z * q.z;
+  const Lanes cx = b.w * q.x - b.x * q.w - b.y * q.z + b.z * q.y;
+  const Lanes cy = b.w * q.y + b.x * q.z - b.y * q.w - b.z * q.x;
+  const Lanes cz = b.w * q.z - b.x * q.y + b.y * q.x - b.z * q.w;
   if (turns.keep) {
     for (int l = 0; l < count; ++l) *turns.before[l] = Eigen::Quaterniond(q.w[l], q.x[l], q.y[l], q.z[l]);
   }
@@ -177,11 +189,7 @@ void start_extrapolated(int count, const TurnsBefore& turns, LaneQuaternion& q) 
   p.x = q.w * cx + q.x * cw + q.y * cz - q.z * cy;
   p.y = q.w * cy - q.x * cz + q.y * cw + q.z * cx;
   p.z = q.w * cz + q.x * cy - q.y * cx + q.z * cw;
-  const Lanes inverse_norm = 1.0 / lane_sqrt(p.w * p.w + p.x * p.x + p.y * p.y + p.z * p.z);
-  q.w = p.w * inverse_norm;
-  q.x = p.x * inverse_norm;
-  q.y = p.y * inverse_norm;
-  q.z = p.z * inverse_norm;
+  q = normalized(p);
 }
 
 bool any(LaneMask mask) {
@@ -208,12 +216,7 @@ TISSUE_HOT_KERNEL void extract_rotations(int count, const Eigen::Matrix3d* f_in,
   const Eigen::Matrix3d &f0 = f_in[0], &f1 = f_in[k1], &f2 = f_in[k2], &f3 = f_in[k3];
   Lanes f[9];
   for (int e = 0; e < 9; ++e) f[e] = Lanes{f0(e), f1(e), f2(e), f3(e)};
-  const Eigen::Quaterniond &w0 = *warm_starts[0], &w1 = *warm_starts[k1], &w2 = *warm_starts[k2], &w3 = *warm_starts[k3];
-  LaneQuaternion q{};
-  q.w = Lanes{w0.w(), w1.w(), w2.w(), w3.w()};
-  q.x = Lanes{w0.x(), w1.x(), w2.x(), w3.x()};
-  q.y = Lanes{w0.y(), w1.y(), w2.y(), w3.y()};
-  q.z = Lanes{w0.z(), w1.z(), w2.z(), w3.z()};
+  LaneQuaternion q = load_lanes(warm_starts, count);
   if (turns.before != nullptr) start_extrapolated(count, turns, q);
   const Lanes scale{f0.cwiseAbs().maxCoeff(), f1.cwiseAbs().maxCoeff(), f2.cwiseAbs().maxCoeff(),
                     f3.cwiseAbs().maxCoeff()};
@@ -256,12 +259,12 @@ TISSUE_HOT_KERNEL void extract_rotations(int count, const Eigen::Matrix3d* f_in,
     p.x = q.w * hx + q.x + q.y * hz - q.z * hy;
     p.y = q.w * hy - q.x * hz + q.y + q.z * hx;
     p.z = q.w * hz + q.x * hy - q.y * hx + q.z;
-    const Lanes inverse_norm = 1.0 / lane_sqrt(p.w * p.w + p.x * p.x + p.y * p.y + p.z * p.z);
+    const LaneQuaternion unit = normalized(p);
     const LaneMask update = active & (angle > 0.0);
-    q.w = lane_select(update, p.w * inverse_norm, q.w);
-    q.x = lane_select(update, p.x * inverse_norm, q.x);
-    q.y = lane_select(update, p.y * inverse_norm, q.y);
-    q.z = lane_select(update, p.z * inverse_norm, q.z);
+    q.w = lane_select(update, unit.w, q.w);
+    q.x = lane_select(update, unit.x, q.x);
+    q.y = lane_select(update, unit.y, q.y);
+    q.z = lane_select(update, unit.z, q.z);
     lane_rotation_matrix(q, r);
     const LaneMask done = active & newton & (RotationSettings::NEWTON_ERROR_BOUND * angle * angle * angle <=
                                             settings.max_error_rad);
