@@ -64,7 +64,6 @@ CorotationalElasticity::CorotationalElasticity(const TetMesh& mesh, const std::v
 namespace {
 
 constexpr int ASSEMBLY_LEVELS = 3;  // the mesh, its separator, that one's: leaves ~3% of the frog alone
-constexpr int PREFETCH_AHEAD = 8;  // tets ahead of the one assembled: two rotation batches
 
 // Splits `tets` in two at the median of their centroids along the longest axis of their extent;
 // tets that share a vertex with the other half go to `separator`.
@@ -285,26 +284,11 @@ TISSUE_HOT_KERNEL void CorotationalElasticity::add_tets(const std::vector<int>& 
                                                         const std::vector<TetSlots>* slots, double* energy_j,
                                                         ExtractInto into) {
   double energy = 0.0;
-  // The tangent's blocks are scattered over K (10 MB on the 52k-tet organ): each visit asks for the
-  // blocks of the tet PREFETCH_AHEAD places on in the list, so that they are in cache when it comes.
-  size_t ahead = 0;
-  const auto prefetch_next = [&] {
-    if (tangent == nullptr || ahead >= tets.size()) return;
-    const TetSlots& next = (*slots)[static_cast<size_t>(m_tet_id[static_cast<size_t>(tets[ahead++])])];
-    for (const int slot : next) {
-      if (slot < 0) continue;
-      const double* block = tangent->block(slot).data();
-      __builtin_prefetch(block, 1);
-      __builtin_prefetch(block + 8, 1);
-    }
-  };
-  for (int k = 0; k < PREFETCH_AHEAD; ++k) prefetch_next();
   in_rotation_batches(
       tets.size(), [&tets](size_t k) { return tets[k]; }, positions_m,
       into == ExtractInto::ahead ? &m_warm_starts_ahead : &m_warm_starts,
       into == ExtractInto::ahead ? &m_rotations_ahead : &m_rotations, &m_turns_before,
       [&](size_t t, const Eigen::Matrix3d& f, const Eigen::Matrix3d& rotation) {
-        prefetch_next();
         add_tet(t, f, rotation, internal_forces_n, tangent, slots);
         if (energy_j != nullptr) energy += m_elements.energy_j(m_rest[t], rotation, f);
       });

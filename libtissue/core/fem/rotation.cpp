@@ -20,8 +20,11 @@ namespace {
 // so the step is theta = H^-1 g, and R is the maximum exactly when g = 0 and H is positive
 // definite. Where H is not (far from the maximum, or at a saddle such as a half turn), the step
 // falls back to theta = g / |tr S|, the step of Mueller et al. 2016 written in the body frame.
+// The step as theta = numerator / denominator (denominator > 0): the division is left to the caller,
+// which limits the step and divides once (see extract_rotation).
 struct NewtonStep {
-  Eigen::Vector3d theta;
+  Eigen::Vector3d numerator;
+  double denominator = 1.0;
   bool newton = false;  // H was positive definite, so the iterate is near a true maximum
 };
 
@@ -46,9 +49,9 @@ NewtonStep rotation_step(const Eigen::Matrix3d& s, double scale) {
     adjugate(1, 0) = adjugate(0, 1);
     adjugate(2, 0) = adjugate(0, 2);
     adjugate(2, 1) = adjugate(1, 2);
-    return {adjugate * g / det, true};
+    return {adjugate * g, det, true};
   }
-  return {g / (std::abs(trace) + 1e-9 * scale), false};
+  return {g, std::abs(trace) + 1e-9 * scale, false};
 }
 
 }  // namespace
@@ -91,13 +94,18 @@ Eigen::Matrix3d extract_rotation(const Eigen::Matrix3d& f, Eigen::Quaterniond& w
   bool converged = false;
   for (int iteration = 0; iteration < settings.max_iterations; ++iteration) {
     const NewtonStep step = rotation_step(r.transpose() * f, scale);
-    const double angle = step.theta.norm();
+    const double numerator_norm = step.numerator.norm();
+    const double angle = numerator_norm / step.denominator;  // |theta|
     if (angle > 0.0) {
-      // A step is limited to |theta| <= 1 rad: far from the maximum the model is not to be trusted.
+      // A step is limited to |theta| <= 1 rad: far from the maximum the model is not to be trusted;
+      // theta min(1, 1/|theta|) = numerator / max(denominator, |numerator|), one division.
       // The retraction exp([theta]x) is replaced by the unit quaternion (1, theta/2) normalised,
-      // which agrees with it to second order (Newton stays quadratic) and needs no sin/cos.
-      const Eigen::Vector3d half = (0.5 * std::min(1.0, 1.0 / angle)) * step.theta;
-      q = (q * Eigen::Quaterniond(1.0, half.x(), half.y(), half.z())).normalized();
+      // which agrees with it to second order (Newton stays quadratic) and needs no sin/cos; its
+      // norm is |q| |(1, theta/2)|, known before the product (a shorter chain of dependent steps).
+      const Eigen::Vector3d half = (0.5 / std::max(step.denominator, numerator_norm)) * step.numerator;
+      const double inverse_norm = 1.0 / std::sqrt(q.squaredNorm() * (1.0 + half.squaredNorm()));
+      q = q * Eigen::Quaterniond(1.0, half.x(), half.y(), half.z());
+      q.coeffs() *= inverse_norm;
       r = q.toRotationMatrix();
     }
     if (step.newton && RotationSettings::NEWTON_ERROR_BOUND * angle * angle * angle <= settings.max_error_rad) {
@@ -243,23 +251,24 @@ TISSUE_HOT_KERNEL void extract_rotations(int count, const Eigen::Matrix3d* f_in,
     const Lanes a11 = h00 * h22 - h02 * h02, a12 = h02 * h01 - h00 * h12;
     const Lanes det = h00 * a00 + h01 * a01 + h02 * a02;
     const LaneMask newton = (h00 > tol) & (minor2 > tol * scale) & (det > tol * scale * scale);
-    const Lanes inverse_det = 1.0 / lane_select(newton, det, Lanes{} + 1.0);
+    // theta = n / d (rotation_step), limited to 1 rad: h = theta/2 min(1, 1/|theta|) = n / (2 max(d, |n|)).
     const Lanes abs_trace = lane_select(trace < 0.0, -trace, trace);
-    const Lanes fallback = 1.0 / (abs_trace + 1e-9 * scale);
-    const Lanes t0 = lane_select(newton, (a00 * g0 + a01 * g1 + a02 * g2) * inverse_det, g0 * fallback);
-    const Lanes t1 = lane_select(newton, (a01 * g0 + a11 * g1 + a12 * g2) * inverse_det, g1 * fallback);
-    const Lanes t2 = lane_select(newton, (a02 * g0 + a12 * g1 + minor2 * g2) * inverse_det, g2 * fallback);
-    const Lanes angle = lane_sqrt(t0 * t0 + t1 * t1 + t2 * t2);
-    // |theta| <= 1 rad per step; the quaternion (1, theta/2) normalised stands in for exp([theta]x).
-    const Lanes inverse_angle = 1.0 / angle;
-    const Lanes limit = 0.5 * lane_select(inverse_angle < 1.0, inverse_angle, Lanes{} + 1.0);
-    const Lanes hx = limit * t0, hy = limit * t1, hz = limit * t2;
-    LaneQuaternion p;
-    p.w = q.w - q.x * hx - q.y * hy - q.z * hz;
-    p.x = q.w * hx + q.x + q.y * hz - q.z * hy;
-    p.y = q.w * hy - q.x * hz + q.y + q.z * hx;
-    p.z = q.w * hz + q.x * hy - q.y * hx + q.z;
-    const LaneQuaternion unit = normalized(p);
+    const Lanes d = lane_select(newton, det, abs_trace + 1e-9 * scale);
+    const Lanes n0 = lane_select(newton, a00 * g0 + a01 * g1 + a02 * g2, g0);
+    const Lanes n1 = lane_select(newton, a01 * g0 + a11 * g1 + a12 * g2, g1);
+    const Lanes n2 = lane_select(newton, a02 * g0 + a12 * g1 + minor2 * g2, g2);
+    const Lanes n_norm = lane_sqrt(n0 * n0 + n1 * n1 + n2 * n2);
+    const Lanes angle = n_norm / d;
+    const Lanes half_over = 0.5 / lane_select(d < n_norm, n_norm, d);
+    const Lanes hx = half_over * n0, hy = half_over * n1, hz = half_over * n2;
+    // q (1, h), normalised by |q| |(1, h)| (the quaternion (1, theta/2) stands in for exp([theta]x)).
+    const Lanes inverse_norm =
+        1.0 / lane_sqrt((q.w * q.w + q.x * q.x + q.y * q.y + q.z * q.z) * (1.0 + (hx * hx + hy * hy + hz * hz)));
+    LaneQuaternion unit;
+    unit.w = (q.w - q.x * hx - q.y * hy - q.z * hz) * inverse_norm;
+    unit.x = (q.w * hx + q.x + q.y * hz - q.z * hy) * inverse_norm;
+    unit.y = (q.w * hy - q.x * hz + q.y + q.z * hx) * inverse_norm;
+    unit.z = (q.w * hz + q.x * hy - q.y * hx + q.z) * inverse_norm;
     const LaneMask update = active & (angle > 0.0);
     q.w = lane_select(update, unit.w, q.w);
     q.x = lane_select(update, unit.x, q.x);
