@@ -169,7 +169,9 @@ Lanes lane_select(LaneMask mask, Lanes yes, Lanes no) { return mask ? yes : no; 
 
 Lanes lane_sqrt(Lanes v) {
   Lanes out;
-  for (int l = 0; l < ROTATION_BATCH; ++l) out[l] = std::sqrt(v[l]);  // vectorised (sqrtpd) at -O2 and up
+  // One sqrtpd at -O2 and up, given -fno-math-errno (libtissue/core/CMakeLists.txt): with errno
+  // GCC made a scalar root a lane, each tested for a negative argument.
+  for (int l = 0; l < ROTATION_BATCH; ++l) out[l] = std::sqrt(v[l]);
   return out;
 }
 
