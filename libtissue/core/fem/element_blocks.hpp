@@ -8,6 +8,7 @@
 // the end of the two files that include this (clang warns alike).
 #pragma once
 
+#include "core/fem/corotational_kernel.hpp"
 #include "core/material/material.hpp"
 #include "core/system/assembly.hpp"
 #include "core/system/block_sparse_matrix.hpp"
@@ -37,9 +38,8 @@ void add_blocks(const TetSlots& slots, BlockSparseMatrix& tangent, Block block) 
   }
 }
 
-/// Four doubles in one AVX2 register (two SSE registers in the baseline clone); lane 3 of a column
-/// is zero.
-using Lanes = double __attribute__((vector_size(32)));
+/// A column in lanes (corotational_kernel.hpp); lane 3 of a column is zero.
+using Lanes = ColumnLanes;
 
 /// A block's nine values (column-major) += low (values 0-3), high (4-7) and last (8): the same
 /// loads and stores for every add of this kernel to a block, so that the next element's loads take
