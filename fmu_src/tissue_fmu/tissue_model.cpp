@@ -441,6 +441,7 @@ void TissueModel::get_float64(const VariableInfo& info, std::span<double> out) {
       out[0] = tissue.elastic_energy_j();
       return;
     case Vr::blade_depth:
+      settle();  // its query may write the positions the surface job reads
       out[0] = tissue.blade_depth_m();
       return;
     case Vr::tool_applied_position:

@@ -32,19 +32,31 @@ SurfaceViews::SurfaceViews(const DeformableBody& body, bool with_bvh, const Tria
       m_vertex_positions_m(rest_positions(body)),
       m_positions_m(m_vertex_positions_m),
       m_cut_surface(body.mesh().vertex_count()),
-      m_bvh(with_bvh ? m_surface.triangles : std::vector<std::array<int, 3>>{}, m_positions_m),
+      m_bvh(with_bvh ? m_surface.triangles : std::vector<std::array<int, 3>>{}, m_positions_m,
+            [this] { bring_positions_up_to_date(); }),
       m_render(embedded(body.mesh(), render_surface)) {}
 
 void SurfaceViews::update_positions(const DeformableBody& body, const Eigen::VectorXd& displacement_m) {
   m_render_mapped = false;
+  m_positions_body = &body;
+  m_positions_displacement_m = &displacement_m;
+  m_drawn_current = false;
+}
+
+void SurfaceViews::bring_positions_up_to_date() const {
+  if (m_positions_body == nullptr) return;
+  const DeformableBody& body = *m_positions_body;
+  const Eigen::VectorXd& displacement_m = *m_positions_displacement_m;
+  m_positions_body = nullptr;
+  m_positions_displacement_m = nullptr;
   body.positions(displacement_m, m_vertex_positions_m);
   m_positions_m.head(m_vertex_positions_m.size()) = m_vertex_positions_m;
   m_cut_surface.update_points(body, displacement_m, m_positions_m);
-  m_drawn_current = false;
 }
 
 void SurfaceViews::bring_drawn_up_to_date(const DeformableBody& body, const Eigen::VectorXd& displacement_m) const {
   if (m_drawn_current) return;
+  bring_positions_up_to_date();
   const int points = m_cut_surface.point_count();
   m_cut_surface.update_drawn(body, m_surface, displacement_m, m_positions_m);
   // Points the drawn lists added (split triangles' centres) get their positions.

@@ -1,6 +1,7 @@
 // SurfaceViews: the tissue's surfaces at the current state, each for its reader. The mesh's surface
 // and the faces the cuts opened, at the current positions (3 per mesh vertex, then the cut faces'
-// corners); the surface BVH over both, refitted when a query needs it (contact, cutting); the
+// corners, written when first read after a step: a step nothing reads them after pays nothing for
+// them); the surface BVH over both, refitted when a query needs it (contact, cutting); the
 // triangles to draw (the tet skin); and the finer render surface riding on the tets, re-meshed and
 // mapped only when asked for.
 #pragma once
@@ -30,7 +31,10 @@ class SurfaceViews {
   SurfaceViews(const SurfaceViews&) = delete;
   SurfaceViews& operator=(const SurfaceViews&) = delete;
 
-  /// The positions at `displacement_m` (the BVH is marked stale by moved(), not here).
+  /// The positions are now those at `displacement_m`: written when first read (positions_m(), the
+  /// BVH's queries, the drawn surface), from `body` and `displacement_m` as they are then, so both
+  /// must outlive the views and change only with a call of this again (the Tissue's body and state).
+  /// The BVH is marked stale by moved(), not here.
   void update_positions(const DeformableBody& body, const Eigen::VectorXd& displacement_m);
   /// The positions moved: the BVH refits at its next query.
   void moved() { m_bvh.positions_moved(); }
@@ -46,7 +50,10 @@ class SurfaceViews {
   [[nodiscard]] const SurfaceMesh& surface() const { return m_surface; }
   [[nodiscard]] const CutSurface& cut_surface() const { return m_cut_surface; }
   /// The mesh vertices (3 each), then the corners of the cut faces.
-  [[nodiscard]] const Eigen::VectorXd& positions_m() const { return m_positions_m; }
+  [[nodiscard]] const Eigen::VectorXd& positions_m() const {
+    bring_positions_up_to_date();
+    return m_positions_m;
+  }
   [[nodiscard]] const LazySurfaceBvh& bvh() const { return m_bvh; }
   [[nodiscard]] int mesh_triangle_count() const { return static_cast<int>(m_surface.triangles.size()); }
 
@@ -81,12 +88,17 @@ class SurfaceViews {
   // The BVH id of the first cut face (cut face t is this + t).
   [[nodiscard]] int first_cut_face_id() const;
   void bring_drawn_up_to_date(const DeformableBody& body, const Eigen::VectorXd& displacement_m) const;
+  // Writes the positions update_positions() left to their first read.
+  void bring_positions_up_to_date() const;
 
   SurfaceMesh m_surface;
-  Eigen::VectorXd m_vertex_positions_m;
+  mutable Eigen::VectorXd m_vertex_positions_m;
   // The positions and the cut faces; their drawn lists (and the points those add) are brought up to
   // date by the readers of the drawn surface (bring_drawn_up_to_date).
   mutable Eigen::VectorXd m_positions_m;
+  // Set by update_positions() until the positions are written (nullptr: they are current).
+  mutable const DeformableBody* m_positions_body = nullptr;
+  mutable const Eigen::VectorXd* m_positions_displacement_m = nullptr;
   mutable CutSurface m_cut_surface;
   mutable bool m_drawn_current = true;
   LazySurfaceBvh m_bvh;

@@ -18,6 +18,7 @@
 #include <array>
 #include <cmath>
 #include <cstdio>
+#include <memory>
 #include <vector>
 
 namespace tissue {
@@ -264,6 +265,50 @@ TEST(ScalpelCut, CutAlongGridFacesStaysSolvableForAnySmallestVolumeFraction) {
   }
   std::printf("  scaled condition number: eps 1e-3 %.6g, eps 1e-6 %.6g\n", conditions[0], conditions[1]);
   EXPECT_NEAR(conditions[1] / conditions[0], 1.0, 0.01);
+}
+
+// The surface's positions are written when first read after a step (SurfaceViews), and a cut
+// body's update skips the corners of retired faces (CutSurface::update_points' runs). A tissue read
+// after every step and one read only at the end hold the same positions, bitwise; the first's mesh
+// vertices are those of the step just taken at every read (never the step before); and a fresh
+// instance that replays the cuts (every corner written by the full pass) agrees with both.
+TEST(ScalpelCut, PositionsWrittenWhenReadAreThoseOfTheLastStepWhoeverReads) {
+  TetMesh mesh = make_box_mesh(10, 2, 2, 0.01);
+  Tissue every_step(mesh, beam_settings(mesh));
+  Tissue at_end(mesh, beam_settings(mesh));
+  int stale_reads = 0, reads = 0;
+  Eigen::VectorXd vertices_m;
+  const auto read = [&] {
+    const Eigen::VectorXd& x = every_step.current_positions_m();
+    (void)every_step.surface_bvh();  // the refit reads them too
+    every_step.vertex_positions(vertices_m);
+    ++reads;
+    if (x.head(vertices_m.size()) != vertices_m) ++stale_reads;
+  };
+  // An X through the beam seen from above (two slanted strokes past both sides, crossing at
+  // x = 5 cm): the tets both cross retire their first cut's faces.
+  for (Tissue* tissue : {&every_step, &at_end}) {
+    const auto after_step = [&, reading = tissue == &every_step] {
+      if (reading) read();
+    };
+    test_support::draw_scalpel(*tissue, {0.0443, -0.005}, {0.0623, 0.025}, STEP_S, after_step);
+    test_support::draw_scalpel(*tissue, {0.0563, -0.005}, {0.0383, 0.025}, STEP_S, after_step);
+    for (int n = 0; n < 20; ++n) {
+      tissue->step();
+      after_step();
+    }
+  }
+  EXPECT_EQ(stale_reads, 0) << "of " << reads;
+  int retired = 0;
+  for (int k = 0; k < every_step.body().cut_tet_count(); ++k) retired += every_step.body().retired(k) ? 1 : 0;
+  EXPECT_GT(retired, 0);
+  ASSERT_TRUE(every_step.current_positions_m().allFinite());
+  EXPECT_EQ(every_step.current_positions_m(), at_end.current_positions_m());
+  TissueSnapshot snapshot;
+  at_end.save(snapshot);
+  std::unique_ptr<Tissue> replayed = std::make_unique<Tissue>(mesh, beam_settings(mesh));
+  restore_or_replay(replayed, snapshot);
+  EXPECT_EQ(replayed->current_positions_m(), at_end.current_positions_m());
 }
 
 class SeparateCuts : public ::testing::TestWithParam<std::vector<double>> {};

@@ -77,7 +77,9 @@ CutSweepReport CutSession::stop(const LazySurfaceBvh& bvh, const ApplyCuts& appl
   if (!m_cutter) return report;
   // Also after a session that ended itself (then nothing is cut): the next is a new stroke.
   const auto cut_start = std::chrono::steady_clock::now();
-  report.cut = m_cutter->end_cut(bvh.positions_m());
+  // The positions only for an open session (end_cut reads them then): a step with the tool away
+  // brings none up to date (SurfaceViews writes them when first read).
+  report.cut = m_cutter->cutting() ? m_cutter->end_cut(bvh.positions_m()) : m_cutter->end_cut(Eigen::VectorXd());
   report.cut_s = seconds_since(cut_start);
   apply_new_cuts(apply, report);
   return report;

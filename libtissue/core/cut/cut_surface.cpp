@@ -27,6 +27,7 @@ double ratio_from(const TetCut& cut, int a, int b) {
 
 int CutSurface::add_point(int cut_tet, int piece, const std::array<double, 4>& weights, const WeldKey& key) {
   m_points.push_back(Point{cut_tet, piece, weights});
+  m_live_runs_current = false;
   m_point_owner.push_back(cut_tet);
   const int id = m_vertex_count + static_cast<int>(m_points.size()) - 1;
   m_point_key.push_back(weld_key_id(key, id));
@@ -75,6 +76,7 @@ void CutSurface::retire(const DeformableBody& body, const std::vector<std::uint8
     const int current = body.cut_tet_index(body.cut_tets()[static_cast<size_t>(k)].cut.tet);
     m_points[p] = Point{current, 0, {1.0, 0.0, 0.0, 0.0}};
     m_points[p].retired = Point::Retired::to_place;
+    m_live_runs_current = false;
   }
   for (size_t t = 0; t < m_triangles.size(); ++t) {
     if (is_retiring(m_triangle_cut_tet[t])) m_retired_faces.push_back(static_cast<int>(t));
@@ -256,6 +258,34 @@ void CutSurface::update_points(const DeformableBody& body, const Eigen::VectorXd
   int last_piece = -1;
   TetPositions piece_positions{Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero(),
                                Eigen::Vector3d::Zero()};
+  const auto update_live = [&](size_t p) {
+    const Point& point = m_points[p];
+    Eigen::Vector3d x = Eigen::Vector3d::Zero();
+    if (point.cut_tet < 0) {  // of real vertices, whose positions the caller wrote
+      for (size_t j = 0; j < 4; ++j) {
+        if (point.vertices[j] >= 0) x += point.weights[j] * positions_m.segment<3>(3 * point.vertices[j]);
+      }
+    } else {
+      if (point.cut_tet != last_cut_tet || point.piece != last_piece) {
+        piece_positions = body.piece_positions(displacement_m, point.cut_tet, point.piece);
+        last_cut_tet = point.cut_tet;
+        last_piece = point.piece;
+      }
+      for (size_t j = 0; j < 4; ++j) {
+        if (point.weights[j] != 0.0) x += point.weights[j] * piece_positions[j];
+      }
+    }
+    positions_m.segment<3>(3 * (m_vertex_count + static_cast<Eigen::Index>(p))) = x;
+  };
+  if (m_live_runs_current) {  // the points retired since the runs were found are placed already
+    for (const auto& [begin, end] : m_live_runs) {
+      for (auto p = static_cast<size_t>(begin); p < static_cast<size_t>(end); ++p) update_live(p);
+    }
+    return;
+  }
+  // Every point, and the runs of live ones for the next calls: a diced body's retired corners (a
+  // third of them after 30 + 30 strokes) are then not read again.
+  m_live_runs.clear();
   for (size_t p = 0; p < m_points.size(); ++p) {
     const Point& point = m_points[p];
     if (point.retired != Point::Retired::no) {
@@ -269,25 +299,14 @@ void CutSurface::update_points(const DeformableBody& body, const Eigen::VectorXd
       }
       continue;
     }
-    if (point.cut_tet < 0) {  // of real vertices, whose positions the caller wrote
-      Eigen::Vector3d x = Eigen::Vector3d::Zero();
-      for (size_t j = 0; j < 4; ++j) {
-        if (point.vertices[j] >= 0) x += point.weights[j] * positions_m.segment<3>(3 * point.vertices[j]);
-      }
-      positions_m.segment<3>(3 * (m_vertex_count + static_cast<Eigen::Index>(p))) = x;
-      continue;
-    }
-    if (point.cut_tet != last_cut_tet || point.piece != last_piece) {
-      piece_positions = body.piece_positions(displacement_m, point.cut_tet, point.piece);
-      last_cut_tet = point.cut_tet;
-      last_piece = point.piece;
-    }
-    Eigen::Vector3d x = Eigen::Vector3d::Zero();
-    for (size_t j = 0; j < 4; ++j) {
-      if (point.weights[j] != 0.0) x += point.weights[j] * piece_positions[j];
-    }
-    positions_m.segment<3>(3 * (m_vertex_count + static_cast<Eigen::Index>(p))) = x;
+    update_live(p);
+    const int id = static_cast<int>(p);
+    if (m_live_runs.empty() || m_live_runs.back()[1] != id)
+      m_live_runs.push_back({id, id + 1});
+    else
+      ++m_live_runs.back()[1];
   }
+  m_live_runs_current = true;
 }
 
 bool cut_by(const DeformableBody& body, int tet, int cut_id) {

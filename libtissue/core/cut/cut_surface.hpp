@@ -62,7 +62,7 @@ class CutSurface {
   /// Resizes `positions_m` to 3 (vertex_count + point_count()) and writes the cut-face corners after
   /// the mesh vertices, whose positions (the first 3 vertex_count entries) the caller has written.
   /// The corners of retired faces (nothing reads them) are placed once, at their collapse point's
-  /// rest position.
+  /// rest position, and not read again: `positions_m` is the same vector at every call.
   void update_points(const DeformableBody& body, const Eigen::VectorXd& displacement_m,
                      Eigen::VectorXd& positions_m) const;
 
@@ -175,6 +175,9 @@ class CutSurface {
   int m_vertex_count = 0;
   int m_cut_tets = 0;
   std::vector<Point> m_points;
+  // update_points()' runs [begin, end) of points not retired, current until a point is added or retired.
+  mutable std::vector<std::array<int, 2>> m_live_runs;
+  mutable bool m_live_runs_current = false;
   std::vector<std::array<int, 3>> m_triangles;
   std::vector<int> m_triangle_cut_tet;  // per triangle, the cut tet it belongs to
   std::vector<std::array<int, 3>> m_drawn;

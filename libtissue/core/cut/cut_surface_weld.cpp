@@ -88,6 +88,7 @@ int CutSurface::weld_key_id(const WeldKey& key, int point) {
 
 int CutSurface::add_real_point(const std::array<int, 4>& vertices, const std::array<double, 4>& weights) {
   m_points.push_back(Point{-1, 0, weights, vertices});
+  m_live_runs_current = false;
   m_point_owner.push_back(-1);
   m_point_key.push_back(-1);
   return m_vertex_count + static_cast<int>(m_points.size()) - 1;
