@@ -441,7 +441,10 @@ void TissueModel::get_float64(const VariableInfo& info, std::span<double> out) {
       out[0] = tissue.elastic_energy_j();
       return;
     case Vr::blade_depth:
-      settle();  // its query may write the positions the surface job reads
+      // Its query may write the surface's positions, which the job reads and adds to only when it
+      // draws the tet skin: then it waits; a render surface's job leaves them alone (the host reads
+      // this after every step, while the job re-meshes).
+      if (!tissue.has_render_surface()) settle();
       out[0] = tissue.blade_depth_m();
       return;
     case Vr::tool_applied_position:

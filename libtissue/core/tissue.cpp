@@ -95,9 +95,13 @@ TissueStepReport Tissue::step() {
   m_tool.apply(move);
   report.parked_rows = park_fallen_parts();
 
+  // The surface's positions: written now while the tool works the tissue (a probe's outputs below
+  // and the next sweep of a scalpel read them anyway; written later, they ran beside a Tissue FMU's
+  // surface job that the host's next step then waited for), else when first read.
   const auto positions_start = std::chrono::steady_clock::now();
   m_surfaces.update_positions(m_body, m_state.displacement_m);
   m_surfaces.moved();
+  if (m_tool.applied().mode != ToolMode::none) (void)m_surfaces.positions_m();
   report.positions_s = seconds_since(positions_start);
 
   // Report: the contact outputs at the new positions, and the surface near a probe not touching.

@@ -78,8 +78,8 @@ struct TissueStepReport {
   double cut_s = 0.0;           ///< volume cutter
   double enrich_s = 0.0;        ///< enrichment and in-place growth
   double contact_s = 0.0;       ///< god-object update and contact outputs
-  double positions_s = 0.0;     ///< marking the surface's positions moved: they and the BVH's refit
-                                ///< are written by their first read (the cutter's or probe's query)
+  double positions_s = 0.0;     ///< the surface's positions (written here while the tool is in use,
+                                ///< else by their first read); the BVH's refit waits for the next query
   double total_s = 0.0;
   int parked_rows = 0;  ///< block rows this step took out of the dynamics (parts fallen out of the field)
 };

@@ -624,7 +624,7 @@ TEST(TissueFmu, TheRenderSurfaceIsDrawnWholeAndClosedAfterTheCut) {
 // surface.prepareAfterStep (issue 42): after a step that cuts, the FMU prepares surface.embedding in
 // a thread of its own while the importer goes on; what a read then gives is bitwise what the same
 // session gives on demand, at every step of the stroke, whatever is read in between (the contact
-// outputs and counters while the work may run, the surface arrays, which wait for it), and after a
+// outputs, the blade's depth and counters while the work may run, the surface arrays, which wait for it), and after a
 // restore to a state before the cut, whose revision number the cut steps had used.
 TEST(TissueFmu, ASurfacePreparedAfterTheStepIsTheSurfaceReadOnDemand) {
   const FrogGeometry g = rest_geometry();
@@ -652,6 +652,12 @@ TEST(TissueFmu, ASurfacePreparedAfterTheStepIsTheSurfaceReadOnDemand) {
     ASSERT_EQ(prepared.fmu().get_float64("contact.force", force_prepared), fmi3OK);
     ASSERT_EQ(plain.fmu().get_float64("contact.force", force_plain), fmi3OK);
     EXPECT_EQ(force_plain, force_prepared);
+    // The blade's depth, read while the preparation may still run: it does not wait for it (a
+    // render surface's job leaves the positions its query reads alone), and agrees.
+    std::vector<double> depth_plain, depth_prepared;
+    ASSERT_EQ(prepared.fmu().get_float64("cut.bladeDepth", depth_prepared), fmi3OK);
+    ASSERT_EQ(plain.fmu().get_float64("cut.bladeDepth", depth_plain), fmi3OK);
+    EXPECT_EQ(depth_plain, depth_prepared);
     // surface.preparing, read at once: never in the plain session; in the prepared one, while the
     // work runs (whether a read sees it depends on the machine's timing: counted, not asserted;
     // BackgroundWork.BusyWhileAJobRuns is the deterministic check), and never once the surface was
