@@ -30,15 +30,20 @@ import os
 import resource
 import statistics
 import sys
+import time
 
 ROOT = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..")
 PARTS = ("total_s", "assembly_s", "solve_s", "guard_s", "cut_s", "enrich_s", "positions_s")
 
 
 def step_counting_faults(body):
-    """body.step()'s report, with the page faults the step took (memory first touched in it)."""
+    """body.step()'s report, with the page faults the step took (memory first touched in it) and when
+    it began and ended (time.monotonic: CLOCK_MONOTONIC, as cut_step_profile.py's perf samples)."""
     before = resource.getrusage(resource.RUSAGE_SELF).ru_minflt
+    started_s = time.monotonic()
     report = body.step()
+    report["ended_s"] = time.monotonic()
+    report["started_s"] = started_s
     report["page_faults"] = resource.getrusage(resource.RUSAGE_SELF).ru_minflt - before
     return report
 
