@@ -279,6 +279,9 @@ void TissueModel::prepare_surface() {
   const bool mesh_output = m_values.boolean(vr(Vr::mesh_output_enabled));
   if (!m_values.boolean(vr(Vr::surface_prepare)) || !mesh_output || embedding_encoded(true)) return;
   (void)surface_revision();  // here, not in the job (surface_revision's rule)
+  // The surface's positions too (written when first read): the tet skin's job reads them, and the
+  // blade's depth (read beside the job, without waiting for it) may refit the BVH to them.
+  if (!m_tissue->has_render_surface()) (void)m_tissue->current_positions_m();
   // The job reads the tissue (const) and writes the render surface's and the embedding's members,
   // which every other call leaves alone until settle(); noexcept: a failure leaves the bytes stale,
   // so the read that follows computes them again and reports it.
@@ -440,11 +443,7 @@ void TissueModel::get_float64(const VariableInfo& info, std::span<double> out) {
       settle();  // not const: the body's scratch
       out[0] = tissue.elastic_energy_j();
       return;
-    case Vr::blade_depth:
-      // Its query may write the surface's positions, which the job reads and adds to only when it
-      // draws the tet skin: then it waits; a render surface's job leaves them alone (the host reads
-      // this after every step, while the job re-meshes).
-      if (!tissue.has_render_surface()) settle();
+    case Vr::blade_depth:  // no settle(): the host reads it after every step, while the job runs
       out[0] = tissue.blade_depth_m();
       return;
     case Vr::tool_applied_position:
