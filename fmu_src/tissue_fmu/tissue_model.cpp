@@ -247,8 +247,7 @@ void TissueModel::drawn_nodes(ports::SurfaceNodes& nodes) {
   ensure_built();
   nodes.revision = surface_revision();
   if (const CutRenderSurface* render = m_tissue->render_surface()) {
-    // The nodes alone: not the drawn mesh's points and triangles (a copy of the organ's 82k
-    // triangles every frame, which the host maps itself).
+    // The nodes alone: not the drawn mesh's points and triangles (the organ's 82k every frame; the host maps them).
     nodes.positions_m.clear();
     for (const Eigen::Vector3d& x : render->node_positions_m()) nodes.positions_m.insert(nodes.positions_m.end(), x.data(), x.data() + 3);
     return;
@@ -279,12 +278,10 @@ void TissueModel::prepare_surface() {
   const bool mesh_output = m_values.boolean(vr(Vr::mesh_output_enabled));
   if (!m_values.boolean(vr(Vr::surface_prepare)) || !mesh_output || embedding_encoded(true)) return;
   (void)surface_revision();  // here, not in the job (surface_revision's rule)
-  // The surface's positions too (written when first read): the tet skin's job reads them, and the
-  // blade's depth (read beside the job, without waiting for it) may refit the BVH to them.
-  if (!m_tissue->has_render_surface()) (void)m_tissue->current_positions_m();
-  // The job reads the tissue (const) and writes the render surface's and the embedding's members,
-  // which every other call leaves alone until settle(); noexcept: a failure leaves the bytes stale,
-  // so the read that follows computes them again and reports it.
+  if (!m_tissue->has_render_surface()) (void)m_tissue->current_positions_m();  // the tet skin's job reads them
+  // The job reads the tissue (const) and writes the render surface's and the embedding's members, which every
+  // other call leaves alone until settle(); noexcept: a failure leaves the bytes stale, so the read that follows
+  // computes them again and reports it. (Written when first read, the surface's positions are written above.)
   m_surface_work.start([this] {
     try {
       (void)embedding_bytes(true);
@@ -308,6 +305,7 @@ void TissueModel::start_surface_revision(std::uint64_t revision) {
   m_surface_triangles = revision_triangles();
   m_surface_cut_tets = m_tissue->body().cut_tets().size();
   m_drawn_current = false;
+  m_blade_depth_m.reset();  // a state built or restored: found when read
 }
 
 void TissueModel::surface_moved() {
@@ -352,6 +350,7 @@ void TissueModel::exit_initialization_mode() { ensure_built(); }
 
 fmi3::StepOutcome TissueModel::do_step(double current_time_s, double step_s) {
   settle();
+  m_blade_depth_m.reset();
   Tissue& tissue = *m_tissue;
   const double now = m_start_time_s + tissue.time_s();
   const long count = fmi3::whole_internal_steps(now, current_time_s, step_s, tissue.settings().step_size_s);
@@ -386,6 +385,7 @@ fmi3::StepOutcome TissueModel::do_step(double current_time_s, double step_s) {
   }
   surface_moved();
   log_events();
+  m_blade_depth_m = tissue.blade_depth_m();
   prepare_surface();
   return {true, m_start_time_s + tissue.time_s()};
 }
@@ -443,8 +443,9 @@ void TissueModel::get_float64(const VariableInfo& info, std::span<double> out) {
       settle();  // not const: the body's scratch
       out[0] = tissue.elastic_energy_j();
       return;
-    case Vr::blade_depth:  // no settle(): the host reads it after every step, while the job runs
-      out[0] = tissue.blade_depth_m();
+    case Vr::blade_depth:  // no wait for the job after a doStep: found there before it started
+      if (!m_blade_depth_m) settle();
+      out[0] = m_blade_depth_m ? *m_blade_depth_m : *(m_blade_depth_m = tissue.blade_depth_m());
       return;
     case Vr::tool_applied_position:
       put3(tissue.applied_tool_position_m());
@@ -479,8 +480,7 @@ void TissueModel::get_uint64(const VariableInfo& info, std::span<std::uint64_t> 
   ensure_built();
   const Tissue& tissue = *m_tissue;
   const bool mesh_out = m_values.boolean(vr(Vr::mesh_output_enabled));
-  // The drawn surface is brought up to date only for the variables that count it: reading the cut
-  // counters after a step re-meshes and maps nothing.
+  // The drawn surface is brought up to date only for the variables that count it: the cut counters are cheap.
   const Vr which = static_cast<Vr>(info.vr);
   if (which == Vr::vertex_count || which == Vr::triangle_count || which == Vr::cut_triangle_count) settle();
   switch (which) {

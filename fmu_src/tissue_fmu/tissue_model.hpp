@@ -125,6 +125,10 @@ class TissueModel final : public fmi3::Model {
   };
   std::optional<EncodedEmbedding> m_encoded_embedding;
   bool m_capacity_warned = false;
+  // cut.bladeDepth at the last doStep's end, found before its surface job starts, so that a read
+  // beside the job (tissue-host's, after every step) touches nothing the job reads or writes (none:
+  // found when read, after a restore, a reset or a failed step).
+  std::optional<double> m_blade_depth_m;
   // Last: destroyed first, so that a job still running ends before the members it uses.
   mutable BackgroundWork m_surface_work;
 };
