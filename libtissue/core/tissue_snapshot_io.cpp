@@ -19,8 +19,9 @@ constexpr std::uint64_t MAGIC = 0x31305353'49535354ULL;  // "TSSISS01" read as l
 // had turned when each tet was cut and each edge crossed (a spiral cuts a tet once per turn);
 // 12: the contact spring's direction and constant force, the contact's sticking and friction (issue 42);
 // 13: a pad probe's springs and its samples pressed (issue 42); 14: each tet's and piece's turn
-// before (the rotations' warm start extrapolated, issue 40)
-constexpr std::uint32_t VERSION = 14;
+// before (the rotations' warm start extrapolated, issue 40); 15: copies of fixed vertices that touch held
+// material are held, without unknowns (issue 41): a state saved before has more unknowns
+constexpr std::uint32_t VERSION = 15;
 
 // The core's Eigen types and cut records on top of the shared byte stream.
 class Writer : public serial::ByteWriter {

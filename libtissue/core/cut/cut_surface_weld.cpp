@@ -79,7 +79,7 @@ std::size_t CutSurface::WeldKeyHash::operator()(const WeldKey& key) const {
 int CutSurface::weld_key_id(const WeldKey& key, int point) {
   const auto [it, inserted] = m_key_ids.try_emplace(key, static_cast<int>(m_key_drawn.size()));
   if (inserted) {
-    const bool real_vertex = key.vertex[1] < 0 && key.ghost_row[0] < 0;
+    const bool real_vertex = key.vertex[1] < 0 && key.ghost_row[0] == -1;  // not a ghost or a held copy
     m_key_drawn.push_back(real_vertex ? key.vertex[0] : point);
     m_keys.push_back(key);
   }
@@ -119,7 +119,7 @@ int CutSurface::add_edge_point(const DeformableBody& body, int k, int piece, int
   const int edge =
       body.adjacency().tet_edges[static_cast<size_t>(cut_tet.cut.tet)][static_cast<size_t>(local_edge(a, b))];
   // The side a corner is on: the end of the edge its piece holds (sees as the real vertex).
-  note_crossed_edge(key, edge, a_lower ? ratio_from_a : 1.0 - ratio_from_a, key.ghost_row[0] < 0, id);
+  note_crossed_edge(key, edge, a_lower ? ratio_from_a : 1.0 - ratio_from_a, key.ghost_row[0] == -1, id);
   return id;
 }
 
@@ -220,9 +220,10 @@ namespace {
 SeparatingCuts separating_among(const DeformableBody& body, const std::vector<int>& dof_of_row, int row,
                                 const std::vector<int>& common) {
   SeparatingCuts kept;
-  if (row < 0) return kept;
-  const SeparatingCuts& all =
-      body.enriched_dofs()[static_cast<size_t>(dof_of_row[static_cast<size_t>(row)])].separated_by;
+  if (row == -1) return kept;
+  const SeparatingCuts all =
+      row >= 0 ? body.enriched_dofs()[static_cast<size_t>(dof_of_row[static_cast<size_t>(row)])].separated_by
+               : body.copy_separated_by(row);  // a held copy
   for (int i = 0; i < all.count; ++i) {
     if (!std::binary_search(common.begin(), common.end(), all.cut_id[static_cast<size_t>(i)])) continue;
     kept.cut_id[static_cast<size_t>(kept.count)] = all.cut_id[static_cast<size_t>(i)];

@@ -7,7 +7,8 @@
 // vertices, in vertex order; then come the enriched unknowns a, one per ghost key (vertex, the cuts
 // that separate the piece from it: for a single cut (vertex, cut id, side)), in creation order. A
 // fixed vertex has no u row but gets an enriched row when cut: its ghost copy on the other side of
-// the cut must be free to move.
+// the cut must be free to move, unless the copy's pieces touch held material (a tet whose four
+// vertices are fixed): then it is a held copy, at rest with no row (HELD_COPY_FIRST).
 #pragma once
 
 #include "core/fem/body_parts.hpp"
@@ -211,6 +212,15 @@ class DeformableBody final : public DynamicsModel {
 
   [[nodiscard]] int enriched_dof_count() const { return static_cast<int>(m_enriched_dofs.size()); }
   [[nodiscard]] const std::vector<EnrichedDof>& enriched_dofs() const { return m_enriched_dofs; }
+  /// The held copies, in creation order (row: HELD_COPY_FIRST + index): copies of fixed vertices
+  /// whose pieces touch held material, a tet whose four vertices are fixed (or an uncut one of them
+  /// across a face around the vertex). Material the fixed region holds stays held when cut.
+  [[nodiscard]] const std::vector<EnrichedDof>& held_copies() const { return m_held_copies; }
+  /// Whether tet t is held material: its four vertices fixed.
+  [[nodiscard]] bool held_tet(int t) const { return m_tet_held[static_cast<size_t>(t)] != 0; }
+  /// The cuts that separate a piece's copy of a vertex from it, by CutPiece::ghost_row: a ghost
+  /// row's or a held copy's (none for -1, the real vertex).
+  [[nodiscard]] SeparatingCuts copy_separated_by(int ghost_row) const;
   /// Index into enriched_dofs() of the unknown of (vertex, cut id, side) of a single cut, or -1.
   [[nodiscard]] int find_enriched_dof(int vertex, int cut_id, int side) const;
   /// Index into enriched_dofs() of the ghost of `vertex` behind `cuts`, or -1.
@@ -368,7 +378,11 @@ class DeformableBody final : public DynamicsModel {
   void collect_star_nodes(int v, std::span<const int> star, EnrichBatch& batch) const;
   void collect_star_faces(std::span<const int> star, EnrichBatch& batch) const;
   void join_star_pieces(std::span<const int> star, const std::vector<size_t>& members, EnrichBatch& batch) const;
-  void assign_ghost_rows(int v, const std::vector<size_t>& members, EnrichBatch& batch) const;
+  void assign_ghost_rows(int v, std::span<const int> star, const std::vector<size_t>& members,
+                         EnrichBatch& batch) const;
+  [[nodiscard]] bool touches_held_material(int v, std::span<const int> star, const std::vector<size_t>& members,
+                                           int root, EnrichBatch& batch) const;
+  [[nodiscard]] const SeparatingCuts& planned_copy_cuts(int ghost_row, const EnrichBatch& batch) const;
   static void check_offsets(std::span<const std::vector<TetPositions>> offsets_m, const EnrichBatch& batch);
   void append_ghost_rows(const EnrichBatch& batch);
   void start_pieces(const EnrichBatch& batch, size_t c, std::span<const std::vector<TetPositions>> offsets_m,
@@ -404,6 +418,8 @@ class DeformableBody final : public DynamicsModel {
   XfemElasticity m_xfem;
   std::vector<int> m_enriched_row_capacity;  // per vertex: blocks its enriched row is given
   std::vector<EnrichedDof> m_enriched_dofs;
+  std::vector<EnrichedDof> m_held_copies;      // row: HELD_COPY_FIRST + index
+  std::vector<std::uint8_t> m_tet_held;        // per tet: its four vertices fixed
   std::vector<CutTetGeometry> m_cut_geometry;  // per cut tet
   std::vector<int> m_ghost_users;              // per enriched unknown: pieces of live cut tets using it
   long m_retired_slots = 0;  // slots of the cut tets retired since the last compaction (shared ones counted again)

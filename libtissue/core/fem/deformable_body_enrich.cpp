@@ -212,6 +212,7 @@ EnrichmentResult DeformableBody::enrich_pieces(std::span<const TetCut> cuts,
   m_orphaned_rows.clear();
   m_arrivals.clear();
   append_ghost_rows(batch);
+  m_held_copies.insert(m_held_copies.end(), batch.new_held.begin(), batch.new_held.end());
   m_new_row_start_m.assign(batch.new_rows.size(), std::nullopt);
   for (size_t c = 0; c < batch.plans.size(); ++c) {
     const size_t piece_count = batch.plans[c].geometry.pieces.size();
@@ -341,7 +342,9 @@ void DeformableBody::start_pieces(const EnrichBatch& batch, size_t c,
     if (displacement_m == nullptr || 3 * row >= displacement_m->size()) return Eigen::Vector3d::Zero();
     return displacement_m->segment<3>(3 * row);
   };
-  const auto row_of = [&](int planned) { return planned >= -1 ? planned : first_new_row + (-2 - planned); };
+  const auto row_of = [&](int planned) {
+    return planned >= -1 || is_held_copy(planned) ? planned : first_new_row + (-2 - planned);
+  };
   for (size_t q = 0; q < pieces.size(); ++q) {
     CutPiece& piece = pieces[q];
     piece.weight = geometry.pieces[q].volume_fraction;
@@ -361,8 +364,9 @@ void DeformableBody::start_pieces(const EnrichBatch& batch, size_t c,
         if (!start) start = from_m;
       }
       if (row >= 0 && row != from_row) m_arrivals.push_back({row, from_row, 0.25 * piece.weight * mass_kg});
-      if (planned < 0) continue;  // the real vertex
+      if (planned == -1) continue;  // the real vertex
       piece.ghost_row[j] = planned;
+      if (planned < 0) continue;  // a held copy: at the fixed vertex's rest position
       piece.offset_m[j] = offsets_m.empty() ? Eigen::Vector3d(current(planned) - from_m) : offsets_m[c][q][j];
     }
   }
@@ -411,6 +415,12 @@ int DeformableBody::replace_cut_tet(EnrichBatch& batch, size_t c, const std::vec
   m_xfem.add(cut_tet, pieces, m_elasticity.rest(plan.tet), rotations);
   m_cut_geometry.push_back(std::move(geometry));
   add_piece_loads(k, 1.0);
+  // A piece of held material (every node a fixed vertex or a held copy) has no unknowns and stays at
+  // rest: it adds nothing, as a parked piece (its cut faces face held material only).
+  for (int p = 0; p < static_cast<int>(m_xfem.piece_count(k)); ++p) {
+    const std::array<int, 4> rows = piece_rows(k, p);
+    if (std::all_of(rows.begin(), rows.end(), [](int row) { return row < 0; })) m_xfem.park(k, p);
+  }
   // A ghost no piece uses any more (its pieces moved to other ghosts): it keeps a mass so the
   // system stays regular, and loses its load; nothing moves it.
   if (old >= 0) {

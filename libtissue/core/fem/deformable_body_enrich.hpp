@@ -21,7 +21,9 @@ struct DeformableBody::EnrichBatch {
     int old = -1;  // the live cut tet it replaces, or -1
     bool from_cut = true;
     CutTetGeometry geometry;
-    std::vector<std::array<int, 4>> rows;  // per piece and local vertex: ghost row, -1 real, -2 - n the n-th new row
+    // per piece and local vertex: ghost row, -1 real, -2 - n the n-th new row, or a held copy
+    // (HELD_COPY_FIRST + its index, the batch's new ones after the body's)
+    std::vector<std::array<int, 4>> rows;
   };
   // A piece of a tet around a vertex that cuts separate from it.
   struct Node {
@@ -29,7 +31,7 @@ struct DeformableBody::EnrichBatch {
     size_t piece;
     size_t local;  // v's local index in the tet
     SeparatingCuts key;
-    int candidate;  // the row it uses now (or its parent used), -1 none
+    int candidate;  // the row or held copy it uses now (or its parent used), -1 none
   };
   // A face two tets of a vertex's star share (star indices and the face's rest corners).
   struct StarFace {
@@ -42,6 +44,7 @@ struct DeformableBody::EnrichBatch {
   std::vector<int> plan_of_tet;          // per tet: its plan, or -1
   std::vector<SeparatingCuts> new_rows;  // keys of the rows to create
   std::vector<int> new_row_vertex;
+  std::vector<EnrichedDof> new_held;  // the held copies to create
   int old_dofs = 0;  // the enriched unknowns before the batch
   std::vector<Node> nodes;
   std::vector<StarFace> faces;

@@ -102,7 +102,7 @@ void DeformableBody::plan_ghosts(int v, EnrichBatch& batch) const {
     }
     for (const size_t i : members) done[i] = true;
     join_star_pieces(star, members, batch);
-    assign_ghost_rows(v, members, batch);
+    assign_ghost_rows(v, star, members, batch);
   }
 }
 
@@ -130,10 +130,8 @@ void DeformableBody::collect_star_nodes(int v, std::span<const int> star, Enrich
       } else if (!plan.from_cut) {
         candidate = plan.rows[q][local];
       }
-      if (candidate >= 0 &&
-          !(m_enriched_dofs[static_cast<size_t>(candidate - m_dofs.free_vertex_count())].separated_by == key)) {
-        candidate = -1;  // a ghost behind other cuts
-      }
+      // None (-1, or a row new in this batch), or a ghost or held copy behind other cuts: none.
+      if ((candidate < 0 && !is_held_copy(candidate)) || !(planned_copy_cuts(candidate, batch) == key)) candidate = -1;
       batch.nodes.push_back(EnrichBatch::Node{t, q, local, key, candidate});
     }
   }
@@ -205,9 +203,39 @@ void DeformableBody::join_star_pieces(std::span<const int> star, const std::vect
   }
 }
 
-// Each component of the key's nodes (join_star_pieces) keeps the row most of its nodes use (one
-// component per row), or gets a new one.
-void DeformableBody::assign_ghost_rows(int v, const std::vector<size_t>& members, EnrichBatch& batch) const {
+// The separating cuts of an existing ghost row or of a held copy, the batch's new ones included.
+const SeparatingCuts& DeformableBody::planned_copy_cuts(int ghost_row, const EnrichBatch& batch) const {
+  if (!is_held_copy(ghost_row)) {
+    return m_enriched_dofs[static_cast<size_t>(ghost_row - m_dofs.free_vertex_count())].separated_by;
+  }
+  const auto index = static_cast<size_t>(held_copy_index(ghost_row));
+  return index < m_held_copies.size() ? m_held_copies[index].separated_by
+                                      : batch.new_held[index - m_held_copies.size()].separated_by;
+}
+
+// Whether the component `root` of the key's nodes around fixed vertex v touches held material: one
+// of its pieces lies in a held tet, or it joins an uncut held tet of the star (join_star_pieces:
+// elements n, n + 1, ... are the star's uncut tets, in star order). Its material at v is then held
+// (Dirichlet on the material, not on the mesh's vertices only): the copy is held.
+bool DeformableBody::touches_held_material(int v, std::span<const int> star, const std::vector<size_t>& members,
+                                           int root, EnrichBatch& batch) const {
+  if (vertex_block_row(v) >= 0) return false;
+  const auto find = [&](int i) { return find_root(batch.parent_of, i); };
+  for (size_t m = 0; m < members.size(); ++m) {
+    if (find(static_cast<int>(m)) == root && held_tet(batch.nodes[members[m]].tet)) return true;
+  }
+  for (size_t s = 0; s < star.size(); ++s) {
+    const int t = star[s];
+    const bool uncut = batch.plan_of_tet[static_cast<size_t>(t)] < 0 && cut_tet_index(t) < 0;
+    if (uncut && held_tet(t) && find(batch.elements[s].front()) == root) return true;
+  }
+  return false;
+}
+
+// Each component of the key's nodes (join_star_pieces) keeps the row (a held component: the held
+// copy) most of its nodes use (one component per row), or gets a new one.
+void DeformableBody::assign_ghost_rows(int v, std::span<const int> star, const std::vector<size_t>& members,
+                                       EnrichBatch& batch) const {
   std::vector<EnrichBatch::Plan>& plans = batch.plans;
   std::vector<int>& plan_of_tet = batch.plan_of_tet;
   const std::vector<EnrichBatch::Node>& nodes = batch.nodes;
@@ -221,9 +249,11 @@ void DeformableBody::assign_ghost_rows(int v, const std::vector<size_t>& members
     if (std::find(roots.begin(), roots.end(), root) == roots.end()) roots.push_back(root);
   }
   for (const int root : roots) {
+    const bool held = touches_held_material(v, star, members, root, batch);
     std::map<int, int> votes;
     for (size_t m = 0; m < n; ++m) {
-      if (find(static_cast<int>(m)) == root && nodes[members[m]].candidate >= 0) ++votes[nodes[members[m]].candidate];
+      const int candidate = nodes[members[m]].candidate;
+      if (find(static_cast<int>(m)) == root && candidate != -1 && is_held_copy(candidate) == held) ++votes[candidate];
     }
     int row = -1;
     int best = 0;
@@ -233,7 +263,11 @@ void DeformableBody::assign_ghost_rows(int v, const std::vector<size_t>& members
         best = voters;
       }
     }
-    if (row < 0) {
+    if (row == -1 && held) {
+      row = HELD_COPY_FIRST + static_cast<int>(m_held_copies.size() + batch.new_held.size());
+      const SeparatingCuts& key = nodes[members.front()].key;
+      batch.new_held.push_back(EnrichedDof{v, key.cut_id[0], key.side[0], row, key});
+    } else if (row == -1) {
       row = -2 - static_cast<int>(batch.new_rows.size());
       batch.new_rows.push_back(nodes[members.front()].key);
       batch.new_row_vertex.push_back(v);

@@ -35,6 +35,7 @@
 
 #include <array>
 #include <cstdint>
+#include <limits>
 #include <span>
 #include <vector>
 
@@ -78,9 +79,18 @@ struct CutTet {
   }
 };
 
+/// CutPiece::ghost_row of a held copy (issue 41): a copy of a fixed vertex whose pieces touch held
+/// material (a tet whose four vertices are fixed) stays at the vertex's rest position and has no
+/// unknowns. Held copy h (DeformableBody::held_copies()) is HELD_COPY_FIRST + h: negative, so the
+/// dynamics treats it as the fixed vertex itself; the drawn surface tells it from the real vertex.
+inline constexpr int HELD_COPY_FIRST = std::numeric_limits<int>::min();
+[[nodiscard]] constexpr bool is_held_copy(int ghost_row) { return ghost_row < HELD_COPY_FIRST + (1 << 30); }
+[[nodiscard]] constexpr int held_copy_index(int ghost_row) { return ghost_row - HELD_COPY_FIRST; }
+
 /// A piece of a cut tet as an element copy: its rest volume fraction and, per local vertex, the
-/// row of its ghost there (-1: the real vertex) and the ghost's offset: p_j = X_j + c_{row_j} -
-/// offset_j, so that a piece joining a ghost that has moved starts where its material was.
+/// row of its ghost there (-1: the real vertex; is_held_copy(): a held copy) and the ghost's offset:
+/// p_j = X_j + c_{row_j} - offset_j, so that a piece joining a ghost that has moved starts where its
+/// material was.
 struct CutPiece {
   double weight = 0.0;
   std::array<int, 4> ghost_row{-1, -1, -1, -1};

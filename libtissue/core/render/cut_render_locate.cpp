@@ -32,10 +32,11 @@ CutRenderSurface::Point CutRenderSurface::locate(const DeformableBody& body, int
 }
 
 void CutRenderSurface::find_material_parts(const DeformableBody& body) {
-  // Union-find over the copies of the vertices (real: the vertex id; ghost: vertex count + its row),
-  // joined within each cell.
+  // Union-find over the copies of the vertices (real: the vertex id; ghost: vertex count + its row;
+  // held copy: after the rows), joined within each cell.
   const int vertex_count = m_mesh.vertex_count();
-  m_copy_root.resize(static_cast<size_t>(vertex_count) + static_cast<size_t>(body.dof_count() / 3));
+  m_copy_root.resize(static_cast<size_t>(vertex_count) + static_cast<size_t>(body.dof_count() / 3) +
+                     body.held_copies().size());
   std::iota(m_copy_root.begin(), m_copy_root.end(), 0);
   const auto find = [&](int i) { return find_root(m_copy_root, i); };
   for (int t = 0; t < m_mesh.tet_count(); ++t) {
@@ -53,7 +54,8 @@ int CutRenderSurface::copy_of(const DeformableBody& body, int tet, int cut_tet, 
   const int vertex = m_mesh.tets[static_cast<size_t>(tet)][j];
   if (cut_tet < 0) return vertex;
   const int row = body.xfem().piece(cut_tet, piece).ghost_row[j];
-  return row < 0 ? vertex : m_mesh.vertex_count() + row;
+  if (row == -1) return vertex;
+  return m_mesh.vertex_count() + (row >= 0 ? row : body.dof_count() / 3 + held_copy_index(row));
 }
 
 int CutRenderSurface::part_of(const DeformableBody& body, const Point& point) const {
