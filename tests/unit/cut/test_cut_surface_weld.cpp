@@ -108,6 +108,30 @@ TEST(CutSurfaceWeld, ClosedAtEveryStepOfTheStroke) {
   EXPECT_EQ(worst_open, 0);
 }
 
+// Cut through material the fixed region holds (issue 41): the clamped cubes' pieces take held copies of
+// their fixed vertices, which the weld keeps apart from the real vertices as it keeps ghosts apart. A
+// stroke along the whole beam through the 3 cm clamp draws two closed surfaces at every step (the
+// halves share no material), and a stroke across inside the clamp one closed surface.
+TEST(CutSurfaceWeld, CutsThroughHeldMaterialStayClosedAtEveryStep) {
+  const TetMesh mesh = make_box_mesh(10, 2, 2, 0.01);
+  TissueSettings settings = beam_settings(mesh);
+  settings.body.fixed_vertices = vertices_at_minimum(mesh, 0, 0.3 + 1e-6);
+  Tissue along(mesh, settings);
+  EXPECT_EQ(stroke_worst_open(along, {-0.005, 0.0095}, {0.105, 0.0095}), 0);
+  ASSERT_GT(along.body().held_copies().size(), 0u);
+  for (int n = 0; n < 20; ++n) along.step();
+  const SurfaceCheck halves = check_drawn_surface(along);
+  EXPECT_EQ(halves.open_edges, 0);
+  EXPECT_EQ(halves.degenerate, 0);
+  EXPECT_EQ(halves.pieces, 2);
+  Tissue across(mesh, settings);
+  EXPECT_EQ(stroke_worst_open(across, {0.0153, -0.005}, {0.0153, 0.025}), 0);
+  ASSERT_GT(across.body().held_copies().size(), 0u);
+  const SurfaceCheck clamp = check_drawn_surface(across);
+  EXPECT_EQ(clamp.open_edges, 0);
+  EXPECT_EQ(clamp.degenerate, 0);
+  EXPECT_EQ(clamp.pieces, 2);
+}
 
 TissueSettings block_settings(const TetMesh& mesh) {
   TissueSettings settings = beam_settings(mesh);
