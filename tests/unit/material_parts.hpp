@@ -15,7 +15,8 @@ namespace tissue {
 /// simulation's own connectivity) and their rest volumes, largest first. [m^3]
 inline std::vector<double> material_part_volumes_m3(const TetMesh& mesh, const DeformableBody& body) {
   const int vertices = mesh.vertex_count();
-  std::vector<int> parent(static_cast<size_t>(vertices + body.dof_count() / 3));
+  const int rows = body.dof_count() / 3;
+  std::vector<int> parent(static_cast<size_t>(vertices + rows) + body.held_copies().size());
   std::iota(parent.begin(), parent.end(), 0);
   const auto find = [&](int i) {
     while (parent[static_cast<size_t>(i)] != i) i = parent[static_cast<size_t>(i)] = parent[static_cast<size_t>(parent[static_cast<size_t>(i)])];
@@ -33,7 +34,10 @@ inline std::vector<double> material_part_volumes_m3(const TetMesh& mesh, const D
     }
     for (int p = 0; p < static_cast<int>(body.xfem().piece_count(k)); ++p) {
       const CutPiece& piece = body.xfem().piece(k, p);
-      const auto copy = [&](size_t j) { return piece.ghost_row[j] < 0 ? tet[j] : vertices + piece.ghost_row[j]; };
+      const auto copy = [&](size_t j) {  // the real vertex, a ghost row, or a held copy (issue 41)
+        const int row = piece.ghost_row[j];
+        return row == -1 ? tet[j] : vertices + (row >= 0 ? row : rows + held_copy_index(row));
+      };
       for (size_t j = 1; j < 4; ++j) parent[static_cast<size_t>(find(copy(j)))] = find(copy(0));
       cells.emplace_back(copy(0), body.piece_mass_kg(k, p) / body.settings().material.density_kg_per_m3);
     }

@@ -349,6 +349,19 @@ TEST(CutRenderSurface, AnXLeavesFourClosedPiecesOfTheSimulatedVolumes) {
   }
 }
 
+// Strokes through the held tail (issue 41: its pieces take held copies of the fixed vertices): one
+// along the whole body and one across inside the held third leave four material parts (the halves,
+// each with its tail's end cut off in the clamp), each drawn closed with its volume.
+TEST(CutRenderSurface, StrokesThroughHeldMaterialLeaveClosedPieces) {
+  CutFrog frog({{Eigen::Vector2d(-0.09, 0.0051), Eigen::Vector2d(0.08, 0.0051)},
+                {Eigen::Vector2d(-0.0553, -0.07), Eigen::Vector2d(-0.0553, 0.07)}},
+               -0.032);
+  ASSERT_GT(frog.body.held_copies().size(), 0u);
+  CutRenderSurface render = frog.cut_render_surface();
+  EXPECT_EQ(render.open_loop_count(), 0);
+  EXPECT_EQ(expect_closed_parts(render, frog, 2e-6).size(), 4u);
+}
+
 TEST(CutRenderSurface, AFlapCutFreeByThreeStrokesIsClosed) {
   // The flap of the crossing-cuts test: three strokes overshooting each other's corners by 2 cm (so
   // partial cuts run on beyond each corner).
