@@ -102,7 +102,8 @@ constexpr auto body_settings() {
           .at_least("-1")
           .at_most("2")
           .describe("-1: nothing fixed; 0, 1, 2: the vertices within fixedRegion.fraction of the extent from the "
-                    "minimum along x, y, z keep their rest positions (Python: fixed_vertices lists them instead)")
+                    "minimum along x, y, z keep their rest positions, and the material between them (tets whose "
+                    "four vertices are fixed) stays held when cut (Python: fixed_vertices lists them instead)")
           .member(TISSUE_MEMBER(fixed_axis)),
       Setting("fixedRegion.fraction", 9, real)
           .python("fixed_fraction")
