@@ -215,15 +215,11 @@ int CutSurface::key_root(int key) const {
 
 namespace {
 
-// The cuts that separate a piece from a vertex it sees through block row `row` (-1: the real vertex,
-// none), kept to the cuts in `common` (ascending).
-SeparatingCuts separating_among(const DeformableBody& body, const std::vector<int>& dof_of_row, int row,
-                                const std::vector<int>& common) {
+// The cuts that separate a piece from a vertex it sees through `row` (CutPiece::ghost_row: -1, the
+// real vertex, none), kept to the cuts in `common` (ascending).
+SeparatingCuts separating_among(const DeformableBody& body, int row, const std::vector<int>& common) {
   SeparatingCuts kept;
-  if (row == -1) return kept;
-  const SeparatingCuts all =
-      row >= 0 ? body.enriched_dofs()[static_cast<size_t>(dof_of_row[static_cast<size_t>(row)])].separated_by
-               : body.copy_separated_by(row);  // a held copy
+  const SeparatingCuts& all = body.copy_separated_by(row);
   for (int i = 0; i < all.count; ++i) {
     if (!std::binary_search(common.begin(), common.end(), all.cut_id[static_cast<size_t>(i)])) continue;
     kept.cut_id[static_cast<size_t>(kept.count)] = all.cut_id[static_cast<size_t>(i)];
@@ -239,16 +235,6 @@ std::vector<int> sorted_cut_ids(const DeformableBody& body, int k) {
   return ids;
 }
 
-// Block row -> index into enriched_dofs().
-std::vector<int> enriched_dof_of_row(const DeformableBody& body) {
-  std::vector<int> dof_of_row;
-  for (size_t i = 0; i < body.enriched_dofs().size(); ++i) {
-    const auto row = static_cast<size_t>(body.enriched_dofs()[i].row);
-    if (row >= dof_of_row.size()) dof_of_row.resize(row + 1, -1);
-    dof_of_row[row] = static_cast<int>(i);
-  }
-  return dof_of_row;
-}
 
 }  // namespace
 
@@ -282,7 +268,6 @@ void CutSurface::join_compatible_keys(const DeformableBody& body) {
     const auto it = at_place.find(key_place(m_point_key[p]));
     if (it != at_place.end()) it->second.push_back(p);
   }
-  const std::vector<int> dof_of_row = at_place.empty() ? std::vector<int>{} : enriched_dof_of_row(body);
   std::vector<std::vector<int>> cuts_of;  // per point of the place: its tet's cut ids, ascending
   for (const auto& [place, points] : at_place) {
     cuts_of.clear();
@@ -298,8 +283,8 @@ void CutSurface::join_compatible_keys(const DeformableBody& body) {
         std::set_intersection(cuts_i.begin(), cuts_i.end(), cuts_j.begin(), cuts_j.end(), std::back_inserter(common));
         bool same_sides = true;
         for (size_t v = 0; v < 4 && same_sides && place.vertex[v] >= 0; ++v) {
-          same_sides = separating_among(body, dof_of_row, m_keys[static_cast<size_t>(key_i)].ghost_row[v], common) ==
-                       separating_among(body, dof_of_row, m_keys[static_cast<size_t>(key_j)].ghost_row[v], common);
+          same_sides = separating_among(body, m_keys[static_cast<size_t>(key_i)].ghost_row[v], common) ==
+                       separating_among(body, m_keys[static_cast<size_t>(key_j)].ghost_row[v], common);
         }
         if (same_sides) m_key_parent[static_cast<size_t>(key_root(key_j))] = key_root(key_i);
       }

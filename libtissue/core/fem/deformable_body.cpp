@@ -153,20 +153,22 @@ DeformableBody::DeformableBody(TetMesh mesh, BodySettings settings)
   m_enriched_dofs.reserve(static_cast<size_t>(spare_rows));
   m_next_enriched_dof.reserve(static_cast<size_t>(spare_rows));
   m_xfem.reserve(std::min(m_mesh.tet_count(), 2 * spare_rows));
-  m_tet_held.resize(static_cast<size_t>(m_mesh.tet_count()));
-  for (size_t t = 0; t < m_tet_held.size(); ++t) {
-    const Tet& tet = m_mesh.tets[t];
-    m_tet_held[t] = std::all_of(tet.begin(), tet.end(), [&](int v) { return vertex_block_row(v) < 0; }) ? 1 : 0;
-  }
   for (int t = 0; t < m_mesh.tet_count(); ++t) {
     m_largest_shape_gradient_per_m = std::max(m_largest_shape_gradient_per_m,
                                               m_elasticity.rest(t).shape_gradients_per_m.colwise().norm().maxCoeff());
   }
 }
 
-SeparatingCuts DeformableBody::copy_separated_by(int ghost_row) const {
+bool DeformableBody::held_tet(int t) const {
+  const Tet& tet = m_mesh.tets[static_cast<size_t>(t)];
+  return std::all_of(tet.begin(), tet.end(), [&](int v) { return vertex_block_row(v) < 0; });
+}
+
+const SeparatingCuts& DeformableBody::copy_separated_by(int ghost_row) const {
+  static const SeparatingCuts NONE;
   if (is_held_copy(ghost_row)) return m_held_copies.at(static_cast<size_t>(held_copy_index(ghost_row))).separated_by;
-  if (ghost_row < 0) return {};
+  if (ghost_row < 0) return NONE;
+  // Ghost row r is enriched unknown r - free_vertex_count() (append_ghost_rows checks it).
   return m_enriched_dofs.at(static_cast<size_t>(ghost_row - m_dofs.free_vertex_count())).separated_by;
 }
 

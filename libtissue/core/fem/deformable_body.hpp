@@ -217,10 +217,10 @@ class DeformableBody final : public DynamicsModel {
   /// across a face around the vertex). Material the fixed region holds stays held when cut.
   [[nodiscard]] const std::vector<EnrichedDof>& held_copies() const { return m_held_copies; }
   /// Whether tet t is held material: its four vertices fixed.
-  [[nodiscard]] bool held_tet(int t) const { return m_tet_held[static_cast<size_t>(t)] != 0; }
+  [[nodiscard]] bool held_tet(int t) const;
   /// The cuts that separate a piece's copy of a vertex from it, by CutPiece::ghost_row: a ghost
   /// row's or a held copy's (none for -1, the real vertex).
-  [[nodiscard]] SeparatingCuts copy_separated_by(int ghost_row) const;
+  [[nodiscard]] const SeparatingCuts& copy_separated_by(int ghost_row) const;
   /// Index into enriched_dofs() of the unknown of (vertex, cut id, side) of a single cut, or -1.
   [[nodiscard]] int find_enriched_dof(int vertex, int cut_id, int side) const;
   /// Index into enriched_dofs() of the ghost of `vertex` behind `cuts`, or -1.
@@ -419,7 +419,6 @@ class DeformableBody final : public DynamicsModel {
   std::vector<int> m_enriched_row_capacity;  // per vertex: blocks its enriched row is given
   std::vector<EnrichedDof> m_enriched_dofs;
   std::vector<EnrichedDof> m_held_copies;      // row: HELD_COPY_FIRST + index
-  std::vector<std::uint8_t> m_tet_held;        // per tet: its four vertices fixed
   std::vector<CutTetGeometry> m_cut_geometry;  // per cut tet
   std::vector<int> m_ghost_users;              // per enriched unknown: pieces of live cut tets using it
   long m_retired_slots = 0;  // slots of the cut tets retired since the last compaction (shared ones counted again)

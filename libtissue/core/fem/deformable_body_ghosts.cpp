@@ -203,14 +203,13 @@ void DeformableBody::join_star_pieces(std::span<const int> star, const std::vect
   }
 }
 
-// The separating cuts of an existing ghost row or of a held copy, the batch's new ones included.
+// copy_separated_by(), the batch's new held copies included.
 const SeparatingCuts& DeformableBody::planned_copy_cuts(int ghost_row, const EnrichBatch& batch) const {
-  if (!is_held_copy(ghost_row)) {
-    return m_enriched_dofs[static_cast<size_t>(ghost_row - m_dofs.free_vertex_count())].separated_by;
+  if (is_held_copy(ghost_row)) {
+    const auto held = static_cast<size_t>(held_copy_index(ghost_row));
+    if (held >= m_held_copies.size()) return batch.new_held[held - m_held_copies.size()].separated_by;
   }
-  const auto index = static_cast<size_t>(held_copy_index(ghost_row));
-  return index < m_held_copies.size() ? m_held_copies[index].separated_by
-                                      : batch.new_held[index - m_held_copies.size()].separated_by;
+  return copy_separated_by(ghost_row);
 }
 
 // Whether the component `root` of the key's nodes around fixed vertex v touches held material: one
