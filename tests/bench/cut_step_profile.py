@@ -24,6 +24,7 @@ import tempfile
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.join(HERE, "..", "..")
+TIME_LINE = re.compile(r"^\s*\d+\.\d+:")
 
 
 def record_steps(args, out_path):
@@ -53,7 +54,7 @@ def samples(script_path):
                 if time_s is not None and stack:
                     yield time_s, stack
                 time_s, stack = None, []
-            elif not line[0].isspace():
+            elif TIME_LINE.match(line):  # some perf versions indent it as the frames
                 time_s = float(line.split(":")[0])
             else:
                 parts = line.strip().split(None, 1)

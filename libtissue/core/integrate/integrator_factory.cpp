@@ -2,6 +2,7 @@
 #include "core/integrate/integrator_factory.hpp"
 
 #include "core/integrate/backward_euler.hpp"
+#include "core/solve/compact_rows_solver.hpp"
 
 #include <cmath>
 #include <string>
@@ -22,8 +23,9 @@ void validate(const SolverSettings& settings) {
   if (const std::string problem = settings.refresh.problem(); !problem.empty()) throw ParameterError(problem);
 }
 
-std::unique_ptr<LinearSolver> make_linear_solver(const SolverSettings& settings) {
-  validate(settings);
+namespace {
+
+std::unique_ptr<LinearSolver> make_solver_of_kind(const SolverSettings& settings) {
   switch (settings.kind) {
     case LinearSolverKind::pcg:
       return std::make_unique<PcgSolver>(settings.pcg);
@@ -35,6 +37,14 @@ std::unique_ptr<LinearSolver> make_linear_solver(const SolverSettings& settings)
       return std::make_unique<TwoLevelPcgSolver>(settings.pcg);
   }
   throw ParameterError("unknown linear solver kind");
+}
+
+}  // namespace
+
+// Every kind behind CompactRowsSolver: the rows a cut body leaves uncoupled are solved apart.
+std::unique_ptr<LinearSolver> make_linear_solver(const SolverSettings& settings) {
+  validate(settings);
+  return std::make_unique<CompactRowsSolver>(make_solver_of_kind(settings));
 }
 
 IntegratorKind parse_integrator_kind(std::string_view name) { return INTEGRATOR_NAMES.parse(name); }

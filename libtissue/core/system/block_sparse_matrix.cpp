@@ -171,7 +171,7 @@ TISSUE_HOT_KERNEL void BlockSparseMatrix::multiply_rows(const Eigen::VectorXd& x
   // so that the compiler keeps them in registers and the slots are streamed once, in order.
   const double* __restrict xv = x.data();
   double* __restrict yv = y.data();
-  const double* __restrict values = m_values.data();
+  const double* __restrict values = this->values();
   const int* __restrict column = m_column.data();
   const int* row_begin = m_row_begin.data();
   const int* row_size = m_row_size.data();
@@ -205,6 +205,52 @@ TISSUE_HOT_KERNEL void BlockSparseMatrix::multiply_rows(const Eigen::VectorXd& x
     yv[3 * r + 1] = y1 + z1;
     yv[3 * r + 2] = y2 + z2;
   }
+}
+
+void BlockSparseMatrix::view_rows_of(const BlockSparseMatrix& k, const std::vector<int>& rows,
+                                     const std::vector<int>& index_of_row) {
+  if (index_of_row.size() != to_size(k.block_rows())) {
+    throw std::invalid_argument("BlockSparseMatrix::view_rows_of: index_of_row has " +
+                                std::to_string(index_of_row.size()) + " entries for " + std::to_string(k.block_rows()) +
+                                " rows");
+  }
+  const auto n = rows.size();
+  m_row_begin.resize(n);
+  m_row_size.resize(n);
+  m_row_capacity.resize(n);
+  m_diagonal_slot.resize(n);
+  m_column.assign(k.m_column.size(), -1);
+  m_values.clear();
+  m_viewed = &k;
+  m_nonzero_blocks = 0;
+  for (size_t c = 0; c < n; ++c) {
+    const auto r = to_size(rows[c]);
+    if (index_of_row[r] != static_cast<int>(c)) {
+      throw std::invalid_argument("BlockSparseMatrix::view_rows_of: row " + std::to_string(r) + " is not numbered " +
+                                  std::to_string(c));
+    }
+    const int begin = k.m_row_begin[r];
+    m_row_begin[c] = begin;
+    m_row_size[c] = k.m_row_size[r];
+    m_row_capacity[c] = k.m_row_capacity[r];
+    m_diagonal_slot[c] = k.m_diagonal_slot[r];
+    for (int slot = begin; slot < begin + k.m_row_size[r]; ++slot) {
+      const int column = index_of_row[to_size(k.m_column[to_size(slot)])];
+      if (column < 0) {
+        throw std::invalid_argument("BlockSparseMatrix::view_rows_of: row " + std::to_string(r) +
+                                    " has a block with row " + std::to_string(k.m_column[to_size(slot)]) +
+                                    ", which is left out");
+      }
+      m_column[to_size(slot)] = column;
+    }
+    m_nonzero_blocks += k.m_row_size[r];
+  }
+  m_relayout_slot_map.clear();
+  m_spare_row_capacity = 0;
+  m_block_row_capacity = static_cast<int>(n);
+  m_reserve = k.m_reserve;
+  ++m_pattern_revision;
+  ++m_layout_revision;
 }
 
 void BlockSparseMatrix::diagonal(Eigen::VectorXd& diagonal) const {

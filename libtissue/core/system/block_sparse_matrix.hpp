@@ -51,7 +51,7 @@ class BlockSparseMatrix {
     return Eigen::Map<Eigen::Matrix3d>(&m_values[9 * static_cast<size_t>(slot)]);
   }
   [[nodiscard]] Eigen::Map<const Eigen::Matrix3d> block(int slot) const {
-    return Eigen::Map<const Eigen::Matrix3d>(&m_values[9 * static_cast<size_t>(slot)]);
+    return Eigen::Map<const Eigen::Matrix3d>(values() + 9 * static_cast<size_t>(slot));
   }
 
   /// Adds b (add_block) or b^T (add_block_transposed) to the block in `slot`, entry by entry in
@@ -124,6 +124,14 @@ class BlockSparseMatrix {
   /// After a re-layout: the new slot of each old slot (-1: an unused one), until the next re-layout.
   [[nodiscard]] const std::vector<int>& relayout_slot_map() const { return m_relayout_slot_map; }
 
+  /// Makes this matrix a view of the block rows `rows` of `k` (ascending), renumbered 0, 1, ... in
+  /// that order, each in the slots it has in k: `index_of_row[r]` is k's row r's number here, or -1
+  /// for a row left out, with which no row kept may have a block (throws std::invalid_argument). Its
+  /// values are k's, read where k keeps them (no copy): it is read only (block() const, products),
+  /// valid while k's layout stays as it is and k lives. Both revisions move on: nothing made of this
+  /// matrix's earlier pattern is taken for this one (core/solve/compact_rows_solver.hpp).
+  void view_rows_of(const BlockSparseMatrix& k, const std::vector<int>& rows, const std::vector<int>& index_of_row);
+
   /// Changes whenever the set of blocks changes (append_block_row, insert_block of a new block).
   [[nodiscard]] std::uint64_t pattern_revision() const { return m_pattern_revision; }
   /// Changes only when existing slots moved (storage re-laid out: a row outgrew its room, or the
@@ -155,7 +163,11 @@ class BlockSparseMatrix {
   std::vector<int> m_row_size;       // blocks in use in each row
   std::vector<int> m_row_capacity;   // slots reserved for each row
   std::vector<int> m_column;         // block column of each slot (-1 = unused)
-  std::vector<double> m_values;      // 9 per slot, column-major 3x3
+  std::vector<double> m_values;      // 9 per slot, column-major 3x3 (none in a view)
+  const BlockSparseMatrix* m_viewed = nullptr;  // view_rows_of's k, whose values this one reads
+  [[nodiscard]] const double* values() const {
+    return m_viewed != nullptr ? m_viewed->m_values.data() : m_values.data();
+  }
   std::vector<int> m_diagonal_slot;  // slot of the diagonal block of each row (always present)
   std::vector<int> m_relayout_slot_map;  // old slot -> new slot of the last re-layout
   int m_nonzero_blocks = 0;
