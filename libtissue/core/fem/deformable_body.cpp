@@ -405,7 +405,7 @@ int DeformableBody::cut_tet_dof_row(int cut_tet_index, int dof) const {
   return m_xfem.ghost_rows(cut_tet_index)[static_cast<size_t>(dof - 4)];
 }
 
-void DeformableBody::refresh_cut_tet_slots(int cut_tet_index) {
+void DeformableBody::refresh_cut_tet_slots(int cut_tet_index, const std::vector<int>* moved) {
   const CutTet& cut_tet = m_xfem.cut_tets()[static_cast<size_t>(cut_tet_index)];
   const int dofs = m_xfem.dof_count(cut_tet_index);
   const auto row_of = [&](int dof) { return cut_tet_dof_row(cut_tet_index, dof); };
@@ -418,13 +418,16 @@ void DeformableBody::refresh_cut_tet_slots(int cut_tet_index) {
   m_xfem.coupled_dofs(cut_tet_index, coupled);
   for (int r = 0; r < dofs; ++r) {
     for (int col = 0; col < dofs; ++col) {
-      int slot = -1;
-      if (coupled[static_cast<size_t>(dofs * r + col)] != 0 && row_of(r) >= 0 && row_of(col) >= 0) {
-        slot = m_tangent.find_slot(row_of(r), row_of(col));
-        if (slot < 0)
-          throw std::logic_error("enrich: a block of cut tet " + std::to_string(cut_tet.cut.tet) + " is missing");
+      int& slot = slots[static_cast<size_t>(dofs * r + col)];
+      if (coupled[static_cast<size_t>(dofs * r + col)] == 0 || row_of(r) < 0 || row_of(col) < 0) {
+        slot = -1;
+        continue;
       }
-      slots[static_cast<size_t>(dofs * r + col)] = slot;
+      // Where the one re-layout since moved it (a pair's block stays while a piece uses it), else searched.
+      slot = moved != nullptr && slot >= 0 ? (*moved)[static_cast<size_t>(slot)] : -1;
+      if (slot < 0) slot = m_tangent.find_slot(row_of(r), row_of(col));
+      if (slot < 0)
+        throw std::logic_error("enrich: a block of cut tet " + std::to_string(cut_tet.cut.tet) + " is missing");
     }
   }
 }
@@ -462,7 +465,9 @@ void DeformableBody::refresh_all_slots(bool one_relayout) {
   } else {
     m_slots = make_tet_slots(m_mesh, m_dofs, m_tangent);
   }
-  for (int k = 0; k < m_xfem.cut_tet_count(); ++k) refresh_cut_tet_slots(k);
+  for (int k = 0; k < m_xfem.cut_tet_count(); ++k) {
+    refresh_cut_tet_slots(k, one_relayout ? &m_tangent.relayout_slot_map() : nullptr);
+  }
   for (ForceTerm* term : m_force_terms) term->locate(term_layout());
 }
 

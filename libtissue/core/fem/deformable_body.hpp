@@ -362,8 +362,10 @@ class DeformableBody final : public DynamicsModel {
   // All slots again after the tangent was re-laid out: by its slot map when it was re-laid out once
   // since they were right (`one_relayout`), else by search.
   void refresh_all_slots(bool one_relayout);
-  /// A retired cut tet's slots are all -1 (it adds nothing; its blocks may be gone).
-  void refresh_cut_tet_slots(int cut_tet_index);
+  /// A retired cut tet's slots are all -1 (it adds nothing; its blocks may be gone). `moved`: the
+  /// tangent's relayout_slot_map() when it was re-laid out once since the table was right; a slot
+  /// the map does not give (a table made since, still -1) is searched.
+  void refresh_cut_tet_slots(int cut_tet_index, const std::vector<int>* moved = nullptr);
   /// The block row of local DOF `dof` of a cut tet (XfemElasticity::dof_count): u of a local vertex
   /// (-1 if fixed) or a ghost row.
   [[nodiscard]] int cut_tet_dof_row(int cut_tet_index, int dof) const;
