@@ -4,6 +4,7 @@
 #include <Eigen/Cholesky>
 
 #include <cmath>
+#include <stdexcept>
 #include <string>
 #include <utility>
 
@@ -48,11 +49,17 @@ bool CompactRowsSolver::keep_rows(const ShiftedSystem& system) {
     m_index_of_row.push_back(static_cast<int>(m_kept_rows.size()));
     m_kept_rows.push_back(r);
   }
-  if (compaction_due(k)) {
-    compact_all(k);
-  } else if (m_compacted) {
-    m_compact_stiffness[static_cast<size_t>(m_current)].view_rows_of(k, m_kept_rows, m_index_of_row);
+  bool viewed = false;
+  if (m_compacted && !compaction_due(k)) {
+    try {
+      m_compact_stiffness[static_cast<size_t>(m_current)].view_rows_of(k, m_kept_rows, m_index_of_row);
+      viewed = true;
+    } catch (const std::invalid_argument&) {
+      // A row kept has a block with a row left out whose own row has none (a pattern not symmetric):
+      // compacted anew, leaving out only rows no block reaches.
+    }
   }
+  if (!viewed && (m_compacted || compaction_due(k))) compact_all(k);
   m_source = &k;
   m_pattern_revision = k.pattern_revision();
   m_layout_revision = k.layout_revision();
@@ -73,8 +80,17 @@ void CompactRowsSolver::compact_all(const BlockSparseMatrix& k) {
   m_index_of_row.assign(static_cast<size_t>(rows), -1);
   m_kept_rows.clear();
   m_left_rows.clear();
+  // A row goes when its only block is its diagonal and no other row has a block with it.
+  std::vector<std::uint8_t>& reached = m_reached;
+  reached.assign(static_cast<size_t>(rows), 0);
   for (int r = 0; r < rows; ++r) {
-    if (k.row_size(r) > 1) {
+    for (int slot = k.row_begin(r); slot < k.row_begin(r) + k.row_size(r); ++slot) {
+      const int column = k.slot_column(slot);
+      if (column != r) reached[static_cast<size_t>(column)] = 1;
+    }
+  }
+  for (int r = 0; r < rows; ++r) {
+    if (k.row_size(r) > 1 || reached[static_cast<size_t>(r)] != 0) {
       m_index_of_row[static_cast<size_t>(r)] = static_cast<int>(m_kept_rows.size());
       m_kept_rows.push_back(r);
     } else {

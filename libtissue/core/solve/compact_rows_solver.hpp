@@ -7,7 +7,8 @@
 //
 // The rows kept are those of the system as it was when the solver last compacted, plus every row
 // appended since (XFEM rows grow at the end). It compacts again, at a setup, when a quarter of the
-// rows it keeps have only their diagonal block (or a row it left out gained a block): rows that fall
+// rows it keeps have only their diagonal block (or a row it left out gained a block, or another row
+// one with it: only rows no block reaches go): rows that fall
 // out one cut at a time keep their numbers until then, so that what the inner solver made of the
 // rows (the two-level preconditioner's aggregates, CHOLMOD's analysis) serves from cut to cut as on
 // the full matrix. The compacted matrix is a view of K's kept rows in K's own slots
@@ -78,6 +79,7 @@ class CompactRowsSolver final : public LinearSolver {
   std::vector<int> m_index_of_row;
   std::vector<int> m_kept_rows;
   std::vector<int> m_left_rows;
+  std::vector<std::uint8_t> m_reached;  // compact_all's: per row, whether another row has a block with it
   // K's identity and revisions when the kept rows' pattern was taken.
   const BlockSparseMatrix* m_source = nullptr;
   std::uint64_t m_pattern_revision = 0, m_layout_revision = 0;

@@ -127,6 +127,23 @@ TEST(CompactRowsSolver, FollowsThePatternAsItChanges) {
   EXPECT_LT(relative_error(x, dense_solution(system, SCALE, b)), 1e-10);
 }
 
+// A pattern that is not symmetric (row 3 has a block with row 70, row 70 none with row 3): row 70 is
+// kept, as every row a block reaches, and the solution is still the system's.
+TEST(CompactRowsSolver, KeepsEveryRowABlockReaches) {
+  constexpr double SCALE = 0.3;
+  test::TestSystem system = grid_with_uncoupled_rows(4, 4, 4, 80, 13);
+  CompactRowsSolver solver(std::make_unique<CholmodSolver>());
+  std::mt19937 rng(7);
+  const Eigen::VectorXd b = test::random_vector(system.stiffness.rows(), rng);
+  Eigen::VectorXd x;
+  solver.solve(system.shifted(SCALE), b, x);
+  ASSERT_EQ(solver.kept_block_rows(), 64);
+  system.stiffness.insert_block(3, 70);  // its value zero: A is unchanged
+  solver.solve(system.shifted(SCALE), b, x);
+  EXPECT_EQ(solver.kept_block_rows(), 65);
+  EXPECT_LT(relative_error(x, dense_solution(system, SCALE, b)), 1e-10);
+}
+
 TEST(CompactRowsSolver, RefusesWhatItCannotSolve) {
   const test::TestSystem system = grid_with_uncoupled_rows(4, 4, 4, 80, 2);
   CompactRowsSolver solver(std::make_unique<PcgSolver>(PcgSolver::Settings{1e-8, 100}));
