@@ -4,6 +4,7 @@
 #include <Eigen/Cholesky>
 
 #include <cmath>
+#include <numeric>
 #include <stdexcept>
 #include <string>
 #include <utility>
@@ -99,9 +100,8 @@ void CompactRowsSolver::compact_all(const BlockSparseMatrix& k) {
   }
   // Nothing to leave out, or nothing left to solve but 3 x 3 systems: the system as it is.
   if (m_left_rows.empty() || m_kept_rows.empty()) {
-    for (int r = 0; r < rows; ++r) m_index_of_row[static_cast<size_t>(r)] = r;
-    m_kept_rows.resize(static_cast<size_t>(rows));
-    for (int r = 0; r < rows; ++r) m_kept_rows[static_cast<size_t>(r)] = r;
+    std::iota(m_index_of_row.begin(), m_index_of_row.end(), 0);
+    m_kept_rows = m_index_of_row;
     m_left_rows.clear();
     m_compacted = false;
     return;
@@ -212,10 +212,7 @@ bool CompactRowsSolver::multiply_set_up(const ShiftedSystem& system, const Eigen
 }
 
 void CompactRowsSolver::forget_earlier_setups() {
-  m_source = nullptr;
-  m_index_of_row.clear();
-  m_kept_rows.clear();
-  m_left_rows.clear();
+  m_source = nullptr;  // (keep_rows then numbers the rows anew)
   m_compacted = false;
   m_system = ShiftedSystem{nullptr, 1.0, nullptr};
   m_inner->forget_earlier_setups();

@@ -59,7 +59,6 @@ class CompactRowsSolver final : public LinearSolver {
 
   /// The block rows the inner solver got at the last setup (all of them while none is left out).
   [[nodiscard]] int kept_block_rows() const;
-  [[nodiscard]] const LinearSolver& inner() const { return *m_inner; }
 
  private:
   enum class Pass { full, rough, refine };
