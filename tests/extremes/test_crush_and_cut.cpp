@@ -15,8 +15,10 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cstdint>
 #include <cstdio>
 #include <random>
+#include <span>
 #include <string>
 #include <tuple>
 #include <vector>
@@ -188,6 +190,44 @@ Case hinged_cube() {
   return c;
 }
 
+// TISSUE_EXTREMES_VERBOSE: what coarsening the cut pieces could give (issue 41, item 3): the block
+// rows and elements the dynamics would keep if every live piece below a share of its tet's volume
+// were taken out (its rows gone unless another element uses them), parked parts left out as the
+// solver leaves them out. A measurement for docs/BENCHMARKS.md, not a check.
+void print_rows_left_by_piece_share(const DeformableBody& body) {
+  const TetMesh& mesh = body.mesh();
+  const std::span<const int> vertex_row = body.term_layout().vertex_row;
+  const int rows = body.dof_count() / 3;
+  for (const double share : {0.0, 1e-3, 1e-2, 3e-2, 1e-1, 2e-1}) {
+    std::vector<std::uint8_t> used(static_cast<size_t>(rows), 0);
+    long elements = 0;
+    const auto use = [&](int row) {
+      if (row >= 0) used[static_cast<size_t>(row)] = 1;
+    };
+    for (int t = 0; t < mesh.tet_count(); ++t) {
+      const Tet& tet = mesh.tets[static_cast<size_t>(t)];
+      const bool live = std::any_of(tet.begin(), tet.end(), [&](int v) {
+        const int row = vertex_row[static_cast<size_t>(v)];
+        return row >= 0 && !body.parked(row);
+      });
+      if (body.cut_tet_index(t) >= 0 || !live) continue;
+      ++elements;
+      for (const int v : tet) use(vertex_row[static_cast<size_t>(v)]);
+    }
+    for (int k = 0; k < static_cast<int>(body.cut_tets().size()); ++k) {
+      if (body.retired(k)) continue;
+      const std::vector<TetPiece>& pieces = body.cut_geometry(k).pieces;
+      for (int p = 0; p < static_cast<int>(pieces.size()); ++p) {
+        if (body.xfem().parked(k, p) || pieces[static_cast<size_t>(p)].volume_fraction < share) continue;
+        ++elements;
+        for (const int row : body.piece_rows(k, p)) use(row);
+      }
+    }
+    std::printf("[extremes] pieces below %g of their tet taken out: %ld block rows used (of %d), %ld elements\n", share,
+                static_cast<long>(std::count(used.begin(), used.end(), 1)), rows, elements);
+  }
+}
+
 // A careless hand on the frog (issue 21): the frog on its tray, STROKES strokes of a vertical
 // scalpel across the body (along y) and then STROKES along it (along x), each at 5 m/s, offset and
 // tilted at random (seeded): the tets where they cross are cut several times. 30 + 30 strokes (issue
@@ -230,6 +270,7 @@ Case careless_cross_hatching() {
       if (run.tissue().body().cut_tets().size() > before) ++strokes_that_cut;
     }
     run.steps(phase_steps(50));
+    if (verbose()) print_rows_left_by_piece_share(run.tissue().body());
     if (run.running() && strokes_that_cut < STROKES) {
       run.fail("only " + std::to_string(strokes_that_cut) + " of the " + std::to_string(2 * STROKES) + " strokes cut a tet");
     }

@@ -432,8 +432,9 @@ TEST(CrossingCuts, ThreeStrokesPlungedAndLiftedAtTheCornersCutATriangularFlapTha
 // The frog hatched by 4 + 4 full-height strokes (tets cut up to three times, their earlier cut tets
 // retired): dropping the blocks only retired cut tets used (DeformableBody::drop_retired_blocks, which
 // enrich() does itself past RETIRED_SLOT_SHARE_TO_COMPACT) leaves the internal forces bitwise and the
-// tangent's product to round-off as they were (the dropped blocks were zeros), and every XFEM block
-// left is one a live cut tet uses.
+// tangent's product to round-off as they were (the dropped blocks were zeros); packing the rows then
+// (issue 41, item 3) leaves both bitwise as they were; and every XFEM block left is one a live cut
+// tet uses.
 TEST(CrossingCuts, DroppingTheRetiredCutTetsBlocksChangesNeitherTheForcesNorTheProduct) {
   std::vector<Stroke> strokes;
   for (int k = 0; k < 4; ++k) {
@@ -476,6 +477,19 @@ TEST(CrossingCuts, DroppingTheRetiredCutTetsBlocksChangesNeitherTheForcesNorTheP
               blocks_before - body.tangent().nonzero_blocks(), blocks_before,
               (product_after - product_before).cwiseAbs().maxCoeff() / product_before.cwiseAbs().maxCoeff());
   EXPECT_FALSE(body.drop_retired_blocks());  // nothing left to drop
+
+  // The rows packed (what the drop does by itself once their room passes ROW_ROOM_PER_BLOCK_TO_PACK
+  // times their blocks): the forces and the product bitwise as they were, the room given back.
+  ASSERT_GT(body.tangent().row_room(), body.tangent().nonzero_blocks());
+  ASSERT_TRUE(body.drop_retired_blocks(DeformableBody::PackRows::always));
+  EXPECT_EQ(body.tangent().row_room(), body.tangent().nonzero_blocks());
+  Eigen::VectorXd force_packed, product_packed;
+  body.restore_rotations(warm_starts);
+  body.evaluate(u, force_packed, /*update_tangent=*/true);
+  body.tangent().multiply(x, product_packed);
+  EXPECT_TRUE((force_packed.array() == force_before.array()).all());
+  EXPECT_TRUE((product_packed.array() == product_after.array()).all());
+  EXPECT_FALSE(body.drop_retired_blocks(DeformableBody::PackRows::always));  // packed already
 
   // Every block with a ghost row or column is one a live cut tet uses.
   const BlockSparseMatrix& tangent = body.tangent();

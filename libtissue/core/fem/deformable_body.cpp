@@ -432,7 +432,7 @@ void DeformableBody::refresh_cut_tet_slots(int cut_tet_index, const std::vector<
   }
 }
 
-bool DeformableBody::drop_retired_blocks() {
+bool DeformableBody::drop_retired_blocks(PackRows pack) {
   const int u_rows = m_dofs.free_vertex_count();
   std::vector<std::uint8_t> keep(static_cast<size_t>(m_tangent.slot_capacity()), 0);
   // The blocks between two u rows stay (the uncut tets' and the force terms'): only XFEM blocks can
@@ -447,7 +447,10 @@ bool DeformableBody::drop_retired_blocks() {
     if (!m_xfem.retired(k)) m_xfem.mark_written_slots(k, keep);
   }
   m_retired_slots = 0;
-  if (!m_tangent.remove_blocks(keep)) return false;
+  const bool packed = pack == PackRows::always || static_cast<double>(m_tangent.row_room()) >
+                                                      ROW_ROOM_PER_BLOCK_TO_PACK * m_tangent.nonzero_blocks();
+  using RowRoom = BlockSparseMatrix::RowRoom;
+  if (!m_tangent.remove_blocks(keep, packed ? RowRoom::packed : RowRoom::kept)) return false;
   changed();
   refresh_all_slots(/*one_relayout=*/true);
   return true;

@@ -87,6 +87,12 @@ struct CutTetGeometry {
 /// since it last did reach this share of its blocks (DeformableBody::enrich).
 inline constexpr double RETIRED_SLOT_SHARE_TO_COMPACT = 0.25;
 
+/// ... and packs its rows back to back (BlockSparseMatrix::RowRoom::packed) when the room the rows
+/// take is more than this many times their blocks: the cuts' room (CUT_ROOM_RINGS, doubled at each
+/// re-layout) grew to 20 times the blocks after the extremes suite's 30 + 30 strokes (852k slots for
+/// 42k blocks), and the step's passes over the blocks ran through 61 MB (docs/BENCHMARKS.md).
+inline constexpr double ROW_ROOM_PER_BLOCK_TO_PACK = 4.0;
+
 /// When a cut must re-lay the tangent out (a row near it lacks room), the rows of the vertices within
 /// this many rings (vertex - tet - vertex) of its cut tets get a cut's room in the same re-layout, so
 /// that the blade moving on finds room for the next steps: a stroke through the frog re-laid the
@@ -235,9 +241,12 @@ class DeformableBody final : public DynamicsModel {
   /// piece uses (those only retired cut tets or parked pieces used: zeros the product multiplies
   /// every step) and looks every slot up again; returns whether any went (the tangent's layout
   /// changed). enrich() does it itself once the retired cut tets' slots reach
-  /// RETIRED_SLOT_SHARE_TO_COMPACT of the blocks, park_parts_outside() whenever it parks. The
-  /// product and the forces are unchanged.
-  bool drop_retired_blocks();
+  /// RETIRED_SLOT_SHARE_TO_COMPACT of the blocks, park_parts_outside() whenever it parks. Packs the
+  /// rows too (BlockSparseMatrix::RowRoom::packed) when their room passes ROW_ROOM_PER_BLOCK_TO_PACK
+  /// times their blocks, or always if asked (then returns true when a row moved, even if no block
+  /// went). The forces are unchanged, bitwise; so is the product when no block went.
+  enum class PackRows { when_sparse, always };
+  bool drop_retired_blocks(PackRows pack = PackRows::when_sparse);
   // --- Parts out of the dynamics ---
 
   /// Takes out of the dynamics every part of the body (find_body_parts) that no fixed vertex holds

@@ -337,24 +337,29 @@ void BlockSparseMatrix::relayout(const std::vector<std::pair<int, int>>& min_cap
   ++m_pattern_revision;
 }
 
-bool BlockSparseMatrix::remove_blocks(const std::vector<std::uint8_t>& keep) {
+bool BlockSparseMatrix::remove_blocks(const std::vector<std::uint8_t>& keep, RowRoom room) {
   if (keep.size() != m_column.size()) {
     throw std::invalid_argument("BlockSparseMatrix::remove_blocks: " + std::to_string(keep.size()) + " marks for " +
                                 std::to_string(m_column.size()) + " slots");
   }
-  m_relayout_slot_map.assign(m_column.size(), -1);
-  bool removed = false;
+  const size_t old_slots = m_column.size();
+  m_relayout_slot_map.assign(old_slots, -1);
+  bool changed = false;
+  // Packed, each row moves to a slot at or before its old first one (the rows before it shrink or
+  // keep their room), so the rows go front to back and a block never lands on one not yet read.
+  int packed_begin = 0;
   for (int r = 0; r < block_rows(); ++r) {
-    const int begin = m_row_begin[to_size(r)];
+    const int old_begin = m_row_begin[to_size(r)];
+    const int begin = room == RowRoom::packed ? packed_begin : old_begin;
     const int size = m_row_size[to_size(r)];
     int kept = 0;
     for (int k = 0; k < size; ++k) {
-      const int slot = begin + k;
+      const int slot = old_begin + k;
       if (keep[to_size(slot)] == 0 && m_column[to_size(slot)] != r) {
-        removed = true;
+        changed = true;
         continue;
       }
-      const int target = begin + kept++;  // never after `slot`: the row closes up front to back
+      const int target = begin + kept++;  // never after `slot`: blocks keep their order
       if (target != slot) {
         m_column[to_size(target)] = m_column[to_size(slot)];
         std::copy_n(&m_values[9 * to_size(slot)], 9, &m_values[9 * to_size(target)]);
@@ -362,18 +367,39 @@ bool BlockSparseMatrix::remove_blocks(const std::vector<std::uint8_t>& keep) {
       m_relayout_slot_map[to_size(slot)] = target;
       if (m_column[to_size(target)] == r) m_diagonal_slot[to_size(r)] = target;
     }
-    for (int k = kept; k < size; ++k) {
-      m_column[to_size(begin + k)] = -1;
-      std::fill_n(&m_values[9 * to_size(begin + k)], 9, 0.0);
+    // The old blocks' slots that no block of this row now holds are unused (column -1, zeros); the
+    // rest of its room was already.
+    for (int slot = std::max(begin + kept, old_begin); slot < old_begin + size; ++slot) {
+      m_column[to_size(slot)] = -1;
+      std::fill_n(&m_values[9 * to_size(slot)], 9, 0.0);
     }
     m_nonzero_blocks -= size - kept;
     m_row_size[to_size(r)] = kept;
+    if (room == RowRoom::packed) {
+      changed = changed || begin != old_begin || m_row_capacity[to_size(r)] != kept;
+      m_row_begin[to_size(r)] = begin;
+      m_row_capacity[to_size(r)] = kept;
+      packed_begin += kept;
+    }
   }
-  if (removed) {
+  if (room == RowRoom::packed) {  // the spare rows' room follows the rows again
+    const size_t slots =
+        to_size(packed_begin) + to_size(m_block_row_capacity - block_rows()) * to_size(m_spare_row_capacity);
+    if (slots < old_slots) {
+      m_column.resize(slots);
+      m_values.resize(9 * slots);
+    }
+  }
+  if (changed) {
     ++m_layout_revision;
     ++m_pattern_revision;
   }
-  return removed;
+  return changed;
+}
+
+long BlockSparseMatrix::row_room() const {
+  const int n = block_rows();
+  return n == 0 ? 0 : m_row_begin[to_size(n - 1)] + m_row_capacity[to_size(n - 1)];
 }
 
 int BlockSparseMatrix::append_block_row(int min_capacity) {

@@ -115,12 +115,23 @@ class BlockSparseMatrix {
   /// they need, at least twice their blocks, in one re-layout (none when every row has the room).
   /// Pairs need not be unique (a row's extras add up). Returns whether the storage was re-laid out.
   bool reserve_room(const std::vector<std::pair<int, int>>& row_extra);
+  /// What remove_blocks leaves of the rows' room.
+  enum class RowRoom {
+    kept,   ///< each row closes up in place and keeps its room
+    packed  ///< the rows move back to back, each with room for just its blocks
+  };
   /// Removes the blocks whose slot is not marked in `keep` (one entry per slot, slot_capacity();
-  /// the diagonal blocks stay whatever it says), each row's blocks closing up in place (the row
-  /// keeps its room). Returns whether a block went; then the layout changed (layout_revision(),
-  /// pattern_revision()) and relayout_slot_map() tells where the kept slots went. For the XFEM's
-  /// blocks that only retired cut tets used (zeros the product would multiply every step).
-  bool remove_blocks(const std::vector<std::uint8_t>& keep);
+  /// the diagonal blocks stay whatever it says), each row's blocks closing up in their order.
+  /// Returns whether a block went or (packed) a row moved or lost room; then the layout changed
+  /// (layout_revision(), pattern_revision()) and relayout_slot_map() tells where the kept slots
+  /// went. For the XFEM's blocks that only retired cut tets used (zeros the product would multiply
+  /// every step); packed, for the room cuts left in the rows (row_room()), which spreads every pass
+  /// over the blocks (zeroing, assembly, products) over memory it mostly does not use. Neither
+  /// changes a value, a row's blocks' order, or so any product.
+  bool remove_blocks(const std::vector<std::uint8_t>& keep, RowRoom room = RowRoom::kept);
+  /// The slots the rows take with their room (the spare rows' room not counted): nonzero_blocks()
+  /// when packed.
+  [[nodiscard]] long row_room() const;
   /// After a re-layout: the new slot of each old slot (-1: an unused one), until the next re-layout.
   [[nodiscard]] const std::vector<int>& relayout_slot_map() const { return m_relayout_slot_map; }
 

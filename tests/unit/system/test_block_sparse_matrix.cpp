@@ -507,5 +507,90 @@ TEST(BlockSparseMatrix, ReservingRoomInPlaceKeepsEveryBlockAndClearsTheRest) {
   }
 }
 
+// Removing blocks with the rows packed (issue 41, item 3: the room cuts left in the rows): rows that
+// had grown room (and appended rows with their own) move back to back with room for just their
+// blocks, each keeping its blocks in their order (so the product's sums are the same, bitwise), the
+// slot map says where every kept block went, the freed slots are unused and zero, and the matrix then
+// grows again (a block inserted into a packed row re-lays it out) as before.
+TEST(BlockSparseMatrix, RemovingBlocksWithTheRowsPackedKeepsOrderValuesAndProduct) {
+  std::mt19937 rng(23);
+  const Pattern pattern = random_symmetric_pattern(40, 2, rng);
+  BlockSparseMatrix matrix(pattern, {0.5, 1});
+  BlockMap blocks = fill_random(matrix, pattern, rng);
+  std::uniform_int_distribution<int> pick(0, 39);
+  ASSERT_TRUE(matrix.reserve_room({{0, 20}, {39, 9}, {pick(rng), 30}, {pick(rng), 14}}));
+  for (int k = 0; k < 3; ++k) {  // rows appended (XFEM's ghosts), with blocks to the first rows
+    const int row = matrix.append_block_row(24);
+    for (const int c : {k, 2 * k + 1}) {
+      for (const auto& [r, col] : {std::pair{row, c}, std::pair{c, row}}) {
+        const Eigen::Matrix3d value = random_block(rng);
+        matrix.block(matrix.insert_block(r, col)) = value;
+        blocks[{r, col}] = value;
+      }
+    }
+    blocks[{row, row}] = matrix.block(matrix.diagonal_slot(row));
+  }
+  // Every fourth off-diagonal block goes.
+  std::vector<std::uint8_t> keep(static_cast<size_t>(matrix.slot_capacity()), 1);
+  std::map<int, std::pair<int, int>> kept_at;  // old slot -> block
+  std::vector<std::vector<int>> order_before(static_cast<size_t>(matrix.block_rows()));
+  int counted = 0;
+  for (int r = 0; r < matrix.block_rows(); ++r) {
+    for (int slot = matrix.row_begin(r); slot < matrix.row_begin(r) + matrix.row_size(r); ++slot) {
+      const int column = matrix.slot_column(slot);
+      if (column != r && ++counted % 4 == 0) {
+        keep[static_cast<size_t>(slot)] = 0;
+        blocks.erase({r, column});
+        continue;
+      }
+      kept_at[slot] = {r, column};
+      order_before[static_cast<size_t>(r)].push_back(column);
+    }
+  }
+  ASSERT_GT(matrix.row_room(), matrix.nonzero_blocks() + 50L);  // room to give back
+  Eigen::VectorXd x = Eigen::VectorXd::Random(matrix.rows());
+  const auto layout = matrix.layout_revision();
+  const int slots_before = matrix.slot_capacity();
+  ASSERT_TRUE(matrix.remove_blocks(keep, BlockSparseMatrix::RowRoom::packed));
+  EXPECT_EQ(matrix.layout_revision(), layout + 1);
+  EXPECT_EQ(matrix.row_room(), matrix.nonzero_blocks());
+  EXPECT_LT(matrix.slot_capacity(), slots_before);
+  const std::vector<int>& map = matrix.relayout_slot_map();
+  for (const auto& [old_slot, block] : kept_at) {
+    EXPECT_EQ(map[static_cast<size_t>(old_slot)], matrix.find_slot(block.first, block.second));
+  }
+  for (int r = 0; r < matrix.block_rows(); ++r) {
+    EXPECT_EQ(matrix.row_capacity(r), matrix.row_size(r));
+    if (r > 0) {
+      EXPECT_EQ(matrix.row_begin(r), matrix.row_begin(r - 1) + matrix.row_size(r - 1));
+    }
+    std::vector<int> order;
+    for (int slot = matrix.row_begin(r); slot < matrix.row_begin(r) + matrix.row_size(r); ++slot) {
+      order.push_back(matrix.slot_column(slot));
+    }
+    EXPECT_EQ(order, order_before[static_cast<size_t>(r)]) << "row " << r;
+    EXPECT_EQ(matrix.slot_column(matrix.diagonal_slot(r)), r);
+  }
+  expect_values(matrix, blocks);
+  expect_product_matches(matrix, blocks, rng);
+  for (int slot = matrix.row_room(); slot < matrix.slot_capacity(); ++slot) {
+    EXPECT_EQ(matrix.slot_column(slot), -1);
+    EXPECT_TRUE(matrix.block(slot).isZero()) << "slot " << slot;
+  }
+  // Nothing to remove and nothing to pack: unchanged.
+  EXPECT_FALSE(matrix.remove_blocks(std::vector<std::uint8_t>(static_cast<size_t>(matrix.slot_capacity()), 1),
+                                    BlockSparseMatrix::RowRoom::packed));
+  // Growth as before: a block into a packed row, a row appended.
+  const Eigen::Matrix3d value = random_block(rng);
+  int column = 0;
+  while (matrix.find_slot(5, column) >= 0) ++column;
+  matrix.block(matrix.insert_block(5, column)) = value;
+  blocks[{5, column}] = value;
+  const int row = matrix.append_block_row();
+  blocks[{row, row}] = Eigen::Matrix3d::Zero();
+  expect_values(matrix, blocks);
+  expect_product_matches(matrix, blocks, rng);
+}
+
 }  // namespace
 }  // namespace tissue
