@@ -33,6 +33,13 @@ int spare_row_count(double fraction, int rows) {
 
 }  // namespace
 
+void BlockSparseMatrix::refuse_on_a_view(const char* operation) const {
+  if (m_viewed != nullptr) {
+    throw std::logic_error(std::string("BlockSparseMatrix::") + operation +
+                           ": a view of another matrix's rows (view_rows_of) is read only");
+  }
+}
+
 BlockSparseMatrix::BlockSparseMatrix(const std::vector<std::vector<int>>& pattern, Reserve reserve,
                                      const std::vector<int>& min_row_capacity)
     : m_reserve(reserve) {
@@ -115,6 +122,7 @@ int BlockSparseMatrix::find_slot(int row, int col) const {
 void BlockSparseMatrix::set_zero() { set_zero(nullptr); }
 
 void BlockSparseMatrix::set_zero(WorkTeam* team) {
+  refuse_on_a_view("set_zero");
   // Only the used slots: unused slots are zero already (relayout and insert keep them so).
   const int parts = team_parts(team);
   run_parts(team, parts, [&](int part) {
@@ -338,6 +346,7 @@ void BlockSparseMatrix::relayout(const std::vector<std::pair<int, int>>& min_cap
 }
 
 bool BlockSparseMatrix::remove_blocks(const std::vector<std::uint8_t>& keep, RowRoom room) {
+  refuse_on_a_view("remove_blocks");
   if (keep.size() != m_column.size()) {
     throw std::invalid_argument("BlockSparseMatrix::remove_blocks: " + std::to_string(keep.size()) + " marks for " +
                                 std::to_string(m_column.size()) + " slots");
@@ -403,6 +412,7 @@ long BlockSparseMatrix::row_room() const {
 }
 
 int BlockSparseMatrix::append_block_row(int min_capacity) {
+  refuse_on_a_view("append_block_row");
   int n = block_rows();
   int begin = n == 0 ? 0 : m_row_begin[to_size(n - 1)] + m_row_capacity[to_size(n - 1)];
   int capacity = std::max(m_spare_row_capacity, min_capacity);
@@ -429,6 +439,7 @@ int BlockSparseMatrix::append_block_row(int min_capacity) {
 }
 
 int BlockSparseMatrix::insert_block(int row, int col) {
+  refuse_on_a_view("insert_block");
   const int n = block_rows();
   if (row < 0 || row >= n || col < 0 || col >= n) {
     throw std::out_of_range("BlockSparseMatrix::insert_block: block (" + std::to_string(row) + ", " +
@@ -450,6 +461,7 @@ int BlockSparseMatrix::insert_block(int row, int col) {
 }
 
 bool BlockSparseMatrix::reserve_room(const std::vector<std::pair<int, int>>& row_extra) {
+  refuse_on_a_view("reserve_room");
   const int n = block_rows();
   std::vector<std::pair<int, int>> needed;  // (row, blocks it must hold)
   std::vector<int> extra_of;

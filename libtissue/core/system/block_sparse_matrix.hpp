@@ -140,7 +140,10 @@ class BlockSparseMatrix {
   /// for a row left out, with which no row kept may have a block (throws std::invalid_argument). Its
   /// values are k's, read where k keeps them (no copy): it is read only (block() const, products),
   /// valid while k's layout stays as it is and k lives. Both revisions move on: nothing made of this
-  /// matrix's earlier pattern is taken for this one (core/solve/compact_rows_solver.hpp).
+  /// matrix's earlier pattern is taken for this one (core/solve/compact_rows_solver.hpp). Its
+  /// mutators that are not per block (set_zero, insert_block, append_block_row, reserve_room,
+  /// remove_blocks) throw std::logic_error on a view; block(slot) and add_block are not checked (a
+  /// step's inner loops): writing through them is the caller's error.
   void view_rows_of(const BlockSparseMatrix& k, const std::vector<int>& rows, const std::vector<int>& index_of_row);
 
   /// Changes whenever the set of blocks changes (append_block_row, insert_block of a new block).
@@ -169,6 +172,8 @@ class BlockSparseMatrix {
   /// importer) otherwise took a fault per page in the cut step whose re-layout first wrote it
   /// (the frog: 1.3-2.0 ms of a re-layout, 0.2-0.7 ms without).
   void reserve_slots(size_t slots);
+  /// Throws std::logic_error when this matrix is a view (view_rows_of), whose values are another's.
+  void refuse_on_a_view(const char* operation) const;
 
   std::vector<int> m_row_begin;      // first slot of each block row
   std::vector<int> m_row_size;       // blocks in use in each row

@@ -507,6 +507,29 @@ TEST(BlockSparseMatrix, ReservingRoomInPlaceKeepsEveryBlockAndClearsTheRest) {
   }
 }
 
+// A view of another matrix's rows (view_rows_of, CompactRowsSolver's system) reads that matrix's
+// values: the mutators that would write values it does not hold refuse, and the viewed matrix keeps
+// its blocks.
+TEST(BlockSparseMatrix, AViewRefusesToChangeItsValuesOrPattern) {
+  std::mt19937 rng(29);
+  const Pattern pattern = random_symmetric_pattern(12, 2, rng);
+  BlockSparseMatrix matrix(pattern, {0.5, 1});
+  const BlockMap blocks = fill_random(matrix, pattern, rng);
+  std::vector<int> rows(12);
+  std::vector<int> index_of_row(12);
+  for (int r = 0; r < 12; ++r) rows[static_cast<size_t>(r)] = index_of_row[static_cast<size_t>(r)] = r;
+  BlockSparseMatrix view;
+  view.view_rows_of(matrix, rows, index_of_row);
+  EXPECT_THROW(view.set_zero(), std::logic_error);
+  EXPECT_THROW(view.insert_block(0, 11), std::logic_error);
+  EXPECT_THROW(view.append_block_row(), std::logic_error);
+  EXPECT_THROW(view.reserve_room({{0, 4}}), std::logic_error);
+  EXPECT_THROW(view.remove_blocks(std::vector<std::uint8_t>(static_cast<size_t>(view.slot_capacity()), 1)),
+               std::logic_error);
+  expect_values(matrix, blocks);
+  expect_product_matches(view, blocks, rng);
+}
+
 // Removing blocks with the rows packed (issue 41, item 3: the room cuts left in the rows): rows that
 // had grown room (and appended rows with their own) move back to back with room for just their
 // blocks, each keeping its blocks in their order (so the product's sums are the same, bitwise), the
