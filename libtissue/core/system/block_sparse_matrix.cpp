@@ -297,7 +297,7 @@ void BlockSparseMatrix::relayout(const std::vector<std::pair<int, int>>& min_cap
   for (int r = 1; r < n; ++r) row_begin[to_size(r)] = row_begin[to_size(r - 1)] + capacity[to_size(r - 1)];
 
   // The old rows end here; every slot after it is unused (zero), and so is storage added below.
-  const int old_rows_end = n == 0 ? 0 : m_row_begin[to_size(n - 1)] + m_row_capacity[to_size(n - 1)];
+  const int old_rows_end = row_room();
   const size_t old_slots = m_column.size();
   const auto slots = static_cast<size_t>(slot_count);
   if (slots > old_slots) {
@@ -406,7 +406,7 @@ bool BlockSparseMatrix::remove_blocks(const std::vector<std::uint8_t>& keep, Row
   return changed;
 }
 
-long BlockSparseMatrix::row_room() const {
+int BlockSparseMatrix::row_room() const {
   const int n = block_rows();
   return n == 0 ? 0 : m_row_begin[to_size(n - 1)] + m_row_capacity[to_size(n - 1)];
 }
@@ -414,7 +414,7 @@ long BlockSparseMatrix::row_room() const {
 int BlockSparseMatrix::append_block_row(int min_capacity) {
   refuse_on_a_view("append_block_row");
   int n = block_rows();
-  int begin = n == 0 ? 0 : m_row_begin[to_size(n - 1)] + m_row_capacity[to_size(n - 1)];
+  int begin = row_room();
   int capacity = std::max(m_spare_row_capacity, min_capacity);
   if (n >= m_block_row_capacity || capacity < 1 || begin + capacity > slot_capacity()) {
     // Out of spare room: reserve a fresh batch, as the constructor did, so that the next
@@ -425,7 +425,7 @@ int BlockSparseMatrix::append_block_row(int min_capacity) {
     const int rows_for_this_one = (std::max(min_capacity, per_row) + per_row - 1) / per_row;
     relayout({}, std::max(spare_row_count(m_reserve.extra_row_fraction, n), n / 4 + 1) + rows_for_this_one);
     capacity = std::max(m_spare_row_capacity, min_capacity);
-    begin = n == 0 ? 0 : m_row_begin[to_size(n - 1)] + m_row_capacity[to_size(n - 1)];
+    begin = row_room();
   }
   m_row_begin.push_back(begin);
   m_row_size.push_back(1);

@@ -127,11 +127,12 @@ class BlockSparseMatrix {
   /// went. For the XFEM's blocks that only retired cut tets used (zeros the product would multiply
   /// every step); packed, for the room cuts left in the rows (row_room()), which spreads every pass
   /// over the blocks (zeroing, assembly, products) over memory it mostly does not use. Neither
-  /// changes a value, a row's blocks' order, or so any product.
+  /// changes a kept block's value or a row's blocks' order: packing alone leaves every product
+  /// bitwise as it was.
   bool remove_blocks(const std::vector<std::uint8_t>& keep, RowRoom room = RowRoom::kept);
-  /// The slots the rows take with their room (the spare rows' room not counted): nonzero_blocks()
+  /// The slots the rows take with their room, where the spare rows' room begins: nonzero_blocks()
   /// when packed.
-  [[nodiscard]] long row_room() const;
+  [[nodiscard]] int row_room() const;
   /// After a re-layout: the new slot of each old slot (-1: an unused one), until the next re-layout.
   [[nodiscard]] const std::vector<int>& relayout_slot_map() const { return m_relayout_slot_map; }
 

@@ -532,7 +532,7 @@ TEST(BlockSparseMatrix, AViewRefusesToChangeItsValuesOrPattern) {
 
 // Removing blocks with the rows packed (issue 41, item 3: the room cuts left in the rows): rows that
 // had grown room (and appended rows with their own) move back to back with room for just their
-// blocks, each keeping its blocks in their order (so the product's sums are the same, bitwise), the
+// blocks, each keeping its blocks in their order (the product's sums in the same order), the
 // slot map says where every kept block went, the freed slots are unused and zero, and the matrix then
 // grows again (a block inserted into a packed row re-lays it out) as before.
 TEST(BlockSparseMatrix, RemovingBlocksWithTheRowsPackedKeepsOrderValuesAndProduct) {
@@ -570,7 +570,7 @@ TEST(BlockSparseMatrix, RemovingBlocksWithTheRowsPackedKeepsOrderValuesAndProduc
       order_before[static_cast<size_t>(r)].push_back(column);
     }
   }
-  ASSERT_GT(matrix.row_room(), matrix.nonzero_blocks() + 50L);  // room to give back
+  ASSERT_GT(matrix.row_room(), matrix.nonzero_blocks() + 50);  // room to give back
   Eigen::VectorXd x = Eigen::VectorXd::Random(matrix.rows());
   const auto layout = matrix.layout_revision();
   const int slots_before = matrix.slot_capacity();
