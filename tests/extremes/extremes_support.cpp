@@ -87,8 +87,14 @@ void use_method(TissueSettings& settings, Method method) {
   }
 }
 
+int step_threads() {
+  const char* value = std::getenv("TISSUE_EXTREMES_THREADS");
+  return value != nullptr && std::atoi(value) > 0 ? std::atoi(value) : 1;
+}
+
 TissueSettings default_settings() {
   TissueSettings settings;
+  settings.integrator.threads = step_threads();
   settings.body.material = Material{1.0e5, 0.4, 1000.0};
   settings.body.damping = RayleighDamping{1.0, 1e-3};
   settings.body.gravity_m_per_s2 = {0.0, 0.0, -9.81};

@@ -49,6 +49,9 @@ inline constexpr std::array<Method, 4> ALL_METHODS{Method::euler_pcg, Method::eu
 /// the same way, but in 0.3-2 s instead of 3-8 s or more on these 200-2100 unknown bodies
 /// (docs/BENCHMARKS.md); the cases that end bounded need at most ~1400 (the 1 GPa beam, GMRES).
 inline constexpr int IDA_MAX_INTERNAL_STEPS = 2000;
+/// The step's threads (IntegratorSettings::threads): 1, or TISSUE_EXTREMES_THREADS when set (> 0;
+/// the settings' check refuses more than MAX_STEP_THREADS), to time the cases on a team.
+int step_threads();
 /// IDA_MAX_INTERNAL_STEPS, or TISSUE_EXTREMES_IDA_MAX_INTERNAL_STEPS when set (> 0): 20000 runs
 /// IDA at its default guard (docs/BENCHMARKS.md measures what that costs).
 int ida_max_internal_steps();

@@ -137,6 +137,19 @@ void CorotationalElasticity::partition(const TetMesh& mesh, const std::vector<in
   for (int& t : m_serial_tets) t = m_storage[static_cast<size_t>(t)];
 }
 
+std::vector<int> CorotationalElasticity::assembly_list_of_tets() const {
+  std::vector<int> list_of_tet(m_tet_id.size(), ASSEMBLY_PARTS * static_cast<int>(m_phases.size()));
+  for (size_t phase = 0; phase < m_phases.size(); ++phase) {
+    for (size_t part = 0; part < ASSEMBLY_PARTS; ++part) {
+      for (const int k : m_phases[phase][part]) {
+        list_of_tet[static_cast<size_t>(m_tet_id[static_cast<size_t>(k)])] =
+            ASSEMBLY_PARTS * static_cast<int>(phase) + static_cast<int>(part);
+      }
+    }
+  }
+  return list_of_tet;
+}
+
 void CorotationalElasticity::sort_lists(const TetMesh& mesh, const std::vector<int>& vertex_order) {
   // Each list by the earliest position of its tets' vertices in the order (ties by id).
   if (vertex_order.empty()) return;

@@ -100,6 +100,9 @@ class CorotationalElasticity {
   [[nodiscard]] const std::vector<AssemblyPhase>& assembly_phases() const { return m_phases; }
   /// The tets assembled alone, after the phases (storage indices).
   [[nodiscard]] const std::vector<int>& serial_tets() const { return m_serial_tets; }
+  /// Per mesh tet, its assembly list: ASSEMBLY_PARTS ph + part for the part of phase ph it is in, or
+  /// ASSEMBLY_PARTS assembly_phases().size() for a serial tet (XfemElasticity::set_assembly_lists).
+  [[nodiscard]] std::vector<int> assembly_list_of_tets() const;
   /// The mesh's id of the tet at storage index k.
   [[nodiscard]] int tet_id(int k) const { return m_tet_id[static_cast<size_t>(k)]; }
 

@@ -153,6 +153,9 @@ DeformableBody::DeformableBody(TetMesh mesh, BodySettings settings)
   m_enriched_dofs.reserve(static_cast<size_t>(spare_rows));
   m_next_enriched_dof.reserve(static_cast<size_t>(spare_rows));
   m_xfem.reserve(std::min(m_mesh.tet_count(), 2 * spare_rows));
+  static_assert(XfemElasticity::LIST_PARTS == CorotationalElasticity::ASSEMBLY_PARTS);
+  m_xfem.set_assembly_lists(m_elasticity.assembly_list_of_tets(),
+                            static_cast<int>(m_elasticity.assembly_phases().size()));
   for (int t = 0; t < m_mesh.tet_count(); ++t) {
     m_largest_shape_gradient_per_m = std::max(m_largest_shape_gradient_per_m,
                                               m_elasticity.rest(t).shape_gradients_per_m.colwise().norm().maxCoeff());
@@ -261,7 +264,7 @@ void DeformableBody::evaluate_pass(const Eigen::VectorXd& displacement_m, Eigen:
   const int u_rows = m_dofs.free_vertex_count();
   internal_force_n.tail(3 * enriched_dof_count()).setZero();
   m_xfem.evaluate(m_positions_m, displacement_m, m_vertex_forces_n, internal_force_n, tangent,
-                  with_potential ? &cut_energy_j : nullptr, into);
+                  with_potential ? &cut_energy_j : nullptr, into, m_team);
 
   for (ForceTerm* term : m_force_terms) {
     term->add_force(m_positions_m, m_vertex_forces_n);
@@ -306,7 +309,8 @@ bool DeformableBody::take_evaluation_ahead(const Eigen::VectorXd& displacement_m
 double DeformableBody::elastic_energy_j(const Eigen::VectorXd& displacement_m) {
   check_unknowns(displacement_m);
   positions(displacement_m, m_positions_m);
-  return m_elasticity.elastic_energy_j(m_positions_m, m_team) + m_xfem.elastic_energy_j(m_positions_m, displacement_m);
+  return m_elasticity.elastic_energy_j(m_positions_m, m_team) +
+         m_xfem.elastic_energy_j(m_positions_m, displacement_m, m_team);
 }
 
 double DeformableBody::potential_energy_j(const Eigen::VectorXd& displacement_m) {

@@ -421,9 +421,11 @@ class DeformableBody final : public DynamicsModel {
   template <class Visit>
   void for_each_tet_turn(size_t first, size_t end, std::array<const Eigen::VectorXd*, 2> increments_m,
                          Visit&& visit) const;
-  // The same for each live cut piece not parked, its turns times the square root of its volume share.
+  // The same for each live cut piece not parked of the cut tets [first, end), its turns times the
+  // square root of its volume share.
   template <class Visit>
-  void for_each_piece_turn(std::array<const Eigen::VectorXd*, 2> increments_m, Visit&& visit) const;
+  void for_each_piece_turn(size_t first, size_t end, std::array<const Eigen::VectorXd*, 2> increments_m,
+                           Visit&& visit) const;
   [[nodiscard]] int vertex_block_row(int vertex) const { return m_dofs.vertex_row[static_cast<size_t>(vertex)]; }
 
   XfemElasticity m_xfem;

@@ -70,24 +70,26 @@ std::array<double, 2> DeformableBody::largest_turns_rad(const Eigen::VectorXd& f
 TISSUE_HOT_KERNEL std::array<double, 2> DeformableBody::largest_element_turns_rad(
     std::array<const Eigen::VectorXd*, 2> increments_m) const {
   // The uncut tets (those the co-rotational model has not handed to XFEM) in halves of its storage
-  // order, which streams its per-tet data, side by side with a team (a maximum: the same in any order).
+  // order, which streams its per-tet data, and the cut tets in halves of theirs, side by side with a
+  // team (a maximum: the same in any order).
   std::array<std::array<double, 2>, MAX_STEP_THREADS> largest_of_part{};
   const int parts = team_parts(m_team);
   run_parts(m_team, parts, [&](int member) {
     std::array<double, 2> largest{};
+    const auto share = [&](size_t count, int end_member) {
+      return count * static_cast<size_t>(end_member) / static_cast<size_t>(parts);
+    };
+    const auto take = [&](const std::array<int, 4>& /*rows*/, const std::array<double, 2>& turn_rad) {
+      take_larger(largest, turn_rad);
+    };
     const auto tets = static_cast<size_t>(m_elasticity.tet_count());
-    for_each_tet_turn(tets * static_cast<size_t>(member) / static_cast<size_t>(parts),
-                      tets * static_cast<size_t>(member + 1) / static_cast<size_t>(parts), increments_m,
-                      [&](const std::array<int, 4>& /*rows*/, const std::array<double, 2>& turn_rad) {
-                        take_larger(largest, turn_rad);
-                      });
+    for_each_tet_turn(share(tets, member), share(tets, member + 1), increments_m, take);
+    const auto cut_tets = static_cast<size_t>(m_xfem.cut_tet_count());
+    for_each_piece_turn(share(cut_tets, member), share(cut_tets, member + 1), increments_m, take);
     largest_of_part[static_cast<size_t>(member)] = largest;
   });
   std::array<double, 2> largest_rad{};
   for (int member = 0; member < parts; ++member) take_larger(largest_rad, largest_of_part[static_cast<size_t>(member)]);
-  for_each_piece_turn(increments_m, [&](const std::array<int, 4>& /*rows*/, const std::array<double, 2>& turn_rad) {
-    take_larger(largest_rad, turn_rad);
-  });
   return largest_rad;
 }
 
@@ -106,8 +108,9 @@ void DeformableBody::for_each_tet_turn(size_t first, size_t end, std::array<cons
 }
 
 template <class Visit>
-void DeformableBody::for_each_piece_turn(std::array<const Eigen::VectorXd*, 2> increments_m, Visit&& visit) const {
-  for (int k = 0; k < m_xfem.cut_tet_count(); ++k) {
+void DeformableBody::for_each_piece_turn(size_t first, size_t end, std::array<const Eigen::VectorXd*, 2> increments_m,
+                                         Visit&& visit) const {
+  for (int k = static_cast<int>(first); k < static_cast<int>(end); ++k) {
     if (m_xfem.retired(k)) continue;
     for (int p = 0; p < static_cast<int>(m_xfem.piece_count(k)); ++p) {
       if (m_xfem.parked(k, p)) continue;
@@ -134,7 +137,7 @@ void DeformableBody::mark_turning_rows(const Eigen::VectorXd& increment_m, doubl
     }
   };
   for_each_tet_turn(0, static_cast<size_t>(m_elasticity.tet_count()), {&increment_m, nullptr}, mark);
-  for_each_piece_turn({&increment_m, nullptr}, mark);
+  for_each_piece_turn(0, static_cast<size_t>(m_xfem.cut_tet_count()), {&increment_m, nullptr}, mark);
 }
 
 }  // namespace tissue

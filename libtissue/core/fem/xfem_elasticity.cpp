@@ -111,6 +111,7 @@ void XfemElasticity::add(const CutTet& cut_tet, std::span<const CutPiece> pieces
                          std::span<const Eigen::Matrix3d> rotations) {
   if (pieces.size() < 2) throw std::invalid_argument("XFEM: a cut tet needs two pieces or more");
   if (rotations.size() != pieces.size()) throw std::invalid_argument("XFEM: one start rotation per piece");
+  const int list = list_of(cut_tet);
   double total = 0.0;
   const std::size_t first_ghost = m_ghost_rows.size();
   const auto ghost_rows = [&] { return std::span<const int>(m_ghost_rows).subspan(first_ghost); };
@@ -148,9 +149,52 @@ void XfemElasticity::add(const CutTet& cut_tet, std::span<const CutPiece> pieces
   const std::size_t dofs = 4 + ghost_rows().size();
   m_slots.insert(m_slots.end(), dofs * dofs, -1);
   m_slot_begin.push_back(m_slots.size());
+  m_lists[static_cast<std::size_t>(list)].push_back(static_cast<int>(m_cut_tets.size()));
   m_cut_tets.push_back(cut_tet);
   m_rest.push_back(rest);
   m_retired.push_back(0);
+}
+
+void XfemElasticity::set_assembly_lists(std::vector<int> list_of_tet, int phases) {
+  if (phases < 0) throw std::invalid_argument("XFEM: " + std::to_string(phases) + " assembly phases");
+  const int lists = LIST_PARTS * phases + 1;
+  for (const int list : list_of_tet) {
+    if (list < 0 || list >= lists) {
+      throw std::invalid_argument("XFEM: assembly list " + std::to_string(list) + " of " + std::to_string(lists));
+    }
+  }
+  for (const CutTet& cut_tet : m_cut_tets) {
+    if (cut_tet.cut.tet < 0 || static_cast<std::size_t>(cut_tet.cut.tet) >= list_of_tet.size()) {
+      throw std::invalid_argument("XFEM: no assembly list for tet " + std::to_string(cut_tet.cut.tet));
+    }
+  }
+  m_list_of_tet = std::move(list_of_tet);
+  m_phases = phases;
+  m_lists.assign(static_cast<std::size_t>(lists), {});
+  for (std::size_t k = 0; k < m_cut_tets.size(); ++k) {
+    m_lists[static_cast<std::size_t>(list_of(m_cut_tets[k]))].push_back(static_cast<int>(k));
+  }
+}
+
+int XfemElasticity::list_of(const CutTet& cut_tet) const {
+  if (m_list_of_tet.empty()) return 0;
+  if (cut_tet.cut.tet < 0 || static_cast<std::size_t>(cut_tet.cut.tet) >= m_list_of_tet.size()) {
+    throw std::invalid_argument("XFEM: tet " + std::to_string(cut_tet.cut.tet) + " has no assembly list");
+  }
+  return m_list_of_tet[static_cast<std::size_t>(cut_tet.cut.tet)];
+}
+
+template <class Job>
+double XfemElasticity::sum_over_lists(WorkTeam* team, Job&& job) const {
+  double sum = 0.0;
+  for (int phase = 0; phase < m_phases; ++phase) {
+    std::array<double, LIST_PARTS> part_sum{};
+    run_parts(team, LIST_PARTS, [&](int part) {
+      part_sum[static_cast<std::size_t>(part)] = job(m_lists[static_cast<std::size_t>(LIST_PARTS * phase + part)]);
+    });
+    for (const double part : part_sum) sum += part;
+  }
+  return sum + job(m_lists.back());
 }
 
 bool XfemElasticity::all_parked(int k) const {
@@ -230,10 +274,10 @@ TetPositions piece_positions(const CutPiece& piece, const TetPositions& real_pos
 
 // Every counted piece's F and, in SIMD lanes four pieces at a time, its rotation (extract_rotations,
 // as the uncut tets'): F into m_gradients.
-void XfemElasticity::extract_piece_rotations(const Eigen::VectorXd& positions_m, const Eigen::VectorXd& displacement_m,
+void XfemElasticity::extract_piece_rotations(const std::vector<int>& cut_tets, const Eigen::VectorXd& positions_m,
+                                             const Eigen::VectorXd& displacement_m,
                                              std::vector<Eigen::Matrix3d>& rotations,
                                              std::vector<Eigen::Quaterniond>& warm_starts, bool keep) {
-  m_gradients.resize(m_pieces.size());
   std::array<Eigen::Matrix3d, ROTATION_BATCH> lane_gradients;
   std::array<Eigen::Quaterniond*, ROTATION_BATCH> lane_warm_starts{};
   std::array<Eigen::Matrix3d*, ROTATION_BATCH> lane_rotations{};
@@ -241,11 +285,12 @@ void XfemElasticity::extract_piece_rotations(const Eigen::VectorXd& positions_m,
   const TurnsBefore turns{lane_turns_before.data(), keep};
   int lanes = 0;
   TetPositions real_m;
-  for (size_t k = 0; k < m_cut_tets.size(); ++k) {
-    if (m_retired[k] != 0 || all_parked(static_cast<int>(k))) continue;
+  for (const int cut_tet : cut_tets) {
+    const auto k = static_cast<size_t>(cut_tet);
+    if (m_retired[k] != 0 || all_parked(cut_tet)) continue;
     gather(k, positions_m, real_m);
-    const std::size_t first = piece_begin(static_cast<int>(k));
-    for (size_t p = first; p < first + piece_count(static_cast<int>(k)); ++p) {
+    const std::size_t first = piece_begin(cut_tet);
+    for (size_t p = first; p < first + piece_count(cut_tet); ++p) {
       if (m_parked[p] != 0) continue;
       m_gradients[p] =
           deformation_gradient(m_rest[k], piece_positions(m_pieces[p], real_m, m_cut_tets[k].rest_m, displacement_m));
@@ -266,26 +311,40 @@ void XfemElasticity::extract_piece_rotations(const Eigen::VectorXd& positions_m,
   }
 }
 
-TISSUE_HOT_KERNEL void XfemElasticity::evaluate(const Eigen::VectorXd& positions_m,
-                                                const Eigen::VectorXd& displacement_m, Eigen::VectorXd& vertex_forces_n,
-                                                Eigen::VectorXd& internal_force_n, BlockSparseMatrix* tangent,
-                                                double* elastic_energy_j, ExtractInto into) {
+void XfemElasticity::evaluate(const Eigen::VectorXd& positions_m, const Eigen::VectorXd& displacement_m,
+                              Eigen::VectorXd& vertex_forces_n, Eigen::VectorXd& internal_force_n,
+                              BlockSparseMatrix* tangent, double* elastic_energy_j, ExtractInto into, WorkTeam* team) {
   // Ahead: every piece's as it is first (retired and parked ones keep theirs), then extracted there.
   if (into == ExtractInto::ahead) {
     m_rotations_ahead = m_rotations;
     m_warm_starts_ahead = m_warm_starts;
   }
-  std::vector<Eigen::Matrix3d>& rotations = into == ExtractInto::ahead ? m_rotations_ahead : m_rotations;
-  std::vector<Eigen::Quaterniond>& warm_starts = into == ExtractInto::ahead ? m_warm_starts_ahead : m_warm_starts;
-  extract_piece_rotations(positions_m, displacement_m, rotations, warm_starts, into == ExtractInto::own);
+  m_gradients.resize(m_pieces.size());
+  const Pass pass{positions_m,
+                  displacement_m,
+                  vertex_forces_n,
+                  internal_force_n,
+                  tangent,
+                  into == ExtractInto::ahead ? m_rotations_ahead : m_rotations,
+                  into == ExtractInto::ahead ? m_warm_starts_ahead : m_warm_starts,
+                  into == ExtractInto::own,
+                  elastic_energy_j != nullptr};
+  const double energy = sum_over_lists(team, [&](const std::vector<int>& list) { return evaluate_list(list, pass); });
+  if (elastic_energy_j != nullptr) *elastic_energy_j = energy;
+}
+
+TISSUE_HOT_KERNEL double XfemElasticity::evaluate_list(const std::vector<int>& cut_tets, const Pass& pass) {
+  extract_piece_rotations(cut_tets, pass.positions_m, pass.displacement_m, pass.rotations, pass.warm_starts, pass.keep);
+  BlockSparseMatrix* const tangent = pass.tangent;
   double energy = 0.0;
-  for (size_t k = 0; k < m_cut_tets.size(); ++k) {
-    if (m_retired[k] != 0 || all_parked(static_cast<int>(k))) continue;
+  for (const int cut_tet_index : cut_tets) {
+    const auto k = static_cast<size_t>(cut_tet_index);
+    if (m_retired[k] != 0 || all_parked(cut_tet_index)) continue;
     const CutTet& cut_tet = m_cut_tets[k];
     const TetRest& rest = m_rest[k];
-    const std::size_t first = piece_begin(static_cast<int>(k));
-    const std::size_t count = piece_count(static_cast<int>(k));
-    const int dofs = dof_count(static_cast<int>(k));
+    const std::size_t first = piece_begin(cut_tet_index);
+    const std::size_t count = piece_count(cut_tet_index);
+    const int dofs = dof_count(cut_tet_index);
     const int* const slots = m_slots.data() + m_slot_begin[k];
     // Per piece: its nodal forces Fp_i and, through the slots of its local DOFs, its blocks (each
     // piece's block of two real vertices added on its own, as a tet's).
@@ -294,14 +353,14 @@ TISSUE_HOT_KERNEL void XfemElasticity::evaluate(const Eigen::VectorXd& positions
       if (m_parked[p] != 0) continue;
       const CutPiece& piece = m_pieces[p];
       const Eigen::Matrix3d& f = m_gradients[p];
-      const Eigen::Matrix3d& r = rotations[p];
+      const Eigen::Matrix3d& r = pass.rotations[p];
       const Eigen::Matrix<double, 3, 4> forces = m_elements.forces(rest, r, f);
-      if (elastic_energy_j != nullptr) energy += piece.weight * m_elements.energy_j(rest, r, f);
+      if (pass.with_energy) energy += piece.weight * m_elements.energy_j(rest, r, f);
       for (size_t i = 0; i < 4; ++i) {
         if (piece.ghost_row[i] < 0) {
           vertex_sum.col(to_int(i)) += piece.weight * forces.col(to_int(i));
         } else {
-          internal_force_n.segment<3>(3 * piece.ghost_row[i]) += piece.weight * forces.col(to_int(i));
+          pass.internal_force_n.segment<3>(3 * piece.ghost_row[i]) += piece.weight * forces.col(to_int(i));
         }
       }
       if (tangent == nullptr) continue;
@@ -322,20 +381,27 @@ TISSUE_HOT_KERNEL void XfemElasticity::evaluate(const Eigen::VectorXd& positions
       element_blocks::add_blocks(piece_slots, *tangent,
                                  [&](int i, int j) { return piece.weight * blocks[to_size(4 * i + j)]; });
     }
-    for (int i = 0; i < 4; ++i) vertex_forces_n.segment<3>(3 * cut_tet.vertices[to_size(i)]) += vertex_sum.col(i);
+    for (int i = 0; i < 4; ++i) pass.vertex_forces_n.segment<3>(3 * cut_tet.vertices[to_size(i)]) += vertex_sum.col(i);
   }
-  if (elastic_energy_j != nullptr) *elastic_energy_j = energy;
+  return energy;
 }
 
-double XfemElasticity::elastic_energy_j(const Eigen::VectorXd& positions_m,
-                                        const Eigen::VectorXd& displacement_m) const {
+double XfemElasticity::elastic_energy_j(const Eigen::VectorXd& positions_m, const Eigen::VectorXd& displacement_m,
+                                        WorkTeam* team) const {
+  return sum_over_lists(team,
+                        [&](const std::vector<int>& list) { return energy_of(list, positions_m, displacement_m); });
+}
+
+double XfemElasticity::energy_of(const std::vector<int>& cut_tets, const Eigen::VectorXd& positions_m,
+                                 const Eigen::VectorXd& displacement_m) const {
   double energy = 0.0;
   TetPositions real_m;
-  for (size_t k = 0; k < m_cut_tets.size(); ++k) {
+  for (const int cut_tet : cut_tets) {
+    const auto k = static_cast<size_t>(cut_tet);
     if (m_retired[k] != 0) continue;
     gather(k, positions_m, real_m);
-    const std::size_t first = piece_begin(static_cast<int>(k));
-    for (size_t p = first; p < first + piece_count(static_cast<int>(k)); ++p) {
+    const std::size_t first = piece_begin(cut_tet);
+    for (size_t p = first; p < first + piece_count(cut_tet); ++p) {
       if (m_parked[p] != 0) continue;
       const CutPiece& piece = m_pieces[p];
       const Eigen::Matrix3d f =

@@ -22,13 +22,14 @@
 // pieces that use both DOFs.
 #pragma once
 
-#include "core/fem/tet_cut.hpp"
 #include "core/fem/element_model.hpp"
-#include "core/material/material.hpp"
 #include "core/fem/rotation.hpp"
+#include "core/fem/tet_cut.hpp"
 #include "core/fem/tet_element.hpp"
+#include "core/material/material.hpp"
 #include "core/mesh/tet_mesh.hpp"
 #include "core/system/block_sparse_matrix.hpp"
+#include "core/system/work_team.hpp"
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
@@ -135,6 +136,18 @@ class XfemElasticity {
   /// Room for this many cut tets without reallocation.
   void reserve(int cut_tets);
 
+  /// How many assembly lists a phase has: the parts a step's team runs side by side.
+  static constexpr int LIST_PARTS = MAX_STEP_THREADS;
+  /// The cut tets are assembled in their mesh tets' lists of the uncut assembly
+  /// (CorotationalElasticity::assembly_list_of_tets): `list_of_tet[t]` for mesh tet t, lists
+  /// LIST_PARTS ph + part for phase ph < `phases`, whose parts share no vertex, then list LIST_PARTS
+  /// phases alone. Two cut tets in one phase's parts then share no row (a piece's ghosts copy its
+  /// tet's vertices) and no block, and a step's team assembles them side by side (issue 41: 80% of a
+  /// hatched frog's assembly was its cut tets', on one thread). Until it is set, one list. Throws
+  /// std::invalid_argument (nothing changed) for a negative phase count, a list out of range, or
+  /// fewer entries than a cut tet's tet needs.
+  void set_assembly_lists(std::vector<int> list_of_tet, int phases);
+
   /// Adds a cut tet with its rest data. Both parts' rotations start from `rotation` (the tet's
   /// rotation before the cut: with each ghost a copy of its vertex both parts coincide with the tet). Slots start at -1 (set
   /// them with slots() before the first evaluate with a tangent).
@@ -197,9 +210,11 @@ class XfemElasticity {
   /// With `elastic_energy_j`, also their elastic energy with the rotations just extracted
   /// (elastic_energy_j() there, to round-off). [J]
   /// `into` ahead: the pieces' rotations go beside their own (ExtractInto), which stay as they were.
+  /// With `team` (of LIST_PARTS members) each phase's lists run side by side, each writing only its
+  /// own entries, the energies added list by list in order: bitwise the same result as without.
   void evaluate(const Eigen::VectorXd& positions_m, const Eigen::VectorXd& displacement_m,
                 Eigen::VectorXd& vertex_forces_n, Eigen::VectorXd& internal_force_n, BlockSparseMatrix* tangent,
-                double* elastic_energy_j = nullptr, ExtractInto into = ExtractInto::own);
+                double* elastic_energy_j = nullptr, ExtractInto into = ExtractInto::own, WorkTeam* team = nullptr);
   /// The rotations and warm starts of the last evaluate() ahead become the pieces' own, the own ones
   /// the turns before.
   void take_ahead() {
@@ -210,8 +225,9 @@ class XfemElasticity {
 
   /// Sum over the cut tets of w_a E(part a) + w_b E(part b), with the rotations of these
   /// positions (warm starts unchanged). [J]
-  [[nodiscard]] double elastic_energy_j(const Eigen::VectorXd& positions_m,
-                                        const Eigen::VectorXd& displacement_m) const;
+  /// Added list by list as evaluate() adds them (side by side with a team).
+  [[nodiscard]] double elastic_energy_j(const Eigen::VectorXd& positions_m, const Eigen::VectorXd& displacement_m,
+                                        WorkTeam* team = nullptr) const;
 
   /// Forgets the warm starts (rotations back to identity).
   void reset_rotations();
@@ -234,9 +250,32 @@ class XfemElasticity {
   // evaluate's first pass: every counted piece's F (into m_gradients) and its rotation, from
   // extrapolated_turn(warm start, turn before); `keep`: the own set's, which keeps the warm starts it
   // replaces as the turns before.
-  void extract_piece_rotations(const Eigen::VectorXd& positions_m, const Eigen::VectorXd& displacement_m,
-                               std::vector<Eigen::Matrix3d>& rotations, std::vector<Eigen::Quaterniond>& warm_starts,
-                               bool keep);
+  void extract_piece_rotations(const std::vector<int>& cut_tets, const Eigen::VectorXd& positions_m,
+                               const Eigen::VectorXd& displacement_m, std::vector<Eigen::Matrix3d>& rotations,
+                               std::vector<Eigen::Quaterniond>& warm_starts, bool keep);
+  // What evaluate() hands each list.
+  struct Pass {
+    const Eigen::VectorXd& positions_m;
+    const Eigen::VectorXd& displacement_m;
+    Eigen::VectorXd& vertex_forces_n;
+    Eigen::VectorXd& internal_force_n;
+    BlockSparseMatrix* tangent;
+    std::vector<Eigen::Matrix3d>& rotations;
+    std::vector<Eigen::Quaterniond>& warm_starts;
+    bool keep;         // the own set (ExtractInto::own)
+    bool with_energy;  // sum the pieces' energies
+  };
+  // evaluate() of the cut tets `cut_tets` (counted ones only), in order; their energy (0 without).
+  double evaluate_list(const std::vector<int>& cut_tets, const Pass& pass);
+  // The energy of the counted cut tets `cut_tets`, added in order.
+  [[nodiscard]] double energy_of(const std::vector<int>& cut_tets, const Eigen::VectorXd& positions_m,
+                                 const Eigen::VectorXd& displacement_m) const;
+  // job(list) for every list, each phase's parts side by side with `team`, then the last list; the
+  // sum of what the jobs return, added list by list in order (the same with a team or without).
+  template <class Job>
+  double sum_over_lists(WorkTeam* team, Job&& job) const;
+  // The list cut tet k is assembled in.
+  [[nodiscard]] int list_of(const CutTet& cut_tet) const;
 
   [[nodiscard]] std::size_t piece_begin(int k) const {
     return static_cast<std::size_t>(m_piece_begin[static_cast<std::size_t>(k)]);
@@ -263,6 +302,9 @@ class XfemElasticity {
   std::vector<int> m_ghost_rows;
   std::vector<std::size_t> m_slot_begin{0};
   std::vector<int> m_slots;
+  std::vector<int> m_list_of_tet;  // per mesh tet (set_assembly_lists); empty: every cut tet in list 0
+  int m_phases = 0;
+  std::vector<std::vector<int>> m_lists = std::vector<std::vector<int>>(1);  // cut tets, increasing
 };
 
 }  // namespace tissue

@@ -15,6 +15,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cmath>
 #include <cstdio>
 #include <random>
 #include <vector>
@@ -260,6 +261,33 @@ TEST(XfemPieces, BadPiecesAreRefused) {
   two[1].ghost_row[0] = 7;
   EXPECT_THROW(tet.xfem.add(cut_tet, two, tet.rest, std::span(identities).first(1)), std::invalid_argument);
   EXPECT_EQ(tet.xfem.cut_tet_count(), 1);
+}
+
+// The assembly lists (set_assembly_lists: the uncut tets' phases, for a step's team): a cut tet whose
+// tet has no list, a list past the phases' and a negative phase count are refused with nothing
+// changed; the forces stay as they were.
+TEST(XfemAssemblyLists, RefusesWhatNamesNoListAndKeepsTheForces) {
+  FourPieces four;  // its cut tet names no mesh tet (-1)
+  Vector q = Vector::Zero();
+  for (int k = 0; k < UNKNOWNS; ++k) q(k) = 1e-4 * std::sin(1.0 + k);
+  const Vector before = four.force(q);
+  EXPECT_THROW(four.xfem.set_assembly_lists({0, 0}, 1), std::invalid_argument);  // tet -1
+  EXPECT_THROW(four.xfem.set_assembly_lists({}, -1), std::invalid_argument);
+  EXPECT_THROW(four.xfem.set_assembly_lists({3}, 1), std::invalid_argument);  // lists 0, 1 and 2
+  // (Warm starts move on from call to call: the rotations agree to their 4e-18 rad, the forces to rounding.)
+  EXPECT_LE((four.force(q) - before).norm(), 1e-12 * before.norm());
+
+  XfemElasticity listed{{four.lame}, RotationSettings{}};
+  listed.set_assembly_lists({0, 1}, 1);  // tet 0 in phase 0's first part, tet 1 in its second
+  CutTet cut_tet;
+  cut_tet.vertices = Tet{0, 1, 2, 3};
+  cut_tet.rest_m = REST;
+  cut_tet.cut.tet = 2;  // past the lists
+  EXPECT_THROW(listed.add(cut_tet, four.rest, Eigen::Matrix3d::Identity()), std::invalid_argument);
+  EXPECT_EQ(listed.cut_tet_count(), 0);
+  cut_tet.cut.tet = 1;
+  listed.add(cut_tet, four.rest, Eigen::Matrix3d::Identity());
+  EXPECT_EQ(listed.cut_tet_count(), 1);
 }
 
 }  // namespace

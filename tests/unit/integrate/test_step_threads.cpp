@@ -177,5 +177,53 @@ TEST(StepThreads, TwoThreadsGiveBitwiseTheStepsOfOne) {
   }
 }
 
+// The frog held at its tail, cut by a scalpel drawn across it and then along it (cut tets cut again
+// where the strokes cross), swinging on after: the cut tets' assembly, energies and turns run in the
+// uncut tets' phases (XfemElasticity::set_assembly_lists), with the shipped two-level solver.
+DynamicState run_cut(int threads) {
+  TetMesh mesh = frog();
+  Eigen::Vector3d low = Eigen::Vector3d::Constant(1e9);
+  Eigen::Vector3d high = -low;
+  for (const Eigen::Vector3d& p : mesh.rest_positions_m) {
+    low = low.cwiseMin(p);
+    high = high.cwiseMax(p);
+  }
+  TissueSettings settings;
+  settings.body.material = {3.0e5, 0.4, 1000.0};
+  settings.body.fixed_vertices = vertices_at_minimum(mesh, 0, 0.3);
+  settings.step_size_s = 0.002;
+  settings.interaction.blade_length_m = 3.0 * (high.z() - low.z());
+  settings.integrator.threads = threads;
+  Tissue tissue(std::move(mesh), settings);
+  const double z = low.z() - (high.z() - low.z());
+  const auto stroke = [&](const Eigen::Vector3d& from, const Eigen::Vector3d& to) {
+    constexpr int STEPS = 40;
+    for (int n = 0; n <= STEPS; ++n) {
+      const Eigen::Vector3d at = from + (to - from) * n / STEPS;
+      tissue.set_tool(ToolPose{Eigen::Vector3d(at.x(), at.y(), z), Eigen::Quaterniond::Identity(), ToolMode::scalpel});
+      tissue.step();
+    }
+    tissue.set_tool(ToolPose{Eigen::Vector3d(to.x(), to.y(), z), Eigen::Quaterniond::Identity(), ToolMode::none});
+  };
+  const Eigen::Vector3d size = high - low;
+  const double x = low.x() + 0.6 * size.x();
+  stroke({x, low.y() - 0.01, 0.0}, {x, high.y() + 0.01, 0.0});
+  const double y = low.y() + 0.5 * size.y();
+  stroke({low.x() + 0.4 * size.x(), y, 0.0}, {high.x() + 0.01, y, 0.0});
+  for (int step = 0; step < 30; ++step) tissue.step();
+  EXPECT_GT(tissue.body().xfem().cut_tet_count(), 40);
+  std::printf("cut frog on %d thread(s): %d cut tets made\n", threads, tissue.body().xfem().cut_tet_count());
+  return tissue.state();
+}
+
+TEST(StepThreads, TwoThreadsGiveBitwiseTheStepsOfOneThroughCuts) {
+  const DynamicState one = run_cut(1);
+  const DynamicState two = run_cut(2);
+  ASSERT_GT(one.displacement_m.cwiseAbs().maxCoeff(), 1e-3);
+  ASSERT_EQ(one.displacement_m.size(), two.displacement_m.size());
+  EXPECT_TRUE(one.displacement_m == two.displacement_m);
+  EXPECT_TRUE(one.velocity_m_per_s == two.velocity_m_per_s);
+}
+
 }  // namespace
 }  // namespace tissue
