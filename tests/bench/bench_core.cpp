@@ -14,6 +14,7 @@
 #include "core/solve/block_cholesky.hpp"
 #include "core/solve/half_matrix.hpp"
 #include "core/solve/two_level_preconditioner.hpp"
+#include "core/system/work_team.hpp"
 #include "core/tissue.hpp"
 #include "resources/default_mesh.hpp"
 
@@ -453,11 +454,8 @@ void BM_CutRenderSurfaceStep(benchmark::State& state) {
 }
 BENCHMARK(BM_CutRenderSurfaceStep)->Unit(benchmark::kMillisecond);
 
-// Issue 22: re-meshing the render surface from scratch after a careless hand: N strokes along y
-// spread over the body's length, then N across them.
-void BM_CutRenderSurfaceHatched(benchmark::State& state) {
-  FrogStrokes frog;
-  const auto strokes = static_cast<int>(state.range(0));
+// A careless hand on the frog: N strokes along y spread over the body's length, then N across them.
+std::vector<std::pair<Eigen::Vector2d, Eigen::Vector2d>> hatched_strokes(int strokes) {
   std::vector<std::pair<Eigen::Vector2d, Eigen::Vector2d>> hatched;
   for (int k = 0; k < strokes; ++k) {
     const double x = -0.025 + 0.06 * (k + 0.5) / strokes;
@@ -467,7 +465,35 @@ void BM_CutRenderSurfaceHatched(benchmark::State& state) {
     const double y = -0.05 + 0.10 * (k + 0.5) / strokes;
     hatched.emplace_back(Eigen::Vector2d(-0.0301, y), Eigen::Vector2d(0.0399, y));
   }
-  frog.cut(hatched);
+  return hatched;
+}
+
+// Issue 41: the forces and tangent of the frog after N + N hatched strokes (0: uncut) on one thread
+// or a team of two (range(1)): the cut tets are assembled in the uncut tets' phases.
+void BM_HatchedForcesAndTangent(benchmark::State& state) {
+  FrogStrokes frog;
+  frog.cut(hatched_strokes(static_cast<int>(state.range(0))));
+  std::optional<WorkTeam> team;
+  if (state.range(1) == 2) team.emplace(2);
+  frog.body->lend_work_team(team ? &*team : nullptr);
+  std::mt19937 rng(1);
+  std::uniform_real_distribution<double> jitter(-1e-4, 1e-4);
+  const Eigen::VectorXd displacement =
+      Eigen::VectorXd::NullaryExpr(frog.body->dof_count(), [&] { return jitter(rng); });
+  Eigen::VectorXd forces;
+  for (auto _ : state) {
+    frog.body->evaluate(displacement, forces, true);
+    benchmark::DoNotOptimize(forces.data());
+  }
+  state.counters["cut_tets"] = frog.body->cut_tet_count();
+  state.counters["dofs"] = frog.body->dof_count();
+}
+BENCHMARK(BM_HatchedForcesAndTangent)->ArgsProduct({{0, 30}, {1, 2}})->Unit(benchmark::kMicrosecond);
+
+// Issue 22: re-meshing the render surface from scratch after a careless hand.
+void BM_CutRenderSurfaceHatched(benchmark::State& state) {
+  FrogStrokes frog;
+  frog.cut(hatched_strokes(static_cast<int>(state.range(0))));
   const CutRenderSurface fresh = frog.render();
   std::optional<CutRenderSurface> render;
   for (auto _ : state) {
