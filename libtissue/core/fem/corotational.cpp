@@ -237,15 +237,12 @@ void CorotationalElasticity::evaluate(const Eigen::VectorXd& positions_m, Eigen:
                                       double* elastic_energy_j, ExtractInto into) {
   assert(tangent == nullptr || (slots != nullptr && slots->size() == m_tets.size()));
   // Each part's energy apart, added in part order: bitwise the same with a team or without.
-  double energy = 0.0;
-  for (const AssemblyPhase& phase : m_phases) {
-    std::array<double, ASSEMBLY_PARTS> part_energy{};
-    run_parts(team, ASSEMBLY_PARTS, [&](int part) {
-      add_tets(phase[static_cast<size_t>(part)], positions_m, internal_forces_n, tangent, slots,
-               elastic_energy_j != nullptr ? &part_energy[static_cast<size_t>(part)] : nullptr, into);
-    });
-    for (const double part : part_energy) energy += part;
-  }
+  double energy = sum_over_phases(team, static_cast<int>(m_phases.size()), [&](int phase, int part) {
+    double part_energy = 0.0;
+    add_tets(m_phases[static_cast<size_t>(phase)][static_cast<size_t>(part)], positions_m, internal_forces_n, tangent,
+             slots, elastic_energy_j != nullptr ? &part_energy : nullptr, into);
+    return part_energy;
+  });
   add_tets(m_serial_tets, positions_m, internal_forces_n, tangent, slots,
            elastic_energy_j != nullptr ? &energy : nullptr, into);
   if (elastic_energy_j != nullptr) *elastic_energy_j = energy;
@@ -348,15 +345,10 @@ TISSUE_HOT_KERNEL double CorotationalElasticity::energy_of(const std::vector<int
 // serial tets): the energy guard reads the same potential whichever pass found it, and a step kept
 // from the guard's evaluation continues as one evaluated anew after a restore (backward_euler.cpp).
 double CorotationalElasticity::elastic_energy_j(const Eigen::VectorXd& positions_m, WorkTeam* team) const {
-  double energy = 0.0;
-  for (const AssemblyPhase& phase : m_phases) {
-    std::array<double, ASSEMBLY_PARTS> part_energy{};
-    run_parts(team, ASSEMBLY_PARTS, [&](int part) {
-      part_energy[static_cast<size_t>(part)] = energy_of(phase[static_cast<size_t>(part)], positions_m);
-    });
-    for (const double part : part_energy) energy += part;
-  }
-  return energy + energy_of(m_serial_tets, positions_m);
+  const double phased = sum_over_phases(team, static_cast<int>(m_phases.size()), [&](int phase, int part) {
+    return energy_of(m_phases[static_cast<size_t>(phase)][static_cast<size_t>(part)], positions_m);
+  });
+  return phased + energy_of(m_serial_tets, positions_m);
 }
 
 std::vector<double> lumped_vertex_sums(const TetMesh& mesh, std::span<const double> per_region_per_m3) {

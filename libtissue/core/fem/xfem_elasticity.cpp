@@ -155,46 +155,45 @@ void XfemElasticity::add(const CutTet& cut_tet, std::span<const CutPiece> pieces
   m_retired.push_back(0);
 }
 
+namespace {
+
+// The list of `tet` in a set_assembly_lists table; std::invalid_argument for a tet it lacks.
+int list_in(const std::vector<int>& list_of_tet, int tet) {
+  if (tet < 0 || static_cast<std::size_t>(tet) >= list_of_tet.size()) {
+    throw std::invalid_argument("XFEM: tet " + std::to_string(tet) + " has no assembly list");
+  }
+  return list_of_tet[static_cast<std::size_t>(tet)];
+}
+
+}  // namespace
+
 void XfemElasticity::set_assembly_lists(std::vector<int> list_of_tet, int phases) {
   if (phases < 0) throw std::invalid_argument("XFEM: " + std::to_string(phases) + " assembly phases");
-  const int lists = LIST_PARTS * phases + 1;
+  const int list_count = LIST_PARTS * phases + 1;
   for (const int list : list_of_tet) {
-    if (list < 0 || list >= lists) {
-      throw std::invalid_argument("XFEM: assembly list " + std::to_string(list) + " of " + std::to_string(lists));
+    if (list < 0 || list >= list_count) {
+      throw std::invalid_argument("XFEM: assembly list " + std::to_string(list) + " of " + std::to_string(list_count));
     }
   }
-  for (const CutTet& cut_tet : m_cut_tets) {
-    if (cut_tet.cut.tet < 0 || static_cast<std::size_t>(cut_tet.cut.tet) >= list_of_tet.size()) {
-      throw std::invalid_argument("XFEM: no assembly list for tet " + std::to_string(cut_tet.cut.tet));
-    }
+  std::vector<std::vector<int>> lists(static_cast<std::size_t>(list_count));
+  for (std::size_t k = 0; k < m_cut_tets.size(); ++k) {
+    lists[static_cast<std::size_t>(list_in(list_of_tet, m_cut_tets[k].cut.tet))].push_back(static_cast<int>(k));
   }
   m_list_of_tet = std::move(list_of_tet);
-  m_phases = phases;
-  m_lists.assign(static_cast<std::size_t>(lists), {});
-  for (std::size_t k = 0; k < m_cut_tets.size(); ++k) {
-    m_lists[static_cast<std::size_t>(list_of(m_cut_tets[k]))].push_back(static_cast<int>(k));
-  }
+  m_lists = std::move(lists);
 }
 
 int XfemElasticity::list_of(const CutTet& cut_tet) const {
-  if (m_list_of_tet.empty()) return 0;
-  if (cut_tet.cut.tet < 0 || static_cast<std::size_t>(cut_tet.cut.tet) >= m_list_of_tet.size()) {
-    throw std::invalid_argument("XFEM: tet " + std::to_string(cut_tet.cut.tet) + " has no assembly list");
-  }
-  return m_list_of_tet[static_cast<std::size_t>(cut_tet.cut.tet)];
+  return m_list_of_tet.empty() ? 0 : list_in(m_list_of_tet, cut_tet.cut.tet);
 }
 
 template <class Job>
 double XfemElasticity::sum_over_lists(WorkTeam* team, Job&& job) const {
-  double sum = 0.0;
-  for (int phase = 0; phase < m_phases; ++phase) {
-    std::array<double, LIST_PARTS> part_sum{};
-    run_parts(team, LIST_PARTS, [&](int part) {
-      part_sum[static_cast<std::size_t>(part)] = job(m_lists[static_cast<std::size_t>(LIST_PARTS * phase + part)]);
-    });
-    for (const double part : part_sum) sum += part;
-  }
-  return sum + job(m_lists.back());
+  const auto phases = static_cast<int>((m_lists.size() - 1) / LIST_PARTS);
+  const double phased = sum_over_phases(team, phases, [&](int phase, int part) {
+    return job(m_lists[static_cast<std::size_t>(LIST_PARTS * phase + part)]);
+  });
+  return phased + job(m_lists.back());
 }
 
 bool XfemElasticity::all_parked(int k) const {

@@ -303,8 +303,8 @@ class XfemElasticity {
   std::vector<std::size_t> m_slot_begin{0};
   std::vector<int> m_slots;
   std::vector<int> m_list_of_tet;  // per mesh tet (set_assembly_lists); empty: every cut tet in list 0
-  int m_phases = 0;
-  std::vector<std::vector<int>> m_lists = std::vector<std::vector<int>>(1);  // cut tets, increasing
+  // LIST_PARTS lists per phase, then the one run alone: cut tets, increasing.
+  std::vector<std::vector<int>> m_lists = std::vector<std::vector<int>>(1);
 };
 
 }  // namespace tissue

@@ -12,6 +12,7 @@
 // results stay bitwise those of one thread.
 #pragma once
 
+#include <array>
 #include <atomic>
 #include <cstdint>
 #include <thread>
@@ -83,6 +84,21 @@ void run_parts(WorkTeam* team, int parts, Job&& job) {
   } else {
     for (int part = 0; part < parts; ++part) job(part);
   }
+}
+
+/// job(phase, part) for every part of `phases` phases of MAX_STEP_THREADS parts each, a phase's
+/// parts side by side on `team`, phase after phase (the assembly's conflict-free halves); returns
+/// the sum of what the parts return, added phase by phase in part order: bitwise the same with a
+/// team or without.
+template <class Job>
+double sum_over_phases(WorkTeam* team, int phases, Job&& job) {
+  double sum = 0.0;
+  for (int phase = 0; phase < phases; ++phase) {
+    std::array<double, MAX_STEP_THREADS> part_sum{};
+    run_parts(team, MAX_STEP_THREADS, [&](int part) { part_sum[static_cast<std::size_t>(part)] = job(phase, part); });
+    for (const double part : part_sum) sum += part;
+  }
+  return sum;
 }
 
 }  // namespace tissue
