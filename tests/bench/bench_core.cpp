@@ -490,6 +490,20 @@ void BM_HatchedForcesAndTangent(benchmark::State& state) {
 }
 BENCHMARK(BM_HatchedForcesAndTangent)->ArgsProduct({{0, 30}, {1, 2}})->Unit(benchmark::kMicrosecond);
 
+// Issue 41: the energy guard's pass over the same hatched frog (its elastic energy, the pieces'
+// rotations from copies of their warm starts).
+void BM_HatchedElasticEnergy(benchmark::State& state) {
+  FrogStrokes frog;
+  frog.cut(hatched_strokes(static_cast<int>(state.range(0))));
+  std::mt19937 rng(1);
+  std::uniform_real_distribution<double> jitter(-1e-4, 1e-4);
+  const Eigen::VectorXd displacement =
+      Eigen::VectorXd::NullaryExpr(frog.body->dof_count(), [&] { return jitter(rng); });
+  for (auto _ : state) benchmark::DoNotOptimize(frog.body->potential_energy_j(displacement));
+  state.counters["cut_tets"] = frog.body->cut_tet_count();
+}
+BENCHMARK(BM_HatchedElasticEnergy)->Arg(0)->Arg(30)->Unit(benchmark::kMicrosecond);
+
 // Issue 22: re-meshing the render surface from scratch after a careless hand.
 void BM_CutRenderSurfaceHatched(benchmark::State& state) {
   FrogStrokes frog;

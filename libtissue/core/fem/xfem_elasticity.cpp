@@ -391,9 +391,31 @@ double XfemElasticity::elastic_energy_j(const Eigen::VectorXd& positions_m, cons
                         [&](const std::vector<int>& list) { return energy_of(list, positions_m, displacement_m); });
 }
 
-double XfemElasticity::energy_of(const std::vector<int>& cut_tets, const Eigen::VectorXd& positions_m,
-                                 const Eigen::VectorXd& displacement_m) const {
+// The pieces' rotations in SIMD lanes as a step extracts them (extract_piece_rotations), from copies
+// of the warm starts (reporting must not change the dynamics); the terms added in the pieces' order.
+TISSUE_HOT_KERNEL double XfemElasticity::energy_of(const std::vector<int>& cut_tets, const Eigen::VectorXd& positions_m,
+                                                   const Eigen::VectorXd& displacement_m) const {
+  std::array<Eigen::Matrix3d, ROTATION_BATCH> gradients;
+  std::array<Eigen::Quaterniond, ROTATION_BATCH> warm_starts;
+  std::array<Eigen::Matrix3d, ROTATION_BATCH> rotations;
+  std::array<Eigen::Quaterniond*, ROTATION_BATCH> lane_warm_starts{};
+  std::array<Eigen::Matrix3d*, ROTATION_BATCH> lane_rotations{};
+  std::array<size_t, ROTATION_BATCH> lane_piece{};
+  std::array<size_t, ROTATION_BATCH> lane_tet{};
+  for (size_t lane = 0; lane < to_size(ROTATION_BATCH); ++lane) {
+    lane_warm_starts[lane] = &warm_starts[lane];
+    lane_rotations[lane] = &rotations[lane];
+  }
   double energy = 0.0;
+  int lanes = 0;
+  const auto add_lanes = [&] {
+    extract_rotations(lanes, gradients.data(), lane_warm_starts.data(), lane_rotations.data(), m_rotation_settings);
+    for (size_t lane = 0; lane < to_size(lanes); ++lane) {
+      energy += m_pieces[lane_piece[lane]].weight *
+                m_elements.energy_j(m_rest[lane_tet[lane]], rotations[lane], gradients[lane]);
+    }
+    lanes = 0;
+  };
   TetPositions real_m;
   for (const int cut_tet : cut_tets) {
     const auto k = static_cast<size_t>(cut_tet);
@@ -402,13 +424,16 @@ double XfemElasticity::energy_of(const std::vector<int>& cut_tets, const Eigen::
     const std::size_t first = piece_begin(cut_tet);
     for (size_t p = first; p < first + piece_count(cut_tet); ++p) {
       if (m_parked[p] != 0) continue;
-      const CutPiece& piece = m_pieces[p];
-      const Eigen::Matrix3d f =
-          deformation_gradient(m_rest[k], piece_positions(piece, real_m, m_cut_tets[k].rest_m, displacement_m));
-      Eigen::Quaterniond warm_start = m_warm_starts[p];  // a copy: reporting must not change the dynamics
-      energy += piece.weight * m_elements.energy_j(m_rest[k], extract_rotation(f, warm_start, m_rotation_settings), f);
+      const auto lane = to_size(lanes++);
+      gradients[lane] =
+          deformation_gradient(m_rest[k], piece_positions(m_pieces[p], real_m, m_cut_tets[k].rest_m, displacement_m));
+      warm_starts[lane] = m_warm_starts[p];
+      lane_piece[lane] = p;
+      lane_tet[lane] = k;
+      if (lanes == ROTATION_BATCH) add_lanes();
     }
   }
+  if (lanes > 0) add_lanes();
   return energy;
 }
 
