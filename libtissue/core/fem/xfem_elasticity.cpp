@@ -271,18 +271,36 @@ TetPositions piece_positions(const CutPiece& piece, const TetPositions& real_pos
   return p;
 }
 
-// Every counted piece's F and, in SIMD lanes four pieces at a time, its rotation (extract_rotations,
-// as the uncut tets'): F into m_gradients.
-void XfemElasticity::extract_piece_rotations(const std::vector<int>& cut_tets, const Eigen::VectorXd& positions_m,
-                                             const Eigen::VectorXd& displacement_m,
-                                             std::vector<Eigen::Matrix3d>& rotations,
-                                             std::vector<Eigen::Quaterniond>& warm_starts, bool keep) {
-  std::array<Eigen::Matrix3d, ROTATION_BATCH> lane_gradients;
+// Each counted piece of `cut_tets`, in their order, its F and, in SIMD lanes four pieces at a time,
+// its rotation (extract_rotations, as the uncut tets' in_rotation_batches): visit(p, k, F, R) for
+// piece p of cut tet k. With `warm_starts`, into `rotations` from extrapolated_turn(warm start, turn
+// before), `keep` keeping the warm starts replaced as the turns before; without (nullptr), from copies
+// of the pieces' own warm starts, which stay as they are (reporting must not change the dynamics).
+template <class Visit>
+void XfemElasticity::in_piece_rotation_batches(const std::vector<int>& cut_tets, const Eigen::VectorXd& positions_m,
+                                               const Eigen::VectorXd& displacement_m,
+                                               std::vector<Eigen::Quaterniond>* warm_starts,
+                                               std::vector<Eigen::Matrix3d>* rotations,
+                                               std::vector<Eigen::Quaterniond>* turns_before, bool keep,
+                                               Visit visit) const {
+  std::array<Eigen::Matrix3d, ROTATION_BATCH> gradients;
+  std::array<Eigen::Quaterniond, ROTATION_BATCH> warm_start_copies;
+  std::array<Eigen::Matrix3d, ROTATION_BATCH> rotation_copies;
   std::array<Eigen::Quaterniond*, ROTATION_BATCH> lane_warm_starts{};
   std::array<Eigen::Matrix3d*, ROTATION_BATCH> lane_rotations{};
   std::array<Eigen::Quaterniond*, ROTATION_BATCH> lane_turns_before{};
-  const TurnsBefore turns{lane_turns_before.data(), keep};
+  std::array<size_t, ROTATION_BATCH> lane_piece{};
+  std::array<size_t, ROTATION_BATCH> lane_tet{};
+  const TurnsBefore turns = warm_starts != nullptr ? TurnsBefore{lane_turns_before.data(), keep} : TurnsBefore{};
   int lanes = 0;
+  const auto extract = [&] {
+    extract_rotations(lanes, gradients.data(), lane_warm_starts.data(), lane_rotations.data(), m_rotation_settings,
+                      turns);
+    for (size_t lane = 0; lane < to_size(lanes); ++lane) {
+      visit(lane_piece[lane], lane_tet[lane], gradients[lane], *lane_rotations[lane]);
+    }
+    lanes = 0;
+  };
   TetPositions real_m;
   for (const int cut_tet : cut_tets) {
     const auto k = static_cast<size_t>(cut_tet);
@@ -291,23 +309,35 @@ void XfemElasticity::extract_piece_rotations(const std::vector<int>& cut_tets, c
     const std::size_t first = piece_begin(cut_tet);
     for (size_t p = first; p < first + piece_count(cut_tet); ++p) {
       if (m_parked[p] != 0) continue;
-      m_gradients[p] =
+      const auto lane = to_size(lanes++);
+      gradients[lane] =
           deformation_gradient(m_rest[k], piece_positions(m_pieces[p], real_m, m_cut_tets[k].rest_m, displacement_m));
-      const auto lane = static_cast<size_t>(lanes++);
-      lane_gradients[lane] = m_gradients[p];
-      lane_warm_starts[lane] = &warm_starts[p];
-      lane_turns_before[lane] = &m_turns_before[p];
-      lane_rotations[lane] = &rotations[p];
-      if (lanes < ROTATION_BATCH) continue;
-      extract_rotations(lanes, lane_gradients.data(), lane_warm_starts.data(), lane_rotations.data(),
-                        m_rotation_settings, turns);
-      lanes = 0;
+      lane_piece[lane] = p;
+      lane_tet[lane] = k;
+      if (warm_starts != nullptr) {
+        lane_warm_starts[lane] = &(*warm_starts)[p];
+        lane_rotations[lane] = &(*rotations)[p];
+        lane_turns_before[lane] = &(*turns_before)[p];
+      } else {
+        warm_start_copies[lane] = m_warm_starts[p];
+        lane_warm_starts[lane] = &warm_start_copies[lane];
+        lane_rotations[lane] = &rotation_copies[lane];
+      }
+      if (lanes == ROTATION_BATCH) extract();
     }
   }
-  if (lanes > 0) {
-    extract_rotations(lanes, lane_gradients.data(), lane_warm_starts.data(), lane_rotations.data(), m_rotation_settings,
-                      turns);
-  }
+  if (lanes > 0) extract();
+}
+
+// Not a hot kernel, so the pieces' F and positions round as they always have in the step (the hot
+// kernels' clones contract to FMA).
+void XfemElasticity::extract_piece_rotations(const std::vector<int>& cut_tets, const Eigen::VectorXd& positions_m,
+                                             const Eigen::VectorXd& displacement_m,
+                                             std::vector<Eigen::Matrix3d>& rotations,
+                                             std::vector<Eigen::Quaterniond>& warm_starts, bool keep) {
+  in_piece_rotation_batches(
+      cut_tets, positions_m, displacement_m, &warm_starts, &rotations, &m_turns_before, keep,
+      [&](size_t p, size_t /*k*/, const Eigen::Matrix3d& f, const Eigen::Matrix3d& /*r*/) { m_gradients[p] = f; });
 }
 
 void XfemElasticity::evaluate(const Eigen::VectorXd& positions_m, const Eigen::VectorXd& displacement_m,
@@ -391,49 +421,15 @@ double XfemElasticity::elastic_energy_j(const Eigen::VectorXd& positions_m, cons
                         [&](const std::vector<int>& list) { return energy_of(list, positions_m, displacement_m); });
 }
 
-// The pieces' rotations in SIMD lanes as a step extracts them (extract_piece_rotations), from copies
-// of the warm starts (reporting must not change the dynamics); the terms added in the pieces' order.
+// The pieces' rotations as a step extracts them, from copies of the warm starts; the terms added in
+// the pieces' order.
 TISSUE_HOT_KERNEL double XfemElasticity::energy_of(const std::vector<int>& cut_tets, const Eigen::VectorXd& positions_m,
                                                    const Eigen::VectorXd& displacement_m) const {
-  std::array<Eigen::Matrix3d, ROTATION_BATCH> gradients;
-  std::array<Eigen::Quaterniond, ROTATION_BATCH> warm_starts;
-  std::array<Eigen::Matrix3d, ROTATION_BATCH> rotations;
-  std::array<Eigen::Quaterniond*, ROTATION_BATCH> lane_warm_starts{};
-  std::array<Eigen::Matrix3d*, ROTATION_BATCH> lane_rotations{};
-  std::array<size_t, ROTATION_BATCH> lane_piece{};
-  std::array<size_t, ROTATION_BATCH> lane_tet{};
-  for (size_t lane = 0; lane < to_size(ROTATION_BATCH); ++lane) {
-    lane_warm_starts[lane] = &warm_starts[lane];
-    lane_rotations[lane] = &rotations[lane];
-  }
   double energy = 0.0;
-  int lanes = 0;
-  const auto add_lanes = [&] {
-    extract_rotations(lanes, gradients.data(), lane_warm_starts.data(), lane_rotations.data(), m_rotation_settings);
-    for (size_t lane = 0; lane < to_size(lanes); ++lane) {
-      energy += m_pieces[lane_piece[lane]].weight *
-                m_elements.energy_j(m_rest[lane_tet[lane]], rotations[lane], gradients[lane]);
-    }
-    lanes = 0;
-  };
-  TetPositions real_m;
-  for (const int cut_tet : cut_tets) {
-    const auto k = static_cast<size_t>(cut_tet);
-    if (m_retired[k] != 0) continue;
-    gather(k, positions_m, real_m);
-    const std::size_t first = piece_begin(cut_tet);
-    for (size_t p = first; p < first + piece_count(cut_tet); ++p) {
-      if (m_parked[p] != 0) continue;
-      const auto lane = to_size(lanes++);
-      gradients[lane] =
-          deformation_gradient(m_rest[k], piece_positions(m_pieces[p], real_m, m_cut_tets[k].rest_m, displacement_m));
-      warm_starts[lane] = m_warm_starts[p];
-      lane_piece[lane] = p;
-      lane_tet[lane] = k;
-      if (lanes == ROTATION_BATCH) add_lanes();
-    }
-  }
-  if (lanes > 0) add_lanes();
+  in_piece_rotation_batches(cut_tets, positions_m, displacement_m, nullptr, nullptr, nullptr, false,
+                            [&](size_t p, size_t k, const Eigen::Matrix3d& f, const Eigen::Matrix3d& r) {
+                              energy += m_pieces[p].weight * m_elements.energy_j(m_rest[k], r, f);
+                            });
   return energy;
 }
 

@@ -247,9 +247,16 @@ class XfemElasticity {
   void gather(size_t k, const Eigen::VectorXd& positions_m, TetPositions& real_m) const;
   // Piece p's local DOF at each of its tet's vertices: u of the vertex (0-3) or its ghost (>= 4).
   [[nodiscard]] std::array<int, 4> piece_dofs(std::size_t p) const;
-  // evaluate's first pass: every counted piece's F (into m_gradients) and its rotation, from
-  // extrapolated_turn(warm start, turn before); `keep`: the own set's, which keeps the warm starts it
-  // replaces as the turns before.
+  // Each counted piece of `cut_tets` with its F and rotation, four at a time in SIMD lanes: for
+  // evaluate() (into the pieces' own or ahead set) and the energy (from copies). Defined in the .cpp.
+  template <class Visit>
+  void in_piece_rotation_batches(const std::vector<int>& cut_tets, const Eigen::VectorXd& positions_m,
+                                 const Eigen::VectorXd& displacement_m, std::vector<Eigen::Quaterniond>* warm_starts,
+                                 std::vector<Eigen::Matrix3d>* rotations, std::vector<Eigen::Quaterniond>* turns_before,
+                                 bool keep, Visit visit) const;
+  // evaluate's first pass: every counted piece's F (into m_gradients) and its rotation into
+  // `rotations` from extrapolated_turn(warm start, turn before); `keep`: the own set's, which keeps
+  // the warm starts it replaces as the turns before.
   void extract_piece_rotations(const std::vector<int>& cut_tets, const Eigen::VectorXd& positions_m,
                                const Eigen::VectorXd& displacement_m, std::vector<Eigen::Matrix3d>& rotations,
                                std::vector<Eigen::Quaterniond>& warm_starts, bool keep);
